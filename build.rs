@@ -1,0 +1,2 @@
+//! Code generation from coeffs/ (in progress).
+fn main() {}

@@ -1,0 +1,2 @@
+//! Build-time code generation for `needle-haptics` (filled in by the model issue).
+#![forbid(unsafe_code)]

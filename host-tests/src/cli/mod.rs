@@ -1,0 +1,5 @@
+//! The `needle` command line: one module per command group.
+
+pub mod fe;
+pub mod fit;
+pub mod model;

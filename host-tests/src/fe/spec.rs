@@ -1,0 +1,512 @@
+//! The campaign spec, `coeffs/<set>/campaign.toml`: tissue, needle, block, contact,
+//! loading, mesh levels and the named poses. Parsing, validation and the spec hash.
+
+use anyhow::{bail, Context, Result};
+use rand::{seq::SliceRandom, Rng, SeedableRng};
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// The domain of the model (design.md section 4); poses outside it are refused.
+pub const X_MAX_MM: f64 = 12.0;
+/// Largest |z| of a pose, mm.
+pub const Z_MAX_MM: f64 = 12.0;
+/// Largest |theta_x|, |theta_z| of a pose, degrees.
+pub const THETA_MAX_DEG: f64 = 15.0;
+
+/// The whole campaign spec as written in `campaign.toml`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Campaign {
+    /// Name and description of the set.
+    pub set: SetInfo,
+    /// The tissue material.
+    pub tissue: Tissue,
+    /// The (rigid) needle.
+    pub needle: Needle,
+    /// The tissue block.
+    pub block: Block,
+    /// Needle-tissue contact.
+    pub contact: Contact,
+    /// The insertion.
+    pub loading: Loading,
+    /// Named mesh levels.
+    pub mesh: BTreeMap<String, MeshLevel>,
+    /// Campaign-wide settings.
+    pub campaign: CampaignSettings,
+    /// The named poses as written (the Latin hypercube poses are added by [`Campaign::poses`]).
+    #[serde(rename = "pose", default)]
+    pub pose: Vec<PoseSpec>,
+}
+
+/// `[set]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SetInfo {
+    /// Short name.
+    pub name: String,
+    /// One line on what the set is.
+    pub description: String,
+}
+
+/// `[tissue]`: Ogden hyperelastic tissue, Abaqus/CalculiX convention.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Tissue {
+    /// Ogden mu_i, N/mm^2.
+    pub mu_n_per_mm2: Vec<f64>,
+    /// Ogden alpha_i (dimensionless).
+    pub alpha: Vec<f64>,
+    /// Initial bulk modulus over initial shear modulus, K0 / mu0.
+    pub bulk_to_shear: f64,
+    /// Smallest principal stretch the stability check covers.
+    pub stretch_min: f64,
+    /// Largest principal stretch the stability check covers.
+    pub stretch_max: f64,
+}
+
+impl Tissue {
+    /// Initial shear modulus mu0 = sum mu_i, N/mm^2.
+    pub fn mu0_n_per_mm2(&self) -> f64 {
+        self.mu_n_per_mm2.iter().sum()
+    }
+    /// Initial bulk modulus K0 = bulk_to_shear * mu0, N/mm^2.
+    pub fn k0_n_per_mm2(&self) -> f64 {
+        self.bulk_to_shear * self.mu0_n_per_mm2()
+    }
+}
+
+/// `[needle]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Needle {
+    /// Shaft diameter, mm.
+    pub diameter_mm: f64,
+    /// Length from tip to hub, mm.
+    pub length_mm: f64,
+    /// Half angle of the symmetric wedge, degrees.
+    pub wedge_half_angle_deg: f64,
+    /// Radius of the rounded cutting edge, mm.
+    pub tip_edge_radius_mm: f64,
+    /// Distance of the wrench reference point from the tip along the axis, mm.
+    pub reference_from_tip_mm: f64,
+}
+
+/// `[block]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Block {
+    /// Extent along x, mm (centred on the origin).
+    pub size_x_mm: f64,
+    /// Extent along z, mm (centred on the origin).
+    pub size_z_mm: f64,
+    /// Depth below the top surface, mm.
+    pub depth_mm: f64,
+    /// Boundary condition on the four sides: "pinned".
+    pub sides: String,
+    /// Boundary condition on the bottom: "encastre".
+    pub bottom: String,
+}
+
+/// `[contact]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Contact {
+    /// "surface-to-surface".
+    #[serde(rename = "type")]
+    pub kind: String,
+    /// Penalty slope of the linear pressure-overclosure law, N/mm^3.
+    pub penalty_slope_n_per_mm3: f64,
+    /// Coulomb friction coefficient.
+    pub friction: f64,
+    /// Stick slope of the friction law, N/mm^3.
+    pub stick_slope_n_per_mm3: f64,
+}
+
+/// `[loading]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Loading {
+    /// Final depth along the needle axis, mm.
+    pub depth_mm: f64,
+    /// Number of equal load steps (results at steps + 1 depths, 0 included).
+    pub steps: u32,
+}
+
+impl Loading {
+    /// Depth after step `k` (0 ..= steps), mm.
+    pub fn depth_at(&self, k: u32) -> f64 {
+        self.depth_mm * f64::from(k) / f64::from(self.steps)
+    }
+}
+
+/// `[mesh.<level>]`: the O-grid tissue mesh and the needle facets.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshLevel {
+    /// Half side of the fine core square around the needle path, mm.
+    pub core_half_mm: f64,
+    /// Elements along each side of the core square (even).
+    pub core_elements: u32,
+    /// Size of the first ring and of the fine layers, mm.
+    pub fine_size_mm: f64,
+    /// Depth of the fine layers under the surface, mm.
+    pub fine_depth_mm: f64,
+    /// Geometric growth ratio of rings and layers.
+    pub growth: f64,
+    /// Needle facets per quarter circumference.
+    pub needle_facets_per_quarter: u32,
+    /// Needle layer length near the tip, mm.
+    pub needle_axial_mm: f64,
+}
+
+/// `[campaign]`
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CampaignSettings {
+    /// Mesh level of the committed reference data.
+    pub mesh: String,
+    /// Seed of the Latin hypercube of validation poses.
+    pub lhs_seed: u64,
+    /// Number of Latin hypercube poses.
+    pub lhs_count: u32,
+}
+
+/// What a pose is for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, PartialOrd, Ord)]
+#[serde(rename_all = "kebab-case")]
+pub enum Role {
+    /// The centred vertical needle: the baseline of every sweep.
+    Centre,
+    /// Sweep along x (others zero), fitted.
+    SweepX,
+    /// Sweep along z, fitted.
+    SweepZ,
+    /// Sweep in theta_x, fitted.
+    SweepThetaX,
+    /// Sweep in theta_z, fitted.
+    SweepThetaZ,
+    /// Mirror-side run that checks a symmetry, not fitted.
+    Mirror,
+    /// The paper's Table 2 validation points, never fitted.
+    Table2,
+    /// Latin hypercube validation poses, never fitted.
+    Lhs,
+}
+
+impl Role {
+    /// Whether the fitter may use runs of this role.
+    pub fn is_fitted(self) -> bool {
+        matches!(
+            self,
+            Role::Centre | Role::SweepX | Role::SweepZ | Role::SweepThetaX | Role::SweepThetaZ
+        )
+    }
+    /// Whether the run is a validation run (never fitted).
+    pub fn is_validation(self) -> bool {
+        matches!(self, Role::Table2 | Role::Lhs)
+    }
+}
+
+/// One named pose: needle tip on the top surface at (x, 0, z), tilted by theta_x about x
+/// and theta_z about z, then fed `loading.depth_mm` along its own axis.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PoseSpec {
+    /// File stem of the result, `fe/<name>.csv`.
+    pub name: String,
+    /// What the run is for.
+    pub role: Role,
+    /// Tip x on the top surface, mm.
+    #[serde(default)]
+    pub x_mm: f64,
+    /// Tip z on the top surface, mm.
+    #[serde(default)]
+    pub z_mm: f64,
+    /// Tilt about the x axis, degrees.
+    #[serde(default)]
+    pub theta_x_deg: f64,
+    /// Tilt about the z axis, degrees.
+    #[serde(default)]
+    pub theta_z_deg: f64,
+}
+
+/// Mirror planes of the block and the needle that a pose keeps: a run can be solved on
+/// the half (or quarter) of the block on the positive side of each plane.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Symmetry {
+    /// The pose is symmetric under x -> -x (plane x = 0).
+    pub plane_x: bool,
+    /// The pose is symmetric under z -> -z (plane z = 0).
+    pub plane_z: bool,
+}
+
+impl PoseSpec {
+    /// The mirror planes this pose keeps. The block is symmetric about x = 0 and z = 0 and
+    /// the double-bevel wedge about both of its own mid-planes, so a pose keeps plane
+    /// x = 0 when x = 0 and theta_z = 0, and plane z = 0 when z = 0 and theta_x = 0.
+    pub fn symmetry(&self) -> Symmetry {
+        Symmetry {
+            plane_x: self.x_mm == 0.0 && self.theta_z_deg == 0.0,
+            plane_z: self.z_mm == 0.0 && self.theta_x_deg == 0.0,
+        }
+    }
+
+    /// Unit vector along the needle axis from the tip towards the hub (at theta = 0: +y).
+    /// The needle is rotated first by theta_x about x, then by theta_z about z.
+    pub fn axis(&self) -> [f64; 3] {
+        let (sx, cx) = self.theta_x_deg.to_radians().sin_cos();
+        let (sz, cz) = self.theta_z_deg.to_radians().sin_cos();
+        // R = Rz * Rx applied to (0, 1, 0): Rx(0,1,0) = (0, cx, sx); Rz(a,b,c) = (cz a - sz b, sz a + cz b, c)
+        [-sz * cx, cz * cx, sx]
+    }
+}
+
+/// Read and validate a campaign spec.
+///
+/// # Errors
+/// The file cannot be read, is not valid TOML for [`Campaign`] (the message has the file
+/// and line), or a value is out of range (the message names the field and the value).
+pub fn load(set_dir: &Path) -> Result<(Campaign, PathBuf)> {
+    let path = set_dir.join("campaign.toml");
+    let text = std::fs::read_to_string(&path)
+        .with_context(|| format!("{}: cannot read the campaign spec", path.display()))?;
+    let campaign = parse(&text, &path)?;
+    Ok((campaign, path))
+}
+
+/// Parse and validate a campaign spec from text; `path` is only used in messages.
+///
+/// # Errors
+/// As [`load`].
+pub fn parse(text: &str, path: &Path) -> Result<Campaign> {
+    let campaign: Campaign = toml::from_str(text).map_err(|e| {
+        let line = e
+            .span()
+            .map(|s| text[..s.start.min(text.len())].lines().count().max(1))
+            .unwrap_or(0);
+        anyhow::anyhow!("{}:{}: {}", path.display(), line, e.message())
+    })?;
+    campaign.validate(path)?;
+    Ok(campaign)
+}
+
+impl Campaign {
+    fn validate(&self, path: &Path) -> Result<()> {
+        let p = path.display();
+        let t = &self.tissue;
+        if t.mu_n_per_mm2.is_empty() || t.mu_n_per_mm2.len() != t.alpha.len() {
+            bail!(
+                "{p}: tissue: mu_n_per_mm2 has {} terms and alpha {}; they must match and be non-empty",
+                t.mu_n_per_mm2.len(),
+                t.alpha.len()
+            );
+        }
+        for (name, v) in [
+            ("tissue.bulk_to_shear", t.bulk_to_shear),
+            ("needle.diameter_mm", self.needle.diameter_mm),
+            ("needle.length_mm", self.needle.length_mm),
+            ("needle.wedge_half_angle_deg", self.needle.wedge_half_angle_deg),
+            ("needle.tip_edge_radius_mm", self.needle.tip_edge_radius_mm),
+            ("needle.reference_from_tip_mm", self.needle.reference_from_tip_mm),
+            ("block.size_x_mm", self.block.size_x_mm),
+            ("block.size_z_mm", self.block.size_z_mm),
+            ("block.depth_mm", self.block.depth_mm),
+            ("contact.penalty_slope_n_per_mm3", self.contact.penalty_slope_n_per_mm3),
+            ("contact.stick_slope_n_per_mm3", self.contact.stick_slope_n_per_mm3),
+            ("loading.depth_mm", self.loading.depth_mm),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                bail!("{p}: {name} = {v}: must be finite and > 0");
+            }
+        }
+        if self.needle.wedge_half_angle_deg >= 90.0 {
+            bail!(
+                "{p}: needle.wedge_half_angle_deg = {}: must be < 90",
+                self.needle.wedge_half_angle_deg
+            );
+        }
+        if !(self.contact.friction.is_finite() && self.contact.friction >= 0.0) {
+            bail!("{p}: contact.friction = {}: must be finite and >= 0", self.contact.friction);
+        }
+        if self.loading.steps == 0 {
+            bail!("{p}: loading.steps = 0: must be >= 1");
+        }
+        if self.block.sides != "pinned" || self.block.bottom != "encastre" {
+            bail!(
+                "{p}: block: sides = {:?}, bottom = {:?}: only \"pinned\" and \"encastre\" are implemented",
+                self.block.sides,
+                self.block.bottom
+            );
+        }
+        if self.contact.kind != "surface-to-surface" {
+            bail!(
+                "{p}: contact.type = {:?}: only \"surface-to-surface\" converges (node-to-surface did not)",
+                self.contact.kind
+            );
+        }
+        for (name, m) in &self.mesh {
+            if m.core_elements < 2 || m.core_elements % 2 != 0 {
+                bail!("{p}: mesh.{name}.core_elements = {}: must be even and >= 2", m.core_elements);
+            }
+            if m.needle_facets_per_quarter < 2 {
+                bail!(
+                    "{p}: mesh.{name}.needle_facets_per_quarter = {}: must be >= 2",
+                    m.needle_facets_per_quarter
+                );
+            }
+            for (f, v) in [
+                ("core_half_mm", m.core_half_mm),
+                ("fine_size_mm", m.fine_size_mm),
+                ("fine_depth_mm", m.fine_depth_mm),
+                ("needle_axial_mm", m.needle_axial_mm),
+            ] {
+                if !(v.is_finite() && v > 0.0) {
+                    bail!("{p}: mesh.{name}.{f} = {v}: must be finite and > 0");
+                }
+            }
+            if !(m.growth.is_finite() && m.growth >= 1.0) {
+                bail!("{p}: mesh.{name}.growth = {}: must be >= 1", m.growth);
+            }
+        }
+        if !self.mesh.contains_key(&self.campaign.mesh) {
+            bail!(
+                "{p}: campaign.mesh = {:?}: no [mesh.{}] level (levels: {})",
+                self.campaign.mesh,
+                self.campaign.mesh,
+                self.mesh.keys().cloned().collect::<Vec<_>>().join(", ")
+            );
+        }
+        let mut seen = std::collections::BTreeSet::new();
+        for pose in &self.pose {
+            check_pose(pose, &p.to_string())?;
+            if !seen.insert(pose.name.clone()) {
+                bail!("{p}: pose {:?} is listed twice", pose.name);
+            }
+            if pose.role == Role::Lhs {
+                bail!("{p}: pose {:?}: role lhs is generated from campaign.lhs_seed, not listed", pose.name);
+            }
+        }
+        Ok(())
+    }
+
+    /// Every pose of the campaign: the listed ones, then `lhs_count` Latin hypercube
+    /// poses named `lhs-01`, `lhs-02`, ... drawn with ChaCha8 from `lhs_seed`: each of the
+    /// four inputs is split into `lhs_count` equal strata over the whole domain, one point
+    /// uniform in each stratum, strata shuffled independently per input. Coordinates are
+    /// rounded to 0.01 mm / 0.01 degree so that the deck is reproducible from the name.
+    pub fn poses(&self) -> Vec<PoseSpec> {
+        let mut out = self.pose.clone();
+        let n = self.campaign.lhs_count as usize;
+        if n == 0 {
+            return out;
+        }
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(self.campaign.lhs_seed);
+        let ranges = [X_MAX_MM, Z_MAX_MM, THETA_MAX_DEG, THETA_MAX_DEG];
+        let mut cols: Vec<Vec<f64>> = Vec::new();
+        for half in ranges {
+            let mut col: Vec<f64> = (0..n)
+                .map(|i| {
+                    let u = (i as f64 + rng.gen::<f64>()) / n as f64;
+                    let v = -half + 2.0 * half * u;
+                    (v * 100.0).round() / 100.0
+                })
+                .collect();
+            col.shuffle(&mut rng);
+            cols.push(col);
+        }
+        for i in 0..n {
+            out.push(PoseSpec {
+                name: format!("lhs-{:02}", i + 1),
+                role: Role::Lhs,
+                x_mm: cols[0][i],
+                z_mm: cols[1][i],
+                theta_x_deg: cols[2][i],
+                theta_z_deg: cols[3][i],
+            });
+        }
+        out
+    }
+
+    /// The mesh level named `name`.
+    ///
+    /// # Errors
+    /// No such level in `[mesh.*]`.
+    pub fn mesh_level(&self, name: &str) -> Result<&MeshLevel> {
+        self.mesh.get(name).with_context(|| {
+            format!(
+                "no mesh level {name:?} in the spec (levels: {})",
+                self.mesh.keys().cloned().collect::<Vec<_>>().join(", ")
+            )
+        })
+    }
+
+    /// Hash of everything that determines the result of one run: the whole spec except
+    /// the pose list and description, plus this pose and the mesh level. Hex SHA-256.
+    pub fn run_hash(&self, pose: &PoseSpec, mesh_name: &str) -> String {
+        #[derive(Serialize)]
+        struct Key<'a> {
+            tissue: &'a Tissue,
+            needle: &'a Needle,
+            block: &'a Block,
+            contact: &'a Contact,
+            loading: &'a Loading,
+            mesh_name: &'a str,
+            mesh: Option<&'a MeshLevel>,
+            pose: &'a PoseSpec,
+            generator: u32,
+        }
+        let key = Key {
+            tissue: &self.tissue,
+            needle: &self.needle,
+            block: &self.block,
+            contact: &self.contact,
+            loading: &self.loading,
+            mesh_name,
+            mesh: self.mesh.get(mesh_name),
+            pose,
+            generator: crate::fe::deck::GENERATOR_VERSION,
+        };
+        let json = serde_json::to_string(&key).unwrap_or_default();
+        hex(&Sha256::digest(json.as_bytes()))
+    }
+}
+
+fn check_pose(pose: &PoseSpec, p: &str) -> Result<()> {
+    if pose.name.is_empty()
+        || !pose.name.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '+' | '_'))
+    {
+        bail!("{p}: pose name {:?}: use letters, digits, '-', '+', '_' only", pose.name);
+    }
+    for (f, v, max, unit) in [
+        ("x_mm", pose.x_mm, X_MAX_MM, "mm"),
+        ("z_mm", pose.z_mm, Z_MAX_MM, "mm"),
+        ("theta_x_deg", pose.theta_x_deg, THETA_MAX_DEG, "deg"),
+        ("theta_z_deg", pose.theta_z_deg, THETA_MAX_DEG, "deg"),
+    ] {
+        if !(v.is_finite() && v.abs() <= max) {
+            bail!("{p}: pose {:?}: {f} = {v}: outside the domain |{f}| <= {max} {unit}", pose.name);
+        }
+    }
+    Ok(())
+}
+
+/// Lower-case hex of a byte string.
+pub fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// Select poses whose name matches a glob `pattern` (`*`, `?`, `[..]`).
+///
+/// # Errors
+/// The pattern is not a valid glob.
+pub fn select<'a>(poses: &'a [PoseSpec], pattern: Option<&str>) -> Result<Vec<&'a PoseSpec>> {
+    match pattern {
+        None => Ok(poses.iter().collect()),
+        Some(pat) => {
+            let g = glob::Pattern::new(pat).with_context(|| format!("--only {pat:?}: not a valid glob"))?;
+            Ok(poses.iter().filter(|p| g.matches(&p.name)).collect())
+        }
+    }
+}

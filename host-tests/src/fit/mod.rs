@@ -1,0 +1,1 @@
+//! The fitter: FE sweeps -> model.toml (filled in by the model issue).

@@ -1,0 +1,44 @@
+//! `needle`: the needle-haptics command-line tool (FE campaign, fitter, model queries).
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "needle", version, about = "needle-haptics: FE campaign, fitter and model tool")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// FE campaign on CalculiX: run, verify.
+    #[command(subcommand)]
+    Fe(needle_host::cli::fe::FeCommand),
+    /// Fit the paper model to a set's FE sweeps and write model.toml and golden vectors.
+    Fit(needle_host::cli::fit::FitArgs),
+    /// Evaluate the wrench at one pose with the library (the firmware's code).
+    Eval(needle_host::cli::model::EvalArgs),
+    /// Compare the model with the FE runs it was not fitted on.
+    Validate(needle_host::cli::fit::ValidateArgs),
+    /// Copy the generated C header out for C users.
+    Header(needle_host::cli::model::HeaderArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Fe(c) => needle_host::cli::fe::run(c),
+        Command::Fit(a) => needle_host::cli::fit::fit(a),
+        Command::Eval(a) => needle_host::cli::model::eval(a),
+        Command::Validate(a) => needle_host::cli::fit::validate(a),
+        Command::Header(a) => needle_host::cli::model::header(a),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}
