@@ -1,1 +1,84 @@
-//! The fitter: FE sweeps -> model.toml (filled in by the model issue).
+//! The fitter: FE sweeps -> `model.toml` and `golden-f32.csv` (coeffs/README.md), and the
+//! validation of a fitted model against the FE runs it was not fitted on.
+//!
+//! Pipeline: [`data::load_fit_data`] reads the centre and sweep runs, [`model::fit`] fits
+//! the paper model by least squares ([`lsq`]) in normalised variables,
+//! [`model_file::to_toml`] writes it, [`golden::to_csv`] evaluates it with this crate's
+//! own f32 implementation of the contract ([`eval_f32`]). [`validate`] compares the
+//! model ([`eval_f64`], [`eval_f32`]) with the validation runs.
+
+pub mod contract;
+pub mod data;
+pub mod eval_f32;
+pub mod eval_f64;
+pub mod golden;
+pub mod lsq;
+pub mod model;
+pub mod model_file;
+pub mod validate;
+
+use anyhow::Result;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Name of the model file inside a set folder.
+pub const MODEL_FILE: &str = "model.toml";
+/// Name of the golden-vector file inside a set folder.
+pub const GOLDEN_FILE: &str = "golden-f32.csv";
+
+/// What `needle fit` produces for a set, in memory.
+#[derive(Debug, Clone)]
+pub struct FitOutput {
+    /// The fitted model.
+    pub model: model::Model,
+    /// The text of `model.toml`.
+    pub model_toml: String,
+    /// The text of `golden-f32.csv`.
+    pub golden_csv: String,
+}
+
+/// Fit the set in `set_dir` and render both output files, without writing anything.
+///
+/// # Errors
+/// As [`data::load_fit_data`] (missing or malformed runs, bad spec) and [`model::fit`]
+/// (rank-deficient fits).
+pub fn fit_set(set_dir: &Path) -> Result<FitOutput> {
+    let data = data::load_fit_data(set_dir)?;
+    let model = model::fit(&data)?;
+    let model_toml = model_file::to_toml(&model);
+    let golden_csv = golden::to_csv(&eval_f32::Tables32::from_model(&model));
+    Ok(FitOutput { model, model_toml, golden_csv })
+}
+
+/// A plain-text table of the fit residuals (RMS and max, in N or N·mm).
+pub fn summary(m: &model::Model) -> String {
+    use contract::{unit, Sweep, COMPONENTS};
+    let mut s = String::new();
+    let _ = writeln!(s, "fit residuals (model - FE over the fitted runs and all depths)");
+    let _ = writeln!(s, "{:<10} {:<8} {:>12} {:>12}  unit", "sweep", "comp", "rms", "max");
+    for (c, b) in m.baseline.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "{:<10} {:<8} {:>12.4e} {:>12.4e}  {}",
+            "baseline",
+            COMPONENTS[c],
+            b.residual_rms,
+            b.residual_max,
+            unit(c)
+        );
+    }
+    for k in Sweep::ALL {
+        for (c, d) in m.matrices[k.index()].iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "{:<10} {:<8} {:>12.4e} {:>12.4e}  {}",
+                k.name(),
+                COMPONENTS[c],
+                d.residual_rms,
+                d.residual_max,
+                unit(c)
+            );
+        }
+    }
+    s
+}

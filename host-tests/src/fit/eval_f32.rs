@@ -1,0 +1,168 @@
+//! An independent f32 implementation of the contract's evaluation algorithm
+//! (coeffs/README.md, "Evaluation algorithm"): it writes the golden vectors, so it must
+//! not call the `needle-haptics` library. Every operation is a plain binary32 `*`, `+`
+//! or `-` (Rust never fuses them), each rounded to nearest even on its own.
+
+use super::contract::{
+    NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z,
+};
+use super::model::Model;
+
+/// The f32 nearest 1/3 (IEEE division is correctly rounded): 0x3eaaaaab.
+pub const ONE_THIRD: f32 = 1.0 / 3.0;
+/// The f32 nearest 2/12, the scale of x and z: 0x3e2aaaab.
+pub const S_XZ: f32 = 2.0 / 12.0;
+/// The f32 nearest 2/15, the scale of theta_x and theta_z: 0x3e088889.
+pub const S_THETA: f32 = 2.0 / 15.0;
+
+/// `ODD[k][c]`: component c changes sign under sweep k's mirror (contract table: sweeps
+/// x and theta_z: fx, my, mz; sweeps z and theta_x: fz, mx, my).
+pub const ODD: [[bool; 6]; 4] = [
+    [true, false, false, false, true, true],
+    [false, false, true, true, true, false],
+    [false, false, true, true, true, false],
+    [true, false, false, false, true, true],
+];
+
+/// The coefficients the firmware uses: every f64 coefficient rounded to the nearest f32.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tables32 {
+    /// `baseline[c][i]` multiplies `u^i`.
+    pub baseline: [[f32; NCOEF]; 6],
+    /// `rows[k][c][i][j]` multiplies `u^i t^j` for sweep k, component c.
+    pub rows: [[[[f32; NCOEF]; NCOEF]; 6]; 4],
+}
+
+impl Tables32 {
+    /// Round every coefficient of `model` to the nearest f32 (`as`, round to nearest even).
+    pub fn from_model(model: &Model) -> Self {
+        let mut t = Tables32 { baseline: [[0.0; NCOEF]; 6], rows: [[[[0.0; NCOEF]; NCOEF]; 6]; 4] };
+        for (dst, src) in t.baseline.iter_mut().zip(&model.baseline) {
+            for (d, s) in dst.iter_mut().zip(&src.coeffs) {
+                *d = *s as f32;
+            }
+        }
+        for (dk, sk) in t.rows.iter_mut().zip(&model.matrices) {
+            for (dc, sc) in dk.iter_mut().zip(sk) {
+                for (di, si) in dc.iter_mut().zip(&sc.rows) {
+                    for (d, s) in di.iter_mut().zip(si) {
+                        *d = *s as f32;
+                    }
+                }
+            }
+        }
+        t
+    }
+}
+
+/// `h(p, w) = (((p4*w + p3)*w + p2)*w + p1)*w + p0` in f32, written out.
+#[inline(never)]
+pub fn h32(p: &[f32; NCOEF], w: f32) -> f32 {
+    let [p0, p1, p2, p3, p4] = *p;
+    let a = p4 * w + p3;
+    let b = a * w + p2;
+    let c = b * w + p1;
+    c * w + p0
+}
+
+/// Clamp to `[lo, hi]` by comparison: a value inside (either zero sign included) is
+/// returned unchanged.
+fn clamp32(v: f32, lo: f32, hi: f32) -> f32 {
+    if v < lo {
+        lo
+    } else if v > hi {
+        hi
+    } else {
+        v
+    }
+}
+
+/// Evaluate at `pose = [x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm]` (f32): the wrench
+/// `[fx_n, fy_n, fz_n, mx_nmm, my_nmm, mz_nmm]` (N, N·mm) and the status byte, bit for
+/// bit as coeffs/README.md specifies.
+pub fn eval(t: &Tables32, pose: [f32; 5]) -> ([f32; 6], u8) {
+    // 1. error
+    for v in pose {
+        if !v.is_finite() {
+            return ([0.0; 6], STATUS_ERROR);
+        }
+    }
+    let [x, z, tx, tz, d] = pose;
+    // 2. saturation
+    let xc = clamp32(x, -12.0, 12.0);
+    let zc = clamp32(z, -12.0, 12.0);
+    let txc = clamp32(tx, -15.0, 15.0);
+    let tzc = clamp32(tz, -15.0, 15.0);
+    let dc = clamp32(d, 0.0, 6.0);
+    let mut status = 0u8;
+    if xc != x {
+        status |= STATUS_SAT_X;
+    }
+    if zc != z {
+        status |= STATUS_SAT_Z;
+    }
+    if txc != tx {
+        status |= STATUS_SAT_THETA_X;
+    }
+    if tzc != tz {
+        status |= STATUS_SAT_THETA_Z;
+    }
+    if dc != d {
+        status |= STATUS_SAT_DEPTH;
+    }
+    // 3. normalisation
+    let u = dc * ONE_THIRD - 1.0;
+    let vals = [xc, zc, txc, tzc];
+    let scales = [S_XZ, S_XZ, S_THETA, S_THETA];
+    let mut tt = [0.0f32; 4];
+    let mut negative = [false; 4];
+    for k in 0..4 {
+        tt[k] = vals[k].abs() * scales[k] - 1.0;
+        negative[k] = vals[k] < 0.0;
+    }
+    // 4. polynomials, 5. superposition
+    let mut w = [0.0f32; 6];
+    for c in 0..6 {
+        let mut acc = h32(&t.baseline[c], u);
+        for k in 0..4 {
+            let m = &t.rows[k][c];
+            let r = [h32(&m[0], tt[k]), h32(&m[1], tt[k]), h32(&m[2], tt[k]), h32(&m[3], tt[k]), h32(&m[4], tt[k])];
+            let dev = h32(&r, u);
+            if negative[k] && ODD[k][c] {
+                acc = acc - dev;
+            } else {
+                acc = acc + dev;
+            }
+        }
+        w[c] = acc;
+    }
+    (w, status)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn constants_are_the_nearest_f32() {
+        assert_eq!(ONE_THIRD.to_bits(), 0x3eaa_aaab);
+        assert_eq!(S_XZ.to_bits(), 0x3e2a_aaab);
+        assert_eq!(S_THETA.to_bits(), 0x3e08_8889);
+        for (c, exact) in [(ONE_THIRD, 1.0 / 3.0), (S_XZ, 2.0 / 12.0), (S_THETA, 2.0 / 15.0)] {
+            let below = f32::from_bits(c.to_bits() - 1) as f64;
+            let above = f32::from_bits(c.to_bits() + 1) as f64;
+            let e = (c as f64 - exact).abs();
+            assert!(e < (below - exact).abs() && e < (above - exact).abs());
+        }
+    }
+
+    #[test]
+    fn odd_table_matches_contract() {
+        use super::super::contract::Sweep;
+        for k in Sweep::ALL {
+            for c in 0..6 {
+                assert_eq!(k.is_odd(c), ODD[k.index()][c]);
+            }
+        }
+    }
+}

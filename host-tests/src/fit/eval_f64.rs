@@ -1,0 +1,71 @@
+//! The contract's evaluation algorithm (coeffs/README.md) in f64 on the f64 coefficients:
+//! the reference for validation and for the f32 evaluator's error.
+
+use super::contract::{
+    u_of, Sweep, DEPTH_MAX_MM, NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z,
+    STATUS_SAT_X, STATUS_SAT_Z,
+};
+use super::model::Model;
+
+/// Horner, highest power first: `(((p4 w + p3) w + p2) w + p1) w + p0`.
+pub fn horner(p: &[f64; NCOEF], w: f64) -> f64 {
+    let mut acc = p[NCOEF - 1];
+    for c in p[..NCOEF - 1].iter().rev() {
+        acc = acc * w + c;
+    }
+    acc
+}
+
+/// `D(t, u)`: `r_i = h(rows[i], t)`, then `h(r, u)`.
+pub fn deviation(rows: &[[f64; NCOEF]; NCOEF], t: f64, u: f64) -> f64 {
+    let mut r = [0.0; NCOEF];
+    for (ri, row) in r.iter_mut().zip(rows) {
+        *ri = horner(row, t);
+    }
+    horner(&r, u)
+}
+
+/// A pose in f64: x and z in mm, the tilts in degrees, depth in mm (contract order
+/// `[x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm]`).
+pub type Pose64 = [f64; 5];
+
+/// Evaluate the model at `pose`: the wrench `[fx_n, fy_n, fz_n, mx_nmm, my_nmm, mz_nmm]`
+/// (N, N·mm) and the contract's status byte. NaN or infinite input gives the zero wrench
+/// and status 0x80; inputs outside the domain are clamped and flagged.
+pub fn eval(model: &Model, pose: Pose64) -> ([f64; 6], u8) {
+    if pose.iter().any(|v| !v.is_finite()) {
+        return ([0.0; 6], STATUS_ERROR);
+    }
+    let mut status = 0u8;
+    let mut clamped = [0.0f64; 4];
+    let bits = [STATUS_SAT_X, STATUS_SAT_Z, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z];
+    for k in Sweep::ALL {
+        let i = k.index();
+        let m = k.half_range();
+        let v = pose[i].clamp(-m, m);
+        if v != pose[i] {
+            status |= bits[i];
+        }
+        clamped[i] = v;
+    }
+    let d = pose[4].clamp(0.0, DEPTH_MAX_MM);
+    if d != pose[4] {
+        status |= STATUS_SAT_DEPTH;
+    }
+    let u = u_of(d);
+    let mut w = [0.0f64; 6];
+    for (c, wc) in w.iter_mut().enumerate() {
+        let mut acc = horner(&model.baseline[c].coeffs, u);
+        for k in Sweep::ALL {
+            let v = clamped[k.index()];
+            let dev = deviation(&model.matrices[k.index()][c].rows, k.t_of(v), u);
+            if v < 0.0 && k.is_odd(c) {
+                acc -= dev;
+            } else {
+                acc += dev;
+            }
+        }
+        *wc = acc;
+    }
+    (w, status)
+}
