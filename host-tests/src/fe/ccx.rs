@@ -1,1 +1,256 @@
-//! (in progress)
+//! Running CalculiX (`ccx`): finding the binary, its version, one job in a work folder
+//! with one thread, a wall-clock timeout, and the job's `.sta` status file (increments,
+//! iterations, and the last completed step while the job runs).
+
+use anyhow::{bail, Context, Result};
+use std::fmt;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// Environment variable that names the `ccx` binary to use instead of the one on `PATH`.
+pub const CCX_ENV: &str = "NEEDLE_CCX";
+
+/// Number of lines of the ccx output kept for failure reports.
+pub const LOG_TAIL_LINES: usize = 25;
+
+/// Find the `ccx` binary: `$NEEDLE_CCX` if set, else the first `ccx` on `PATH`.
+///
+/// # Errors
+/// `$NEEDLE_CCX` names a file that does not exist, or there is no `ccx` on `PATH`
+/// ("ccx not found: apt-get install calculix-ccx").
+pub fn find_ccx() -> Result<PathBuf> {
+    if let Some(p) = std::env::var_os(CCX_ENV).filter(|p| !p.is_empty()) {
+        let p = PathBuf::from(p);
+        if p.is_file() {
+            return Ok(p);
+        }
+        // a bare name: look it up on PATH
+        if p.components().count() == 1 {
+            if let Some(found) = which(&p) {
+                return Ok(found);
+            }
+        }
+        bail!("ccx not found: {CCX_ENV}={} is not a file", p.display());
+    }
+    which(Path::new("ccx")).context("ccx not found: apt-get install calculix-ccx (or set NEEDLE_CCX to the binary)")
+}
+
+fn which(name: &Path) -> Option<PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path).map(|d| d.join(name)).find(|p| is_executable(p))
+}
+
+fn is_executable(p: &Path) -> bool {
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::metadata(p).is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
+}
+
+/// The version of a `ccx` binary, e.g. `"2.20"`, from `ccx -v` ("This is Version 2.20").
+/// `ccx -v` exits with a non-zero status; only its output is read.
+///
+/// # Errors
+/// The binary cannot be started, or its output has no "Version" word.
+pub fn ccx_version(ccx: &Path) -> Result<String> {
+    let out = Command::new(ccx)
+        .arg("-v")
+        .stdin(Stdio::null())
+        .output()
+        .with_context(|| format!("{}: cannot run `ccx -v`", ccx.display()))?;
+    let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    parse_version(&text).with_context(|| format!("{} -v: no version in its output {:?}", ccx.display(), text.trim()))
+}
+
+/// The version number in `ccx -v` output ("This is Version 2.20" -> "2.20").
+pub fn parse_version(text: &str) -> Option<String> {
+    let mut words = text.split_whitespace();
+    while let Some(w) = words.next() {
+        if w.eq_ignore_ascii_case("version") {
+            return words.next().map(|v| v.trim_end_matches([',', '.']).to_string());
+        }
+    }
+    None
+}
+
+/// How a ccx process ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExitKind {
+    /// Exited with this code (ccx exits 201 on input and convergence errors).
+    Code(i32),
+    /// Killed by this signal.
+    Signal(i32),
+    /// Killed by the runner after the wall-clock timeout.
+    TimedOut,
+}
+
+impl fmt::Display for ExitKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ExitKind::Code(c) => write!(f, "exit code {c}"),
+            ExitKind::Signal(s) => write!(f, "killed by signal {s}"),
+            ExitKind::TimedOut => write!(f, "timed out (killed)"),
+        }
+    }
+}
+
+/// Increments and iterations of a job, from its `.sta` file.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StaSummary {
+    /// Converged increments, all steps.
+    pub increments: u32,
+    /// Newton iterations, all attempts (cut-back attempts included).
+    pub iterations: u32,
+    /// Attempts that did not converge and were cut back (lines marked `U`).
+    pub cutbacks: u32,
+    /// Total time at the end of the last converged increment.
+    pub total_time: f64,
+}
+
+impl StaSummary {
+    /// Steps completed when step k ends at total time k (as in the campaign's decks).
+    pub fn steps_done(&self) -> u32 {
+        let t = self.total_time + 1e-6;
+        if t.is_finite() && t >= 1.0 {
+            t.floor().min(f64::from(u32::MAX)) as u32
+        } else {
+            0
+        }
+    }
+}
+
+/// Read a `.sta` file's text. Each data line is
+/// `STEP INC ATT ITRS TOT_TIME STEP_TIME INC_TIME`; an attempt that did not converge has
+/// its ATT suffixed with `U`. Lines that are not data (headers, a line being written) are
+/// skipped.
+pub fn parse_sta(text: &str) -> StaSummary {
+    let mut s = StaSummary::default();
+    for line in text.lines() {
+        let f: Vec<&str> = line.split_whitespace().collect();
+        let [step, inc, att, itrs, tot, _step_time, _inc_time] = f.as_slice() else {
+            continue;
+        };
+        if step.parse::<u32>().is_err() || inc.parse::<u32>().is_err() {
+            continue;
+        }
+        let (att, failed) = match att.strip_suffix(['U', 'u']) {
+            Some(a) => (a, true),
+            None => (*att, false),
+        };
+        let (Ok(_), Ok(itrs), Some(tot)) = (att.parse::<u32>(), itrs.parse::<u32>(), crate::fe::dat::parse_fortran(tot))
+        else {
+            continue;
+        };
+        s.iterations += itrs;
+        if failed {
+            s.cutbacks += 1;
+        } else {
+            s.increments += 1;
+            s.total_time = tot;
+        }
+    }
+    s
+}
+
+/// The `.sta` file of job `job` in `work_dir`.
+pub fn sta_path(work_dir: &Path, job: &str) -> PathBuf {
+    work_dir.join(format!("{job}.sta"))
+}
+
+/// Steps completed so far by a running (or finished) job: for progress display. 0 when
+/// the `.sta` file does not exist yet or cannot be read.
+pub fn steps_done(work_dir: &Path, job: &str) -> u32 {
+    std::fs::read_to_string(sta_path(work_dir, job)).map(|t| parse_sta(&t).steps_done()).unwrap_or(0)
+}
+
+/// The outcome of one ccx job.
+#[derive(Debug, Clone)]
+pub struct JobResult {
+    /// How the process ended.
+    pub exit: ExitKind,
+    /// Wall-clock time of the process.
+    pub wall: Duration,
+    /// Increments and iterations from the `.sta` file.
+    pub sta: StaSummary,
+    /// The file holding ccx's stdout and stderr.
+    pub log_path: PathBuf,
+    /// The last [`LOG_TAIL_LINES`] lines of the log.
+    pub log_tail: String,
+}
+
+impl JobResult {
+    /// Whether ccx exited with status 0 (the caller still checks the output).
+    pub fn success(&self) -> bool {
+        self.exit == ExitKind::Code(0)
+    }
+}
+
+/// Run `ccx -i <job>` in `work_dir` (which holds `<job>.inp`) on one thread
+/// (`OMP_NUM_THREADS=1`, `CCX_NPROC_*=1`), stdout and stderr to `<job>.log` in the same
+/// folder. With a `timeout`, the process is killed when it runs longer (wall clock).
+///
+/// # Errors
+/// The log file cannot be created, or ccx cannot be started or waited for. A job that
+/// starts and then fails is not an error: see [`JobResult::exit`].
+pub fn run_job(ccx: &Path, work_dir: &Path, job: &str, timeout: Option<Duration>) -> Result<JobResult> {
+    let log_path = work_dir.join(format!("{job}.log"));
+    let log = std::fs::File::create(&log_path).with_context(|| format!("{}: cannot create", log_path.display()))?;
+    let log_err = log.try_clone().with_context(|| format!("{}: cannot reopen", log_path.display()))?;
+    let start = Instant::now();
+    let mut child = Command::new(ccx)
+        .arg("-i")
+        .arg(job)
+        .current_dir(work_dir)
+        .env("OMP_NUM_THREADS", "1")
+        .env("CCX_NPROC_EQUATION_SOLVER", "1")
+        .env("CCX_NPROC_STIFFNESS", "1")
+        .env("CCX_NPROC_RESULTS", "1")
+        .stdin(Stdio::null())
+        .stdout(log)
+        .stderr(log_err)
+        .spawn()
+        .with_context(|| format!("{}: cannot start ccx in {}", ccx.display(), work_dir.display()))?;
+    let exit = loop {
+        if let Some(status) = child.try_wait().context("cannot wait for ccx")? {
+            use std::os::unix::process::ExitStatusExt;
+            break match (status.code(), status.signal()) {
+                (Some(c), _) => ExitKind::Code(c),
+                (None, Some(s)) => ExitKind::Signal(s),
+                (None, None) => ExitKind::Code(-1),
+            };
+        }
+        if timeout.is_some_and(|t| start.elapsed() > t) {
+            // the process may have exited just now: kill errors are not interesting
+            let _ = child.kill();
+            let _ = child.wait();
+            break ExitKind::TimedOut;
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let wall = start.elapsed();
+    let sta = std::fs::read_to_string(sta_path(work_dir, job)).map(|t| parse_sta(&t)).unwrap_or_default();
+    let log_text = std::fs::read(&log_path).map(|b| String::from_utf8_lossy(&b).into_owned()).unwrap_or_default();
+    Ok(JobResult { exit, wall, sta, log_tail: tail(&log_text, LOG_TAIL_LINES), log_path })
+}
+
+/// The last `n` non-blank-trailing lines of `text`.
+pub fn tail(text: &str, n: usize) -> String {
+    let lines: Vec<&str> = text.trim_end().lines().collect();
+    lines[lines.len().saturating_sub(n)..].join("\n")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn version() {
+        assert_eq!(parse_version("\nThis is Version 2.20\n\n").as_deref(), Some("2.20"));
+        assert_eq!(parse_version("nothing"), None);
+    }
+
+    #[test]
+    fn tail_lines() {
+        assert_eq!(tail("a\nb\nc\n\n", 2), "b\nc");
+        assert_eq!(tail("a", 5), "a");
+    }
+}
