@@ -131,6 +131,14 @@ const CONTACT_RADIUS_MM: f64 = 4.0;
 
 /// Mesh the tissue block for `pose`: an O-grid centred on the middle of the tip's path.
 pub fn tissue(block: &Block, m: &MeshLevel, pose: &PoseSpec, sym: Symmetry, depth_mm: f64) -> TissueMesh {
+    tissue_shaped(block, m, pose, sym, depth_mm, false)
+}
+
+/// As [`tissue`]; with `round_core` the square core is mapped onto a disc of radius
+/// `core_half_mm` (elliptical grid mapping) and the first rings blend from that circle
+/// back to squares, so that a circular footprint of radius `core_half_mm` is meshed
+/// exactly (used by the flat-punch verification; needs a pose without tilt).
+pub fn tissue_shaped(block: &Block, m: &MeshLevel, pose: &PoseSpec, sym: Symmetry, depth_mm: f64, round_core: bool) -> TissueMesh {
     let (tx, tz) = lateral_travel(pose, depth_mm);
     let (hx, hz) = (block.size_x_mm / 2.0, block.size_z_mm / 2.0);
     let xc = if sym.plane_x { 0.0 } else { pose.x_mm + 0.5 * tx };
@@ -222,7 +230,12 @@ pub fn tissue(block: &Block, m: &MeshLevel, pose: &PoseSpec, sym: Symmetry, dept
         prev = cur;
     }
     // clip to the modelled part
-    let pts = pat.pts;
+    let mut pts = pat.pts;
+    if round_core {
+        for p in &mut pts {
+            *p = round(*p, [xc, zc], c);
+        }
+    }
     let quads: Vec<[usize; 4]> = quads
         .into_iter()
         .filter(|q| {
@@ -454,4 +467,24 @@ pub fn needle(nd: &Needle, m: &MeshLevel, pose: &PoseSpec, depth_mm: f64, sym: S
     mesh.surface_nodes = (0..pts.len()).filter(|&i| on_surface[i]).collect();
     mesh.nodes = pts;
     mesh
+}
+
+/// Map a point of the square O-grid to the rounded one: inside the core square of half
+/// side `c` by the elliptical grid mapping onto the disc of radius `c`; outside, rings of
+/// square radius s (in units of c) move towards the circle of radius s, fully at s = 1
+/// and not at all from s = 3 on.
+fn round(p: [f64; 2], centre: [f64; 2], c: f64) -> [f64; 2] {
+    let (dx, dz) = (p[0] - centre[0], p[1] - centre[1]);
+    let s = dx.abs().max(dz.abs()) / c;
+    if s < 1e-12 {
+        return p;
+    }
+    let (q, b) = if s <= 1.0 {
+        let (u, v) = (dx / c, dz / c);
+        ([c * u * (1.0 - v * v / 2.0).sqrt(), c * v * (1.0 - u * u / 2.0).sqrt()], 0.0)
+    } else {
+        let r = (dx * dx + dz * dz).sqrt();
+        ([dx * s * c / r, dz * s * c / r], ((s - 1.0) / 2.0).clamp(0.0, 1.0))
+    };
+    [centre[0] + (1.0 - b) * q[0] + b * dx, centre[1] + (1.0 - b) * q[1] + b * dz]
 }
