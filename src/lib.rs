@@ -1,3 +1,56 @@
-//! needle-haptics: no_std needle-tissue reaction wrench models (in progress).
+//! `needle-haptics`: the reaction wrench of soft tissue on an inserted needle, fast
+//! enough for a haptic control loop, from the parametric model of Bora, Mishra and
+//! Siva Kumar ("Parametric modelling of needle-tissue interaction using finite element
+//! analysis").
+//!
+//! `no_std`, no allocation, no `unsafe`, no panics. The coefficients are fitted on the
+//! host (`needle fit`) from finite-element runs and compiled in at build time from the
+//! coefficient set named by `NEEDLE_COEFFS` (default `coeffs/default`).
+//!
+//! ```
+//! use needle_haptics::{wrench, Pose};
+//!
+//! let pose = Pose { x_mm: 3.0, z_mm: -2.0, theta_x_deg: 5.0, theta_z_deg: 0.0, depth_mm: 4.5 };
+//! let eval = wrench(&pose);
+//! if !eval.status.is_error() {
+//!     let _fy_n: f32 = eval.wrench.fy_n; // axial reaction force, N
+//! }
+//! ```
+//!
+//! # The model
+//!
+//! With `u = depth_mm / 3 - 1` and, for each sweep k (x, z, theta_x, theta_z) with value
+//! `v_k`, `t_k = |v_k| / (V_k / 2) - 1` (`V` = 12 mm, 12 mm, 15°, 15°), each wrench
+//! component c is
+//!
+//! ```text
+//! w_c = B_c(u) + sum over k of  s_kc * D_kc(t_k, u)
+//! ```
+//!
+//! where `B_c` is the quartic in depth of the centred vertical needle, `D_kc` the
+//! deviation of sweep k's fitted model from its value at `v_k = 0` (a 5x5 polynomial,
+//! zero at `t = -1`), and `s_kc = -1` when `v_k < 0` and component c is odd under that
+//! sweep's mirror, else `+1`. The exact f32 operation order is the contract in
+//! `coeffs/README.md`; [`wrench`] follows it bit for bit.
+//!
+//! Without a fitted model (a new set before `needle fit`), the library still builds
+//! (with a cargo warning) and [`wrench`] returns a zero wrench with
+//! `Status::NO_MODEL | Status::ERROR` for every pose ([`model_info::FITTED`] is `false`).
 #![no_std]
 #![forbid(unsafe_code)]
+#![deny(missing_docs)]
+
+mod evaluation;
+mod horner;
+mod model_f32;
+pub mod model_info;
+mod pose;
+mod status;
+mod tables;
+mod wrench;
+
+pub use evaluation::Evaluation;
+pub use model_f32::wrench;
+pub use pose::Pose;
+pub use status::Status;
+pub use wrench::Wrench;

@@ -1,2 +1,87 @@
-//! Build-time code generation for `needle-haptics` (filled in by the model issue).
+//! Build-time code generation for `needle-haptics`.
+//!
+//! Reads and validates a set's `model.toml` (format and evaluation contract:
+//! `coeffs/README.md`) and writes two files into an output folder (the library's
+//! `OUT_DIR` when called from `build.rs`):
+//!
+//! - [`RUST_TABLES_FILE`] (`tables_f32.rs`): `pub const` f32 tables, every coefficient an
+//!   exact decimal literal with its bits in a comment, and per polynomial its domain and
+//!   the fit's residual against FE (the model's error bound, libm style);
+//! - [`C_HEADER_FILE`] (`needle_coeffs.h`): the same tables for C users.
+//!
+//! Every refusal is a [`CodegenError`] naming the file and the line (`path:line: what is
+//! wrong`). It is a library, so the checks are testable without running cargo.
 #![forbid(unsafe_code)]
+#![deny(missing_docs)]
+
+pub mod contract;
+mod error;
+mod model;
+mod render;
+
+pub use error::{line_of, CodegenError};
+pub use model::{parse_bits, parse_model, parse_model_str, Baseline, Matrix, Model};
+pub use render::{f32_literal, render_c_header, render_rust};
+
+use std::path::{Path, PathBuf};
+
+/// File name of the generated Rust tables in the output folder.
+pub const RUST_TABLES_FILE: &str = "tables_f32.rs";
+/// File name of the generated C header in the output folder.
+pub const C_HEADER_FILE: &str = "needle_coeffs.h";
+/// File name of the model inside a set folder.
+pub const MODEL_FILE: &str = "model.toml";
+
+/// What [`generate`] produced.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Generated {
+    /// The validated model (the all-zero placeholder for [`generate_unfitted`]).
+    pub model: Model,
+    /// Text of `tables_f32.rs`.
+    pub rust: String,
+    /// Text of `needle_coeffs.h`.
+    pub c_header: String,
+    /// Where `tables_f32.rs` was written.
+    pub rust_path: PathBuf,
+    /// Where `needle_coeffs.h` was written.
+    pub c_header_path: PathBuf,
+}
+
+/// Validates the model at `model_path` and writes [`RUST_TABLES_FILE`] and
+/// [`C_HEADER_FILE`] into `out_dir` (which must exist). A file whose contents would not
+/// change is not rewritten.
+///
+/// # Errors
+/// The model file is unreadable, is not valid TOML or departs from the contract (the
+/// error has its line), or an output file cannot be written.
+pub fn generate(model_path: &Path, out_dir: &Path) -> Result<Generated, CodegenError> {
+    let model = parse_model(model_path)?;
+    write_all(model, out_dir)
+}
+
+/// Writes the placeholder tables of a set that has no `model.toml` yet: every table is
+/// zero and `FITTED` is `false`, so the library's evaluator answers `NO_MODEL | ERROR`.
+/// `set` is the set's name (its folder's name).
+///
+/// # Errors
+/// An output file cannot be written.
+pub fn generate_unfitted(set: &str, out_dir: &Path) -> Result<Generated, CodegenError> {
+    write_all(Model::unfitted(set), out_dir)
+}
+
+fn write_all(model: Model, out_dir: &Path) -> Result<Generated, CodegenError> {
+    let rust = render_rust(&model);
+    let c_header = render_c_header(&model);
+    let rust_path = out_dir.join(RUST_TABLES_FILE);
+    let c_header_path = out_dir.join(C_HEADER_FILE);
+    write_if_changed(&rust_path, &rust)?;
+    write_if_changed(&c_header_path, &c_header)?;
+    Ok(Generated { model, rust, c_header, rust_path, c_header_path })
+}
+
+fn write_if_changed(path: &Path, text: &str) -> Result<(), CodegenError> {
+    if std::fs::read_to_string(path).is_ok_and(|old| old == text) {
+        return Ok(());
+    }
+    std::fs::write(path, text).map_err(|e| CodegenError::file(path, format!("cannot write: {e}")))
+}

@@ -1,0 +1,437 @@
+//! Reading and validating `model.toml` (format in `coeffs/README.md`).
+use crate::contract::{COMPONENTS, DEPTH_MAX_MM, FORMAT, HALF_RANGES, ODD, SWEEPS};
+use crate::error::CodegenError;
+use serde::Deserialize;
+use std::ops::Range;
+use std::path::Path;
+use toml::Spanned;
+
+/// One baseline polynomial `B_c(u)` (centred, vertical needle), validated.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Baseline {
+    /// Component index (0..5, order of [`COMPONENTS`]).
+    pub component: usize,
+    /// f64 coefficients; `coeffs[i]` multiplies `u^i`.
+    pub coeffs: [f64; 5],
+    /// The f32 the firmware uses: the nearest f32 of each `coeffs[i]`.
+    pub coeffs_f32: [f32; 5],
+    /// RMS fit residual, in the component's unit (N or N*mm).
+    pub residual_rms: f64,
+    /// Maximum absolute fit residual, in the component's unit.
+    pub residual_max: f64,
+}
+
+/// One deviation matrix `D_kc(t, u)`, validated.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Matrix {
+    /// Sweep index (0..3, order of [`SWEEPS`]).
+    pub sweep: usize,
+    /// Component index (0..5).
+    pub component: usize,
+    /// The component changes sign under the sweep's mirror.
+    pub odd: bool,
+    /// f64 coefficients; `rows[i][j]` multiplies `u^i * t^j`.
+    pub rows: [[f64; 5]; 5],
+    /// The nearest f32 of each `rows[i][j]`.
+    pub rows_f32: [[f32; 5]; 5],
+    /// RMS residual of (centre run + deviation) against FE over the sweep, in the
+    /// component's unit.
+    pub residual_rms: f64,
+    /// Maximum absolute residual, same definition and unit.
+    pub residual_max: f64,
+}
+
+/// A validated model: everything the generators need.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    /// `false` for the placeholder of a set that has no `model.toml` yet (all zero).
+    pub fitted: bool,
+    /// Name of the set (`set` in model.toml, or the folder's name when unfitted).
+    pub set: String,
+    /// Hash of the FE files the model was fitted on (empty when unfitted).
+    pub fe_sha256: String,
+    /// 6 baselines, component order.
+    pub baseline: Vec<Baseline>,
+    /// 24 deviation matrices, sweep-major then component order.
+    pub matrices: Vec<Matrix>,
+}
+
+impl Model {
+    /// The placeholder of a set without a fitted model: zero tables, `fitted == false`.
+    pub fn unfitted(set: &str) -> Self {
+        let baseline = (0..6)
+            .map(|c| Baseline {
+                component: c,
+                coeffs: [0.0; 5],
+                coeffs_f32: [0.0; 5],
+                residual_rms: 0.0,
+                residual_max: 0.0,
+            })
+            .collect();
+        let matrices = (0..24)
+            .map(|n| Matrix {
+                sweep: n / 6,
+                component: n % 6,
+                odd: ODD[n / 6][n % 6],
+                rows: [[0.0; 5]; 5],
+                rows_f32: [[0.0; 5]; 5],
+                residual_rms: 0.0,
+                residual_max: 0.0,
+            })
+            .collect();
+        Self { fitted: false, set: set.to_string(), fe_sha256: String::new(), baseline, matrices }
+    }
+
+    /// The f32 baseline table, `[component][i]`.
+    pub fn baseline_f32(&self) -> [[f32; 5]; 6] {
+        let mut out = [[0.0; 5]; 6];
+        for (o, b) in out.iter_mut().zip(&self.baseline) {
+            *o = b.coeffs_f32;
+        }
+        out
+    }
+
+    /// The f32 deviation table, `[sweep][component][i][j]`.
+    pub fn deviation_f32(&self) -> [[[[f32; 5]; 5]; 6]; 4] {
+        let mut out = [[[[0.0; 5]; 5]; 6]; 4];
+        for m in &self.matrices {
+            out[m.sweep][m.component] = m.rows_f32;
+        }
+        out
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawModel {
+    format: Spanned<i64>,
+    set: Spanned<String>,
+    fe_sha256: Spanned<String>,
+    depth_max_mm: Spanned<f64>,
+    x_max_mm: Spanned<f64>,
+    z_max_mm: Spanned<f64>,
+    theta_max_deg: Spanned<f64>,
+    baseline: Spanned<Vec<Spanned<RawBaseline>>>,
+    matrix: Spanned<Vec<Spanned<RawMatrix>>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawBaseline {
+    component: Spanned<String>,
+    coeffs: Spanned<Vec<Spanned<f64>>>,
+    coeffs_f32: Spanned<Vec<Spanned<String>>>,
+    residual_rms: Spanned<f64>,
+    residual_max: Spanned<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMatrix {
+    sweep: Spanned<String>,
+    component: Spanned<String>,
+    odd: Spanned<bool>,
+    rows: Spanned<Vec<Spanned<Vec<Spanned<f64>>>>>,
+    rows_f32: Spanned<Vec<Spanned<Vec<Spanned<String>>>>>,
+    residual_rms: Spanned<f64>,
+    residual_max: Spanned<f64>,
+}
+
+/// Reads and validates the model file at `path`.
+///
+/// # Errors
+/// An unreadable file, invalid TOML, or any departure from the format of
+/// `coeffs/README.md`, with the line it is on.
+pub fn parse_model(path: &Path) -> Result<Model, CodegenError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| CodegenError::file(path, format!("cannot read the model file: {e}")))?;
+    parse_model_str(&text, path)
+}
+
+/// Validates `text`, the contents of the model file `path` (used in error messages).
+///
+/// # Errors
+/// Invalid TOML, or any departure from the format of `coeffs/README.md`, with the line.
+pub fn parse_model_str(text: &str, path: &Path) -> Result<Model, CodegenError> {
+    let raw: RawModel = toml::from_str(text).map_err(|e| {
+        let offset = e.span().map_or(text.trim_end().len(), |s| s.start);
+        CodegenError::at(path, text, offset, e.message())
+    })?;
+    Checker { path, text }.model(raw)
+}
+
+struct Checker<'a> {
+    path: &'a Path,
+    text: &'a str,
+}
+
+impl Checker<'_> {
+    fn err(&self, span: Range<usize>, message: impl Into<String>) -> CodegenError {
+        CodegenError::at(self.path, self.text, span.start, message)
+    }
+
+    fn model(&self, raw: RawModel) -> Result<Model, CodegenError> {
+        if *raw.format.get_ref() != FORMAT {
+            return Err(self.err(
+                raw.format.span(),
+                format!(
+                    "format = {}: this build reads model format {FORMAT} (coeffs/README.md)",
+                    raw.format.get_ref()
+                ),
+            ));
+        }
+        let set = raw.set.get_ref();
+        if set.is_empty()
+            || !set.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'))
+        {
+            return Err(self.err(
+                raw.set.span(),
+                format!("set = {set:?}: a set name is a folder name of ASCII letters, digits, '-', '_' and '.'"),
+            ));
+        }
+        let hash = raw.fe_sha256.get_ref();
+        if hash.len() != 64 || !hash.chars().all(|c| c.is_ascii_digit() || ('a'..='f').contains(&c)) {
+            return Err(self.err(
+                raw.fe_sha256.span(),
+                format!("fe_sha256 = {hash:?}: expected 64 lower-case hex digits (a SHA-256)"),
+            ));
+        }
+        let domain = [
+            (&raw.depth_max_mm, "depth_max_mm", DEPTH_MAX_MM, "0 <= depth <= 6 mm"),
+            (&raw.x_max_mm, "x_max_mm", HALF_RANGES[0], "|x| <= 12 mm"),
+            (&raw.z_max_mm, "z_max_mm", HALF_RANGES[1], "|z| <= 12 mm"),
+            (&raw.theta_max_deg, "theta_max_deg", HALF_RANGES[2], "|theta_x|, |theta_z| <= 15 deg"),
+        ];
+        for (value, key, want, what) in domain {
+            if *value.get_ref() != want {
+                return Err(self.err(
+                    value.span(),
+                    format!(
+                        "{key} = {:?}: the contract's domain is {what} (coeffs/README.md); the evaluator's normalisation is built on it",
+                        value.get_ref()
+                    ),
+                ));
+            }
+        }
+
+        let baseline_span = raw.baseline.span();
+        let baselines = raw.baseline.into_inner();
+        self.count(&baselines, 6, "[[baseline]]", baseline_span)?;
+        let mut baseline = Vec::with_capacity(6);
+        for (c, entry) in baselines.into_iter().enumerate() {
+            baseline.push(self.baseline(c, entry.into_inner())?);
+        }
+
+        let matrix_span = raw.matrix.span();
+        let matrices_raw = raw.matrix.into_inner();
+        self.count(&matrices_raw, 24, "[[matrix]]", matrix_span)?;
+        let mut matrices = Vec::with_capacity(24);
+        for (n, entry) in matrices_raw.into_iter().enumerate() {
+            matrices.push(self.matrix(n / 6, n % 6, entry.into_inner())?);
+        }
+
+        Ok(Model { fitted: true, set: set.clone(), fe_sha256: hash.clone(), baseline, matrices })
+    }
+
+    fn count<T>(
+        &self,
+        entries: &[Spanned<T>],
+        want: usize,
+        what: &str,
+        all: Range<usize>,
+    ) -> Result<(), CodegenError> {
+        if entries.len() == want {
+            return Ok(());
+        }
+        let (offset, hint) = match entries.get(want) {
+            // One too many: point at the first extra entry.
+            Some(extra) => (extra.span().start, ""),
+            // Too few: point at the end of the last one (a truncated file ends there).
+            None => (
+                entries.last().map_or(all.start, |e| e.span().end.saturating_sub(1)),
+                " (truncated file?)",
+            ),
+        };
+        Err(CodegenError::at(
+            self.path,
+            self.text,
+            offset,
+            format!("{} {what} entries, the contract has exactly {want}{hint}", entries.len()),
+        ))
+    }
+
+    fn name_at(
+        &self,
+        value: &Spanned<String>,
+        key: &str,
+        names: &[&str],
+        want: usize,
+        order: &str,
+    ) -> Result<(), CodegenError> {
+        let got = value.get_ref();
+        let expected = names.get(want).copied().unwrap_or_default();
+        if got == expected {
+            return Ok(());
+        }
+        let known = if names.contains(&got.as_str()) { "out of order" } else { "unknown" };
+        Err(self.err(
+            value.span(),
+            format!("{key} = {got:?} ({known}): expected {expected:?} here; the order is {order}"),
+        ))
+    }
+
+    fn finite(&self, v: &Spanned<f64>, what: &str) -> Result<f64, CodegenError> {
+        let x = *v.get_ref();
+        if x.is_finite() {
+            Ok(x)
+        } else {
+            Err(self.err(v.span(), format!("{what} = {x}: every number must be finite")))
+        }
+    }
+
+    fn residual(&self, v: &Spanned<f64>, what: &str) -> Result<f64, CodegenError> {
+        let x = self.finite(v, what)?;
+        if x < 0.0 {
+            return Err(self.err(v.span(), format!("{what} = {x:?}: a residual is >= 0")));
+        }
+        Ok(x)
+    }
+
+    /// Five finite f64 and their five f32 bit strings, each the nearest f32.
+    fn five(
+        &self,
+        values: &Spanned<Vec<Spanned<f64>>>,
+        bits: &Spanned<Vec<Spanned<String>>>,
+        what: &str,
+        what_f32: &str,
+    ) -> Result<([f64; 5], [f32; 5]), CodegenError> {
+        for (list, name) in [(values.get_ref().len(), what), (bits.get_ref().len(), what_f32)] {
+            if list != 5 {
+                let span = if name == what { values.span() } else { bits.span() };
+                return Err(self.err(span, format!("{name} has {list} values, expected 5 (powers 0..=4)")));
+            }
+        }
+        let mut out = [0.0; 5];
+        let mut out32 = [0.0; 5];
+        for (j, ((v, b), (o, o32))) in values
+            .get_ref()
+            .iter()
+            .zip(bits.get_ref())
+            .zip(out.iter_mut().zip(out32.iter_mut()))
+            .enumerate()
+        {
+            let x = self.finite(v, &format!("{what}[{j}]"))?;
+            let nearest = x as f32;
+            if !nearest.is_finite() {
+                return Err(self.err(v.span(), format!("{what}[{j}] = {x:?} overflows f32")));
+            }
+            let text = b.get_ref();
+            let parsed = parse_bits(text).ok_or_else(|| {
+                self.err(
+                    b.span(),
+                    format!("{what_f32}[{j}] = {text:?}: expected \"0x\" and 8 lower-case hex digits (f32 bits)"),
+                )
+            })?;
+            if parsed != nearest.to_bits() {
+                return Err(self.err(
+                    b.span(),
+                    format!(
+                        "{what_f32}[{j}] = {text} ({:?}) is not the nearest f32 of {what}[{j}] = {x:?}, which is {:#010x} ({nearest:?})",
+                        f32::from_bits(parsed),
+                        nearest.to_bits()
+                    ),
+                ));
+            }
+            *o = x;
+            *o32 = nearest;
+        }
+        Ok((out, out32))
+    }
+
+    fn baseline(&self, c: usize, raw: RawBaseline) -> Result<Baseline, CodegenError> {
+        self.name_at(&raw.component, "component", &COMPONENTS, c, &COMPONENTS.join(", "))?;
+        let name = COMPONENTS[c];
+        let (coeffs, coeffs_f32) = self.five(
+            &raw.coeffs,
+            &raw.coeffs_f32,
+            &format!("baseline {name}: coeffs"),
+            &format!("baseline {name}: coeffs_f32"),
+        )?;
+        Ok(Baseline {
+            component: c,
+            coeffs,
+            coeffs_f32,
+            residual_rms: self.residual(&raw.residual_rms, &format!("baseline {name}: residual_rms"))?,
+            residual_max: self.residual(&raw.residual_max, &format!("baseline {name}: residual_max"))?,
+        })
+    }
+
+    fn matrix(&self, k: usize, c: usize, raw: RawMatrix) -> Result<Matrix, CodegenError> {
+        let order = "sweep-major (x, z, theta_x, theta_z), then component (fx_n .. mz_nmm)";
+        self.name_at(&raw.sweep, "sweep", &SWEEPS, k, order)?;
+        self.name_at(&raw.component, "component", &COMPONENTS, c, order)?;
+        let label = format!("matrix {}/{}", SWEEPS[k], COMPONENTS[c]);
+        let odd = ODD[k][c];
+        if *raw.odd.get_ref() != odd {
+            return Err(self.err(
+                raw.odd.span(),
+                format!(
+                    "{label}: odd = {}, but the contract's mirror table says {odd} (coeffs/README.md, \"Mirror symmetries\")",
+                    raw.odd.get_ref()
+                ),
+            ));
+        }
+        for (n, name, span) in [
+            (raw.rows.get_ref().len(), "rows", raw.rows.span()),
+            (raw.rows_f32.get_ref().len(), "rows_f32", raw.rows_f32.span()),
+        ] {
+            if n != 5 {
+                return Err(self.err(span, format!("{label}: {name} has {n} rows, expected 5 (powers of u 0..=4)")));
+            }
+        }
+        let mut rows = [[0.0; 5]; 5];
+        let mut rows_f32 = [[0.0; 5]; 5];
+        for (i, ((r, b), (o, o32))) in raw
+            .rows
+            .get_ref()
+            .iter()
+            .zip(raw.rows_f32.get_ref())
+            .zip(rows.iter_mut().zip(rows_f32.iter_mut()))
+            .enumerate()
+        {
+            let (row, row32) =
+                self.five(r, b, &format!("{label}: rows[{i}]"), &format!("{label}: rows_f32[{i}]"))?;
+            // A deviation is zero at t = -1 (sweep value 0), in f64 up to rounding.
+            let at_zero: f64 = row.iter().zip([1.0, -1.0, 1.0, -1.0, 1.0]).map(|(a, s)| a * s).sum();
+            let scale: f64 = row.iter().map(|a| a.abs()).sum();
+            if at_zero.abs() > 1e-9 * scale {
+                return Err(self.err(
+                    r.span(),
+                    format!(
+                        "{label}: rows[{i}] at t = -1 is {at_zero:e}, not 0: a deviation vanishes at sweep value 0 (rows[i][0] -= sum_j rows[i][j] * (-1)^j)"
+                    ),
+                ));
+            }
+            *o = row;
+            *o32 = row32;
+        }
+        Ok(Matrix {
+            sweep: k,
+            component: c,
+            odd,
+            rows,
+            rows_f32,
+            residual_rms: self.residual(&raw.residual_rms, &format!("{label}: residual_rms"))?,
+            residual_max: self.residual(&raw.residual_max, &format!("{label}: residual_max"))?,
+        })
+    }
+}
+
+/// Parses `0x` and exactly 8 lower-case hex digits.
+pub fn parse_bits(text: &str) -> Option<u32> {
+    let digits = text.strip_prefix("0x")?;
+    if digits.len() != 8 || !digits.chars().all(|c| c.is_ascii_digit() || ('a'..='f').contains(&c)) {
+        return None;
+    }
+    u32::from_str_radix(digits, 16).ok()
+}

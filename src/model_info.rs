@@ -1,0 +1,26 @@
+//! Identity, domain and tables of the model compiled into this build.
+//!
+//! Everything here comes from the coefficient set selected at build time
+//! (`NEEDLE_COEFFS`, default `coeffs/default`), through `build.rs` and `needle-codegen`.
+
+pub use crate::tables::{
+    BASELINE, DEPTH_MAX_MM, DEVIATION, FE_SHA256, FITTED, FORMAT, SET, THETA_MAX_DEG, X_MAX_MM,
+    Z_MAX_MM,
+};
+
+/// `ODD[k][c]`: wrench component `c` (fx, fy, fz, mx, my, mz) changes sign under the
+/// mirror of sweep `k` (x, z, theta_x, theta_z). Fixed by the geometry (coeffs/README.md);
+/// every model file is checked against it at build time.
+pub const ODD: [[bool; 6]; 4] = crate::model_f32::ODD;
+
+/// Absolute path of the set folder this build was generated from (on the build machine).
+pub const SET_DIR: &str = env!("NEEDLE_SET_DIR");
+
+/// The C header `needle_coeffs.h` generated with these tables: the same coefficients as
+/// `static const float` with their bits, the domain, the normalisation constants and the
+/// status bits. `needle header --out DIR` writes it out.
+pub const C_HEADER: &str = include_str!(concat!(env!("OUT_DIR"), "/needle_coeffs.h"));
+
+/// The generated Rust source of the tables compiled into this build (for audits and the
+/// regeneration test).
+pub const TABLES_RS: &str = include_str!(concat!(env!("OUT_DIR"), "/tables_f32.rs"));

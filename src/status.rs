@@ -1,0 +1,145 @@
+//! [`Status`]: what an evaluation had to do to its input, as bit flags.
+use core::fmt;
+use core::ops::{BitOr, BitOrAssign};
+
+/// Status of an evaluation: bit flags, `0` ([`Status::OK`]) when the pose was inside the
+/// domain and the model is present.
+///
+/// | flag | bit | meaning |
+/// | --- | --- | --- |
+/// | [`SAT_X`](Self::SAT_X) | `0x01` | `x_mm` was outside `±12` and was clamped |
+/// | [`SAT_Z`](Self::SAT_Z) | `0x02` | `z_mm` was outside `±12` and was clamped |
+/// | [`SAT_THETA_X`](Self::SAT_THETA_X) | `0x04` | `theta_x_deg` was outside `±15` and was clamped |
+/// | [`SAT_THETA_Z`](Self::SAT_THETA_Z) | `0x08` | `theta_z_deg` was outside `±15` and was clamped |
+/// | [`SAT_DEPTH`](Self::SAT_DEPTH) | `0x10` | `depth_mm` was outside `0..=6` and was clamped |
+/// | [`NO_MODEL`](Self::NO_MODEL) | `0x40` | the library was built without a fitted model (always with `ERROR`) |
+/// | [`ERROR`](Self::ERROR) | `0x80` | no wrench: an input was NaN or infinite, or `NO_MODEL`; the wrench is zero |
+///
+/// A saturated evaluation is still a valid wrench (of the clamped pose).
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct Status(u8);
+
+impl Status {
+    /// Nothing to report: the pose was in the domain.
+    pub const OK: Self = Self(0x00);
+    /// `x_mm` was clamped to `±X_MAX_MM`.
+    pub const SAT_X: Self = Self(0x01);
+    /// `z_mm` was clamped to `±Z_MAX_MM`.
+    pub const SAT_Z: Self = Self(0x02);
+    /// `theta_x_deg` was clamped to `±THETA_MAX_DEG`.
+    pub const SAT_THETA_X: Self = Self(0x04);
+    /// `theta_z_deg` was clamped to `±THETA_MAX_DEG`.
+    pub const SAT_THETA_Z: Self = Self(0x08);
+    /// `depth_mm` was clamped to `0..=DEPTH_MAX_MM`.
+    pub const SAT_DEPTH: Self = Self(0x10);
+    /// The library has no fitted model (its set had no `model.toml` at build time).
+    /// Always reported together with [`ERROR`](Self::ERROR).
+    pub const NO_MODEL: Self = Self(0x40);
+    /// No wrench could be computed; the wrench is zero. Alone when an input was NaN or
+    /// infinite, with [`NO_MODEL`](Self::NO_MODEL) when there is no model.
+    pub const ERROR: Self = Self(0x80);
+    /// All five saturation flags.
+    pub const SATURATION: Self = Self(0x1f);
+
+    /// Every flag with its name, in bit order (for printing).
+    pub const FLAGS: [(Self, &'static str); 7] = [
+        (Self::SAT_X, "SAT_X"),
+        (Self::SAT_Z, "SAT_Z"),
+        (Self::SAT_THETA_X, "SAT_THETA_X"),
+        (Self::SAT_THETA_Z, "SAT_THETA_Z"),
+        (Self::SAT_DEPTH, "SAT_DEPTH"),
+        (Self::NO_MODEL, "NO_MODEL"),
+        (Self::ERROR, "ERROR"),
+    ];
+
+    /// A status from its bits (kept as given, unknown bits included).
+    #[inline]
+    #[must_use]
+    pub const fn from_bits(bits: u8) -> Self {
+        Self(bits)
+    }
+
+    /// The bits of this status.
+    #[inline]
+    #[must_use]
+    pub const fn bits(self) -> u8 {
+        self.0
+    }
+
+    /// `true` when no flag is set: the pose was in the domain and the wrench is the model's.
+    #[inline]
+    #[must_use]
+    pub const fn is_ok(self) -> bool {
+        self.0 == 0
+    }
+
+    /// `true` when [`ERROR`](Self::ERROR) is set: the wrench is zero, not a model value.
+    #[inline]
+    #[must_use]
+    pub const fn is_error(self) -> bool {
+        self.0 & Self::ERROR.0 != 0
+    }
+
+    /// `true` when at least one input was clamped to the domain (any `SAT_*` flag).
+    #[inline]
+    #[must_use]
+    pub const fn saturated(self) -> bool {
+        self.0 & Self::SATURATION.0 != 0
+    }
+
+    /// `true` when every flag set in `flags` is also set here.
+    #[inline]
+    #[must_use]
+    pub const fn contains(self, flags: Self) -> bool {
+        self.0 & flags.0 == flags.0
+    }
+}
+
+impl BitOr for Status {
+    type Output = Self;
+    #[inline]
+    fn bitor(self, rhs: Self) -> Self {
+        Self(self.0 | rhs.0)
+    }
+}
+
+impl BitOrAssign for Status {
+    #[inline]
+    fn bitor_assign(&mut self, rhs: Self) {
+        self.0 |= rhs.0;
+    }
+}
+
+/// The flag names joined by ` | `, or `OK` (for example `SAT_X | SAT_DEPTH`).
+impl fmt::Display for Status {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.is_ok() {
+            return f.write_str("OK");
+        }
+        let mut first = true;
+        for (flag, name) in Self::FLAGS {
+            if self.contains(flag) {
+                if !first {
+                    f.write_str(" | ")?;
+                }
+                f.write_str(name)?;
+                first = false;
+            }
+        }
+        let unknown = self.0 & !(Self::SATURATION.0 | Self::NO_MODEL.0 | Self::ERROR.0);
+        if unknown != 0 {
+            if !first {
+                f.write_str(" | ")?;
+            }
+            write!(f, "{unknown:#04x}")?;
+        }
+        Ok(())
+    }
+}
+
+/// `Status(0x11: SAT_X | SAT_DEPTH)`.
+impl fmt::Debug for Status {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "Status({:#04x}: {})", self.0, self)
+    }
+}
