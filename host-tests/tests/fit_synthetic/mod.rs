@@ -1,0 +1,58 @@
+//! A synthetic set for the fitter's tests: the shipped campaign spec, and for every pose an
+//! analytic "FE" wrench with the block's mirror symmetries (odd components exactly zero
+//! where a symmetry forces them to be), written as `fe/<pose>.csv`.
+
+#![allow(dead_code)]
+
+use needle_host::fe::results::{to_csv, Row};
+use needle_host::fe::spec::{self, PoseSpec};
+use needle_host::fit::{fit_set, FitOutput};
+use std::path::{Path, PathBuf};
+
+/// Lever arm used to scale moments in the tolerances, mm (the default set's hub).
+pub const LEVER_MM: f64 = 60.0;
+
+/// The analytic wrench at a pose and depth: forces in N, moments in N*mm. Mirror x -> -x
+/// ((x, tz) -> (-x, -tz)) flips fx, my, mz; mirror z -> -z ((z, tx) -> (-z, -tx)) flips
+/// fz, mx, my; the x-tz and z-tx couplings make combined poses differ from superposition.
+pub fn wrench(p: &PoseSpec, d: f64) -> [f64; 6] {
+    let (x, z, tx, tz) = (p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg);
+    let depth_law = 0.01 * d.powf(1.5) + 0.002 * d * d;
+    let fy = -depth_law * (1.0 + 0.003 * x * x + 0.002 * z * z + 0.001 * tx * tx + 0.0015 * tz * tz + 0.0001 * x * tz);
+    let lateral = 0.004 * d.powf(1.2);
+    let fx = lateral * (x + 0.5 * tz) * (1.0 + 0.01 * z * z);
+    let fz = lateral * (z + 0.6 * tx) * (1.0 + 0.01 * x * x);
+    let mx = 0.8 * LEVER_MM * fz + 0.01 * d * tx;
+    let my = 0.0005 * d * (x + tz) * (z + tx);
+    let mz = -0.8 * LEVER_MM * fx + 0.01 * d * tz;
+    [fx, fy, fz, mx, my, mz]
+}
+
+/// Create a synthetic set in `dir` (campaign.toml copied from coeffs/default, one CSV per
+/// pose). `skip` names poses whose CSV is not written.
+pub fn make_set(dir: &Path, skip: &[&str]) {
+    let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default/campaign.toml");
+    std::fs::create_dir_all(dir.join("fe")).expect("create set folder");
+    std::fs::copy(&src, dir.join("campaign.toml")).expect("copy campaign.toml");
+    let (campaign, _) = spec::load(dir).expect("load spec");
+    for pose in campaign.poses() {
+        if skip.contains(&pose.name.as_str()) {
+            continue;
+        }
+        let rows: Vec<Row> = (0..=campaign.loading.steps)
+            .map(|k| {
+                let d = campaign.loading.depth_at(k);
+                Row { depth_mm: d, wrench: wrench(&pose, d) }
+            })
+            .collect();
+        std::fs::write(dir.join("fe").join(format!("{}.csv", pose.name)), to_csv(&rows)).expect("write csv");
+    }
+}
+
+/// A fitted synthetic set: the temporary folder (kept alive) and the fit output.
+pub fn fitted() -> (tempfile::TempDir, FitOutput) {
+    let dir = tempfile::tempdir().expect("tempdir");
+    make_set(dir.path(), &[]);
+    let out = fit_set(dir.path()).unwrap_or_else(|e| panic!("fit of the synthetic set: {e:#}"));
+    (dir, out)
+}
