@@ -1,25 +1,194 @@
-//! `needle eval`, `needle header`: query the library's model.
+//! `needle eval`, `needle header`: query the library's compiled-in model.
+//!
+//! Both use `needle-haptics` itself (the code and tables the firmware runs), not a host
+//! re-implementation. The library has one coefficient set compiled in (chosen by
+//! `NEEDLE_COEFFS` at build time); `needle eval --set DIR` checks that `DIR` is that set.
+use anyhow::{bail, Context};
 use clap::Args;
+use needle_haptics::{model_info, wrench, Evaluation, Pose, Status};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-/// Arguments of `needle eval` (in progress).
-#[derive(Args)]
-pub struct EvalArgs {}
-/// Arguments of `needle header` (in progress).
-#[derive(Args)]
-pub struct HeaderArgs {}
-
-/// `needle eval`.
-///
-/// # Errors
-/// Any failure, with its context.
-pub fn eval(_a: EvalArgs) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("not implemented yet")
+/// Arguments of `needle eval`.
+#[derive(Args, Debug)]
+pub struct EvalArgs {
+    /// The coefficient set folder (e.g. coeffs/default); must be the set this build has
+    /// compiled in (rebuild with NEEDLE_COEFFS=DIR to use another).
+    #[arg(long, value_name = "DIR")]
+    pub set: PathBuf,
+    /// x of the insertion point on the top surface, mm.
+    #[arg(long, allow_negative_numbers = true)]
+    pub x_mm: f32,
+    /// z of the insertion point on the top surface, mm.
+    #[arg(long, allow_negative_numbers = true)]
+    pub z_mm: f32,
+    /// Tilt about x away from vertical, degrees.
+    #[arg(long, allow_negative_numbers = true)]
+    pub theta_x_deg: f32,
+    /// Tilt about z away from vertical, degrees.
+    #[arg(long, allow_negative_numbers = true)]
+    pub theta_z_deg: f32,
+    /// Insertion depth along the needle axis, mm.
+    #[arg(long, allow_negative_numbers = true)]
+    pub depth_mm: f32,
+    /// Print one JSON object instead of the table.
+    #[arg(long)]
+    pub json: bool,
 }
-/// `needle header`.
+
+/// Arguments of `needle header`.
+#[derive(Args, Debug)]
+pub struct HeaderArgs {
+    /// Folder to write needle_coeffs.h into (created if missing).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+}
+
+/// Checks that the set folder `dir` is the one compiled into the library: same
+/// `fe_sha256` and the same f32 coefficient bits as its `model.toml`.
 ///
 /// # Errors
-/// Any failure, with its context.
-pub fn header(_a: HeaderArgs) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("not implemented yet")
+/// The library has no fitted model, `dir` has no valid model.toml, or it is another set
+/// (or another fit of the same FE data) than the one compiled in.
+pub fn check_compiled_set(dir: &Path) -> anyhow::Result<()> {
+    let model_path = dir.join(needle_codegen::MODEL_FILE);
+    let rebuild = format!(
+        "rebuild with NEEDLE_COEFFS={} (e.g. `NEEDLE_COEFFS={} cargo build --release -p needle-host`)",
+        dir.display(),
+        dir.display()
+    );
+    if !model_info::FITTED {
+        bail!(
+            "this build of needle-haptics has no fitted model: it was built from {}, which had no model.toml (run `needle fit --set {}`, then rebuild); {rebuild}",
+            model_info::SET_DIR,
+            model_info::SET_DIR
+        );
+    }
+    if !model_path.is_file() {
+        bail!("{}: no such file: --set names a coefficient set folder holding model.toml", model_path.display());
+    }
+    let model = needle_codegen::parse_model(&model_path).map_err(anyhow::Error::new)?;
+    let built = format!(
+        "this build has set {:?} compiled in, from {} (fe_sha256 {})",
+        model_info::SET,
+        model_info::SET_DIR,
+        model_info::FE_SHA256
+    );
+    if model.fe_sha256 != model_info::FE_SHA256 {
+        bail!(
+            "{} is fitted on other FE data (fe_sha256 {}) than the compiled-in model: {built}; {rebuild}",
+            model_path.display(),
+            model.fe_sha256
+        );
+    }
+    let same_bits = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+    let base_same = model.baseline_f32().iter().zip(model_info::BASELINE.iter()).all(|(a, b)| same_bits(a, b));
+    let dev_same = model.deviation_f32().iter().flatten().flatten().zip(model_info::DEVIATION.iter().flatten().flatten())
+        .all(|(a, b)| same_bits(a, b));
+    if !(base_same && dev_same) {
+        bail!(
+            "{} has other coefficients than the compiled-in model (same FE data, refitted?): {built}; {rebuild}",
+            model_path.display()
+        );
+    }
+    Ok(())
+}
+
+/// Names of the flags set in `status` (empty for OK).
+pub fn status_names(status: Status) -> Vec<&'static str> {
+    Status::FLAGS.iter().filter(|(f, _)| status.contains(*f)).map(|(_, n)| *n).collect()
+}
+
+const NAMES: [(&str, &str); 6] =
+    [("fx_n", "N"), ("fy_n", "N"), ("fz_n", "N"), ("mx_nmm", "N*mm"), ("my_nmm", "N*mm"), ("mz_nmm", "N*mm")];
+
+/// The JSON object `needle eval --json` prints.
+pub fn eval_json(pose: &Pose, e: &Evaluation) -> serde_json::Value {
+    let mut wrench = serde_json::Map::new();
+    let mut bits = serde_json::Map::new();
+    for ((name, _), v) in NAMES.iter().zip(e.wrench.to_array()) {
+        wrench.insert((*name).to_string(), serde_json::json!(v));
+        bits.insert((*name).to_string(), serde_json::json!(format!("{:#010x}", v.to_bits())));
+    }
+    let pose_bits = [pose.x_mm, pose.z_mm, pose.theta_x_deg, pose.theta_z_deg, pose.depth_mm]
+        .map(|v| format!("{:#010x}", v.to_bits()));
+    serde_json::json!({
+        "set": model_info::SET,
+        "fe_sha256": model_info::FE_SHA256,
+        "pose": {
+            "x_mm": pose.x_mm, "z_mm": pose.z_mm, "theta_x_deg": pose.theta_x_deg,
+            "theta_z_deg": pose.theta_z_deg, "depth_mm": pose.depth_mm,
+        },
+        "pose_bits": pose_bits,
+        "wrench": wrench,
+        "wrench_bits": bits,
+        "reference_point": "needle hub (on the axis, needle.reference_from_tip_mm from the tip)",
+        "status": {
+            "bits": format!("{:#04x}", e.status.bits()),
+            "flags": status_names(e.status),
+            "ok": e.status.is_ok(),
+            "saturated": e.status.saturated(),
+            "error": e.status.is_error(),
+        },
+    })
+}
+
+/// `needle eval`: the wrench at one pose from the library. Exit code 0 for a wrench
+/// (in the domain or saturated), 1 when the status is an error (NaN/infinite input).
+///
+/// # Errors
+/// `--set` is not the set compiled into this build (see [`check_compiled_set`]).
+pub fn eval(a: EvalArgs) -> anyhow::Result<ExitCode> {
+    check_compiled_set(&a.set)?;
+    let pose = Pose {
+        x_mm: a.x_mm,
+        z_mm: a.z_mm,
+        theta_x_deg: a.theta_x_deg,
+        theta_z_deg: a.theta_z_deg,
+        depth_mm: a.depth_mm,
+    };
+    let e = wrench(&pose);
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&eval_json(&pose, &e))?);
+    } else {
+        println!("set {} ({}), f32 paper model", model_info::SET, model_info::SET_DIR);
+        println!(
+            "pose: x_mm = {} z_mm = {} theta_x_deg = {} theta_z_deg = {} depth_mm = {}",
+            pose.x_mm, pose.z_mm, pose.theta_x_deg, pose.theta_z_deg, pose.depth_mm
+        );
+        println!("wrench on the needle, moments about the hub:");
+        for ((name, unit), v) in NAMES.iter().zip(e.wrench.to_array()) {
+            println!("  {name:<7} = {:>15} {unit:<5} ({:#010x})", format!("{v:?}"), v.to_bits());
+        }
+        let meaning = if e.status.is_error() {
+            "error: no wrench"
+        } else if e.status.saturated() {
+            "saturated: the wrench of the pose clamped to the domain"
+        } else {
+            "in the domain"
+        };
+        println!("status  = {:#04x} ({}): {meaning}", e.status.bits(), e.status);
+    }
+    Ok(if e.status.is_error() { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+/// `needle header`: writes the C header generated with the compiled-in tables to
+/// `DIR/needle_coeffs.h`.
+///
+/// # Errors
+/// The folder cannot be created or the file cannot be written.
+pub fn header(a: HeaderArgs) -> anyhow::Result<ExitCode> {
+    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    let path = a.out.join(needle_codegen::C_HEADER_FILE);
+    std::fs::write(&path, model_info::C_HEADER).with_context(|| format!("writing {}", path.display()))?;
+    if model_info::FITTED {
+        println!("wrote {} (set {}, fe_sha256 {})", path.display(), model_info::SET, model_info::FE_SHA256);
+    } else {
+        eprintln!(
+            "warning: this build has no fitted model ({} had no model.toml): the header's tables are all zero (NEEDLE_COEFFS_FITTED 0)",
+            model_info::SET_DIR
+        );
+        println!("wrote {}", path.display());
+    }
+    Ok(ExitCode::SUCCESS)
 }
