@@ -154,8 +154,10 @@ pub fn parse_model(path: &Path) -> Result<Model, CodegenError> {
 /// Invalid TOML, or any departure from the format of `coeffs/README.md`, with the line.
 pub fn parse_model_str(text: &str, path: &Path) -> Result<Model, CodegenError> {
     let raw: RawModel = toml::from_str(text).map_err(|e| {
-        let offset = e.span().map_or(text.trim_end().len(), |s| s.start);
-        CodegenError::at(path, text, offset, e.message())
+        let end = text.trim_end().len();
+        let offset = e.span().map_or(end, |s| s.start);
+        let hint = if offset >= end { " (at the end of the file: truncated?)" } else { "" };
+        CodegenError::at(path, text, offset, format!("{}{hint}", e.message().trim_end()))
     })?;
     Checker { path, text }.model(raw)
 }
