@@ -1,18 +1,84 @@
 //! `needle fe ...`: the FE campaign commands.
-use clap::Subcommand;
+use crate::fe::campaign::{self, RunOptions};
+use clap::{Args, Subcommand};
+use std::path::PathBuf;
 use std::process::ExitCode;
+use std::time::Duration;
 
 /// `needle fe` subcommands.
 #[derive(Subcommand)]
 pub enum FeCommand {
-    /// Run the FE campaign (in progress).
-    Run,
+    /// Run the FE campaign of a set on CalculiX: one deck and one ccx job per pose,
+    /// results in <set>/fe/<pose>.csv (depth in mm, forces in N, moments in N*mm about the
+    /// needle hub) and <set>/fe/manifest.toml. Poses whose result matches the current
+    /// spec are skipped; a killed campaign resumes where it stopped. Exit status 1 when a
+    /// run failed (the others are still written), 2 on an error before any run.
+    Run(RunArgs),
+    /// Verify the FE setup: flat punch against Sneddon, mesh convergence (not implemented yet).
+    Verify,
+}
+
+/// Arguments of `needle fe run`.
+#[derive(Args, Debug)]
+pub struct RunArgs {
+    /// Set folder holding campaign.toml, e.g. coeffs/default.
+    #[arg(long, value_name = "DIR")]
+    pub set: PathBuf,
+    /// Number of ccx jobs at the same time, each on one thread (memory: about 2.5 GB per
+    /// job on the committed mesh).
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub jobs: usize,
+    /// Only the poses whose name matches this glob, e.g. 'x+*' or 'centre' (quote it).
+    #[arg(long, value_name = "PATTERN")]
+    pub only: Option<String>,
+    /// Mesh level of campaign.toml ([mesh.<LEVEL>]); default: campaign.mesh.
+    #[arg(long, value_name = "LEVEL")]
+    pub mesh: Option<String>,
+    /// Number of load steps instead of loading.steps (smoke runs: rows at N+1 depths from 0
+    /// to loading.depth_mm). Part of the spec hash: results of other step counts are rerun.
+    #[arg(long, value_name = "N")]
+    pub steps: Option<u32>,
+    /// Output folder for <pose>.csv, manifest.toml and .work/; default: <set>/fe.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Rerun the selected poses even when their results are up to date.
+    #[arg(long)]
+    pub force: bool,
+    /// Wall-clock limit of one ccx job, in seconds; a job running longer is killed and
+    /// reported failed.
+    #[arg(long, value_name = "S")]
+    pub timeout_s: Option<f64>,
 }
 
 /// Run an `fe` subcommand.
 ///
 /// # Errors
-/// Any failure, with its context.
-pub fn run(_c: FeCommand) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("not implemented yet")
+/// Any failure before the runs start (spec, material check, ccx missing, output folder),
+/// with its context. Failed runs are reported and give exit status 1, not an error.
+pub fn run(c: FeCommand) -> anyhow::Result<ExitCode> {
+    match c {
+        FeCommand::Run(a) => run_campaign(a),
+        FeCommand::Verify => anyhow::bail!("needle fe verify: not implemented yet"),
+    }
+}
+
+fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
+    let timeout = match a.timeout_s {
+        None => None,
+        Some(s) if s.is_finite() && s > 0.0 => Some(Duration::from_secs_f64(s)),
+        Some(s) => anyhow::bail!("--timeout-s {s}: must be a number of seconds > 0"),
+    };
+    let opts = RunOptions {
+        set_dir: a.set,
+        jobs: a.jobs.max(1),
+        only: a.only,
+        mesh: a.mesh,
+        steps: a.steps,
+        out_dir: a.out,
+        force: a.force,
+        timeout,
+    };
+    let report = campaign::run(&opts)?;
+    print!("{}", report.table());
+    Ok(if report.failed() > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS })
 }

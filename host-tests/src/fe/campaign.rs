@@ -1,1 +1,1062 @@
-//! (in progress)
+//! The FE campaign driver behind `needle fe run`: select the poses, skip the ones whose
+//! result is up to date, solve the others in parallel (one ccx thread per job), write
+//! `fe/<pose>.csv` and the manifest atomically, and report.
+//!
+//! Files, in the output folder (default `<set>/fe/`):
+//! - `<pose>.csv`: the wrench at `steps + 1` depths (format: coeffs/README.md). Written
+//!   with [`results::write_atomic`]: a killed run never leaves a half-written CSV.
+//! - `manifest.toml`: one table per finished pose (see [`ManifestEntry`]), sorted by
+//!   pose name, rewritten atomically after each pose.
+//! - `.work/<pose>/`: the deck and ccx's files of a run; removed when the run succeeds,
+//!   kept for debugging when it fails.
+//!
+//! A pose is up to date, and skipped, when its CSV exists with `steps + 1` rows and its
+//! manifest entry has the spec hash of the current run ([`Campaign::run_hash`] of the
+//! spec with the `--steps` override applied, the pose and the mesh level). Before a pose
+//! is solved its manifest entry is removed, so a CSV is only ever trusted when the entry
+//! written after it says which spec it came from.
+
+use crate::fe::ccx;
+use crate::fe::dat;
+use crate::fe::deck::{self, MeshSummary};
+use crate::fe::results::{self, Row};
+use crate::fe::spec::{self, Campaign, MeshLevel, PoseSpec, Role};
+use crate::fe::wrench;
+use anyhow::{bail, Context, Result};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use serde::{Deserialize, Serialize};
+use std::collections::{BTreeMap, VecDeque};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::{mpsc, Mutex};
+use std::time::{Duration, Instant, SystemTime};
+
+/// The ccx job name inside a pose's work folder (`pose.inp`, `pose.dat`, `pose.sta`...).
+pub const JOB: &str = "pose";
+
+/// Name of the manifest file in the output folder.
+pub const MANIFEST: &str = "manifest.toml";
+
+/// What `needle fe run` was asked to do.
+#[derive(Debug, Clone)]
+pub struct RunOptions {
+    /// The set folder, holding `campaign.toml`.
+    pub set_dir: PathBuf,
+    /// Number of ccx jobs run at the same time (each on one thread); 0 counts as 1.
+    pub jobs: usize,
+    /// Glob over pose names (`*`, `?`, `[..]`); `None`: every pose.
+    pub only: Option<String>,
+    /// Mesh level; `None`: `campaign.mesh` of the spec.
+    pub mesh: Option<String>,
+    /// Number of load steps instead of `loading.steps` (smoke runs); part of the hash.
+    pub steps: Option<u32>,
+    /// Output folder; `None`: `<set_dir>/fe`.
+    pub out_dir: Option<PathBuf>,
+    /// Solve every selected pose, even when its result is up to date.
+    pub force: bool,
+    /// Wall-clock limit of one ccx job; the job is killed and reported failed after it.
+    pub timeout: Option<Duration>,
+}
+
+impl RunOptions {
+    /// Options for the whole campaign of `set_dir` with the spec's settings, one job.
+    pub fn new(set_dir: impl Into<PathBuf>) -> Self {
+        RunOptions {
+            set_dir: set_dir.into(),
+            jobs: 1,
+            only: None,
+            mesh: None,
+            steps: None,
+            out_dir: None,
+            force: false,
+            timeout: None,
+        }
+    }
+}
+
+/// What happened to one selected pose.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Status {
+    /// Solved now; CSV and manifest entry written.
+    Done,
+    /// Result already up to date; nothing run.
+    UpToDate,
+    /// The run failed; no CSV written. `message` says how (exit status, steps done),
+    /// `log_tail` holds the end of the ccx output (may be empty).
+    Failed {
+        /// One line: what failed.
+        message: String,
+        /// The last lines of ccx's output.
+        log_tail: String,
+    },
+}
+
+/// One line of the final report.
+#[derive(Debug, Clone)]
+pub struct PoseReport {
+    /// Pose name.
+    pub pose: String,
+    /// Outcome.
+    pub status: Status,
+    /// Wall time of the solve, s (from the manifest for up-to-date poses).
+    pub wall_s: Option<f64>,
+    /// Converged increments of the solve.
+    pub increments: Option<u32>,
+    /// Fy at the final depth, N (reaction on the needle).
+    pub fy_final_n: Option<f64>,
+    /// The kept work folder of a failed run.
+    pub work_dir: Option<PathBuf>,
+}
+
+/// The result of [`run`].
+#[derive(Debug, Clone)]
+pub struct Report {
+    /// One entry per selected pose, in campaign order.
+    pub poses: Vec<PoseReport>,
+    /// Mesh level used.
+    pub mesh: String,
+    /// Load steps per run.
+    pub steps: u32,
+    /// Final depth, mm.
+    pub depth_mm: f64,
+    /// The output folder.
+    pub out_dir: PathBuf,
+    /// Wall time of the whole campaign.
+    pub wall: Duration,
+}
+
+impl Report {
+    /// Number of poses solved now.
+    pub fn done(&self) -> usize {
+        self.poses.iter().filter(|p| p.status == Status::Done).count()
+    }
+    /// Number of poses skipped as up to date.
+    pub fn up_to_date(&self) -> usize {
+        self.poses.iter().filter(|p| p.status == Status::UpToDate).count()
+    }
+    /// Number of failed poses.
+    pub fn failed(&self) -> usize {
+        self.poses.iter().filter(|p| matches!(p.status, Status::Failed { .. })).count()
+    }
+
+    /// The summary table (pose, status, wall time, increments, Fy at the final depth),
+    /// then one paragraph per failure with its log tail.
+    pub fn table(&self) -> String {
+        let mut s = format!(
+            "{:<10} {:<10} {:>9} {:>10} {:>14}\n",
+            "pose",
+            "status",
+            "wall_s",
+            "increments",
+            format!("fy_n@{}mm", self.depth_mm)
+        );
+        let opt = |v: Option<String>| v.unwrap_or_else(|| "-".into());
+        for p in &self.poses {
+            let status = match p.status {
+                Status::Done => "done",
+                Status::UpToDate => "up to date",
+                Status::Failed { .. } => "FAILED",
+            };
+            s.push_str(&format!(
+                "{:<10} {:<10} {:>9} {:>10} {:>14}\n",
+                p.pose,
+                status,
+                opt(p.wall_s.map(|w| format!("{w:.1}"))),
+                opt(p.increments.map(|i| i.to_string())),
+                opt(p.fy_final_n.map(|f| format!("{f:.6e}"))),
+            ));
+        }
+        s.push_str(&format!(
+            "{} done, {} up to date, {} failed; mesh {}, {} steps, {:.1} s\n",
+            self.done(),
+            self.up_to_date(),
+            self.failed(),
+            self.mesh,
+            self.steps,
+            self.wall.as_secs_f64()
+        ));
+        for p in &self.poses {
+            if let Status::Failed { message, log_tail } = &p.status {
+                s.push_str(&format!("\nFAILED {}: {message}\n", p.pose));
+                if let Some(w) = &p.work_dir {
+                    s.push_str(&format!("  work folder kept: {}\n", w.display()));
+                }
+                if !log_tail.is_empty() {
+                    s.push_str("  end of the ccx output:\n");
+                    for l in log_tail.lines() {
+                        s.push_str(&format!("  | {l}\n"));
+                    }
+                }
+            }
+        }
+        s
+    }
+}
+
+/// `manifest.toml`: one entry per finished pose, keyed and sorted by pose name.
+#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Manifest {
+    /// Entries by pose name.
+    #[serde(default)]
+    pub pose: BTreeMap<String, ManifestEntry>,
+}
+
+/// What is known about how one `fe/<pose>.csv` was made.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ManifestEntry {
+    /// [`Campaign::run_hash`] of the spec (with the steps actually run), pose and mesh.
+    pub spec_hash: String,
+    /// Version of ccx that solved it, e.g. "2.20".
+    pub ccx_version: String,
+    /// Mesh level name.
+    pub mesh: String,
+    /// The model solved, e.g. "half, mirror plane z = 0".
+    pub model: String,
+    /// The tissue mesh in words.
+    pub tissue_mesh: String,
+    /// Tissue nodes of the model.
+    pub tissue_nodes: u64,
+    /// Tissue elements of the model.
+    pub tissue_elements: u64,
+    /// Needle nodes of the model.
+    pub needle_nodes: u64,
+    /// Needle elements of the model.
+    pub needle_elements: u64,
+    /// Load steps.
+    pub steps: u32,
+    /// Final depth, mm.
+    pub depth_mm: f64,
+    /// Converged increments, all steps.
+    pub increments: u32,
+    /// Newton iterations, all steps and attempts.
+    pub iterations: u32,
+    /// Wall time of the solve (deck, ccx, reading back), s.
+    pub wall_s: f64,
+    /// When the run finished, UTC, RFC 3339 (`2025-01-31T12:00:00Z`).
+    pub date: String,
+    /// Role of the pose.
+    pub role: Role,
+    /// Pose: tip x, mm.
+    pub x_mm: f64,
+    /// Pose: tip z, mm.
+    pub z_mm: f64,
+    /// Pose: tilt about x, degrees.
+    pub theta_x_deg: f64,
+    /// Pose: tilt about z, degrees.
+    pub theta_z_deg: f64,
+}
+
+/// Read a manifest; a missing file is an empty manifest.
+///
+/// # Errors
+/// The file exists but cannot be read or is not a valid manifest.
+pub fn read_manifest(path: &Path) -> Result<Manifest> {
+    let text = match std::fs::read_to_string(path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Manifest::default()),
+        Err(e) => return Err(e).with_context(|| format!("{}: cannot read", path.display())),
+    };
+    toml::from_str(&text).map_err(|e| {
+        anyhow::anyhow!(
+            "{}: not a valid manifest ({}); it is written by `needle fe run` only: delete it to rerun every pose",
+            path.display(),
+            e.message()
+        )
+    })
+}
+
+/// The manifest's text: a comment, then the entries sorted by pose name.
+///
+/// # Errors
+/// Serialization failed (a bug).
+pub fn manifest_text(m: &Manifest) -> Result<String> {
+    let body = toml::to_string(m).context("cannot serialize the manifest")?;
+    let nl = if body.ends_with('\n') { "" } else { "\n" };
+    Ok(format!(
+        "# Written by `needle fe run`, one table per pose whose fe/<pose>.csv is current. Do not edit.\n\n{body}{nl}"
+    ))
+}
+
+/// One pose to solve, as given to a [`Backend`].
+#[derive(Debug, Clone, Copy)]
+pub struct Job<'a> {
+    /// The spec, with `loading.steps` already set to the steps of this run.
+    pub campaign: &'a Campaign,
+    /// The pose.
+    pub pose: &'a PoseSpec,
+    /// Name of the mesh level.
+    pub mesh_name: &'a str,
+    /// The mesh level.
+    pub mesh: &'a MeshLevel,
+    /// Load steps (= `campaign.loading.steps`).
+    pub steps: u32,
+    /// An empty folder for the solver's files.
+    pub work_dir: &'a Path,
+    /// Wall-clock limit of the solve.
+    pub timeout: Option<Duration>,
+}
+
+/// A solved pose.
+#[derive(Debug, Clone)]
+pub struct Solved {
+    /// The wrench on the needle about its reference point after each step, `steps`
+    /// entries: fx, fy, fz (N), mx, my, mz (N·mm).
+    pub wrenches: Vec<[f64; 6]>,
+    /// Size of the model.
+    pub summary: MeshSummary,
+    /// Converged increments.
+    pub increments: u32,
+    /// Newton iterations.
+    pub iterations: u32,
+}
+
+/// Why a pose could not be solved.
+#[derive(Debug, Clone)]
+pub struct SolveFailure {
+    /// One line: what failed (exit status, steps done, or the error).
+    pub message: String,
+    /// The end of the solver's output, if it ran.
+    pub log_tail: String,
+}
+
+impl From<anyhow::Error> for SolveFailure {
+    fn from(e: anyhow::Error) -> Self {
+        SolveFailure { message: format!("{e:#}"), log_tail: String::new() }
+    }
+}
+
+/// The solver side of a campaign; [`CcxBackend`] is the real one, tests inject others.
+pub trait Backend: Sync {
+    /// Get ready to solve (find the solver) and return its version. Called once, before
+    /// the first solve, and only when there is something to solve.
+    ///
+    /// # Errors
+    /// The solver is missing or unusable: the campaign stops before any solve.
+    fn prepare(&mut self) -> Result<String>;
+
+    /// Solve one pose in `job.work_dir`.
+    ///
+    /// # Errors
+    /// Any failure of the solve, with the end of the solver's output.
+    fn solve(&self, job: &Job<'_>) -> std::result::Result<Solved, SolveFailure>;
+
+    /// Steps completed so far by the job running in `work_dir` (for the progress bar).
+    fn steps_done(&self, work_dir: &Path) -> u32;
+}
+
+/// The real backend: the project's deck writer, CalculiX, the `.dat` reader and the
+/// wrench reduction.
+#[derive(Debug, Default)]
+pub struct CcxBackend {
+    ccx: Option<PathBuf>,
+}
+
+impl Backend for CcxBackend {
+    fn prepare(&mut self) -> Result<String> {
+        let path = ccx::find_ccx()?;
+        let version = ccx::ccx_version(&path)?;
+        self.ccx = Some(path);
+        Ok(version)
+    }
+
+    fn solve(&self, job: &Job<'_>) -> std::result::Result<Solved, SolveFailure> {
+        let ccx_path = self.ccx.as_deref().context("CcxBackend::solve before prepare")?;
+        let deck = deck::write_deck(job.campaign, job.pose, job.mesh, job.steps).context("writing the deck")?;
+        if deck.steps != job.steps {
+            return Err(anyhow::anyhow!("the deck has {} steps, {} were asked for", deck.steps, job.steps).into());
+        }
+        let inp = job.work_dir.join(format!("{JOB}.inp"));
+        std::fs::write(&inp, &deck.text).with_context(|| format!("{}: cannot write", inp.display()))?;
+        let r = ccx::run_job(ccx_path, job.work_dir, JOB, job.timeout)?;
+        let done = r.sta.steps_done();
+        if !r.success() || done < job.steps {
+            let how = if r.success() { "finished (exit code 0)".to_string() } else { r.exit.to_string() };
+            return Err(SolveFailure {
+                message: format!(
+                    "ccx {how} after {done} of {} steps, {} increments, {:.1} s",
+                    job.steps,
+                    r.sta.increments,
+                    r.wall.as_secs_f64()
+                ),
+                log_tail: r.log_tail,
+            });
+        }
+        let fail = |e: anyhow::Error| SolveFailure { message: format!("{e:#}"), log_tail: r.log_tail.clone() };
+        let dat_path = job.work_dir.join(format!("{JOB}.dat"));
+        let text = std::fs::read_to_string(&dat_path)
+            .with_context(|| format!("{}: cannot read", dat_path.display()))
+            .map_err(fail)?;
+        let blocks = dat::parse_rf(&text, &deck.print_set)
+            .with_context(|| format!("{}", dat_path.display()))
+            .map_err(fail)?;
+        check_step_times(&blocks, job.steps).with_context(|| format!("{}", dat_path.display())).map_err(fail)?;
+        let wrenches = blocks
+            .iter()
+            .enumerate()
+            .map(|(k, b)| {
+                wrench::reduce(&deck, job.pose, job.campaign, &b.nodes)
+                    .with_context(|| format!("reducing the reactions of step {}", k + 1))
+            })
+            .collect::<Result<Vec<_>>>()
+            .map_err(fail)?;
+        Ok(Solved { wrenches, summary: deck.summary, increments: r.sta.increments, iterations: r.sta.iterations })
+    }
+
+    fn steps_done(&self, work_dir: &Path) -> u32 {
+        ccx::steps_done(work_dir, JOB)
+    }
+}
+
+/// The deck prints the reactions once at the end of each step; step k ends at total
+/// time k. Check that there is exactly one block per step, in order.
+fn check_step_times(blocks: &[dat::StepRf], steps: u32) -> Result<()> {
+    if blocks.len() != steps as usize {
+        bail!(
+            "{} reaction force blocks (times {}), expected one per step ({steps})",
+            blocks.len(),
+            blocks.iter().map(|b| b.total_time.to_string()).collect::<Vec<_>>().join(", ")
+        );
+    }
+    for (k, b) in (1u32..).zip(blocks) {
+        let want = f64::from(k);
+        if (b.total_time - want).abs() > 1e-5 * want {
+            bail!("reaction force block {k} is at time {}, expected {want} (end of step {k})", b.total_time);
+        }
+    }
+    Ok(())
+}
+
+/// Run the campaign with CalculiX. See the module docs.
+///
+/// # Errors
+/// The spec cannot be loaded or is invalid, the tissue fails the material check,
+/// `--mesh` names no level, `--only` matches no pose or is not a glob, `--steps 0`,
+/// ccx is missing, the manifest is corrupt or the output folder cannot be written.
+/// Failed solves are not errors: they are in the [`Report`].
+pub fn run(opts: &RunOptions) -> Result<Report> {
+    run_with(opts, &mut CcxBackend::default())
+}
+
+/// Everything shared by the workers.
+struct Ctx<'a> {
+    campaign: &'a Campaign,
+    mesh_name: &'a str,
+    mesh: &'a MeshLevel,
+    steps: u32,
+    out_dir: &'a Path,
+    timeout: Option<Duration>,
+    backend: &'a dyn Backend,
+    solver_version: String,
+    manifest_lock: Mutex<()>,
+}
+
+/// [`run`] with a given solver backend (tests use a fake one).
+///
+/// # Errors
+/// As [`run`].
+pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> {
+    let start = Instant::now();
+    let (mut campaign, spec_path) = spec::load(&opts.set_dir)?;
+    let stability = crate::fe::material::check(&campaign.tissue).with_context(|| {
+        format!("{}: the tissue fails the material stability check; nothing was run", spec_path.display())
+    })?;
+    eprintln!("material check passed: {}", stability.to_string().replace('\n', "\n  "));
+    if let Some(s) = opts.steps {
+        if s == 0 {
+            bail!("--steps 0: must be >= 1");
+        }
+        campaign.loading.steps = s;
+    }
+    let steps = campaign.loading.steps;
+    let mesh_name = opts.mesh.clone().unwrap_or_else(|| campaign.campaign.mesh.clone());
+    let mesh = campaign.mesh_level(&mesh_name)?.clone();
+    let all = campaign.poses();
+    let selected = spec::select(&all, opts.only.as_deref())?;
+    if selected.is_empty() {
+        bail!(
+            "--only {:?} matches no pose (poses: {})",
+            opts.only.as_deref().unwrap_or(""),
+            all.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ")
+        );
+    }
+    let out_dir = opts.out_dir.clone().unwrap_or_else(|| opts.set_dir.join("fe"));
+    std::fs::create_dir_all(&out_dir).with_context(|| format!("{}: cannot create", out_dir.display()))?;
+    let manifest_path = out_dir.join(MANIFEST);
+    let manifest = read_manifest(&manifest_path)?;
+
+    let mut reports: Vec<PoseReport> = Vec::with_capacity(selected.len());
+    let mut to_run: Vec<(usize, &PoseSpec)> = Vec::new();
+    for pose in &selected {
+        let hash = campaign.run_hash(pose, &mesh_name);
+        let csv = out_dir.join(format!("{}.csv", pose.name));
+        let entry = manifest.pose.get(&pose.name).filter(|e| e.spec_hash == hash);
+        let rows = entry.and_then(|_| results::read_csv(&csv).ok()).filter(|r| r.len() == steps as usize + 1);
+        let mut report = PoseReport {
+            pose: pose.name.clone(),
+            status: Status::UpToDate,
+            wall_s: None,
+            increments: None,
+            fy_final_n: None,
+            work_dir: None,
+        };
+        match (entry, rows) {
+            (Some(e), Some(rows)) if !opts.force => {
+                report.wall_s = Some(e.wall_s);
+                report.increments = Some(e.increments);
+                report.fy_final_n = rows.last().map(|r| r.wrench[1]);
+            }
+            _ => to_run.push((reports.len(), pose)),
+        }
+        reports.push(report);
+    }
+    let skipped = reports.len() - to_run.len();
+    let jobs = opts.jobs.clamp(1, to_run.len().max(1));
+    eprintln!(
+        "needle fe run: {} pose(s) selected; skipped {skipped} up to date; {} to run with {jobs} job(s) (mesh {mesh_name}, {steps} steps to {} mm) -> {}",
+        reports.len(),
+        to_run.len(),
+        campaign.loading.depth_mm,
+        out_dir.display()
+    );
+    if !to_run.is_empty() {
+        let solver_version = backend.prepare()?;
+        let backend: &dyn Backend = backend;
+        let ctx = Ctx {
+            campaign: &campaign,
+            mesh_name: &mesh_name,
+            mesh: &mesh,
+            steps,
+            out_dir: &out_dir,
+            timeout: opts.timeout,
+            backend,
+            solver_version,
+            manifest_lock: Mutex::new(()),
+        };
+        run_workers(&ctx, &to_run, jobs, &mut reports);
+    }
+    Ok(Report { poses: reports, mesh: mesh_name, steps, depth_mm: campaign.loading.depth_mm, out_dir, wall: start.elapsed() })
+}
+
+enum Event {
+    Started(usize),
+    Finished(usize, PoseReport),
+}
+
+/// Solve `to_run` (report index, pose) with `jobs` worker threads, filling `reports`.
+fn run_workers(ctx: &Ctx<'_>, to_run: &[(usize, &PoseSpec)], jobs: usize, reports: &mut [PoseReport]) {
+    let queue: Mutex<VecDeque<usize>> = Mutex::new((0..to_run.len()).collect());
+    let (tx, rx) = mpsc::channel::<Event>();
+    let mut progress = Progress::new(to_run.iter().map(|(_, p)| p.name.clone()).collect(), ctx.steps);
+    std::thread::scope(|s| {
+        for _ in 0..jobs {
+            let tx = tx.clone();
+            let queue = &queue;
+            s.spawn(move || loop {
+                let next = queue.lock().map(|mut q| q.pop_front()).unwrap_or(None);
+                let Some(i) = next else { break };
+                let Some(&(_, pose)) = to_run.get(i) else { break };
+                if tx.send(Event::Started(i)).is_err() {
+                    break;
+                }
+                let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| solve_pose(ctx, pose)))
+                    .unwrap_or_else(|panic| {
+                        let what = panic
+                            .downcast_ref::<String>()
+                            .cloned()
+                            .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                            .unwrap_or_default();
+                        failed_report(pose, ctx, format!("panic while solving: {what}"), String::new())
+                    });
+                if tx.send(Event::Finished(i, r)).is_err() {
+                    break;
+                }
+            });
+        }
+        drop(tx);
+        loop {
+            match rx.recv_timeout(Duration::from_millis(500)) {
+                Ok(Event::Started(i)) => progress.started(i),
+                Ok(Event::Finished(i, r)) => {
+                    progress.finished(i, &r);
+                    if let Some(dst) = to_run.get(i).and_then(|&(slot, _)| reports.get_mut(slot)) {
+                        *dst = r;
+                    }
+                }
+                Err(mpsc::RecvTimeoutError::Timeout) => {}
+                Err(mpsc::RecvTimeoutError::Disconnected) => break,
+            }
+            progress.tick(|i| {
+                to_run.get(i).map(|(_, p)| ctx.backend.steps_done(&work_dir(ctx.out_dir, &p.name))).unwrap_or(0)
+            });
+        }
+    });
+    progress.finish();
+}
+
+/// `<out_dir>/.work/<pose>/`
+fn work_dir(out_dir: &Path, pose: &str) -> PathBuf {
+    out_dir.join(".work").join(pose)
+}
+
+fn failed_report(pose: &PoseSpec, ctx: &Ctx<'_>, message: String, log_tail: String) -> PoseReport {
+    PoseReport {
+        pose: pose.name.clone(),
+        status: Status::Failed { message, log_tail },
+        wall_s: None,
+        increments: None,
+        fy_final_n: None,
+        work_dir: Some(work_dir(ctx.out_dir, &pose.name)),
+    }
+}
+
+/// Solve one pose and write its results; never returns an error, a failure is a report.
+fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
+    let start = Instant::now();
+    let wd = work_dir(ctx.out_dir, &pose.name);
+    let fail = |message: String, log_tail: String| failed_report(pose, ctx, message, log_tail);
+    let prepared = (|| -> Result<()> {
+        if wd.exists() {
+            std::fs::remove_dir_all(&wd).with_context(|| format!("{}: cannot clear", wd.display()))?;
+        }
+        std::fs::create_dir_all(&wd).with_context(|| format!("{}: cannot create", wd.display()))?;
+        // From here on the CSV (if any) is not trusted until the new entry is written.
+        update_manifest(ctx, |m| {
+            m.pose.remove(&pose.name);
+        })
+    })();
+    if let Err(e) = prepared {
+        return fail(format!("{e:#}"), String::new());
+    }
+    let job = Job {
+        campaign: ctx.campaign,
+        pose,
+        mesh_name: ctx.mesh_name,
+        mesh: ctx.mesh,
+        steps: ctx.steps,
+        work_dir: &wd,
+        timeout: ctx.timeout,
+    };
+    let solved = match ctx.backend.solve(&job) {
+        Ok(s) => s,
+        Err(f) => return fail(f.message, f.log_tail),
+    };
+    let wall_s = (start.elapsed().as_secs_f64() * 1000.0).round() / 1000.0;
+    match write_results(ctx, pose, &solved, wall_s) {
+        Ok(fy) => {
+            // the work folder is only for debugging failed runs; a leftover is harmless
+            let _ = std::fs::remove_dir_all(&wd);
+            PoseReport {
+                pose: pose.name.clone(),
+                status: Status::Done,
+                wall_s: Some(wall_s),
+                increments: Some(solved.increments),
+                fy_final_n: Some(fy),
+                work_dir: None,
+            }
+        }
+        Err(e) => fail(format!("{e:#}"), String::new()),
+    }
+}
+
+/// Check the wrenches, write the CSV, then the manifest entry. Returns Fy at the final depth.
+fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Result<f64> {
+    if s.wrenches.len() != ctx.steps as usize {
+        bail!("the solver returned {} wrenches for {} steps", s.wrenches.len(), ctx.steps);
+    }
+    let mut rows = vec![Row { depth_mm: 0.0, wrench: [0.0; 6] }];
+    for (k, w) in (1u32..).zip(&s.wrenches) {
+        if w.iter().any(|v| !v.is_finite()) {
+            bail!("step {k}: the wrench is not finite: {w:?}");
+        }
+        rows.push(Row { depth_mm: ctx.campaign.loading.depth_at(k), wrench: *w });
+    }
+    let csv = ctx.out_dir.join(format!("{}.csv", pose.name));
+    results::write_atomic(&csv, results::to_csv(&rows).as_bytes())?;
+    let entry = ManifestEntry {
+        spec_hash: ctx.campaign.run_hash(pose, ctx.mesh_name),
+        ccx_version: ctx.solver_version.clone(),
+        mesh: ctx.mesh_name.to_string(),
+        model: s.summary.model.clone(),
+        tissue_mesh: s.summary.tissue_mesh.clone(),
+        tissue_nodes: s.summary.tissue_nodes as u64,
+        tissue_elements: s.summary.tissue_elements as u64,
+        needle_nodes: s.summary.needle_nodes as u64,
+        needle_elements: s.summary.needle_elements as u64,
+        steps: ctx.steps,
+        depth_mm: ctx.campaign.loading.depth_mm,
+        increments: s.increments,
+        iterations: s.iterations,
+        wall_s,
+        date: rfc3339_utc(SystemTime::now()),
+        role: pose.role,
+        x_mm: pose.x_mm,
+        z_mm: pose.z_mm,
+        theta_x_deg: pose.theta_x_deg,
+        theta_z_deg: pose.theta_z_deg,
+    };
+    update_manifest(ctx, |m| {
+        m.pose.insert(pose.name.clone(), entry);
+    })?;
+    Ok(rows.last().map(|r| r.wrench[1]).unwrap_or(0.0))
+}
+
+/// Read the manifest from disk (another `needle fe run` may have written it), change it,
+/// write it back atomically; under the campaign's manifest lock.
+fn update_manifest(ctx: &Ctx<'_>, f: impl FnOnce(&mut Manifest)) -> Result<()> {
+    let _guard = ctx.manifest_lock.lock().unwrap_or_else(|p| p.into_inner());
+    let path = ctx.out_dir.join(MANIFEST);
+    let mut m = read_manifest(&path)?;
+    let before = m.clone();
+    f(&mut m);
+    if m == before && path.exists() {
+        return Ok(());
+    }
+    results::write_atomic(&path, manifest_text(&m)?.as_bytes())
+}
+
+/// `t` as an RFC 3339 UTC timestamp with whole seconds, e.g. `2025-01-31T12:00:00Z`.
+pub fn rfc3339_utc(t: SystemTime) -> String {
+    let secs = t.duration_since(SystemTime::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0);
+    let days = (secs / 86_400) as i64;
+    let rem = secs % 86_400;
+    // civil_from_days (H. Hinnant): days since 1970-01-01 -> proleptic Gregorian date
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1_460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z",
+        rem / 3_600,
+        rem % 3_600 / 60,
+        rem % 60
+    )
+}
+
+/// Progress display: an indicatif bar on a terminal, plain lines otherwise (CI).
+struct Progress {
+    names: Vec<String>,
+    steps: u32,
+    running: BTreeMap<usize, u32>,
+    done: usize,
+    failed: usize,
+    bar: Option<ProgressBar>,
+    start: Instant,
+    last_plain: Instant,
+    last_line: String,
+}
+
+impl Progress {
+    fn new(names: Vec<String>, steps: u32) -> Self {
+        let total_steps = names.len() as u64 * u64::from(steps);
+        let bar = std::io::stderr().is_terminal().then(|| {
+            let bar = ProgressBar::with_draw_target(Some(total_steps), ProgressDrawTarget::stderr_with_hz(4));
+            let style = ProgressStyle::with_template(
+                "[{elapsed_precise}] {bar:30.cyan/blue} {percent:>3}% ETA {eta_precise} | {prefix}\n  {wide_msg}",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> ");
+            bar.set_style(style);
+            bar
+        });
+        let now = Instant::now();
+        let mut p = Progress {
+            names,
+            steps,
+            running: BTreeMap::new(),
+            done: 0,
+            failed: 0,
+            bar,
+            start: now,
+            last_plain: now,
+            last_line: String::new(),
+        };
+        p.redraw();
+        p
+    }
+
+    fn name(&self, i: usize) -> &str {
+        self.names.get(i).map(String::as_str).unwrap_or("?")
+    }
+
+    fn counts(&self) -> String {
+        let finished = self.done + self.failed;
+        let left = self.names.len().saturating_sub(finished + self.running.len());
+        let mut s = format!("{finished}/{} runs done, {} running, {left} left", self.names.len(), self.running.len());
+        if self.failed > 0 {
+            s.push_str(&format!(", {} failed", self.failed));
+        }
+        s
+    }
+
+    fn running_text(&self) -> String {
+        if self.running.is_empty() {
+            return "-".into();
+        }
+        self.running
+            .iter()
+            .map(|(&i, &k)| format!("{} step {k}/{}", self.name(i), self.steps))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
+    fn steps_done_total(&self) -> u64 {
+        (self.done + self.failed) as u64 * u64::from(self.steps) + self.running.values().map(|&k| u64::from(k)).sum::<u64>()
+    }
+
+    fn line(&self, text: &str) {
+        let t = self.start.elapsed().as_secs();
+        match &self.bar {
+            Some(b) => b.println(format!("[{t:>5}s] {text}")),
+            None => eprintln!("[{t:>5}s] {text}"),
+        }
+    }
+
+    fn redraw(&mut self) {
+        if let Some(b) = &self.bar {
+            b.set_position(self.steps_done_total());
+            b.set_prefix(self.counts());
+            b.set_message(format!("running: {}", self.running_text()));
+        }
+    }
+
+    fn started(&mut self, i: usize) {
+        self.running.insert(i, 0);
+        self.line(&format!("start {}", self.name(i)));
+        self.redraw();
+    }
+
+    fn finished(&mut self, i: usize, r: &PoseReport) {
+        self.running.remove(&i);
+        match &r.status {
+            Status::Failed { message, .. } => {
+                self.failed += 1;
+                self.line(&format!("FAILED {}: {message}", r.pose));
+            }
+            _ => {
+                self.done += 1;
+                self.line(&format!(
+                    "done {}: {:.1} s, {} increments, fy = {} N at the final depth",
+                    r.pose,
+                    r.wall_s.unwrap_or(0.0),
+                    r.increments.unwrap_or(0),
+                    r.fy_final_n.map(|f| format!("{f:.6e}")).unwrap_or_else(|| "-".into())
+                ));
+            }
+        }
+        self.redraw();
+    }
+
+    /// Re-read the running jobs' steps; on a terminal redraw the bar, otherwise print a
+    /// status line every 30 s when something changed.
+    fn tick(&mut self, steps_of: impl Fn(usize) -> u32) {
+        let keys: Vec<usize> = self.running.keys().copied().collect();
+        for i in keys {
+            let k = steps_of(i).min(self.steps);
+            self.running.insert(i, k);
+        }
+        if self.bar.is_some() {
+            self.redraw();
+            return;
+        }
+        if self.last_plain.elapsed() >= Duration::from_secs(30) && !self.running.is_empty() {
+            let done_steps = self.steps_done_total();
+            let total = self.names.len() as u64 * u64::from(self.steps);
+            let eta = if done_steps > 0 {
+                let per_step = self.start.elapsed().as_secs_f64() / done_steps as f64;
+                format!("ETA {:.0} s", per_step * total.saturating_sub(done_steps) as f64)
+            } else {
+                "ETA ?".into()
+            };
+            let line = format!("{}; {eta}; running: {}", self.counts(), self.running_text());
+            if line != self.last_line {
+                self.line(&line);
+                self.last_line = line;
+            }
+            self.last_plain = Instant::now();
+        }
+    }
+
+    fn finish(&mut self) {
+        if let Some(b) = self.bar.take() {
+            b.finish_and_clear();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    #[test]
+    fn dates() {
+        let at = |s: u64| rfc3339_utc(SystemTime::UNIX_EPOCH + Duration::from_secs(s));
+        assert_eq!(at(0), "1970-01-01T00:00:00Z");
+        // 2000-02-29 (leap day of a century leap year) and 2100-03-01 (not a leap year)
+        assert_eq!(at(951_782_400 + 3_600 + 61), "2000-02-29T01:01:01Z");
+        assert_eq!(at(4_107_542_400), "2100-03-01T00:00:00Z");
+        assert_eq!(at(1_735_689_599), "2024-12-31T23:59:59Z");
+    }
+
+    /// A solver that returns a made-up wrench (bookkeeping tests only, no physics), can
+    /// fail or panic on one pose, and counts its solves.
+    #[derive(Default)]
+    struct Fake {
+        fail: Option<String>,
+        panic_on: Option<String>,
+        solves: AtomicUsize,
+        prepared: usize,
+    }
+
+    impl Backend for Fake {
+        fn prepare(&mut self) -> Result<String> {
+            self.prepared += 1;
+            Ok("fake-1".into())
+        }
+        fn solve(&self, job: &Job<'_>) -> std::result::Result<Solved, SolveFailure> {
+            self.solves.fetch_add(1, Ordering::SeqCst);
+            assert!(job.work_dir.is_dir(), "work dir exists");
+            assert_eq!(std::fs::read_dir(job.work_dir).map(|d| d.count()).unwrap_or(9), 0, "work dir is empty");
+            std::fs::write(job.work_dir.join("pose.log"), "fake log\n").map_err(anyhow::Error::from)?;
+            if self.panic_on.as_deref() == Some(job.pose.name.as_str()) {
+                panic!("fake panic");
+            }
+            if self.fail.as_deref() == Some(job.pose.name.as_str()) {
+                return Err(SolveFailure { message: "fake exit code 201".into(), log_tail: "*ERROR fake".into() });
+            }
+            let wrenches = (1..=job.steps)
+                .map(|k| {
+                    let d = job.campaign.loading.depth_at(k);
+                    [job.pose.x_mm * d, d * d, job.pose.z_mm, 0.0, 0.0, 0.0]
+                })
+                .collect();
+            let summary = MeshSummary {
+                tissue_nodes: 1,
+                tissue_elements: 2,
+                needle_nodes: 3,
+                needle_elements: 4,
+                model: "fake".into(),
+                tissue_mesh: "fake".into(),
+            };
+            Ok(Solved { wrenches, summary, increments: job.steps, iterations: 2 * job.steps })
+        }
+        fn steps_done(&self, _work_dir: &Path) -> u32 {
+            0
+        }
+    }
+
+    fn set_dir() -> tempfile::TempDir {
+        let d = tempfile::tempdir().expect("tempdir");
+        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default/campaign.toml");
+        std::fs::copy(&src, d.path().join("campaign.toml")).expect("copy the default spec");
+        d
+    }
+
+    fn opts(dir: &Path, only: &str, steps: u32) -> RunOptions {
+        RunOptions { only: Some(only.into()), steps: Some(steps), mesh: Some("smoke".into()), jobs: 2, ..RunOptions::new(dir) }
+    }
+
+    #[test]
+    fn writes_results_and_skips_up_to_date_poses() {
+        let d = set_dir();
+        let mut fake = Fake::default();
+        let o = opts(d.path(), "x+0[24]", 2);
+        let r = run_with(&o, &mut fake).expect("run");
+        assert_eq!((r.done(), r.up_to_date(), r.failed()), (2, 0, 0), "{}", r.table());
+        let fe = d.path().join("fe");
+        for name in ["x+02", "x+04"] {
+            let rows = results::read_csv(&fe.join(format!("{name}.csv"))).expect("csv");
+            assert_eq!(rows.len(), 3);
+            assert_eq!(rows[0], Row { depth_mm: 0.0, wrench: [0.0; 6] });
+            assert_eq!(rows.iter().map(|r| r.depth_mm).collect::<Vec<_>>(), [0.0, 3.0, 6.0]);
+            assert_eq!(rows[2].wrench[1], 36.0);
+            assert!(!fe.join(".work").join(name).exists(), "work dir removed on success");
+        }
+        let text = std::fs::read_to_string(fe.join(MANIFEST)).expect("manifest");
+        let m = read_manifest(&fe.join(MANIFEST)).expect("parse");
+        assert_eq!(m.pose.keys().cloned().collect::<Vec<_>>(), ["x+02", "x+04"]);
+        assert!(text.find("[pose.\"x+02\"]") < text.find("[pose.\"x+04\"]"), "sorted:\n{text}");
+        let (mut c, _) = spec::load(d.path()).expect("spec");
+        c.loading.steps = 2;
+        let p4 = c.poses().into_iter().find(|p| p.name == "x+04").expect("x+04");
+        let e = &m.pose["x+04"];
+        assert_eq!(e.spec_hash, c.run_hash(&p4, "smoke"));
+        assert_eq!((e.ccx_version.as_str(), e.mesh.as_str(), e.steps, e.increments, e.iterations), ("fake-1", "smoke", 2, 2, 4));
+        assert_eq!((e.x_mm, e.role), (4.0, Role::SweepX));
+        assert_eq!(e.date.len(), "2025-01-01T00:00:00Z".len());
+        assert_eq!(fake.solves.load(Ordering::SeqCst), 2);
+
+        // rerun: nothing to do, the solver is not even prepared, files untouched
+        let mut again = Fake::default();
+        let r = run_with(&o, &mut again).expect("rerun");
+        assert_eq!((r.done(), r.up_to_date()), (0, 2));
+        assert_eq!((again.prepared, again.solves.load(Ordering::SeqCst)), (0, 0));
+        assert_eq!(std::fs::read_to_string(fe.join(MANIFEST)).expect("manifest"), text);
+        assert!(r.table().contains("up to date"));
+        assert_eq!(r.poses[0].fy_final_n, Some(36.0));
+
+        // another step count is another spec: rerun
+        let r = run_with(&opts(d.path(), "x+02", 3), &mut again).expect("steps 3");
+        assert_eq!(r.done(), 1);
+        assert_eq!(results::read_csv(&fe.join("x+02.csv")).expect("csv").len(), 4);
+        // --force reruns an up-to-date pose
+        let r = run_with(&RunOptions { force: true, ..opts(d.path(), "x+04", 2) }, &mut again).expect("force");
+        assert_eq!(r.done(), 1);
+        // a CSV deleted by hand is rerun even though the manifest has its entry
+        std::fs::remove_file(fe.join("x+04.csv")).expect("rm");
+        let r = run_with(&o, &mut again).expect("missing csv");
+        assert_eq!((r.done(), r.up_to_date()), (2, 0), "x+02 has 4 rows (3 steps), x+04 has no CSV");
+    }
+
+    #[test]
+    fn a_failed_pose_keeps_its_work_dir_and_the_others_finish() {
+        let d = set_dir();
+        let fe = d.path().join("fe");
+        // a first, good result of x+04
+        run_with(&opts(d.path(), "x+04", 2), &mut Fake::default()).expect("first");
+        assert!(fe.join("x+04.csv").exists());
+
+        let mut fake = Fake { fail: Some("x+04".into()), panic_on: Some("x+06".into()), ..Fake::default() };
+        let r = run_with(&RunOptions { force: true, ..opts(d.path(), "x+0[246]", 2) }, &mut fake).expect("run");
+        assert_eq!((r.done(), r.failed()), (1, 2), "{}", r.table());
+        let t = r.table();
+        assert!(t.contains("FAILED x+04: fake exit code 201") && t.contains("| *ERROR fake"), "{t}");
+        assert!(t.contains("FAILED x+06: panic while solving: fake panic"), "{t}");
+        assert!(fe.join(".work/x+04/pose.log").exists(), "work dir kept on failure");
+        assert!(!fe.join("x+06.csv").exists());
+        // the old CSV of x+04 is still there, but its manifest entry is gone...
+        let m = read_manifest(&fe.join(MANIFEST)).expect("manifest");
+        assert_eq!(m.pose.keys().cloned().collect::<Vec<_>>(), ["x+02"]);
+        // ...so the next run does not trust it
+        let mut ok = Fake::default();
+        let r = run_with(&opts(d.path(), "x+0[246]", 2), &mut ok).expect("resume");
+        assert_eq!((r.done(), r.up_to_date(), r.failed()), (2, 1, 0));
+        assert!(!fe.join(".work/x+04").exists());
+    }
+
+    #[test]
+    fn refuses_bad_options_and_a_corrupt_manifest_before_solving() {
+        let d = set_dir();
+        let mut fake = Fake::default();
+        let e = run_with(&opts(d.path(), "nothing*", 2), &mut fake).expect_err("no pose").to_string();
+        assert!(e.contains("matches no pose"), "{e}");
+        let e = run_with(&RunOptions { mesh: Some("huge".into()), ..opts(d.path(), "x+02", 2) }, &mut fake)
+            .expect_err("mesh")
+            .to_string();
+        assert!(e.contains("huge"), "{e}");
+        let e = run_with(&opts(d.path(), "x+02", 0), &mut fake).expect_err("steps").to_string();
+        assert!(e.contains("--steps 0"), "{e}");
+        std::fs::create_dir_all(d.path().join("fe")).expect("mkdir");
+        std::fs::write(d.path().join("fe").join(MANIFEST), "[pose.x]\nspec_hash = 1\n").expect("write");
+        let e = run_with(&opts(d.path(), "x+02", 2), &mut fake).expect_err("manifest").to_string();
+        assert!(e.contains("delete it"), "{e}");
+        assert_eq!((fake.prepared, fake.solves.load(Ordering::SeqCst)), (0, 0));
+    }
+}
