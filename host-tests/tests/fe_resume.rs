@@ -218,3 +218,22 @@ fn bad_options_are_refused() {
     let out = needle(&args, &[]);
     assert_eq!(out.status.code(), Some(2), "{}", show(&out));
 }
+
+#[test]
+fn a_timed_out_job_is_reported_and_kept_for_debugging() {
+    require_ccx();
+    let (_tmp, set) = default_set();
+    let mut args = run_args(&set, "centre", "2");
+    args.extend([std::ffi::OsStr::new("--timeout-s"), std::ffi::OsStr::new("0.3")]);
+    let out = needle(&args, &[]);
+    assert_eq!(out.status.code(), Some(1), "a failed run gives exit status 1\n{}", show(&out));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("FAILED centre: ccx timed out (killed) after 0 of 2 steps"), "{}", show(&out));
+    assert!(stdout.contains("end of the ccx output:"), "{}", show(&out));
+    let fe = set.join("fe");
+    assert!(!fe.join("centre.csv").exists());
+    let work = fe.join(".work").join("centre");
+    assert!(work.join("pose.inp").exists() && work.join("pose.log").exists(), "work folder kept");
+    assert!(stdout.contains(&work.display().to_string()), "{}", show(&out));
+    assert!(!read_manifest(&fe.join(MANIFEST)).expect("manifest").pose.contains_key("centre"));
+}
