@@ -58,7 +58,7 @@ fn valid_model() -> String {
                     for (j, v) in r.iter_mut().enumerate().skip(1) {
                         *v = (n + 1.0) * (i as f64 + 1.0) * (j as f64) / 64.0 * if j % 2 == 0 { 1.0 } else { -0.5 };
                     }
-                    r[0] = -(r[1] * -1.0 + r[2] - r[3] + r[4]);
+                    r[0] = -(-r[1] + r[2] - r[3] + r[4]);
                     r
                 })
                 .collect();
@@ -225,6 +225,16 @@ fn wrong_component_or_sweep_order_names_the_line() {
 #[test]
 fn hex_bits_that_are_not_the_nearest_f32_name_the_line() {
     let text = valid_model();
+    // TOML integers read as f64 where the contract has a float.
+    let l = line_starting(&text, "depth_max_mm", 0);
+    let ints = edit_line(&text, l, |_| "depth_max_mm = 6".into());
+    let l = line_starting(&ints, "coeffs =", 0);
+    let ints = edit_line(&ints, l, |_| "coeffs = [0, 1, 0.0, 0.125, -0.0625]".into());
+    let l = line_starting(&ints, "coeffs_f32 =", 0);
+    let ints = edit_line(&ints, l, |_| {
+        format!("coeffs_f32 = {}", list32(&[0.0, 1.0, 0.0, 0.125, -0.0625]))
+    });
+    parse_model_str(&ints, Path::new("m.toml")).unwrap_or_else(|e| panic!("{e}"));
     // One ulp off in matrix 9's rows_f32[1][2].
     let line = matrix_line(&text, 9, "rows_f32 =") + 2;
     let bad = edit_line(&text, line, |l| {
