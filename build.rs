@@ -84,6 +84,12 @@ fn example_link_args(manifest_dir: &Path) {
     }
     // ---- example-only link arguments (bare metal): add new ones here ----
     println!("cargo::rustc-link-arg-examples=-Tlink.x");
+    // The Cortex-M0 examples run on QEMU's microbit (16 KiB RAM at 0x2000_0000), the
+    // others on MPS2 (memory.x, 4 MiB RAM): the M0's initial stack pointer goes to the
+    // end of the micro:bit's RAM. `_stack_start` is a PROVIDE in cortex-m-rt's link.x.
+    if std::env::var("TARGET").is_ok_and(|t| t.starts_with("thumbv6m")) {
+        println!("cargo::rustc-link-arg-examples=--defsym=_stack_start=0x20004000");
+    }
     // ---- end of example-only link arguments ----
 }
 

@@ -1,0 +1,191 @@
+//! Firmware example `bench`: instructions per 6-axis wrench evaluation and the stack
+//! high-water mark of one evaluation, on the core it is compiled for.
+//!
+//! Run it under QEMU with `-icount shift=0` (the runners in .cargo/config.toml do; so
+//! does `needle firmware bench`): QEMU's virtual clock then advances exactly 1 ns per
+//! executed instruction, and SysTick, clocked by the core clock (25 MHz on MPS2, 16 MHz
+//! on the micro:bit), counts executed instructions in steps of 40 (62.5).
+//!
+//! - **Calibration**: an assembly loop of exactly 2 instructions per iteration
+//!   (`subs; bne`) is timed at two lengths; the difference gives instructions per
+//!   SysTick tick without knowing the board's clock, and two runs of the same length
+//!   must give the same ticks (else the run is not under `-icount`: `deterministic=no`).
+//! - **Instructions per wrench**: `CALLS` calls of [`needle_haptics::wrench`] through an
+//!   opaque function pointer on an opaque pose (`core::hint::black_box`, so nothing is
+//!   hoisted out of the loop or folded at compile time), minus the same loop without the
+//!   call, divided by `CALLS`. The figure includes the call, the return and the store of
+//!   the 28-byte result.
+//! - **Stack**: the 4 KiB below the caller's stack pointer is painted with a pattern,
+//!   one evaluation runs, and the deepest overwritten word gives the bytes used.
+//!
+//! Output (semihosting stdout):
+//!
+//! ```text
+//! needle-bench target=<triple> calls=<CALLS> calibration_instructions=<n> calibration_ticks=<n> deterministic=<yes|no>
+//! needle-bench pose=<name> instructions_per_wrench=<n.n> stack_bytes=<n> status=0x<ss>
+//! ...
+//! needle-bench end
+//! ```
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+mod common;
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use crate::common::{exit, target_name, Out};
+    use core::arch::asm;
+    use core::hint::black_box;
+    use cortex_m::peripheral::{syst::SystClkSource, SYST};
+    use needle_haptics::{wrench, Evaluation, Pose};
+
+    /// Evaluations per timed loop.
+    const CALLS: u32 = 256;
+    /// Iterations of the two calibration loops (2 instructions each).
+    const CAL_SHORT: u32 = 10_000;
+    const CAL_LONG: u32 = 1_010_000;
+    /// Bytes of stack painted below the caller's stack pointer.
+    const STACK_WINDOW: usize = 4096;
+    const PAINT: u32 = 0xa5c3_5a3c;
+
+    /// The poses timed: in the domain with mixed signs (the typical case), all
+    /// positive, every input saturated, and a NaN input (the error path).
+    const POSES: [(&str, Pose); 4] = [
+        ("typical", Pose::new(3.0, -2.0, 5.0, -7.0, 4.5)),
+        ("positive", Pose::new(6.0, 4.0, 10.0, 2.0, 3.0)),
+        ("saturated", Pose::new(20.0, -20.0, 30.0, -30.0, 9.0)),
+        ("nan-input", Pose::new(f32::NAN, 0.0, 0.0, 0.0, 1.0)),
+    ];
+
+    fn elapsed(start: u32, end: u32) -> u32 {
+        // SysTick counts down from 0xff_ffff and wraps: ticks modulo 2^24.
+        start.wrapping_sub(end) & 0x00ff_ffff
+    }
+
+    /// Ticks taken by `n` (>= 1) iterations of a 2-instruction loop.
+    #[inline(never)]
+    fn spin(n: u32) -> u32 {
+        let start = SYST::get_current();
+        // SAFETY: a register-only countdown loop; n >= 1 (callers pass constants).
+        unsafe {
+            asm!("2:", "subs {n}, #1", "bne 2b", n = inout(reg) n => _, options(nomem, nostack));
+        }
+        elapsed(start, SYST::get_current())
+    }
+
+    #[inline(never)]
+    fn loop_wrench(f: fn(&Pose) -> Evaluation, pose: &Pose, calls: u32) -> u32 {
+        let start = SYST::get_current();
+        for _ in 0..calls {
+            black_box(f(black_box(pose)));
+        }
+        elapsed(start, SYST::get_current())
+    }
+
+    #[inline(never)]
+    fn loop_empty(pose: &Pose, calls: u32) -> u32 {
+        let start = SYST::get_current();
+        for _ in 0..calls {
+            black_box(black_box(pose));
+        }
+        elapsed(start, SYST::get_current())
+    }
+
+    /// Bytes of stack one call of `f` uses below this function's stack pointer.
+    #[inline(never)]
+    fn stack_use(f: fn(&Pose) -> Evaluation, pose: &Pose) -> usize {
+        let top: usize;
+        // SAFETY: reads the stack pointer.
+        unsafe { asm!("mov {}, sp", out(reg) top, options(nomem, nostack, preserves_flags)) };
+        let bottom = top - STACK_WINDOW;
+        let mut a = bottom;
+        while a < top {
+            // SAFETY: the window lies below the live stack (nothing else runs: no
+            // interrupts are enabled) and inside RAM (4 KiB of the 16 KiB or 4 MiB).
+            unsafe { (a as *mut u32).write_volatile(PAINT) };
+            a += 4;
+        }
+        black_box(f(black_box(pose)));
+        let mut a = bottom;
+        // SAFETY: as above.
+        while a < top && unsafe { (a as *const u32).read_volatile() } == PAINT {
+            a += 4;
+        }
+        top - a
+    }
+
+    #[cortex_m_rt::entry]
+    fn main() -> ! {
+        let mut out = Out::new();
+        let Some(p) = cortex_m::Peripherals::take() else {
+            out.str("needle-bench error: core peripherals taken\n");
+            out.flush();
+            exit(false)
+        };
+        let mut syst = p.SYST;
+        syst.set_clock_source(SystClkSource::Core);
+        syst.set_reload(0x00ff_ffff);
+        syst.clear_current();
+        syst.enable_counter();
+
+        let cal_instructions = u64::from(2 * (CAL_LONG - CAL_SHORT));
+        let long_a = spin(black_box(CAL_LONG));
+        let long_b = spin(black_box(CAL_LONG));
+        let short = spin(black_box(CAL_SHORT));
+        let cal_ticks = u64::from(long_a.saturating_sub(short));
+        out.str("needle-bench target=");
+        out.str(target_name());
+        out.str(" calls=");
+        out.dec(u64::from(CALLS));
+        out.str(" calibration_instructions=");
+        out.dec(cal_instructions);
+        out.str(" calibration_ticks=");
+        out.dec(cal_ticks);
+        out.str(" deterministic=");
+        out.str(if long_a == long_b { "yes" } else { "no" });
+        out.nl();
+        if cal_ticks == 0 {
+            out.str("needle-bench error: SysTick does not count\n");
+            out.flush();
+            exit(false)
+        }
+
+        let eval: fn(&Pose) -> Evaluation = black_box(wrench);
+        for (name, pose) in POSES.iter() {
+            let tw = u64::from(loop_wrench(eval, pose, black_box(CALLS)));
+            let te = u64::from(loop_empty(pose, black_box(CALLS)));
+            // Instructions per call in tenths, rounded: ticks * (instructions per tick).
+            let num = tw.saturating_sub(te) * cal_instructions * 10;
+            let den = cal_ticks * u64::from(CALLS);
+            let tenths = (num + den / 2) / den;
+            let stack = stack_use(eval, pose);
+            let status = eval(pose).status.bits();
+            out.str("needle-bench pose=");
+            out.str(name);
+            out.str(" instructions_per_wrench=");
+            out.dec(tenths / 10);
+            out.str(".");
+            out.dec(tenths % 10);
+            out.str(" stack_bytes=");
+            if stack >= STACK_WINDOW {
+                out.str(">=");
+            }
+            out.dec(stack as u64);
+            out.str(" status=");
+            out.hex(u32::from(status), 2);
+            out.nl();
+        }
+        out.str("needle-bench end\n");
+        out.flush();
+        exit(true)
+    }
+}
+
+/// On the host this example does nothing: it is firmware.
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!(
+        "`bench` is firmware: cargo run --release --example bench --target thumbv7em-none-eabihf \
+         (the runner adds -icount shift=0), or `needle firmware bench`"
+    );
+}

@@ -1,0 +1,166 @@
+//! Firmware example `golden`: evaluates every pose of the compiled-in set's
+//! `golden-f32.csv` on the target and prints the results' bits, for the host to compare
+//! with the golden file (host-tests/tests/firmware_golden.rs, `needle firmware golden`).
+//!
+//! The poses are parsed from the CSV *at compile time* (const evaluation of
+//! `include_str!` of `$NEEDLE_SET_DIR/golden-f32.csv`, the set build.rs selected) into a
+//! `[[u32; 5]; ROWS]` table of f32 bits: the firmware holds the inputs only (20 bytes a
+//! pose), never the expected outputs, and parses nothing at run time.
+//!
+//! Output (semihosting stdout), every line `\n`-terminated:
+//!
+//! ```text
+//! needle-golden target=<target triple> set=<SET> fe_sha256=<hex> rows=<ROWS>
+//! x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,status,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm
+//! <one row per pose in the golden file's format: inputs as read, status and wrench as computed>
+//! needle-golden end rows=<ROWS>
+//! ```
+//!
+//! ```text
+//! cargo run --release --example golden --target thumbv7em-none-eabihf
+//! ```
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+mod common;
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use crate::common::{exit, Out};
+    use core::hint::black_box;
+    use needle_haptics::{model_info, wrench, Pose};
+
+    const HEADER: &str =
+        "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,status,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm";
+
+    /// The golden file of the set this build compiled in; used in const evaluation only
+    /// (it is not in the firmware image).
+    const CSV: &[u8] = include_bytes!(concat!(env!("NEEDLE_SET_DIR"), "/golden-f32.csv"));
+
+    /// Number of data rows (lines after the header).
+    const ROWS: usize = count_rows(CSV);
+
+    /// The five input bits (x, z, theta_x, theta_z, depth) of every row, in file order.
+    static POSES: [[u32; 5]; ROWS] = parse_poses(CSV);
+
+    const fn header_len(s: &[u8]) -> usize {
+        let h = HEADER.as_bytes();
+        if s.len() <= h.len() || s[h.len()] != b'\n' {
+            panic!("golden-f32.csv: the first line is not the golden-file header");
+        }
+        let mut i = 0;
+        while i < h.len() {
+            if s[i] != h[i] {
+                panic!("golden-f32.csv: the first line is not the golden-file header");
+            }
+            i += 1;
+        }
+        h.len() + 1
+    }
+
+    const fn count_rows(s: &[u8]) -> usize {
+        let mut i = header_len(s);
+        let mut rows = 0;
+        while i < s.len() {
+            if s[i] == b'\n' {
+                rows += 1;
+            }
+            i += 1;
+        }
+        if s[s.len() - 1] != b'\n' {
+            panic!("golden-f32.csv: no final newline");
+        }
+        rows
+    }
+
+    const fn hex_digit(b: u8) -> u32 {
+        match b {
+            b'0'..=b'9' => (b - b'0') as u32,
+            b'a'..=b'f' => (b - b'a' + 10) as u32,
+            _ => panic!("golden-f32.csv: an input is not 0x and 8 lower-case hex digits"),
+        }
+    }
+
+    const fn parse_poses<const N: usize>(s: &[u8]) -> [[u32; 5]; N] {
+        let mut out = [[0u32; 5]; N];
+        let mut i = header_len(s);
+        let mut r = 0;
+        while r < N {
+            let mut f = 0;
+            while f < 5 {
+                if s[i] != b'0' || s[i + 1] != b'x' || s[i + 10] != b',' {
+                    panic!("golden-f32.csv: an input is not 0x and 8 lower-case hex digits");
+                }
+                let mut v = 0u32;
+                let mut k = 0;
+                while k < 8 {
+                    v = (v << 4) | hex_digit(s[i + 2 + k]);
+                    k += 1;
+                }
+                out[r][f] = v;
+                i += 11;
+                f += 1;
+            }
+            while s[i] != b'\n' {
+                i += 1;
+            }
+            i += 1;
+            r += 1;
+        }
+        out
+    }
+
+    #[cortex_m_rt::entry]
+    fn main() -> ! {
+        let mut out = Out::new();
+        out.str("needle-golden target=");
+        out.str(crate::common::target_name());
+        out.str(" set=");
+        out.str(model_info::SET);
+        out.str(" fe_sha256=");
+        out.str(model_info::FE_SHA256);
+        out.str(" rows=");
+        out.dec(ROWS as u64);
+        out.nl();
+        out.str(HEADER);
+        out.nl();
+        // Read the table through black_box so the compiler cannot evaluate the model at
+        // compile time: every wrench below is computed by the target's instructions.
+        let poses: &[[u32; 5]] = black_box(&POSES[..]);
+        for p in poses {
+            let [x, z, tx, tz, d] = *p;
+            let pose = Pose::new(
+                f32::from_bits(x),
+                f32::from_bits(z),
+                f32::from_bits(tx),
+                f32::from_bits(tz),
+                f32::from_bits(d),
+            );
+            let e = wrench(black_box(&pose));
+            for v in p {
+                out.hex(*v, 8);
+                out.str(",");
+            }
+            out.hex(u32::from(e.status.bits()), 2);
+            for w in e.wrench.to_array() {
+                out.str(",");
+                out.hex(w.to_bits(), 8);
+            }
+            out.nl();
+        }
+        out.str("needle-golden end rows=");
+        out.dec(poses.len() as u64);
+        out.nl();
+        out.flush();
+        exit(true)
+    }
+}
+
+/// On the host this example does nothing: it is firmware.
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!(
+        "`golden` is firmware: cargo run --release --example golden --target thumbv7em-none-eabihf \
+         (or thumbv7m-none-eabi, thumbv6m-none-eabi; runners in .cargo/config.toml)"
+    );
+}
