@@ -20,9 +20,9 @@ pub fn wrench(p: &PoseSpec, d: f64) -> [f64; 6] {
     let depth_law = 0.01 * d.powf(1.5) + 0.002 * d * d;
     let fy = -depth_law * (1.0 + 0.003 * x * x + 0.002 * z * z + 0.001 * tx * tx + 0.0015 * tz * tz + 0.0001 * x * tz);
     let lateral = 0.004 * d.powf(1.2);
-    let fx = lateral * (x + 0.5 * tz) * (1.0 + 0.01 * z * z);
-    let fz = lateral * (z + 0.6 * tx) * (1.0 + 0.01 * x * x);
-    let mx = 0.8 * LEVER_MM * fz + 0.01 * d * tx;
+    let fx = lateral * (8.0 * (x / 8.0).sin() + 0.5 * tz + 0.002 * tz * tz * tz) * (1.0 + 0.01 * z * z);
+    let fz = lateral * (9.0 * (z / 9.0).sin() + 0.6 * tx + 0.001 * tx * tx * tx) * (1.0 + 0.01 * x * x);
+    let mx = 0.8 * LEVER_MM * fz + 0.01 * d * (tx / 5.0).sinh();
     let my = 0.0005 * d * (x + tz) * (z + tx);
     let mz = -0.8 * LEVER_MM * fx + 0.01 * d * tz;
     [fx, fy, fz, mx, my, mz]
