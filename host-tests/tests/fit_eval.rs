@@ -96,7 +96,7 @@ fn check_mirrors_bitwise(m: &Model, what: &str) {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
     for _ in 0..5_000 {
         let p = random_pose(&mut rng, 1.0);
-        if p[..4].iter().any(|v| *v == 0.0) {
+        if p[..4].contains(&0.0) {
             continue;
         }
         let (w, s) = eval32(&t, p);

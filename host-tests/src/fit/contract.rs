@@ -78,7 +78,7 @@ impl Sweep {
     pub fn is_odd(self, c: usize) -> bool {
         match self {
             Sweep::X | Sweep::ThetaZ => matches!(c, 0 | 4 | 5),
-            Sweep::Z | Sweep::ThetaX => matches!(c, 2 | 3 | 4),
+            Sweep::Z | Sweep::ThetaX => matches!(c, 2..=4),
         }
     }
 

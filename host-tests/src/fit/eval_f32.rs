@@ -129,9 +129,9 @@ pub fn eval(t: &Tables32, pose: [f32; 5]) -> ([f32; 6], u8) {
             let r = [h32(&m[0], tt[k]), h32(&m[1], tt[k]), h32(&m[2], tt[k]), h32(&m[3], tt[k]), h32(&m[4], tt[k])];
             let dev = h32(&r, u);
             if negative[k] && ODD[k][c] {
-                acc = acc - dev;
+                acc -= dev;
             } else {
-                acc = acc + dev;
+                acc += dev;
             }
         }
         w[c] = acc;
@@ -160,8 +160,8 @@ mod tests {
     fn odd_table_matches_contract() {
         use super::super::contract::Sweep;
         for k in Sweep::ALL {
-            for c in 0..6 {
-                assert_eq!(k.is_odd(c), ODD[k.index()][c]);
+            for (c, odd) in ODD[k.index()].iter().enumerate() {
+                assert_eq!(k.is_odd(c), *odd);
             }
         }
     }

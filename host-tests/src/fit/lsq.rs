@@ -41,7 +41,8 @@ pub fn lstsq(a: &DMatrix<f64>, b: &DVector<f64>) -> Result<DVector<f64>> {
     let sv = a.clone().svd(false, false).singular_values;
     let s_max = sv.iter().copied().fold(0.0f64, f64::max);
     let s_min = sv.iter().copied().fold(f64::INFINITY, f64::min);
-    if !(s_max > 0.0) || !(s_min * MAX_CONDITION >= s_max) {
+    let well_posed = s_max > 0.0 && s_min * MAX_CONDITION >= s_max; // false on NaN too
+    if !well_posed {
         let list: Vec<String> = sv.iter().map(|s| format!("{s:.3e}")).collect();
         bail!(
             "least squares: the {m} x {n} design matrix is rank deficient or too badly conditioned \

@@ -66,8 +66,7 @@ pub fn to_toml(model: &Model) -> String {
         let _ = writeln!(s, "residual_max = {}", num(b.residual_max));
     }
     for k in Sweep::ALL {
-        for c in 0..6 {
-            let m = &model.matrices[k.index()][c];
+        for (c, m) in model.matrices[k.index()].iter().enumerate() {
             let _ = writeln!(s);
             let _ = writeln!(s, "[[matrix]]");
             let _ = writeln!(s, "sweep = \"{}\"", k.name());
