@@ -4,4 +4,5 @@
 
 pub mod cli;
 pub mod fe;
+pub mod firmware;
 pub mod fit;

@@ -23,6 +23,9 @@ enum Command {
     Validate(needle_host::cli::fit::ValidateArgs),
     /// Copy the generated C header out for C users.
     Header(needle_host::cli::model::HeaderArgs),
+    /// The library on Cortex-M under QEMU: size, bench, golden, check.
+    #[command(subcommand)]
+    Firmware(needle_host::cli::firmware::FirmwareCommand),
 }
 
 fn main() -> ExitCode {
@@ -33,6 +36,7 @@ fn main() -> ExitCode {
         Command::Eval(a) => needle_host::cli::model::eval(a),
         Command::Validate(a) => needle_host::cli::fit::validate(a),
         Command::Header(a) => needle_host::cli::model::header(a),
+        Command::Firmware(c) => needle_host::cli::firmware::run(c),
     };
     match result {
         Ok(code) => code,

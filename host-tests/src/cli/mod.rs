@@ -1,5 +1,6 @@
 //! The `needle` command line: one module per command group.
 
 pub mod fe;
+pub mod firmware;
 pub mod fit;
 pub mod model;

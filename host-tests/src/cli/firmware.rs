@@ -1,0 +1,160 @@
+//! `needle firmware ...`: the library on Cortex-M under QEMU (examples/ firmware).
+use crate::firmware::{self, bench, build, golden, size, Core};
+use clap::{Args, Subcommand};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// `needle firmware` subcommands.
+#[derive(Subcommand)]
+pub enum FirmwareCommand {
+    /// Flash and RAM of the model per core, from arm-none-eabi-size and -nm on the
+    /// `no_panic` example ELF (release): evaluator code, tables, soft-float runtime,
+    /// static RAM, with the goals (model flash <= 8 KiB, no static RAM).
+    Size(FirmwareArgs),
+    /// Instructions per 6-axis wrench and stack high-water mark per core: the `bench`
+    /// example under QEMU -icount shift=0 (SysTick counts instructions), with the goals
+    /// (<= 900 instructions on the M4F, stack <= 512 B).
+    Bench(FirmwareArgs),
+    /// Run the `golden` example on each core's QEMU board and compare every printed bit
+    /// with the set's golden-f32.csv. Exit status 1 when a bit differs.
+    Golden(FirmwareArgs),
+    /// Build the library for each core with every combination of its features, and the
+    /// `no_panic` example (links only if the evaluator has no panic path).
+    Check(FirmwareArgs),
+}
+
+/// Arguments common to the `needle firmware` commands.
+#[derive(Args, Debug)]
+pub struct FirmwareArgs {
+    /// Coefficient set to build the firmware with (NEEDLE_COEFFS of the nested build);
+    /// default: the set compiled into this `needle`.
+    #[arg(long, value_name = "DIR")]
+    pub set: Option<PathBuf>,
+    /// Core to use: m4f (thumbv7em-none-eabihf), m3 (thumbv7m-none-eabi) or m0
+    /// (thumbv6m-none-eabi); repeat for several; default all three.
+    #[arg(long = "core", value_name = "CORE")]
+    pub cores: Vec<String>,
+}
+
+impl FirmwareArgs {
+    fn set(&self) -> PathBuf {
+        self.set.clone().unwrap_or_else(firmware::compiled_set)
+    }
+}
+
+/// Run a `firmware` subcommand.
+///
+/// # Errors
+/// A build, QEMU run or binutils call failed, or the set is not fitted.
+pub fn run(c: FirmwareCommand) -> anyhow::Result<ExitCode> {
+    match c {
+        FirmwareCommand::Size(a) => size_cmd(&a),
+        FirmwareCommand::Bench(a) => bench_cmd(&a),
+        FirmwareCommand::Golden(a) => golden_cmd(&a),
+        FirmwareCommand::Check(a) => check_cmd(&a),
+    }
+}
+
+fn goal(ok: bool) -> &'static str {
+    if ok {
+        "met"
+    } else {
+        "MISSED"
+    }
+}
+
+fn banner(what: &str, set: &std::path::Path) -> anyhow::Result<()> {
+    let model = needle_codegen::parse_model(&set.join(needle_codegen::MODEL_FILE)).map_err(anyhow::Error::new)?;
+    println!("{what}: set {:?} ({}), fe_sha256 {}", model.set, set.display(), model.fe_sha256);
+    Ok(())
+}
+
+fn size_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
+    let set = firmware::fitted_set(&a.set())?;
+    let cores = firmware::cores(&a.cores)?;
+    let reports = cores.iter().map(|c| size::run(c, &set)).collect::<anyhow::Result<Vec<_>>>()?;
+    banner("needle firmware size", &set)?;
+    println!("release profile, `no_panic` example ELF; text/data/bss from size -B, tables = .rodata, symbols from nm -S -C\n");
+    print!("{}", size::table(&reports));
+    println!();
+    for r in &reports {
+        println!(
+            "goals {}: model flash {} <= 8 KiB: {}; static RAM {} B == 0: {}",
+            r.core.core,
+            size::bytes(r.model_flash()),
+            goal(r.model_flash() <= 8 * 1024),
+            r.static_ram(),
+            goal(r.static_ram() == 0)
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn bench_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
+    let set = firmware::fitted_set(&a.set())?;
+    let cores = firmware::cores(&a.cores)?;
+    let figures = cores.iter().map(|c| bench::run(c, &set)).collect::<anyhow::Result<Vec<_>>>()?;
+    banner("needle firmware bench", &set)?;
+    println!("QEMU -icount shift=0, SysTick; {} calls per pose minus an empty loop; stack painted\n", 256);
+    print!("{}", bench::table(&figures));
+    println!();
+    for f in &figures {
+        let Some(t) = f.pose("typical") else { continue };
+        let max_stack = f.poses.iter().map(|p| p.stack_bytes).max().unwrap_or(0);
+        let instr_goal = if f.core.name == "m4f" {
+            format!("; <= 900 instructions: {}", goal(t.instructions <= 900.0))
+        } else {
+            String::new()
+        };
+        println!(
+            "goals {}: {:.1} instructions per wrench (typical pose){instr_goal}; stack {max_stack} B <= 512 B: {}",
+            f.core.core,
+            t.instructions,
+            goal(max_stack <= 512)
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn golden_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
+    let set = firmware::fitted_set(&a.set())?;
+    let cores = firmware::cores(&a.cores)?;
+    let mut failed = false;
+    for c in &cores {
+        let run = golden::run(c, &set)?;
+        let m = &run.comparison.mismatches;
+        println!(
+            "{} ({}, QEMU {}): {} of {} golden rows differ ({:.1} s)",
+            c.core,
+            c.target,
+            c.machine,
+            m.len(),
+            run.comparison.rows,
+            run.run_time.as_secs_f64()
+        );
+        for line in m.iter().take(10) {
+            println!("  {line}");
+        }
+        failed |= !m.is_empty();
+    }
+    Ok(if failed { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+fn check_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
+    let set = a.set();
+    let cores: Vec<Core> = firmware::cores(&a.cores)?;
+    let features = build::library_features()?;
+    for c in &cores {
+        for combo in build::feature_combinations(&features) {
+            build::build_library(c, &combo, &set)?;
+        }
+        build::build_examples(c, &["no_panic"], &set)?;
+        println!(
+            "{} ({}): library builds with all {} feature combinations; no_panic links",
+            c.core,
+            c.target,
+            1usize << features.len()
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}

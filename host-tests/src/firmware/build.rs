@@ -1,0 +1,152 @@
+//! Nested `cargo build`s of the library and its firmware examples for a core.
+use super::{workspace_root, Core};
+use anyhow::{bail, Context};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+/// The undefined symbol the `no_panic` example's panic handler calls.
+pub const NO_PANIC_SYMBOL: &str = "needle_haptics_panic_path_not_optimised_away";
+
+/// Target folder of the firmware builds: `firmware/` inside the workspace's target folder
+/// (`CARGO_TARGET_DIR`, relative to the workspace root, or `target`).
+#[must_use]
+pub fn target_dir() -> PathBuf {
+    let root = workspace_root();
+    let base = match std::env::var_os("CARGO_TARGET_DIR") {
+        Some(d) if !d.is_empty() => root.join(d),
+        _ => root.join("target"),
+    };
+    base.join("firmware")
+}
+
+/// Folder of the release examples of `core` in [`target_dir`].
+#[must_use]
+pub fn examples_dir(core: &Core) -> PathBuf {
+    target_dir().join(core.target).join("release").join("examples")
+}
+
+/// `cargo` as the outer cargo named it (`$CARGO`), else from `PATH`.
+fn cargo() -> Command {
+    Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()))
+}
+
+/// Checks that the Rust standard library of `target` is installed (rustup target).
+///
+/// # Errors
+/// `rustc` cannot be run, or the target is missing, with the command that installs it.
+pub fn check_target(target: &str) -> anyhow::Result<()> {
+    let rustc = std::env::var_os("RUSTC").unwrap_or_else(|| "rustc".into());
+    let out = Command::new(&rustc)
+        .args(["--print", "sysroot"])
+        .current_dir(workspace_root())
+        .output()
+        .with_context(|| format!("cannot run {} --print sysroot", rustc.to_string_lossy()))?;
+    let sysroot = PathBuf::from(String::from_utf8_lossy(&out.stdout).trim());
+    let lib = sysroot.join("lib").join("rustlib").join(target).join("lib");
+    if !out.status.success() || !lib.is_dir() {
+        bail!(
+            "the Rust target {target} is not installed ({} does not exist): `rustup target add {target}` \
+             (.ci/run installs thumbv7em-none-eabihf, thumbv7m-none-eabi and thumbv6m-none-eabi)",
+            lib.display()
+        );
+    }
+    Ok(())
+}
+
+/// Runs a nested cargo build; on failure the error holds the end of cargo's output.
+fn run_cargo(mut cmd: Command, what: &str) -> anyhow::Result<()> {
+    cmd.current_dir(workspace_root()).stdin(Stdio::null());
+    eprintln!("firmware: building {what}");
+    let out = cmd.output().with_context(|| format!("cannot run cargo to build {what}"))?;
+    if out.status.success() {
+        return Ok(());
+    }
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let tail: Vec<&str> = stderr.lines().rev().take(60).collect::<Vec<_>>().into_iter().rev().collect();
+    let hint = if stderr.contains(NO_PANIC_SYMBOL) {
+        format!(
+            "\nThe link failed on `{NO_PANIC_SYMBOL}`: a panic path (index, unwrap, overflow or \
+             division check) is left in the evaluator. Find it with arm-none-eabi-objdump -d on the \
+             golden example (whose panic handler is defined)."
+        )
+    } else if stderr.contains("can't find crate for `core`") {
+        "\nThe target's standard library is missing: rustup target add it.".to_string()
+    } else {
+        String::new()
+    };
+    bail!("cargo build of {what} failed ({}):\n{}{hint}", out.status, tail.join("\n"))
+}
+
+/// Builds the firmware `examples` for `core` (release profile, the crate's default
+/// features) with the coefficient set `set`, and returns their ELF paths in order.
+///
+/// # Errors
+/// The target is not installed, or the build fails (the error holds cargo's output).
+pub fn build_examples(core: &Core, examples: &[&str], set: &Path) -> anyhow::Result<Vec<PathBuf>> {
+    check_target(core.target)?;
+    let mut cmd = cargo();
+    cmd.args(["build", "--release", "-p", "needle-haptics", "--target", core.target, "--target-dir"])
+        .arg(target_dir())
+        .env("NEEDLE_COEFFS", set);
+    for e in examples {
+        cmd.args(["--example", e]);
+    }
+    run_cargo(cmd, &format!("examples {} for {} ({})", examples.join(", "), core.core, core.target))?;
+    let dir = examples_dir(core);
+    examples
+        .iter()
+        .map(|e| {
+            let elf = dir.join(e);
+            if elf.is_file() {
+                Ok(elf)
+            } else {
+                bail!("{}: cargo built no such file", elf.display())
+            }
+        })
+        .collect()
+}
+
+/// The features of the `needle-haptics` package (root Cargo.toml `[features]`), without
+/// `default`, sorted.
+///
+/// # Errors
+/// Cargo.toml cannot be read or parsed.
+pub fn library_features() -> anyhow::Result<Vec<String>> {
+    let path = workspace_root().join("Cargo.toml");
+    let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
+    let doc: toml::Table = toml::from_str(&text).with_context(|| format!("{}: not valid TOML", path.display()))?;
+    let mut features: Vec<String> = doc
+        .get("features")
+        .and_then(toml::Value::as_table)
+        .map(|t| t.keys().filter(|k| *k != "default").cloned().collect())
+        .unwrap_or_default();
+    features.sort();
+    Ok(features)
+}
+
+/// Every subset of `features` (the empty one first), each in the given order.
+#[must_use]
+pub fn feature_combinations(features: &[String]) -> Vec<Vec<String>> {
+    (0..1usize << features.len())
+        .map(|mask| features.iter().enumerate().filter(|(i, _)| mask & (1 << i) != 0).map(|(_, f)| f.clone()).collect())
+        .collect()
+}
+
+/// Builds the library alone for `core`'s target with exactly `features` (no default
+/// features), release profile.
+///
+/// # Errors
+/// The target is not installed, or the build fails.
+pub fn build_library(core: &Core, features: &[String], set: &Path) -> anyhow::Result<()> {
+    check_target(core.target)?;
+    let mut cmd = cargo();
+    cmd.args(["build", "--release", "-p", "needle-haptics", "--lib", "--no-default-features", "--target", core.target])
+        .arg("--target-dir")
+        .arg(target_dir())
+        .env("NEEDLE_COEFFS", set);
+    if !features.is_empty() {
+        cmd.args(["--features", &features.join(",")]);
+    }
+    let shown = if features.is_empty() { "no features".to_string() } else { format!("features {}", features.join(",")) };
+    run_cargo(cmd, &format!("the library for {} with {shown}", core.target))
+}
