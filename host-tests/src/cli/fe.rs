@@ -14,8 +14,12 @@ pub enum FeCommand {
     /// spec are skipped; a killed campaign resumes where it stopped. Exit status 1 when a
     /// run failed (the others are still written), 2 on an error before any run.
     Run(RunArgs),
-    /// Verify the FE setup: flat punch against Sneddon, mesh convergence (not implemented yet).
-    Verify,
+    /// Verify the FE setup: flat punch against Sneddon (two small solves), mesh
+    /// convergence of the centred needle (two needle solves, the fine one is slow) and
+    /// the mirror runs against their counterparts (no solve). Without --punch, --mesh or
+    /// --mirror all three run. Prints the table and writes <set>/fe/verify.toml. Exit
+    /// status 1 when a check misses its goal, 2 on an error.
+    Verify(VerifyArgs),
 }
 
 /// Arguments of `needle fe run`.
@@ -50,6 +54,34 @@ pub struct RunArgs {
     pub timeout_s: Option<f64>,
 }
 
+/// Arguments of `needle fe verify`.
+#[derive(Args, Debug)]
+pub struct VerifyArgs {
+    /// Set folder holding campaign.toml and fe/, e.g. coeffs/default.
+    #[arg(long, value_name = "DIR")]
+    pub set: PathBuf,
+    /// Run the flat-punch check (Sneddon, goal 5%).
+    #[arg(long)]
+    pub punch: bool,
+    /// Run the mesh-convergence check (Fy at full depth, committed mesh against fine, goal 2%).
+    #[arg(long)]
+    pub mesh: bool,
+    /// Check the mirror runs against their counterparts (goal 1% of peak |Fy|).
+    #[arg(long)]
+    pub mirror: bool,
+    /// Coarsen the flat-punch mesh by this factor (1 = the verification mesh; the goal
+    /// applies to 1).
+    #[arg(long, value_name = "F", default_value_t = 1.0)]
+    pub punch_mesh_scale: f64,
+    /// Skip the flat punch with the campaign's element (C3D8), which is solved and
+    /// reported by default to measure its volumetric locking.
+    #[arg(long)]
+    pub no_campaign_element: bool,
+    /// Work folder for the solves; default: <set>/fe/.work/verify.
+    #[arg(long, value_name = "DIR")]
+    pub work: Option<PathBuf>,
+}
+
 /// Run an `fe` subcommand.
 ///
 /// # Errors
@@ -58,7 +90,7 @@ pub struct RunArgs {
 pub fn run(c: FeCommand) -> anyhow::Result<ExitCode> {
     match c {
         FeCommand::Run(a) => run_campaign(a),
-        FeCommand::Verify => anyhow::bail!("needle fe verify: not implemented yet"),
+        FeCommand::Verify(a) => run_verify(a),
     }
 }
 
@@ -81,4 +113,25 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
     let report = campaign::run(&opts)?;
     print!("{}", report.table());
     Ok(if report.failed() > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+fn run_verify(a: VerifyArgs) -> anyhow::Result<ExitCode> {
+    if !(a.punch_mesh_scale.is_finite() && a.punch_mesh_scale >= 1.0) {
+        anyhow::bail!("--punch-mesh-scale {}: must be a number >= 1", a.punch_mesh_scale);
+    }
+    let all = !(a.punch || a.mesh || a.mirror);
+    let opts = crate::fe::verify::VerifyOptions {
+        set_dir: a.set,
+        punch: a.punch || all,
+        mesh: a.mesh || all,
+        mirror: a.mirror || all,
+        work_dir: a.work,
+        punch_mesh_scale: a.punch_mesh_scale,
+        punch_campaign_element: !a.no_campaign_element,
+    };
+    let (_, ok) = crate::fe::verify::run(&opts)?;
+    if !ok {
+        eprintln!("needle fe verify: a check missed its goal");
+    }
+    Ok(if ok { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
