@@ -269,22 +269,27 @@ pub fn to_table(r: &Report) -> String {
     if !r.missing.is_empty() {
         let _ = writeln!(s, "missing FE runs (goal cannot be met): {}", r.missing.join(", "));
     }
-    let worst = |role: &str, f: fn(&RunReport) -> f64| {
-        r.runs.iter().filter(|x| x.role == role).map(f).fold(0.0, f64::max)
+    let worst = |role: &str, f: fn(&RunReport) -> f64| -> String {
+        let v: Vec<f64> = r.runs.iter().filter(|x| x.role == role).map(f).collect();
+        if v.is_empty() {
+            "no runs".to_string()
+        } else {
+            format!("worst {:.3} % over {} runs", v.iter().copied().fold(0.0, f64::max), v.len())
+        }
     };
     let _ = writeln!(
         s,
-        "goal table2: Fy within {TABLE2_GOAL_PCT} % of FE at every depth >= {TABLE2_MIN_DEPTH_MM} mm: {} (worst {:.3} %)",
+        "goal table2: Fy within {TABLE2_GOAL_PCT} % of FE at every depth >= {TABLE2_MIN_DEPTH_MM} mm: {} ({})",
         pass(r.table2_goal_met),
         worst("table2", |x| x.fy_rel_max_pct)
     );
     let _ = writeln!(
         s,
-        "goal lhs: every component's RMS error <= {LHS_GOAL_PCT} % of peak |Fy|: {} (worst {:.3} %)",
+        "goal lhs: every component's RMS error <= {LHS_GOAL_PCT} % of peak |Fy|: {} ({})",
         pass(r.lhs_goal_met),
         worst("lhs", |x| x.worst_rms_pct)
     );
-    let _ = writeln!(s, "mirror runs (symmetry check, no goal): worst rms {:.3} %", worst("mirror", |x| x.worst_rms_pct));
+    let _ = writeln!(s, "mirror runs (symmetry check, no goal): rms {}", worst("mirror", |x| x.worst_rms_pct));
     let _ = writeln!(s, "f32 model vs f64 model: largest difference {:.3e} % of scale", r.f32_vs_f64_max_pct);
     let _ = writeln!(s, "result: {}", pass(r.passed));
     s
