@@ -14,7 +14,7 @@ pub enum FeCommand {
     /// spec are skipped; a killed campaign resumes where it stopped. Exit status 1 when a
     /// run failed (the others are still written), 2 on an error before any run.
     Run(RunArgs),
-    /// Verify the FE setup: flat punch against Sneddon (two small solves), mesh
+    /// Verify the FE setup: flat punch against Sneddon (four small solves), mesh
     /// convergence of the centred needle (two needle solves, the fine one is slow) and
     /// the mirror runs against their counterparts (no solve). Without --punch, --mesh or
     /// --mirror all three run. Prints the table and writes <set>/fe/verify.toml. Exit

@@ -53,10 +53,11 @@
 //!      linearity was checked with a 4x block (coarse mesh): its force is within 0.03% of
 //!      the linear prediction, and `2 F_4x - F_2x` within 0.06% of `2 F_2x - F_1x`.
 //!
-//!    Cost on the verification mesh: C3D20R 13 481 / 22 061 nodes (block / 2x block),
-//!    C3D8 11 312 / 16 626 nodes; about 3 + 4.5 min and 1 + 2.5 min of ccx on a loaded
-//!    2-core machine. `punch_mesh_scale = 2` (4 C3D20R elements across the punch) takes
-//!    under a minute and is the CI test (tests/fe_verify_punch.rs).
+//!    Cost on the verification mesh (ccx, one thread, 2-core machine shared with the
+//!    FE campaign): C3D20R 13 481 / 22 061 nodes (block / 2x block), 40 s + 60-75 s;
+//!    C3D8 11 312 / 16 626 nodes, 15-25 s + 35 s (up to 4x longer under heavier load).
+//!    `punch_mesh_scale = 2` (4 C3D20R elements across the punch, 4 657 / 8 498 nodes)
+//!    takes about a minute and is the CI test (tests/fe_verify_punch.rs).
 //! 2. **Mesh convergence**: the centred vertical needle on the committed mesh and on the
 //!    `fine` mesh level (2x refined near the needle), Fy at full depth (goal 2%).
 //! 3. **Mirror runs**: each `mirror` pose against its mirrored counterpart from the
@@ -120,6 +121,8 @@ pub struct PunchReport {
     pub force_bonded_n: f64,
     /// Goal on |error_percent|.
     pub goal_percent: f64,
+    /// `ccx -v` of the solver.
+    pub ccx_version: String,
     /// Element of the check.
     pub element: String,
     /// Nodes of the block's mesh (as specified / scaled 2x).
@@ -253,7 +256,11 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
     }
     let path = opts.set_dir.join("fe").join("verify.toml");
     let mut old: toml::Table = std::fs::read_to_string(&path).ok().and_then(|t| t.parse().ok()).unwrap_or_default();
-    let new: toml::Table = toml::Table::try_from(&report).context("cannot serialise the verify report")?;
+    let mut new: toml::Table = toml::Table::try_from(&report).context("cannot serialise the verify report")?;
+    // only the checks that ran replace their part of an earlier verify.toml
+    if !opts.mirror {
+        new.remove("mirror");
+    }
     for (k, v) in new {
         old.insert(k, v);
     }
@@ -484,6 +491,7 @@ fn punch(c: &Campaign, work: &Path, opts: &VerifyOptions) -> Result<PunchReport>
         force_sneddon_n: f_sneddon,
         force_bonded_n: bonded_punch_force(mu, a, delta, nu),
         goal_percent: PUNCH_GOAL_PERCENT,
+        ccx_version: ccx::ccx_version(&ccx::find_ccx()?)?,
         element: check.element,
         nodes: check.nodes,
         elements: check.elements,
