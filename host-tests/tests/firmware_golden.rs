@@ -1,0 +1,76 @@
+//! The `golden` firmware on the three reference cores under QEMU, against the golden
+//! vectors of the set compiled into the library (`NEEDLE_COEFFS`, default
+//! coeffs/default): every status and wrench bit of every row must be the golden file's
+//! (NaN by class, signed zeros by bits). Soft-float add and multiply are correctly
+//! rounded, so the M3 and M0 must match as well as the M4F's FPU.
+//!
+//! Nothing skips: a missing QEMU, rustup target, model.toml or golden file fails with a
+//! message that says what to install or run.
+use needle_host::firmware::{self, golden};
+
+fn golden_on(name: &str) {
+    let core = firmware::core(name).unwrap_or_else(|e| panic!("{e:#}"));
+    let set = firmware::fitted_set(&firmware::compiled_set()).unwrap_or_else(|e| panic!("{e:#}"));
+    let run = golden::run(&core, &set).unwrap_or_else(|e| panic!("{} ({}): {e:#}", core.core, core.target));
+    let c = &run.comparison;
+    assert!(c.rows >= 2000, "{}: only {} golden rows (the contract asks for >= 2,000)", set.display(), c.rows);
+    assert!(
+        c.mismatches.is_empty(),
+        "{} of {} golden rows differ on {} ({}, QEMU {}); first ones:\n{}",
+        c.mismatches.len(),
+        c.rows,
+        core.core,
+        core.target,
+        core.machine,
+        c.mismatches.iter().take(10).cloned().collect::<Vec<_>>().join("\n")
+    );
+    println!(
+        "{} ({}): {} golden rows bit for bit in {:.1} s ({})",
+        core.core,
+        core.machine,
+        c.rows,
+        run.run_time.as_secs_f64(),
+        c.banner
+    );
+}
+
+#[test]
+fn golden_bits_on_cortex_m4f_mps2_an386() {
+    golden_on("m4f");
+}
+
+#[test]
+fn golden_bits_on_cortex_m3_mps2_an385() {
+    golden_on("m3");
+}
+
+#[test]
+fn golden_bits_on_cortex_m0_microbit() {
+    golden_on("m0");
+}
+
+/// The comparison itself, on hand-made output: one flipped bit, a sign of zero, a
+/// status, and NaN payloads.
+#[test]
+fn comparison_catches_one_bit_and_allows_nan_payloads() {
+    let h = golden::HEADER;
+    let csv = format!(
+        "{h}\n\
+         0x00000000,0x00000000,0x00000000,0x00000000,0x40000000,0x00,0x3f800000,0x80000000,0x7fc00000,0x00000000,0x00000000,0x00000000\n"
+    );
+    let out = |row: &str| format!("needle-golden target=t set=s fe_sha256=ab rows=1\n{h}\n{row}\nneedle-golden end rows=1\n");
+    let ok = "0x00000000,0x00000000,0x00000000,0x00000000,0x40000000,0x00,0x3f800000,0x80000000,0x7fc00001,0x00000000,0x00000000,0x00000000";
+    let c = golden::compare(&out(ok), &csv, "ab").expect("well-formed");
+    assert!(c.mismatches.is_empty(), "{:?}", c.mismatches);
+    for bad in [
+        "0x00000000,0x00000000,0x00000000,0x00000000,0x40000000,0x00,0x3f800001,0x80000000,0x7fc00000,0x00000000,0x00000000,0x00000000",
+        "0x00000000,0x00000000,0x00000000,0x00000000,0x40000000,0x00,0x3f800000,0x00000000,0x7fc00000,0x00000000,0x00000000,0x00000000",
+        "0x00000000,0x00000000,0x00000000,0x00000000,0x40000000,0x01,0x3f800000,0x80000000,0x7fc00000,0x00000000,0x00000000,0x00000000",
+        "0x00000000,0x00000000,0x00000000,0x00000000,0x40000000,0x00,0x3f800000,0x80000000,0x3fc00000,0x00000000,0x00000000,0x00000000",
+    ] {
+        let c = golden::compare(&out(bad), &csv, "ab").expect("well-formed");
+        assert_eq!(c.mismatches.len(), 1, "{bad}");
+    }
+    assert!(golden::compare(&out(ok), &csv, "cd").is_err(), "another set's firmware must be refused");
+    assert!(golden::compare(&out(ok).replace("needle-golden end rows=1\n", ""), &csv, "ab").is_err(), "truncated output");
+}
