@@ -171,7 +171,7 @@ fn write_ids(w: &mut String, ids: impl Iterator<Item = usize>) {
     }
 }
 
-pub(crate) fn write_tissue(w: &mut String, t: &TissueMesh) {
+fn write_tissue(w: &mut String, t: &TissueMesh) {
     let _ = writeln!(w, "*NODE, NSET=NTISSUE");
     for (i, p) in t.nodes.iter().enumerate() {
         let _ = writeln!(w, "{},{:.7},{:.7},{:.7}", i + 1, p[0], p[1], p[2]);
@@ -260,7 +260,7 @@ fn write_contact(w: &mut String, c: &Campaign) {
     let _ = writeln!(w, "*CONTACT PAIR, INTERACTION=SI, TYPE=SURFACE TO SURFACE\nTISSUE_TOP, NEEDLE_SURF");
 }
 
-pub(crate) fn write_boundary(w: &mut String, t: &TissueMesh) {
+fn write_boundary(w: &mut String, t: &TissueMesh) {
     let _ = writeln!(w, "** bottom encastred, sides pinned (displacements; C3D8 has no rotations)");
     let _ = writeln!(w, "*BOUNDARY\nTBOTTOM, 1, 3\nTSIDES, 1, 3");
     if !t.plane_x.is_empty() {

@@ -63,13 +63,12 @@
 //! 3. **Mirror runs**: each `mirror` pose against its mirrored counterpart from the
 //!    committed data, with the sign flips of coeffs/README.md (goal 1% of peak |Fy|).
 
+use super::campaign::{Backend, CcxBackend, Job};
 use super::ccx;
 use super::dat;
-use super::deck::{self, Deck};
 use super::mesh::{self, P3};
-use super::results::{self, Row};
+use super::results;
 use super::spec::{self, Campaign, PoseSpec, Role, Symmetry};
-use super::wrench;
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -123,24 +122,10 @@ pub struct PunchReport {
     pub goal_percent: f64,
     /// `ccx -v` of the solver.
     pub ccx_version: String,
-    /// Element of the check.
-    pub element: String,
-    /// Nodes of the block's mesh (as specified / scaled 2x).
-    pub nodes: [usize; 2],
-    /// Elements of the block's mesh (as specified / scaled 2x).
-    pub elements: [usize; 2],
-    /// Force on the block as specified, N.
-    pub force_block_n: f64,
-    /// Force on the block scaled 2x, N.
-    pub force_block_2x_n: f64,
-    /// Linear extrapolation to the half-space, N.
-    pub force_half_space_n: f64,
-    /// (F_inf - F_Sneddon) / F_Sneddon, %.
-    pub error_percent: f64,
-    /// Finite-block stiffening of the block as specified, (F_1x - F_inf) / F_inf, %.
-    pub finite_block_percent: f64,
-    /// ccx wall time of the two solves, s (one thread, on a shared machine).
-    pub wall_s: [f64; 2],
+    /// The check itself: the punch with C3D20R (its fields are written at the top level
+    /// of the report).
+    #[serde(flatten)]
+    pub check: PunchRun,
     /// The same check with the campaign's tissue element (C3D8, fully integrated) on a
     /// mesh with as many nodes across the punch: no goal; its error is the stiffening
     /// (volumetric locking) of that element at the tissue's K0/mu0.
@@ -192,9 +177,6 @@ pub struct VerifyReport {
     pub mirror: Vec<MirrorReport>,
 }
 
-/// Components in file order.
-pub const COMPONENTS: [&str; 6] = ["fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"];
-
 /// Shear modulus of the flat-punch block, N/mm^2.
 pub const PUNCH_MU_N_PER_MM2: f64 = 1.0;
 
@@ -225,15 +207,15 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
             p.radius_mm,
             p.delta_mm,
             p.nu,
-            p.element,
-            p.force_block_n,
-            p.force_block_2x_n,
-            p.force_half_space_n,
+            p.check.element,
+            p.check.force_block_n,
+            p.check.force_block_2x_n,
+            p.check.force_half_space_n,
             p.force_sneddon_n,
-            p.error_percent,
+            p.check.error_percent,
             p.goal_percent,
-            p.wall_s[0],
-            p.wall_s[1]
+            p.check.wall_s[0],
+            p.check.wall_s[1]
         );
         if let Some(r) = &p.campaign_element {
             println!(
@@ -242,7 +224,7 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
                 r.element, r.force_block_n, r.force_block_2x_n, r.force_half_space_n, r.error_percent, p.bulk_to_shear, r.wall_s[0], r.wall_s[1]
             );
         }
-        ok &= p.error_percent.abs() <= p.goal_percent;
+        ok &= p.check.error_percent.abs() <= p.goal_percent;
         report.punch = Some(p);
     }
     if opts.mesh {
@@ -270,46 +252,32 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
     Ok((report, ok))
 }
 
-/// Solve a deck in `work/<name>` and return the wrench rows (depth 0 row included).
-///
-/// # Errors
-/// ccx missing, failing (with the tail of its output), or output without the printed set.
-pub fn solve(c: &Campaign, pose: &PoseSpec, d: &Deck, work: &Path, name: &str) -> Result<(Vec<Row>, f64)> {
-    let dir = work.join(name);
-    std::fs::create_dir_all(&dir).with_context(|| format!("{}: cannot create", dir.display()))?;
-    std::fs::write(dir.join(format!("{name}.inp")), &d.text)?;
-    let exe = ccx::find_ccx()?;
-    let job = ccx::run_job(&exe, &dir, name, None)?;
-    if !job.success() {
-        bail!("{name}: ccx failed ({}); last lines of {}:\n{}", job.exit, job.log_path.display(), job.log_tail);
-    }
-    let dat_path = dir.join(format!("{name}.dat"));
-    let text = std::fs::read_to_string(&dat_path).with_context(|| format!("{}: cannot read", dat_path.display()))?;
-    let steps = dat::parse_rf(&text, &d.print_set).with_context(|| format!("{}", dat_path.display()))?;
-    if steps.len() != d.steps as usize {
-        bail!("{name}: {} result blocks in {}, expected {}", steps.len(), dat_path.display(), d.steps);
-    }
-    let mut rows = vec![Row { depth_mm: 0.0, wrench: [0.0; 6] }];
-    for (k, s) in steps.iter().enumerate() {
-        rows.push(Row {
-            depth_mm: c.loading.depth_mm * (k as f64 + 1.0) / f64::from(d.steps),
-            wrench: wrench::reduce(d, pose, c, &s.nodes)?,
-        });
-    }
-    Ok((rows, job.wall.as_secs_f64()))
-}
-
 fn mesh_convergence(c: &Campaign, work: &Path) -> Result<MeshReport> {
     let centre = c.pose.iter().find(|p| p.role == Role::Centre).context("no pose with role centre in the spec")?;
     let committed = c.campaign.mesh.clone();
+    let mut backend = CcxBackend::default();
+    backend.prepare()?;
     let mut out = Vec::new();
     for level in [committed.as_str(), "fine"] {
-        let m = c.mesh_level(level)?;
-        let d = deck::write_deck(c, centre, m, c.loading.steps)?;
-        println!("solving the centred needle on mesh {level:?} ({} tissue elements) ...", d.summary.tissue_elements);
-        let (rows, wall) = solve(c, centre, &d, work, &format!("mesh-{level}"))?;
-        let fy = rows.last().map(|r| r.wrench[1]).unwrap_or(f64::NAN);
-        out.push((fy, wall));
+        let mesh = c.mesh_level(level)?;
+        let dir = work.join(format!("mesh-{level}"));
+        std::fs::create_dir_all(&dir).with_context(|| format!("{}: cannot create", dir.display()))?;
+        println!("solving the centred needle on mesh {level:?} ...");
+        let job = Job {
+            campaign: c,
+            pose: centre,
+            mesh_name: level,
+            mesh,
+            steps: c.loading.steps,
+            work_dir: &dir,
+            timeout: None,
+        };
+        let start = std::time::Instant::now();
+        let solved = backend
+            .solve(&job)
+            .map_err(|f| anyhow::anyhow!("mesh {level:?}: {}; last lines of ccx's output:\n{}", f.message, f.log_tail))?;
+        let fy = solved.wrenches.last().map(|w| w[1]).unwrap_or(f64::NAN);
+        out.push((fy, start.elapsed().as_secs_f64()));
     }
     let (a, b) = (out[0], out[1]);
     Ok(MeshReport {
@@ -492,15 +460,7 @@ fn punch(c: &Campaign, work: &Path, opts: &VerifyOptions) -> Result<PunchReport>
         force_bonded_n: bonded_punch_force(mu, a, delta, nu),
         goal_percent: PUNCH_GOAL_PERCENT,
         ccx_version: ccx::ccx_version(&ccx::find_ccx()?)?,
-        element: check.element,
-        nodes: check.nodes,
-        elements: check.elements,
-        force_block_n: check.force_block_n,
-        force_block_2x_n: check.force_block_2x_n,
-        force_half_space_n: check.force_half_space_n,
-        error_percent: check.error_percent,
-        finite_block_percent: check.finite_block_percent,
-        wall_s: check.wall_s,
+        check,
         campaign_element: runs.pop(),
     })
 }
@@ -692,7 +652,7 @@ fn mirror_checks(c: &Campaign, fe: &Path) -> Result<Vec<MirrorReport>> {
             pose: m.name.clone(),
             counterpart: cp.name.clone(),
             max_difference: worst,
-            component: COMPONENTS[comp].to_string(),
+            component: crate::fit::contract::COMPONENTS[comp].to_string(),
             percent_of_peak_fy: if peak > 0.0 { 100.0 * worst_rel / peak } else { f64::INFINITY },
         });
     }
