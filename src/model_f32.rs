@@ -36,6 +36,93 @@ fn clamp(v: f32, lo: f32, hi: f32) -> (f32, bool) {
     }
 }
 
+/// `D_kc(t, u)` of one 5x5 deviation matrix `m`: Horner in `t` along each row (`r_i`),
+/// then Horner in `u` over the five `r_i` (steps 4 of the contract).
+#[inline(always)]
+fn deviation(m: &[[f32; 5]; 5], t: f32, u: f32) -> f32 {
+    let [m0, m1, m2, m3, m4] = m;
+    horner(&[horner(m0, t), horner(m1, t), horner(m2, t), horner(m3, t), horner(m4, t)], u)
+}
+
+/// `t = |v| * s - 1` of one sweep (step 3 of the contract).
+#[inline(always)]
+fn sweep_t(v: f32, s: f32) -> f32 {
+    abs(v) * s - 1.0
+}
+
+/// Steps 4 and 5 of the contract, compact form (targets without a hardware FPU, and
+/// the host): one loop over the 4 sweeps x 6 components. On soft-float cores every
+/// f32 operation is a call into the float runtime, so unrolling would only multiply
+/// the flash (about 8.3 KiB on the M3 and M0) without saving much.
+#[cfg(not(target_abi = "eabihf"))]
+#[inline(always)]
+fn superpose(sweeps: [f32; 4], u: f32) -> [f32; 6] {
+    let mut w = [0.0_f32; 6];
+    for (wc, b) in w.iter_mut().zip(BASELINE.iter()) {
+        *wc = horner(b, u);
+    }
+    for (((v, s), mats), odd) in sweeps.iter().zip(SWEEP_SCALES.iter()).zip(DEVIATION.iter()).zip(ODD.iter()) {
+        let t = sweep_t(*v, *s);
+        let negative = *v < 0.0;
+        for ((wc, m), &o) in w.iter_mut().zip(mats.iter()).zip(odd.iter()) {
+            let dev = deviation(m, t, u);
+            *wc = if negative && o { *wc - dev } else { *wc + dev };
+        }
+    }
+    w
+}
+
+/// Steps 4 and 5 of the contract, unrolled (hard-float targets: `thumbv7em-none-eabihf`,
+/// the Cortex-M4F, and any other `eabihf` target, whose ABI implies an FPU): the same
+/// operations in the same order as the loop above, written out for the 6 baselines and
+/// the 24 deviation matrices, so the core runs straight-line `vldr`/`vmla.f32` with no
+/// loop counter, address arithmetic or select per matrix.
+///
+/// The sign of step 5 is applied as `w_c + sign * D_kc` with `sign = -1.0` when the
+/// sweep value is negative (only for odd components): `sign * D_kc` is exactly `-D_kc`
+/// and `w + (-D)` is by definition `w - D`, so the bits are the contract's; on the FPU
+/// it is one `vmla.f32` (multiply rounded, then add rounded: not fused).
+#[cfg(target_abi = "eabihf")]
+#[inline(always)]
+fn superpose(sweeps: [f32; 4], u: f32) -> [f32; 6] {
+    let [b0, b1, b2, b3, b4, b5] = &BASELINE;
+    let mut w = [horner(b0, u), horner(b1, u), horner(b2, u), horner(b3, u), horner(b4, u), horner(b5, u)];
+    let [v0, v1, v2, v3] = sweeps;
+    let [s0, s1, s2, s3] = SWEEP_SCALES;
+    let [d0, d1, d2, d3] = &DEVIATION;
+    let [o0, o1, o2, o3] = &ODD;
+    add_sweep(&mut w, d0, o0, v0, s0, u);
+    add_sweep(&mut w, d1, o1, v1, s1, u);
+    add_sweep(&mut w, d2, o2, v2, s2, u);
+    add_sweep(&mut w, d3, o3, v3, s3, u);
+    w
+}
+
+/// Adds one sweep's six deviations to `w` (unrolled form of the inner loop).
+#[cfg(target_abi = "eabihf")]
+#[inline(always)]
+fn add_sweep(w: &mut [f32; 6], mats: &[[[f32; 5]; 5]; 6], odd: &[bool; 6], v: f32, s: f32, u: f32) {
+    let t = sweep_t(v, s);
+    let sign = if v < 0.0 { -1.0_f32 } else { 1.0 };
+    let [w0, w1, w2, w3, w4, w5] = w;
+    let [m0, m1, m2, m3, m4, m5] = mats;
+    let [o0, o1, o2, o3, o4, o5] = *odd;
+    add_deviation(w0, m0, o0, sign, t, u);
+    add_deviation(w1, m1, o1, sign, t, u);
+    add_deviation(w2, m2, o2, sign, t, u);
+    add_deviation(w3, m3, o3, sign, t, u);
+    add_deviation(w4, m4, o4, sign, t, u);
+    add_deviation(w5, m5, o5, sign, t, u);
+}
+
+/// `w_c = w_c ± D_kc(t, u)` for one component (`odd` is a constant after unrolling).
+#[cfg(target_abi = "eabihf")]
+#[inline(always)]
+fn add_deviation(wc: &mut f32, m: &[[f32; 5]; 5], odd: bool, sign: f32, t: f32, u: f32) {
+    let dev = deviation(m, t, u);
+    *wc = if odd { *wc + sign * dev } else { *wc + dev };
+}
+
 /// The reaction wrench of the compiled-in set's f32 paper model at `pose`.
 ///
 /// Implements the evaluation algorithm of `coeffs/README.md` exactly, so the result has
@@ -90,20 +177,6 @@ pub fn wrench(pose: &Pose) -> Evaluation {
     );
 
     let u = d * ONE_THIRD - 1.0;
-    let mut w = [0.0_f32; 6];
-    for (wc, b) in w.iter_mut().zip(BASELINE.iter()) {
-        *wc = horner(b, u);
-    }
-    let sweeps = [x, z, tx, tz];
-    for (((v, s), mats), odd) in sweeps.iter().zip(SWEEP_SCALES.iter()).zip(DEVIATION.iter()).zip(ODD.iter()) {
-        let t = abs(*v) * *s - 1.0;
-        let negative = *v < 0.0;
-        for ((wc, m), &o) in w.iter_mut().zip(mats.iter()).zip(odd.iter()) {
-            let [m0, m1, m2, m3, m4] = m;
-            let r = [horner(m0, t), horner(m1, t), horner(m2, t), horner(m3, t), horner(m4, t)];
-            let dev = horner(&r, u);
-            *wc = if negative && o { *wc - dev } else { *wc + dev };
-        }
-    }
+    let w = superpose([x, z, tx, tz], u);
     Evaluation { wrench: Wrench::from_array(w), status }
 }
