@@ -36,6 +36,75 @@ fn clamp(v: f32, lo: f32, hi: f32) -> (f32, bool) {
     }
 }
 
+/// Whether every coefficient of `p` is `+0.0` (bit pattern 0; `-0.0` does not count).
+const fn is_plus_zero(p: &[f32; 5]) -> bool {
+    let [p0, p1, p2, p3, p4] = *p;
+    p0.to_bits() | p1.to_bits() | p2.to_bits() | p3.to_bits() | p4.to_bits() == 0
+}
+
+/// Whether every coefficient of the 5x5 matrix `m` is `+0.0`.
+const fn is_plus_zero_matrix(m: &[[f32; 5]; 5]) -> bool {
+    let [r0, r1, r2, r3, r4] = m;
+    is_plus_zero(r0) && is_plus_zero(r1) && is_plus_zero(r2) && is_plus_zero(r3) && is_plus_zero(r4)
+}
+
+/// `ZERO_BASELINE[c]`: every coefficient of `B_c` is `+0.0`.
+const ZERO_BASELINE: [bool; 6] = {
+    let [b0, b1, b2, b3, b4, b5] = &BASELINE;
+    [is_plus_zero(b0), is_plus_zero(b1), is_plus_zero(b2), is_plus_zero(b3), is_plus_zero(b4), is_plus_zero(b5)]
+};
+
+/// `SKIP_DEVIATION[k][c]`: `D_kc` is skipped (see [`skip_sweep`]).
+const SKIP_DEVIATION: [[bool; 6]; 4] = {
+    let [d0, d1, d2, d3] = &DEVIATION;
+    [skip_sweep(d0), skip_sweep(d1), skip_sweep(d2), skip_sweep(d3)]
+};
+
+/// Which of one sweep's six deviations `w_c = w_c ± D_kc` may be left out, exactly.
+///
+/// The shortcut (computed at compile time, no test at run time) is for the matrices
+/// whose coefficients are all `+0.0`: the default set has 12 of the 24, and 5 of the 6
+/// baselines are zero too, because its FE runs use symmetric half and quarter blocks,
+/// so every component that is odd under a kept mirror is exactly zero. It is exact:
+///
+/// - `t` and `u` are finite (in `[-1, 1]`), so each Horner step of a `+0.0` polynomial
+///   is `(±0) + (+0) = +0`: `D_kc = +0.0` (and a zero baseline is `B_c = +0.0`, which
+///   [`superpose`] writes as a constant);
+/// - `w_c ± (+0.0)` equals `w_c` unless `w_c` is `-0.0`, and `w_c` never is: a rounded
+///   sum is `-0.0` only when both addends are `-0.0`, so `w_c` could only become
+///   `-0.0` by starting as `-0.0`, from a baseline whose constant coefficient is
+///   `-0.0`. For such a component nothing is skipped.
+const fn skip_sweep(mats: &[[[f32; 5]; 5]; 6]) -> [bool; 6] {
+    let [m0, m1, m2, m3, m4, m5] = mats;
+    let [b0, b1, b2, b3, b4, b5] = &BASELINE;
+    [
+        is_plus_zero_matrix(m0) && starts_not_neg_zero(b0),
+        is_plus_zero_matrix(m1) && starts_not_neg_zero(b1),
+        is_plus_zero_matrix(m2) && starts_not_neg_zero(b2),
+        is_plus_zero_matrix(m3) && starts_not_neg_zero(b3),
+        is_plus_zero_matrix(m4) && starts_not_neg_zero(b4),
+        is_plus_zero_matrix(m5) && starts_not_neg_zero(b5),
+    ]
+}
+
+/// Whether `h(b, u)` is never `-0.0`: its last operation adds `b[0]`, and the sum is
+/// `-0.0` only when `b[0]` is.
+const fn starts_not_neg_zero(b: &[f32; 5]) -> bool {
+    let [b0, ..] = *b;
+    b0.to_bits() != 0x8000_0000
+}
+
+/// `B_c(u)`: `+0.0` without evaluating it when every coefficient is `+0.0` (exact,
+/// see [`skip_sweep`]).
+#[inline(always)]
+fn baseline(b: &[f32; 5], zero: bool, u: f32) -> f32 {
+    if zero {
+        0.0
+    } else {
+        horner(b, u)
+    }
+}
+
 /// `D_kc(t, u)` of one 5x5 deviation matrix `m`: Horner in `t` along each row (`r_i`),
 /// then Horner in `u` over the five `r_i` (steps 4 of the contract).
 #[inline(always)]
@@ -58,15 +127,18 @@ fn sweep_t(v: f32, s: f32) -> f32 {
 #[inline(always)]
 fn superpose(sweeps: [f32; 4], u: f32) -> [f32; 6] {
     let mut w = [0.0_f32; 6];
-    for (wc, b) in w.iter_mut().zip(BASELINE.iter()) {
-        *wc = horner(b, u);
+    for ((wc, b), &zero) in w.iter_mut().zip(BASELINE.iter()).zip(ZERO_BASELINE.iter()) {
+        *wc = baseline(b, zero, u);
     }
-    for (((v, s), mats), odd) in sweeps.iter().zip(SWEEP_SCALES.iter()).zip(DEVIATION.iter()).zip(ODD.iter()) {
+    let sweeps = sweeps.iter().zip(SWEEP_SCALES.iter()).zip(DEVIATION.iter()).zip(ODD.iter()).zip(SKIP_DEVIATION.iter());
+    for ((((v, s), mats), odd), skip) in sweeps {
         let t = sweep_t(*v, *s);
         let negative = *v < 0.0;
-        for ((wc, m), &o) in w.iter_mut().zip(mats.iter()).zip(odd.iter()) {
-            let dev = deviation(m, t, u);
-            *wc = if negative && o { *wc - dev } else { *wc + dev };
+        for (((wc, m), &o), &skip) in w.iter_mut().zip(mats.iter()).zip(odd.iter()).zip(skip.iter()) {
+            if !skip {
+                let dev = deviation(m, t, u);
+                *wc = if negative && o { *wc - dev } else { *wc + dev };
+            }
         }
     }
     w
@@ -86,39 +158,52 @@ fn superpose(sweeps: [f32; 4], u: f32) -> [f32; 6] {
 #[inline(always)]
 fn superpose(sweeps: [f32; 4], u: f32) -> [f32; 6] {
     let [b0, b1, b2, b3, b4, b5] = &BASELINE;
-    let mut w = [horner(b0, u), horner(b1, u), horner(b2, u), horner(b3, u), horner(b4, u), horner(b5, u)];
+    let [z0, z1, z2, z3, z4, z5] = ZERO_BASELINE;
+    let mut w = [
+        baseline(b0, z0, u),
+        baseline(b1, z1, u),
+        baseline(b2, z2, u),
+        baseline(b3, z3, u),
+        baseline(b4, z4, u),
+        baseline(b5, z5, u),
+    ];
     let [v0, v1, v2, v3] = sweeps;
     let [s0, s1, s2, s3] = SWEEP_SCALES;
     let [d0, d1, d2, d3] = &DEVIATION;
     let [o0, o1, o2, o3] = &ODD;
-    add_sweep(&mut w, d0, o0, v0, s0, u);
-    add_sweep(&mut w, d1, o1, v1, s1, u);
-    add_sweep(&mut w, d2, o2, v2, s2, u);
-    add_sweep(&mut w, d3, o3, v3, s3, u);
+    let [k0, k1, k2, k3] = &SKIP_DEVIATION;
+    add_sweep(&mut w, d0, o0, k0, v0, s0, u);
+    add_sweep(&mut w, d1, o1, k1, v1, s1, u);
+    add_sweep(&mut w, d2, o2, k2, v2, s2, u);
+    add_sweep(&mut w, d3, o3, k3, v3, s3, u);
     w
 }
 
 /// Adds one sweep's six deviations to `w` (unrolled form of the inner loop).
 #[cfg(target_abi = "eabihf")]
 #[inline(always)]
-fn add_sweep(w: &mut [f32; 6], mats: &[[[f32; 5]; 5]; 6], odd: &[bool; 6], v: f32, s: f32, u: f32) {
+fn add_sweep(w: &mut [f32; 6], mats: &[[[f32; 5]; 5]; 6], odd: &[bool; 6], skip: &[bool; 6], v: f32, s: f32, u: f32) {
     let t = sweep_t(v, s);
     let sign = if v < 0.0 { -1.0_f32 } else { 1.0 };
     let [w0, w1, w2, w3, w4, w5] = w;
     let [m0, m1, m2, m3, m4, m5] = mats;
     let [o0, o1, o2, o3, o4, o5] = *odd;
-    add_deviation(w0, m0, o0, sign, t, u);
-    add_deviation(w1, m1, o1, sign, t, u);
-    add_deviation(w2, m2, o2, sign, t, u);
-    add_deviation(w3, m3, o3, sign, t, u);
-    add_deviation(w4, m4, o4, sign, t, u);
-    add_deviation(w5, m5, o5, sign, t, u);
+    let [k0, k1, k2, k3, k4, k5] = *skip;
+    add_deviation(w0, m0, o0, k0, sign, t, u);
+    add_deviation(w1, m1, o1, k1, sign, t, u);
+    add_deviation(w2, m2, o2, k2, sign, t, u);
+    add_deviation(w3, m3, o3, k3, sign, t, u);
+    add_deviation(w4, m4, o4, k4, sign, t, u);
+    add_deviation(w5, m5, o5, k5, sign, t, u);
 }
 
 /// `w_c = w_c ± D_kc(t, u)` for one component (`odd` is a constant after unrolling).
 #[cfg(target_abi = "eabihf")]
 #[inline(always)]
-fn add_deviation(wc: &mut f32, m: &[[f32; 5]; 5], odd: bool, sign: f32, t: f32, u: f32) {
+fn add_deviation(wc: &mut f32, m: &[[f32; 5]; 5], odd: bool, skip: bool, sign: f32, t: f32, u: f32) {
+    if skip {
+        return;
+    }
     let dev = deviation(m, t, u);
     *wc = if odd { *wc + sign * dev } else { *wc + dev };
 }
