@@ -24,18 +24,6 @@ fn abs(v: f32) -> f32 {
     f32::from_bits(v.to_bits() & 0x7fff_ffff)
 }
 
-/// `v` clamped to `lo..=hi`, and whether it changed (`v` finite; `-0.0 == +0.0`).
-#[inline(always)]
-fn clamp(v: f32, lo: f32, hi: f32) -> (f32, bool) {
-    if v < lo {
-        (lo, true)
-    } else if v > hi {
-        (hi, true)
-    } else {
-        (v, false)
-    }
-}
-
 /// Whether every coefficient of `p` is `+0.0` (bit pattern 0; `-0.0` does not count).
 const fn is_plus_zero(p: &[f32; 5]) -> bool {
     let [p0, p1, p2, p3, p4] = *p;
@@ -208,6 +196,77 @@ fn add_deviation(wc: &mut f32, m: &[[f32; 5]; 5], odd: bool, skip: bool, sign: f
     *wc = if odd { *wc + sign * dev } else { *wc + dev };
 }
 
+/// `|v| <= max` (`max` positive and finite), on the bit patterns: for f32 values that
+/// are not NaN, the order of `|v|` is the order of the bits without the sign, and NaN
+/// and the infinities have bits above every finite value, so they fail the test.
+#[inline(always)]
+fn within(v: f32, max: f32) -> bool {
+    v.to_bits() & 0x7fff_ffff <= max.to_bits()
+}
+
+/// `+0.0 <= d <= max` (`max` positive and finite), on the bit patterns: a set sign bit
+/// (any negative value, and `-0.0`, which the general path handles) fails the test.
+#[inline(always)]
+fn within_depth(d: f32, max: f32) -> bool {
+    d.to_bits() <= max.to_bits()
+}
+
+/// Bits of the largest finite f32 without the sign: above it, infinities and NaN.
+const MAX_FINITE_BITS: u32 = 0x7f7f_ffff;
+
+/// Steps 1 and 2 of the contract for a pose outside the fast path of [`wrench`]:
+/// `None` when an input is NaN or infinite, else the clamped pose and its status.
+/// On the bit patterns, like [`within`], so soft-float cores need no float comparison.
+#[cold]
+#[inline(never)]
+fn saturate(pose: &Pose) -> Option<(Pose, Status)> {
+    let Pose { x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm } = *pose;
+    let finite = |v: f32| v.to_bits() & 0x7fff_ffff <= MAX_FINITE_BITS;
+    if !(finite(x_mm) & finite(z_mm) & finite(theta_x_deg) & finite(theta_z_deg) & finite(depth_mm)) {
+        return None;
+    }
+    let (x, sat_x) = clamp_symmetric(x_mm, X_MAX_MM);
+    let (z, sat_z) = clamp_symmetric(z_mm, Z_MAX_MM);
+    let (tx, sat_tx) = clamp_symmetric(theta_x_deg, THETA_MAX_DEG);
+    let (tz, sat_tz) = clamp_symmetric(theta_z_deg, THETA_MAX_DEG);
+    let (d, sat_d) = clamp_depth(depth_mm, DEPTH_MAX_MM);
+    let status = Status::from_bits(
+        u8::from(sat_x)
+            | u8::from(sat_z) << 1
+            | u8::from(sat_tx) << 2
+            | u8::from(sat_tz) << 3
+            | u8::from(sat_d) << 4,
+    );
+    Some((Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, depth_mm: d }, status))
+}
+
+/// `min(max(v, -max), max)` and whether it differs from `v` (`v` finite, `max` positive
+/// and finite): `|v| > max` on the bits (see [`within`]) gives `max` with `v`'s sign,
+/// else `v` itself (`-0.0` stays `-0.0`, unsaturated).
+#[inline(always)]
+fn clamp_symmetric(v: f32, max: f32) -> (f32, bool) {
+    if within(v, max) {
+        (v, false)
+    } else {
+        (f32::from_bits(max.to_bits() | (v.to_bits() & 0x8000_0000)), true)
+    }
+}
+
+/// `min(max(d, 0), max)` and whether it differs from `d` (`d` finite, `max` positive and
+/// finite): `+0.0` for a negative `d`, `max` above it, else `d` itself; `-0.0` equals
+/// `0` and stays `-0.0`, unsaturated.
+#[inline(always)]
+fn clamp_depth(d: f32, max: f32) -> (f32, bool) {
+    let bits = d.to_bits();
+    if bits > 0x8000_0000 {
+        (0.0, true)
+    } else if bits == 0x8000_0000 || bits <= max.to_bits() {
+        (d, false)
+    } else {
+        (max, true)
+    }
+}
+
 /// The reaction wrench of the compiled-in set's f32 paper model at `pose`.
 ///
 /// Implements the evaluation algorithm of `coeffs/README.md` exactly, so the result has
@@ -238,28 +297,23 @@ pub fn wrench(pose: &Pose) -> Evaluation {
     if !FITTED {
         return Evaluation { wrench: Wrench::ZERO, status: Status::NO_MODEL | Status::ERROR };
     }
-    let Pose { x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm } = *pose;
-    if !(x_mm.is_finite()
-        && z_mm.is_finite()
-        && theta_x_deg.is_finite()
-        && theta_z_deg.is_finite()
-        && depth_mm.is_finite())
-    {
-        return Evaluation { wrench: Wrench::ZERO, status: Status::ERROR };
-    }
-
-    let (x, sat_x) = clamp(x_mm, -X_MAX_MM, X_MAX_MM);
-    let (z, sat_z) = clamp(z_mm, -Z_MAX_MM, Z_MAX_MM);
-    let (tx, sat_tx) = clamp(theta_x_deg, -THETA_MAX_DEG, THETA_MAX_DEG);
-    let (tz, sat_tz) = clamp(theta_z_deg, -THETA_MAX_DEG, THETA_MAX_DEG);
-    let (d, sat_d) = clamp(depth_mm, 0.0, DEPTH_MAX_MM);
-    let status = Status::from_bits(
-        u8::from(sat_x)
-            | u8::from(sat_z) << 1
-            | u8::from(sat_tx) << 2
-            | u8::from(sat_tz) << 3
-            | u8::from(sat_d) << 4,
-    );
+    // Steps 1 and 2. Fast path, the usual case in a control loop: every input inside
+    // its domain, so no clamp changes anything and no status bit is set. NaN and the
+    // infinities fail these tests too and take the general path.
+    let inside = within(pose.x_mm, X_MAX_MM)
+        & within(pose.z_mm, Z_MAX_MM)
+        & within(pose.theta_x_deg, THETA_MAX_DEG)
+        & within(pose.theta_z_deg, THETA_MAX_DEG)
+        & within_depth(pose.depth_mm, DEPTH_MAX_MM);
+    let (clamped, status) = if inside {
+        (*pose, Status::OK)
+    } else {
+        match saturate(pose) {
+            Some(c) => c,
+            None => return Evaluation { wrench: Wrench::ZERO, status: Status::ERROR },
+        }
+    };
+    let Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, depth_mm: d } = clamped;
 
     let u = d * ONE_THIRD - 1.0;
     let w = superpose([x, z, tx, tz], u);
