@@ -44,8 +44,10 @@ fn coarse_flat_punch_matches_sneddon() {
     let p = r.punch.expect("a punch report");
     assert_eq!(p.check.element, "C3D20R");
     assert!(p.campaign_element.is_none());
-    // Sneddon at nu = 0.495 (K0/mu0 = 100): 4 mu a delta / (1 - nu)
-    let nu = (3.0 * 100.0 - 2.0) / (2.0 * (3.0 * 100.0 + 1.0));
+    // Sneddon at the set's nu (K0/mu0 = bulk_to_shear, mu = 1): 4 mu a delta / (1 - nu)
+    let (c, _) = spec::load(&set).expect("spec");
+    let k = c.tissue.bulk_to_shear;
+    let nu = (3.0 * k - 2.0) / (2.0 * (3.0 * k + 1.0));
     assert!((p.nu - nu).abs() < 1e-12, "nu {}", p.nu);
     let want = 4.0 * 1.0 * 0.5 * 0.005 / (1.0 - nu);
     assert!((p.force_sneddon_n - want).abs() < 1e-12 * want, "Sneddon {} N, expected {want} N", p.force_sneddon_n);
@@ -86,7 +88,8 @@ fn punch_deck_structure() {
     assert_eq!(mesh.core_elements, 4);
     let d = verify::punch_deck(&c, &mesh, PunchElement::C3D20R, a, a / 100.0, 1.0).expect("deck");
     assert!(d.text.contains("*ELEMENT, TYPE=C3D20R, ELSET=BLOCK"));
-    assert!(d.text.contains("*HYPERELASTIC, NEO HOOKE\n5e-1, 2e-2"), "neo-Hookean C10 = mu/2, D1 = 2/K0");
+    let d1 = format!("*HYPERELASTIC, NEO HOOKE\n5e-1, {:e}", 2.0 / c.tissue.bulk_to_shear);
+    assert!(d.text.contains(&d1), "neo-Hookean C10 = mu/2, D1 = 2/K0: {d1}");
     for set in ["PUNCH", "BBOTTOM", "BSIDES", "SYMX", "SYMZ"] {
         assert!(d.text.contains(&format!("*NSET, NSET={set}\n")), "set {set}");
     }

@@ -22,7 +22,10 @@ use std::fmt::Write;
 
 /// Version of the mesh and deck generator; part of every run's spec hash, so that a
 /// change of the generator reruns the campaign.
-pub const GENERATOR_VERSION: u32 = 1;
+///
+/// History: 1, tissue surface as contact slave; 2, needle surface as contact slave (v1 lost
+/// contact when the wedge's edge landed between tissue nodes, the theta_z sweep).
+pub const GENERATOR_VERSION: u32 = 2;
 
 /// First CalculiX node and element id of the needle (tissue ids start at 1).
 pub const NEEDLE_ID0: usize = 1_000_001;
@@ -257,7 +260,12 @@ fn write_contact(w: &mut String, c: &Campaign) {
         let _ = writeln!(w, "** Coulomb friction {}, stick slope {} N/mm^3", c.contact.friction, c.contact.stick_slope_n_per_mm3);
         let _ = writeln!(w, "*FRICTION\n{}, {}", c.contact.friction, c.contact.stick_slope_n_per_mm3);
     }
-    let _ = writeln!(w, "*CONTACT PAIR, INTERACTION=SI, TYPE=SURFACE TO SURFACE\nTISSUE_TOP, NEEDLE_SURF");
+    // Slave first, then master. The needle is the slave: its fine, sharp surface is
+    // sampled at its own integration points, so the wedge's edge cannot slip between the
+    // coarser tissue faces' integration points (with the tissue as slave, an edge landing
+    // between two tissue nodes went undetected: theta_z runs lost contact, v1 of the generator).
+    let _ = writeln!(w, "** slave (needle), master (tissue)");
+    let _ = writeln!(w, "*CONTACT PAIR, INTERACTION=SI, TYPE=SURFACE TO SURFACE\nNEEDLE_SURF, TISSUE_TOP");
 }
 
 fn write_boundary(w: &mut String, t: &TissueMesh) {
