@@ -214,9 +214,6 @@ fn within_depth(d: f32, max: f32) -> bool {
     d.to_bits() <= max.to_bits()
 }
 
-/// Bits of the largest finite f32 without the sign: above it, infinities and NaN.
-const MAX_FINITE_BITS: u32 = 0x7f7f_ffff;
-
 /// Steps 1 and 2 of the contract for a pose outside the fast path of [`wrench`]:
 /// `None` when an input is NaN or infinite, else the clamped pose and its status.
 /// On the bit patterns, like [`within`], so soft-float cores need no float comparison.
@@ -224,7 +221,8 @@ const MAX_FINITE_BITS: u32 = 0x7f7f_ffff;
 #[inline(never)]
 fn saturate(pose: &Pose) -> Option<(Pose, Status)> {
     let Pose { x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm } = *pose;
-    let finite = |v: f32| v.to_bits() & 0x7fff_ffff <= MAX_FINITE_BITS;
+    // `|v| <= f32::MAX`: false for the infinities and NaN only.
+    let finite = |v: f32| within(v, f32::MAX);
     if !(finite(x_mm) & finite(z_mm) & finite(theta_x_deg) & finite(theta_z_deg) & finite(depth_mm)) {
         return None;
     }
@@ -233,13 +231,12 @@ fn saturate(pose: &Pose) -> Option<(Pose, Status)> {
     let (tx, sat_tx) = clamp_symmetric(theta_x_deg, THETA_MAX_DEG);
     let (tz, sat_tz) = clamp_symmetric(theta_z_deg, THETA_MAX_DEG);
     let (d, sat_d) = clamp_depth(depth_mm, DEPTH_MAX_MM);
-    let status = Status::from_bits(
-        u8::from(sat_x)
-            | u8::from(sat_z) << 1
-            | u8::from(sat_tx) << 2
-            | u8::from(sat_tz) << 3
-            | u8::from(sat_d) << 4,
-    );
+    let flag = |saturated: bool, f: Status| if saturated { f } else { Status::OK };
+    let status = flag(sat_x, Status::SAT_X)
+        | flag(sat_z, Status::SAT_Z)
+        | flag(sat_tx, Status::SAT_THETA_X)
+        | flag(sat_tz, Status::SAT_THETA_Z)
+        | flag(sat_d, Status::SAT_DEPTH);
     Some((Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, depth_mm: d }, status))
 }
 

@@ -260,10 +260,8 @@ fn write_contact(w: &mut String, c: &Campaign) {
         let _ = writeln!(w, "** Coulomb friction {}, stick slope {} N/mm^3", c.contact.friction, c.contact.stick_slope_n_per_mm3);
         let _ = writeln!(w, "*FRICTION\n{}, {}", c.contact.friction, c.contact.stick_slope_n_per_mm3);
     }
-    // Slave first, then master. The needle is the slave: its fine, sharp surface is
-    // sampled at its own integration points, so the wedge's edge cannot slip between the
-    // coarser tissue faces' integration points (with the tissue as slave, an edge landing
-    // between two tissue nodes went undetected: theta_z runs lost contact, v1 of the generator).
+    // Slave first, then master: the needle's fine, sharp surface is sampled at its own
+    // integration points (why: GENERATOR_VERSION's history).
     let _ = writeln!(w, "** slave (needle), master (tissue)");
     let _ = writeln!(w, "*CONTACT PAIR, INTERACTION=SI, TYPE=SURFACE TO SURFACE\nNEEDLE_SURF, TISSUE_TOP");
 }
