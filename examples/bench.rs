@@ -10,11 +10,13 @@
 //!   (`subs; bne`) is timed at two lengths; the difference gives instructions per
 //!   SysTick tick without knowing the board's clock, and two runs of the same length
 //!   must give the same ticks (else the run is not under `-icount`: `deterministic=no`).
-//! - **Instructions per wrench**: `CALLS` calls of [`needle_haptics::wrench`] through an
-//!   opaque function pointer on an opaque pose (`core::hint::black_box`, so nothing is
-//!   hoisted out of the loop or folded at compile time), minus the same loop without the
-//!   call, divided by `CALLS`. The figure includes the call, the return and the store of
-//!   the 28-byte result.
+//! - **Instructions per wrench**: `CALLS` calls of [`needle_haptics::wrench`] (f32) or
+//!   [`needle_haptics::fixed::wrench`] (fixed point) through an opaque function pointer
+//!   on an opaque pose (`core::hint::black_box`, so nothing is hoisted out of the loop or
+//!   folded at compile time), minus the same loop without the call, divided by `CALLS`.
+//!   The figure includes the call, the return and the store of the 28-byte result. Both
+//!   evaluators run in the same firmware, one after the other, on the same poses (the
+//!   fixed-point pose is the f32 one in Q16.16).
 //! - **Stack**: the 4 KiB below the caller's stack pointer is painted with a pattern,
 //!   one evaluation runs, and the deepest overwritten word gives the bytes used.
 //!
@@ -22,7 +24,7 @@
 //!
 //! ```text
 //! needle-bench target=<triple> calls=<CALLS> calibration_instructions=<n> calibration_ticks=<n> deterministic=<yes|no>
-//! needle-bench pose=<name> instructions_per_wrench=<n.n> stack_bytes=<n> status=0x<ss>
+//! needle-bench pose=<name> evaluator=<f32|fixed> instructions_per_wrench=<n.n> stack_bytes=<n> status=0x<ss>
 //! ...
 //! needle-bench end
 //! ```
@@ -37,7 +39,7 @@ mod firmware {
     use core::arch::asm;
     use core::hint::black_box;
     use cortex_m::peripheral::{syst::SystClkSource, SYST};
-    use needle_haptics::{wrench, Evaluation, Pose};
+    use needle_haptics::{fixed, wrench, Pose};
 
     /// Evaluations per timed loop.
     const CALLS: u32 = 256;
@@ -57,6 +59,14 @@ mod firmware {
         ("nan-input", Pose::new(f32::NAN, 0.0, 0.0, 0.0, 1.0)),
     ];
 
+    /// The same poses in Q16.16 for the fixed-point evaluator (no NaN in integers).
+    const ONE: i32 = fixed::Pose::ONE;
+    const POSES_FIXED: [(&str, fixed::Pose); 3] = [
+        ("typical", fixed::Pose::new(3 * ONE, -2 * ONE, 5 * ONE, -7 * ONE, 9 * ONE / 2)),
+        ("positive", fixed::Pose::new(6 * ONE, 4 * ONE, 10 * ONE, 2 * ONE, 3 * ONE)),
+        ("saturated", fixed::Pose::new(20 * ONE, -20 * ONE, 30 * ONE, -30 * ONE, 9 * ONE)),
+    ];
+
     fn elapsed(start: u32, end: u32) -> u32 {
         // SysTick counts down from 0xff_ffff and wraps: ticks modulo 2^24.
         start.wrapping_sub(end) & 0x00ff_ffff
@@ -74,7 +84,7 @@ mod firmware {
     }
 
     #[inline(never)]
-    fn loop_wrench(f: fn(&Pose) -> Evaluation, pose: &Pose, calls: u32) -> u32 {
+    fn loop_wrench<P, E>(f: fn(&P) -> E, pose: &P, calls: u32) -> u32 {
         let start = SYST::get_current();
         for _ in 0..calls {
             black_box(f(black_box(pose)));
@@ -83,7 +93,7 @@ mod firmware {
     }
 
     #[inline(never)]
-    fn loop_empty(pose: &Pose, calls: u32) -> u32 {
+    fn loop_empty<P>(pose: &P, calls: u32) -> u32 {
         let start = SYST::get_current();
         for _ in 0..calls {
             black_box(black_box(pose));
@@ -93,7 +103,7 @@ mod firmware {
 
     /// Bytes of stack one call of `f` uses below this function's stack pointer.
     #[inline(never)]
-    fn stack_use(f: fn(&Pose) -> Evaluation, pose: &Pose) -> usize {
+    fn stack_use<P, E>(f: fn(&P) -> E, pose: &P) -> usize {
         let top: usize;
         // SAFETY: reads the stack pointer.
         unsafe { asm!("mov {}, sp", out(reg) top, options(nomem, nostack, preserves_flags)) };
@@ -112,6 +122,26 @@ mod firmware {
             a += 4;
         }
         top - a
+    }
+
+    /// One `needle-bench pose=...` line.
+    fn report(out: &mut Out, pose: &str, evaluator: &str, tenths: u64, stack: usize, status: u8) {
+        out.str("needle-bench pose=");
+        out.str(pose);
+        out.str(" evaluator=");
+        out.str(evaluator);
+        out.str(" instructions_per_wrench=");
+        out.dec(tenths / 10);
+        out.str(".");
+        out.dec(tenths % 10);
+        out.str(" stack_bytes=");
+        if stack >= STACK_WINDOW {
+            out.str(">=");
+        }
+        out.dec(stack as u64);
+        out.str(" status=");
+        out.hex(u32::from(status), 2);
+        out.nl();
     }
 
     #[cortex_m_rt::entry]
@@ -150,30 +180,23 @@ mod firmware {
             exit(false)
         }
 
-        let eval: fn(&Pose) -> Evaluation = black_box(wrench);
-        for (name, pose) in POSES.iter() {
-            let tw = u64::from(loop_wrench(eval, pose, black_box(CALLS)));
-            let te = u64::from(loop_empty(pose, black_box(CALLS)));
+        let eval: fn(&Pose) -> needle_haptics::Evaluation = black_box(wrench);
+        let eval_fixed: fn(&fixed::Pose) -> fixed::Evaluation = black_box(fixed::wrench);
+        let per_call = |tw: u32, te: u32| -> u64 {
             // Instructions per call in tenths, rounded: ticks * (instructions per tick).
-            let num = tw.saturating_sub(te) * cal_instructions * 10;
+            let num = u64::from(tw).saturating_sub(u64::from(te)) * cal_instructions * 10;
             let den = cal_ticks * u64::from(CALLS);
-            let tenths = (num + den / 2) / den;
+            (num + den / 2) / den
+        };
+        for (name, pose) in POSES.iter() {
+            let tenths = per_call(loop_wrench(eval, pose, black_box(CALLS)), loop_empty(pose, black_box(CALLS)));
             let stack = stack_use(eval, pose);
-            let status = eval(pose).status.bits();
-            out.str("needle-bench pose=");
-            out.str(name);
-            out.str(" instructions_per_wrench=");
-            out.dec(tenths / 10);
-            out.str(".");
-            out.dec(tenths % 10);
-            out.str(" stack_bytes=");
-            if stack >= STACK_WINDOW {
-                out.str(">=");
+            report(&mut out, name, "f32", tenths, stack, eval(pose).status.bits());
+            if let Some((_, q)) = POSES_FIXED.iter().find(|(n, _)| n == name) {
+                let tenths = per_call(loop_wrench(eval_fixed, q, black_box(CALLS)), loop_empty(q, black_box(CALLS)));
+                let stack = stack_use(eval_fixed, q);
+                report(&mut out, name, "fixed", tenths, stack, eval_fixed(q).status.bits());
             }
-            out.dec(stack as u64);
-            out.str(" status=");
-            out.hex(u32::from(status), 2);
-            out.nl();
         }
         out.str("needle-bench end\n");
         out.flush();

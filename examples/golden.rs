@@ -1,6 +1,8 @@
 //! Firmware example `golden`: evaluates every pose of the compiled-in set's
-//! `golden-f32.csv` on the target and prints the results' bits, for the host to compare
-//! with the golden file (host-tests/tests/firmware_golden.rs, `needle firmware golden`).
+//! `golden-f32.csv` on the target and prints the results' bits, then every pose of its
+//! `golden-fixed.csv` with the fixed-point evaluator and prints the integers, for the
+//! host to compare with the golden files (host-tests/tests/firmware_golden.rs,
+//! `needle firmware golden`).
 //!
 //! The poses are parsed from the CSV *at compile time* (const evaluation of
 //! `include_str!` of `$NEEDLE_SET_DIR/golden-f32.csv`, the set build.rs selected) into a
@@ -14,6 +16,9 @@
 //! x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,status,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm
 //! <one row per pose in the golden file's format: inputs as read, status and wrench as computed>
 //! needle-golden end rows=<ROWS>
+//! needle-golden-fixed rows=<FIXED_ROWS>
+//! <one row per pose in golden-fixed.csv's format: inputs as read, status and wrench as computed>
+//! needle-golden-fixed end rows=<FIXED_ROWS>
 //! ```
 //!
 //! ```text
@@ -31,7 +36,7 @@ mod common;
 mod firmware {
     use crate::common::{exit, Out};
     use core::hint::black_box;
-    use needle_haptics::{model_info, wrench, Pose};
+    use needle_haptics::{fixed, model_info, wrench, Pose};
 
     const HEADER: &str =
         "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,status,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm";
@@ -113,6 +118,98 @@ mod firmware {
         out
     }
 
+    /// The fixed-point golden file of the set (const evaluation only, like [`CSV`]).
+    const CSV_FIXED: &[u8] = include_bytes!(concat!(env!("NEEDLE_SET_DIR"), "/golden-fixed.csv"));
+    const HEADER_FIXED: &str = "x_mm_q16,z_mm_q16,theta_x_deg_q16,theta_z_deg_q16,depth_mm_q16,status,fx_un,fy_un,fz_un,mx_unmm,my_unmm,mz_unmm";
+    const FIXED_ROWS: usize = count_lines_after(CSV_FIXED, HEADER_FIXED.len() + 1);
+    /// The five Q16.16 inputs of every row of golden-fixed.csv, in file order.
+    static POSES_FIXED: [[i32; 5]; FIXED_ROWS] = parse_fixed_poses(CSV_FIXED);
+
+    const fn count_lines_after(s: &[u8], start: usize) -> usize {
+        let mut i = start;
+        let mut rows = 0;
+        while i < s.len() {
+            if s[i] == b'\n' {
+                rows += 1;
+            }
+            i += 1;
+        }
+        rows
+    }
+
+    const fn parse_fixed_poses<const N: usize>(s: &[u8]) -> [[i32; 5]; N] {
+        let h = HEADER_FIXED.as_bytes();
+        let mut i = 0;
+        while i < h.len() {
+            if s[i] != h[i] {
+                panic!("golden-fixed.csv: the first line is not the fixed golden-file header");
+            }
+            i += 1;
+        }
+        i += 1;
+        let mut out = [[0i32; 5]; N];
+        let mut r = 0;
+        while r < N {
+            let mut f = 0;
+            while f < 5 {
+                let negative = s[i] == b'-';
+                if negative {
+                    i += 1;
+                }
+                let mut v: i64 = 0;
+                while s[i] != b',' {
+                    if !s[i].is_ascii_digit() {
+                        panic!("golden-fixed.csv: an input is not a decimal integer");
+                    }
+                    v = v * 10 + (s[i] - b'0') as i64;
+                    i += 1;
+                }
+                out[r][f] = (if negative { -v } else { v }) as i32;
+                i += 1;
+                f += 1;
+            }
+            while s[i] != b'\n' {
+                i += 1;
+            }
+            i += 1;
+            r += 1;
+        }
+        out
+    }
+
+    /// A signed decimal.
+    fn int(out: &mut Out, v: i32) {
+        if v < 0 {
+            out.str("-");
+        }
+        out.dec(u64::from(v.unsigned_abs()));
+    }
+
+    /// Evaluates every fixed-point golden pose and prints the rows.
+    fn fixed_rows(out: &mut Out) {
+        out.str("needle-golden-fixed rows=");
+        out.dec(FIXED_ROWS as u64);
+        out.nl();
+        let poses: &[[i32; 5]] = black_box(&POSES_FIXED[..]);
+        for p in poses {
+            let [x, z, tx, tz, d] = *p;
+            let e = fixed::wrench(black_box(&fixed::Pose::new(x, z, tx, tz, d)));
+            for v in p {
+                int(out, *v);
+                out.str(",");
+            }
+            out.hex(u32::from(e.status.bits()), 2);
+            for w in e.wrench.to_array() {
+                out.str(",");
+                int(out, w);
+            }
+            out.nl();
+        }
+        out.str("needle-golden-fixed end rows=");
+        out.dec(poses.len() as u64);
+        out.nl();
+    }
+
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut out = Out::new();
@@ -154,6 +251,7 @@ mod firmware {
         out.str("needle-golden end rows=");
         out.dec(poses.len() as u64);
         out.nl();
+        fixed_rows(&mut out);
         out.flush();
         exit(true)
     }

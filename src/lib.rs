@@ -41,6 +41,7 @@
 #![deny(missing_docs)]
 
 mod evaluation;
+pub mod fixed;
 mod horner;
 mod model_f32;
 pub mod model_info;

@@ -6,3 +6,4 @@ pub mod cli;
 pub mod fe;
 pub mod firmware;
 pub mod fit;
+pub mod fixed_error;

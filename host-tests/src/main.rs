@@ -21,6 +21,9 @@ enum Command {
     Eval(needle_host::cli::model::EvalArgs),
     /// Compare the model with the FE runs it was not fitted on.
     Validate(needle_host::cli::fit::ValidateArgs),
+    /// The fixed-point evaluator's error against f64 on a grid and random poses, beside
+    /// its generated bound.
+    FixedError(needle_host::cli::fixed::FixedErrorArgs),
     /// Copy the generated C header out for C users.
     Header(needle_host::cli::model::HeaderArgs),
     /// The library on Cortex-M under QEMU: size, bench, golden, check.
@@ -36,6 +39,7 @@ fn main() -> ExitCode {
         Command::Eval(a) => needle_host::cli::model::eval(a),
         Command::Validate(a) => needle_host::cli::fit::validate(a),
         Command::Header(a) => needle_host::cli::model::header(a),
+        Command::FixedError(a) => needle_host::cli::fixed::fixed_error(a),
         Command::Firmware(c) => needle_host::cli::firmware::run(c),
     };
     match result {

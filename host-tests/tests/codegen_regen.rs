@@ -34,6 +34,11 @@ fn compiled_tables_match_a_fresh_generation() {
         model_info::SET_DIR
     );
     assert!(g.c_header == model_info::C_HEADER, "the library's C header differs from a fresh generation");
+    assert!(
+        g.rust_fixed == needle_haptics::fixed::tables::SOURCE,
+        "the library's tables_fixed.rs differs from a fresh generation from {}",
+        model_info::SET_DIR
+    );
     assert_eq!(g.model.set, model_info::SET);
     assert_eq!(g.model.fe_sha256, model_info::FE_SHA256);
     // The numbers the evaluator uses, against the model file's f32 bits.
@@ -54,6 +59,7 @@ fn generation_is_deterministic() {
     let (ga, gb) = (regenerate(a.path()), regenerate(b.path()));
     assert_eq!(ga.rust, gb.rust);
     assert_eq!(ga.c_header, gb.c_header);
+    assert_eq!(ga.rust_fixed, gb.rust_fixed);
     assert!(!ga.rust.contains(a.path().to_str().unwrap()), "no paths in generated code");
 }
 

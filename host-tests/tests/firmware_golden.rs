@@ -1,12 +1,13 @@
 //! The `golden` firmware on the three reference cores under QEMU, against the golden
 //! vectors of the set compiled into the library (`NEEDLE_COEFFS`, default
 //! coeffs/default): every status and wrench bit of every row must be the golden file's
-//! (NaN by class, signed zeros by bits). Soft-float add and multiply are correctly
+//! (NaN by class, signed zeros by bits), and every integer of the fixed-point evaluator
+//! the one in golden-fixed.csv. Soft-float add and multiply are correctly
 //! rounded, so the M3 and M0 must match as well as the M4F's FPU.
 //!
 //! Nothing skips: a missing QEMU, rustup target, model.toml or golden file fails with a
 //! message that says what to install or run.
-use needle_host::firmware::{self, golden};
+use needle_host::firmware::{self, golden, golden_fixed};
 
 fn golden_on(name: &str) {
     let core = firmware::core(name).unwrap_or_else(|e| panic!("{e:#}"));
@@ -24,6 +25,18 @@ fn golden_on(name: &str) {
         core.machine,
         c.mismatches.iter().take(10).cloned().collect::<Vec<_>>().join("\n")
     );
+    let f = &run.fixed;
+    assert!(f.rows >= 2000, "{}: only {} fixed-point golden rows", set.display(), f.rows);
+    assert!(
+        f.mismatches.is_empty(),
+        "{} of {} fixed-point golden rows differ on {} ({}); first ones:\n{}",
+        f.mismatches.len(),
+        f.rows,
+        core.core,
+        core.target,
+        f.mismatches.iter().take(10).cloned().collect::<Vec<_>>().join("\n")
+    );
+    println!("{} ({}): {} fixed-point golden rows exactly", core.core, core.machine, f.rows);
     println!(
         "{} ({}): {} golden rows bit for bit in {:.1} s ({})",
         core.core,
@@ -73,4 +86,26 @@ fn comparison_catches_one_bit_and_allows_nan_payloads() {
     }
     assert!(golden::compare(&out(ok), &csv, "cd").is_err(), "another set's firmware must be refused");
     assert!(golden::compare(&out(ok).replace("needle-golden end rows=1\n", ""), &csv, "ab").is_err(), "truncated output");
+}
+
+/// The fixed-point comparison on hand-made output: one flipped bit of one integer, a
+/// status, a missing section and a truncated one are all caught.
+#[test]
+fn fixed_comparison_catches_one_bit() {
+    let h = golden_fixed::HEADER;
+    let row = "0,0,0,0,196608,0x00,0,80000,-3,17,0,-5";
+    let csv = format!("{h}\n{row}\n");
+    let out = |r: &str| format!("needle-golden end rows=9\nneedle-golden-fixed rows=1\n{r}\nneedle-golden-fixed end rows=1\n");
+    let c = golden_fixed::compare(&out(row), &csv).expect("well-formed");
+    assert!(c.mismatches.is_empty(), "{:?}", c.mismatches);
+    for bad in [
+        "0,0,0,0,196608,0x00,0,80001,-3,17,0,-5", // Fy one bit off
+        "0,0,0,0,196608,0x00,0,80000,-3,17,0,-4", // Mz: -5 ^ 1
+        "0,0,0,0,196608,0x10,0,80000,-3,17,0,-5", // status
+    ] {
+        let c = golden_fixed::compare(&out(bad), &csv).expect("well-formed");
+        assert_eq!(c.mismatches.len(), 1, "{bad}");
+    }
+    assert!(golden_fixed::compare("needle-golden end rows=9\n", &csv).is_err(), "no fixed section");
+    assert!(golden_fixed::compare(&out(row).replace("needle-golden-fixed end rows=1\n", ""), &csv).is_err(), "truncated");
 }

@@ -1,10 +1,13 @@
 //! The library on the three reference Cortex-M targets: it builds with every
 //! combination of its features (enumerated from the root Cargo.toml), and the `no_panic`
-//! firmware links (its panic handler calls an undefined function, so it links only if the
-//! optimiser removed every panic path from the evaluator) and runs under QEMU.
+//! (f32) and `no_panic_fixed` (fixed point) firmware link (their panic handlers call an
+//! undefined function, so they link only if the optimiser removed every panic path from
+//! the evaluator) and run under QEMU. The fixed-point evaluator is integer-only: its
+//! disassembly calls no soft-float helper and has no FPU instruction on any core (and the
+//! same check does find them in the f32 evaluator).
 //!
 //! Nothing skips: a missing rustup target, QEMU or fitted model fails with a message.
-use needle_host::firmware::{self, build, qemu, CORES};
+use needle_host::firmware::{self, build, float_check, qemu, size, CORES};
 use std::time::Duration;
 
 #[test]
@@ -26,11 +29,67 @@ fn no_panic_firmware_links_and_runs_on_every_core() {
     // The placeholder of an unfitted set has no evaluator to check: require the model.
     let set = firmware::fitted_set(&firmware::compiled_set()).unwrap_or_else(|e| panic!("{e:#}"));
     for core in &CORES {
-        let elf = build::build_examples(core, &["no_panic"], &set)
-            .unwrap_or_else(|e| panic!("no_panic for {} ({}): {e:#}", core.core, core.target))
-            .remove(0);
-        let run = qemu::run(core, &elf, false, Duration::from_secs(60)).unwrap_or_else(|e| panic!("{e:#}"));
-        assert!(run.status.success(), "no_panic on {} exited with {}: {}{}", core.core, run.status, run.stdout, run.stderr);
-        println!("{} ({}): no_panic links and runs", core.core, core.target);
+        let elfs = build::build_examples(core, &["no_panic", "no_panic_fixed"], &set)
+            .unwrap_or_else(|e| panic!("no_panic, no_panic_fixed for {} ({}): {e:#}", core.core, core.target));
+        for elf in &elfs {
+            let run = qemu::run(core, elf, false, Duration::from_secs(60)).unwrap_or_else(|e| panic!("{e:#}"));
+            assert!(
+                run.status.success(),
+                "{} on {} exited with {}: {}{}",
+                elf.display(),
+                core.core,
+                run.status,
+                run.stdout,
+                run.stderr
+            );
+        }
+        println!("{} ({}): no_panic and no_panic_fixed link and run", core.core, core.target);
+    }
+}
+
+#[test]
+fn fixed_point_evaluator_has_no_floating_point_on_any_core() {
+    let set = firmware::fitted_set(&firmware::compiled_set()).unwrap_or_else(|e| panic!("{e:#}"));
+    for core in &CORES {
+        let elfs = build::build_examples(core, &["no_panic", "no_panic_fixed"], &set).unwrap_or_else(|e| panic!("{e:#}"));
+        let fixed = float_check::analyse_elf(&elfs[1], "needle_haptics::fixed::").unwrap_or_else(|e| panic!("{e:#}"));
+        assert!(fixed.instructions > 100, "{}: {} is not the evaluator ({} instructions)", core.core, fixed.function, fixed.instructions);
+        assert!(fixed.float_calls.is_empty(), "{}: {} calls soft-float helpers {:?}", core.core, fixed.function, fixed.float_calls);
+        assert!(
+            fixed.fpu_instructions.is_empty(),
+            "{}: {} has FPU instructions: {:?}",
+            core.core,
+            fixed.function,
+            &fixed.fpu_instructions[..fixed.fpu_instructions.len().min(5)]
+        );
+        // Nothing in the whole fixed-point image is floating point.
+        let report = size::measure(core, &elfs[1], "fixed").unwrap_or_else(|e| panic!("{e:#}"));
+        let helpers: Vec<&str> =
+            report.runtime.iter().map(|s| s.name.as_str()).filter(|n| float_check::is_float_helper(n)).collect();
+        assert!(helpers.is_empty(), "{}: the fixed-point firmware links float helpers {helpers:?}", core.core);
+        // The same check on the f32 evaluator does see floating point (soft float on the
+        // M0 and M3, FPU instructions on the M4F): it can fail.
+        let f32_use = float_check::analyse_elf(&elfs[0], "needle_haptics::model_f32::").unwrap_or_else(|e| panic!("{e:#}"));
+        if core.name == "m4f" {
+            assert!(!f32_use.fpu_instructions.is_empty(), "{}: no FPU instruction found in {}", core.core, f32_use.function);
+        } else {
+            assert!(
+                f32_use.float_calls.iter().any(|c| c.starts_with("__aeabi_f")),
+                "{}: no soft-float call found in {} (calls {:?})",
+                core.core,
+                f32_use.function,
+                f32_use.calls
+            );
+        }
+        println!(
+            "{} ({}): {} ({} instructions) calls {:?}, no float; f32 evaluator: {} float calls, {} FPU instructions",
+            core.core,
+            core.target,
+            fixed.function,
+            fixed.instructions,
+            fixed.calls,
+            f32_use.float_calls.len(),
+            f32_use.fpu_instructions.len()
+        );
     }
 }

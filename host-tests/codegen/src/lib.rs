@@ -7,7 +7,10 @@
 //! - [`RUST_TABLES_FILE`] (`tables_f32.rs`): `pub const` f32 tables, every coefficient an
 //!   exact decimal literal with its bits in a comment, and per polynomial its domain and
 //!   the fit's residual against FE (the model's error bound, libm style);
-//! - [`C_HEADER_FILE`] (`needle_coeffs.h`): the same tables for C users.
+//! - [`C_HEADER_FILE`] (`needle_coeffs.h`): the same tables for C users;
+//! - [`RUST_FIXED_TABLES_FILE`] (`tables_fixed.rs`): the fixed-point tables ([`fixed`]):
+//!   Q formats chosen from the coefficients so that no integer intermediate can overflow,
+//!   the integer coefficients, and the derived error bound against f64.
 //!
 //! Every refusal is a [`CodegenError`] naming the file and the line (`path:line: what is
 //! wrong`). It is a library, so the checks are testable without running cargo.
@@ -16,17 +19,24 @@
 
 pub mod contract;
 mod error;
+pub mod fixed;
+mod fixed_bound;
 mod model;
 mod render;
+mod render_fixed;
 
 pub use error::{line_of, CodegenError};
 pub use model::{parse_bits, parse_model, parse_model_str, Baseline, Matrix, Model};
+pub use fixed::{fixed_tables, FixedTables};
 pub use render::{f32_literal, render_c_header, render_rust};
+pub use render_fixed::render_rust_fixed;
 
 use std::path::{Path, PathBuf};
 
 /// File name of the generated Rust tables in the output folder.
 pub const RUST_TABLES_FILE: &str = "tables_f32.rs";
+/// File name of the generated fixed-point tables in the output folder.
+pub const RUST_FIXED_TABLES_FILE: &str = "tables_fixed.rs";
 /// File name of the generated C header in the output folder.
 pub const C_HEADER_FILE: &str = "needle_coeffs.h";
 /// File name of the model inside a set folder.
@@ -41,22 +51,27 @@ pub struct Generated {
     pub rust: String,
     /// Text of `needle_coeffs.h`.
     pub c_header: String,
+    /// The fixed-point tables.
+    pub fixed: FixedTables,
+    /// Text of `tables_fixed.rs`.
+    pub rust_fixed: String,
     /// Where `tables_f32.rs` was written.
     pub rust_path: PathBuf,
     /// Where `needle_coeffs.h` was written.
     pub c_header_path: PathBuf,
 }
 
-/// Validates the model at `model_path` and writes [`RUST_TABLES_FILE`] and
-/// [`C_HEADER_FILE`] into `out_dir` (which must exist). A file whose contents would not
-/// change is not rewritten.
+/// Validates the model at `model_path` and writes [`RUST_TABLES_FILE`],
+/// [`C_HEADER_FILE`] and [`RUST_FIXED_TABLES_FILE`] into `out_dir` (which must exist). A
+/// file whose contents would not change is not rewritten.
 ///
 /// # Errors
 /// The model file is unreadable, is not valid TOML or departs from the contract (the
-/// error has its line), or an output file cannot be written.
+/// error has its line), a matrix or component does not fit the fixed-point evaluator
+/// ([`fixed_tables`]), or an output file cannot be written.
 pub fn generate(model_path: &Path, out_dir: &Path) -> Result<Generated, CodegenError> {
     let model = parse_model(model_path)?;
-    write_all(model, out_dir)
+    write_all(model, model_path, out_dir)
 }
 
 /// Writes the placeholder tables of a set that has no `model.toml` yet: every table is
@@ -66,17 +81,20 @@ pub fn generate(model_path: &Path, out_dir: &Path) -> Result<Generated, CodegenE
 /// # Errors
 /// An output file cannot be written.
 pub fn generate_unfitted(set: &str, out_dir: &Path) -> Result<Generated, CodegenError> {
-    write_all(Model::unfitted(set), out_dir)
+    write_all(Model::unfitted(set), Path::new(MODEL_FILE), out_dir)
 }
 
-fn write_all(model: Model, out_dir: &Path) -> Result<Generated, CodegenError> {
+fn write_all(model: Model, model_path: &Path, out_dir: &Path) -> Result<Generated, CodegenError> {
+    let fixed = fixed_tables(&model, model_path)?;
     let rust = render_rust(&model);
     let c_header = render_c_header(&model);
+    let rust_fixed = render_rust_fixed(&model, &fixed);
     let rust_path = out_dir.join(RUST_TABLES_FILE);
     let c_header_path = out_dir.join(C_HEADER_FILE);
     write_if_changed(&rust_path, &rust)?;
     write_if_changed(&c_header_path, &c_header)?;
-    Ok(Generated { model, rust, c_header, rust_path, c_header_path })
+    write_if_changed(&out_dir.join(RUST_FIXED_TABLES_FILE), &rust_fixed)?;
+    Ok(Generated { model, rust, c_header, fixed, rust_fixed, rust_path, c_header_path })
 }
 
 fn write_if_changed(path: &Path, text: &str) -> Result<(), CodegenError> {

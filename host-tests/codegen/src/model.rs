@@ -19,6 +19,8 @@ pub struct Baseline {
     pub residual_rms: f64,
     /// Maximum absolute fit residual, in the component's unit.
     pub residual_max: f64,
+    /// 1-based line of its `[[baseline]]` header in the model file (0 when unfitted).
+    pub line: usize,
 }
 
 /// One deviation matrix `D_kc(t, u)`, validated.
@@ -39,6 +41,8 @@ pub struct Matrix {
     pub residual_rms: f64,
     /// Maximum absolute residual, same definition and unit.
     pub residual_max: f64,
+    /// 1-based line of its `[[matrix]]` entry in the model file (0 when unfitted).
+    pub line: usize,
 }
 
 /// A validated model: everything the generators need.
@@ -66,6 +70,7 @@ impl Model {
                 coeffs_f32: [0.0; 5],
                 residual_rms: 0.0,
                 residual_max: 0.0,
+                line: 0,
             })
             .collect();
         let matrices = (0..24)
@@ -77,6 +82,7 @@ impl Model {
                 rows_f32: [[0.0; 5]; 5],
                 residual_rms: 0.0,
                 residual_max: 0.0,
+                line: 0,
             })
             .collect();
         Self { fitted: false, set: set.to_string(), fe_sha256: String::new(), baseline, matrices }
@@ -221,7 +227,8 @@ impl Checker<'_> {
         self.count(&baselines, 6, "[[baseline]]", baseline_span)?;
         let mut baseline = Vec::with_capacity(6);
         for (c, entry) in baselines.into_iter().enumerate() {
-            baseline.push(self.baseline(c, entry.into_inner())?);
+            let line = crate::error::line_of(self.text, entry.span().start);
+            baseline.push(Baseline { line, ..self.baseline(c, entry.into_inner())? });
         }
 
         let matrix_span = raw.matrix.span();
@@ -229,7 +236,8 @@ impl Checker<'_> {
         self.count(&matrices_raw, 24, "[[matrix]]", matrix_span)?;
         let mut matrices = Vec::with_capacity(24);
         for (n, entry) in matrices_raw.into_iter().enumerate() {
-            matrices.push(self.matrix(n / 6, n % 6, entry.into_inner())?);
+            let line = crate::error::line_of(self.text, entry.span().start);
+            matrices.push(Matrix { line, ..self.matrix(n / 6, n % 6, entry.into_inner())? });
         }
 
         Ok(Model { fitted: true, set: set.clone(), fe_sha256: hash.clone(), baseline, matrices })
@@ -365,6 +373,7 @@ impl Checker<'_> {
             coeffs_f32,
             residual_rms: self.residual(&raw.residual_rms, &format!("baseline {name}: residual_rms"))?,
             residual_max: self.residual(&raw.residual_max, &format!("baseline {name}: residual_max"))?,
+            line: 0,
         })
     }
 
@@ -425,6 +434,7 @@ impl Checker<'_> {
             rows_f32,
             residual_rms: self.residual(&raw.residual_rms, &format!("{label}: residual_rms"))?,
             residual_max: self.residual(&raw.residual_max, &format!("{label}: residual_max"))?,
+            line: 0,
         })
     }
 }

@@ -7,19 +7,23 @@ use std::process::ExitCode;
 /// `needle firmware` subcommands.
 #[derive(Subcommand)]
 pub enum FirmwareCommand {
-    /// Flash and RAM of the model per core, from arm-none-eabi-size and -nm on the
-    /// `no_panic` example ELF (release): evaluator code, tables, soft-float runtime,
-    /// static RAM, with the goals (model flash <= 8 KiB, no static RAM).
+    /// Flash and RAM of the model per core and evaluator, from arm-none-eabi-size and -nm
+    /// on the `no_panic` (f32) and `no_panic_fixed` example ELFs (release): evaluator code,
+    /// tables, compiler runtime, static RAM, with the goals (model flash <= 8 KiB, no
+    /// static RAM).
     Size(FirmwareArgs),
-    /// Instructions per 6-axis wrench and stack high-water mark per core: the `bench`
-    /// example under QEMU -icount shift=0 (SysTick counts instructions), with the goals
-    /// (<= 900 instructions on the M4F, stack <= 512 B).
+    /// Instructions per 6-axis wrench and stack high-water mark per core, f32 and fixed
+    /// point side by side: the `bench` example under QEMU -icount shift=0 (SysTick counts
+    /// instructions), with the goals (f32: <= 900 instructions on the M4F, stack <= 512 B;
+    /// fixed point: <= 10,000 instructions on the M0).
     Bench(FirmwareArgs),
     /// Run the `golden` example on each core's QEMU board and compare every printed bit
-    /// with the set's golden-f32.csv. Exit status 1 when a bit differs.
+    /// with the set's golden-f32.csv, and every fixed-point integer with its
+    /// golden-fixed.csv. Exit status 1 when a bit differs.
     Golden(FirmwareArgs),
     /// Build the library for each core with every combination of its features, and the
-    /// `no_panic` example (links only if the evaluator has no panic path).
+    /// `no_panic` and `no_panic_fixed` examples (link only if the evaluators have no panic
+    /// path).
     Check(FirmwareArgs),
 }
 
@@ -72,15 +76,19 @@ fn banner(what: &str, set: &std::path::Path) -> anyhow::Result<()> {
 fn size_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
     let set = firmware::fitted_set(&a.set())?;
     let cores = firmware::cores(&a.cores)?;
-    let reports = cores.iter().map(|c| size::run(c, &set)).collect::<anyhow::Result<Vec<_>>>()?;
+    let mut reports = Vec::new();
+    for c in &cores {
+        reports.extend(size::run(c, &set)?);
+    }
     banner("needle firmware size", &set)?;
-    println!("release profile, `no_panic` example ELF; text/data/bss from size -B, tables = .rodata, symbols from nm -S -C\n");
+    println!("release profile; f32: `no_panic` example ELF, fixed: `no_panic_fixed`; text/data/bss from size -B, tables = .rodata, symbols from nm -S -C\n");
     print!("{}", size::table(&reports));
     println!();
     for r in &reports {
         println!(
-            "goals {}: model flash {} <= 8 KiB: {}; static RAM {} B == 0: {}",
+            "goals {} {}: model flash {} <= 8 KiB: {}; static RAM {} B == 0: {}",
             r.core.core,
+            r.evaluator,
             size::bytes(r.model_flash()),
             goal(r.model_flash() <= 8 * 1024),
             r.static_ram(),
@@ -99,7 +107,7 @@ fn bench_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
     print!("{}", bench::table(&figures));
     println!();
     for f in &figures {
-        let Some(t) = f.pose("typical") else { continue };
+        let Some(t) = f.pose("typical", "f32") else { continue };
         let max_stack = f.poses.iter().map(|p| p.stack_bytes).max().unwrap_or(0);
         let instr_goal = if f.core.name == "m4f" {
             format!("; <= 900 instructions: {}", goal(t.instructions <= 900.0))
@@ -112,6 +120,19 @@ fn bench_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
             t.instructions,
             goal(max_stack <= 512)
         );
+        if let Some(q) = f.pose("typical", "fixed") {
+            let m0_goal = if f.core.name == "m0" {
+                format!("; <= 10,000 instructions on the M0: {}", goal(q.instructions <= 10_000.0))
+            } else {
+                String::new()
+            };
+            println!(
+                "fixed point {}: {:.1} instructions per wrench (typical pose), {:.2}x the f32 evaluator's speed{m0_goal}",
+                f.core.core,
+                q.instructions,
+                t.instructions / q.instructions
+            );
+        }
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -135,7 +156,12 @@ fn golden_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
         for line in m.iter().take(10) {
             println!("  {line}");
         }
-        failed |= !m.is_empty();
+        let mf = &run.fixed.mismatches;
+        println!("{} ({}): {} of {} fixed-point golden rows differ", c.core, c.target, mf.len(), run.fixed.rows);
+        for line in mf.iter().take(10) {
+            println!("  {line}");
+        }
+        failed |= !m.is_empty() || !mf.is_empty();
     }
     Ok(if failed { ExitCode::from(1) } else { ExitCode::SUCCESS })
 }
@@ -148,9 +174,9 @@ fn check_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
         for combo in build::feature_combinations(&features) {
             build::build_library(c, &combo, &set)?;
         }
-        build::build_examples(c, &["no_panic"], &set)?;
+        build::build_examples(c, &["no_panic", "no_panic_fixed"], &set)?;
         println!(
-            "{} ({}): library builds with all {} feature combinations; no_panic links",
+            "{} ({}): library builds with all {} feature combinations; no_panic and no_panic_fixed link",
             c.core,
             c.target,
             1usize << features.len()

@@ -1,6 +1,6 @@
 //! `needle fit`, `needle validate`: fit the model, compare it with FE.
 use crate::fe::results::write_atomic;
-use crate::fit::{self, validate as val, GOLDEN_FILE, MODEL_FILE};
+use crate::fit::{self, validate as val, GOLDEN_FILE, GOLDEN_FIXED_FILE, MODEL_FILE};
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -9,8 +9,8 @@ use std::process::ExitCode;
 /// Arguments of `needle fit`.
 #[derive(Args)]
 pub struct FitArgs {
-    /// The set folder (holds campaign.toml and fe/); model.toml and golden-f32.csv are
-    /// written there.
+    /// The set folder (holds campaign.toml and fe/); model.toml, golden-f32.csv and
+    /// golden-fixed.csv are written there.
     #[arg(long, value_name = "DIR")]
     pub set: PathBuf,
     /// Regenerate in memory and compare with the files in the set: exit 1 if they differ,
@@ -64,8 +64,8 @@ fn check_file(path: &Path, want: &str) -> Result<bool> {
     }
 }
 
-/// `needle fit --set DIR [--check]`: fit the set's FE sweeps and write `model.toml` and
-/// `golden-f32.csv` atomically (or, with `--check`, compare them). Exit code 0 on
+/// `needle fit --set DIR [--check]`: fit the set's FE sweeps and write `model.toml`,
+/// `golden-f32.csv` and `golden-fixed.csv` atomically (or, with `--check`, compare them). Exit code 0 on
 /// success, 1 when `--check` finds a difference.
 ///
 /// # Errors
@@ -75,16 +75,20 @@ pub fn fit(a: FitArgs) -> Result<ExitCode> {
     let out = fit::fit_set(&a.set).with_context(|| format!("needle fit --set {}", a.set.display()))?;
     let model_path = a.set.join(MODEL_FILE);
     let golden_path = a.set.join(GOLDEN_FILE);
+    let golden_fixed_path = a.set.join(GOLDEN_FIXED_FILE);
     if a.check {
         let ok_model = check_file(&model_path, &out.model_toml)?;
         let ok_golden = check_file(&golden_path, &out.golden_csv)?;
-        return Ok(if ok_model && ok_golden { ExitCode::SUCCESS } else { ExitCode::from(1) });
+        let ok_fixed = check_file(&golden_fixed_path, &out.golden_fixed_csv)?;
+        return Ok(if ok_model && ok_golden && ok_fixed { ExitCode::SUCCESS } else { ExitCode::from(1) });
     }
     write_atomic(&model_path, out.model_toml.as_bytes())?;
     write_atomic(&golden_path, out.golden_csv.as_bytes())?;
+    write_atomic(&golden_fixed_path, out.golden_fixed_csv.as_bytes())?;
     print!("{}", fit::summary(&out.model));
     println!("wrote {} ({} bytes)", model_path.display(), out.model_toml.len());
     println!("wrote {} ({} poses)", golden_path.display(), out.golden_csv.lines().count() - 1);
+    println!("wrote {} ({} poses)", golden_fixed_path.display(), out.golden_fixed_csv.lines().count() - 1);
     Ok(ExitCode::SUCCESS)
 }
 

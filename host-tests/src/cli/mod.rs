@@ -3,4 +3,5 @@
 pub mod fe;
 pub mod firmware;
 pub mod fit;
+pub mod fixed;
 pub mod model;

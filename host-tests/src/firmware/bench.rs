@@ -10,6 +10,8 @@ use std::time::Duration;
 pub struct PoseFigures {
     /// The firmware's name of the pose (`typical`, `positive`, `saturated`, `nan-input`).
     pub pose: String,
+    /// The evaluator timed: `f32` or `fixed`.
+    pub evaluator: String,
     /// Executed instructions per `wrench` call (call, return and result store included).
     pub instructions: f64,
     /// Stack bytes used by one call, from the caller's stack pointer.
@@ -30,10 +32,10 @@ pub struct CoreFigures {
 }
 
 impl CoreFigures {
-    /// The figures of the pose named `name`.
+    /// The figures of the pose named `name` with the evaluator `evaluator` (`f32`, `fixed`).
     #[must_use]
-    pub fn pose(&self, name: &str) -> Option<&PoseFigures> {
-        self.poses.iter().find(|p| p.pose == name)
+    pub fn pose(&self, name: &str, evaluator: &str) -> Option<&PoseFigures> {
+        self.poses.iter().find(|p| p.pose == name && p.evaluator == evaluator)
     }
 }
 
@@ -68,6 +70,7 @@ pub fn parse(core: &Core, output: &str) -> anyhow::Result<CoreFigures> {
         }
         let ctx = || format!("bench line {line:?}");
         let pose = field(line, "pose").with_context(ctx)?.to_string();
+        let evaluator = field(line, "evaluator").with_context(ctx)?.to_string();
         let instructions: f64 =
             field(line, "instructions_per_wrench").and_then(|v| v.parse().ok()).with_context(ctx)?;
         let stack = field(line, "stack_bytes").with_context(ctx)?;
@@ -79,7 +82,7 @@ pub fn parse(core: &Core, output: &str) -> anyhow::Result<CoreFigures> {
             .and_then(|s| s.strip_prefix("0x"))
             .and_then(|s| u8::from_str_radix(s, 16).ok())
             .with_context(ctx)?;
-        poses.push(PoseFigures { pose, instructions, stack_bytes, status });
+        poses.push(PoseFigures { pose, evaluator, instructions, stack_bytes, status });
     }
     if !ended || poses.is_empty() {
         bail!("the bench output is incomplete:\n{output}");
@@ -104,16 +107,17 @@ pub fn run(core: &Core, set: &Path) -> anyhow::Result<CoreFigures> {
 #[must_use]
 pub fn table(figures: &[CoreFigures]) -> String {
     let mut s = format!(
-        "{:<11} {:<22} {:<10} {:>22} {:>12} {:>7}\n",
-        "core", "target", "pose", "instructions/wrench", "stack bytes", "status"
+        "{:<11} {:<22} {:<10} {:<6} {:>22} {:>12} {:>7}\n",
+        "core", "target", "pose", "eval", "instructions/wrench", "stack bytes", "status"
     );
     for f in figures {
         for p in &f.poses {
             s.push_str(&format!(
-                "{:<11} {:<22} {:<10} {:>22.1} {:>12} {:>7}\n",
+                "{:<11} {:<22} {:<10} {:<6} {:>22.1} {:>12} {:>7}\n",
                 f.core.core,
                 f.core.target,
                 p.pose,
+                p.evaluator,
                 p.instructions,
                 p.stack_bytes,
                 format!("{:#04x}", p.status)

@@ -129,12 +129,15 @@ pub struct CoreRun {
     pub core: Core,
     /// The comparison with the golden file.
     pub comparison: Comparison,
+    /// The comparison of the fixed-point section with golden-fixed.csv.
+    pub fixed: Comparison,
     /// Wall-clock time of the QEMU run.
     pub run_time: Duration,
 }
 
 /// Builds the `golden` example of the fitted set `set` (absolute path) for `core`, runs
-/// it under QEMU and compares its output with `set/golden-f32.csv`.
+/// it under QEMU and compares its output with `set/golden-f32.csv` and its fixed-point
+/// section with `set/golden-fixed.csv`.
 ///
 /// # Errors
 /// Build, QEMU run or output structure failed (see [`compare`]); mismatching values are
@@ -142,6 +145,9 @@ pub struct CoreRun {
 pub fn run(core: &Core, set: &Path) -> anyhow::Result<CoreRun> {
     let golden = set.join("golden-f32.csv");
     let csv = std::fs::read_to_string(&golden).with_context(|| format!("cannot read {}", golden.display()))?;
+    let golden_fixed = set.join("golden-fixed.csv");
+    let csv_fixed =
+        std::fs::read_to_string(&golden_fixed).with_context(|| format!("cannot read {}", golden_fixed.display()))?;
     let model_path = set.join(needle_codegen::MODEL_FILE);
     let model = needle_codegen::parse_model(&model_path).map_err(anyhow::Error::new)?;
     let elf = build::build_examples(core, &["golden"], set)?.remove(0);
@@ -159,5 +165,7 @@ pub fn run(core: &Core, set: &Path) -> anyhow::Result<CoreRun> {
     }
     let comparison = compare(&run.stdout, &csv, &model.fe_sha256)
         .with_context(|| format!("golden firmware on {} ({})", core.core, core.machine))?;
-    Ok(CoreRun { core: *core, comparison, run_time: run.elapsed })
+    let fixed = super::golden_fixed::compare(&run.stdout, &csv_fixed)
+        .with_context(|| format!("golden firmware on {} ({}), fixed point", core.core, core.machine))?;
+    Ok(CoreRun { core: *core, comparison, fixed, run_time: run.elapsed })
 }

@@ -13,7 +13,9 @@
 
 pub mod bench;
 pub mod build;
+pub mod float_check;
 pub mod golden;
+pub mod golden_fixed;
 pub mod qemu;
 pub mod size;
 
@@ -87,17 +89,17 @@ pub fn compiled_set() -> PathBuf {
 /// Checks that `set` is a fitted set with golden vectors, and returns its absolute path.
 ///
 /// # Errors
-/// The folder, its `model.toml` or its `golden-f32.csv` is missing: the firmware would
+/// The folder, its `model.toml`, `golden-f32.csv` or `golden-fixed.csv` is missing: the firmware would
 /// hold the unfitted placeholder model, whose figures mean nothing.
 pub fn fitted_set(set: &Path) -> anyhow::Result<PathBuf> {
     let dir = std::fs::canonicalize(set)
         .map_err(|e| anyhow::anyhow!("{}: not a coefficient set folder ({e})", set.display()))?;
-    for file in [needle_codegen::MODEL_FILE, "golden-f32.csv"] {
+    for file in [needle_codegen::MODEL_FILE, "golden-f32.csv", "golden-fixed.csv"] {
         if !dir.join(file).is_file() {
             anyhow::bail!(
                 "{}: no {file}: the set is not fitted yet, so the firmware would hold the unfitted \
                  placeholder (every evaluation returns NO_MODEL | ERROR). Run `needle fit --set {}` \
-                 (it writes model.toml and golden-f32.csv) and retry",
+                 (it writes model.toml, golden-f32.csv and golden-fixed.csv) and retry",
                 dir.display(),
                 dir.display()
             );

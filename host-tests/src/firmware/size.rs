@@ -1,4 +1,5 @@
-//! Flash and RAM of the model on each core, from binutils on the `no_panic` example ELF.
+//! Flash and RAM of the model on each core, from binutils on the `no_panic` example ELF
+//! (f32 evaluator) and the `no_panic_fixed` one (fixed-point evaluator).
 //!
 //! `no_panic` is the smallest firmware holding the model: cortex-m-rt's vector table and
 //! startup, a `main` that calls [`needle_haptics::wrench`] through a function pointer
@@ -55,11 +56,13 @@ pub struct Symbol {
     pub name: String,
 }
 
-/// Flash and RAM of the model in one core's `no_panic` ELF.
+/// Flash and RAM of the model in one core's `no_panic` (or `no_panic_fixed`) ELF.
 #[derive(Debug, Clone)]
 pub struct SizeReport {
     /// The core.
     pub core: Core,
+    /// Which evaluator the ELF holds: `f32` (`no_panic`) or `fixed` (`no_panic_fixed`).
+    pub evaluator: &'static str,
     /// The ELF measured.
     pub elf: PathBuf,
     /// Berkeley `size`: text (code and read-only data, flash), data (flash and RAM), bss (RAM).
@@ -71,7 +74,7 @@ pub struct SizeReport {
     /// Bytes of the `.rodata` section (the model's tables).
     pub tables: u64,
     /// The library's code symbols (`wrench`).
-    pub evaluator: Vec<Symbol>,
+    pub evaluator_code: Vec<Symbol>,
     /// The compiler runtime functions in the image (soft float).
     pub runtime: Vec<Symbol>,
     /// Named read-only data symbols inside `.rodata` (may be none).
@@ -82,7 +85,7 @@ impl SizeReport {
     /// Bytes of the evaluator's code.
     #[must_use]
     pub fn evaluator_bytes(&self) -> u64 {
-        self.evaluator.iter().map(|s| s.size).sum()
+        self.evaluator_code.iter().map(|s| s.size).sum()
     }
 
     /// Bytes of the compiler runtime functions.
@@ -157,7 +160,7 @@ fn is_runtime(name: &str) -> bool {
 ///
 /// # Errors
 /// binutils missing or their output unexpected.
-pub fn measure(core: &Core, elf: &Path) -> anyhow::Result<SizeReport> {
+pub fn measure(core: &Core, elf: &Path, evaluator: &'static str) -> anyhow::Result<SizeReport> {
     let size = binutil("size")?;
     let nm = binutil("nm")?;
     let (text, data, bss) = parse_berkeley(&output(&size, &["-B"], elf)?)?;
@@ -165,7 +168,9 @@ pub fn measure(core: &Core, elf: &Path) -> anyhow::Result<SizeReport> {
     let tables = section_size(&sysv, ".rodata");
     let symbols = parse_nm(&output(&nm, &["-S", "-C"], elf)?);
     let code = |s: &&Symbol| matches!(s.kind, 't' | 'T' | 'W' | 'w');
-    let evaluator = symbols.iter().filter(code).filter(|s| s.name.starts_with("needle_haptics::")).cloned().collect();
+    let evaluator_code =
+        symbols.iter().filter(code).filter(|s| s.name.starts_with("needle_haptics::")).cloned().collect();
+    let which = evaluator;
     let runtime = symbols.iter().filter(code).filter(|s| is_runtime(&s.name)).cloned().collect();
     let rodata_start = symbols.iter().find(|s| s.name == "__srodata").map(|s| s.addr);
     let table_symbols = symbols
@@ -173,16 +178,32 @@ pub fn measure(core: &Core, elf: &Path) -> anyhow::Result<SizeReport> {
         .filter(|s| matches!(s.kind, 'r' | 'R') && !s.name.starts_with("__") && rodata_start.is_none_or(|r| s.addr >= r))
         .cloned()
         .collect();
-    Ok(SizeReport { core: *core, elf: elf.to_path_buf(), text, data, bss, tables, evaluator, runtime, table_symbols })
+    Ok(SizeReport {
+        core: *core,
+        evaluator: which,
+        elf: elf.to_path_buf(),
+        text,
+        data,
+        bss,
+        tables,
+        evaluator_code,
+        runtime,
+        table_symbols,
+    })
 }
 
-/// Builds `no_panic` for `core` with the set `set` and measures it.
+/// The evaluators and the firmware example that holds each alone.
+pub const EVALUATORS: [(&str, &str); 2] = [("f32", "no_panic"), ("fixed", "no_panic_fixed")];
+
+/// Builds `no_panic` and `no_panic_fixed` for `core` with the set `set` and measures
+/// both (f32 first).
 ///
 /// # Errors
 /// Build failed or binutils missing.
-pub fn run(core: &Core, set: &Path) -> anyhow::Result<SizeReport> {
-    let elf = build::build_examples(core, &["no_panic"], set)?.remove(0);
-    measure(core, &elf)
+pub fn run(core: &Core, set: &Path) -> anyhow::Result<Vec<SizeReport>> {
+    let names: Vec<&str> = EVALUATORS.iter().map(|(_, e)| *e).collect();
+    let elfs = build::build_examples(core, &names, set)?;
+    EVALUATORS.iter().zip(&elfs).map(|((which, _), elf)| measure(core, elf, which)).collect()
 }
 
 /// `1234 B (1.21 KiB)`.
@@ -199,14 +220,15 @@ pub fn bytes(n: u64) -> String {
 #[must_use]
 pub fn table(reports: &[SizeReport]) -> String {
     let mut s = format!(
-        "{:<11} {:<22} {:>8} {:>6} {:>6} | {:>9} {:>8} {:>10} | {:>20} {:>11}\n",
-        "core", "target", "text", "data", "bss", "evaluator", "tables", "float rt", "model flash", "static RAM"
+        "{:<11} {:<22} {:<6} {:>8} {:>6} {:>6} | {:>9} {:>8} {:>10} | {:>20} {:>11}\n",
+        "core", "target", "eval", "text", "data", "bss", "evaluator", "tables", "runtime", "model flash", "static RAM"
     );
     for r in reports {
         s.push_str(&format!(
-            "{:<11} {:<22} {:>8} {:>6} {:>6} | {:>9} {:>8} {:>10} | {:>20} {:>11}\n",
+            "{:<11} {:<22} {:<6} {:>8} {:>6} {:>6} | {:>9} {:>8} {:>10} | {:>20} {:>11}\n",
             r.core.core,
             r.core.target,
+            r.evaluator,
             format!("{} B", r.text),
             format!("{} B", r.data),
             format!("{} B", r.bss),
@@ -218,8 +240,8 @@ pub fn table(reports: &[SizeReport]) -> String {
         ));
     }
     for r in reports {
-        s.push_str(&format!("\n{} ({}), {}:\n", r.core.core, r.core.target, r.elf.display()));
-        for sym in r.evaluator.iter().chain(&r.table_symbols).chain(&r.runtime) {
+        s.push_str(&format!("\n{} ({}), {} evaluator, {}:\n", r.core.core, r.core.target, r.evaluator, r.elf.display()));
+        for sym in r.evaluator_code.iter().chain(&r.table_symbols).chain(&r.runtime) {
             s.push_str(&format!("  {:>6} B  {}  {}\n", sym.size, sym.kind, sym.name));
         }
         s.push_str(&format!("  {:>6} B  .rodata section (tables, whole)\n", r.tables));

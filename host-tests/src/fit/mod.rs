@@ -1,17 +1,22 @@
-//! The fitter: FE sweeps -> `model.toml` and `golden-f32.csv` (coeffs/README.md), and the
+//! The fitter: FE sweeps -> `model.toml`, `golden-f32.csv` and `golden-fixed.csv`
+//! (coeffs/README.md), and the
 //! validation of a fitted model against the FE runs it was not fitted on.
 //!
 //! Pipeline: [`data::load_fit_data`] reads the centre and sweep runs, [`model::fit`] fits
 //! the paper model by least squares ([`lsq`]) in normalised variables,
 //! [`model_file::to_toml`] writes it, [`golden::to_csv`] evaluates it with this crate's
-//! own f32 implementation of the contract ([`eval_f32`]). [`validate`] compares the
+//! own f32 implementation of the contract ([`eval_f32`]), [`golden_fixed::to_csv`] with its
+//! own fixed-point implementation ([`fixed_formats`], [`eval_fixed`]). [`validate`] compares the
 //! model ([`eval_f64`], [`eval_f32`]) with the validation runs.
 
 pub mod contract;
 pub mod data;
 pub mod eval_f32;
 pub mod eval_f64;
+pub mod eval_fixed;
+pub mod fixed_formats;
 pub mod golden;
+pub mod golden_fixed;
 pub mod lsq;
 pub mod model;
 pub mod model_file;
@@ -25,6 +30,8 @@ use std::path::Path;
 pub const MODEL_FILE: &str = "model.toml";
 /// Name of the golden-vector file inside a set folder.
 pub const GOLDEN_FILE: &str = "golden-f32.csv";
+/// Name of the fixed-point golden-vector file inside a set folder.
+pub const GOLDEN_FIXED_FILE: &str = "golden-fixed.csv";
 
 /// What `needle fit` produces for a set, in memory.
 #[derive(Debug, Clone)]
@@ -35,19 +42,22 @@ pub struct FitOutput {
     pub model_toml: String,
     /// The text of `golden-f32.csv`.
     pub golden_csv: String,
+    /// The text of `golden-fixed.csv`.
+    pub golden_fixed_csv: String,
 }
 
-/// Fit the set in `set_dir` and render both output files, without writing anything.
+/// Fit the set in `set_dir` and render the three output files, without writing anything.
 ///
 /// # Errors
 /// As [`data::load_fit_data`] (missing or malformed runs, bad spec) and [`model::fit`]
-/// (rank-deficient fits).
+/// (rank-deficient fits); a model too large for the fixed-point evaluator.
 pub fn fit_set(set_dir: &Path) -> Result<FitOutput> {
     let data = data::load_fit_data(set_dir)?;
     let model = model::fit(&data)?;
     let model_toml = model_file::to_toml(&model);
     let golden_csv = golden::to_csv(&eval_f32::Tables32::from_model(&model));
-    Ok(FitOutput { model, model_toml, golden_csv })
+    let golden_fixed_csv = golden_fixed::to_csv(&fixed_formats::TablesFixed::from_model(&model)?)?;
+    Ok(FitOutput { model, model_toml, golden_csv, golden_fixed_csv })
 }
 
 /// A plain-text table of the fit residuals (RMS and max, in N or N·mm).

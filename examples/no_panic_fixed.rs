@@ -1,0 +1,53 @@
+//! Firmware example `no_panic_fixed`: the fixed-point evaluator alone, with a panic
+//! handler that cannot link (see `no_panic`): the firmware links only if nothing reachable
+//! from `main` ([`needle_haptics::fixed::wrench`] through an opaque function pointer on an
+//! opaque pose, so it is compiled for every input) can panic.
+//!
+//! It holds no floating-point code at all, so it also shows that the fixed-point path is
+//! integer-only (host-tests/tests/firmware_no_panic.rs disassembles it: no soft-float
+//! helper in the image on the M0 and M3, no FPU instruction in the evaluator on the M4F),
+//! and `needle firmware size` measures the fixed-point model's flash on it.
+//!
+//! ```text
+//! cargo build --release --example no_panic_fixed --target thumbv6m-none-eabi
+//! ```
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use core::hint::black_box;
+    use core::panic::PanicInfo;
+    use cortex_m_semihosting::debug;
+    use needle_haptics::fixed::{self, Evaluation, Pose};
+
+    extern "C" {
+        /// Defined nowhere: a reference left to it is a link error.
+        fn needle_haptics_panic_path_not_optimised_away() -> !;
+    }
+
+    #[panic_handler]
+    fn panic(_info: &PanicInfo) -> ! {
+        // SAFETY: never runs; if a call to the handler survives optimisation, the firmware
+        // does not link, which is the point of this example.
+        unsafe { needle_haptics_panic_path_not_optimised_away() }
+    }
+
+    #[cortex_m_rt::entry]
+    fn main() -> ! {
+        let eval: fn(&Pose) -> Evaluation = black_box(fixed::wrench);
+        let one = Pose::ONE;
+        let pose = black_box(Pose::new(3 * one, -2 * one, 5 * one, -7 * one, 9 * one / 2));
+        let e = eval(&pose);
+        black_box((e.status.bits(), e.status.is_error(), e.status.saturated(), e.wrench.to_array()));
+        debug::exit(debug::EXIT_SUCCESS);
+        loop {
+            cortex_m::asm::bkpt();
+        }
+    }
+}
+
+/// On the host this example does nothing: it is firmware.
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!("`no_panic_fixed` is firmware: cargo build --release --example no_panic_fixed --target thumbv6m-none-eabi");
+}

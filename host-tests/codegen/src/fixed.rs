@@ -1,0 +1,180 @@
+//! The fixed-point tables (coeffs/README.md, "Fixed-point evaluation"): the Q format of
+//! every row polynomial and of every component's accumulator, chosen from the f64
+//! coefficients so that no intermediate of the integer evaluation can exceed
+//! [`LIMIT`] anywhere in the domain (exact integer interval bounds), the integer
+//! coefficients, and the error bound of the integer evaluation against the f64
+//! evaluation of the same model.
+//!
+//! Everything here is exact integer arithmetic on the quantised coefficients except
+//! [`quantize`] (one specified f64 rounding chain) and the error bound (f64, rounded up
+//! by a safety factor), so a second implementation of the rules in coeffs/README.md
+//! picks the same formats and integers.
+use crate::contract::{COMPONENTS, SWEEPS};
+use crate::error::CodegenError;
+use crate::fixed_bound::{error_bound, ErrorBound};
+use crate::model::Model;
+use std::path::Path;
+
+/// Fractional bits of the fixed-point pose inputs (Q16.16: mm or degrees times 65536).
+pub const POSE_FRAC_BITS: u32 = 16;
+/// Fractional bits of the normalised inputs `U`, `T_k` (Q15, in `[-32768, 32768]`).
+pub const NORM_FRAC_BITS: u32 = 15;
+/// `U = (D + DEPTH_DIVISOR / 2) / DEPTH_DIVISOR - 32768` (integer division of the
+/// clamped Q16 depth: u = d / 3 - 1 in Q15, rounded to nearest).
+pub const DEPTH_DIVISOR: u32 = 6;
+/// `T_k = (|V_k| + d / 2) / d - 32768` with `d = SWEEP_DIVISORS[k]` (x, z: 12; theta_x,
+/// theta_z: 15): t = |v| * 2 / V - 1 in Q15, rounded to nearest.
+pub const SWEEP_DIVISORS: [u32; 4] = [12, 12, 15, 15];
+/// Every intermediate of the integer evaluation has a magnitude of at most `2^30`.
+pub const LIMIT: i64 = 1 << 30;
+/// Largest number of fractional bits of any format.
+pub const MAX_FRAC_BITS: u32 = 30;
+/// Output unit: micro-newtons and micro-newton millimetres (coefficients are scaled by 10^6).
+pub const OUTPUT_SCALE: f64 = 1e6;
+
+/// The quantised coefficient `round(c * 10^6 * 2^f)`: one f64 multiplication by 10^6
+/// (round to nearest even), an exact scaling by `2^f`, then rounding to the nearest
+/// integer, ties away from zero (saturating at the i64 range, far beyond [`LIMIT`]).
+#[must_use]
+pub fn quantize(c: f64, frac_bits: u32) -> i64 {
+    let scaled = c * OUTPUT_SCALE;
+    (scaled * (1u64 << frac_bits) as f64).round() as i64
+}
+
+/// One row polynomial `r(t) = sum_j P[j] t^j` in Q(`frac_bits`) micro-units.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FixedRow {
+    /// Integer coefficients; `coeffs[j]` multiplies `t^j`.
+    pub coeffs: [i32; 5],
+    /// Fractional bits `f` of the row (its value is `r * 2^-f` micro-units).
+    pub frac_bits: u32,
+    /// `sum_j |coeffs[j]|`: bound of every Horner intermediate of the row over `|t| <= 1`.
+    pub bound: i64,
+}
+
+/// One wrench component: its 20 row polynomials, the shifts that align them to the
+/// component's accumulator format, the baseline in that format, and the bounds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FixedComponent {
+    /// `rows[k][i]`: row `i` (power of u) of sweep `k`'s deviation matrix.
+    pub rows: [[FixedRow; 5]; 4],
+    /// `shifts[k][i] = rows[k][i].frac_bits - frac_bits` (>= 0).
+    pub shifts: [[u32; 5]; 4],
+    /// Baseline coefficients in Q(`frac_bits`); `baseline[i]` multiplies `u^i`.
+    pub baseline: [i32; 5],
+    /// Fractional bits `G` of the accumulator `A_i` and of the Horner in `u`.
+    pub frac_bits: u32,
+    /// Bound of `|A_i|` (every partial sum) per `i`.
+    pub a_bounds: [i64; 5],
+    /// `sum_i a_bounds[i]`: bound of every intermediate of the Horner in `u`.
+    pub horner_bound: i64,
+    /// Error bound of the integer result against the f64 evaluation, in micro-units.
+    pub error_bound: ErrorBound,
+}
+
+/// The fixed-point tables of a model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FixedTables {
+    /// One entry per component, contract order.
+    pub components: [FixedComponent; 6],
+}
+
+/// The largest `f` in `0..=MAX_FRAC_BITS` whose quantised row fits: `sum_j |q(c_j, f)| <= LIMIT`.
+fn choose_row(c: &[f64; 5]) -> Option<FixedRow> {
+    (0..=MAX_FRAC_BITS).rev().find_map(|f| {
+        let q = c.map(|v| quantize(v, f));
+        let bound = q.iter().map(|v| i128::from(*v).abs()).sum::<i128>();
+        (bound <= i128::from(LIMIT)).then(|| FixedRow {
+            coeffs: q.map(|v| v as i32),
+            frac_bits: f,
+            bound: bound as i64,
+        })
+    })
+}
+
+/// `ceil(s / 2^shift)` for `s >= 0`: the bound of `|r >> shift|` when `|r| <= s`.
+fn shifted_bound(s: i64, shift: u32) -> i64 {
+    (s + (1i64 << shift) - 1) >> shift
+}
+
+/// `(a_bounds, horner_bound, baseline)` of a component at accumulator format `g`.
+fn component_bounds(rows: &[[FixedRow; 5]; 4], base: &[f64; 5], g: u32) -> ([i64; 5], i64, [i64; 5]) {
+    let baseline = base.map(|b| quantize(b, g));
+    let mut a = [0i64; 5];
+    for (i, ai) in a.iter_mut().enumerate() {
+        let mut s = i128::from(baseline[i]).abs();
+        for row in rows {
+            s += i128::from(shifted_bound(row[i].bound, row[i].frac_bits - g));
+        }
+        *ai = s.min(i128::from(i64::MAX)) as i64;
+    }
+    let total = a.iter().map(|v| i128::from(*v)).sum::<i128>().min(i128::from(i64::MAX)) as i64;
+    (a, total, baseline)
+}
+
+/// Chooses every format of `model` and quantises its coefficients.
+///
+/// # Errors
+/// A row polynomial or a component cannot be represented within [`LIMIT`] even with
+/// no fractional bits (coefficients of the order of 1,000 N or N·mm); the error names
+/// the matrix (or baseline), its line in `model_path` and the bound that is exceeded.
+pub fn fixed_tables(model: &Model, model_path: &Path) -> Result<FixedTables, CodegenError> {
+    let at = |line: usize, message: String| CodegenError {
+        path: model_path.to_path_buf(),
+        line: (line > 0).then_some(line),
+        message,
+    };
+    let zero_row = FixedRow { coeffs: [0; 5], frac_bits: 0, bound: 0 };
+    let mut components = Vec::with_capacity(6);
+    for (c, base) in model.baseline.iter().enumerate() {
+        let mut rows = [[zero_row; 5]; 4];
+        for m in model.matrices.iter().filter(|m| m.component == c) {
+            for (i, row) in m.rows.iter().enumerate() {
+                rows[m.sweep][i] = choose_row(row).ok_or_else(|| {
+                    let sum: f64 = row.iter().map(|v| v.abs()).sum();
+                    at(
+                        m.line,
+                        format!(
+                            "matrix {}/{}: row u^{i} does not fit the fixed-point evaluator: sum_j |rows[{i}][j]| = {sum:e} {}, which is {:.0} micro-units even with 0 fractional bits; every integer intermediate is limited to 2^30 = {LIMIT} micro-units (1073.7 N or N*mm)",
+                            SWEEPS[m.sweep],
+                            COMPONENTS[c],
+                            crate::contract::UNITS[c],
+                            sum * OUTPUT_SCALE
+                        ),
+                    )
+                })?;
+            }
+        }
+        let max_g = rows.iter().flatten().map(|r| r.frac_bits).min().unwrap_or(MAX_FRAC_BITS);
+        let chosen = (0..=max_g).rev().find_map(|g| {
+            let (a, total, baseline) = component_bounds(&rows, &base.coeffs, g);
+            (total <= LIMIT).then_some((g, a, total, baseline))
+        });
+        let Some((g, a_bounds, horner_bound, baseline)) = chosen else {
+            let (_, total, _) = component_bounds(&rows, &base.coeffs, 0);
+            return Err(at(
+                base.line,
+                format!(
+                    "baseline {0}: component {0} does not fit the fixed-point evaluator: the baseline plus the four deviations (matrices x/{0} .. theta_z/{0}) can reach {total} micro-units ({1}) in the domain even with 0 fractional bits, over the limit 2^30 = {LIMIT} of every integer intermediate",
+                    COMPONENTS[c],
+                    crate::contract::UNITS[c]
+                ),
+            ));
+        };
+        let shifts = rows.map(|r| r.map(|row| row.frac_bits - g));
+        let mut comp = FixedComponent {
+            rows,
+            shifts,
+            baseline: baseline.map(|v| v as i32),
+            frac_bits: g,
+            a_bounds,
+            horner_bound,
+            error_bound: ErrorBound::default(),
+        };
+        comp.error_bound = error_bound(model, c, &comp);
+        components.push(comp);
+    }
+    let components: [FixedComponent; 6] =
+        components.try_into().map_err(|_| at(0, "the model does not have 6 components".into()))?;
+    Ok(FixedTables { components })
+}

@@ -1,0 +1,134 @@
+//! The error bound of the fixed-point evaluation against the f64 evaluation of the same
+//! model (coeffs/README.md, "Fixed-point error bound"), per component, in micro-units.
+//!
+//! For a pose in the domain, with exact normalised inputs `u`, `t_k` and the integer
+//! evaluator's `U / 2^15`, `T_k / 2^15` (within half a Q15 step of them):
+//!
+//! |fixed - f64| <= arithmetic + coefficients + inputs + output
+//!
+//! - *arithmetic*: every floor of the integer evaluation loses less than one unit of its
+//!   format, and every later step multiplies that loss by `|t|` or `|u|` <= 1: four
+//!   floors per row polynomial (`4 * 2^-f`), one per alignment shift that is not zero
+//!   (`2^-G`), four in the Horner in u (`4 * 2^-G`);
+//! - *coefficients*: `sum |P * 2^-f - c * 10^6|` over every coefficient (each multiplies a
+//!   product of powers of `|u|, |t|` <= 1), plus the rounding of `c * 10^6` in f64;
+//! - *inputs*: the model's slope times the rounding of the inputs:
+//!   `2^-16 * (sup|dw/du| + sum_k sup|dD_k/dt|)`, each `sup` over `[-1, 1]^2` bounded by
+//!   the maximum on a 257 x 257 grid plus (half the grid step) x (a coefficient-sum bound
+//!   of the polynomial's own slopes), so that it is rigorous between grid points;
+//! - *output*: the final rounding to whole micro-units, 0.5.
+use crate::fixed::{FixedComponent, NORM_FRAC_BITS, OUTPUT_SCALE};
+use crate::model::Model;
+
+/// The error bound of one component, term by term, in micro-units (µN or µN·mm).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ErrorBound {
+    /// Rounding of the integer arithmetic (Horner floors, alignment shifts).
+    pub arithmetic: f64,
+    /// Rounding of the f64 coefficients to integers.
+    pub coefficients: f64,
+    /// Rounding of the normalised inputs `U`, `T_k` to Q15.
+    pub inputs: f64,
+    /// Rounding of the result to whole micro-units.
+    pub output: f64,
+}
+
+impl ErrorBound {
+    /// The whole bound, raised by a relative `1e-9` for the f64 arithmetic of the bound
+    /// itself.
+    #[must_use]
+    pub fn total(&self) -> f64 {
+        (self.arithmetic + self.coefficients + self.inputs + self.output) * (1.0 + 1e-9)
+    }
+
+    /// The whole bound in whole micro-units, rounded up.
+    #[must_use]
+    pub fn total_micro(&self) -> u32 {
+        self.total().ceil() as u32
+    }
+}
+
+/// Grid intervals per axis of the slope bounds.
+const GRID: usize = 256;
+
+/// A polynomial `sum a[i][j] u^i t^j` on `[-1, 1]^2`.
+type Poly2 = Vec<Vec<f64>>;
+
+fn eval_row(row: &[f64], w: f64) -> f64 {
+    row.iter().rev().fold(0.0, |acc, c| acc * w + c)
+}
+
+/// `d/du` (`wrt_u`) or `d/dt` of `a`.
+fn derivative(a: &Poly2, wrt_u: bool) -> Poly2 {
+    if wrt_u {
+        a.iter().enumerate().skip(1).map(|(i, row)| row.iter().map(|c| i as f64 * c).collect()).collect()
+    } else {
+        a.iter().map(|row| row.iter().enumerate().skip(1).map(|(j, c)| j as f64 * c).collect()).collect()
+    }
+}
+
+/// `sum |coefficients|` of `a`: a bound of `|a|` on the box.
+fn abs_sum(a: &Poly2) -> f64 {
+    a.iter().flatten().map(|c| c.abs()).sum()
+}
+
+/// A rigorous bound of `sup |a|` over `[-1, 1]^2`: the maximum over the grid plus half the
+/// grid step times bounds of both slopes.
+fn sup_abs(a: &Poly2) -> f64 {
+    if a.is_empty() {
+        return 0.0;
+    }
+    let node = |n: usize| -1.0 + 2.0 * n as f64 / GRID as f64;
+    let mut max = 0.0f64;
+    for nt in 0..=GRID {
+        let t = node(nt);
+        let r: Vec<f64> = a.iter().map(|row| eval_row(row, t)).collect();
+        for nu in 0..=GRID {
+            max = max.max(eval_row(&r, node(nu)).abs());
+        }
+    }
+    let half_step = 1.0 / GRID as f64;
+    max + half_step * (abs_sum(&derivative(a, true)) + abs_sum(&derivative(a, false)))
+}
+
+fn pow2(e: i32) -> f64 {
+    2f64.powi(e)
+}
+
+/// The error bound of component `c` with the tables `comp`.
+pub(crate) fn error_bound(model: &Model, c: usize, comp: &FixedComponent) -> ErrorBound {
+    let g = comp.frac_bits;
+    let lsb_g = pow2(-(g as i32));
+    let coef_err = |q: i32, f: u32, v: f64| -> f64 {
+        let exact = v * OUTPUT_SCALE;
+        (f64::from(q) * pow2(-(f as i32)) - exact).abs() + exact.abs() * pow2(-52)
+    };
+    let mut arithmetic = 4.0 * lsb_g;
+    let mut coefficients = 0.0;
+    let base = &model.baseline[c].coeffs;
+    for (i, b) in base.iter().enumerate() {
+        coefficients += coef_err(comp.baseline[i], g, *b);
+    }
+    let base_poly: Poly2 = base.iter().map(|b| vec![*b]).collect();
+    let mut slope_u = sup_abs(&derivative(&base_poly, true));
+    let mut slope_t = 0.0;
+    for m in model.matrices.iter().filter(|m| m.component == c) {
+        let k = m.sweep;
+        for (i, row) in m.rows.iter().enumerate() {
+            let fr = &comp.rows[k][i];
+            arithmetic += 4.0 * pow2(-(fr.frac_bits as i32));
+            if comp.shifts[k][i] > 0 {
+                arithmetic += lsb_g;
+            }
+            for (j, v) in row.iter().enumerate() {
+                coefficients += coef_err(fr.coeffs[j], fr.frac_bits, *v);
+            }
+        }
+        let poly: Poly2 = m.rows.iter().map(|r| r.to_vec()).collect();
+        slope_u += sup_abs(&derivative(&poly, true));
+        slope_t += sup_abs(&derivative(&poly, false));
+    }
+    let half_step = pow2(-(NORM_FRAC_BITS as i32) - 1);
+    let inputs = (slope_u + slope_t) * OUTPUT_SCALE * half_step;
+    ErrorBound { arithmetic, coefficients, inputs, output: 0.5 }
+}

@@ -1,0 +1,149 @@
+//! An independent implementation of the fixed-point evaluation (coeffs/README.md,
+//! "Fixed-point evaluation"): it writes `golden-fixed.csv`, so it must not call the
+//! `needle-haptics` library nor `needle-codegen`.
+//!
+//! Every intermediate is computed in i64 with checked operations and must stay within
+//! the contract's invariant `|v| <= 2^30`; an intermediate outside it is reported as an
+//! [`Overflow`] (the library, which computes in wrapping i32, would have produced garbage
+//! there). Products are floored with `div_euclid`, not shifts.
+
+use super::contract::{
+    Sweep, NCOEF, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z,
+};
+use super::fixed_formats::{TablesFixed, LIMIT};
+use std::fmt;
+
+/// 1 mm or 1 degree in the Q16.16 pose.
+pub const ONE: i64 = 65536;
+/// Half-ranges of x, z, theta_x, theta_z in Q16.16.
+pub const HALF_RANGE_Q16: [i64; 4] = [12 * ONE, 12 * ONE, 15 * ONE, 15 * ONE];
+/// Depth range end in Q16.16.
+pub const DEPTH_MAX_Q16: i64 = 6 * ONE;
+/// Divisors of the normalisation: `V_k / 2 * 2^16 / 2^15` (x, z: 12; tilts: 15) and
+/// depth `3 * 2^16 / 2^15 = 6`.
+pub const DIVISORS: [i64; 4] = [12, 12, 15, 15];
+/// Depth divisor.
+pub const DEPTH_DIVISOR: i64 = 6;
+/// `2^15`: the scale of U and T.
+const Q15: i64 = 1 << 15;
+
+/// An intermediate left the contract's range `|v| <= 2^30`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Overflow {
+    /// Which intermediate.
+    pub what: String,
+    /// Its value (exact, in i64) or `None` when even i64 overflowed.
+    pub value: Option<i64>,
+}
+
+impl fmt::Display for Overflow {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} = {:?} exceeds 2^30", self.what, self.value)
+    }
+}
+
+fn check(v: Option<i64>, what: impl Fn() -> String) -> Result<i64, Overflow> {
+    match v {
+        Some(x) if x.abs() <= LIMIT => Ok(x),
+        _ => Err(Overflow { what: what(), value: v }),
+    }
+}
+
+/// `floor(a * w / 2^15) + p`, checked.
+fn step(a: i64, w: i64, p: i64, what: &dyn Fn() -> String) -> Result<i64, Overflow> {
+    let prod = check(a.checked_mul(w).map(|m| m.div_euclid(Q15)), || format!("{} (product)", what()))?;
+    check(prod.checked_add(p), what)
+}
+
+/// Horner in Q15, highest power first, every intermediate checked.
+fn horner(p: &[i64; NCOEF], w: i64, what: &dyn Fn() -> String) -> Result<i64, Overflow> {
+    let mut acc = check(Some(p[NCOEF - 1]), what)?;
+    for c in p[..NCOEF - 1].iter().rev() {
+        acc = step(acc, w, *c, what)?;
+    }
+    Ok(acc)
+}
+
+/// `(n + d / 2) / d - 32768` for `n >= 0`: the normalised input in Q15, rounded to nearest.
+fn normalise(n: i64, d: i64) -> i64 {
+    (n + d / 2) / d - Q15
+}
+
+/// Evaluate at the Q16.16 pose `[x, z, theta_x, theta_z, depth]`: the wrench in µN and
+/// µN·mm `[fx, fy, fz, mx, my, mz]` and the status byte.
+///
+/// # Errors
+/// An intermediate leaves `|v| <= 2^30` (the tables do not meet the contract).
+pub fn eval(t: &TablesFixed, pose: [i32; 5]) -> Result<([i32; 6], u8), Overflow> {
+    let p = pose.map(i64::from);
+    let sat_bits = [STATUS_SAT_X, STATUS_SAT_Z, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z];
+    let mut status = 0u8;
+    let mut v = [0i64; 4];
+    for k in 0..4 {
+        v[k] = p[k].clamp(-HALF_RANGE_Q16[k], HALF_RANGE_Q16[k]);
+        if v[k] != p[k] {
+            status |= sat_bits[k];
+        }
+    }
+    let d = p[4].clamp(0, DEPTH_MAX_Q16);
+    if d != p[4] {
+        status |= STATUS_SAT_DEPTH;
+    }
+    let u = normalise(d, DEPTH_DIVISOR);
+    let tk: [i64; 4] = std::array::from_fn(|k| normalise(v[k].abs(), DIVISORS[k]));
+
+    // A[c][i] accumulates the baseline and the four deviations' rows (sweep-major here,
+    // component-major in the library: integer sums do not depend on the order).
+    let mut a = t.baseline;
+    for k in Sweep::ALL {
+        let ki = k.index();
+        for (c, ac) in a.iter_mut().enumerate() {
+            let flip = v[ki] < 0 && k.is_odd(c);
+            for (i, aci) in ac.iter_mut().enumerate() {
+                let name = || format!("row {}/{c}/u^{i}", k.name());
+                let r = horner(&t.rows[ki][c][i], tk[ki], &name)?;
+                let shifted = r.div_euclid(1i64 << (t.row_frac[ki][c][i] - t.acc_frac[c]));
+                let sum = if flip { aci.checked_sub(shifted) } else { aci.checked_add(shifted) };
+                *aci = check(sum, || format!("A[{c}][{i}] after sweep {}", k.name()))?;
+            }
+        }
+    }
+    let mut w = [0i32; 6];
+    for (c, wc) in w.iter_mut().enumerate() {
+        let acc = horner(&a[c], u, &|| format!("Horner in u of component {c}"))?;
+        let g = t.acc_frac[c];
+        let half = (1i64 << g) / 2;
+        let out = (acc + half).div_euclid(1i64 << g);
+        *wc = i32::try_from(out).map_err(|_| Overflow { what: format!("output {c}"), value: Some(out) })?;
+    }
+    Ok((w, status))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn normalisation_rounds_to_nearest_and_spans_q15() {
+        assert_eq!(normalise(0, 12), -32768);
+        assert_eq!(normalise(12 * ONE, 12), 32768);
+        assert_eq!(normalise(15 * ONE, 15), 32768);
+        assert_eq!(normalise(6 * ONE, 6), 32768);
+        assert_eq!(normalise(3 * ONE, 6), 0);
+        // 5/12 rounds down, 6/12 rounds up, 7/15 down, 8/15 up
+        assert_eq!(normalise(5, 12), -32768);
+        assert_eq!(normalise(6, 12), -32767);
+        assert_eq!(normalise(7, 15), -32768);
+        assert_eq!(normalise(8, 15), -32767);
+    }
+
+    #[test]
+    fn steps_floor_towards_minus_infinity() {
+        let what = || String::new();
+        assert_eq!(step(3, -1, 0, &what).unwrap(), -1);
+        assert_eq!(step(-3, 1, 0, &what).unwrap(), -1);
+        assert_eq!(step(3, 1, 0, &what).unwrap(), 0);
+        assert_eq!(step(-(1 << 30), -(1 << 15), 0, &what).unwrap(), 1 << 30);
+        assert!(step(1 << 30, 1 << 15, 1, &what).is_err());
+    }
+}

@@ -1,0 +1,66 @@
+//! The integer primitives of the fixed-point contract: the Q15 product and the
+//! normalisation. Both are exact (the same integer on every core); only how they are
+//! computed differs, for speed.
+
+/// `floor(a * w / 2^15)`, for `|a| <= 2^30` and `|w| <= 2^15` (the generator proves both
+/// for every call): the Q15 product of a Horner step.
+///
+/// Cores with a 32 x 32 -> 64-bit multiply (Armv7-M `smull`, every host) take the 64-bit
+/// product and shift it.
+#[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+#[inline(always)]
+pub(crate) fn mul_q15(a: i32, w: i32) -> i32 {
+    ((i64::from(a) * i64::from(w)) >> 15) as i32
+}
+
+/// `floor(a * w / 2^15)`, for `|a| <= 2^30` and `|w| <= 2^15`.
+///
+/// Armv6-M (Cortex-M0/M0+, the only Arm M-profile without 32-bit atomics, which is how
+/// `cfg` tells it apart: rustc has no architecture-version `cfg` for these targets) has
+/// no 64-bit multiply, and `i64 * i64` would be a library call. With
+/// `a = hi * 2^16 + lo` (`0 <= lo < 2^16`):
+/// `floor(a w / 2^15) = 2 hi w + floor(lo w / 2^15)` exactly, from two 32-bit `muls`.
+/// No overflow: `|lo w| < 2^16 * 2^15 = 2^31`, `|hi| <= 2^14` so `|2 hi w| <= 2^30`.
+#[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+#[inline(always)]
+pub(crate) fn mul_q15(a: i32, w: i32) -> i32 {
+    let hi = a >> 16;
+    let lo = a & 0xffff;
+    hi.wrapping_mul(w).wrapping_shl(1).wrapping_add(lo.wrapping_mul(w) >> 15)
+}
+
+/// `(n + divisor / 2) / divisor - 32768`: a clamped Q16.16 magnitude (`n <= 6 * 2^16`,
+/// `12 * 2^16` or `15 * 2^16`) to its normalised Q15 value in `[-32768, 32768]`, rounded
+/// to nearest.
+#[inline(always)]
+pub(crate) fn normalise(n: u32, divisor: u32) -> i32 {
+    // `divisor` is one of the generated constants 6, 12, 15: never zero. `checked_div`
+    // keeps the no-panic guarantee without relying on that.
+    match n.wrapping_add(divisor >> 1).checked_div(divisor) {
+        Some(q) => (q as i32).wrapping_sub(32768),
+        None => 0,
+    }
+}
+
+/// `v` clamped to `lo..=hi`, and whether it changed.
+#[inline(always)]
+pub(crate) fn clamp(v: i32, lo: i32, hi: i32) -> (i32, bool) {
+    if v < lo {
+        (lo, true)
+    } else if v > hi {
+        (hi, true)
+    } else {
+        (v, false)
+    }
+}
+
+/// `h(p, w) = (((p4 w + p3) w + p2) w + p1) w + p0` with every product [`mul_q15`]:
+/// the contract's Horner step in Q15.
+#[inline(always)]
+pub(crate) fn horner(p: &[i32; 5], w: i32) -> i32 {
+    let [p0, p1, p2, p3, p4] = *p;
+    let a = mul_q15(p4, w).wrapping_add(p3);
+    let a = mul_q15(a, w).wrapping_add(p2);
+    let a = mul_q15(a, w).wrapping_add(p1);
+    mul_q15(a, w).wrapping_add(p0)
+}

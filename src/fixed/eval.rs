@@ -1,0 +1,88 @@
+//! The fixed-point evaluator: the integer algorithm of `coeffs/README.md`, bit-exact.
+use super::arith::{clamp, horner, normalise};
+use super::tables::{
+    BASELINE, DEPTH_DIVISOR, DEPTH_MAX_MM_Q16, FRAC_BITS, ODD, ROWS, SHIFTS, SWEEP_DIVISORS, THETA_MAX_DEG_Q16,
+    X_MAX_MM_Q16, Z_MAX_MM_Q16,
+};
+use super::{Evaluation, Pose, Wrench};
+use crate::tables::FITTED;
+use crate::Status;
+
+/// The reaction wrench of the compiled-in set's model at `pose`, in integer arithmetic
+/// only (no floating point: fast on cores without an FPU).
+///
+/// Implements the fixed-point contract of `coeffs/README.md` exactly, so the result has
+/// the same bits as the fitter's independent implementation (`golden-fixed.csv`) on
+/// every core:
+///
+/// 1. each Q16.16 input is clamped to the domain, with the matching `SAT_*` flag when it
+///    changed (the same flags as [`crate::wrench`]);
+/// 2. `U = (depth + 3) / 6 - 32768` and per sweep `T = (|v| + 6) / 12 - 32768` (x, z)
+///    or `(|v| + 7) / 15 - 32768` (tilts): u and t in Q15, rounded to nearest;
+/// 3. per component c: `A_i = BASELINE[c][i]`, then for each sweep k and row i
+///    `A_i ±= h(ROWS[c][k][i], T_k) >> SHIFTS[c][k][i]` (minus when the sweep value is
+///    negative and c is odd under that sweep's mirror), with `h` a Horner whose products
+///    are `floor(a * w / 2^15)`;
+/// 4. `W = h(A, U)`, and the result `(W + 2^(G-1)) >> G` in µN or µN·mm
+///    ([`tables::FRAC_BITS`](super::tables::FRAC_BITS) = G).
+///
+/// No intermediate can overflow: the code generator bounds every one of them over the
+/// whole domain and chose the formats so that all stay within ±2^30. The result differs
+/// from the f64 evaluation of the model by at most
+/// [`tables::ERROR_BOUND_MICRO`](super::tables::ERROR_BOUND_MICRO) per component.
+///
+/// Without a fitted model every pose gives the zero wrench and
+/// `Status::NO_MODEL | Status::ERROR`.
+///
+/// Constant work: 504 Q15 products (6 components × (20 row polynomials of degree 4 +
+/// one in u)).
+///
+/// # Panics
+/// Never (no indexing, no unchecked division, wrapping arithmetic that the generator's
+/// bounds keep from wrapping).
+#[must_use]
+pub fn wrench(pose: &Pose) -> Evaluation {
+    if !FITTED {
+        return Evaluation { wrench: Wrench::ZERO, status: Status::NO_MODEL | Status::ERROR };
+    }
+    let (x, sat_x) = clamp(pose.x_mm_q16, -X_MAX_MM_Q16, X_MAX_MM_Q16);
+    let (z, sat_z) = clamp(pose.z_mm_q16, -Z_MAX_MM_Q16, Z_MAX_MM_Q16);
+    let (tx, sat_tx) = clamp(pose.theta_x_deg_q16, -THETA_MAX_DEG_Q16, THETA_MAX_DEG_Q16);
+    let (tz, sat_tz) = clamp(pose.theta_z_deg_q16, -THETA_MAX_DEG_Q16, THETA_MAX_DEG_Q16);
+    let (d, sat_d) = clamp(pose.depth_mm_q16, 0, DEPTH_MAX_MM_Q16);
+    let status = Status::from_bits(
+        u8::from(sat_x)
+            | u8::from(sat_z) << 1
+            | u8::from(sat_tx) << 2
+            | u8::from(sat_tz) << 3
+            | u8::from(sat_d) << 4,
+    );
+
+    let u = normalise(d.unsigned_abs(), DEPTH_DIVISOR);
+    let [dx, dz, dtx, dtz] = SWEEP_DIVISORS;
+    let t = [
+        normalise(x.unsigned_abs(), dx),
+        normalise(z.unsigned_abs(), dz),
+        normalise(tx.unsigned_abs(), dtx),
+        normalise(tz.unsigned_abs(), dtz),
+    ];
+    let negative = [x < 0, z < 0, tx < 0, tz < 0];
+
+    let mut w = [0_i32; 6];
+    let tables = ROWS.iter().zip(SHIFTS.iter()).zip(BASELINE.iter()).zip(ODD.iter()).zip(FRAC_BITS.iter());
+    for (wc, ((((rows, shifts), base), odd), &g)) in w.iter_mut().zip(tables) {
+        let mut a = *base;
+        for ((((rows_k, shifts_k), &tk), &neg), &o) in
+            rows.iter().zip(shifts.iter()).zip(t.iter()).zip(negative.iter()).zip(odd.iter())
+        {
+            let flip = neg && o;
+            for ((ai, row), &s) in a.iter_mut().zip(rows_k.iter()).zip(shifts_k.iter()) {
+                let r = horner(row, tk).wrapping_shr(s);
+                *ai = if flip { ai.wrapping_sub(r) } else { ai.wrapping_add(r) };
+            }
+        }
+        let acc = horner(&a, u);
+        *wc = acc.wrapping_add(1_i32.wrapping_shl(g) >> 1).wrapping_shr(g);
+    }
+    Evaluation { wrench: Wrench::from_array(w), status }
+}
