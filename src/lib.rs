@@ -41,6 +41,7 @@
 #![deny(missing_docs)]
 
 pub mod control;
+pub mod command;
 mod evaluation;
 mod horner;
 mod model_f32;
@@ -48,6 +49,7 @@ pub mod model_info;
 mod pose;
 mod status;
 mod tables;
+pub mod telemetry;
 mod wrench;
 
 pub use evaluation::Evaluation;
