@@ -5,10 +5,7 @@
 //! the optimiser removed every call to the panic handler, i.e. if nothing reachable from
 //! `main` (the evaluator [`needle_haptics::wrench`] called through an opaque function
 //! pointer on an opaque pose, so it is compiled for every input, plus the small
-//! [`needle_haptics::Wrench`] / [`needle_haptics::Status`] helpers; and the control loop:
-//! a [`needle_haptics::control::ControlLoop`] tick on opaque poses and faults, a
-//! telemetry push, and the host-link command reader, parser and replies on opaque bytes)
-//! can panic. Build it
+//! [`needle_haptics::Wrench`] / [`needle_haptics::Status`] helpers) can panic. Build it
 //! in release (the crate's release profile: opt-level 3, LTO):
 //!
 //! ```text
@@ -43,81 +40,8 @@ mod firmware {
         unsafe { needle_haptics_panic_path_not_optimised_away() }
     }
 
-    use core::convert::Infallible;
-    use embedded_hal::digital::{ErrorType as PinError, OutputPin};
-    use embedded_hal::pwm::{ErrorType as PwmError, SetDutyCycle};
-    use needle_haptics::command::{respond, FrameReader};
-    use needle_haptics::control::{
-        Channel, ChannelMap, ControlLoop, LoopConfig, OverLimit, PoseFault, PoseSource,
-    };
-    use needle_haptics::telemetry::Telemetry;
-
-    /// Opaque poses and faults.
-    struct Source;
-    impl PoseSource for Source {
-        fn read_pose(&mut self) -> Result<Pose, PoseFault> {
-            black_box(Ok(Pose::new(3.0, -2.0, 5.0, -7.0, 4.5)))
-        }
-    }
-    struct Pwm;
-    impl PwmError for Pwm {
-        type Error = Infallible;
-    }
-    impl SetDutyCycle for Pwm {
-        fn max_duty_cycle(&self) -> u16 {
-            black_box(1000)
-        }
-        fn set_duty_cycle(&mut self, d: u16) -> Result<(), Infallible> {
-            black_box(d);
-            Ok(())
-        }
-    }
-    struct Pin;
-    impl PinError for Pin {
-        type Error = Infallible;
-    }
-    impl OutputPin for Pin {
-        fn set_low(&mut self) -> Result<(), Infallible> {
-            black_box(0);
-            Ok(())
-        }
-        fn set_high(&mut self) -> Result<(), Infallible> {
-            black_box(1);
-            Ok(())
-        }
-    }
-
-    /// A loop tick, a telemetry push and a host-link exchange, all on opaque data.
-    fn control_loop() {
-        let map = ChannelMap { gains_per_n: black_box([10.0, -5.0, 2.0]), direction_inverted: black_box(true) };
-        let config = LoopConfig {
-            channels: [map, map, map],
-            force_limit_n: black_box(0.05),
-            force_limit_max_n: black_box(0.1),
-            over_limit: black_box(OverLimit::Saturate),
-            ramp_step_n: black_box(0.01),
-        };
-        let channels = [Channel { pwm: Pwm, dir: Pin }, Channel { pwm: Pwm, dir: Pin }, Channel { pwm: Pwm, dir: Pin }];
-        let Ok(mut l) = ControlLoop::new(config, Source, channels, Pin) else { return };
-        let mut t: Telemetry<8> = Telemetry::new();
-        let (mut tx, mut rx) = t.split();
-        let mut reader = FrameReader::new();
-        for _ in 0..black_box(3) {
-            tx.push(l.tick());
-            let step = l.core_mut().step(black_box(Err(PoseFault::Stale)));
-            tx.push(step);
-            for b in black_box(b"STATUS\nLIMIT 20\n".as_slice()) {
-                if let Some(frame) = reader.push(black_box(*b)) {
-                    black_box(respond(frame, l.core_mut(), rx.dropped()));
-                }
-            }
-        }
-        black_box(rx.pop());
-    }
-
     #[cortex_m_rt::entry]
     fn main() -> ! {
-        control_loop();
         let eval: fn(&Pose) -> Evaluation = black_box(wrench);
         let pose = black_box(Pose::new(3.0, -2.0, 5.0, -7.0, 4.5));
         let e = eval(&pose);

@@ -45,6 +45,7 @@ pub mod command;
 mod evaluation;
 mod horner;
 mod model_f32;
+pub mod orientation;
 pub mod model_info;
 mod pose;
 mod status;
