@@ -13,10 +13,10 @@
 //! the model and is ignored).
 //!
 //! [`exact`] uses `libm` (correctly rounded or close: < 1 ulp); with the `fast-math`
-//! feature the plain functions of this module use [`fast`], `micromath`'s approximations
-//! (`atan2`, `asin`, `sqrt`: about 0.1° of error at worst, bounded by the
-//! `orientation_fast_math` test, which also bounds the resulting wrench error), cheaper
-//! on cores without an FPU. The model's own evaluation never uses them.
+//! feature the plain functions of this module use `fast`: `micromath`'s `atan2`
+//! approximation for both angles (its error in degrees, and in the resulting wrench, is
+//! bounded by the `orientation_fast_math` test), cheaper on cores without an FPU. The
+//! model's own evaluation never uses it.
 use crate::Pose;
 
 /// Needle tilts, degrees.
@@ -77,19 +77,31 @@ pub mod exact {
     tilt_impl!(libm::sqrtf, libm::asinf, libm::atan2f);
 }
 
-/// `micromath` approximations (feature `fast-math`).
+/// `micromath` approximations (feature `fast-math`): both angles from `micromath`'s
+/// `atan2` (`theta_x = atan2(a_z, sqrt(a_x² + a_y²))`, the same angle as the `asin` form
+/// without its ill-conditioned `asin` approximation; the square root is `libm`'s).
 #[cfg(feature = "fast-math")]
 pub mod fast {
-    fn sqrt(v: f32) -> f32 {
-        micromath::F32Ext::sqrt(v)
+    /// As [`super::exact::tilt_from_axis`], with `micromath::F32Ext::atan2`.
+    #[must_use]
+    pub fn tilt_from_axis(axis: [f32; 3]) -> Option<super::Tilt> {
+        let [ax, ay, az] = axis;
+        let n2 = ax * ax + ay * ay + az * az;
+        if !(n2.is_finite() && n2 > 0.0 && ay > 0.0) {
+            return None;
+        }
+        let h = libm::sqrtf(ax * ax + ay * ay);
+        Some(super::Tilt {
+            theta_x_deg: micromath::F32Ext::atan2(az, h) * super::DEG_PER_RAD,
+            theta_z_deg: micromath::F32Ext::atan2(-ax, ay) * super::DEG_PER_RAD,
+        })
     }
-    fn asin(v: f32) -> f32 {
-        micromath::F32Ext::asin(v)
+
+    /// As [`super::exact::tilt_from_quaternion`], with [`tilt_from_axis`] above.
+    #[must_use]
+    pub fn tilt_from_quaternion(q: [f32; 4]) -> Option<super::Tilt> {
+        tilt_from_axis(super::axis_of_quaternion(q))
     }
-    fn atan2(y: f32, x: f32) -> f32 {
-        micromath::F32Ext::atan2(y, x)
-    }
-    tilt_impl!(sqrt, asin, atan2);
 }
 
 #[cfg(feature = "fast-math")]

@@ -1,7 +1,10 @@
 //! The C API from C: `c/capi_golden.c`, compiled with the host's gcc against this build's
 //! `libneedle_capi.a` and the generated `needle.h`, checks every golden vector, the loop's
 //! duties, pins and ramp, and the commands; and the same program compiled and linked with
-//! arm-none-eabi-gcc for the Cortex-M4F against the thumbv7em-none-eabihf staticlib.
+//! arm-none-eabi-gcc (newlib, semihosting) for the Cortex-M4F against the
+//! thumbv7em-none-eabihf staticlib, then run under QEMU (mps2-an386) on the same golden
+//! file, read through semihosting. `c/m4f_vectors.c` is its vector table: it enables the
+//! FPU and enters newlib's crt0.
 //!
 //! Nothing skips: a missing gcc, arm-none-eabi-gcc, newlib or rustup target fails with a
 //! message (.ci/test installs them).
@@ -95,7 +98,7 @@ fn host_c_program_checks_golden_vectors_loop_and_commands() {
 }
 
 #[test]
-fn arm_c_program_links_for_cortex_m4f() {
+fn arm_c_program_links_and_runs_on_cortex_m4f() {
     let dir = scratch("m4f");
     let lib = staticlib(Some("thumbv7em-none-eabihf"));
     let elf = dir.join("capi_golden.elf");
@@ -112,11 +115,13 @@ fn arm_c_program_links_for_cortex_m4f() {
                 "-Werror",
                 "-ffp-contract=off",
                 "--specs=rdimon.specs",
-                "-Wl,--gc-sections",
+                "-Wl,--section-start=.vectors=0x0",
+                "-Wl,--no-warn-execstack",
                 "-I",
             ])
             .arg(&dir)
             .arg(manifest_dir().join("c").join("capi_golden.c"))
+            .arg(manifest_dir().join("c").join("m4f_vectors.c"))
             .arg(&lib)
             .args(["-lm", "-o"])
             .arg(&elf),
@@ -128,4 +133,16 @@ fn arm_c_program_links_for_cortex_m4f() {
     for f in ["needle_wrench", "needle_loop_tick", "needle_loop_command"] {
         assert!(nm.lines().any(|l| l.ends_with(&format!(" T {f}"))), "{f} not in the ARM image");
     }
+    let golden = golden_csv();
+    let semihosting = format!("enable=on,target=native,arg=capi_golden,arg={}", golden.display());
+    let out = run(
+        // coreutils' timeout: a faulting firmware spins in a handler instead of exiting.
+        Command::new("timeout")
+            .args(["300", "qemu-system-arm", "-cpu", "cortex-m4", "-machine", "mps2-an386", "-display", "none", "-monitor", "none", "-serial", "null"])
+            .args(["-semihosting-config", &semihosting, "-kernel"])
+            .arg(&elf),
+        "capi_golden on QEMU mps2-an386",
+    );
+    println!("{out}");
+    assert!(out.contains("wrench_mismatches=0 ") && out.contains("loop_failures=0 ") && out.contains("command_failures=0"), "{out}");
 }
