@@ -115,6 +115,8 @@ fn arm_c_program_links_and_runs_on_cortex_m4f() {
                 "-Werror",
                 "-ffp-contract=off",
                 "--specs=rdimon.specs",
+                "-Wl,--gc-sections",
+                "-Wl,--undefined=vectors",
                 "-Wl,--section-start=.vectors=0x0",
                 "-Wl,--no-warn-execstack",
                 "-I",
