@@ -1,79 +1,136 @@
 //! [`execute`]: a [`Command`] applied to a [`LoopCore`], and the reply line.
+//!
+//! Replies are assembled with the small [`Line`] writer below (decimal and hex digits by
+//! hand), not `core::fmt`, which would add about 10 KiB of flash to the firmware.
 use super::{mode_word, Command, FrameError, REPLY_MAX};
 use crate::control::LoopCore;
 use crate::model_info;
-use core::fmt::Write;
 
 /// A reply line, `\n` included.
 pub type Reply = heapless::String<REPLY_MAX>;
 
+/// A reply being written; remembers whether anything did not fit.
+struct Line {
+    r: Reply,
+    overflow: bool,
+}
+
+impl Line {
+    fn new() -> Self {
+        Self { r: Reply::new(), overflow: false }
+    }
+
+    fn s(mut self, s: &str) -> Self {
+        self.overflow |= self.r.push_str(s).is_err();
+        self
+    }
+
+    fn dec(mut self, mut v: u32) -> Self {
+        let mut digits = [0u8; 10];
+        let mut n = 0;
+        for d in digits.iter_mut().rev() {
+            *d = b'0' + (v % 10) as u8;
+            v /= 10;
+            n += 1;
+            if v == 0 {
+                break;
+            }
+        }
+        for d in digits.iter().skip(digits.len() - n) {
+            self.overflow |= self.r.push(char::from(*d)).is_err();
+        }
+        self
+    }
+
+    /// `0x` and `digits` lower-case hex digits of `v` (digits <= 8).
+    fn hex(mut self, v: u32, digits: u32) -> Self {
+        self = self.s("0x");
+        for i in (0..digits.min(8)).rev() {
+            let nibble = (v >> (4 * i)) & 0xf;
+            let c = char::from_digit(nibble, 16).unwrap_or('?');
+            self.overflow |= self.r.push(c).is_err();
+        }
+        self
+    }
+
+    fn end(self) -> Reply {
+        let l = self.s("\n");
+        if l.overflow {
+            fixed("ERR INTERNAL reply too long\n")
+        } else {
+            l.r
+        }
+    }
+}
+
 /// Runs `cmd` on the loop `core` (`dropped`: the telemetry overflow count for `STATUS`)
 /// and returns its reply. Only `LIMIT <mN>` (when in range) and `MODE SAT|RAMP` change
-/// the loop; a refused command changes nothing.
+/// the loop; a refused command changes nothing. Never panics.
 pub fn execute<const N: usize>(cmd: Command, core: &mut LoopCore<N>, dropped: u32) -> Reply {
-    let mut r = Reply::new();
-    let written = match cmd {
-        Command::Ping => r.write_str("OK PONG\n"),
+    match cmd {
+        Command::Ping => Line::new().s("OK PONG").end(),
         Command::Status => {
             let s = core.last();
             let c = core.config();
-            writeln!(
-                r,
-                "OK STATUS tick={} flags={:#06x} model={:#04x} limit_mn={} mode={} dropped={}",
-                s.tick,
-                s.flags.bits(),
-                s.model.bits(),
-                millinewtons(c.force_limit_n),
-                mode_word(c.over_limit),
-                dropped
-            )
+            Line::new()
+                .s("OK STATUS tick=")
+                .dec(s.tick)
+                .s(" flags=")
+                .hex(u32::from(s.flags.bits()), 4)
+                .s(" model=")
+                .hex(u32::from(s.model.bits()), 2)
+                .s(" limit_mn=")
+                .dec(millinewtons(c.force_limit_n))
+                .s(" mode=")
+                .s(mode_word(c.over_limit))
+                .s(" dropped=")
+                .dec(dropped)
+                .end()
         }
-        Command::Model => writeln!(
-            r,
-            "OK MODEL set={} fitted={} fe_sha256={} x_mm={} z_mm={} theta_deg={} depth_mm={}",
-            model_info::SET.get(..32).unwrap_or(model_info::SET),
-            u8::from(model_info::FITTED),
-            model_info::FE_SHA256.get(..16).unwrap_or(model_info::FE_SHA256),
-            model_info::X_MAX_MM as u32,
-            model_info::Z_MAX_MM as u32,
-            model_info::THETA_MAX_DEG as u32,
-            model_info::DEPTH_MAX_MM as u32
-        ),
-        Command::GetLimit => limit_reply(&mut r, core),
+        Command::Model => Line::new()
+            .s("OK MODEL set=")
+            .s(model_info::SET.get(..32).unwrap_or(model_info::SET))
+            .s(" fitted=")
+            .dec(u32::from(model_info::FITTED))
+            .s(" fe_sha256=")
+            .s(model_info::FE_SHA256.get(..16).unwrap_or(model_info::FE_SHA256))
+            .s(" x_mm=")
+            .dec(model_info::X_MAX_MM as u32)
+            .s(" z_mm=")
+            .dec(model_info::Z_MAX_MM as u32)
+            .s(" theta_deg=")
+            .dec(model_info::THETA_MAX_DEG as u32)
+            .s(" depth_mm=")
+            .dec(model_info::DEPTH_MAX_MM as u32)
+            .end(),
+        Command::GetLimit => limit_reply(core),
         Command::SetLimit { limit_mn } => {
             #[allow(clippy::cast_precision_loss)] // <= 9 digits: exact below 2^24, else nearest
             let limit_n = limit_mn as f32 / 1000.0;
             if limit_mn == 0 || core.set_force_limit_n(limit_n).is_err() {
-                return range_reply(core);
+                let max = millinewtons(core.config().force_limit_max_n);
+                return Line::new().s("ERR RANGE limit_mn must be 1..=").dec(max).end();
             }
-            limit_reply(&mut r, core)
+            limit_reply(core)
         }
-        Command::GetMode => writeln!(r, "OK MODE {}", mode_word(core.config().over_limit)),
+        Command::GetMode => Line::new().s("OK MODE ").s(mode_word(core.config().over_limit)).end(),
         Command::SetMode(m) => {
             core.set_over_limit(m);
-            writeln!(r, "OK MODE {}", mode_word(m))
+            Line::new().s("OK MODE ").s(mode_word(m)).end()
         }
-    };
-    if written.is_err() {
-        return fixed("ERR INTERNAL reply too long\n");
     }
-    r
 }
 
 /// The reply to a refused frame: `ERR <CODE> <text>`.
 #[must_use]
 pub fn error_reply(e: FrameError) -> Reply {
-    let mut r = Reply::new();
     let text = match e {
         FrameError::Oversize => "frame longer than 32 bytes",
         FrameError::Malformed(why) => why,
         FrameError::Unknown => "no such command",
         FrameError::Range => "value out of range",
     };
-    if writeln!(r, "ERR {} {}", e.code(), text).is_err() {
-        return fixed("ERR INTERNAL reply too long\n");
-    }
-    r
+    Line::new().s("ERR ").s(e.code()).s(" ").s(text).end()
 }
 
 /// The reply to what a [`FrameReader`](super::FrameReader) or [`parse`](super::parse)
@@ -85,17 +142,8 @@ pub fn respond<const N: usize>(frame: Result<Command, FrameError>, core: &mut Lo
     }
 }
 
-fn limit_reply<const N: usize>(r: &mut Reply, core: &LoopCore<N>) -> core::fmt::Result {
-    writeln!(r, "OK LIMIT limit_mn={}", millinewtons(core.config().force_limit_n))
-}
-
-fn range_reply<const N: usize>(core: &LoopCore<N>) -> Reply {
-    let mut r = Reply::new();
-    let max = millinewtons(core.config().force_limit_max_n);
-    if writeln!(r, "ERR RANGE limit_mn must be 1..={max}").is_err() {
-        return fixed("ERR RANGE\n");
-    }
-    r
+fn limit_reply<const N: usize>(core: &LoopCore<N>) -> Reply {
+    Line::new().s("OK LIMIT limit_mn=").dec(millinewtons(core.config().force_limit_n)).end()
 }
 
 /// `n` N in mN, rounded half up (saturating).
