@@ -20,12 +20,12 @@ impl Line {
         Self { r: Reply::new(), overflow: false }
     }
 
-    fn s(mut self, s: &str) -> Self {
+    fn s(&mut self, s: &str) -> &mut Self {
         self.overflow |= self.r.push_str(s).is_err();
         self
     }
 
-    fn dec(mut self, mut v: u32) -> Self {
+    fn dec(&mut self, mut v: u32) -> &mut Self {
         let mut digits = [0u8; 10];
         let mut n = 0;
         for d in digits.iter_mut().rev() {
@@ -43,8 +43,8 @@ impl Line {
     }
 
     /// `0x` and `digits` lower-case hex digits of `v` (digits <= 8).
-    fn hex(mut self, v: u32, digits: u32) -> Self {
-        self = self.s("0x");
+    fn hex(&mut self, v: u32, digits: u32) -> &mut Self {
+        self.s("0x");
         for i in (0..digits.min(8)).rev() {
             let nibble = (v >> (4 * i)) & 0xf;
             let c = char::from_digit(nibble, 16).unwrap_or('?');
@@ -53,12 +53,12 @@ impl Line {
         self
     }
 
-    fn end(self) -> Reply {
-        let l = self.s("\n");
-        if l.overflow {
+    fn end(&mut self) -> Reply {
+        self.s("\n");
+        if self.overflow {
             fixed("ERR INTERNAL reply too long\n")
         } else {
-            l.r
+            core::mem::take(&mut self.r)
         }
     }
 }
