@@ -90,6 +90,11 @@ fn example_link_args(manifest_dir: &Path) {
     if std::env::var("TARGET").is_ok_and(|t| t.starts_with("thumbv6m")) {
         println!("cargo::rustc-link-arg-examples=--defsym=_stack_start=0x20004000");
     }
+    // defmt's linker script (its .defmt section), for examples built with the `defmt`
+    // feature (the defmt_log example); defmt's build script puts defmt.x on the search path.
+    if std::env::var_os("CARGO_FEATURE_DEFMT").is_some() {
+        println!("cargo::rustc-link-arg-examples=-Tdefmt.x");
+    }
     // ---- end of example-only link arguments ----
 }
 

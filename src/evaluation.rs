@@ -3,6 +3,7 @@ use crate::{Status, Wrench};
 
 /// The result of evaluating a model at a pose.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Evaluation {
     /// The reaction wrench (N, N·mm); zero when `status.is_error()`.
     pub wrench: Wrench,

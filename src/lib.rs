@@ -40,14 +40,18 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+pub mod control;
+pub mod command;
 mod evaluation;
 pub mod fixed;
 mod horner;
 mod model_f32;
+pub mod orientation;
 pub mod model_info;
 mod pose;
 mod status;
 mod tables;
+pub mod telemetry;
 mod wrench;
 
 pub use evaluation::Evaluation;

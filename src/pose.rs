@@ -11,6 +11,7 @@
 ///
 /// `Pose::default()` is the centred, vertical needle touching the surface (all zero).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Pose {
     /// x of the insertion point on the top surface, in mm.
     pub x_mm: f32,

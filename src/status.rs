@@ -143,3 +143,11 @@ impl fmt::Debug for Status {
         write!(f, "Status({:#04x}: {})", self.0, self)
     }
 }
+
+/// `Status(0x11)` (the bits; names are in the host-side `Display`).
+#[cfg(feature = "defmt")]
+impl defmt::Format for Status {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        defmt::write!(f, "Status({=u8:#04x})", self.0);
+    }
+}

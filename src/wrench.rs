@@ -7,6 +7,7 @@
 /// tip (the hub, 60 mm for the default set; it moves with the needle). Use
 /// [`Wrench::about`] for another point.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Wrench {
     /// Force along x, N.
     pub fx_n: f32,

@@ -1,10 +1,13 @@
-//! Shared by the `golden` and `bench` firmware examples (bare metal only): output through
+//! Shared by the firmware examples (bare metal only): output through
 //! ARM semihosting (QEMU writes it to its stdout), the semihosting exit, and a panic
 //! handler that reports the panic and exits with a failure status. `no_panic` does not
 //! use this module: it has its own, unlinkable, panic handler.
 #![allow(dead_code)]
 // Fixed-size buffers indexed within their bounds; a panic here is reported by the handler below.
 #![allow(clippy::indexing_slicing)]
+
+pub mod device;
+pub mod icount;
 
 use core::panic::PanicInfo;
 use cortex_m_semihosting::{debug, hio};

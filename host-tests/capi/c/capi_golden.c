@@ -1,0 +1,204 @@
+/* capi_golden.c: the C API of needle-haptics against the golden vectors.
+ *
+ *   capi_golden <golden-f32.csv>
+ *
+ * 1. needle_wrench() on every golden row: status and the six wrench components bit
+ *    for bit (NaN matches NaN).
+ * 2. The control loop: for in-domain rows, needle_loop_tick() must command exactly the
+ *    duties and direction pins of the documented linear map applied to the golden
+ *    forces; then stale ticks ramp the command to zero and disable the output.
+ * 3. Host-link commands: PING, LIMIT, and refused frames that change nothing.
+ *
+ * Prints "capi-golden rows=N wrench_mismatches=M loop_checks=K loop_failures=F command_failures=C"
+ * and exits 0 only when every check passed. Compile with -ffp-contract=off.
+ * Builds with host gcc and with arm-none-eabi-gcc (newlib, semihosting file I/O).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include "needle.h"
+
+static float f32(uint32_t bits) {
+  float f;
+  memcpy(&f, &bits, sizeof f);
+  return f;
+}
+
+static uint32_t bits_of(float f) {
+  uint32_t b;
+  memcpy(&b, &f, sizeof b);
+  return b;
+}
+
+static int same(float want, float got) {
+  if (isnan(want)) return isnan(got);
+  return bits_of(want) == bits_of(got);
+}
+
+static const float GAINS[3][3] = {{20.0f, 0.0f, 0.0f}, {0.0f, -10.0f, 0.0f}, {0.0f, 0.0f, 20.0f}};
+static const bool INVERTED[3] = {false, false, true};
+static const uint16_t MAX_DUTY[3] = {1000, 4095, 255};
+
+/* The documented map of one channel: c = (g0*fx + g1*fy) + g2*fz. */
+static float channel_c(const float g[3], const float f[3]) { return (g[0] * f[0] + g[1] * f[1]) + g[2] * f[2]; }
+
+static uint16_t duty_of(float c, uint16_t max) {
+  float a = c < 0.0f ? -c : c;
+  if (a > 1.0f) a = 1.0f;
+  return (uint16_t)(a * (float)max + 0.5f);
+}
+
+static int check_outputs(const needle_tick_t *t, const float f[3], bool enable, int line) {
+  int bad = 0;
+  for (int i = 0; i < 3; i++) {
+    float c = channel_c(GAINS[i], f);
+    uint16_t d = duty_of(c, MAX_DUTY[i]);
+    bool dir = (c >= 0.0f) != INVERTED[i];
+    if (t->duty[i] != d || t->direction_high[i] != dir) {
+      printf("line %d channel %d: duty %u dir %d, want %u %d\n", line, i, t->duty[i], t->direction_high[i], d, dir);
+      bad++;
+    }
+  }
+  if (t->enable != enable) {
+    printf("line %d: enable %d, want %d\n", line, t->enable, enable);
+    bad++;
+  }
+  return bad;
+}
+
+int main(int argc, char **argv) {
+  if (argc < 2) {
+    printf("usage: capi_golden <golden-f32.csv>\n");
+    return 2;
+  }
+  FILE *fp = fopen(argv[1], "r");
+  if (!fp) {
+    printf("cannot open %s\n", argv[1]);
+    return 2;
+  }
+  needle_model_info_t info;
+  if (needle_model_info(&info) != NEEDLE_OK || !info.fitted) {
+    printf("no fitted model in the library\n");
+    return 2;
+  }
+
+  needle_loop_config_t cfg;
+  memset(&cfg, 0, sizeof cfg);
+  for (int i = 0; i < 3; i++) {
+    for (int k = 0; k < 3; k++) cfg.channels[i].gains_per_n[k] = GAINS[i][k];
+    cfg.channels[i].direction_inverted = INVERTED[i];
+  }
+  cfg.force_limit_n = 10.0f;
+  cfg.force_limit_max_n = 20.0f;
+  cfg.over_limit = NEEDLE_OVER_LIMIT_SATURATE;
+  cfg.ramp_step_n = 0.01f;
+  needle_loop_t loop;
+  if (needle_loop_init(&loop, &cfg) != NEEDLE_OK) {
+    printf("needle_loop_init failed\n");
+    return 2;
+  }
+
+  char line[512];
+  int rows = 0, mismatches = 0, loop_checks = 0, loop_failures = 0, lineno = 1;
+  float last_f[3] = {0, 0, 0};
+  needle_pose_t last_pose;
+  int have_last = 0;
+  if (!fgets(line, sizeof line, fp)) return 2; /* header */
+  while (fgets(line, sizeof line, fp)) {
+    lineno++;
+    unsigned int v[12];
+    if (sscanf(line, "0x%x,0x%x,0x%x,0x%x,0x%x,0x%x,0x%x,0x%x,0x%x,0x%x,0x%x,0x%x", &v[0], &v[1], &v[2], &v[3],
+               &v[4], &v[5], &v[6], &v[7], &v[8], &v[9], &v[10], &v[11]) != 12) {
+      printf("golden line %d: malformed\n", lineno);
+      return 2;
+    }
+    needle_pose_t p = {f32(v[0]), f32(v[1]), f32(v[2]), f32(v[3]), f32(v[4])};
+    needle_wrench_t w;
+    uint8_t status = needle_wrench(&p, &w);
+    float got[6] = {w.fx_n, w.fy_n, w.fz_n, w.mx_nmm, w.my_nmm, w.mz_nmm};
+    int bad = status != v[5];
+    for (int c = 0; c < 6; c++) bad |= !same(f32(v[6 + c]), got[c]);
+    if (bad) {
+      if (mismatches < 10) printf("golden line %d differs (status 0x%02x want 0x%02x)\n", lineno, status, v[5]);
+      mismatches++;
+    }
+    rows++;
+    /* Loop: every 50th in-domain row, one fresh tick. */
+    if (v[5] == 0 && rows % 50 == 0) {
+      needle_tick_t t;
+      float f[3] = {f32(v[6]), f32(v[7]), f32(v[8])};
+      if (needle_loop_tick(&loop, &p, NEEDLE_POSE_FRESH, MAX_DUTY, &t) != NEEDLE_OK) return 2;
+      loop_checks++;
+      int b = check_outputs(&t, f, true, lineno);
+      for (int c = 0; c < 3; c++) b += bits_of(t.force_cmd_n[c]) != bits_of(f[c]);
+      b += t.flags != 0 && t.flags != 0x40; /* OK or DUTY_CLIPPED */
+      loop_failures += b != 0;
+      memcpy(last_f, f, sizeof f);
+      last_pose = p;
+      have_last = 1;
+    }
+  }
+  fclose(fp);
+  if (!have_last) {
+    printf("no in-domain golden rows\n");
+    return 2;
+  }
+
+  /* Stale ticks: each component towards zero by at most 0.01 N a tick, then disabled. */
+  float cmd[3];
+  memcpy(cmd, last_f, sizeof cmd);
+  for (int k = 0; k < 200; k++) {
+    for (int c = 0; c < 3; c++) cmd[c] = cmd[c] > 0.01f ? cmd[c] - 0.01f : (cmd[c] < -0.01f ? cmd[c] + 0.01f : 0.0f);
+    needle_tick_t t;
+    if (needle_loop_tick(&loop, NULL, NEEDLE_POSE_STALE, MAX_DUTY, &t) != NEEDLE_OK) return 2;
+    bool zero = cmd[0] == 0.0f && cmd[1] == 0.0f && cmd[2] == 0.0f;
+    loop_checks++;
+    int b = check_outputs(&t, cmd, !zero, -k);
+    for (int c = 0; c < 3; c++) b += bits_of(t.force_cmd_n[c]) != bits_of(cmd[c]);
+    b += (t.flags & 0x0021) != 0x0021; /* POSE_STALE | RAMPING */
+    b += zero != ((t.flags & 0x0100) != 0); /* DISABLED once at zero */
+    loop_failures += b != 0;
+    if (zero) break;
+  }
+  /* Fresh again: follows the model at once. */
+  {
+    needle_tick_t t;
+    if (needle_loop_tick(&loop, &last_pose, NEEDLE_POSE_FRESH, MAX_DUTY, &t) != NEEDLE_OK) return 2;
+    loop_checks++;
+    loop_failures += check_outputs(&t, last_f, true, 0) != 0;
+  }
+
+  /* Commands. */
+  int command_failures = 0;
+  char reply[128];
+  needle_loop_t before = loop;
+  struct {
+    const char *frame;
+    const char *want;
+  } cases[] = {
+      {"PING", "OK PONG\n"},
+      {"LIMIT 2500", "OK LIMIT limit_mn=2500\n"},
+      {"LIMIT 0", "ERR RANGE limit_mn must be 1..=20000\n"},
+      {"LIMIT x", "ERR MALFORMED a number is 1 to 9 decimal digits\n"},
+      {"FLY", "ERR UNKNOWN no such command\n"},
+  };
+  for (unsigned i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    size_t n = needle_loop_command(&loop, (const uint8_t *)cases[i].frame, strlen(cases[i].frame), 0, (uint8_t *)reply,
+                                   sizeof reply);
+    if (n != strlen(cases[i].want) || strcmp(reply, cases[i].want) != 0) {
+      printf("command %s: reply %s", cases[i].frame, reply);
+      command_failures++;
+    }
+    if (i == 1) before = loop;
+    if (i >= 2 && memcmp(&before, &loop, sizeof loop) != 0) {
+      printf("command %s changed the loop\n", cases[i].frame);
+      command_failures++;
+    }
+  }
+  if (needle_loop_set_force_limit_n(&loop, 30.0f) != NEEDLE_E_CONFIG) command_failures++;
+  if (needle_loop_tick(NULL, NULL, NEEDLE_POSE_MISSING, MAX_DUTY, NULL) != NEEDLE_E_NULL) command_failures++;
+
+  printf("capi-golden set=%s rows=%d wrench_mismatches=%d loop_checks=%d loop_failures=%d command_failures=%d\n",
+         (const char *)info.set, rows, mismatches, loop_checks, loop_failures, command_failures);
+  return (mismatches || loop_failures || command_failures || rows < 2000) ? 1 : 0;
+}

@@ -1,0 +1,69 @@
+//! The evaluator: `needle_wrench`, `needle_model_info`.
+use crate::types::{needle_model_info_t, needle_pose_t, needle_wrench_t};
+use needle_haptics::{model_info, wrench, Pose, Status, Wrench};
+
+pub(crate) fn pose_in(p: &needle_pose_t) -> Pose {
+    Pose::new(p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg, p.depth_mm)
+}
+
+pub(crate) fn pose_out(p: &Pose) -> needle_pose_t {
+    needle_pose_t { x_mm: p.x_mm, z_mm: p.z_mm, theta_x_deg: p.theta_x_deg, theta_z_deg: p.theta_z_deg, depth_mm: p.depth_mm }
+}
+
+pub(crate) fn wrench_out(w: &Wrench) -> needle_wrench_t {
+    needle_wrench_t { fx_n: w.fx_n, fy_n: w.fy_n, fz_n: w.fz_n, mx_nmm: w.mx_nmm, my_nmm: w.my_nmm, mz_nmm: w.mz_nmm }
+}
+
+/// The wrench at `*pose` into `*out`; returns the status bits (`NEEDLE_STATUS_*`).
+///
+/// Bit for bit the Rust evaluator (`needle_haptics::wrench`), hence the golden vectors.
+/// A NULL `pose` returns `0x80` (ERROR) and writes the zero wrench to `out` when it is
+/// not NULL; a NULL `out` still returns the status.
+///
+/// # Safety
+/// `pose` and `out` are NULL or valid, aligned pointers to their types.
+#[no_mangle]
+pub unsafe extern "C" fn needle_wrench(pose: *const needle_pose_t, out: *mut needle_wrench_t) -> u8 {
+    // SAFETY: the caller passes NULL or a valid pointer.
+    let e = match unsafe { pose.as_ref() } {
+        Some(p) => wrench(&pose_in(p)),
+        None => needle_haptics::Evaluation { wrench: Wrench::ZERO, status: Status::ERROR },
+    };
+    // SAFETY: as above.
+    if let Some(o) = unsafe { out.as_mut() } {
+        *o = wrench_out(&e.wrench);
+    }
+    e.status.bits()
+}
+
+/// Copies `s` into `dst` with a NUL, truncated to `dst.len() - 1` bytes.
+fn c_string<const N: usize>(s: &str) -> [u8; N] {
+    let mut dst = [0u8; N];
+    for (d, b) in dst.iter_mut().take(N.saturating_sub(1)).zip(s.bytes()) {
+        *d = b;
+    }
+    dst
+}
+
+/// Writes the compiled-in model's set name, FE hash, fitted flag and domain to `*out`.
+/// Returns `NEEDLE_OK`, or `NEEDLE_E_NULL` when `out` is NULL.
+///
+/// # Safety
+/// `out` is NULL or a valid, aligned pointer.
+#[no_mangle]
+pub unsafe extern "C" fn needle_model_info(out: *mut needle_model_info_t) -> i32 {
+    // SAFETY: the caller passes NULL or a valid pointer.
+    let Some(o) = (unsafe { out.as_mut() }) else {
+        return crate::types::NEEDLE_E_NULL;
+    };
+    *o = needle_model_info_t {
+        set: c_string(model_info::SET),
+        fe_sha256: c_string(model_info::FE_SHA256),
+        fitted: model_info::FITTED,
+        x_max_mm: model_info::X_MAX_MM,
+        z_max_mm: model_info::Z_MAX_MM,
+        theta_max_deg: model_info::THETA_MAX_DEG,
+        depth_max_mm: model_info::DEPTH_MAX_MM,
+    };
+    crate::types::NEEDLE_OK
+}

@@ -1,0 +1,148 @@
+//! The C types of the API (`#[repr(C)]`; cbindgen writes them to `needle.h`).
+
+/// Motor channels of the C loop.
+pub const NEEDLE_CHANNELS: usize = 3;
+/// 64-bit words of opaque storage in a [`needle_loop_t`].
+pub const NEEDLE_LOOP_STORAGE_WORDS: usize = 32;
+/// [`needle_loop_t::magic`] of an initialised loop.
+pub const NEEDLE_LOOP_MAGIC: u32 = 0x4e4c_4f50;
+
+/// Success.
+pub const NEEDLE_OK: i32 = 0;
+/// A pointer argument was NULL.
+pub const NEEDLE_E_NULL: i32 = -1;
+/// The configuration (or the new force limit) was refused; nothing changed.
+pub const NEEDLE_E_CONFIG: i32 = -2;
+/// The loop was not initialised with `needle_loop_init`.
+pub const NEEDLE_E_UNINIT: i32 = -3;
+/// An enumeration argument had an unknown value.
+pub const NEEDLE_E_ARG: i32 = -4;
+
+/// `pose_state` of `needle_loop_tick`: the pose is fresh.
+pub const NEEDLE_POSE_FRESH: u8 = 0;
+/// `pose_state`: the pose is stale (it is not evaluated; the output ramps to zero).
+pub const NEEDLE_POSE_STALE: u8 = 1;
+/// `pose_state`: there is no pose (`pose` may be NULL; the output ramps to zero).
+pub const NEEDLE_POSE_MISSING: u8 = 2;
+
+/// `over_limit`: scale the force down to the limit.
+pub const NEEDLE_OVER_LIMIT_SATURATE: u8 = 0;
+/// `over_limit`: treat a force above the limit as a fault and ramp to zero.
+pub const NEEDLE_OVER_LIMIT_RAMP: u8 = 1;
+
+/// The needle's pose (mm, degrees), as `needle_haptics::Pose`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct needle_pose_t {
+    /// x of the insertion point, mm.
+    pub x_mm: f32,
+    /// z of the insertion point, mm.
+    pub z_mm: f32,
+    /// Tilt about x, degrees.
+    pub theta_x_deg: f32,
+    /// Tilt about z, degrees.
+    pub theta_z_deg: f32,
+    /// Depth along the needle, mm.
+    pub depth_mm: f32,
+}
+
+/// The reaction wrench (N, N·mm about the needle's reference point), as
+/// `needle_haptics::Wrench`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct needle_wrench_t {
+    /// Force along x, N.
+    pub fx_n: f32,
+    /// Force along y, N.
+    pub fy_n: f32,
+    /// Force along z, N.
+    pub fz_n: f32,
+    /// Moment about x, N·mm.
+    pub mx_nmm: f32,
+    /// Moment about y, N·mm.
+    pub my_nmm: f32,
+    /// Moment about z, N·mm.
+    pub mz_nmm: f32,
+}
+
+/// Identity and domain of the compiled-in model.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct needle_model_info_t {
+    /// The coefficient set's name, NUL-terminated (truncated to 32 characters).
+    pub set: [u8; 33],
+    /// SHA-256 of the FE data the model was fitted on, 64 hex digits, NUL-terminated.
+    pub fe_sha256: [u8; 65],
+    /// `false` for a build without a fitted model (every evaluation is an error).
+    pub fitted: bool,
+    /// Domain: `|x_mm| <= x_max_mm`.
+    pub x_max_mm: f32,
+    /// Domain: `|z_mm| <= z_max_mm`.
+    pub z_max_mm: f32,
+    /// Domain: `|theta| <= theta_max_deg`.
+    pub theta_max_deg: f32,
+    /// Domain: `0 <= depth_mm <= depth_max_mm`.
+    pub depth_max_mm: f32,
+}
+
+/// One motor channel's linear map: `c = (g[0]*fx + g[1]*fy) + g[2]*fz`, duty `|c|` of
+/// full scale (clipped to 1), direction pin high when `(c >= 0) != direction_inverted`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct needle_channel_map_t {
+    /// Full-scale fraction per newton of fx, fy, fz.
+    pub gains_per_n: [f32; 3],
+    /// Swap the direction pin's polarity.
+    pub direction_inverted: bool,
+}
+
+/// Configuration of the C loop (see `needle_haptics::control::LoopConfig`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct needle_loop_config_t {
+    /// The map of each channel.
+    pub channels: [needle_channel_map_t; NEEDLE_CHANNELS],
+    /// Device force limit on |F|, N.
+    pub force_limit_n: f32,
+    /// Largest limit the host link may set, N.
+    pub force_limit_max_n: f32,
+    /// `NEEDLE_OVER_LIMIT_SATURATE` or `NEEDLE_OVER_LIMIT_RAMP`.
+    pub over_limit: u8,
+    /// Ramp step per tick and component during a fault, N.
+    pub ramp_step_n: f32,
+}
+
+/// What one tick of the C loop read, computed and commands.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct needle_tick_t {
+    /// Tick count (1 for the first tick).
+    pub tick: u32,
+    /// The pose evaluated (the last fresh one on a stale or missing tick).
+    pub pose: needle_pose_t,
+    /// The model's wrench (zero when not evaluated or on error).
+    pub wrench: needle_wrench_t,
+    /// The force commanded after the limit and the ramp, N.
+    pub force_cmd_n: [f32; 3],
+    /// Duty cycle of each channel, for the `max_duty` given to the tick.
+    pub duty: [u16; NEEDLE_CHANNELS],
+    /// Loop flags (`needle_haptics::control::LoopFlags` bits).
+    pub flags: u16,
+    /// The model's status bits (`NEEDLE_STATUS_*` of needle_coeffs.h).
+    pub model_status: u8,
+    /// Direction pin level of each channel.
+    pub direction_high: [bool; NEEDLE_CHANNELS],
+    /// Enable pin level.
+    pub enable: bool,
+}
+
+/// A control loop's state, opaque to C: allocate it anywhere (static, stack), then
+/// `needle_loop_init`. Plain data: it may be copied with `memcpy`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct needle_loop_t {
+    /// Opaque.
+    pub storage: [u64; NEEDLE_LOOP_STORAGE_WORDS],
+    /// `NEEDLE_LOOP_MAGIC` once initialised.
+    pub magic: u32,
+}

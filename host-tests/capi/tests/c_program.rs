@@ -1,0 +1,150 @@
+//! The C API from C: `c/capi_golden.c`, compiled with the host's gcc against this build's
+//! `libneedle_capi.a` and the generated `needle.h`, checks every golden vector, the loop's
+//! duties, pins and ramp, and the commands; and the same program compiled and linked with
+//! arm-none-eabi-gcc (newlib, semihosting) for the Cortex-M4F against the
+//! thumbv7em-none-eabihf staticlib, then run under QEMU (mps2-an386) on the same golden
+//! file, read through semihosting. `c/m4f_vectors.c` is its vector table: it enables the
+//! FPU and enters newlib's crt0.
+//!
+//! Nothing skips: a missing gcc, arm-none-eabi-gcc, newlib or rustup target fails with a
+//! message (.ci/test installs them).
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn manifest_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn workspace_root() -> PathBuf {
+    manifest_dir().join("..").join("..")
+}
+
+fn golden_csv() -> PathBuf {
+    let p = Path::new(needle_haptics::model_info::SET_DIR).join("golden-f32.csv");
+    assert!(p.is_file(), "{}: no golden vectors; run `needle fit`", p.display());
+    p
+}
+
+/// A scratch folder under the target folder, holding needle.h.
+fn scratch(name: &str) -> PathBuf {
+    let dir = workspace_root().join("target").join("capi-test").join(name);
+    std::fs::create_dir_all(&dir).expect("create scratch folder");
+    std::fs::write(dir.join("needle.h"), needle_capi::HEADER).expect("write needle.h");
+    dir
+}
+
+fn run(cmd: &mut Command, what: &str) -> String {
+    let out = cmd.output().unwrap_or_else(|e| panic!("{what}: cannot run {cmd:?}: {e} (is it installed? .ci/test installs it)"));
+    let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success(), "{what} failed ({}):\n{text}", out.status);
+    text
+}
+
+/// Builds `libneedle_capi.a` in release for `target` (None: the host) in the firmware
+/// target folder (shared with the firmware tests, so it does not wait for this test's
+/// own cargo lock) and returns its path.
+fn staticlib(target: Option<&str>) -> PathBuf {
+    let dir = workspace_root().join("target").join("firmware");
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let mut cmd = Command::new(cargo);
+    cmd.current_dir(workspace_root()).args(["build", "--release", "-p", "needle-capi", "--lib", "--target-dir"]).arg(&dir);
+    if let Some(t) = target {
+        cmd.args(["--target", t]);
+    }
+    run(&mut cmd, "cargo build -p needle-capi");
+    let lib = match target {
+        Some(t) => dir.join(t).join("release").join("libneedle_capi.a"),
+        None => dir.join("release").join("libneedle_capi.a"),
+    };
+    assert!(lib.is_file(), "{}: not built", lib.display());
+    lib
+}
+
+#[test]
+fn header_declares_the_api() {
+    for item in [
+        "needle_wrench(",
+        "needle_model_info(",
+        "needle_loop_init(",
+        "needle_loop_tick(",
+        "needle_loop_set_force_limit_n(",
+        "needle_loop_command(",
+        "} needle_pose_t;",
+        "} needle_loop_t;",
+        "#define NEEDLE_POSE_STALE 1",
+    ] {
+        assert!(needle_capi::HEADER.contains(item), "needle.h lacks {item:?}:\n{}", needle_capi::HEADER);
+    }
+}
+
+#[test]
+fn host_c_program_checks_golden_vectors_loop_and_commands() {
+    let dir = scratch("host");
+    let lib = staticlib(None);
+    let exe = dir.join("capi_golden");
+    run(
+        Command::new("gcc")
+            .args(["-std=c11", "-O2", "-Wall", "-Wextra", "-Werror", "-ffp-contract=off", "-I"])
+            .arg(&dir)
+            .arg(manifest_dir().join("c").join("capi_golden.c"))
+            .arg(&lib)
+            .args(["-lm", "-lpthread", "-ldl", "-o"])
+            .arg(&exe),
+        "gcc capi_golden.c",
+    );
+    let out = run(Command::new(&exe).arg(golden_csv()), "capi_golden");
+    println!("{out}");
+    assert!(out.contains("wrench_mismatches=0 ") && out.contains("loop_failures=0 ") && out.contains("command_failures=0"), "{out}");
+}
+
+#[test]
+fn arm_c_program_links_and_runs_on_cortex_m4f() {
+    let dir = scratch("m4f");
+    let lib = staticlib(Some("thumbv7em-none-eabihf"));
+    let elf = dir.join("capi_golden.elf");
+    run(
+        Command::new("arm-none-eabi-gcc")
+            .args([
+                "-mcpu=cortex-m4",
+                "-mthumb",
+                "-mfpu=fpv4-sp-d16",
+                "-mfloat-abi=hard",
+                "-std=c11",
+                "-O2",
+                "-Wall",
+                "-Werror",
+                "-ffp-contract=off",
+                "--specs=rdimon.specs",
+                "-Wl,--gc-sections",
+                "-Wl,--undefined=vectors",
+                "-Wl,--section-start=.vectors=0x0",
+                "-Wl,--no-warn-execstack",
+                "-I",
+            ])
+            .arg(&dir)
+            .arg(manifest_dir().join("c").join("capi_golden.c"))
+            .arg(manifest_dir().join("c").join("m4f_vectors.c"))
+            .arg(&lib)
+            .args(["-lm", "-o"])
+            .arg(&elf),
+        "arm-none-eabi-gcc capi_golden.c",
+    );
+    let size = run(Command::new("arm-none-eabi-size").arg(&elf), "arm-none-eabi-size");
+    println!("{size}");
+    let nm = run(Command::new("arm-none-eabi-nm").arg(&elf), "arm-none-eabi-nm");
+    for f in ["needle_wrench", "needle_loop_tick", "needle_loop_command"] {
+        assert!(nm.lines().any(|l| l.ends_with(&format!(" T {f}"))), "{f} not in the ARM image");
+    }
+    let golden = golden_csv();
+    let semihosting = format!("enable=on,target=native,arg=capi_golden,arg={}", golden.display());
+    let out = run(
+        // coreutils' timeout: a faulting firmware spins in a handler instead of exiting.
+        Command::new("timeout")
+            .args(["300", "qemu-system-arm", "-cpu", "cortex-m4", "-machine", "mps2-an386", "-display", "none", "-monitor", "none", "-serial", "null"])
+            .args(["-semihosting-config", &semihosting, "-kernel"])
+            .arg(&elf),
+        "capi_golden on QEMU mps2-an386",
+    );
+    println!("{out}");
+    assert!(out.contains("wrench_mismatches=0 ") && out.contains("loop_failures=0 ") && out.contains("command_failures=0"), "{out}");
+}

@@ -1,0 +1,207 @@
+//! [`LoopCore`]: the control law of one tick, free of any hardware: pose in, force
+//! command and channel commands out. [`ControlLoop`](super::ControlLoop) wraps it with
+//! embedded-hal outputs; the C API drives it directly.
+use super::config::check_limit;
+use super::{ConfigError, LoopConfig, LoopFlags, OverLimit, PoseFault, Sample};
+use crate::{Pose, Wrench};
+
+/// One channel's command: a duty fraction and a direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ChannelCommand {
+    /// `|c|` clipped to `0..=1` (fraction of full scale).
+    pub fraction: f32,
+    /// The direction pin level: `(c >= 0) != direction_inverted`.
+    pub direction_high: bool,
+}
+
+impl ChannelCommand {
+    /// The duty cycle for a PWM whose full scale is `max_duty`:
+    /// `(fraction * max_duty as f32 + 0.5) as u16` (round half up; never above
+    /// `max_duty` since `fraction <= 1`).
+    #[inline]
+    #[must_use]
+    pub fn duty(self, max_duty: u16) -> u16 {
+        // `as` saturates: no panic path for any f32.
+        (self.fraction * f32::from(max_duty) + 0.5) as u16
+    }
+}
+
+/// The control law and its state: the configuration, the tick count, the last pose and
+/// the force commanded last tick (the ramp starts from it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LoopCore<const N: usize> {
+    config: LoopConfig<N>,
+    last: Sample,
+    commands: [ChannelCommand; N],
+}
+
+impl<const N: usize> LoopCore<N> {
+    /// A loop at rest: tick 0, zero command, flags `DISABLED`.
+    ///
+    /// # Errors
+    /// The configuration is invalid ([`LoopConfig::validate`]).
+    pub fn new(config: LoopConfig<N>) -> Result<Self, ConfigError> {
+        config.validate()?;
+        let rest = ChannelCommand { fraction: 0.0, direction_high: false };
+        let commands = config.channels.map(|ch| ChannelCommand { direction_high: !ch.direction_inverted, ..rest });
+        Ok(Self { config, last: Sample { flags: LoopFlags::DISABLED, ..Sample::default() }, commands })
+    }
+
+    /// The configuration.
+    #[inline]
+    #[must_use]
+    pub const fn config(&self) -> &LoopConfig<N> {
+        &self.config
+    }
+
+    /// The last tick's sample (tick 0 and `DISABLED` before the first tick).
+    #[inline]
+    #[must_use]
+    pub const fn last(&self) -> &Sample {
+        &self.last
+    }
+
+    /// Sets the device force limit (takes effect at the next tick).
+    ///
+    /// # Errors
+    /// [`ConfigError::ForceLimit`] unless `0 < limit_n <= force_limit_max_n`; the limit is
+    /// then unchanged.
+    pub fn set_force_limit_n(&mut self, limit_n: f32) -> Result<(), ConfigError> {
+        check_limit(limit_n, self.config.force_limit_max_n)?;
+        self.config.force_limit_n = limit_n;
+        Ok(())
+    }
+
+    /// Sets what happens above the force limit (takes effect at the next tick).
+    #[inline]
+    pub fn set_over_limit(&mut self, over_limit: OverLimit) {
+        self.config.over_limit = over_limit;
+    }
+
+    /// One tick of the control law on `reading` (the pose source's answer):
+    ///
+    /// 1. the tick count goes up by one (wrapping);
+    /// 2. a stale or missing pose is a fault (`POSE_STALE` / `POSE_MISSING`), the model is
+    ///    not evaluated; otherwise `wrench(pose)`, and an `ERROR` status is a fault
+    ///    (`EVAL_ERROR`);
+    /// 3. with `F = (fx, fy, fz)`: if `fx² + fy² + fz² > limit²` (`OVER_LIMIT`),
+    ///    [`OverLimit::Saturate`] commands `F * (limit / |F|)` (`FORCE_SATURATED`) and
+    ///    [`OverLimit::RampToZero`] makes it a fault; else the command is `F`;
+    /// 4. on a fault each component of the previous command moves towards zero by at
+    ///    most `ramp_step_n` (`RAMPING`), and when all three are zero the outputs are
+    ///    disabled (`DISABLED`).
+    ///
+    /// A tick without a fault follows the model again at once. Never panics, constant
+    /// work except one square root when the force is above the limit.
+    pub fn step(&mut self, reading: Result<Pose, PoseFault>) -> Sample {
+        let tick = self.last.tick.wrapping_add(1);
+        let mut s = Sample { tick, pose: self.last.pose, ..Sample::default() };
+        let fault = match reading {
+            Err(PoseFault::Stale) => Some(LoopFlags::POSE_STALE),
+            Err(PoseFault::Missing) => Some(LoopFlags::POSE_MISSING),
+            Ok(pose) => {
+                s.pose = pose;
+                let e = crate::wrench(&pose);
+                s.model = e.status;
+                if e.status.is_error() {
+                    Some(LoopFlags::EVAL_ERROR)
+                } else {
+                    s.wrench = e.wrench;
+                    self.limit(&e.wrench, &mut s)
+                }
+            }
+        };
+        if let Some(f) = fault {
+            s.flags |= f | LoopFlags::RAMPING;
+            s.force_cmd_n = ramp(self.last.force_cmd_n, self.config.ramp_step_n);
+            if s.force_cmd_n == [0.0; 3] {
+                s.flags |= LoopFlags::DISABLED;
+            }
+        }
+        let (commands, clipped) = channel_commands(&self.config, s.force_cmd_n);
+        if clipped {
+            s.flags |= LoopFlags::DUTY_CLIPPED;
+        }
+        self.commands = commands;
+        self.last = s;
+        s
+    }
+
+    /// The channel commands of the last tick (all zero fraction, direction of `+0.0`,
+    /// before the first tick).
+    #[inline]
+    #[must_use]
+    pub const fn commands(&self) -> &[ChannelCommand; N] {
+        &self.commands
+    }
+
+    /// Whether the enable pin should be high after the last tick (`DISABLED` not set).
+    #[inline]
+    #[must_use]
+    pub const fn enabled(&self) -> bool {
+        !self.last.flags.contains(LoopFlags::DISABLED)
+    }
+
+    /// Adds `flags` to the last tick's sample (the hardware layer reports
+    /// `OUTPUT_ERROR` this way).
+    #[inline]
+    pub fn add_flags(&mut self, flags: LoopFlags) {
+        self.last.flags |= flags;
+    }
+
+    /// Step 3 of [`step`](Self::step): the command for a valid wrench, or the fault.
+    fn limit(&self, w: &Wrench, s: &mut Sample) -> Option<LoopFlags> {
+        let f = [w.fx_n, w.fy_n, w.fz_n];
+        let limit = self.config.force_limit_n;
+        let norm2 = w.fx_n * w.fx_n + w.fy_n * w.fy_n + w.fz_n * w.fz_n;
+        if norm2 <= limit * limit {
+            s.force_cmd_n = f;
+            return None;
+        }
+        s.flags |= LoopFlags::OVER_LIMIT;
+        match self.config.over_limit {
+            OverLimit::RampToZero => Some(LoopFlags::OVER_LIMIT),
+            OverLimit::Saturate => {
+                let scale = limit / libm::sqrtf(norm2);
+                s.force_cmd_n = f.map(|c| c * scale);
+                s.flags |= LoopFlags::FORCE_SATURATED;
+                None
+            }
+        }
+    }
+}
+
+/// Each component of `cmd_n` moved towards zero by at most `step_n` (never past it).
+fn ramp(cmd_n: [f32; 3], step_n: f32) -> [f32; 3] {
+    cmd_n.map(|c| {
+        if c > step_n {
+            c - step_n
+        } else if c < -step_n {
+            c + step_n
+        } else {
+            0.0
+        }
+    })
+}
+
+/// The channel commands of the force `f_n` through the linear map, and whether one was
+/// clipped to full scale.
+fn channel_commands<const N: usize>(config: &LoopConfig<N>, f_n: [f32; 3]) -> ([ChannelCommand; N], bool) {
+    let [fx, fy, fz] = f_n;
+    let mut clipped = false;
+    let commands = config.channels.map(|ch| {
+        let [gx, gy, gz] = ch.gains_per_n;
+        let c = (gx * fx + gy * fy) + gz * fz;
+        let a = if c < 0.0 { -c } else { c };
+        let fraction = if a > 1.0 {
+            clipped = true;
+            1.0
+        } else {
+            a
+        };
+        ChannelCommand { fraction, direction_high: (c >= 0.0) != ch.direction_inverted }
+    });
+    (commands, clipped)
+}

@@ -1,0 +1,117 @@
+//! The model's tilt angles from a needle direction or an orientation quaternion, as a
+//! device's kinematics gives them.
+//!
+//! Convention (the FE campaign's, `host-tests/src/fe/spec.rs`): the needle is rotated
+//! first by `theta_x` about x, then by `theta_z` about z, so its axis from tip to hub is
+//! `a = (-sin θz cos θx, cos θz cos θx, sin θx)` (vertical: `+y`). Hence, for a unit `a`,
+//!
+//! ```text
+//! theta_x = asin(a_z),    theta_z = atan2(-a_x, a_y)
+//! ```
+//!
+//! (valid for `|theta_x| < 90°`; a twist of the needle about its own axis does not enter
+//! the model and is ignored).
+//!
+//! [`exact`] uses `libm` (correctly rounded or close: < 1 ulp); with the `fast-math`
+//! feature the plain functions of this module use `fast`: `micromath`'s `atan2`
+//! approximation for both angles (its error in degrees, and in the resulting wrench, is
+//! bounded by the `orientation_fast_math` test), cheaper on cores without an FPU. The
+//! model's own evaluation never uses it.
+use crate::Pose;
+
+/// Needle tilts, degrees.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Tilt {
+    /// Rotation about x, degrees.
+    pub theta_x_deg: f32,
+    /// Rotation about z, degrees.
+    pub theta_z_deg: f32,
+}
+
+const DEG_PER_RAD: f32 = 180.0 / core::f32::consts::PI;
+
+/// The unit axis (tip to hub) of the orientation quaternion `q = [w, x, y, z]` (the
+/// rotation from the vertical needle): `q (0, 1, 0) q*`, computed without normalising `q`
+/// first (the tilt functions normalise the axis).
+#[must_use]
+pub fn axis_of_quaternion(q: [f32; 4]) -> [f32; 3] {
+    let [w, x, y, z] = q;
+    // R(q) * (0, 1, 0) for a unit quaternion: the second column of the rotation matrix,
+    // scaled by |q|^2 for a non-unit one.
+    [2.0 * (x * y - w * z), (w * w - x * x + y * y - z * z), 2.0 * (y * z + w * x)]
+}
+
+macro_rules! tilt_impl {
+    ($sqrt:path, $asin:path, $atan2:path) => {
+        /// The tilts of the needle whose axis (tip to hub, any length) is `axis`.
+        /// `None` when `axis` is zero, not finite, or points downwards or sideways
+        /// (`a_y <= 0`: the tilt would be 90° or more, outside any needle's reach).
+        #[must_use]
+        pub fn tilt_from_axis(axis: [f32; 3]) -> Option<super::Tilt> {
+            let [ax, ay, az] = axis;
+            let n2 = ax * ax + ay * ay + az * az;
+            if !(n2.is_finite() && n2 > 0.0 && ay > 0.0) {
+                return None;
+            }
+            let n = $sqrt(n2);
+            let sz = az / n;
+            let sz = if sz > 1.0 { 1.0 } else if sz < -1.0 { -1.0 } else { sz };
+            Some(super::Tilt {
+                theta_x_deg: $asin(sz) * super::DEG_PER_RAD,
+                theta_z_deg: $atan2(-ax, ay) * super::DEG_PER_RAD,
+            })
+        }
+
+        /// The tilts of the orientation quaternion `q = [w, x, y, z]` (any non-zero
+        /// length), see [`super::axis_of_quaternion`]; `None` as [`tilt_from_axis`].
+        #[must_use]
+        pub fn tilt_from_quaternion(q: [f32; 4]) -> Option<super::Tilt> {
+            tilt_from_axis(super::axis_of_quaternion(q))
+        }
+    };
+}
+
+/// `libm` versions (the default).
+pub mod exact {
+    tilt_impl!(libm::sqrtf, libm::asinf, libm::atan2f);
+}
+
+/// `micromath` approximations (feature `fast-math`): both angles from `micromath`'s
+/// `atan2` (`theta_x = atan2(a_z, sqrt(a_x² + a_y²))`, the same angle as the `asin` form
+/// without its ill-conditioned `asin` approximation; the square root is `libm`'s).
+#[cfg(feature = "fast-math")]
+pub mod fast {
+    /// As [`super::exact::tilt_from_axis`], with `micromath::F32Ext::atan2`.
+    #[must_use]
+    pub fn tilt_from_axis(axis: [f32; 3]) -> Option<super::Tilt> {
+        let [ax, ay, az] = axis;
+        let n2 = ax * ax + ay * ay + az * az;
+        if !(n2.is_finite() && n2 > 0.0 && ay > 0.0) {
+            return None;
+        }
+        let h = libm::sqrtf(ax * ax + ay * ay);
+        Some(super::Tilt {
+            theta_x_deg: micromath::F32Ext::atan2(az, h) * super::DEG_PER_RAD,
+            theta_z_deg: micromath::F32Ext::atan2(-ax, ay) * super::DEG_PER_RAD,
+        })
+    }
+
+    /// As [`super::exact::tilt_from_quaternion`], with [`tilt_from_axis`] above.
+    #[must_use]
+    pub fn tilt_from_quaternion(q: [f32; 4]) -> Option<super::Tilt> {
+        tilt_from_axis(super::axis_of_quaternion(q))
+    }
+}
+
+#[cfg(feature = "fast-math")]
+pub use fast::{tilt_from_axis, tilt_from_quaternion};
+#[cfg(not(feature = "fast-math"))]
+pub use exact::{tilt_from_axis, tilt_from_quaternion};
+
+/// The pose of a needle entering at (`x_mm`, `z_mm`) on the surface with axis `axis` (tip
+/// to hub) at `depth_mm`; `None` as [`tilt_from_axis`].
+#[must_use]
+pub fn pose_from_axis(x_mm: f32, z_mm: f32, axis: [f32; 3], depth_mm: f32) -> Option<Pose> {
+    tilt_from_axis(axis).map(|t| Pose::new(x_mm, z_mm, t.theta_x_deg, t.theta_z_deg, depth_mm))
+}
