@@ -52,6 +52,9 @@ pub struct RunArgs {
     /// reported failed.
     #[arg(long, value_name = "S")]
     pub timeout_s: Option<f64>,
+    /// A ccx job that writes no output (log, .sta, .cvg) for this many seconds is killed as stalled; a failed or stalled job is retried once with a smaller first increment per step
+    #[arg(long, value_name = "S", default_value_t = campaign::DEFAULT_STALL.as_secs_f64())]
+    pub stall_s: f64,
 }
 
 /// Arguments of `needle fe verify`.
@@ -100,6 +103,9 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
         Some(s) if s.is_finite() && s > 0.0 => Some(Duration::from_secs_f64(s)),
         Some(s) => anyhow::bail!("--timeout-s {s}: must be a number of seconds > 0"),
     };
+    if !(a.stall_s.is_finite() && a.stall_s > 0.0) {
+        anyhow::bail!("--stall-s {}: must be a number of seconds > 0", a.stall_s);
+    }
     let opts = RunOptions {
         set_dir: a.set,
         jobs: a.jobs.max(1),
@@ -109,6 +115,7 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
         out_dir: a.out,
         force: a.force,
         timeout,
+        stall: Some(Duration::from_secs_f64(a.stall_s)),
     };
     let report = campaign::run(&opts)?;
     print!("{}", report.table());

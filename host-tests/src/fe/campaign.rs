@@ -15,6 +15,13 @@
 //! spec with the `--steps` override applied, the pose and the mesh level). Before a pose
 //! is solved its manifest entry is removed, so a CSV is only ever trusted when the entry
 //! written after it says which spec it came from.
+//!
+//! A run that fails (ccx error, no convergence, timeout) or stalls (no output for
+//! [`RunOptions::stall`]: ccx 2.20 was seen spinning without output at the start of a
+//! step, deterministically, e.g. theta_z = 15 degrees at 5.4 mm) is rerun once with every
+//! load step starting at [`deck::RETRY_FIRST_INCREMENT`] of the step instead of the whole
+//! step. Same model and loads, another incrementation path; the manifest entry records it
+//! (`first_increment`, `retry`). Only when the retry fails too is the pose failed.
 
 use crate::fe::ccx;
 use crate::fe::dat;
@@ -56,6 +63,8 @@ pub struct RunOptions {
     pub force: bool,
     /// Wall-clock limit of one ccx job; the job is killed and reported failed after it.
     pub timeout: Option<Duration>,
+    /// A ccx job that writes no output for this long is killed as stalled (then retried).
+    pub stall: Option<Duration>,
 }
 
 impl RunOptions {
@@ -70,9 +79,15 @@ impl RunOptions {
             out_dir: None,
             force: false,
             timeout: None,
+            stall: Some(DEFAULT_STALL),
         }
     }
 }
+
+/// Default [`RunOptions::stall`]: ccx writes its log in 4 KiB blocks, a few Newton
+/// iterations each (an iteration takes seconds on the committed mesh); ten minutes of
+/// silence is not progress.
+pub const DEFAULT_STALL: Duration = Duration::from_secs(600);
 
 /// What happened to one selected pose.
 #[derive(Debug, Clone, PartialEq)]
@@ -246,6 +261,13 @@ pub struct ManifestEntry {
     pub theta_x_deg: f64,
     /// Pose: tilt about z, degrees.
     pub theta_z_deg: f64,
+    /// First increment of each load step as a fraction of the step, when not 1 (the
+    /// retry of a failed run, see the module docs).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub first_increment: Option<f64>,
+    /// Why the first attempt failed, when this result comes from the retry.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub retry: Option<String>,
 }
 
 /// Read a manifest; a missing file is an empty manifest.
@@ -296,6 +318,11 @@ pub struct Job<'a> {
     pub work_dir: &'a Path,
     /// Wall-clock limit of the solve.
     pub timeout: Option<Duration>,
+    /// Output-silence limit of the solve.
+    pub stall: Option<Duration>,
+    /// First increment of each load step, as a fraction of the step (1 on the first
+    /// attempt, [`deck::RETRY_FIRST_INCREMENT`] on the retry).
+    pub first_increment: f64,
 }
 
 /// A solved pose.
@@ -310,6 +337,10 @@ pub struct Solved {
     pub increments: u32,
     /// Newton iterations.
     pub iterations: u32,
+    /// First increment of each step, as a fraction of the step (1: whole step).
+    pub first_increment: f64,
+    /// Why an earlier attempt failed, when this is the retry.
+    pub retry: Option<String>,
 }
 
 /// Why a pose could not be solved.
@@ -362,14 +393,16 @@ impl Backend for CcxBackend {
     }
 
     fn solve(&self, job: &Job<'_>) -> std::result::Result<Solved, SolveFailure> {
+        let first_increment = job.first_increment;
         let ccx_path = self.ccx.as_deref().context("CcxBackend::solve before prepare")?;
-        let deck = deck::write_deck(job.campaign, job.pose, job.mesh, job.steps).context("writing the deck")?;
+        let deck = deck::write_deck_first_increment(job.campaign, job.pose, job.mesh, job.steps, first_increment)
+            .context("writing the deck")?;
         if deck.steps != job.steps {
             return Err(anyhow::anyhow!("the deck has {} steps, {} were asked for", deck.steps, job.steps).into());
         }
         let inp = job.work_dir.join(format!("{JOB}.inp"));
         std::fs::write(&inp, &deck.text).with_context(|| format!("{}: cannot write", inp.display()))?;
-        let r = ccx::run_job(ccx_path, job.work_dir, JOB, job.timeout)?;
+        let r = ccx::run_job(ccx_path, job.work_dir, JOB, job.timeout, job.stall)?;
         let done = r.sta.steps_done();
         if !r.success() || done < job.steps {
             let how = if r.success() { "finished (exit code 0)".to_string() } else { r.exit.to_string() };
@@ -401,7 +434,14 @@ impl Backend for CcxBackend {
             })
             .collect::<Result<Vec<_>>>()
             .map_err(fail)?;
-        Ok(Solved { wrenches, summary: deck.summary, increments: r.sta.increments, iterations: r.sta.iterations })
+        Ok(Solved {
+            wrenches,
+            summary: deck.summary,
+            increments: r.sta.increments,
+            iterations: r.sta.iterations,
+            first_increment,
+            retry: None,
+        })
     }
 
     fn steps_done(&self, work_dir: &Path) -> u32 {
@@ -447,6 +487,7 @@ struct Ctx<'a> {
     steps: u32,
     out_dir: &'a Path,
     timeout: Option<Duration>,
+    stall: Option<Duration>,
     backend: &'a dyn Backend,
     solver_version: String,
     manifest_lock: Mutex<()>,
@@ -530,6 +571,7 @@ pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> 
             steps,
             out_dir: &out_dir,
             timeout: opts.timeout,
+            stall: opts.stall,
             backend,
             solver_version,
             manifest_lock: Mutex::new(()),
@@ -637,8 +679,10 @@ fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
         steps: ctx.steps,
         work_dir: &wd,
         timeout: ctx.timeout,
+        stall: ctx.stall,
+        first_increment: 1.0,
     };
-    let solved = match ctx.backend.solve(&job) {
+    let solved = match solve_with_retry(ctx.backend, &job) {
         Ok(s) => s,
         Err(f) => return fail(f.message, f.log_tail),
     };
@@ -657,6 +701,24 @@ fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
             }
         }
         Err(e) => fail(format!("{e:#}"), String::new()),
+    }
+}
+
+/// Solve `job`; when that fails, once more with [`deck::RETRY_FIRST_INCREMENT`] (module docs).
+fn solve_with_retry(backend: &dyn Backend, job: &Job<'_>) -> std::result::Result<Solved, SolveFailure> {
+    let first = match backend.solve(job) {
+        Ok(s) => return Ok(s),
+        Err(f) => f,
+    };
+    let r = deck::RETRY_FIRST_INCREMENT;
+    eprintln!("{}: {}; retrying with each step's first increment at {r} of the step", job.pose.name, first.message);
+    let retry = Job { first_increment: r, ..*job };
+    match backend.solve(&retry) {
+        Ok(s) => Ok(Solved { retry: Some(first.message), ..s }),
+        Err(f) => Err(SolveFailure {
+            message: format!("{}; retry with first increment {r}: {}", first.message, f.message),
+            log_tail: f.log_tail,
+        }),
     }
 }
 
@@ -695,6 +757,8 @@ fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Res
         z_mm: pose.z_mm,
         theta_x_deg: pose.theta_x_deg,
         theta_z_deg: pose.theta_z_deg,
+        first_increment: (s.first_increment != 1.0).then_some(s.first_increment),
+        retry: s.retry.clone(),
     };
     update_manifest(ctx, |m| {
         m.pose.insert(pose.name.clone(), entry);
@@ -910,6 +974,8 @@ mod tests {
     #[derive(Default)]
     struct Fake {
         fail: Option<String>,
+        /// Fails this pose's first attempt only (whole-step first increment).
+        fail_first: Option<String>,
         panic_on: Option<String>,
         solves: AtomicUsize,
         prepared: usize,
@@ -923,13 +989,18 @@ mod tests {
         fn solve(&self, job: &Job<'_>) -> std::result::Result<Solved, SolveFailure> {
             self.solves.fetch_add(1, Ordering::SeqCst);
             assert!(job.work_dir.is_dir(), "work dir exists");
-            assert_eq!(std::fs::read_dir(job.work_dir).map(|d| d.count()).unwrap_or(9), 0, "work dir is empty");
+            if job.first_increment == 1.0 {
+                assert_eq!(std::fs::read_dir(job.work_dir).map(|d| d.count()).unwrap_or(9), 0, "work dir is empty");
+            }
             std::fs::write(job.work_dir.join("pose.log"), "fake log\n").map_err(anyhow::Error::from)?;
             if self.panic_on.as_deref() == Some(job.pose.name.as_str()) {
                 panic!("fake panic");
             }
             if self.fail.as_deref() == Some(job.pose.name.as_str()) {
                 return Err(SolveFailure { message: "fake exit code 201".into(), log_tail: "*ERROR fake".into() });
+            }
+            if self.fail_first.as_deref() == Some(job.pose.name.as_str()) && job.first_increment == 1.0 {
+                return Err(SolveFailure { message: "fake stall".into(), log_tail: String::new() });
             }
             let wrenches = (1..=job.steps)
                 .map(|k| {
@@ -945,7 +1016,7 @@ mod tests {
                 model: "fake".into(),
                 tissue_mesh: "fake".into(),
             };
-            Ok(Solved { wrenches, summary, increments: job.steps, iterations: 2 * job.steps })
+            Ok(Solved { wrenches, summary, increments: job.steps, iterations: 2 * job.steps, first_increment: job.first_increment, retry: None })
         }
         fn steps_done(&self, _work_dir: &Path) -> u32 {
             0
@@ -1039,6 +1110,22 @@ mod tests {
         let r = run_with(&opts(d.path(), "x+0[246]", 2), &mut ok).expect("resume");
         assert_eq!((r.done(), r.up_to_date(), r.failed()), (2, 1, 0));
         assert!(!fe.join(".work/x+04").exists());
+    }
+
+    #[test]
+    fn a_failed_run_is_retried_once_with_a_smaller_first_increment_and_the_manifest_says_so() {
+        let d = set_dir();
+        let mut fake = Fake { fail_first: Some("x+04".into()), ..Fake::default() };
+        let r = run_with(&opts(d.path(), "x+0[24]", 2), &mut fake).expect("run");
+        assert_eq!((r.done(), r.failed()), (2, 0), "{}", r.table());
+        assert_eq!(fake.solves.load(Ordering::SeqCst), 3, "x+02 once, x+04 twice");
+        let m = read_manifest(&d.path().join("fe").join(MANIFEST)).expect("manifest");
+        let (x2, x4) = (&m.pose["x+02"], &m.pose["x+04"]);
+        assert_eq!((x2.first_increment, x2.retry.as_deref()), (None, None));
+        assert_eq!((x4.first_increment, x4.retry.as_deref()), (Some(deck::RETRY_FIRST_INCREMENT), Some("fake stall")));
+        let text = std::fs::read_to_string(d.path().join("fe").join(MANIFEST)).expect("manifest text");
+        assert_eq!(text.matches("first_increment = 0.25").count(), 1, "{text}");
+        assert_eq!(text.matches("retry = \"fake stall\"").count(), 1, "{text}");
     }
 
     #[test]

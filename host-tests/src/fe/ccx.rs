@@ -81,6 +81,8 @@ pub enum ExitKind {
     Signal(i32),
     /// Killed by the runner after the wall-clock timeout.
     TimedOut,
+    /// Killed by the runner: no output (log, `.sta`, `.cvg`) for this long.
+    Stalled(Duration),
 }
 
 impl fmt::Display for ExitKind {
@@ -89,6 +91,7 @@ impl fmt::Display for ExitKind {
             ExitKind::Code(c) => write!(f, "exit code {c}"),
             ExitKind::Signal(s) => write!(f, "killed by signal {s}"),
             ExitKind::TimedOut => write!(f, "timed out (killed)"),
+            ExitKind::Stalled(d) => write!(f, "stalled: no output for {:.1} s (killed)", d.as_secs_f64()),
         }
     }
 }
@@ -186,12 +189,20 @@ impl JobResult {
 
 /// Run `ccx -i <job>` in `work_dir` (which holds `<job>.inp`) on one thread
 /// (`OMP_NUM_THREADS=1`, `CCX_NPROC_*=1`), stdout and stderr to `<job>.log` in the same
-/// folder. With a `timeout`, the process is killed when it runs longer (wall clock).
+/// folder. With a `timeout`, the process is killed when it runs longer (wall clock); with
+/// a `stall` limit, when none of its log, `.sta` and `.cvg` files has grown for that long
+/// (ccx 2.20 can spin without output at the start of a step, see `campaign`).
 ///
 /// # Errors
 /// The log file cannot be created, or ccx cannot be started or waited for. A job that
 /// starts and then fails is not an error: see [`JobResult::exit`].
-pub fn run_job(ccx: &Path, work_dir: &Path, job: &str, timeout: Option<Duration>) -> Result<JobResult> {
+pub fn run_job(
+    ccx: &Path,
+    work_dir: &Path,
+    job: &str,
+    timeout: Option<Duration>,
+    stall: Option<Duration>,
+) -> Result<JobResult> {
     let log_path = work_dir.join(format!("{job}.log"));
     let log = std::fs::File::create(&log_path).with_context(|| format!("{}: cannot create", log_path.display()))?;
     let log_err = log.try_clone().with_context(|| format!("{}: cannot reopen", log_path.display()))?;
@@ -209,6 +220,9 @@ pub fn run_job(ccx: &Path, work_dir: &Path, job: &str, timeout: Option<Duration>
         .stderr(log_err)
         .spawn()
         .with_context(|| format!("{}: cannot start ccx in {}", ccx.display(), work_dir.display()))?;
+    let progress_files = [log_path.clone(), sta_path(work_dir, job), work_dir.join(format!("{job}.cvg"))];
+    let output_bytes = || -> u64 { progress_files.iter().filter_map(|p| std::fs::metadata(p).ok()).map(|m| m.len()).sum() };
+    let (mut last_bytes, mut last_change) = (0u64, Instant::now());
     let exit = loop {
         if let Some(status) = child.try_wait().context("cannot wait for ccx")? {
             use std::os::unix::process::ExitStatusExt;
@@ -223,6 +237,16 @@ pub fn run_job(ccx: &Path, work_dir: &Path, job: &str, timeout: Option<Duration>
             let _ = child.kill();
             let _ = child.wait();
             break ExitKind::TimedOut;
+        }
+        if let Some(limit) = stall {
+            let bytes = output_bytes();
+            if bytes != last_bytes {
+                (last_bytes, last_change) = (bytes, Instant::now());
+            } else if last_change.elapsed() > limit {
+                let _ = child.kill();
+                let _ = child.wait();
+                break ExitKind::Stalled(limit);
+            }
         }
         std::thread::sleep(Duration::from_millis(50));
     };
@@ -252,5 +276,31 @@ mod tests {
     fn tail_lines() {
         assert_eq!(tail("a\nb\nc\n\n", 2), "b\nc");
         assert_eq!(tail("a", 5), "a");
+    }
+
+    /// A stand-in for ccx (a shell script): `silent` writes a line then sleeps silently.
+    fn fake_ccx(dir: &Path, body: &str) -> PathBuf {
+        use std::os::unix::fs::PermissionsExt;
+        let p = dir.join("fake-ccx");
+        std::fs::write(&p, format!("#!/bin/sh\n{body}\n")).expect("write fake ccx");
+        std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o755)).expect("chmod");
+        p
+    }
+
+    #[test]
+    fn a_silent_job_is_killed_as_stalled_and_a_talking_one_is_not() {
+        let d = tempfile::tempdir().expect("tempdir");
+        let silent = fake_ccx(d.path(), "echo started; sleep 30");
+        let start = Instant::now();
+        let r = run_job(&silent, d.path(), "job", None, Some(Duration::from_millis(700))).expect("run");
+        assert_eq!(r.exit, ExitKind::Stalled(Duration::from_millis(700)));
+        assert!(start.elapsed() < Duration::from_secs(10), "killed long before the script's 30 s");
+        assert_eq!(r.log_tail, "started");
+
+        // prints every 0.1 s for 1.5 s: never silent for 0.7 s, so it runs to its end
+        let talking = fake_ccx(d.path(), "i=0; while [ $i -lt 15 ]; do echo $i; sleep 0.1; i=$((i+1)); done");
+        let r = run_job(&talking, d.path(), "job", None, Some(Duration::from_millis(700))).expect("run");
+        assert_eq!(r.exit, ExitKind::Code(0), "{}", r.log_tail);
+        assert!(r.log_tail.ends_with("14"));
     }
 }

@@ -88,6 +88,27 @@ pub fn write_deck(c: &Campaign, pose: &PoseSpec, mesh_level: &MeshLevel, steps: 
     write_deck_with_symmetry(c, pose, mesh_level, steps, pose.symmetry())
 }
 
+/// The first increment of every load step, as a fraction of the step (`*STATIC`'s first
+/// value), when the step is not tried in one increment. The campaign's retry of a failed
+/// or stalled run (see `campaign`) uses it; ccx cuts back from there as usual.
+pub const RETRY_FIRST_INCREMENT: f64 = 0.25;
+
+/// As [`write_deck`], with every load step starting at `first_increment` of the step
+/// (`*STATIC` first value; 1 is [`write_deck`]'s). The model and the loads are the same:
+/// only ccx's incrementation within a step differs.
+///
+/// # Errors
+/// As [`write_deck`]; `first_increment` not in (0, 1].
+pub fn write_deck_first_increment(
+    c: &Campaign,
+    pose: &PoseSpec,
+    mesh_level: &MeshLevel,
+    steps: u32,
+    first_increment: f64,
+) -> Result<Deck> {
+    write_deck_full(c, pose, mesh_level, steps, pose.symmetry(), first_increment)
+}
+
 /// As [`write_deck`], with the mirror planes chosen by the caller (a full model of a
 /// symmetric pose, for checking the symmetry reduction).
 ///
@@ -100,6 +121,20 @@ pub fn write_deck_with_symmetry(
     steps: u32,
     sym: Symmetry,
 ) -> Result<Deck> {
+    write_deck_full(c, pose, mesh_level, steps, sym, 1.0)
+}
+
+fn write_deck_full(
+    c: &Campaign,
+    pose: &PoseSpec,
+    mesh_level: &MeshLevel,
+    steps: u32,
+    sym: Symmetry,
+    first_increment: f64,
+) -> Result<Deck> {
+    if !(first_increment > 1e-5 && first_increment <= 1.0) {
+        bail!("pose {}: first increment {first_increment} of a step: must be in (1e-5, 1]", pose.name);
+    }
     let own = pose.symmetry();
     if (sym.plane_x && !own.plane_x) || (sym.plane_z && !own.plane_z) {
         bail!("pose {}: asked for a mirror plane the pose does not have", pose.name);
@@ -134,7 +169,7 @@ pub fn write_deck_with_symmetry(
         let d = depth * f64::from(k) / f64::from(steps);
         let _ = writeln!(w, "** ---- load step {k}: depth {d:.4} mm along the needle axis");
         let _ = writeln!(w, "*STEP, NLGEOM, INC=1000");
-        let _ = writeln!(w, "*STATIC\n1., 1., 1e-5, 1.");
+        let _ = writeln!(w, "*STATIC\n{}, 1., 1e-5, 1.", fortran_real(first_increment));
         let _ = writeln!(w, "*BOUNDARY");
         for (dof, a) in axis.iter().enumerate() {
             let _ = writeln!(w, "NEEDLE, {}, {}, {:.9}", dof + 1, dof + 1, -d * a);
@@ -274,5 +309,15 @@ fn write_boundary(w: &mut String, t: &TissueMesh) {
     }
     if !t.plane_z.is_empty() {
         let _ = writeln!(w, "SYMZ, 3, 3");
+    }
+}
+
+/// `v` as a deck real: `1.` for one (the generator's historical text), else Rust's
+/// shortest round-trip form (`0.25`).
+fn fortran_real(v: f64) -> String {
+    if v == 1.0 {
+        "1.".to_string()
+    } else {
+        format!("{v:?}")
     }
 }

@@ -271,6 +271,8 @@ fn mesh_convergence(c: &Campaign, work: &Path) -> Result<MeshReport> {
             steps: c.loading.steps,
             work_dir: &dir,
             timeout: None,
+            stall: Some(crate::fe::campaign::DEFAULT_STALL),
+            first_increment: 1.0,
         };
         let start = std::time::Instant::now();
         let solved = backend
@@ -409,7 +411,7 @@ fn punch(c: &Campaign, work: &Path, opts: &VerifyOptions) -> Result<PunchReport>
                 d.elements
             );
             let exe = ccx::find_ccx()?;
-            let job = ccx::run_job(&exe, &dir, &name, None)?;
+            let job = ccx::run_job(&exe, &dir, &name, None, None)?;
             if !job.success() {
                 bail!("{name}: ccx failed ({}); last lines of {}:\n{}", job.exit, job.log_path.display(), job.log_tail);
             }
