@@ -40,6 +40,7 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+mod bit_flags;
 pub mod control;
 pub mod command;
 mod evaluation;

@@ -1,6 +1,5 @@
 //! [`Status`]: what an evaluation had to do to its input, as bit flags.
 use core::fmt;
-use core::ops::{BitOr, BitOrAssign};
 
 /// Status of an evaluation: bit flags, `0` ([`Status::OK`]) when the pose was inside the
 /// domain and the model is present.
@@ -95,45 +94,14 @@ impl Status {
     }
 }
 
-impl BitOr for Status {
-    type Output = Self;
-    #[inline]
-    fn bitor(self, rhs: Self) -> Self {
-        Self(self.0 | rhs.0)
-    }
-}
+crate::bit_flags::bit_or_ops!(Status);
 
-impl BitOrAssign for Status {
-    #[inline]
-    fn bitor_assign(&mut self, rhs: Self) {
-        self.0 |= rhs.0;
-    }
-}
-
-/// The flag names joined by ` | `, or `OK` (for example `SAT_X | SAT_DEPTH`).
+/// The flag names joined by ` | `, or `OK` (for example `SAT_X | SAT_DEPTH`); bits no
+/// flag names in hex.
 impl fmt::Display for Status {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if self.is_ok() {
-            return f.write_str("OK");
-        }
-        let mut first = true;
-        for (flag, name) in Self::FLAGS {
-            if self.contains(flag) {
-                if !first {
-                    f.write_str(" | ")?;
-                }
-                f.write_str(name)?;
-                first = false;
-            }
-        }
-        let unknown = self.0 & !(Self::SATURATION.0 | Self::NO_MODEL.0 | Self::ERROR.0);
-        if unknown != 0 {
-            if !first {
-                f.write_str(" | ")?;
-            }
-            write!(f, "{unknown:#04x}")?;
-        }
-        Ok(())
+        let named = Self::FLAGS.map(|(flag, name)| (u32::from(flag.0), name));
+        crate::bit_flags::write_names(f, u32::from(self.0), &named, 2)
     }
 }
 

@@ -1,7 +1,7 @@
 //! Shared by the firmware examples (bare metal only): output through
 //! ARM semihosting (QEMU writes it to its stdout), the semihosting exit, and a panic
-//! handler that reports the panic and exits with a failure status. `no_panic` does not
-//! use this module: it has its own, unlinkable, panic handler.
+//! handler that reports the panic and exits with a failure status. The `no_panic*`
+//! examples do not use this module: they hold `panic_gate`, whose handler cannot link.
 #![allow(dead_code)]
 // Fixed-size buffers indexed within their bounds; a panic here is reported by the handler below.
 #![allow(clippy::indexing_slicing)]

@@ -53,6 +53,20 @@ fn status_flags() {
     assert_eq!(all, 0xdf);
 }
 
+#[test]
+fn loop_flags_text() {
+    use needle_haptics::control::LoopFlags;
+    let mut s = LoopFlags::RAMPING;
+    s |= LoopFlags::POSE_STALE;
+    assert_eq!(s.bits(), 0x0021);
+    assert_eq!(format!("{s}"), "POSE_STALE | RAMPING");
+    assert_eq!(format!("{s:?}"), "LoopFlags(0x0021: POSE_STALE | RAMPING)");
+    assert_eq!(format!("{}", LoopFlags::OK), "OK");
+    assert_eq!(format!("{}", LoopFlags::from_bits(0x0201)), "POSE_STALE | 0x0200");
+    let all: u16 = LoopFlags::FLAGS.iter().fold(0, |a, (f, _)| a | f.bits());
+    assert_eq!(all, 0x01ff);
+}
+
 const NON_FINITE: [f32; 4] = [f32::NAN, -f32::NAN, f32::INFINITY, f32::NEG_INFINITY];
 
 #[test]

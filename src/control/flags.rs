@@ -99,38 +99,13 @@ impl LoopFlags {
     }
 }
 
-impl core::ops::BitOr for LoopFlags {
-    type Output = Self;
-    #[inline]
-    fn bitor(self, rhs: Self) -> Self {
-        Self(self.0 | rhs.0)
-    }
-}
+crate::bit_flags::bit_or_ops!(LoopFlags);
 
-impl core::ops::BitOrAssign for LoopFlags {
-    #[inline]
-    fn bitor_assign(&mut self, rhs: Self) {
-        self.0 |= rhs.0;
-    }
-}
-
-/// The flag names joined by ` | `, or `OK`.
+/// The flag names joined by ` | `, or `OK`; bits no flag names in hex.
 impl fmt::Display for LoopFlags {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if self.is_ok() {
-            return f.write_str("OK");
-        }
-        let mut first = true;
-        for (flag, name) in Self::FLAGS {
-            if self.contains(flag) {
-                if !first {
-                    f.write_str(" | ")?;
-                }
-                f.write_str(name)?;
-                first = false;
-            }
-        }
-        Ok(())
+        let named = Self::FLAGS.map(|(flag, name)| (u32::from(flag.0), name));
+        crate::bit_flags::write_names(f, u32::from(self.0), &named, 4)
     }
 }
 

@@ -1,0 +1,54 @@
+//! What the two bit-flag types ([`Status`](crate::Status) and
+//! [`LoopFlags`](crate::control::LoopFlags)) share: the `|` operators and the
+//! `NAME | NAME` text.
+use core::fmt;
+
+/// `impl BitOr, BitOrAssign` for a `struct $t(uint)` flag type.
+macro_rules! bit_or_ops {
+    ($t:ty) => {
+        impl core::ops::BitOr for $t {
+            type Output = Self;
+            #[inline]
+            fn bitor(self, rhs: Self) -> Self {
+                Self(self.0 | rhs.0)
+            }
+        }
+
+        impl core::ops::BitOrAssign for $t {
+            #[inline]
+            fn bitor_assign(&mut self, rhs: Self) {
+                self.0 |= rhs.0;
+            }
+        }
+    };
+}
+pub(crate) use bit_or_ops;
+
+/// Writes the names of the flags of `named` set in `bits`, in the table's order, joined by
+/// ` | `, then any set bit no name covers in hex (`0x20`, `hex_digits` wide); `OK` when
+/// `bits` is 0.
+pub(crate) fn write_names(f: &mut fmt::Formatter<'_>, bits: u32, named: &[(u32, &str)], hex_digits: usize) -> fmt::Result {
+    if bits == 0 {
+        return f.write_str("OK");
+    }
+    let mut first = true;
+    let mut known = 0;
+    for &(flag, name) in named {
+        known |= flag;
+        if bits & flag == flag && flag != 0 {
+            if !first {
+                f.write_str(" | ")?;
+            }
+            f.write_str(name)?;
+            first = false;
+        }
+    }
+    let unknown = bits & !known;
+    if unknown != 0 {
+        if !first {
+            f.write_str(" | ")?;
+        }
+        write!(f, "{unknown:#0w$x}", w = hex_digits + 2)?;
+    }
+    Ok(())
+}
