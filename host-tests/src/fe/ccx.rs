@@ -253,7 +253,14 @@ pub fn run_job(
     let wall = start.elapsed();
     let sta = std::fs::read_to_string(sta_path(work_dir, job)).map(|t| parse_sta(&t)).unwrap_or_default();
     let log_text = std::fs::read(&log_path).map(|b| String::from_utf8_lossy(&b).into_owned()).unwrap_or_default();
-    Ok(JobResult { exit, wall, sta, log_tail: tail(&log_text, LOG_TAIL_LINES), log_path })
+    let mut log_tail = tail(&log_text, LOG_TAIL_LINES);
+    // SPOOLES reports a singular matrix in its own file, not on stdout (ccx then exits 255)
+    let spooles = std::fs::read_to_string(work_dir.join("spooles.out")).unwrap_or_default();
+    if !spooles.trim().is_empty() {
+        log_tail.push_str("\nspooles.out: ");
+        log_tail.push_str(&tail(&spooles, 3).trim_start().replace('\n', " / "));
+    }
+    Ok(JobResult { exit, wall, sta, log_tail, log_path })
 }
 
 /// The last `n` non-blank-trailing lines of `text`.
@@ -296,6 +303,13 @@ mod tests {
         assert_eq!(r.exit, ExitKind::Stalled(Duration::from_millis(700)));
         assert!(start.elapsed() < Duration::from_secs(10), "killed long before the script's 30 s");
         assert_eq!(r.log_tail, "started");
+
+        // a solver failure reported in spooles.out reaches the log tail
+        let singular = fake_ccx(d.path(), "echo factoring; printf '\\n\\n matrix found to be singular\\n' > spooles.out; exit 255");
+        let r = run_job(&singular, d.path(), "job", None, None).expect("run");
+        assert_eq!(r.exit, ExitKind::Code(255));
+        assert_eq!(r.log_tail, "factoring\nspooles.out: matrix found to be singular");
+        std::fs::remove_file(d.path().join("spooles.out")).expect("rm spooles.out");
 
         // prints every 0.1 s for 1.5 s: never silent for 0.7 s, so it runs to its end
         let talking = fake_ccx(d.path(), "i=0; while [ $i -lt 15 ]; do echo $i; sleep 0.1; i=$((i+1)); done");
