@@ -35,17 +35,15 @@ mod common;
 
 #[cfg(target_os = "none")]
 mod firmware {
+    use crate::common::icount::{elapsed, Calibration};
     use crate::common::{exit, target_name, Out};
     use core::arch::asm;
     use core::hint::black_box;
-    use cortex_m::peripheral::{syst::SystClkSource, SYST};
+    use cortex_m::peripheral::SYST;
     use needle_haptics::{fixed, wrench, Pose};
 
     /// Evaluations per timed loop.
     const CALLS: u32 = 256;
-    /// Iterations of the two calibration loops (2 instructions each).
-    const CAL_SHORT: u32 = 10_000;
-    const CAL_LONG: u32 = 1_010_000;
     /// Bytes of stack painted below the caller's stack pointer.
     const STACK_WINDOW: usize = 4096;
     const PAINT: u32 = 0xa5c3_5a3c;
@@ -66,22 +64,6 @@ mod firmware {
         ("positive", fixed::Pose::new(6 * ONE, 4 * ONE, 10 * ONE, 2 * ONE, 3 * ONE)),
         ("saturated", fixed::Pose::new(20 * ONE, -20 * ONE, 30 * ONE, -30 * ONE, 9 * ONE)),
     ];
-
-    fn elapsed(start: u32, end: u32) -> u32 {
-        // SysTick counts down from 0xff_ffff and wraps: ticks modulo 2^24.
-        start.wrapping_sub(end) & 0x00ff_ffff
-    }
-
-    /// Ticks taken by `n` (>= 1) iterations of a 2-instruction loop.
-    #[inline(never)]
-    fn spin(n: u32) -> u32 {
-        let start = SYST::get_current();
-        // SAFETY: a register-only countdown loop; n >= 1 (callers pass constants).
-        unsafe {
-            asm!("2:", "subs {n}, #1", "bne 2b", n = inout(reg) n => _, options(nomem, nostack));
-        }
-        elapsed(start, SYST::get_current())
-    }
 
     #[inline(never)]
     fn loop_wrench<P, E>(f: fn(&P) -> E, pose: &P, calls: u32) -> u32 {
@@ -153,28 +135,19 @@ mod firmware {
             exit(false)
         };
         let mut syst = p.SYST;
-        syst.set_clock_source(SystClkSource::Core);
-        syst.set_reload(0x00ff_ffff);
-        syst.clear_current();
-        syst.enable_counter();
-
-        let cal_instructions = u64::from(2 * (CAL_LONG - CAL_SHORT));
-        let long_a = spin(black_box(CAL_LONG));
-        let long_b = spin(black_box(CAL_LONG));
-        let short = spin(black_box(CAL_SHORT));
-        let cal_ticks = u64::from(long_a.saturating_sub(short));
+        let cal = Calibration::start(&mut syst);
         out.str("needle-bench target=");
         out.str(target_name());
         out.str(" calls=");
         out.dec(u64::from(CALLS));
         out.str(" calibration_instructions=");
-        out.dec(cal_instructions);
+        out.dec(cal.instructions);
         out.str(" calibration_ticks=");
-        out.dec(cal_ticks);
+        out.dec(cal.ticks);
         out.str(" deterministic=");
-        out.str(if long_a == long_b { "yes" } else { "no" });
+        out.str(if cal.deterministic { "yes" } else { "no" });
         out.nl();
-        if cal_ticks == 0 {
+        if cal.ticks == 0 {
             out.str("needle-bench error: SysTick does not count\n");
             out.flush();
             exit(false)
@@ -182,12 +155,7 @@ mod firmware {
 
         let eval: fn(&Pose) -> needle_haptics::Evaluation = black_box(wrench);
         let eval_fixed: fn(&fixed::Pose) -> fixed::Evaluation = black_box(fixed::wrench);
-        let per_call = |tw: u32, te: u32| -> u64 {
-            // Instructions per call in tenths, rounded: ticks * (instructions per tick).
-            let num = u64::from(tw).saturating_sub(u64::from(te)) * cal_instructions * 10;
-            let den = cal_ticks * u64::from(CALLS);
-            (num + den / 2) / den
-        };
+        let per_call = |tw: u32, te: u32| -> u64 { cal.tenths_per_call(tw, te, CALLS) };
         for (name, pose) in POSES.iter() {
             let tenths = per_call(loop_wrench(eval, pose, black_box(CALLS)), loop_empty(pose, black_box(CALLS)));
             let stack = stack_use(eval, pose);
