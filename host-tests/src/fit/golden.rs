@@ -184,33 +184,78 @@ pub struct GoldenRow {
 /// Wrong header, a row without 12 fields, a malformed hex field (`path:line` in the
 /// message).
 pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<GoldenRow>> {
+    parse_rows(text, path, HEADER, |field, at| {
+        let value = |s: &str| parse_hex32(s).ok_or_else(|| anyhow::anyhow!("{at}: field {s:?} is not 0x + 8 hex digits"));
+        let mut v = [0.0f32; 11];
+        for (j, dst) in v.iter_mut().enumerate() {
+            *dst = value(if j < 5 { field[j] } else { field[j + 1] })?;
+        }
+        Ok(([v[0], v[1], v[2], v[3], v[4]], [v[5], v[6], v[7], v[8], v[9], v[10]]))
+    })
+    .map(|rows| rows.into_iter().map(|(pose, status, wrench)| GoldenRow { pose, status, wrench }).collect())
+}
+
+/// The golden-file layout both golden files share: `header`, then rows of 12 fields
+/// `5 pose values, status (0x + 2 hex digits), 6 wrench values`. `values` reads the pose
+/// and the wrench of one row from its 12 fields; its second argument is the row's
+/// `path:line` for messages.
+///
+/// # Errors
+/// Wrong header, a row without 12 fields, a malformed status, or `values`' error.
+#[allow(clippy::type_complexity)]
+pub(crate) fn parse_rows<P, W>(
+    text: &str,
+    path: &Path,
+    header: &str,
+    values: impl Fn(&[&str], &str) -> Result<(P, W)>,
+) -> Result<Vec<(P, u8, W)>> {
     let p = path.display();
     let mut lines = text.lines();
-    if lines.next() != Some(HEADER) {
-        bail!("{p}:1: expected the header {HEADER:?}");
+    if lines.next() != Some(header) {
+        bail!("{p}:1: expected the header {header:?}");
     }
     let mut rows = Vec::new();
     for (n, line) in lines.enumerate() {
-        let ln = n + 2;
+        let at = format!("{p}:{}", n + 2);
         let f: Vec<&str> = line.split(',').collect();
         if f.len() != 12 {
-            bail!("{p}:{ln}: {} fields, expected 12", f.len());
-        }
-        let mut v = [0.0f32; 11];
-        for (j, dst) in v.iter_mut().enumerate() {
-            let field = if j < 5 { f[j] } else { f[j + 1] };
-            *dst = parse_hex32(field).ok_or_else(|| anyhow::anyhow!("{p}:{ln}: field {field:?} is not 0x + 8 hex digits"))?;
+            bail!("{at}: {} fields, expected 12", f.len());
         }
         let status = f[5]
             .strip_prefix("0x")
             .filter(|h| h.len() == 2)
             .and_then(|h| u8::from_str_radix(h, 16).ok())
-            .ok_or_else(|| anyhow::anyhow!("{p}:{ln}: status {:?} is not 0x + 2 hex digits", f[5]))?;
-        rows.push(GoldenRow {
-            pose: [v[0], v[1], v[2], v[3], v[4]],
-            status,
-            wrench: [v[5], v[6], v[7], v[8], v[9], v[10]],
-        });
+            .ok_or_else(|| anyhow::anyhow!("{at}: status {:?} is not 0x + 2 hex digits", f[5]))?;
+        let (pose, wrench) = values(&f, &at)?;
+        rows.push((pose, status, wrench));
     }
     Ok(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn err(text: &str) -> String {
+        format!("{:#}", parse_csv(text, Path::new("g.csv")).expect_err("must be refused"))
+    }
+
+    #[test]
+    fn malformed_golden_files_name_the_line() {
+        let one = "0x3f800000";
+        let row = |status: &str, last: &str| {
+            let mut f = vec![one; 5];
+            f.push(status);
+            f.extend([one; 5]);
+            f.push(last);
+            f.join(",")
+        };
+        let good = format!("{HEADER}\n{}\n", row("0x01", one));
+        let rows = parse_csv(&good, Path::new("g.csv")).expect("good file");
+        assert_eq!(rows, [GoldenRow { pose: [1.0; 5], status: 1, wrench: [1.0; 6] }]);
+        assert_eq!(err("x\n"), format!("g.csv:1: expected the header {HEADER:?}"));
+        assert_eq!(err(&format!("{HEADER}\n{}\n0x1\n", row("0x00", one))), "g.csv:3: 1 fields, expected 12");
+        assert_eq!(err(&format!("{HEADER}\n{}\n", row("0x1", one))), "g.csv:2: status \"0x1\" is not 0x + 2 hex digits");
+        assert_eq!(err(&format!("{HEADER}\n{}\n", row("0x00", "1.0"))), "g.csv:2: field \"1.0\" is not 0x + 8 hex digits");
+    }
 }

@@ -9,7 +9,7 @@
 
 use super::eval_fixed::{eval, DEPTH_DIVISOR, DEPTH_MAX_Q16, DIVISORS, HALF_RANGE_Q16, ONE};
 use super::fixed_formats::TablesFixed;
-use anyhow::{anyhow, bail, Result};
+use anyhow::{anyhow, Result};
 use rand::{RngCore, SeedableRng};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -165,33 +165,32 @@ pub struct FixedRow {
 /// # Errors
 /// Wrong header, a row without 12 fields, a malformed field (`path:line` in the message).
 pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<FixedRow>> {
-    let p = path.display();
-    let mut lines = text.lines();
-    if lines.next() != Some(HEADER) {
-        bail!("{p}:1: expected the header {HEADER:?}");
-    }
-    let mut rows = Vec::new();
-    for (n, line) in lines.enumerate() {
-        let ln = n + 2;
-        let f: Vec<&str> = line.split(',').collect();
-        if f.len() != 12 {
-            bail!("{p}:{ln}: {} fields, expected 12", f.len());
-        }
-        let int = |s: &str| s.parse::<i32>().map_err(|_| anyhow!("{p}:{ln}: {s:?} is not an i32"));
-        let status = f[5]
-            .strip_prefix("0x")
-            .filter(|h| h.len() == 2)
-            .and_then(|h| u8::from_str_radix(h, 16).ok())
-            .ok_or_else(|| anyhow!("{p}:{ln}: status {:?} is not 0x + 2 hex digits", f[5]))?;
+    super::golden::parse_rows(text, path, HEADER, |field, at| {
+        let int = |s: &str| s.parse::<i32>().map_err(|_| anyhow!("{at}: {s:?} is not an i32"));
         let mut pose = [0; 5];
-        for (d, s) in pose.iter_mut().zip(&f[..5]) {
+        for (d, s) in pose.iter_mut().zip(&field[..5]) {
             *d = int(s)?;
         }
         let mut wrench = [0; 6];
-        for (d, s) in wrench.iter_mut().zip(&f[6..]) {
+        for (d, s) in wrench.iter_mut().zip(&field[6..]) {
             *d = int(s)?;
         }
-        rows.push(FixedRow { pose, status, wrench });
+        Ok((pose, wrench))
+    })
+    .map(|rows| rows.into_iter().map(|(pose, status, wrench)| FixedRow { pose, status, wrench }).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fixed_rows_parse_and_a_bad_integer_names_the_line() {
+        let good = format!("{HEADER}\n1,2,3,4,5,0x10,-1,-2,-3,-4,-5,-6\n");
+        let rows = parse_csv(&good, Path::new("f.csv")).expect("good file");
+        assert_eq!(rows, [FixedRow { pose: [1, 2, 3, 4, 5], status: 0x10, wrench: [-1, -2, -3, -4, -5, -6] }]);
+        let bad = format!("{HEADER}\n1,2,3,4,5,0x10,-1,-2,-3,-4,-5,x\n");
+        let e = format!("{:#}", parse_csv(&bad, Path::new("f.csv")).expect_err("refused"));
+        assert_eq!(e, "f.csv:2: \"x\" is not an i32");
     }
-    Ok(rows)
 }
