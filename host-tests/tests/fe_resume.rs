@@ -128,7 +128,7 @@ fn smoke_campaign_skips_and_resumes_after_a_kill() {
     assert_eq!(std::fs::read(fe.join("centre.csv")).expect("csv"), csv_before);
     assert_eq!(std::fs::read(fe.join(MANIFEST)).expect("manifest"), manifest_before);
 
-    // 3. a second pose, interrupted (SIGINT to its process group, like Ctrl-C) once ccx
+    // 3. a second pose, killed (SIGTERM to its process group) once ccx
     //    has finished its first of three steps
     let work = fe.join(".work").join("x+04");
     let mut child = Command::new(NEEDLE)
@@ -151,14 +151,17 @@ fn smoke_campaign_skips_and_resumes_after_a_kill() {
         assert!(start.elapsed() < Duration::from_secs(300), "x+04: no step done after 300 s");
         std::thread::sleep(Duration::from_millis(20));
     }
-    let kill = Command::new("kill").args(["-INT", "--", &format!("-{pgid}")]).status().expect("kill");
+    // SIGTERM, not SIGINT (Ctrl-C): a shell without job control starts background
+    // commands with SIGINT ignored, and needle and ccx inherit that, so a SIGINT would
+    // not stop them when the tests run from such a script (seen: the run then finished).
+    let kill = Command::new("kill").args(["-TERM", "--", &format!("-{pgid}")]).status().expect("kill");
     assert!(kill.success());
     let status = child.wait().expect("wait");
     assert!(!status.success(), "interrupted run: {status}");
     // wait until ccx (same process group) is gone too
     let gone = Instant::now();
     while Command::new("kill").args(["-0", "--", &format!("-{pgid}")]).stderr(Stdio::null()).status().expect("kill -0").success() {
-        assert!(gone.elapsed() < Duration::from_secs(30), "ccx still running 30 s after SIGINT");
+        assert!(gone.elapsed() < Duration::from_secs(30), "ccx still running 30 s after SIGTERM");
         std::thread::sleep(Duration::from_millis(50));
     }
     assert!(ccx::steps_done(&work, "pose") < 3, "ccx was interrupted before its last step");
