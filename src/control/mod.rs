@@ -31,6 +31,7 @@
 //!     fn set_high(&mut self) -> Result<(), Infallible> { self.0 = true; Ok(()) }
 //! }
 //!
+//! # fn main() -> Result<(), ConfigError> {
 //! // One motor pushing along y: full scale at 2 N.
 //! let config = LoopConfig {
 //!     channels: [ChannelMap { gains_per_n: [0.0, 0.5, 0.0], direction_inverted: false }],
@@ -39,10 +40,12 @@
 //!     over_limit: OverLimit::Saturate,
 //!     ramp_step_n: 0.01,
 //! };
-//! let mut l = ControlLoop::new(config, Encoders, [Channel { pwm: Pwm::default(), dir: Pin::default() }], Pin::default()).unwrap();
+//! let mut l = ControlLoop::new(config, Encoders, [Channel { pwm: Pwm::default(), dir: Pin::default() }], Pin::default())?;
 //! let s = l.tick();
 //! assert_eq!(s.tick, 1);
 //! assert!(!s.flags.contains(LoopFlags::RAMPING));
+//! # Ok(())
+//! # }
 //! ```
 mod config;
 mod core;
