@@ -51,20 +51,6 @@ impl Status {
         (Self::ERROR, "ERROR"),
     ];
 
-    /// A status from its bits (kept as given, unknown bits included).
-    #[inline]
-    #[must_use]
-    pub const fn from_bits(bits: u8) -> Self {
-        Self(bits)
-    }
-
-    /// The bits of this status.
-    #[inline]
-    #[must_use]
-    pub const fn bits(self) -> u8 {
-        self.0
-    }
-
     /// `true` when no flag is set: the pose was in the domain and the wrench is the model's.
     #[inline]
     #[must_use]
@@ -85,16 +71,9 @@ impl Status {
     pub const fn saturated(self) -> bool {
         self.0 & Self::SATURATION.0 != 0
     }
-
-    /// `true` when every flag set in `flags` is also set here.
-    #[inline]
-    #[must_use]
-    pub const fn contains(self, flags: Self) -> bool {
-        self.0 & flags.0 == flags.0
-    }
 }
 
-crate::bit_flags::bit_or_ops!(Status);
+crate::bit_flags::flag_bits!(Status, u8);
 
 /// The flag names joined by ` | `, or `OK` (for example `SAT_X | SAT_DEPTH`); bits no
 /// flag names in hex.

@@ -56,32 +56,11 @@ impl LoopFlags {
         (Self::DISABLED, "DISABLED"),
     ];
 
-    /// Flags from their bits (kept as given).
-    #[inline]
-    #[must_use]
-    pub const fn from_bits(bits: u16) -> Self {
-        Self(bits)
-    }
-
-    /// The bits.
-    #[inline]
-    #[must_use]
-    pub const fn bits(self) -> u16 {
-        self.0
-    }
-
     /// `true` when no flag is set.
     #[inline]
     #[must_use]
     pub const fn is_ok(self) -> bool {
         self.0 == 0
-    }
-
-    /// `true` when every flag of `other` is set here.
-    #[inline]
-    #[must_use]
-    pub const fn contains(self, other: Self) -> bool {
-        self.0 & other.0 == other.0
     }
 
     /// `true` when at least one flag of `other` is set here.
@@ -99,7 +78,7 @@ impl LoopFlags {
     }
 }
 
-crate::bit_flags::bit_or_ops!(LoopFlags);
+crate::bit_flags::flag_bits!(LoopFlags, u16);
 
 /// The flag names joined by ` | `, or `OK`; bits no flag names in hex.
 impl fmt::Display for LoopFlags {
