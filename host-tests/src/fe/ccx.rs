@@ -191,7 +191,10 @@ impl JobResult {
 /// (`OMP_NUM_THREADS=1`, `CCX_NPROC_*=1`), stdout and stderr to `<job>.log` in the same
 /// folder. With a `timeout`, the process is killed when it runs longer (wall clock); with
 /// a `stall` limit, when none of its log, `.sta` and `.cvg` files has grown for that long
-/// (ccx 2.20 can spin without output at the start of a step, see `campaign`).
+/// (ccx 2.20 can spin without output at the start of a step: on `tz+15` a profile of the
+/// spinning process showed SPOOLES's pivot search, `Chv_maxabsInColumn11` and
+/// `Chv_maxabsInRow11`, taking all the time; that is the known endless loop of SPOOLES's
+/// threshold pivoting on a matrix holding NaN, so a stall is a failed run, not a slow one).
 ///
 /// # Errors
 /// The log file cannot be created, or ccx cannot be started or waited for. A job that
