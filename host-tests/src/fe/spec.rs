@@ -171,6 +171,12 @@ pub struct CampaignSettings {
     pub lhs_seed: u64,
     /// Number of Latin hypercube poses.
     pub lhs_count: u32,
+    /// Sweep runs the fitter leaves out, by pose name, each because its FE run cannot be
+    /// solved (the reason is written next to the list in campaign.toml). The run stays in
+    /// the campaign; the fit needs at least 5 distinct values per sweep without it, and
+    /// model.toml names what was left out.
+    #[serde(default)]
+    pub fit_without: Vec<String>,
 }
 
 /// What a pose is for.
@@ -386,6 +392,16 @@ impl Campaign {
             }
             if pose.role == Role::Lhs {
                 bail!("{p}: pose {:?}: role lhs is generated from campaign.lhs_seed, not listed", pose.name);
+            }
+        }
+        for name in &self.campaign.fit_without {
+            match self.pose.iter().find(|q| &q.name == name) {
+                None => bail!("{p}: campaign.fit_without: {name:?} is not a listed pose"),
+                Some(q) if !q.role.is_fitted() || q.role == Role::Centre => bail!(
+                    "{p}: campaign.fit_without: pose {name:?} has role {:?}; only sweep runs can be left out of the fit",
+                    q.role
+                ),
+                Some(_) => {}
             }
         }
         Ok(())

@@ -102,7 +102,8 @@ pub fn read_run(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Result<
 ///
 /// # Errors
 /// The spec cannot be loaded; its loading depth is not the contract's 6 mm; a fitted run
-/// is missing (the message lists every missing pose); a fitted run cannot be read or has
+/// is missing (the message lists every missing pose; runs named in `campaign.fit_without`
+/// are not fitted and may be missing); a fitted run cannot be read or has
 /// the wrong depths; a sweep pose has another input nonzero or a negative value; there is
 /// not exactly one centre pose; a sweep has fewer than 5 distinct values (centre
 /// included) or a value outside its half-range.
@@ -116,7 +117,8 @@ pub fn load_fit_data(set_dir: &Path) -> Result<FitData> {
         );
     }
     let poses = campaign.poses();
-    let fitted: Vec<&PoseSpec> = poses.iter().filter(|p| p.role.is_fitted()).collect();
+    let left_out = &campaign.campaign.fit_without;
+    let fitted: Vec<&PoseSpec> = poses.iter().filter(|p| p.role.is_fitted() && !left_out.contains(&p.name)).collect();
     let missing: Vec<&str> = fitted
         .iter()
         .filter(|p| !run_path(set_dir, p).is_file())
@@ -124,7 +126,7 @@ pub fn load_fit_data(set_dir: &Path) -> Result<FitData> {
         .collect();
     if !missing.is_empty() {
         bail!(
-            "{} of the {} fitted FE runs are missing from {}: {}\n(run `needle fe run --set {}` to finish the campaign; the fit needs the centre run and every sweep run)",
+            "{} of the {} fitted FE runs are missing from {}: {}\n(run `needle fe run --set {}` to finish the campaign; the fit needs the centre run and every sweep run not listed in campaign.fit_without)",
             missing.len(),
             fitted.len(),
             set_dir.join("fe").display(),

@@ -54,7 +54,7 @@ pub struct FitOutput {
 pub fn fit_set(set_dir: &Path) -> Result<FitOutput> {
     let data = data::load_fit_data(set_dir)?;
     let model = model::fit(&data)?;
-    let model_toml = model_file::to_toml(&model);
+    let model_toml = model_file::to_toml(&model, &data.campaign.campaign.fit_without);
     let golden_csv = golden::to_csv(&eval_f32::Tables32::from_model(&model));
     let golden_fixed_csv = golden_fixed::to_csv(&fixed_formats::TablesFixed::from_model(&model)?)?;
     Ok(FitOutput { model, model_toml, golden_csv, golden_fixed_csv })

@@ -43,10 +43,18 @@ fn list32(values: &[f64]) -> String {
     format!("[{}]", items.join(", "))
 }
 
-/// The text of `model.toml` for `model`.
-pub fn to_toml(model: &Model) -> String {
+/// The text of `model.toml` for `model`; `left_out` names the sweep runs of the campaign
+/// that were not fitted (`campaign.fit_without`), written as a comment.
+pub fn to_toml(model: &Model, left_out: &[String]) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "{HEADER_COMMENT}");
+    if !left_out.is_empty() {
+        let _ = writeln!(
+            s,
+            "# Not fitted (campaign.toml, campaign.fit_without; the reason is written there): {}",
+            left_out.join(", ")
+        );
+    }
     let _ = writeln!(s, "# Format and evaluation algorithm: coeffs/README.md. Forces in N, moments in N*mm.");
     let _ = writeln!(s, "# u = depth_mm / 3 - 1; t = |v| * 2 / V - 1 with V = 12 mm (x, z) or 15 deg (theta_x, theta_z).");
     let _ = writeln!(s, "format = {FORMAT}");
