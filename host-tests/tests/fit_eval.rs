@@ -264,3 +264,42 @@ fn validate_runs_on_the_synthetic_set() {
     let table = needle_host::fit::validate::to_table(&r);
     assert!(table.contains("goal table2") && table.contains("goal lhs"));
 }
+
+/// Rewrite the `fit_without = [...]` line of a set's campaign.toml.
+fn set_fit_without(dir: &std::path::Path, list: &str) {
+    let path = dir.join("campaign.toml");
+    let text = std::fs::read_to_string(&path).expect("read campaign.toml");
+    let line = text.lines().find(|l| l.starts_with("fit_without")).expect("the shipped spec has a fit_without line");
+    std::fs::write(&path, text.replace(line, &format!("fit_without = {list}"))).expect("write campaign.toml");
+}
+
+#[test]
+fn fit_without_leaves_a_sweep_run_out_and_model_toml_says_so() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    fit_synthetic::make_set(dir.path(), &["tz+12"]);
+    // not listed: the missing run is refused
+    set_fit_without(dir.path(), "[]");
+    let e = needle_host::fit::fit_set(dir.path()).expect_err("tz+12 is missing and not listed");
+    assert!(format!("{e:#}").contains("tz+12"), "{e:#}");
+    // listed: the fit goes on without it and names it
+    set_fit_without(dir.path(), r#"["tz+12"]"#);
+    let out = needle_host::fit::fit_set(dir.path()).unwrap_or_else(|e| panic!("{e:#}"));
+    let note = out.model_toml.lines().nth(1).unwrap_or_default();
+    assert!(note.starts_with("# Not fitted") && note.ends_with("tz+12"), "{note}");
+}
+
+#[test]
+fn fit_without_accepts_only_listed_sweep_runs() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    fit_synthetic::make_set(dir.path(), &[]);
+    for (list, want) in [
+        (r#"["nope"]"#, "\"nope\" is not a listed pose"),
+        (r#"["centre"]"#, "only sweep runs can be left out"),
+        (r#"["t2-a"]"#, "only sweep runs can be left out"),
+    ] {
+        set_fit_without(dir.path(), list);
+        let e = needle_host::fe::spec::load(dir.path()).expect_err(list);
+        let msg = format!("{e:#}");
+        assert!(msg.contains("campaign.fit_without") && msg.contains(want), "{list}: {msg}");
+    }
+}
