@@ -98,6 +98,13 @@ pub fn read_run(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Result<
     Ok(Run { pose: pose.clone(), file_name: format!("{}.csv", pose.name), rows })
 }
 
+/// The poses the fitter uses: the centre and every sweep run not listed in
+/// `campaign.fit_without` (their files make up `fe_sha256`).
+pub fn fitted_poses(campaign: &Campaign) -> Vec<PoseSpec> {
+    let left_out = &campaign.campaign.fit_without;
+    campaign.poses().into_iter().filter(|p| p.role.is_fitted() && !left_out.contains(&p.name)).collect()
+}
+
 /// Load the campaign and every run the fitter uses: the centre and the four sweeps.
 ///
 /// # Errors
@@ -116,9 +123,8 @@ pub fn load_fit_data(set_dir: &Path) -> Result<FitData> {
             campaign.loading.depth_mm
         );
     }
-    let poses = campaign.poses();
-    let left_out = &campaign.campaign.fit_without;
-    let fitted: Vec<&PoseSpec> = poses.iter().filter(|p| p.role.is_fitted() && !left_out.contains(&p.name)).collect();
+    let poses = fitted_poses(&campaign);
+    let fitted: Vec<&PoseSpec> = poses.iter().collect();
     let missing: Vec<&str> = fitted
         .iter()
         .filter(|p| !run_path(set_dir, p).is_file())

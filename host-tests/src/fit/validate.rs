@@ -176,7 +176,7 @@ pub fn validate(set_dir: &Path) -> Result<Report> {
     let (campaign, runs, missing) = load_validation_runs(set_dir)?;
     let lever = campaign.needle.reference_from_tip_mm;
 
-    let fitted: Vec<PoseSpec> = campaign.poses().into_iter().filter(|p| p.role.is_fitted()).collect();
+    let fitted: Vec<PoseSpec> = super::data::fitted_poses(&campaign);
     let all_present = fitted.iter().all(|p| run_path(set_dir, p).is_file());
     let model_matches_fe = all_present && {
         let mut files: Vec<_> = fitted.iter().map(|p| (format!("{}.csv", p.name), run_path(set_dir, p))).collect();
