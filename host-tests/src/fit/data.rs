@@ -123,8 +123,7 @@ pub fn load_fit_data(set_dir: &Path) -> Result<FitData> {
             campaign.loading.depth_mm
         );
     }
-    let poses = fitted_poses(&campaign);
-    let fitted: Vec<&PoseSpec> = poses.iter().collect();
+    let fitted = fitted_poses(&campaign);
     let missing: Vec<&str> = fitted
         .iter()
         .filter(|p| !run_path(set_dir, p).is_file())
@@ -141,9 +140,9 @@ pub fn load_fit_data(set_dir: &Path) -> Result<FitData> {
         );
     }
 
-    let centres: Vec<&&PoseSpec> = fitted.iter().filter(|p| p.role == Role::Centre).collect();
+    let centres: Vec<&PoseSpec> = fitted.iter().filter(|p| p.role == Role::Centre).collect();
     let centre_pose = match centres.as_slice() {
-        [one] => (**one).clone(),
+        [one] => (*one).clone(),
         _ => bail!("{}: {} poses with role centre, expected exactly one", spec_path.display(), centres.len()),
     };
     if centre_pose.x_mm != 0.0 || centre_pose.z_mm != 0.0 || centre_pose.theta_x_deg != 0.0 || centre_pose.theta_z_deg != 0.0 {
@@ -193,10 +192,18 @@ pub fn load_fit_data(set_dir: &Path) -> Result<FitData> {
         }
     }
 
-    let mut files: Vec<(String, PathBuf)> =
-        fitted.iter().map(|p| (format!("{}.csv", p.name), run_path(set_dir, p))).collect();
-    let fe_sha256 = fe_sha256(&mut files)?;
+    let fe_sha256 = fitted_fe_sha256(set_dir, &fitted)?;
     Ok(FitData { campaign, centre, sweeps, fe_sha256 })
+}
+
+/// `fe_sha256` of the runs of `poses` in `set_dir` (their `<pose>.csv` files).
+///
+/// # Errors
+/// A file cannot be read.
+pub fn fitted_fe_sha256(set_dir: &Path, poses: &[PoseSpec]) -> Result<String> {
+    let mut files: Vec<(String, PathBuf)> =
+        poses.iter().map(|p| (format!("{}.csv", p.name), run_path(set_dir, p))).collect();
+    fe_sha256(&mut files)
 }
 
 /// `fe_sha256` of coeffs/README.md: SHA-256 over, for each file in byte order of its

@@ -13,12 +13,12 @@
 //! Validation poses are never tuned, dropped or refitted on: a missing run is a missed goal.
 
 use super::contract::{unit, COMPONENTS};
-use super::data::{fe_sha256, load_validation_runs, run_path, Run};
+use super::data::{fitted_fe_sha256, fitted_poses, load_validation_runs, run_path, Run};
 use super::eval_f32::{eval as eval32, Tables32};
 use super::eval_f64::eval as eval64;
 use super::model::{rms_max, Model};
 use super::model_file;
-use crate::fe::spec::{PoseSpec, Role};
+use crate::fe::spec::Role;
 use anyhow::Result;
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -176,12 +176,9 @@ pub fn validate(set_dir: &Path) -> Result<Report> {
     let (campaign, runs, missing) = load_validation_runs(set_dir)?;
     let lever = campaign.needle.reference_from_tip_mm;
 
-    let fitted: Vec<PoseSpec> = super::data::fitted_poses(&campaign);
+    let fitted = fitted_poses(&campaign);
     let all_present = fitted.iter().all(|p| run_path(set_dir, p).is_file());
-    let model_matches_fe = all_present && {
-        let mut files: Vec<_> = fitted.iter().map(|p| (format!("{}.csv", p.name), run_path(set_dir, p))).collect();
-        fe_sha256(&mut files)? == model.fe_sha256
-    };
+    let model_matches_fe = all_present && fitted_fe_sha256(set_dir, &fitted)? == model.fe_sha256;
 
     let mut reports = Vec::new();
     let mut diff = 0.0f64;
