@@ -3,7 +3,7 @@
 //! interrupted halfway through a solve. These tests need `ccx` (Debian `calculix-ccx`);
 //! without it they fail, they are not skipped.
 
-use needle_host::fe::campaign::{read_manifest, MANIFEST};
+use needle_host::fe::manifest::{read_manifest, MANIFEST};
 use needle_host::fe::{ccx, results, spec};
 use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};

@@ -1,5 +1,6 @@
 //! The FE campaign: spec, material check, mesh and deck writer, the ccx runner and
-//! result parser, and the reduction of nodal reactions to the needle wrench.
+//! result parser, the reduction of nodal reactions to the needle wrench, and the campaign
+//! driver (backend, manifest, report, progress).
 
 pub mod spec;
 pub mod material;
@@ -9,5 +10,9 @@ pub mod dat;
 pub mod wrench;
 pub mod ccx;
 pub mod results;
+pub mod backend;
+pub mod manifest;
+pub mod report;
+mod progress;
 pub mod campaign;
 pub mod verify;
