@@ -303,3 +303,32 @@ fn fit_without_accepts_only_listed_sweep_runs() {
         assert!(msg.contains("campaign.fit_without") && msg.contains(want), "{list}: {msg}");
     }
 }
+
+/// Rewrite one `key = value` line of a set's campaign.toml (the first line starting with `key =`).
+fn set_spec_line(dir: &std::path::Path, key: &str, value: &str) {
+    let path = dir.join("campaign.toml");
+    let text = std::fs::read_to_string(&path).expect("read campaign.toml");
+    let line = text.lines().find(|l| l.starts_with(&format!("{key} ="))).expect("the shipped spec has the key");
+    std::fs::write(&path, text.replacen(line, &format!("{key} = {value}"), 1)).expect("write campaign.toml");
+}
+
+#[test]
+fn runs_solved_from_another_spec_are_stale_for_the_fit_and_for_validate() {
+    let (dir, out) = fit_synthetic::fitted();
+    std::fs::write(dir.path().join("model.toml"), &out.model_toml).expect("write model");
+    // the same runs under a changed tissue: every result now comes from another spec
+    set_spec_line(dir.path(), "bulk_to_shear", "11.0");
+    let e = needle_host::fit::fit_set(dir.path()).expect_err("the fit must refuse stale runs");
+    let msg = format!("{e:#}");
+    assert!(msg.contains("stale") && msg.contains("x+02: solved from another spec"), "{msg}");
+    let r = needle_host::fit::validate::validate(dir.path()).unwrap_or_else(|e| panic!("{e:#}"));
+    assert!(r.runs.is_empty(), "no stale run is compared");
+    assert_eq!(r.missing.len(), 24, "{:?}", r.missing);
+    assert!(r.missing.iter().any(|m| m.starts_with("t2-a (table2, solved from another spec")), "{:?}", r.missing);
+    assert!(!r.passed);
+    // a run whose manifest entry is gone is not trusted either
+    let manifest = dir.path().join("fe").join("manifest.toml");
+    std::fs::remove_file(&manifest).expect("remove manifest");
+    let e = needle_host::fit::fit_set(dir.path()).expect_err("no manifest: nothing is current");
+    assert!(format!("{e:#}").contains("centre: no entry in fe/manifest.toml"), "{e:#}");
+}

@@ -2,6 +2,7 @@
 //! validation runs, read from `<set>/fe/<pose>.csv` as the campaign spec names them.
 
 use super::contract::{Sweep, DEPTH_MAX_MM, NCOEF};
+use crate::fe::manifest::{read_manifest, Manifest, MANIFEST};
 use crate::fe::results::{read_csv, Row};
 use crate::fe::spec::{self, hex, Campaign, PoseSpec, Role};
 use anyhow::{bail, Context, Result};
@@ -98,6 +99,33 @@ pub fn read_run(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Result<
     Ok(Run { pose: pose.clone(), file_name: format!("{}.csv", pose.name), rows })
 }
 
+/// The manifest of a set's FE runs (`<set>/fe/manifest.toml`; none is an empty one).
+///
+/// # Errors
+/// The file exists but is not a valid manifest.
+pub fn read_set_manifest(set_dir: &Path) -> Result<Manifest> {
+    read_manifest(&set_dir.join("fe").join(MANIFEST))
+}
+
+/// Why the present result of `pose` cannot be used with the current spec, or `None` when
+/// its manifest entry carries the spec hash `needle fe run` gives the pose today (on the
+/// spec's committed mesh level and load steps). A result solved before `campaign.toml`
+/// changed (tissue, contact, mesh, loading...) is stale: fitting or validating on a mix
+/// of old and new runs would be silently wrong.
+pub fn stale_reason(manifest: &Manifest, campaign: &Campaign, pose: &PoseSpec) -> Option<String> {
+    let want = campaign.run_hash(pose, &campaign.campaign.mesh);
+    let short = |h: &str| h.get(..12).unwrap_or(h).to_string();
+    match manifest.pose.get(&pose.name) {
+        None => Some(format!("no entry in fe/{MANIFEST}")),
+        Some(e) if e.spec_hash != want => Some(format!(
+            "solved from another spec (spec_hash {} in fe/{MANIFEST}, {} for the current campaign.toml)",
+            short(&e.spec_hash),
+            short(&want)
+        )),
+        Some(_) => None,
+    }
+}
+
 /// The poses the fitter uses: the centre and every sweep run not listed in
 /// `campaign.fit_without` (their files make up `fe_sha256`).
 pub fn fitted_poses(campaign: &Campaign) -> Vec<PoseSpec> {
@@ -136,6 +164,22 @@ pub fn load_fit_data(set_dir: &Path) -> Result<FitData> {
             fitted.len(),
             set_dir.join("fe").display(),
             missing.join(", "),
+            set_dir.display()
+        );
+    }
+
+    let manifest = read_set_manifest(set_dir)?;
+    let stale: Vec<String> = fitted
+        .iter()
+        .filter_map(|p| stale_reason(&manifest, &campaign, p).map(|why| format!("{}: {why}", p.name)))
+        .collect();
+    if !stale.is_empty() {
+        bail!(
+            "{} of the {} fitted FE runs in {} are stale:\n  {}\n(run `needle fe run --set {}`: it solves exactly the poses whose result is not current)",
+            stale.len(),
+            fitted.len(),
+            set_dir.join("fe").display(),
+            stale.join("\n  "),
             set_dir.display()
         );
     }
@@ -223,24 +267,38 @@ pub fn fe_sha256(files: &mut [(String, PathBuf)]) -> Result<String> {
     Ok(hex(&h.finalize()))
 }
 
-/// The validation runs of a set: roles table2, lhs and mirror, in spec order, and the
-/// names of those whose result file is missing.
+/// A validation run that cannot be compared: its pose and why (no result file, or a
+/// stale one, see [`stale_reason`]).
+#[derive(Debug, Clone)]
+pub struct Unusable {
+    /// The pose.
+    pub pose: PoseSpec,
+    /// Why, e.g. `no result file`.
+    pub why: String,
+}
+
+/// The validation runs of a set: roles table2, lhs and mirror, in spec order, and those
+/// that cannot be used (missing or stale).
 ///
 /// # Errors
-/// The spec cannot be loaded, or a present run cannot be read or has the wrong depths.
-pub fn load_validation_runs(set_dir: &Path) -> Result<(Campaign, Vec<Run>, Vec<PoseSpec>)> {
+/// The spec or the manifest cannot be loaded, or a present run cannot be read or has the
+/// wrong depths.
+pub fn load_validation_runs(set_dir: &Path) -> Result<(Campaign, Vec<Run>, Vec<Unusable>)> {
     let (campaign, _) = spec::load(set_dir)?;
+    let manifest = read_set_manifest(set_dir)?;
     let mut runs = Vec::new();
-    let mut missing = Vec::new();
+    let mut unusable = Vec::new();
     for pose in campaign.poses() {
         if !(pose.role.is_validation() || pose.role == Role::Mirror) {
             continue;
         }
-        if run_path(set_dir, &pose).is_file() {
-            runs.push(read_run(set_dir, &campaign, &pose)?);
+        if !run_path(set_dir, &pose).is_file() {
+            unusable.push(Unusable { pose, why: "no result file".into() });
+        } else if let Some(why) = stale_reason(&manifest, &campaign, &pose) {
+            unusable.push(Unusable { pose, why });
         } else {
-            missing.push(pose);
+            runs.push(read_run(set_dir, &campaign, &pose)?);
         }
     }
-    Ok((campaign, runs, missing))
+    Ok((campaign, runs, unusable))
 }

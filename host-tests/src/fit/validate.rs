@@ -10,7 +10,8 @@
 //! - table2: at every depth >= 1 mm, |Fy_model - Fy_FE| <= 5 % of |Fy_FE| at that depth;
 //! - lhs: for every run and component, RMS error <= 2 % of the run's peak |Fy|.
 //!
-//! Validation poses are never tuned, dropped or refitted on: a missing run is a missed goal.
+//! Validation poses are never tuned, dropped or refitted on: a missing or stale run is
+//! a missed goal.
 
 use super::contract::{unit, COMPONENTS};
 use super::data::{fitted_fe_sha256, fitted_poses, load_validation_runs, run_path, Run};
@@ -79,7 +80,8 @@ pub struct Report {
     pub model_matches_fe: bool,
     /// Validation runs (table2, lhs, mirror) in spec order.
     pub runs: Vec<RunReport>,
-    /// Validation poses without a result file.
+    /// Validation poses without a usable result, as `name (role, why)`: no result file, or
+    /// a stale one (solved from another spec, see `data::stale_reason`).
     pub missing: Vec<String>,
     /// Largest |f32 - f64| model difference at the validation points, in % of the run's
     /// peak |Fy| scale.
@@ -188,7 +190,7 @@ pub fn validate(set_dir: &Path) -> Result<Report> {
         reports.push(r);
     }
     let goal = |role: Role| {
-        !missing.iter().any(|p| p.role == role)
+        !missing.iter().any(|u| u.pose.role == role)
             && reports.iter().filter(|r| r.role == role_name(role)).all(|r| r.goal_met == Some(true))
     };
     let table2_goal_met = goal(Role::Table2);
@@ -198,7 +200,7 @@ pub fn validate(set_dir: &Path) -> Result<Report> {
         lever_arm_mm: lever,
         model_matches_fe,
         runs: reports,
-        missing: missing.iter().map(|p| format!("{} ({})", p.name, role_name(p.role))).collect(),
+        missing: missing.iter().map(|u| format!("{} ({}, {})", u.pose.name, role_name(u.pose.role), u.why)).collect(),
         f32_vs_f64_max_pct: diff,
         table2_goal_met,
         lhs_goal_met,
@@ -264,7 +266,7 @@ pub fn to_table(r: &Report) -> String {
     }
     let _ = writeln!(s);
     if !r.missing.is_empty() {
-        let _ = writeln!(s, "missing FE runs (goal cannot be met): {}", r.missing.join(", "));
+        let _ = writeln!(s, "missing or stale FE runs (goal cannot be met): {}", r.missing.join(", "));
     }
     let worst = |role: &str, f: fn(&RunReport) -> f64| -> String {
         let v: Vec<f64> = r.runs.iter().filter(|x| x.role == role).map(f).collect();

@@ -4,6 +4,7 @@
 
 #![allow(dead_code)]
 
+use needle_host::fe::manifest::{manifest_text, Manifest, ManifestEntry, MANIFEST};
 use needle_host::fe::results::{to_csv, Row};
 use needle_host::fe::spec::{self, PoseSpec};
 use needle_host::fit::{fit_set, FitOutput};
@@ -29,16 +30,19 @@ pub fn wrench(p: &PoseSpec, d: f64) -> [f64; 6] {
 }
 
 /// Create a synthetic set in `dir` (campaign.toml copied from coeffs/default, one CSV per
-/// pose). `skip` names poses whose CSV is not written.
+/// pose, and a manifest entry per CSV with the spec hash of the current spec, so that the
+/// runs count as current). `skip` names poses whose CSV is not written.
 pub fn make_set(dir: &Path, skip: &[&str]) {
     let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default/campaign.toml");
     std::fs::create_dir_all(dir.join("fe")).expect("create set folder");
     std::fs::copy(&src, dir.join("campaign.toml")).expect("copy campaign.toml");
     let (campaign, _) = spec::load(dir).expect("load spec");
+    let mut manifest = Manifest::default();
     for pose in campaign.poses() {
         if skip.contains(&pose.name.as_str()) {
             continue;
         }
+        manifest.pose.insert(pose.name.clone(), synthetic_entry(&campaign, &pose));
         let rows: Vec<Row> = (0..=campaign.loading.steps)
             .map(|k| {
                 let d = campaign.loading.depth_at(k);
@@ -46,6 +50,36 @@ pub fn make_set(dir: &Path, skip: &[&str]) {
             })
             .collect();
         std::fs::write(dir.join("fe").join(format!("{}.csv", pose.name)), to_csv(&rows)).expect("write csv");
+    }
+    let text = manifest_text(&manifest).expect("manifest text");
+    std::fs::write(dir.join("fe").join(MANIFEST), text).expect("write manifest");
+}
+
+/// A manifest entry for a synthetic run: the current spec hash, no solver.
+fn synthetic_entry(campaign: &spec::Campaign, pose: &PoseSpec) -> ManifestEntry {
+    ManifestEntry {
+        spec_hash: campaign.run_hash(pose, &campaign.campaign.mesh),
+        ccx_version: "none (synthetic wrench)".into(),
+        mesh: campaign.campaign.mesh.clone(),
+        model: "synthetic".into(),
+        tissue_mesh: "none".into(),
+        tissue_nodes: 0,
+        tissue_elements: 0,
+        needle_nodes: 0,
+        needle_elements: 0,
+        steps: campaign.loading.steps,
+        depth_mm: campaign.loading.depth_mm,
+        increments: 0,
+        iterations: 0,
+        wall_s: 0.0,
+        date: "1970-01-01T00:00:00Z".into(),
+        role: pose.role,
+        x_mm: pose.x_mm,
+        z_mm: pose.z_mm,
+        theta_x_deg: pose.theta_x_deg,
+        theta_z_deg: pose.theta_z_deg,
+        first_increment: None,
+        retry: None,
     }
 }
 
