@@ -117,8 +117,12 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
         timeout,
         stall: Some(Duration::from_secs_f64(a.stall_s)),
     };
+    crate::fe::ccx::stop_jobs_on_termination()?;
     let report = campaign::run(&opts)?;
     print!("{}", report.table());
+    if crate::fe::ccx::interrupted() {
+        return Ok(ExitCode::from(crate::fe::ccx::EXIT_INTERRUPTED));
+    }
     Ok(if report.failed() > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS })
 }
 
@@ -136,6 +140,7 @@ fn run_verify(a: VerifyArgs) -> anyhow::Result<ExitCode> {
         punch_mesh_scale: a.punch_mesh_scale,
         punch_campaign_element: !a.no_campaign_element,
     };
+    crate::fe::ccx::stop_jobs_on_termination()?;
     let (_, ok) = crate::fe::verify::run(&opts)?;
     if !ok {
         eprintln!("needle fe verify: a check missed its goal");

@@ -28,6 +28,7 @@
 //! `progress` the display.
 
 use crate::fe::backend::{Backend, CcxBackend, Job, Solved, SolveFailure};
+use crate::fe::ccx;
 use crate::fe::deck;
 use crate::fe::manifest::{read_manifest, manifest_text, rfc3339_utc, Manifest, ManifestEntry, MANIFEST};
 use crate::fe::progress::Progress;
@@ -213,6 +214,9 @@ fn run_workers(ctx: &Ctx<'_>, to_run: &[(usize, &PoseSpec)], jobs: usize, report
             let tx = tx.clone();
             let queue = &queue;
             s.spawn(move || loop {
+                if ccx::interrupted() {
+                    break;
+                }
                 let next = queue.lock().map(|mut q| q.pop_front()).unwrap_or(None);
                 let Some(i) = next else { break };
                 let Some(&(_, pose)) = to_run.get(i) else { break };
@@ -327,6 +331,9 @@ fn solve_with_retry(backend: &dyn Backend, job: &Job<'_>) -> std::result::Result
         Ok(s) => return Ok(s),
         Err(f) => f,
     };
+    if ccx::interrupted() {
+        return Err(first);
+    }
     let r = deck::RETRY_FIRST_INCREMENT;
     eprintln!("{}: {}; retrying with each step's first increment at {r} of the step", job.pose.name, first.message);
     let retry = Job { first_increment: r, ..*job };

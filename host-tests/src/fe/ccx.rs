@@ -6,6 +6,7 @@ use anyhow::{bail, Context, Result};
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 /// Environment variable that names the `ccx` binary to use instead of the one on `PATH`.
@@ -79,6 +80,8 @@ pub enum ExitKind {
     Code(i32),
     /// Killed by this signal.
     Signal(i32),
+    /// Killed by the runner because the process was asked to stop (SIGINT, SIGTERM).
+    Interrupted,
     /// Killed by the runner after the wall-clock timeout.
     TimedOut,
     /// Killed by the runner: no output (log, `.sta`, `.cvg`) for this long.
@@ -90,6 +93,7 @@ impl fmt::Display for ExitKind {
         match self {
             ExitKind::Code(c) => write!(f, "exit code {c}"),
             ExitKind::Signal(s) => write!(f, "killed by signal {s}"),
+            ExitKind::Interrupted => write!(f, "interrupted (killed)"),
             ExitKind::TimedOut => write!(f, "timed out (killed)"),
             ExitKind::Stalled(d) => write!(f, "stalled: no output for {:.1} s (killed)", d.as_secs_f64()),
         }
@@ -187,6 +191,44 @@ impl JobResult {
     }
 }
 
+/// Set once the process was asked to stop ([`stop_jobs_on_termination`]): every running
+/// [`run_job`] kills its ccx at its next poll (within 50 ms) and any new one is killed at
+/// once.
+static STOP: AtomicBool = AtomicBool::new(false);
+
+/// How long the termination handler waits for the campaign to wind down (its jobs kill
+/// their ccx within 50 ms, no new job starts) before it exits the process itself.
+const STOP_GRACE: Duration = Duration::from_secs(3);
+
+/// `true` once the process was asked to stop: callers start no new job, retry nothing,
+/// and exit with [`EXIT_INTERRUPTED`].
+pub fn interrupted() -> bool {
+    STOP.load(Ordering::SeqCst)
+}
+
+/// Exit status of a process stopped by SIGINT, SIGTERM or SIGHUP (128 + SIGINT, as a shell
+/// reports an interrupted command).
+pub const EXIT_INTERRUPTED: u8 = 130;
+
+/// On SIGINT, SIGTERM or SIGHUP: kill every running ccx job, then exit with
+/// [`EXIT_INTERRUPTED`]. Without it a `kill PID` of `needle fe run` (not of its process
+/// group) left its ccx children running as orphans for hours, writing into the work
+/// folders that a resumed campaign reuses. What was written before stays: finished poses
+/// keep their CSV and manifest entry; the interrupted pose has neither (its entry is
+/// removed before it is solved), so a rerun solves it again.
+///
+/// # Errors
+/// A handler is already installed in this process.
+pub fn stop_jobs_on_termination() -> Result<()> {
+    ctrlc::set_handler(|| {
+        STOP.store(true, Ordering::SeqCst);
+        eprintln!("needle: interrupted: stopping the running ccx jobs; finished poses are kept, a rerun resumes");
+        std::thread::sleep(STOP_GRACE);
+        std::process::exit(i32::from(EXIT_INTERRUPTED));
+    })
+    .context("cannot install the SIGINT/SIGTERM handler")
+}
+
 /// Run `ccx -i <job>` in `work_dir` (which holds `<job>.inp`) on one thread
 /// (`OMP_NUM_THREADS=1`, `CCX_NPROC_*=1`), stdout and stderr to `<job>.log` in the same
 /// folder. With a `timeout`, the process is killed when it runs longer (wall clock); with
@@ -234,6 +276,11 @@ pub fn run_job(
                 (None, Some(s)) => ExitKind::Signal(s),
                 (None, None) => ExitKind::Code(-1),
             };
+        }
+        if interrupted() {
+            let _ = child.kill();
+            let _ = child.wait();
+            break ExitKind::Interrupted;
         }
         if timeout.is_some_and(|t| start.elapsed() > t) {
             // the process may have exited just now: kill errors are not interesting
