@@ -7,73 +7,33 @@
 //! the contract's format, and then broken on purpose. They are not a fitted model and
 //! never go under coeffs/.
 use needle_codegen::{generate, parse_model, parse_model_str, CodegenError};
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-const COMPONENTS: [&str; 6] = ["fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"];
-const SWEEPS: [&str; 4] = ["x", "z", "theta_x", "theta_z"];
-const ODD: [[bool; 6]; 4] = [
-    [true, false, false, false, true, true],
-    [false, false, true, true, true, false],
-    [false, false, true, true, true, false],
-    [true, false, false, false, true, true],
-];
-
-fn hex(v: f64) -> String {
-    format!("\"{:#010x}\"", (v as f32).to_bits())
-}
-
-fn list(values: &[f64]) -> String {
-    format!("[{}]", values.iter().map(|v| format!("{v:?}")).collect::<Vec<_>>().join(", "))
-}
-
-fn list32(values: &[f64]) -> String {
-    format!("[{}]", values.iter().map(|v| hex(*v)).collect::<Vec<_>>().join(", "))
-}
+mod made_up_model;
+use made_up_model::{list32, model_text, Part};
 
 /// A valid model file in the contract's format, with made-up coefficients. Every
 /// deviation row vanishes at t = -1 exactly (dyadic values).
 fn valid_model() -> String {
-    let mut s = String::new();
-    let w = &mut s;
-    let _ = writeln!(w, "# made-up coefficients for the codegen error tests (not a fit)");
-    let _ = writeln!(w, "format = 1");
-    let _ = writeln!(w, "set = \"codegen-test\"");
-    let _ = writeln!(w, "fe_sha256 = \"{}\"", "ab".repeat(32));
-    let _ = writeln!(w, "depth_max_mm = 6.0\nx_max_mm = 12.0\nz_max_mm = 12.0\ntheta_max_deg = 15.0");
-    for (c, name) in COMPONENTS.iter().enumerate() {
-        let b = [0.1 * (c as f64 + 1.0), 0.5, -0.25, 0.125, -0.0625];
-        let _ = writeln!(w, "\n[[baseline]]\ncomponent = \"{name}\"");
-        let _ = writeln!(w, "coeffs = {}\ncoeffs_f32 = {}", list(&b), list32(&b));
-        let _ = writeln!(w, "residual_rms = 1.0e-4\nresidual_max = 3.0e-4");
-    }
-    for (k, sweep) in SWEEPS.iter().enumerate() {
-        for (c, name) in COMPONENTS.iter().enumerate() {
-            let n = (k * 6 + c) as f64;
-            let _ = writeln!(w, "\n[[matrix]]\nsweep = \"{sweep}\"\ncomponent = \"{name}\"\nodd = {}", ODD[k][c]);
-            let rows: Vec<[f64; 5]> = (0..5)
-                .map(|i| {
-                    let mut r = [0.0; 5];
-                    for (j, v) in r.iter_mut().enumerate().skip(1) {
-                        *v = (n + 1.0) * (i as f64 + 1.0) * (j as f64) / 64.0 * if j % 2 == 0 { 1.0 } else { -0.5 };
-                    }
-                    r[0] = -(-r[1] + r[2] - r[3] + r[4]);
-                    r
-                })
-                .collect();
-            let _ = writeln!(w, "rows = [");
-            for r in &rows {
-                let _ = writeln!(w, "  {},", list(r));
+    let header = format!(
+        "# made-up coefficients for the codegen error tests (not a fit)\nformat = 1\nset = \"codegen-test\"\nfe_sha256 = \"{}\"\ndepth_max_mm = 6.0\nx_max_mm = 12.0\nz_max_mm = 12.0\ntheta_max_deg = 15.0",
+        "ab".repeat(32)
+    );
+    let baseline = |c: usize| Part { coeffs: [0.1 * (c as f64 + 1.0), 0.5, -0.25, 0.125, -0.0625], residual: (1.0e-4, 3.0e-4) };
+    let matrix = |k: usize, c: usize| {
+        let n = (k * 6 + c) as f64;
+        let row = |i: usize| {
+            let mut r = [0.0; 5];
+            for (j, v) in r.iter_mut().enumerate().skip(1) {
+                *v = (n + 1.0) * (i as f64 + 1.0) * (j as f64) / 64.0 * if j % 2 == 0 { 1.0 } else { -0.5 };
             }
-            let _ = writeln!(w, "]\nrows_f32 = [");
-            for r in &rows {
-                let _ = writeln!(w, "  {},", list32(r));
-            }
-            let _ = writeln!(w, "]\nresidual_rms = 2.0e-3\nresidual_max = 5.0e-3");
-        }
-    }
-    s
+            r[0] = -(-r[1] + r[2] - r[3] + r[4]);
+            r
+        };
+        Part { coeffs: [row(0), row(1), row(2), row(3), row(4)], residual: (2.0e-3, 5.0e-3) }
+    };
+    model_text(&header, baseline, matrix)
 }
 
 /// 1-based line of the `nth` (0-based) line that starts with `prefix` (after indentation).

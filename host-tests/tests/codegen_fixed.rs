@@ -4,57 +4,28 @@
 //! the library and through a real cargo build; and the generated tables obey the format
 //! rules of coeffs/README.md.
 use needle_codegen::{fixed, generate, parse_model_str};
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-const COMPONENTS: [&str; 6] = ["fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"];
-const SWEEPS: [&str; 4] = ["x", "z", "theta_x", "theta_z"];
-const ODD: [[bool; 6]; 4] = [
-    [true, false, false, false, true, true],
-    [false, false, true, true, true, false],
-    [false, false, true, true, true, false],
-    [true, false, false, false, true, true],
-];
-
-fn list(v: &[f64]) -> String {
-    format!("[{}]", v.iter().map(|x| format!("{x:?}")).collect::<Vec<_>>().join(", "))
-}
-
-fn list32(v: &[f64]) -> String {
-    format!("[{}]", v.iter().map(|x| format!("\"{:#010x}\"", (*x as f32).to_bits())).collect::<Vec<_>>().join(", "))
-}
+mod made_up_model;
+use made_up_model::{model_text, Part};
 
 /// A model in the contract's format (made-up coefficients, not a fit): baseline fy_n =
 /// `base_fy`, matrix z/fy_n row 2 = `[a, a, 0, 0, 0]` (zero at t = -1), the rest small.
 fn model(base_fy: f64, a: f64) -> String {
-    let mut s = String::new();
-    let w = &mut s;
-    let _ = writeln!(w, "format = 1\nset = \"fixed-test\"\nfe_sha256 = \"{}\"", "cd".repeat(32));
-    let _ = writeln!(w, "depth_max_mm = 6.0\nx_max_mm = 12.0\nz_max_mm = 12.0\ntheta_max_deg = 15.0");
-    for (c, name) in COMPONENTS.iter().enumerate() {
-        let b = if c == 1 { [base_fy, 0.5, 0.0, 0.0, 0.0] } else { [0.125, 0.0, 0.0, 0.0, 0.0] };
-        let _ = writeln!(w, "\n[[baseline]]\ncomponent = \"{name}\"\ncoeffs = {}\ncoeffs_f32 = {}", list(&b), list32(&b));
-        let _ = writeln!(w, "residual_rms = 0.0\nresidual_max = 0.0");
-    }
-    for (k, sweep) in SWEEPS.iter().enumerate() {
-        for (c, name) in COMPONENTS.iter().enumerate() {
-            let _ = writeln!(w, "\n[[matrix]]\nsweep = \"{sweep}\"\ncomponent = \"{name}\"\nodd = {}", ODD[k][c]);
-            let rows: Vec<[f64; 5]> = (0..5)
-                .map(|i| if k == 1 && c == 1 && i == 2 { [a, a, 0.0, 0.0, 0.0] } else { [0.25, 0.25, 0.0, 0.0, 0.0] })
-                .collect();
-            let _ = writeln!(w, "rows = [");
-            for r in &rows {
-                let _ = writeln!(w, "  {},", list(r));
-            }
-            let _ = writeln!(w, "]\nrows_f32 = [");
-            for r in &rows {
-                let _ = writeln!(w, "  {},", list32(r));
-            }
-            let _ = writeln!(w, "]\nresidual_rms = 0.0\nresidual_max = 0.0");
-        }
-    }
-    s
+    let header = format!(
+        "format = 1\nset = \"fixed-test\"\nfe_sha256 = \"{}\"\ndepth_max_mm = 6.0\nx_max_mm = 12.0\nz_max_mm = 12.0\ntheta_max_deg = 15.0",
+        "cd".repeat(32)
+    );
+    let baseline = |c: usize| Part {
+        coeffs: if c == 1 { [base_fy, 0.5, 0.0, 0.0, 0.0] } else { [0.125, 0.0, 0.0, 0.0, 0.0] },
+        residual: (0.0, 0.0),
+    };
+    let matrix = |k: usize, c: usize| {
+        let row = |i: usize| if k == 1 && c == 1 && i == 2 { [a, a, 0.0, 0.0, 0.0] } else { [0.25, 0.25, 0.0, 0.0, 0.0] };
+        Part { coeffs: [row(0), row(1), row(2), row(3), row(4)], residual: (0.0, 0.0) }
+    };
+    model_text(&header, baseline, matrix)
 }
 
 fn nth_line(text: &str, prefix: &str, nth: usize) -> usize {
