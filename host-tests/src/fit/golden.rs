@@ -57,6 +57,25 @@ fn with(i: usize, v: f32) -> [f32; 5] {
     p
 }
 
+/// Every pose with one of the five `levels[i]` for each input `i` (x, z, theta_x,
+/// theta_z, depth), input 0 varying slowest: 5^5 poses in file order. Both golden files
+/// start with this grid.
+pub fn grid<T: Copy>(levels: &[[T; 5]]) -> Vec<[T; 5]> {
+    let mut out = Vec::with_capacity(3125);
+    for &x in &levels[0] {
+        for &z in &levels[1] {
+            for &tx in &levels[2] {
+                for &tz in &levels[3] {
+                    for &d in &levels[4] {
+                        out.push([x, z, tx, tz, d]);
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
 /// Every golden pose `[x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm]`, in file order.
 pub fn poses() -> Vec<[f32; 5]> {
     let mut out = Vec::with_capacity(4500);
@@ -66,17 +85,7 @@ pub fn poses() -> Vec<[f32; 5]> {
         [lo, lo + (hi - lo) * 0.25, lo + (hi - lo) * 0.5, lo + (hi - lo) * 0.75, hi]
     };
     let g: Vec<[f32; 5]> = (0..5).map(lin).collect();
-    for &x in &g[0] {
-        for &z in &g[1] {
-            for &tx in &g[2] {
-                for &tz in &g[3] {
-                    for &d in &g[4] {
-                        out.push([x, z, tx, tz, d]);
-                    }
-                }
-            }
-        }
-    }
+    out.extend(grid(&g));
     // 2. random poses, uniform over the domain
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(GOLDEN_SEED);
     for _ in 0..RANDOM_POSES {

@@ -47,17 +47,7 @@ pub fn poses() -> Vec<[i32; 5]> {
     let g: Vec<[i32; 5]> = (0..5)
         .map(|i| std::array::from_fn(|n| (min[i] + (max[i] - min[i]) * n as i64 / 4) as i32))
         .collect();
-    for &x in &g[0] {
-        for &z in &g[1] {
-            for &tx in &g[2] {
-                for &tz in &g[3] {
-                    for &d in &g[4] {
-                        out.push([x, z, tx, tz, d]);
-                    }
-                }
-            }
-        }
-    }
+    out.extend(super::golden::grid(&g));
     // 2. random poses, uniform over the domain
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(GOLDEN_FIXED_SEED);
     for _ in 0..RANDOM_POSES {
