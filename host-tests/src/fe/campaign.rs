@@ -148,9 +148,8 @@ pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> 
     let mut reports: Vec<PoseReport> = Vec::with_capacity(selected.len());
     let mut to_run: Vec<(usize, &PoseSpec)> = Vec::new();
     for pose in &selected {
-        let hash = campaign.run_hash(pose, &mesh_name);
         let csv = out_dir.join(format!("{}.csv", pose.name));
-        let entry = manifest.pose.get(&pose.name).filter(|e| e.spec_hash == hash);
+        let entry = manifest.current_entry(&campaign, pose, &mesh_name).ok();
         let rows = entry.and_then(|_| results::read_csv(&csv).ok()).filter(|r| r.len() == steps as usize + 1);
         let mut report = PoseReport {
             pose: pose.name.clone(),

@@ -2,7 +2,7 @@
 //! increments, wall time), read to skip up-to-date poses and rewritten atomically by the
 //! campaign after each pose.
 
-use crate::fe::spec::Role;
+use crate::fe::spec::{Campaign, PoseSpec, Role};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -72,6 +72,30 @@ pub struct ManifestEntry {
     /// Why the first attempt failed, when this result comes from the retry.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub retry: Option<String>,
+}
+
+impl Manifest {
+    /// The entry of `pose` when it says the pose's result came from the spec `campaign`
+    /// as it is now, on mesh level `mesh_name` (its spec hash is
+    /// [`Campaign::run_hash`](crate::fe::spec::Campaign::run_hash)); otherwise why not.
+    /// The one test of "current" shared by the campaign's skipping and by the fitter's
+    /// and validator's refusal of stale runs.
+    ///
+    /// # Errors
+    /// The reason, e.g. `no entry in fe/manifest.toml` or `solved from another spec (...)`.
+    pub fn current_entry(&self, campaign: &Campaign, pose: &PoseSpec, mesh_name: &str) -> std::result::Result<&ManifestEntry, String> {
+        let want = campaign.run_hash(pose, mesh_name);
+        let short = |h: &str| h.get(..12).unwrap_or(h).to_string();
+        match self.pose.get(&pose.name) {
+            None => Err(format!("no entry in fe/{MANIFEST}")),
+            Some(e) if e.spec_hash != want => Err(format!(
+                "solved from another spec (spec_hash {} in fe/{MANIFEST}, {} for the current campaign.toml)",
+                short(&e.spec_hash),
+                short(&want)
+            )),
+            Some(e) => Ok(e),
+        }
+    }
 }
 
 /// Read a manifest; a missing file is an empty manifest.

@@ -108,22 +108,11 @@ pub fn read_set_manifest(set_dir: &Path) -> Result<Manifest> {
 }
 
 /// Why the present result of `pose` cannot be used with the current spec, or `None` when
-/// its manifest entry carries the spec hash `needle fe run` gives the pose today (on the
-/// spec's committed mesh level and load steps). A result solved before `campaign.toml`
-/// changed (tissue, contact, mesh, loading...) is stale: fitting or validating on a mix
-/// of old and new runs would be silently wrong.
+/// it is current on the spec's committed mesh level ([`Manifest::current_entry`]). A
+/// result solved before `campaign.toml` changed (tissue, contact, mesh, loading...) is
+/// stale: fitting or validating on a mix of old and new runs would be silently wrong.
 pub fn stale_reason(manifest: &Manifest, campaign: &Campaign, pose: &PoseSpec) -> Option<String> {
-    let want = campaign.run_hash(pose, &campaign.campaign.mesh);
-    let short = |h: &str| h.get(..12).unwrap_or(h).to_string();
-    match manifest.pose.get(&pose.name) {
-        None => Some(format!("no entry in fe/{MANIFEST}")),
-        Some(e) if e.spec_hash != want => Some(format!(
-            "solved from another spec (spec_hash {} in fe/{MANIFEST}, {} for the current campaign.toml)",
-            short(&e.spec_hash),
-            short(&want)
-        )),
-        Some(_) => None,
-    }
+    manifest.current_entry(campaign, pose, &campaign.campaign.mesh).err()
 }
 
 /// The poses the fitter uses: the centre and every sweep run not listed in
