@@ -32,7 +32,8 @@ pub struct RunArgs {
     /// job on the committed mesh).
     #[arg(long, value_name = "N", default_value_t = 1)]
     pub jobs: usize,
-    /// Only the poses whose name matches this glob, e.g. 'x+*' or 'centre' (quote it).
+    /// Only the poses whose name matches this glob, e.g. 'x+*' or 'centre' (quote it), or
+    /// any of several comma-separated globs, e.g. 'lhs-09,lhs-1*'.
     #[arg(long, value_name = "PATTERN")]
     pub only: Option<String>,
     /// Mesh level of campaign.toml ([mesh.<LEVEL>]); default: campaign.mesh.

@@ -513,16 +513,51 @@ pub fn hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
 
-/// Select poses whose name matches a glob `pattern` (`*`, `?`, `[..]`).
+/// Select poses whose name matches a glob `pattern` (`*`, `?`, `[..]`), or any of several
+/// globs separated by commas (`lhs-09,lhs-1*`). Poses keep the spec's order.
 ///
 /// # Errors
-/// The pattern is not a valid glob.
+/// A pattern is empty or not a valid glob.
 pub fn select<'a>(poses: &'a [PoseSpec], pattern: Option<&str>) -> Result<Vec<&'a PoseSpec>> {
-    match pattern {
-        None => Ok(poses.iter().collect()),
-        Some(pat) => {
-            let g = glob::Pattern::new(pat).with_context(|| format!("--only {pat:?}: not a valid glob"))?;
-            Ok(poses.iter().filter(|p| g.matches(&p.name)).collect())
-        }
+    let Some(list) = pattern else { return Ok(poses.iter().collect()) };
+    let globs = list
+        .split(',')
+        .map(|pat| {
+            if pat.trim().is_empty() {
+                bail!("--only {list:?}: empty pattern between commas");
+            }
+            glob::Pattern::new(pat.trim()).with_context(|| format!("--only {list:?}: {pat:?} is not a valid glob"))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok(poses.iter().filter(|p| globs.iter().any(|g| g.matches(&p.name))).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{select, PoseSpec, Role};
+
+    fn names(poses: &[&PoseSpec]) -> Vec<String> {
+        poses.iter().map(|p| p.name.clone()).collect()
+    }
+
+    #[test]
+    fn select_takes_comma_separated_globs_in_spec_order() {
+        let poses: Vec<PoseSpec> = ["centre", "lhs-03", "lhs-09", "lhs-10", "lhs-13"]
+            .iter()
+            .map(|n| PoseSpec {
+                name: (*n).to_owned(),
+                role: Role::Lhs,
+                x_mm: 0.0,
+                z_mm: 0.0,
+                theta_x_deg: 0.0,
+                theta_z_deg: 0.0,
+            })
+            .collect();
+        let all = select(&poses, None).map(|v| names(&v)).ok();
+        assert_eq!(all.map(|v| v.len()), Some(5));
+        let two = select(&poses, Some("lhs-1*,lhs-09")).map(|v| names(&v)).ok();
+        assert_eq!(two, Some(vec!["lhs-09".into(), "lhs-10".into(), "lhs-13".into()]));
+        assert!(select(&poses, Some("lhs-09,,x")).is_err(), "an empty pattern is refused");
+        assert!(select(&poses, Some("lhs-[")).is_err(), "a broken glob is refused");
     }
 }
