@@ -207,7 +207,8 @@ enum Event {
 fn run_workers(ctx: &Ctx<'_>, to_run: &[(usize, &PoseSpec)], jobs: usize, reports: &mut [PoseReport]) {
     let queue: Mutex<VecDeque<usize>> = Mutex::new((0..to_run.len()).collect());
     let (tx, rx) = mpsc::channel::<Event>();
-    let mut progress = Progress::new(to_run.iter().map(|(_, p)| p.name.clone()).collect(), ctx.steps);
+    let earlier = read_manifest(&ctx.out_dir.join(MANIFEST)).map(|m| m.wall_times_s(ctx.mesh_name, ctx.steps)).unwrap_or_default();
+    let mut progress = Progress::new(to_run.iter().map(|(_, p)| p.name.clone()).collect(), ctx.steps, jobs, earlier);
     std::thread::scope(|s| {
         for _ in 0..jobs {
             let tx = tx.clone();

@@ -98,6 +98,19 @@ impl Manifest {
     }
 }
 
+impl Manifest {
+    /// Wall times in s of the recorded runs on mesh level `mesh_name` with `steps` load
+    /// steps (any spec hash: a spec change rarely changes the cost much), for the ETA of
+    /// a campaign.
+    pub fn wall_times_s(&self, mesh_name: &str, steps: u32) -> Vec<f64> {
+        self.pose
+            .values()
+            .filter(|e| e.mesh == mesh_name && e.steps == steps && e.wall_s.is_finite() && e.wall_s > 0.0)
+            .map(|e| e.wall_s)
+            .collect()
+    }
+}
+
 /// Read a manifest; a missing file is an empty manifest.
 ///
 /// # Errors

@@ -1,5 +1,10 @@
 //! The progress display of `needle fe run`: runs done, running (with their load step)
 //! and left, with an ETA; an indicatif bar on a terminal, plain lines otherwise (CI).
+//!
+//! The ETA comes from measured run times when there are any (the median wall time of the
+//! manifest's runs on the same mesh and step count, and of this campaign's finished
+//! runs), scheduled over the jobs; only without them from the load steps done so far,
+//! which underestimates: the deeper steps take more increments.
 
 use crate::fe::report::{PoseReport, Status};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -11,22 +16,27 @@ use std::time::{Duration, Instant};
 pub(crate) struct Progress {
     names: Vec<String>,
     steps: u32,
-    running: BTreeMap<usize, u32>,
+    jobs: usize,
+    /// Wall times of finished runs, s: the manifest's, then this campaign's.
+    walls_s: Vec<f64>,
+    /// Running jobs: load steps done and start time.
+    running: BTreeMap<usize, (u32, Instant)>,
     done: usize,
     failed: usize,
     bar: Option<ProgressBar>,
     start: Instant,
     last_plain: Instant,
+    /// Counts and running steps of the last plain line (printed again when they change).
     last_line: String,
 }
 
 impl Progress {
-    pub(crate) fn new(names: Vec<String>, steps: u32) -> Self {
+    pub(crate) fn new(names: Vec<String>, steps: u32, jobs: usize, earlier_walls_s: Vec<f64>) -> Self {
         let total_steps = names.len() as u64 * u64::from(steps);
         let bar = std::io::stderr().is_terminal().then(|| {
             let bar = ProgressBar::with_draw_target(Some(total_steps), ProgressDrawTarget::stderr_with_hz(4));
             let style = ProgressStyle::with_template(
-                "[{elapsed_precise}] {bar:30.cyan/blue} {percent:>3}% ETA {eta_precise} | {prefix}\n  {wide_msg}",
+                "[{elapsed_precise}] {bar:30.cyan/blue} {percent:>3}% | {prefix}\n  {wide_msg}",
             )
             .unwrap_or_else(|_| ProgressStyle::default_bar())
             .progress_chars("=> ");
@@ -37,6 +47,8 @@ impl Progress {
         let mut p = Progress {
             names,
             steps,
+            jobs: jobs.max(1),
+            walls_s: earlier_walls_s,
             running: BTreeMap::new(),
             done: 0,
             failed: 0,
@@ -69,13 +81,13 @@ impl Progress {
         }
         self.running
             .iter()
-            .map(|(&i, &k)| format!("{} step {k}/{}", self.name(i), self.steps))
+            .map(|(&i, &(k, _))| format!("{} step {k}/{}", self.name(i), self.steps))
             .collect::<Vec<_>>()
             .join(", ")
     }
 
     fn steps_done_total(&self) -> u64 {
-        (self.done + self.failed) as u64 * u64::from(self.steps) + self.running.values().map(|&k| u64::from(k)).sum::<u64>()
+        (self.done + self.failed) as u64 * u64::from(self.steps) + self.running.values().map(|&(k, _)| u64::from(k)).sum::<u64>()
     }
 
     fn line(&self, text: &str) {
@@ -89,13 +101,13 @@ impl Progress {
     fn redraw(&mut self) {
         if let Some(b) = &self.bar {
             b.set_position(self.steps_done_total());
-            b.set_prefix(self.counts());
+            b.set_prefix(format!("{}; {}", self.counts(), self.eta_text()));
             b.set_message(format!("running: {}", self.running_text()));
         }
     }
 
     pub(crate) fn started(&mut self, i: usize) {
-        self.running.insert(i, 0);
+        self.running.insert(i, (0, Instant::now()));
         self.line(&format!("start {}", self.name(i)));
         self.redraw();
     }
@@ -109,6 +121,9 @@ impl Progress {
             }
             _ => {
                 self.done += 1;
+                if let Some(w) = r.wall_s.filter(|w| w.is_finite() && *w > 0.0) {
+                    self.walls_s.push(w);
+                }
                 self.line(&format!(
                     "done {}: {:.1} s, {} increments, fy = {} N at the final depth",
                     r.pose,
@@ -127,33 +142,109 @@ impl Progress {
         let keys: Vec<usize> = self.running.keys().copied().collect();
         for i in keys {
             let k = steps_of(i).min(self.steps);
-            self.running.insert(i, k);
+            if let Some(slot) = self.running.get_mut(&i) {
+                slot.0 = k;
+            }
         }
         if self.bar.is_some() {
             self.redraw();
             return;
         }
-        if self.last_plain.elapsed() >= Duration::from_secs(30) && !self.running.is_empty() {
-            let done_steps = self.steps_done_total();
-            let total = self.names.len() as u64 * u64::from(self.steps);
-            let eta = if done_steps > 0 {
-                let per_step = self.start.elapsed().as_secs_f64() / done_steps as f64;
-                format!("ETA {:.0} s", per_step * total.saturating_sub(done_steps) as f64)
-            } else {
-                "ETA ?".into()
-            };
-            let line = format!("{}; {eta}; running: {}", self.counts(), self.running_text());
-            if line != self.last_line {
+        // a line every 30 s when a run moved on, at least every 5 min while runs are going
+        let since = self.last_plain.elapsed();
+        if since >= Duration::from_secs(30) && !self.running.is_empty() {
+            let state = format!("{}; running: {}", self.counts(), self.running_text());
+            if state != self.last_line || since >= Duration::from_secs(300) {
+                let line = format!("{}; {}; running: {}", self.counts(), self.eta_text(), self.running_text());
                 self.line(&line);
-                self.last_line = line;
+                self.last_line = state;
+                self.last_plain = Instant::now();
             }
-            self.last_plain = Instant::now();
         }
+    }
+
+    /// `ETA ~N s (median run M s of K)`, or from the load steps when no run time is known.
+    fn eta_text(&self) -> String {
+        let finished = self.done + self.failed;
+        let left = self.names.len().saturating_sub(finished + self.running.len());
+        if let Some(typical) = median(&self.walls_s) {
+            let running: Vec<(f64, u32)> =
+                self.running.values().map(|&(k, t)| (t.elapsed().as_secs_f64(), k)).collect();
+            let eta = eta_s(typical, self.jobs, &running, self.steps, left);
+            return format!("ETA ~{eta:.0} s (median run {typical:.0} s of {})", self.walls_s.len());
+        }
+        let done_steps = self.steps_done_total();
+        let total = self.names.len() as u64 * u64::from(self.steps);
+        if done_steps == 0 {
+            return "ETA ?".into();
+        }
+        let per_step = self.start.elapsed().as_secs_f64() / done_steps as f64;
+        format!("ETA >{:.0} s (from load steps)", per_step * total.saturating_sub(done_steps) as f64)
     }
 
     pub(crate) fn finish(&mut self) {
         if let Some(b) = self.bar.take() {
             b.finish_and_clear();
         }
+    }
+}
+
+/// Median of `v`, `None` when empty.
+fn median(v: &[f64]) -> Option<f64> {
+    let mut s: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    s.sort_by(f64::total_cmp);
+    let n = s.len();
+    match n {
+        0 => None,
+        _ if n % 2 == 1 => s.get(n / 2).copied(),
+        _ => Some((s.get(n / 2 - 1)? + s.get(n / 2)?) / 2.0),
+    }
+}
+
+/// Seconds until a campaign ends when every run takes `typical_s`: the `running` jobs
+/// (elapsed s, load steps done of `steps`) first, then `left` runs each given to the job
+/// that is free first, over `jobs` jobs. A running job past `typical_s` is given the time
+/// its load steps so far suggest.
+fn eta_s(typical_s: f64, jobs: usize, running: &[(f64, u32)], steps: u32, left: usize) -> f64 {
+    let mut free_at: Vec<f64> = running
+        .iter()
+        .map(|&(elapsed, k)| {
+            if elapsed < typical_s {
+                typical_s - elapsed
+            } else if k > 0 {
+                elapsed * f64::from(steps.saturating_sub(k)) / f64::from(k)
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    free_at.resize(jobs.max(running.len()).max(1), 0.0);
+    for _ in 0..left {
+        if let Some(first) = free_at.iter_mut().min_by(|a, b| a.total_cmp(b)) {
+            *first += typical_s;
+        }
+    }
+    free_at.into_iter().fold(0.0, f64::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{eta_s, median};
+
+    #[test]
+    fn eta_schedules_left_runs_on_the_first_free_job() {
+        // jobs free at 60 s and 90 s; three runs of 100 s: 60+100, 90+100, 160+100
+        assert_eq!(eta_s(100.0, 2, &[(40.0, 5), (10.0, 1)], 20, 3), 260.0);
+        // a job past the typical time: 150 s for 15 of 20 steps -> 50 s more
+        assert_eq!(eta_s(100.0, 1, &[(150.0, 15)], 20, 0), 50.0);
+        // nothing running, one job
+        assert_eq!(eta_s(100.0, 1, &[], 20, 2), 200.0);
+    }
+
+    #[test]
+    fn median_of_odd_even_and_empty() {
+        assert_eq!(median(&[3.0, 1.0, 2.0]), Some(2.0));
+        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), Some(2.5));
+        assert_eq!(median(&[]), None);
     }
 }
