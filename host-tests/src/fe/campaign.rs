@@ -208,7 +208,8 @@ fn run_workers(ctx: &Ctx<'_>, to_run: &[(usize, &PoseSpec)], jobs: usize, report
     let queue: Mutex<VecDeque<usize>> = Mutex::new((0..to_run.len()).collect());
     let (tx, rx) = mpsc::channel::<Event>();
     let earlier = read_manifest(&ctx.out_dir.join(MANIFEST)).map(|m| m.wall_times_s(ctx.mesh_name, ctx.steps)).unwrap_or_default();
-    let mut progress = Progress::new(to_run.iter().map(|(_, p)| p.name.clone()).collect(), ctx.steps, jobs, earlier);
+    let runs = to_run.iter().map(|(_, p)| (p.name.clone(), deck::model_name(p.symmetry()).to_string())).collect();
+    let mut progress = Progress::new(runs, ctx.steps, jobs, earlier);
     std::thread::scope(|s| {
         for _ in 0..jobs {
             let tx = tx.clone();

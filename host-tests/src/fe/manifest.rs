@@ -100,14 +100,16 @@ impl Manifest {
 
 impl Manifest {
     /// Wall times in s of the recorded runs on mesh level `mesh_name` with `steps` load
-    /// steps (any spec hash: a spec change rarely changes the cost much), for the ETA of
-    /// a campaign.
-    pub fn wall_times_s(&self, mesh_name: &str, steps: u32) -> Vec<f64> {
-        self.pose
-            .values()
-            .filter(|e| e.mesh == mesh_name && e.steps == steps && e.wall_s.is_finite() && e.wall_s > 0.0)
-            .map(|e| e.wall_s)
-            .collect()
+    /// steps, by model (e.g. "full block, no mirror plane"), for the ETA of a campaign.
+    /// Any spec hash counts: a spec change rarely changes the cost much.
+    pub fn wall_times_s(&self, mesh_name: &str, steps: u32) -> BTreeMap<String, Vec<f64>> {
+        let mut by_model: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+        for e in self.pose.values() {
+            if e.mesh == mesh_name && e.steps == steps && e.wall_s.is_finite() && e.wall_s > 0.0 {
+                by_model.entry(e.model.clone()).or_default().push(e.wall_s);
+            }
+        }
+        by_model
     }
 }
 

@@ -1,10 +1,11 @@
 //! The progress display of `needle fe run`: runs done, running (with their load step)
 //! and left, with an ETA; an indicatif bar on a terminal, plain lines otherwise (CI).
 //!
-//! The ETA comes from measured run times when there are any (the median wall time of the
-//! manifest's runs on the same mesh and step count, and of this campaign's finished
-//! runs), scheduled over the jobs; only without them from the load steps done so far,
-//! which underestimates: the deeper steps take more increments.
+//! The ETA comes from measured run times when there are any: each run is expected to
+//! take the median wall time of the runs of its model (quarter, half or full block) on
+//! the same mesh and step count, from the manifest and from this campaign's finished
+//! runs, and the runs are scheduled over the jobs. Without them it comes from the load
+//! steps done so far, which underestimates: the deeper steps take more increments.
 
 use crate::fe::report::{PoseReport, Status};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -15,10 +16,14 @@ use std::time::{Duration, Instant};
 /// Progress display: an indicatif bar on a terminal, plain lines otherwise (CI).
 pub(crate) struct Progress {
     names: Vec<String>,
+    /// Model of each run (`deck::model_name`), the key of `walls_s`.
+    models: Vec<String>,
+    /// Runs finished (done or failed).
+    finished: Vec<bool>,
     steps: u32,
     jobs: usize,
-    /// Wall times of finished runs, s: the manifest's, then this campaign's.
-    walls_s: Vec<f64>,
+    /// Wall times of finished runs by model, s: the manifest's, then this campaign's.
+    walls_s: BTreeMap<String, Vec<f64>>,
     /// Running jobs: load steps done and start time.
     running: BTreeMap<usize, (u32, Instant)>,
     done: usize,
@@ -31,7 +36,10 @@ pub(crate) struct Progress {
 }
 
 impl Progress {
-    pub(crate) fn new(names: Vec<String>, steps: u32, jobs: usize, earlier_walls_s: Vec<f64>) -> Self {
+    /// `runs`: (pose name, model) in queue order; `earlier_walls_s`: measured wall times
+    /// by model ([`Manifest::wall_times_s`](crate::fe::manifest::Manifest::wall_times_s)).
+    pub(crate) fn new(runs: Vec<(String, String)>, steps: u32, jobs: usize, earlier_walls_s: BTreeMap<String, Vec<f64>>) -> Self {
+        let (names, models): (Vec<String>, Vec<String>) = runs.into_iter().unzip();
         let total_steps = names.len() as u64 * u64::from(steps);
         let bar = std::io::stderr().is_terminal().then(|| {
             let bar = ProgressBar::with_draw_target(Some(total_steps), ProgressDrawTarget::stderr_with_hz(4));
@@ -45,7 +53,9 @@ impl Progress {
         });
         let now = Instant::now();
         let mut p = Progress {
+            finished: vec![false; names.len()],
             names,
+            models,
             steps,
             jobs: jobs.max(1),
             walls_s: earlier_walls_s,
@@ -114,6 +124,9 @@ impl Progress {
 
     pub(crate) fn finished(&mut self, i: usize, r: &PoseReport) {
         self.running.remove(&i);
+        if let Some(f) = self.finished.get_mut(i) {
+            *f = true;
+        }
         match &r.status {
             Status::Failed { message, .. } => {
                 self.failed += 1;
@@ -121,8 +134,8 @@ impl Progress {
             }
             _ => {
                 self.done += 1;
-                if let Some(w) = r.wall_s.filter(|w| w.is_finite() && *w > 0.0) {
-                    self.walls_s.push(w);
+                if let (Some(w), Some(model)) = (r.wall_s.filter(|w| w.is_finite() && *w > 0.0), self.models.get(i)) {
+                    self.walls_s.entry(model.clone()).or_default().push(w);
                 }
                 self.line(&format!(
                     "done {}: {:.1} s, {} increments, fy = {} N at the final depth",
@@ -163,15 +176,26 @@ impl Progress {
         }
     }
 
-    /// `ETA ~N s (median run M s of K)`, or from the load steps when no run time is known.
+    /// Median wall time of run `i`'s model, s.
+    fn typical_s(&self, i: usize) -> Option<f64> {
+        self.models.get(i).and_then(|m| self.walls_s.get(m)).and_then(|w| median(w))
+    }
+
+    /// `ETA ~N s (median run times of each model)`, or from the load steps when a run's
+    /// model has no measured time.
     fn eta_text(&self) -> String {
-        let finished = self.done + self.failed;
-        let left = self.names.len().saturating_sub(finished + self.running.len());
-        if let Some(typical) = median(&self.walls_s) {
-            let running: Vec<(f64, u32)> =
-                self.running.values().map(|&(k, t)| (t.elapsed().as_secs_f64(), k)).collect();
-            let eta = eta_s(typical, self.jobs, &running, self.steps, left);
-            return format!("ETA ~{eta:.0} s (median run {typical:.0} s of {})", self.walls_s.len());
+        let running: Option<Vec<(f64, f64, u32)>> = self
+            .running
+            .iter()
+            .map(|(&i, &(k, t))| self.typical_s(i).map(|typ| (typ, t.elapsed().as_secs_f64(), k)))
+            .collect();
+        let left: Option<Vec<f64>> = (0..self.names.len())
+            .filter(|i| !self.running.contains_key(i) && !self.finished.get(*i).copied().unwrap_or(true))
+            .map(|i| self.typical_s(i))
+            .collect();
+        if let (Some(running), Some(left)) = (running, left) {
+            let eta = eta_s(self.jobs, &running, self.steps, &left);
+            return format!("ETA ~{eta:.0} s (median run time of each model)");
         }
         let done_steps = self.steps_done_total();
         let total = self.names.len() as u64 * u64::from(self.steps);
@@ -201,16 +225,16 @@ fn median(v: &[f64]) -> Option<f64> {
     }
 }
 
-/// Seconds until a campaign ends when every run takes `typical_s`: the `running` jobs
-/// (elapsed s, load steps done of `steps`) first, then `left` runs each given to the job
-/// that is free first, over `jobs` jobs. A running job past `typical_s` is given the time
-/// its load steps so far suggest.
-fn eta_s(typical_s: f64, jobs: usize, running: &[(f64, u32)], steps: u32, left: usize) -> f64 {
+/// Seconds until a campaign ends over `jobs` jobs: the `running` runs (expected s,
+/// elapsed s, load steps done of `steps`) first, then the `left` runs (expected s each)
+/// in queue order, each given to the job that is free first. A running run past its
+/// expected time is given the time its load steps so far suggest.
+fn eta_s(jobs: usize, running: &[(f64, f64, u32)], steps: u32, left: &[f64]) -> f64 {
     let mut free_at: Vec<f64> = running
         .iter()
-        .map(|&(elapsed, k)| {
-            if elapsed < typical_s {
-                typical_s - elapsed
+        .map(|&(typical, elapsed, k)| {
+            if elapsed < typical {
+                typical - elapsed
             } else if k > 0 {
                 elapsed * f64::from(steps.saturating_sub(k)) / f64::from(k)
             } else {
@@ -219,9 +243,9 @@ fn eta_s(typical_s: f64, jobs: usize, running: &[(f64, u32)], steps: u32, left: 
         })
         .collect();
     free_at.resize(jobs.max(running.len()).max(1), 0.0);
-    for _ in 0..left {
+    for &typical in left {
         if let Some(first) = free_at.iter_mut().min_by(|a, b| a.total_cmp(b)) {
-            *first += typical_s;
+            *first += typical;
         }
     }
     free_at.into_iter().fold(0.0, f64::max)
@@ -234,11 +258,13 @@ mod tests {
     #[test]
     fn eta_schedules_left_runs_on_the_first_free_job() {
         // jobs free at 60 s and 90 s; three runs of 100 s: 60+100, 90+100, 160+100
-        assert_eq!(eta_s(100.0, 2, &[(40.0, 5), (10.0, 1)], 20, 3), 260.0);
-        // a job past the typical time: 150 s for 15 of 20 steps -> 50 s more
-        assert_eq!(eta_s(100.0, 1, &[(150.0, 15)], 20, 0), 50.0);
-        // nothing running, one job
-        assert_eq!(eta_s(100.0, 1, &[], 20, 2), 200.0);
+        assert_eq!(eta_s(2, &[(100.0, 40.0, 5), (100.0, 10.0, 1)], 20, &[100.0; 3]), 260.0);
+        // a job past the expected time: 150 s for 15 of 20 steps -> 50 s more
+        assert_eq!(eta_s(1, &[(100.0, 150.0, 15)], 20, &[]), 50.0);
+        // nothing running, one job, runs of two models
+        assert_eq!(eta_s(1, &[], 20, &[100.0, 400.0]), 500.0);
+        // two jobs: the long run goes to the job that is free first
+        assert_eq!(eta_s(2, &[(100.0, 90.0, 19)], 20, &[400.0, 50.0]), 400.0);
     }
 
     #[test]
