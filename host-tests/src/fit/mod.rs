@@ -7,10 +7,12 @@
 //! [`model_file::to_toml`] writes it, [`golden::to_csv`] evaluates it with this crate's
 //! own f32 implementation of the contract ([`eval_f32`]), [`golden_fixed::to_csv`] with its
 //! own fixed-point implementation ([`fixed_formats`], [`eval_fixed`]). [`validate`] compares the
-//! model ([`eval_f64`], [`eval_f32`]) with the validation runs.
+//! model ([`eval_f64`], [`eval_f32`]) with the validation runs, and [`error_trend`] tells
+//! whether its errors follow the tilt or the offset.
 
 pub mod contract;
 pub mod data;
+pub mod error_trend;
 pub mod eval_f32;
 pub mod eval_f64;
 pub mod eval_fixed;

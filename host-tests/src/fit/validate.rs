@@ -14,6 +14,7 @@
 //! a missed goal.
 
 use super::contract::{unit, COMPONENTS};
+use super::error_trend::{trend, ErrorTrend};
 use super::data::{fitted_fe_sha256, fitted_poses, load_validation_runs, run_path, Run};
 use super::eval_f32::{eval as eval32, Tables32};
 use super::eval_f64::eval as eval64;
@@ -92,6 +93,9 @@ pub struct Report {
     pub lhs_goal_met: bool,
     /// Both goals met.
     pub passed: bool,
+    /// Whether the errors of the table2 and lhs runs follow the tilt or the offset
+    /// (diagnostic, no goal); `None` below 3 runs.
+    pub error_trend: Option<ErrorTrend>,
 }
 
 fn role_name(r: Role) -> &'static str {
@@ -195,6 +199,11 @@ pub fn validate(set_dir: &Path) -> Result<Report> {
     };
     let table2_goal_met = goal(Role::Table2);
     let lhs_goal_met = goal(Role::Lhs);
+    let judged: Vec<&RunReport> = reports.iter().filter(|r| r.goal_met.is_some()).collect();
+    let error_trend = trend(
+        &judged.iter().map(|r| r.pose).collect::<Vec<_>>(),
+        &judged.iter().map(|r| r.worst_rms_pct).collect::<Vec<_>>(),
+    );
     Ok(Report {
         set_dir: set_dir.display().to_string(),
         lever_arm_mm: lever,
@@ -205,6 +214,7 @@ pub fn validate(set_dir: &Path) -> Result<Report> {
         table2_goal_met,
         lhs_goal_met,
         passed: table2_goal_met && lhs_goal_met,
+        error_trend,
     })
 }
 
@@ -289,6 +299,13 @@ pub fn to_table(r: &Report) -> String {
         worst("lhs", |x| x.worst_rms_pct)
     );
     let _ = writeln!(s, "mirror runs (symmetry check, no goal): rms {}", worst("mirror", |x| x.worst_rms_pct));
+    if let Some(t) = r.error_trend {
+        let _ = writeln!(
+            s,
+            "error trend (no goal): Spearman rank correlation of a run's worst rms % over {} table2 and lhs runs: {:+.2} with its tilt |theta_x|+|theta_z|, {:+.2} with its offset |x|+|z|",
+            t.runs, t.tilt_rho, t.offset_rho
+        );
+    }
     let _ = writeln!(s, "f32 model vs f64 model: largest difference {:.3e} % of scale", r.f32_vs_f64_max_pct);
     let _ = writeln!(s, "result: {}", pass(r.passed));
     s
