@@ -237,6 +237,11 @@ fn a_timed_out_job_is_reported_and_kept_for_debugging() {
     assert!(!fe.join("centre.csv").exists());
     let work = fe.join(".work").join("centre");
     assert!(work.join("pose.inp").exists() && work.join("pose.log").exists(), "work folder kept");
+    // both attempts' logs are kept: the retry rewrites pose.log
+    for attempt in ["first-increment-1", "first-increment-0.25"] {
+        assert!(work.join(format!("failed-{attempt}.log")).is_file(), "{attempt} log kept\n{}", show(&out));
+        assert!(stdout.contains(&format!("(kept as failed-{attempt}.*)")), "{}", show(&out));
+    }
     assert!(stdout.contains(&work.display().to_string()), "{}", show(&out));
     assert!(!read_manifest(&fe.join(MANIFEST)).expect("manifest").pose.contains_key("centre"));
 }

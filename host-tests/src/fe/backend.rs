@@ -27,7 +27,8 @@ pub struct Job<'a> {
     pub mesh: &'a MeshLevel,
     /// Load steps (= `campaign.loading.steps`).
     pub steps: u32,
-    /// An empty folder for the solver's files.
+    /// The solver's folder, emptied before a pose's first attempt (the retry reuses it;
+    /// a failed attempt's log is kept there as `failed-first-increment-<r>.*`).
     pub work_dir: &'a Path,
     /// Wall-clock limit of the solve.
     pub timeout: Option<Duration>,
@@ -119,12 +120,14 @@ impl Backend for CcxBackend {
         let done = r.sta.steps_done();
         if !r.success() || done < job.steps {
             let how = if r.success() { "finished (exit code 0)".to_string() } else { r.exit.to_string() };
+            let kept = keep_failed_attempt(job);
             return Err(SolveFailure {
                 message: format!(
-                    "ccx {how} after {done} of {} steps, {} increments, {:.1} s",
+                    "ccx {how} after {done} of {} steps, {} increments, {:.1} s{}{kept}",
                     job.steps,
                     r.sta.increments,
-                    r.wall.as_secs_f64()
+                    r.wall.as_secs_f64(),
+                    r.cause.as_deref().map(|c| format!(": {c}")).unwrap_or_default(),
                 ),
                 log_tail: r.log_tail,
             });
@@ -179,4 +182,23 @@ fn check_step_times(blocks: &[dat::StepRf], steps: u32) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Copy a failed attempt's log, status and SPOOLES files to `failed-<attempt>.*` in its
+/// work folder, where the retry (which rewrites `pose.*`) leaves them; returns
+/// ` (kept as failed-<attempt>.*)`, or nothing when no file could be copied.
+fn keep_failed_attempt(job: &Job<'_>) -> String {
+    let attempt = format!("first-increment-{}", job.first_increment);
+    let mut kept = 0;
+    for (from, ext) in [(format!("{JOB}.log"), "log"), (format!("{JOB}.sta"), "sta"), ("spooles.out".to_string(), "spooles.out")] {
+        let src = job.work_dir.join(from);
+        if src.is_file() && std::fs::copy(&src, job.work_dir.join(format!("failed-{attempt}.{ext}"))).is_ok() {
+            kept += 1;
+        }
+    }
+    if kept > 0 {
+        format!(" (kept as failed-{attempt}.*)")
+    } else {
+        String::new()
+    }
 }

@@ -182,6 +182,10 @@ pub struct JobResult {
     pub log_path: PathBuf,
     /// The last [`LOG_TAIL_LINES`] lines of the log.
     pub log_tail: String,
+    /// Why ccx stopped, in its own words, when it said so: the last line of SPOOLES's
+    /// `spooles.out` (e.g. "matrix found to be singular") or the last `*ERROR` line of
+    /// the log.
+    pub cause: Option<String>,
 }
 
 impl JobResult {
@@ -249,6 +253,11 @@ pub fn run_job(
     stall: Option<Duration>,
 ) -> Result<JobResult> {
     let log_path = work_dir.join(format!("{job}.log"));
+    // a spooles.out left by an earlier attempt in this folder would be taken for this one's
+    let spooles_path = work_dir.join("spooles.out");
+    if spooles_path.exists() {
+        std::fs::remove_file(&spooles_path).with_context(|| format!("{}: cannot remove the earlier attempt's", spooles_path.display()))?;
+    }
     let log = std::fs::File::create(&log_path).with_context(|| format!("{}: cannot create", log_path.display()))?;
     let log_err = log.try_clone().with_context(|| format!("{}: cannot reopen", log_path.display()))?;
     let start = Instant::now();
@@ -305,12 +314,20 @@ pub fn run_job(
     let log_text = std::fs::read(&log_path).map(|b| String::from_utf8_lossy(&b).into_owned()).unwrap_or_default();
     let mut log_tail = tail(&log_text, LOG_TAIL_LINES);
     // SPOOLES reports a singular matrix in its own file, not on stdout (ccx then exits 255)
-    let spooles = std::fs::read_to_string(work_dir.join("spooles.out")).unwrap_or_default();
+    let spooles = std::fs::read_to_string(&spooles_path).unwrap_or_default();
     if !spooles.trim().is_empty() {
         log_tail.push_str("\nspooles.out: ");
         log_tail.push_str(&tail(&spooles, 3).trim_start().replace('\n', " / "));
     }
-    Ok(JobResult { exit, wall, sta, log_tail, log_path })
+    let cause = stated_cause(&log_text, &spooles);
+    Ok(JobResult { exit, wall, sta, log_tail, log_path, cause })
+}
+
+/// ccx's own statement of why it stopped: the last non-blank line of `spooles.out`, else
+/// the last line of the log holding `*ERROR`.
+pub fn stated_cause(log_text: &str, spooles: &str) -> Option<String> {
+    let last = |t: &str, want: fn(&str) -> bool| t.lines().map(str::trim).filter(|l| want(l)).last().map(str::to_string);
+    last(spooles, |l| !l.is_empty()).or_else(|| last(log_text, |l| l.contains("*ERROR")))
 }
 
 /// The last `n` non-blank-trailing lines of `text`.
@@ -359,7 +376,14 @@ mod tests {
         let r = run_job(&singular, d.path(), "job", None, None).expect("run");
         assert_eq!(r.exit, ExitKind::Code(255));
         assert_eq!(r.log_tail, "factoring\nspooles.out: matrix found to be singular");
-        std::fs::remove_file(d.path().join("spooles.out")).expect("rm spooles.out");
+        assert_eq!(r.cause.as_deref(), Some("matrix found to be singular"));
+
+        // the next attempt in the same folder does not inherit that spooles.out
+        let error = fake_ccx(d.path(), "echo ' *ERROR in checkslavedof: bad node'; echo done; exit 201");
+        let r = run_job(&error, d.path(), "job", None, None).expect("run");
+        assert_eq!(r.exit, ExitKind::Code(201));
+        assert!(!d.path().join("spooles.out").exists());
+        assert_eq!(r.cause.as_deref(), Some("*ERROR in checkslavedof: bad node"));
 
         // prints every 0.1 s for 1.5 s: never silent for 0.7 s, so it runs to its end
         let talking = fake_ccx(d.path(), "i=0; while [ $i -lt 15 ]; do echo $i; sleep 0.1; i=$((i+1)); done");
