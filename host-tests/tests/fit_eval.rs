@@ -263,6 +263,11 @@ fn validate_runs_on_the_synthetic_set() {
     assert!(r.f32_vs_f64_max_pct < 1e-3);
     let table = needle_host::fit::validate::to_table(&r);
     assert!(table.contains("goal table2") && table.contains("goal lhs"));
+    // the error trend is computed over the 20 table2 and lhs runs and printed
+    let t = r.error_trend.unwrap_or_else(|| panic!("no error trend over {} runs", r.runs.len()));
+    assert_eq!(t.runs, 20);
+    assert!(t.tilt_rho.abs() <= 1.0 && t.offset_rho.abs() <= 1.0, "{t:?}");
+    assert!(table.contains("error trend (no goal)"), "{table}");
 }
 
 /// Rewrite the `fit_without = [...]` line of a set's campaign.toml.
