@@ -326,7 +326,7 @@ pub fn run_job(
 /// ccx's own statement of why it stopped: the last non-blank line of `spooles.out`, else
 /// the last line of the log holding `*ERROR`.
 pub fn stated_cause(log_text: &str, spooles: &str) -> Option<String> {
-    let last = |t: &str, want: fn(&str) -> bool| t.lines().map(str::trim).filter(|l| want(l)).last().map(str::to_string);
+    let last = |t: &str, want: fn(&str) -> bool| t.lines().map(str::trim).rfind(|l| want(l)).map(str::to_string);
     last(spooles, |l| !l.is_empty()).or_else(|| last(log_text, |l| l.contains("*ERROR")))
 }
 
