@@ -36,6 +36,7 @@ use crate::fe::report::{PoseReport, Report, Status};
 use crate::fe::results::{self, Row};
 use crate::fe::spec::{self, Campaign, MeshLevel, PoseSpec};
 use anyhow::{bail, Context, Result};
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::{mpsc, Mutex};
 use std::collections::VecDeque;
@@ -193,7 +194,8 @@ pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> 
             solver_version,
             manifest_lock: Mutex::new(()),
         };
-        run_workers(&ctx, &to_run, jobs, &mut reports);
+        let earlier_walls_s = manifest.wall_times_s(&mesh_name, steps);
+        run_workers(&ctx, &to_run, jobs, earlier_walls_s, &mut reports);
     }
     Ok(Report { poses: reports, mesh: mesh_name, steps, depth_mm: campaign.loading.depth_mm, out_dir, wall: start.elapsed() })
 }
@@ -204,12 +206,18 @@ enum Event {
 }
 
 /// Solve `to_run` (report index, pose) with `jobs` worker threads, filling `reports`.
-fn run_workers(ctx: &Ctx<'_>, to_run: &[(usize, &PoseSpec)], jobs: usize, reports: &mut [PoseReport]) {
+/// `earlier_walls_s`: the manifest's measured wall times by model, for the ETA.
+fn run_workers(
+    ctx: &Ctx<'_>,
+    to_run: &[(usize, &PoseSpec)],
+    jobs: usize,
+    earlier_walls_s: BTreeMap<String, Vec<f64>>,
+    reports: &mut [PoseReport],
+) {
     let queue: Mutex<VecDeque<usize>> = Mutex::new((0..to_run.len()).collect());
     let (tx, rx) = mpsc::channel::<Event>();
-    let earlier = read_manifest(&ctx.out_dir.join(MANIFEST)).map(|m| m.wall_times_s(ctx.mesh_name, ctx.steps)).unwrap_or_default();
     let runs = to_run.iter().map(|(_, p)| (p.name.clone(), deck::model_name(p.symmetry()).to_string())).collect();
-    let mut progress = Progress::new(runs, ctx.steps, jobs, earlier);
+    let mut progress = Progress::new(runs, ctx.steps, jobs, earlier_walls_s);
     std::thread::scope(|s| {
         for _ in 0..jobs {
             let tx = tx.clone();

@@ -75,9 +75,14 @@ impl Progress {
         self.names.get(i).map(String::as_str).unwrap_or("?")
     }
 
+    /// Runs neither finished nor running, in queue order.
+    fn left(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..self.names.len()).filter(|i| !self.running.contains_key(i) && !self.finished.get(*i).copied().unwrap_or(true))
+    }
+
     fn counts(&self) -> String {
         let finished = self.done + self.failed;
-        let left = self.names.len().saturating_sub(finished + self.running.len());
+        let left = self.left().count();
         let mut s = format!("{finished}/{} runs done, {} running, {left} left", self.names.len(), self.running.len());
         if self.failed > 0 {
             s.push_str(&format!(", {} failed", self.failed));
@@ -189,10 +194,7 @@ impl Progress {
             .iter()
             .map(|(&i, &(k, t))| self.typical_s(i).map(|typ| (typ, t.elapsed().as_secs_f64(), k)))
             .collect();
-        let left: Option<Vec<f64>> = (0..self.names.len())
-            .filter(|i| !self.running.contains_key(i) && !self.finished.get(*i).copied().unwrap_or(true))
-            .map(|i| self.typical_s(i))
-            .collect();
+        let left: Option<Vec<f64>> = self.left().map(|i| self.typical_s(i)).collect();
         if let (Some(running), Some(left)) = (running, left) {
             let eta = eta_s(self.jobs, &running, self.steps, &left);
             return format!("ETA ~{eta:.0} s (median run time of each model)");
