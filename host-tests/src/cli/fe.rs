@@ -8,7 +8,8 @@ use std::time::Duration;
 /// `needle fe` subcommands.
 #[derive(Subcommand)]
 pub enum FeCommand {
-    /// Run the FE campaign of a set on CalculiX: one deck and one ccx job per pose,
+    /// Run the FE campaign of a set on its engine (FEBio or CalculiX, campaign.toml's
+    /// [solver] engine or --solver): one input and one solver job per pose,
     /// results in <set>/fe/<pose>.csv (depth in mm, forces in N, moments in N*mm about the
     /// needle hub) and <set>/fe/manifest.toml. Poses whose result matches the current
     /// spec are skipped; a killed campaign resumes where it stopped. Exit status 1 when a
@@ -28,10 +29,17 @@ pub struct RunArgs {
     /// Set folder holding campaign.toml, e.g. coeffs/default.
     #[arg(long, value_name = "DIR")]
     pub set: PathBuf,
-    /// Number of ccx jobs at the same time, each on one thread (memory: about 2.5 GB per
-    /// job on the committed mesh).
-    #[arg(long, value_name = "N", default_value_t = 1)]
-    pub jobs: usize,
+    /// FE engine of this run instead of campaign.toml's [solver] engine: febio or ccx.
+    #[arg(long, value_name = "ENGINE", value_parser = ["febio", "ccx"])]
+    pub solver: Option<String>,
+    /// Number of solver jobs at the same time (memory: about 2.5 GB per ccx job on the
+    /// committed mesh).
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub jobs: u32,
+    /// Solver threads per job (FEBio's Pardiso and assembly; ccx always runs on one).
+    /// Default: the machine's cores divided by --jobs.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub threads: Option<u32>,
     /// Only the poses whose name matches this glob, e.g. 'x+*' or 'centre' (quote it), or
     /// any of several comma-separated globs, e.g. 'lhs-09,lhs-1*'.
     #[arg(long, value_name = "PATTERN")]
@@ -107,9 +115,13 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
     if !(a.stall_s.is_finite() && a.stall_s > 0.0) {
         anyhow::bail!("--stall-s {}: must be a number of seconds > 0", a.stall_s);
     }
+    let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    let jobs = a.jobs as usize;
     let opts = RunOptions {
         set_dir: a.set,
-        jobs: a.jobs.max(1),
+        jobs,
+        threads: a.threads.map(|t| t as usize).unwrap_or((cores / jobs).max(1)),
+        solver: a.solver.as_deref().map(crate::fe::spec::Engine::parse).transpose()?,
         only: a.only,
         mesh: a.mesh,
         steps: a.steps,
@@ -118,11 +130,11 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
         timeout,
         stall: Some(Duration::from_secs_f64(a.stall_s)),
     };
-    crate::fe::ccx::stop_jobs_on_termination()?;
+    crate::fe::process::stop_jobs_on_termination()?;
     let report = campaign::run(&opts)?;
     print!("{}", report.table());
-    if crate::fe::ccx::interrupted() {
-        return Ok(ExitCode::from(crate::fe::ccx::EXIT_INTERRUPTED));
+    if crate::fe::process::interrupted() {
+        return Ok(ExitCode::from(crate::fe::process::EXIT_INTERRUPTED));
     }
     Ok(if report.failed() > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS })
 }
@@ -141,7 +153,7 @@ fn run_verify(a: VerifyArgs) -> anyhow::Result<ExitCode> {
         punch_mesh_scale: a.punch_mesh_scale,
         punch_campaign_element: !a.no_campaign_element,
     };
-    crate::fe::ccx::stop_jobs_on_termination()?;
+    crate::fe::process::stop_jobs_on_termination()?;
     let (_, ok) = crate::fe::verify::run(&opts)?;
     if !ok {
         eprintln!("needle fe verify: a check missed its goal");

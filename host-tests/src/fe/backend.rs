@@ -1,11 +1,12 @@
-//! The solver side of a campaign: the [`Backend`] trait (one pose in, wrenches out) and
+//! The solver side of a campaign: the [`Backend`] trait (one pose in, wrenches out),
 //! [`CcxBackend`], which writes the deck, runs CalculiX, reads the `.dat` back and reduces
-//! the needle's nodal reactions to the wrench. Tests inject other backends.
+//! the needle's nodal reactions to the wrench, and [`backend_for`], the engine of a run.
+//! FEBio's backend is `fe::febio::FebioBackend`. Tests inject other backends.
 
 use crate::fe::ccx;
 use crate::fe::dat;
 use crate::fe::deck::{self, MeshSummary};
-use crate::fe::spec::{Campaign, MeshLevel, PoseSpec};
+use crate::fe::spec::{Campaign, Engine, MeshLevel, PoseSpec};
 use crate::fe::wrench;
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
@@ -55,6 +56,11 @@ pub struct Solved {
     pub first_increment: f64,
     /// Why an earlier attempt failed, when this is the retry.
     pub retry: Option<String>,
+    /// The tissue element and formulation, e.g. "C3D8, full integration".
+    pub element: String,
+    /// The solver settings that shaped the result, one line (contact enforcement,
+    /// threads...).
+    pub settings: String,
 }
 
 /// Why a pose could not be solved.
@@ -81,6 +87,9 @@ pub trait Backend: Sync {
     /// The solver is missing or unusable: the campaign stops before any solve.
     fn prepare(&mut self) -> Result<String>;
 
+    /// The engine's name as the manifest records it (`ccx`, `febio`).
+    fn engine(&self) -> &'static str;
+
     /// Solve one pose in `job.work_dir`.
     ///
     /// # Errors
@@ -89,6 +98,15 @@ pub trait Backend: Sync {
 
     /// Steps completed so far by the job running in `work_dir` (for the progress bar).
     fn steps_done(&self, work_dir: &Path) -> u32;
+}
+
+/// The backend of `engine`, its jobs each on `threads` solver threads (ccx always runs
+/// on one: its SPOOLES factorisation is serial in Debian's build).
+pub fn backend_for(engine: Engine, threads: usize) -> Box<dyn Backend> {
+    match engine {
+        Engine::Ccx => Box::new(CcxBackend::default()),
+        Engine::Febio => Box::new(crate::fe::febio::FebioBackend::new(threads)),
+    }
 }
 
 /// The real backend: the project's deck writer, CalculiX, the `.dat` reader and the
@@ -104,6 +122,10 @@ impl Backend for CcxBackend {
         let version = ccx::ccx_version(&path)?;
         self.ccx = Some(path);
         Ok(version)
+    }
+
+    fn engine(&self) -> &'static str {
+        "ccx"
     }
 
     fn solve(&self, job: &Job<'_>) -> std::result::Result<Solved, SolveFailure> {
@@ -157,6 +179,11 @@ impl Backend for CcxBackend {
             iterations: r.sta.iterations,
             first_increment,
             retry: None,
+            element: "C3D8 (fully integrated hexahedron)".into(),
+            settings: format!(
+                "surface-to-surface penalty contact {} N/mm^3, friction {} (stick slope {} N/mm^3); SPOOLES, 1 thread",
+                job.campaign.contact.penalty_slope_n_per_mm3, job.campaign.contact.friction, job.campaign.contact.stick_slope_n_per_mm3
+            ),
         })
     }
 

@@ -27,14 +27,14 @@
 //! records how each CSV was made, [`report`](crate::fe::report) is the outcome and
 //! `progress` the display.
 
-use crate::fe::backend::{Backend, CcxBackend, Job, Solved, SolveFailure};
-use crate::fe::ccx;
+use crate::fe::backend::{backend_for, Backend, Job, Solved, SolveFailure};
+use crate::fe::process;
 use crate::fe::deck;
 use crate::fe::manifest::{read_manifest, manifest_text, rfc3339_utc, Manifest, ManifestEntry, MANIFEST};
 use crate::fe::progress::Progress;
 use crate::fe::report::{PoseReport, Report, Status};
 use crate::fe::results::{self, Row};
-use crate::fe::spec::{self, Campaign, MeshLevel, PoseSpec};
+use crate::fe::spec::{self, Campaign, Engine, MeshLevel, PoseSpec};
 use anyhow::{bail, Context, Result};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -47,8 +47,13 @@ use std::time::{Duration, Instant, SystemTime};
 pub struct RunOptions {
     /// The set folder, holding `campaign.toml`.
     pub set_dir: PathBuf,
-    /// Number of ccx jobs run at the same time (each on one thread); 0 counts as 1.
+    /// Number of solver jobs run at the same time; 0 counts as 1.
     pub jobs: usize,
+    /// Solver threads per job (FEBio: OpenMP threads of Pardiso and the assembly; ccx
+    /// always runs on one); 0 counts as 1.
+    pub threads: usize,
+    /// The engine instead of the spec's `[solver] engine`; part of the spec hash.
+    pub solver: Option<Engine>,
     /// Glob over pose names (`*`, `?`, `[..]`); `None`: every pose.
     pub only: Option<String>,
     /// Mesh level; `None`: `campaign.mesh` of the spec.
@@ -71,6 +76,8 @@ impl RunOptions {
         RunOptions {
             set_dir: set_dir.into(),
             jobs: 1,
+            threads: 1,
+            solver: None,
             only: None,
             mesh: None,
             steps: None,
@@ -87,7 +94,8 @@ impl RunOptions {
 /// silence is not progress.
 pub const DEFAULT_STALL: Duration = Duration::from_secs(600);
 
-/// Run the campaign with CalculiX. See the module docs.
+/// Run the campaign on its engine (`opts.solver`, else the spec's `[solver] engine`).
+/// See the module docs.
 ///
 /// # Errors
 /// The spec cannot be loaded or is invalid, the tissue fails the material check,
@@ -95,7 +103,9 @@ pub const DEFAULT_STALL: Duration = Duration::from_secs(600);
 /// ccx is missing, the manifest is corrupt or the output folder cannot be written.
 /// Failed solves are not errors: they are in the [`Report`].
 pub fn run(opts: &RunOptions) -> Result<Report> {
-    run_with(opts, &mut CcxBackend::default())
+    let (campaign, _) = spec::load(&opts.set_dir)?;
+    let engine = opts.solver.unwrap_or(campaign.solver.engine);
+    run_with(opts, backend_for(engine, opts.threads).as_mut())
 }
 
 /// Everything shared by the workers.
@@ -123,6 +133,9 @@ pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> 
         format!("{}: the tissue fails the material stability check; nothing was run", spec_path.display())
     })?;
     eprintln!("material check passed: {}", stability.to_string().replace('\n', "\n  "));
+    if let Some(engine) = opts.solver {
+        campaign.solver.engine = engine;
+    }
     if let Some(s) = opts.steps {
         if s == 0 {
             bail!("--steps 0: must be >= 1");
@@ -194,7 +207,7 @@ pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> 
             solver_version,
             manifest_lock: Mutex::new(()),
         };
-        let earlier_walls_s = manifest.wall_times_s(&mesh_name, steps);
+        let earlier_walls_s = manifest.wall_times_s(ctx.campaign.solver.engine.name(), &mesh_name, steps);
         run_workers(&ctx, &to_run, jobs, earlier_walls_s, &mut reports);
     }
     Ok(Report { poses: reports, mesh: mesh_name, steps, depth_mm: campaign.loading.depth_mm, out_dir, wall: start.elapsed() })
@@ -223,7 +236,7 @@ fn run_workers(
             let tx = tx.clone();
             let queue = &queue;
             s.spawn(move || loop {
-                if ccx::interrupted() {
+                if process::interrupted() {
                     break;
                 }
                 let next = queue.lock().map(|mut q| q.pop_front()).unwrap_or(None);
@@ -340,7 +353,7 @@ fn solve_with_retry(backend: &dyn Backend, job: &Job<'_>) -> std::result::Result
         Ok(s) => return Ok(s),
         Err(f) => f,
     };
-    if ccx::interrupted() {
+    if process::interrupted() {
         return Err(first);
     }
     let r = deck::RETRY_FIRST_INCREMENT;
@@ -371,7 +384,10 @@ fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Res
     results::write_atomic(&csv, results::to_csv(&rows).as_bytes())?;
     let entry = ManifestEntry {
         spec_hash: ctx.campaign.run_hash(pose, ctx.mesh_name),
-        ccx_version: ctx.solver_version.clone(),
+        engine: ctx.backend.engine().to_string(),
+        engine_version: ctx.solver_version.clone(),
+        element: s.element.clone(),
+        solver_settings: s.settings.clone(),
         mesh: ctx.mesh_name.to_string(),
         model: s.summary.model.clone(),
         tissue_mesh: s.summary.tissue_mesh.clone(),
@@ -437,6 +453,9 @@ mod tests {
             self.prepared += 1;
             Ok("fake-1".into())
         }
+        fn engine(&self) -> &'static str {
+            "fake"
+        }
         fn solve(&self, job: &Job<'_>) -> std::result::Result<Solved, SolveFailure> {
             self.solves.fetch_add(1, Ordering::SeqCst);
             assert!(job.work_dir.is_dir(), "work dir exists");
@@ -467,7 +486,16 @@ mod tests {
                 model: "fake".into(),
                 tissue_mesh: "fake".into(),
             };
-            Ok(Solved { wrenches, summary, increments: job.steps, iterations: 2 * job.steps, first_increment: job.first_increment, retry: None })
+            Ok(Solved {
+                wrenches,
+                summary,
+                increments: job.steps,
+                iterations: 2 * job.steps,
+                first_increment: job.first_increment,
+                retry: None,
+                element: "fake".into(),
+                settings: "fake".into(),
+            })
         }
         fn steps_done(&self, _work_dir: &Path) -> u32 {
             0
@@ -510,7 +538,7 @@ mod tests {
         let p4 = c.poses().into_iter().find(|p| p.name == "x+04").expect("x+04");
         let e = &m.pose["x+04"];
         assert_eq!(e.spec_hash, c.run_hash(&p4, "smoke"));
-        assert_eq!((e.ccx_version.as_str(), e.mesh.as_str(), e.steps, e.increments, e.iterations), ("fake-1", "smoke", 2, 2, 4));
+        assert_eq!((e.engine_version.as_str(), e.mesh.as_str(), e.steps, e.increments, e.iterations), ("fake-1", "smoke", 2, 2, 4));
         assert_eq!((e.x_mm, e.role), (4.0, Role::SweepX));
         assert_eq!(e.date.len(), "2025-01-01T00:00:00Z".len());
         assert_eq!(fake.solves.load(Ordering::SeqCst), 2);

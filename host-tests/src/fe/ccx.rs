@@ -2,18 +2,15 @@
 //! with one thread, a wall-clock timeout, and the job's `.sta` status file (increments,
 //! iterations, and the last completed step while the job runs).
 
+use crate::fe::process;
 use anyhow::{bail, Context, Result};
-use std::fmt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// Environment variable that names the `ccx` binary to use instead of the one on `PATH`.
 pub const CCX_ENV: &str = "NEEDLE_CCX";
 
-/// Number of lines of the ccx output kept for failure reports.
-pub const LOG_TAIL_LINES: usize = 25;
 
 /// Find the `ccx` binary: `$NEEDLE_CCX` if set, else the first `ccx` on `PATH`.
 ///
@@ -35,16 +32,6 @@ pub fn find_ccx() -> Result<PathBuf> {
         bail!("ccx not found: {CCX_ENV}={} is not a file", p.display());
     }
     which(Path::new("ccx")).context("ccx not found: apt-get install calculix-ccx (or set NEEDLE_CCX to the binary)")
-}
-
-fn which(name: &Path) -> Option<PathBuf> {
-    let path = std::env::var_os("PATH")?;
-    std::env::split_paths(&path).map(|d| d.join(name)).find(|p| is_executable(p))
-}
-
-fn is_executable(p: &Path) -> bool {
-    use std::os::unix::fs::PermissionsExt;
-    std::fs::metadata(p).is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
 }
 
 /// The version of a `ccx` binary, e.g. `"2.20"`, from `ccx -v` ("This is Version 2.20").
@@ -73,32 +60,8 @@ pub fn parse_version(text: &str) -> Option<String> {
     None
 }
 
-/// How a ccx process ended.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ExitKind {
-    /// Exited with this code (ccx exits 201 on input and convergence errors).
-    Code(i32),
-    /// Killed by this signal.
-    Signal(i32),
-    /// Killed by the runner because the process was asked to stop (SIGINT, SIGTERM).
-    Interrupted,
-    /// Killed by the runner after the wall-clock timeout.
-    TimedOut,
-    /// Killed by the runner: no output (log, `.sta`, `.cvg`) for this long.
-    Stalled(Duration),
-}
-
-impl fmt::Display for ExitKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            ExitKind::Code(c) => write!(f, "exit code {c}"),
-            ExitKind::Signal(s) => write!(f, "killed by signal {s}"),
-            ExitKind::Interrupted => write!(f, "interrupted (killed)"),
-            ExitKind::TimedOut => write!(f, "timed out (killed)"),
-            ExitKind::Stalled(d) => write!(f, "stalled: no output for {:.1} s (killed)", d.as_secs_f64()),
-        }
-    }
-}
+pub use crate::fe::process::{interrupted, stop_jobs_on_termination, tail, ExitKind, EXIT_INTERRUPTED, LOG_TAIL_LINES};
+use crate::fe::process::which;
 
 /// Increments and iterations of a job, from its `.sta` file.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -195,44 +158,6 @@ impl JobResult {
     }
 }
 
-/// Set once the process was asked to stop ([`stop_jobs_on_termination`]): every running
-/// [`run_job`] kills its ccx at its next poll (within 50 ms) and any new one is killed at
-/// once.
-static STOP: AtomicBool = AtomicBool::new(false);
-
-/// How long the termination handler waits for the campaign to wind down (its jobs kill
-/// their ccx within 50 ms, no new job starts) before it exits the process itself.
-const STOP_GRACE: Duration = Duration::from_secs(3);
-
-/// `true` once the process was asked to stop: callers start no new job, retry nothing,
-/// and exit with [`EXIT_INTERRUPTED`].
-pub fn interrupted() -> bool {
-    STOP.load(Ordering::SeqCst)
-}
-
-/// Exit status of a process stopped by SIGINT, SIGTERM or SIGHUP (128 + SIGINT, as a shell
-/// reports an interrupted command).
-pub const EXIT_INTERRUPTED: u8 = 130;
-
-/// On SIGINT, SIGTERM or SIGHUP: kill every running ccx job, then exit with
-/// [`EXIT_INTERRUPTED`]. Without it a `kill PID` of `needle fe run` (not of its process
-/// group) left its ccx children running as orphans for hours, writing into the work
-/// folders that a resumed campaign reuses. What was written before stays: finished poses
-/// keep their CSV and manifest entry; the interrupted pose has neither (its entry is
-/// removed before it is solved), so a rerun solves it again.
-///
-/// # Errors
-/// A handler is already installed in this process.
-pub fn stop_jobs_on_termination() -> Result<()> {
-    ctrlc::set_handler(|| {
-        STOP.store(true, Ordering::SeqCst);
-        eprintln!("needle: interrupted: stopping the running ccx jobs; finished poses are kept, a rerun resumes");
-        std::thread::sleep(STOP_GRACE);
-        std::process::exit(i32::from(EXIT_INTERRUPTED));
-    })
-    .context("cannot install the SIGINT/SIGTERM handler")
-}
-
 /// Run `ccx -i <job>` in `work_dir` (which holds `<job>.inp`) on one thread
 /// (`OMP_NUM_THREADS=1`, `CCX_NPROC_*=1`), stdout and stderr to `<job>.log` in the same
 /// folder. With a `timeout`, the process is killed when it runs longer (wall clock); with
@@ -258,60 +183,17 @@ pub fn run_job(
     if spooles_path.exists() {
         std::fs::remove_file(&spooles_path).with_context(|| format!("{}: cannot remove the earlier attempt's", spooles_path.display()))?;
     }
-    let log = std::fs::File::create(&log_path).with_context(|| format!("{}: cannot create", log_path.display()))?;
-    let log_err = log.try_clone().with_context(|| format!("{}: cannot reopen", log_path.display()))?;
-    let start = Instant::now();
-    let mut child = Command::new(ccx)
-        .arg("-i")
+    let mut cmd = Command::new(ccx);
+    cmd.arg("-i")
         .arg(job)
-        .current_dir(work_dir)
         .env("OMP_NUM_THREADS", "1")
         .env("CCX_NPROC_EQUATION_SOLVER", "1")
         .env("CCX_NPROC_STIFFNESS", "1")
-        .env("CCX_NPROC_RESULTS", "1")
-        .stdin(Stdio::null())
-        .stdout(log)
-        .stderr(log_err)
-        .spawn()
-        .with_context(|| format!("{}: cannot start ccx in {}", ccx.display(), work_dir.display()))?;
-    let progress_files = [log_path.clone(), sta_path(work_dir, job), work_dir.join(format!("{job}.cvg"))];
-    let output_bytes = || -> u64 { progress_files.iter().filter_map(|p| std::fs::metadata(p).ok()).map(|m| m.len()).sum() };
-    let (mut last_bytes, mut last_change) = (0u64, Instant::now());
-    let exit = loop {
-        if let Some(status) = child.try_wait().context("cannot wait for ccx")? {
-            use std::os::unix::process::ExitStatusExt;
-            break match (status.code(), status.signal()) {
-                (Some(c), _) => ExitKind::Code(c),
-                (None, Some(s)) => ExitKind::Signal(s),
-                (None, None) => ExitKind::Code(-1),
-            };
-        }
-        if interrupted() {
-            let _ = child.kill();
-            let _ = child.wait();
-            break ExitKind::Interrupted;
-        }
-        if timeout.is_some_and(|t| start.elapsed() > t) {
-            // the process may have exited just now: kill errors are not interesting
-            let _ = child.kill();
-            let _ = child.wait();
-            break ExitKind::TimedOut;
-        }
-        if let Some(limit) = stall {
-            let bytes = output_bytes();
-            if bytes != last_bytes {
-                (last_bytes, last_change) = (bytes, Instant::now());
-            } else if last_change.elapsed() > limit {
-                let _ = child.kill();
-                let _ = child.wait();
-                break ExitKind::Stalled(limit);
-            }
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    };
-    let wall = start.elapsed();
+        .env("CCX_NPROC_RESULTS", "1");
+    let progress_files = [sta_path(work_dir, job), work_dir.join(format!("{job}.cvg"))];
+    let done = process::run(cmd, work_dir, &log_path, &progress_files, timeout, stall)?;
+    let (exit, wall, log_text, log_path) = (done.exit, done.wall, done.log_text, done.log_path);
     let sta = std::fs::read_to_string(sta_path(work_dir, job)).map(|t| parse_sta(&t)).unwrap_or_default();
-    let log_text = std::fs::read(&log_path).map(|b| String::from_utf8_lossy(&b).into_owned()).unwrap_or_default();
     let mut log_tail = tail(&log_text, LOG_TAIL_LINES);
     // SPOOLES reports a singular matrix in its own file, not on stdout (ccx then exits 255)
     let spooles = std::fs::read_to_string(&spooles_path).unwrap_or_default();
@@ -330,12 +212,6 @@ pub fn stated_cause(log_text: &str, spooles: &str) -> Option<String> {
     last(spooles, |l| !l.is_empty()).or_else(|| last(log_text, |l| l.contains("*ERROR")))
 }
 
-/// The last `n` non-blank-trailing lines of `text`.
-pub fn tail(text: &str, n: usize) -> String {
-    let lines: Vec<&str> = text.trim_end().lines().collect();
-    lines[lines.len().saturating_sub(n)..].join("\n")
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -346,11 +222,6 @@ mod tests {
         assert_eq!(parse_version("nothing"), None);
     }
 
-    #[test]
-    fn tail_lines() {
-        assert_eq!(tail("a\nb\nc\n\n", 2), "b\nc");
-        assert_eq!(tail("a", 5), "a");
-    }
 
     /// A stand-in for ccx (a shell script): `silent` writes a line then sleeps silently.
     fn fake_ccx(dir: &Path, body: &str) -> PathBuf {
@@ -365,7 +236,7 @@ mod tests {
     fn a_silent_job_is_killed_as_stalled_and_a_talking_one_is_not() {
         let d = tempfile::tempdir().expect("tempdir");
         let silent = fake_ccx(d.path(), "echo started; sleep 30");
-        let start = Instant::now();
+        let start = std::time::Instant::now();
         let r = run_job(&silent, d.path(), "job", None, Some(Duration::from_millis(700))).expect("run");
         assert_eq!(r.exit, ExitKind::Stalled(Duration::from_millis(700)));
         assert!(start.elapsed() < Duration::from_secs(10), "killed long before the script's 30 s");

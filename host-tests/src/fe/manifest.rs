@@ -27,8 +27,20 @@ pub struct Manifest {
 pub struct ManifestEntry {
     /// [`Campaign::run_hash`](crate::fe::spec::Campaign::run_hash) of the spec (with the steps actually run), pose and mesh.
     pub spec_hash: String,
-    /// Version of ccx that solved it, e.g. "2.20".
-    pub ccx_version: String,
+    /// The engine that solved it: "ccx" or "febio" (entries written before there were
+    /// two engines have none: ccx).
+    #[serde(default = "ccx")]
+    pub engine: String,
+    /// Version of that engine, e.g. "2.20" (ccx) or "4.11.0" (febio); read from the
+    /// older key `ccx_version` too.
+    #[serde(alias = "ccx_version")]
+    pub engine_version: String,
+    /// The tissue element and formulation (empty in entries from before it was recorded).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub element: String,
+    /// The solver settings of the run, one line (empty in entries from before).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub solver_settings: String,
     /// Mesh level name.
     pub mesh: String,
     /// The model solved, e.g. "half, mirror plane z = 0".
@@ -99,18 +111,22 @@ impl Manifest {
 }
 
 impl Manifest {
-    /// Wall times in s of the recorded runs on mesh level `mesh_name` with `steps` load
+    /// Wall times in s of the recorded runs of `engine` on mesh level `mesh_name` with `steps` load
     /// steps, by model (e.g. "full block, no mirror plane"), for the ETA of a campaign.
     /// Any spec hash counts: a spec change rarely changes the cost much.
-    pub fn wall_times_s(&self, mesh_name: &str, steps: u32) -> BTreeMap<String, Vec<f64>> {
+    pub fn wall_times_s(&self, engine: &str, mesh_name: &str, steps: u32) -> BTreeMap<String, Vec<f64>> {
         let mut by_model: BTreeMap<String, Vec<f64>> = BTreeMap::new();
         for e in self.pose.values() {
-            if e.mesh == mesh_name && e.steps == steps && e.wall_s.is_finite() && e.wall_s > 0.0 {
+            if e.engine == engine && e.mesh == mesh_name && e.steps == steps && e.wall_s.is_finite() && e.wall_s > 0.0 {
                 by_model.entry(e.model.clone()).or_default().push(e.wall_s);
             }
         }
         by_model
     }
+}
+
+fn ccx() -> String {
+    "ccx".into()
 }
 
 /// Read a manifest; a missing file is an empty manifest.

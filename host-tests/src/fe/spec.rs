@@ -35,6 +35,9 @@ pub struct Campaign {
     pub mesh: BTreeMap<String, MeshLevel>,
     /// Campaign-wide settings.
     pub campaign: CampaignSettings,
+    /// The FE engine and its settings; absent: CalculiX with the deck's fixed settings.
+    #[serde(default)]
+    pub solver: Solver,
     /// The named poses as written (the Latin hypercube poses are added by [`Campaign::poses`]).
     #[serde(rename = "pose", default)]
     pub pose: Vec<PoseSpec>,
@@ -159,6 +162,168 @@ pub struct MeshLevel {
     pub needle_facets_per_quarter: u32,
     /// Needle layer length near the tip, mm.
     pub needle_axial_mm: f64,
+}
+
+/// The FE engines a campaign can run on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, PartialOrd, Ord)]
+#[serde(rename_all = "kebab-case")]
+pub enum Engine {
+    /// CalculiX `ccx` (Debian `calculix-ccx`): C3D8 tissue, penalty contact.
+    #[default]
+    Ccx,
+    /// FEBio 4 `febio4`: three-field hex8 tissue, rigid-body needle, sliding-elastic contact.
+    Febio,
+}
+
+impl Engine {
+    /// The name used in campaign.toml, on the command line and in the manifest.
+    pub fn name(self) -> &'static str {
+        match self {
+            Engine::Ccx => "ccx",
+            Engine::Febio => "febio",
+        }
+    }
+
+    /// Parse a name as written in campaign.toml or after `--solver`.
+    ///
+    /// # Errors
+    /// Not one of `ccx`, `febio`.
+    pub fn parse(name: &str) -> Result<Self> {
+        match name {
+            "ccx" => Ok(Engine::Ccx),
+            "febio" => Ok(Engine::Febio),
+            other => bail!("solver {other:?}: must be \"febio\" or \"ccx\""),
+        }
+    }
+}
+
+/// `[solver]`: which engine solves the campaign and that engine's settings. Everything
+/// here is part of the spec hash of a FEBio run (a ccx run hashes as before the section
+/// existed, so that ccx results stay current).
+#[derive(Debug, Clone, Default, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Solver {
+    /// The engine of the campaign; `needle fe run --solver` overrides it per run.
+    #[serde(default)]
+    pub engine: Engine,
+    /// Settings of the FEBio engine (ignored by ccx).
+    #[serde(default)]
+    pub febio: FebioSettings,
+}
+
+/// `[solver.febio]`: the FEBio model's numerical settings (the physics, friction
+/// included, is in the other sections). Defaults are the campaign's verified choice;
+/// `coeffs/default/campaign.toml` says why.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct FebioSettings {
+    /// FEBio contact type: "sliding-elastic" (or "sliding-facet-on-facet",
+    /// "sliding-node-on-facet").
+    pub contact: String,
+    /// Which surface is the contact's primary (FEBio's former "slave"): "tissue" or "needle".
+    pub primary: String,
+    /// Augmented Lagrangian enforcement (FEBio `laugon` = AUGLAG) instead of a pure penalty.
+    pub augmented: bool,
+    /// Penalty factor (with `auto_penalty`: a multiplier of FEBio's modulus-based
+    /// estimate; without: N/mm^3).
+    pub penalty: f64,
+    /// Scale `penalty` by FEBio's estimate from the tissue's modulus and element size.
+    pub auto_penalty: bool,
+    /// Relative tolerance of the augmentations (`tolerance`), when `augmented`.
+    pub aug_tolerance: f64,
+    /// Gap tolerance of the augmentations (`gaptol`), mm; 0: off.
+    pub gap_tolerance_mm: f64,
+    /// Most augmentations per time step.
+    pub max_aug: u32,
+    /// Two-pass contact (each surface is primary once).
+    pub two_pass: bool,
+    /// Projection search tolerance (`search_tol`, parametric).
+    pub search_tol: f64,
+    /// Search radius of the projection, mm (`search_radius`).
+    pub search_radius_mm: f64,
+    /// Quasi-Newton updates between stiffness reformations (0: full Newton).
+    pub max_ups: u32,
+    /// Most stiffness reformations per time step.
+    pub max_refs: u32,
+    /// Optimal Newton iterations of the automatic time stepper.
+    pub opt_iter: u32,
+    /// Retries with a smaller time step before FEBio gives up.
+    pub max_retries: u32,
+    /// Smallest automatic time step, as a fraction of one load step.
+    pub dtmin_fraction: f64,
+    /// Displacement convergence tolerance (`dtol`).
+    pub dtol: f64,
+    /// Energy convergence tolerance (`etol`).
+    pub etol: f64,
+    /// Residual convergence tolerance (`rtol`; 0: off).
+    pub rtol: f64,
+    /// Line search tolerance (`lstol`; 0: off).
+    pub lstol: f64,
+}
+
+impl Default for FebioSettings {
+    fn default() -> Self {
+        FebioSettings {
+            contact: "sliding-elastic".into(),
+            primary: "tissue".into(),
+            augmented: true,
+            penalty: 1.0,
+            auto_penalty: true,
+            aug_tolerance: 0.1,
+            gap_tolerance_mm: 0.0,
+            max_aug: 10,
+            two_pass: false,
+            search_tol: 0.01,
+            search_radius_mm: 1.0,
+            max_ups: 0,
+            max_refs: 15,
+            opt_iter: 10,
+            max_retries: 8,
+            dtmin_fraction: 1e-3,
+            dtol: 1e-3,
+            etol: 1e-2,
+            rtol: 0.0,
+            lstol: 0.9,
+        }
+    }
+}
+
+impl FebioSettings {
+    fn validate(&self, path: &Path) -> Result<()> {
+        let p = path.display();
+        const CONTACTS: [&str; 3] = ["sliding-elastic", "sliding-facet-on-facet", "sliding-node-on-facet"];
+        if !CONTACTS.contains(&self.contact.as_str()) {
+            bail!("{p}: solver.febio.contact = {:?}: must be one of {}", self.contact, CONTACTS.join(", "));
+        }
+        if !matches!(self.primary.as_str(), "tissue" | "needle") {
+            bail!("{p}: solver.febio.primary = {:?}: must be \"tissue\" or \"needle\"", self.primary);
+        }
+        for (name, v) in [
+            ("penalty", self.penalty),
+            ("aug_tolerance", self.aug_tolerance),
+            ("search_tol", self.search_tol),
+            ("search_radius_mm", self.search_radius_mm),
+            ("dtmin_fraction", self.dtmin_fraction),
+            ("dtol", self.dtol),
+            ("etol", self.etol),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                bail!("{p}: solver.febio.{name} = {v}: must be finite and > 0");
+            }
+        }
+        for (name, v) in [("gap_tolerance_mm", self.gap_tolerance_mm), ("rtol", self.rtol), ("lstol", self.lstol)] {
+            if !(v.is_finite() && v >= 0.0) {
+                bail!("{p}: solver.febio.{name} = {v}: must be finite and >= 0");
+            }
+        }
+        if self.dtmin_fraction > 1.0 {
+            bail!("{p}: solver.febio.dtmin_fraction = {}: must be <= 1 (a fraction of one load step)", self.dtmin_fraction);
+        }
+        if self.max_refs == 0 || self.opt_iter == 0 {
+            bail!("{p}: solver.febio.max_refs and opt_iter must be >= 1");
+        }
+        Ok(())
+    }
 }
 
 /// `[campaign]`
@@ -384,6 +549,7 @@ impl Campaign {
                 self.mesh.keys().cloned().collect::<Vec<_>>().join(", ")
             );
         }
+        self.solver.febio.validate(path)?;
         let mut seen = std::collections::BTreeSet::new();
         for pose in &self.pose {
             check_pose(pose, &p.to_string())?;
@@ -472,6 +638,8 @@ impl Campaign {
             mesh: Option<&'a MeshLevel>,
             pose: &'a PoseSpec,
             generator: u32,
+            #[serde(skip_serializing_if = "Option::is_none")]
+            solver: Option<&'a Solver>,
         }
         let key = Key {
             tissue: &self.tissue,
@@ -482,7 +650,11 @@ impl Campaign {
             mesh_name,
             mesh: self.mesh.get(mesh_name),
             pose,
-            generator: crate::fe::deck::GENERATOR_VERSION,
+            generator: match self.solver.engine {
+                Engine::Ccx => crate::fe::deck::GENERATOR_VERSION,
+                Engine::Febio => crate::fe::febio::GENERATOR_VERSION,
+            },
+            solver: (self.solver.engine != Engine::Ccx).then_some(&self.solver),
         };
         let json = serde_json::to_string(&key).unwrap_or_default();
         hex(&Sha256::digest(json.as_bytes()))

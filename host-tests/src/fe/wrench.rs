@@ -12,7 +12,7 @@
 //! doubles Fy, Fz, Mx and zeroes Fx, My, Mz.
 
 use super::deck::Deck;
-use super::spec::{Campaign, PoseSpec};
+use super::spec::{Campaign, PoseSpec, Symmetry};
 use anyhow::{bail, Result};
 use std::collections::HashMap;
 
@@ -41,20 +41,26 @@ pub fn reduce(deck: &Deck, _pose: &PoseSpec, _c: &Campaign, rf: &[(u32, [f64; 3]
         w[4] += r[2] * f[0] - r[0] * f[2];
         w[5] += r[0] * f[1] - r[1] * f[0];
     }
-    // expand mirror models: factor per component
+    Ok(expand_mirrors(w, deck.symmetry))
+}
+
+/// The wrench on the whole needle from the wrench `w` on the modelled part of a mirror
+/// model: plane z = 0 doubles Fx, Fy, Mz and zeroes Fz, Mx, My; plane x = 0 doubles Fy,
+/// Fz, Mx and zeroes Fx, My, Mz (the components odd under a mirror vanish exactly).
+pub fn expand_mirrors(mut w: [f64; 6], sym: Symmetry) -> [f64; 6] {
     let mut k = [1.0f64; 6];
-    if deck.symmetry.plane_z {
+    if sym.plane_z {
         for (i, f) in [2.0, 2.0, 0.0, 0.0, 0.0, 2.0].iter().enumerate() {
             k[i] *= f;
         }
     }
-    if deck.symmetry.plane_x {
+    if sym.plane_x {
         for (i, f) in [0.0, 2.0, 2.0, 2.0, 0.0, 0.0].iter().enumerate() {
             k[i] *= f;
         }
     }
-    for i in 0..6 {
-        w[i] *= k[i];
+    for (v, f) in w.iter_mut().zip(k) {
+        *v *= f;
     }
-    Ok(w)
+    w
 }

@@ -1,0 +1,189 @@
+//! Running one FE solver process (any engine): a wall-clock timeout, a stall limit on its
+//! output files, and the process-wide stop on SIGINT/SIGTERM/SIGHUP that kills every
+//! running solver. The engines (`ccx`, `febio`) build the command; this runs it.
+
+use anyhow::{Context, Result};
+use std::fmt;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+/// Number of lines of a solver's output kept for failure reports.
+pub const LOG_TAIL_LINES: usize = 25;
+
+/// How a solver process ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExitKind {
+    /// Exited with this code (ccx exits 201 on input and convergence errors).
+    Code(i32),
+    /// Killed by this signal.
+    Signal(i32),
+    /// Killed by the runner because the process was asked to stop (SIGINT, SIGTERM).
+    Interrupted,
+    /// Killed by the runner after the wall-clock timeout.
+    TimedOut,
+    /// Killed by the runner: none of its output files grew for this long.
+    Stalled(Duration),
+}
+
+impl fmt::Display for ExitKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ExitKind::Code(c) => write!(f, "exit code {c}"),
+            ExitKind::Signal(s) => write!(f, "killed by signal {s}"),
+            ExitKind::Interrupted => write!(f, "interrupted (killed)"),
+            ExitKind::TimedOut => write!(f, "timed out (killed)"),
+            ExitKind::Stalled(d) => write!(f, "stalled: no output for {:.1} s (killed)", d.as_secs_f64()),
+        }
+    }
+}
+
+/// Set once the process was asked to stop ([`stop_jobs_on_termination`]): every running
+/// [`run`] kills its solver at its next poll (within 50 ms) and any new one is killed at
+/// once.
+static STOP: AtomicBool = AtomicBool::new(false);
+
+/// How long the termination handler waits for the campaign to wind down (its jobs kill
+/// their solvers within 50 ms, no new job starts) before it exits the process itself.
+const STOP_GRACE: Duration = Duration::from_secs(3);
+
+/// `true` once the process was asked to stop: callers start no new job, retry nothing,
+/// and exit with [`EXIT_INTERRUPTED`].
+pub fn interrupted() -> bool {
+    STOP.load(Ordering::SeqCst)
+}
+
+/// Exit status of a process stopped by SIGINT, SIGTERM or SIGHUP (128 + SIGINT, as a shell
+/// reports an interrupted command).
+pub const EXIT_INTERRUPTED: u8 = 130;
+
+/// On SIGINT, SIGTERM or SIGHUP: kill every running solver job, then exit with
+/// [`EXIT_INTERRUPTED`]. Without it a `kill PID` of `needle fe run` (not of its process
+/// group) left its solver children running as orphans for hours, writing into the work
+/// folders that a resumed campaign reuses. What was written before stays: finished poses
+/// keep their CSV and manifest entry; the interrupted pose keeps its earlier result, if
+/// any, and is solved again by a rerun.
+///
+/// # Errors
+/// A handler is already installed in this process.
+pub fn stop_jobs_on_termination() -> Result<()> {
+    ctrlc::set_handler(|| {
+        STOP.store(true, Ordering::SeqCst);
+        eprintln!("needle: interrupted: stopping the running solver jobs; finished poses are kept, a rerun resumes");
+        std::thread::sleep(STOP_GRACE);
+        std::process::exit(i32::from(EXIT_INTERRUPTED));
+    })
+    .context("cannot install the SIGINT/SIGTERM handler")
+}
+
+/// The outcome of one solver process.
+#[derive(Debug, Clone)]
+pub struct Finished {
+    /// How the process ended.
+    pub exit: ExitKind,
+    /// Wall-clock time of the process.
+    pub wall: Duration,
+    /// The file holding the process's stdout and stderr.
+    pub log_path: PathBuf,
+    /// The whole log (lossy UTF-8).
+    pub log_text: String,
+}
+
+/// Run `cmd` (program, arguments, environment already set) in `work_dir`, stdin from
+/// /dev/null, stdout and stderr to `log_path`. With a `timeout` the process is killed when
+/// it runs longer (wall clock); with a `stall` limit, when none of `log_path` and
+/// `progress_files` has grown for that long (a solver spinning without output is a
+/// failed run, not a slow one). Polls every 50 ms; kills the process on [`interrupted`].
+///
+/// # Errors
+/// The log file cannot be created, or the process cannot be started or waited for. A
+/// process that starts and then fails is not an error: see [`Finished::exit`].
+pub fn run(
+    mut cmd: Command,
+    work_dir: &Path,
+    log_path: &Path,
+    progress_files: &[PathBuf],
+    timeout: Option<Duration>,
+    stall: Option<Duration>,
+) -> Result<Finished> {
+    let log = std::fs::File::create(log_path).with_context(|| format!("{}: cannot create", log_path.display()))?;
+    let log_err = log.try_clone().with_context(|| format!("{}: cannot reopen", log_path.display()))?;
+    let program = cmd.get_program().to_string_lossy().into_owned();
+    let start = Instant::now();
+    let mut child = cmd
+        .current_dir(work_dir)
+        .stdin(Stdio::null())
+        .stdout(log)
+        .stderr(log_err)
+        .spawn()
+        .with_context(|| format!("{program}: cannot start in {}", work_dir.display()))?;
+    let mut watched = vec![log_path.to_path_buf()];
+    watched.extend_from_slice(progress_files);
+    let output_bytes = || -> u64 { watched.iter().filter_map(|p| std::fs::metadata(p).ok()).map(|m| m.len()).sum() };
+    let (mut last_bytes, mut last_change) = (0u64, Instant::now());
+    let exit = loop {
+        if let Some(status) = child.try_wait().with_context(|| format!("cannot wait for {program}"))? {
+            use std::os::unix::process::ExitStatusExt;
+            break match (status.code(), status.signal()) {
+                (Some(c), _) => ExitKind::Code(c),
+                (None, Some(s)) => ExitKind::Signal(s),
+                (None, None) => ExitKind::Code(-1),
+            };
+        }
+        if interrupted() {
+            let _ = child.kill();
+            let _ = child.wait();
+            break ExitKind::Interrupted;
+        }
+        if timeout.is_some_and(|t| start.elapsed() > t) {
+            // the process may have exited just now: kill errors are not interesting
+            let _ = child.kill();
+            let _ = child.wait();
+            break ExitKind::TimedOut;
+        }
+        if let Some(limit) = stall {
+            let bytes = output_bytes();
+            if bytes != last_bytes {
+                (last_bytes, last_change) = (bytes, Instant::now());
+            } else if last_change.elapsed() > limit {
+                let _ = child.kill();
+                let _ = child.wait();
+                break ExitKind::Stalled(limit);
+            }
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let wall = start.elapsed();
+    let log_text = std::fs::read(log_path).map(|b| String::from_utf8_lossy(&b).into_owned()).unwrap_or_default();
+    Ok(Finished { exit, wall, log_path: log_path.to_path_buf(), log_text })
+}
+
+/// The last `n` lines of `text`, trailing blank lines dropped.
+pub fn tail(text: &str, n: usize) -> String {
+    let lines: Vec<&str> = text.trim_end().lines().collect();
+    lines[lines.len().saturating_sub(n)..].join("\n")
+}
+
+/// The first executable file called `name` on `PATH`.
+pub fn which(name: &Path) -> Option<PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path).map(|d| d.join(name)).find(|p| is_executable(p))
+}
+
+/// Whether `p` is a file with an execute bit.
+pub fn is_executable(p: &Path) -> bool {
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::metadata(p).is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tail_lines() {
+        assert_eq!(tail("a\nb\nc\n\n", 2), "b\nc");
+        assert_eq!(tail("a", 5), "a");
+    }
+}
