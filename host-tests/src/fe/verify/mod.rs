@@ -10,6 +10,7 @@
 mod mesh_check;
 mod mirror;
 pub mod punch;
+pub mod punch_febio;
 
 pub use mesh_check::MeshReport;
 pub use mirror::MirrorReport;
@@ -80,7 +81,7 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
         let p = punch::punch(&c, &work, opts)?;
         println!(
             "flat punch a = {} mm, delta = {} mm, nu = {:.4}, {}: F(block) = {:.5e} N, F(2x block) = {:.5e} N, \
-             F(half-space, extrapolated) = {:.5e} N, Sneddon {:.5e} N: error {:+.2}% (goal within {}%); ccx {:.0} s + {:.0} s",
+             F(half-space, extrapolated) = {:.5e} N, Sneddon {:.5e} N: error {:+.2}% (goal within {}%); {} {:.0} s + {:.0} s",
             p.radius_mm,
             p.delta_mm,
             p.nu,
@@ -91,6 +92,7 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
             p.force_sneddon_n,
             p.check.error_percent,
             p.goal_percent,
+            p.solver,
             p.check.wall_s[0],
             p.check.wall_s[1]
         );
