@@ -39,6 +39,8 @@ fn coarse_flat_punch_matches_sneddon() {
         work_dir: None,
         punch_mesh_scale: 2.0,
         punch_campaign_element: false,
+        threads: 1,
+        engine: Some(spec::Engine::Ccx),
     };
     let (r, ok) = verify::run(&opts).unwrap_or_else(|e| panic!("{e:#}"));
     let p = r.punch.expect("a punch report");

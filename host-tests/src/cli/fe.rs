@@ -57,6 +57,10 @@ pub struct RunArgs {
     /// Rerun the selected poses even when their results are up to date.
     #[arg(long)]
     pub force: bool,
+    /// Keep the work folder (<out>/.work/<pose>: solver input and logs) of successful
+    /// runs too; failed runs always keep theirs.
+    #[arg(long)]
+    pub keep_work: bool,
     /// Wall-clock limit of one ccx job, in seconds; a job running longer is killed and
     /// reported failed.
     #[arg(long, value_name = "S")]
@@ -75,7 +79,7 @@ pub struct VerifyArgs {
     /// Run the flat-punch check (Sneddon, goal 5%).
     #[arg(long)]
     pub punch: bool,
-    /// Run the mesh-convergence check (Fy at full depth, committed mesh against fine, goal 2%).
+    /// Run the mesh-convergence check (Fy at full depth on the levels of campaign.mesh_study: committed level against its 2x refinement, goal 2%; Richardson estimate).
     #[arg(long)]
     pub mesh: bool,
     /// Check the mirror runs against their counterparts (goal 1% of peak |Fy|).
@@ -92,6 +96,12 @@ pub struct VerifyArgs {
     /// Work folder for the solves; default: <set>/fe/.work/verify.
     #[arg(long, value_name = "DIR")]
     pub work: Option<PathBuf>,
+    /// Solver threads of each solve (FEBio); default: all cores.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub threads: Option<u32>,
+    /// FE engine of the checks instead of campaign.toml's [solver] engine: febio or ccx.
+    #[arg(long, value_name = "ENGINE", value_parser = ["febio", "ccx"])]
+    pub solver: Option<String>,
 }
 
 /// Run an `fe` subcommand.
@@ -127,6 +137,7 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
         steps: a.steps,
         out_dir: a.out,
         force: a.force,
+        keep_work: a.keep_work,
         timeout,
         stall: Some(Duration::from_secs_f64(a.stall_s)),
     };
@@ -152,6 +163,8 @@ fn run_verify(a: VerifyArgs) -> anyhow::Result<ExitCode> {
         work_dir: a.work,
         punch_mesh_scale: a.punch_mesh_scale,
         punch_campaign_element: !a.no_campaign_element,
+        threads: a.threads.map(|t| t as usize).unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)),
+        engine: a.solver.as_deref().map(crate::fe::spec::Engine::parse).transpose()?,
     };
     crate::fe::process::stop_jobs_on_termination()?;
     let (_, ok) = crate::fe::verify::run(&opts)?;

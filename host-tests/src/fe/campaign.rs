@@ -54,6 +54,8 @@ pub struct RunOptions {
     pub threads: usize,
     /// The engine instead of the spec's `[solver] engine`; part of the spec hash.
     pub solver: Option<Engine>,
+    /// Keep the work folder of a successful run too (inputs and solver logs, for study).
+    pub keep_work: bool,
     /// Glob over pose names (`*`, `?`, `[..]`); `None`: every pose.
     pub only: Option<String>,
     /// Mesh level; `None`: `campaign.mesh` of the spec.
@@ -78,6 +80,7 @@ impl RunOptions {
             jobs: 1,
             threads: 1,
             solver: None,
+            keep_work: false,
             only: None,
             mesh: None,
             steps: None,
@@ -120,6 +123,7 @@ struct Ctx<'a> {
     backend: &'a dyn Backend,
     solver_version: String,
     manifest_lock: Mutex<()>,
+    keep_work: bool,
 }
 
 /// [`run`] with a given solver backend (tests use a fake one).
@@ -206,6 +210,7 @@ pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> 
             backend,
             solver_version,
             manifest_lock: Mutex::new(()),
+            keep_work: opts.keep_work,
         };
         let earlier_walls_s = manifest.wall_times_s(ctx.campaign.solver.engine.name(), &mesh_name, steps);
         run_workers(&ctx, &to_run, jobs, earlier_walls_s, &mut reports);
@@ -333,7 +338,9 @@ fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
     match write_results(ctx, pose, &solved, wall_s) {
         Ok(fy) => {
             // the work folder is only for debugging failed runs; a leftover is harmless
-            let _ = std::fs::remove_dir_all(&wd);
+            if !ctx.keep_work {
+                let _ = std::fs::remove_dir_all(&wd);
+            }
             PoseReport {
                 pose: pose.name.clone(),
                 status: Status::Done,

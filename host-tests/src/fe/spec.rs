@@ -342,6 +342,11 @@ pub struct CampaignSettings {
     /// model.toml names what was left out.
     #[serde(default)]
     pub fit_without: Vec<String>,
+    /// Mesh levels of `needle fe verify --mesh`, coarse to fine, each a 2x refinement of
+    /// the one before; the committed level (`mesh`) must be followed by its refinement.
+    /// Empty: `[mesh, "fine"]`.
+    #[serde(default)]
+    pub mesh_study: Vec<String>,
 }
 
 /// What a pose is for.
@@ -550,6 +555,11 @@ impl Campaign {
             );
         }
         self.solver.febio.validate(path)?;
+        for level in &self.campaign.mesh_study {
+            if !self.mesh.contains_key(level) {
+                bail!("{p}: campaign.mesh_study: no [mesh.{level}] level");
+            }
+        }
         let mut seen = std::collections::BTreeSet::new();
         for pose in &self.pose {
             check_pose(pose, &p.to_string())?;
@@ -609,6 +619,16 @@ impl Campaign {
             });
         }
         out
+    }
+
+    /// The levels of the mesh study (`campaign.mesh_study`, or the committed level and
+    /// `fine` when it is empty).
+    pub fn mesh_study(&self) -> Vec<String> {
+        if self.campaign.mesh_study.is_empty() {
+            vec![self.campaign.mesh.clone(), "fine".to_string()]
+        } else {
+            self.campaign.mesh_study.clone()
+        }
     }
 
     /// The mesh level named `name`.

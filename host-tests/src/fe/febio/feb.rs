@@ -246,9 +246,12 @@ fn write_mesh(w: &mut String, t: &TissueMesh, n: &NeedleMesh, needle0: usize, ne
         ids(w, set.iter().map(|i| i + 1));
         let _ = writeln!(w, "    </NodeSet>");
     }
+    // FACES lists each face's nodes the Abaqus way, whose right-hand normal points into
+    // the element; FEBio takes a facet's right-hand normal as its outward normal, so the
+    // order is reversed.
     let face = |e: usize, f: u8, nodes: &[[usize; 8]], off: usize| -> String {
         let el = nodes[e];
-        let v: Vec<String> = FACES[usize::from(f - 1)].iter().map(|&k| (off + el[k] + 1).to_string()).collect();
+        let v: Vec<String> = FACES[usize::from(f - 1)].iter().rev().map(|&k| (off + el[k] + 1).to_string()).collect();
         v.join(",")
     };
     let _ = writeln!(w, r#"    <Surface name="tissue_top">"#);

@@ -119,7 +119,7 @@ impl FebioBackend {
 /// contact forces the needle's nodes receive in the residual) into the wrench the tissue
 /// exerts on the needle. Checked by `tests/fe_febio.rs` (Fy > 0: the tissue pushes the
 /// needle back up).
-pub const REACTION_SIGN: f64 = 1.0;
+pub const REACTION_SIGN: f64 = -1.0;
 
 impl Backend for FebioBackend {
     fn prepare(&mut self) -> Result<String> {
