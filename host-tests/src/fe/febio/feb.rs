@@ -145,9 +145,12 @@ pub fn write_with_symmetry(
 
 fn write_control(w: &mut String, s: &FebioSettings, depth: f64, steps: u32, dt_fraction: f64) {
     let dt = depth / f64::from(steps);
+    // FEBio ends at time_steps * step_size: keep that the insertion depth when the first
+    // step is a fraction of a load step (the automatic stepper then grows it to dt)
+    let time_steps = (f64::from(steps) / dt_fraction).round().max(1.0) as u64;
     let _ = writeln!(w, "  <Control>");
     let _ = writeln!(w, "    <analysis>STATIC</analysis>");
-    let _ = writeln!(w, "    <time_steps>{}</time_steps>", steps);
+    let _ = writeln!(w, "    <time_steps>{time_steps}</time_steps>");
     let _ = writeln!(w, "    <step_size>{}</step_size>", num(dt * dt_fraction));
     let _ = writeln!(w, "    <plot_zero_state>0</plot_zero_state>");
     let _ = writeln!(w, "    <plot_level>PLOT_NEVER</plot_level>");
