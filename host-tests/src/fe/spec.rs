@@ -251,7 +251,7 @@ pub struct FebioSettings {
     pub max_retries: u32,
     /// Smallest automatic time step, as a fraction of one load step.
     pub dtmin_fraction: f64,
-    /// Displacement convergence tolerance (`dtol`).
+    /// Displacement convergence tolerance (`dtol`; 0: off).
     pub dtol: f64,
     /// Energy convergence tolerance (`etol`).
     pub etol: f64,
@@ -259,6 +259,13 @@ pub struct FebioSettings {
     pub rtol: f64,
     /// Line search tolerance (`lstol`; 0: off).
     pub lstol: f64,
+    /// `dtol` of the campaign's retry of a failed run (0: off). Seen on the committed
+    /// mesh: a contact point chattering by a few micrometres keeps the displacement norm
+    /// from converging (x+06, "max nr of reformations") while energy and residual have;
+    /// the retry then judges convergence by energy and residual.
+    pub retry_dtol: f64,
+    /// `rtol` of the retry.
+    pub retry_rtol: f64,
 }
 
 impl Default for FebioSettings {
@@ -284,6 +291,8 @@ impl Default for FebioSettings {
             etol: 1e-2,
             rtol: 0.0,
             lstol: 0.9,
+            retry_dtol: 0.0,
+            retry_rtol: 1e-3,
         }
     }
 }
@@ -304,14 +313,20 @@ impl FebioSettings {
             ("search_tol", self.search_tol),
             ("search_radius_mm", self.search_radius_mm),
             ("dtmin_fraction", self.dtmin_fraction),
-            ("dtol", self.dtol),
             ("etol", self.etol),
         ] {
             if !(v.is_finite() && v > 0.0) {
                 bail!("{p}: solver.febio.{name} = {v}: must be finite and > 0");
             }
         }
-        for (name, v) in [("gap_tolerance_mm", self.gap_tolerance_mm), ("rtol", self.rtol), ("lstol", self.lstol)] {
+        for (name, v) in [
+            ("gap_tolerance_mm", self.gap_tolerance_mm),
+            ("dtol", self.dtol),
+            ("rtol", self.rtol),
+            ("lstol", self.lstol),
+            ("retry_dtol", self.retry_dtol),
+            ("retry_rtol", self.retry_rtol),
+        ] {
             if !(v.is_finite() && v >= 0.0) {
                 bail!("{p}: solver.febio.{name} = {v}: must be finite and >= 0");
             }

@@ -46,9 +46,9 @@ pub struct Feb {
 }
 
 /// Write the FEBio input of `pose` on mesh level `mesh_level` with `steps` load steps
-/// over the spec's insertion depth. `dt_fraction`: the first (and largest) automatic
-/// time step as a fraction of a load step (1 on a first attempt; the campaign's retry
-/// asks for less).
+/// over the spec's insertion depth. `dt_fraction`: the first automatic time step as a
+/// fraction of a load step (1 on a first attempt; the campaign's retry asks for less,
+/// and then also gets the retry's convergence tolerances, `retry_dtol`/`retry_rtol`).
 ///
 /// # Errors
 /// The spec's values make an empty mesh, `steps` is 0, or `dt_fraction` is not in (0, 1].
@@ -175,9 +175,12 @@ fn write_control(w: &mut String, s: &FebioSettings, depth: f64, steps: u32, dt_f
     let _ = writeln!(w, "      <reform_each_time_step>1</reform_each_time_step>");
     let _ = writeln!(w, "      <diverge_reform>1</diverge_reform>");
     let _ = writeln!(w, "      <min_residual>1e-20</min_residual>");
-    let _ = writeln!(w, "      <dtol>{}</dtol>", num(s.dtol));
+    // the campaign's retry (a first step below a whole load step) converges on energy and
+    // residual with `retry_dtol` / `retry_rtol` (FebioSettings docs)
+    let (dtol, rtol) = if dt_fraction < 1.0 { (s.retry_dtol, s.retry_rtol) } else { (s.dtol, s.rtol) };
+    let _ = writeln!(w, "      <dtol>{}</dtol>", num(dtol));
     let _ = writeln!(w, "      <etol>{}</etol>", num(s.etol));
-    let _ = writeln!(w, "      <rtol>{}</rtol>", num(s.rtol));
+    let _ = writeln!(w, "      <rtol>{}</rtol>", num(rtol));
     let _ = writeln!(w, "      <qn_method type=\"BFGS\">");
     let _ = writeln!(w, "        <max_ups>{}</max_ups>", s.max_ups);
     let _ = writeln!(w, "      </qn_method>");

@@ -84,8 +84,27 @@ pub fn parse_run_log(text: &str) -> RunLog {
     let mut r = RunLog::default();
     let mut iters_summary: Option<u32> = None;
     let mut iters_counted = 0u32;
+    let mut in_error_box = false;
+    let mut boxed: Option<String> = None;
+    let mut last_failed: Option<String> = None;
     for line in text.lines() {
         let l = line.trim();
+        // FEBio's error box: "*   ERROR   *", then "* <message> *" lines, then a row of '*'
+        if l.starts_with('*') && l.ends_with('*') && l.len() > 2 {
+            let inner = l.trim_matches('*').trim();
+            if inner == "ERROR" {
+                in_error_box = true;
+            } else if in_error_box && !inner.is_empty() {
+                boxed = Some(inner.to_string());
+            } else if inner.is_empty() {
+                in_error_box = false;
+            }
+            continue;
+        }
+        in_error_box = false;
+        if l.starts_with("------- failed to converge at time") {
+            last_failed = Some(l.trim_start_matches('-').trim().to_string());
+        }
         if l.contains("N O R M A L   T E R M I N A T I O N") {
             r.normal_termination = true;
         } else if l.contains("E R R O R   T E R M I N A T I O N") {
@@ -109,15 +128,16 @@ pub fn parse_run_log(text: &str) -> RunLog {
             }
         }
         let lower = l.to_ascii_lowercase();
-        if lower.contains("negative jacobian")
-            || lower.contains("max nr of reformations")
-            || lower.starts_with("*** error")
-            || lower.contains("fatal error")
-            || lower.contains("failed to converge")
-            || (lower.contains("error") && lower.contains("reading"))
-        {
+        if lower.contains("fatal error") || (lower.contains("error") && lower.contains("reading")) {
             r.cause = Some(l.to_string());
         }
+    }
+    // the last boxed error (e.g. "Max nr of reformations reached.") with where it failed
+    if r.cause.is_none() {
+        r.cause = match (boxed, last_failed) {
+            (Some(b), Some(f)) => Some(format!("{b} ({f})")),
+            (b, f) => b.or(f),
+        };
     }
     r.iterations = iters_summary.unwrap_or(iters_counted);
     r
@@ -145,8 +165,10 @@ mod tests {
         let r = parse_run_log(text);
         assert!(r.normal_termination && !r.error_termination);
         assert_eq!((r.time_steps, r.iterations, r.retries, r.last_time), (2, 17, 1, 0.6));
-        let bad = parse_run_log(" *** Error: negative jacobian detected\n E R R O R   T E R M I N A T I O N\n");
+        let bad = parse_run_log(
+            " *************************************************************************\n *                                ERROR                                  *\n * 2 negative jacobians detected.                                        *\n *************************************************************************\n\n------- failed to converge at time : 0.3\n E R R O R   T E R M I N A T I O N\n",
+        );
         assert!(bad.error_termination);
-        assert_eq!(bad.cause.as_deref(), Some("*** Error: negative jacobian detected"));
+        assert_eq!(bad.cause.as_deref(), Some("2 negative jacobians detected. (failed to converge at time : 0.3)"));
     }
 }

@@ -202,7 +202,7 @@ impl Backend for FebioBackend {
             first_increment: job.first_increment,
             retry: None,
             element: "hex8, three-field (u-p-J) for the uncoupled Ogden tissue; rigid-body needle".into(),
-            settings: settings_line(&job.campaign.solver.febio, job.campaign.contact.friction, self.threads),
+            settings: settings_line(&job.campaign.solver.febio, job.campaign.contact.friction, self.threads, job.first_increment < 1.0),
         })
     }
 
@@ -216,7 +216,8 @@ impl Backend for FebioBackend {
 }
 
 /// The FEBio settings of a run in one line, for the manifest.
-pub fn settings_line(s: &crate::fe::spec::FebioSettings, friction: f64, threads: usize) -> String {
+pub fn settings_line(s: &crate::fe::spec::FebioSettings, friction: f64, threads: usize, retry: bool) -> String {
+    let (dtol, rtol) = if retry { (s.retry_dtol, s.retry_rtol) } else { (s.dtol, s.rtol) };
     format!(
         "{} contact, primary {}, {} penalty {}{}{}, friction {friction}; {}, max_refs {}, dtol {} etol {} rtol {}; Pardiso, {threads} thread(s)",
         s.contact,
@@ -227,9 +228,9 @@ pub fn settings_line(s: &crate::fe::spec::FebioSettings, friction: f64, threads:
         if s.augmented { format!(" (tolerance {}, at most {} augmentations)", s.aug_tolerance, s.max_aug) } else { String::new() },
         if s.max_ups == 0 { "full Newton".to_string() } else { format!("BFGS {} updates", s.max_ups) },
         s.max_refs,
-        s.dtol,
+        dtol,
         s.etol,
-        s.rtol,
+        rtol,
     )
 }
 
