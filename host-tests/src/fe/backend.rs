@@ -211,21 +211,9 @@ fn check_step_times(blocks: &[dat::StepRf], steps: u32) -> Result<()> {
     Ok(())
 }
 
-/// Copy a failed attempt's log, status and SPOOLES files to `failed-<attempt>.*` in its
-/// work folder, where the retry (which rewrites `pose.*`) leaves them; returns
-/// ` (kept as failed-<attempt>.*)`, or nothing when no file could be copied.
+/// Keep a failed ccx attempt's log, status and SPOOLES files (see
+/// [`process::keep_failed_attempt`](crate::fe::process::keep_failed_attempt)).
 fn keep_failed_attempt(job: &Job<'_>) -> String {
-    let attempt = format!("first-increment-{}", job.first_increment);
-    let mut kept = 0;
-    for (from, ext) in [(format!("{JOB}.log"), "log"), (format!("{JOB}.sta"), "sta"), ("spooles.out".to_string(), "spooles.out")] {
-        let src = job.work_dir.join(from);
-        if src.is_file() && std::fs::copy(&src, job.work_dir.join(format!("failed-{attempt}.{ext}"))).is_ok() {
-            kept += 1;
-        }
-    }
-    if kept > 0 {
-        format!(" (kept as failed-{attempt}.*)")
-    } else {
-        String::new()
-    }
+    let files = [(format!("{JOB}.log"), "log"), (format!("{JOB}.sta"), "sta"), ("spooles.out".to_string(), "spooles.out")];
+    crate::fe::process::keep_failed_attempt(job.work_dir, &format!("first-increment-{}", job.first_increment), &files)
 }

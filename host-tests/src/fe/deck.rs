@@ -152,19 +152,8 @@ fn write_deck_full(
     if !(first_increment > 1e-5 && first_increment <= 1.0) {
         bail!("pose {}: first increment {first_increment} of a step: must be in (1e-5, 1]", pose.name);
     }
-    let own = pose.symmetry();
-    if (sym.plane_x && !own.plane_x) || (sym.plane_z && !own.plane_z) {
-        bail!("pose {}: asked for a mirror plane the pose does not have", pose.name);
-    }
-    if steps == 0 {
-        bail!("pose {}: 0 load steps", pose.name);
-    }
     let depth = c.loading.depth_mm;
-    let t = mesh::tissue(&c.block, mesh_level, pose, sym, depth);
-    let n = mesh::needle(&c.needle, mesh_level, pose, depth, sym);
-    if t.top_faces.is_empty() || n.faces.is_empty() {
-        bail!("pose {}: the mesh has no contact faces (tissue {}, needle {})", pose.name, t.top_faces.len(), n.faces.len());
-    }
+    let (t, n) = mesh::pose_meshes(c, pose, mesh_level, steps, sym)?;
     let mut s = String::with_capacity(200 * (t.nodes.len() + n.nodes.len()));
     let w = &mut s;
     let _ = writeln!(w, "** needle-haptics CalculiX deck (generator v{GENERATOR_VERSION}), set {:?}, pose {:?}", c.set.name, pose.name);

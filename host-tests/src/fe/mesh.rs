@@ -4,7 +4,8 @@
 //! Frame (design.md section 4): origin at the centre of the top surface, y up, the
 //! block occupies |x| <= size_x/2, |z| <= size_z/2, -depth <= y <= 0.
 
-use super::spec::{Block, MeshLevel, Needle, PoseSpec, Symmetry};
+use super::spec::{Block, Campaign, MeshLevel, Needle, PoseSpec, Symmetry};
+use anyhow::{bail, Result};
 use std::collections::HashMap;
 
 /// A point in the block frame, mm.
@@ -124,6 +125,28 @@ impl Pattern {
         self.key.insert(k, self.pts.len() - 1);
         self.pts.len() - 1
     }
+}
+
+/// The tissue and needle meshes of `pose` on `mesh_level` with mirror planes `sym`, for
+/// a solver input of `steps` load steps (every engine's writer starts here).
+///
+/// # Errors
+/// A mirror plane the pose does not have, 0 steps, or a mesh without contact faces.
+pub fn pose_meshes(c: &Campaign, pose: &PoseSpec, mesh_level: &MeshLevel, steps: u32, sym: Symmetry) -> Result<(TissueMesh, NeedleMesh)> {
+    let own = pose.symmetry();
+    if (sym.plane_x && !own.plane_x) || (sym.plane_z && !own.plane_z) {
+        bail!("pose {}: asked for a mirror plane the pose does not have", pose.name);
+    }
+    if steps == 0 {
+        bail!("pose {}: 0 load steps", pose.name);
+    }
+    let depth = c.loading.depth_mm;
+    let t = tissue(&c.block, mesh_level, pose, sym, depth);
+    let n = needle(&c.needle, mesh_level, pose, depth, sym);
+    if t.top_faces.is_empty() || n.faces.is_empty() {
+        bail!("pose {}: the mesh has no contact faces (tissue {}, needle {})", pose.name, t.top_faces.len(), n.faces.len());
+    }
+    Ok((t, n))
 }
 
 /// Contact slave region around the needle path: radius in mm beyond the path's centre.

@@ -159,6 +159,25 @@ pub fn run(
     Ok(Finished { exit, wall, log_path: log_path.to_path_buf(), log_text })
 }
 
+/// Copy a failed attempt's files (`(name in work_dir, extension)`) to
+/// `failed-<attempt>.<extension>` in `work_dir`, where the retry (which rewrites the
+/// solver's files) leaves them; returns ` (kept as failed-<attempt>.*)`, or nothing when
+/// no file could be copied.
+pub fn keep_failed_attempt(work_dir: &Path, attempt: &str, files: &[(String, &str)]) -> String {
+    let mut kept = 0;
+    for (from, ext) in files {
+        let src = work_dir.join(from);
+        if src.is_file() && std::fs::copy(&src, work_dir.join(format!("failed-{attempt}.{ext}"))).is_ok() {
+            kept += 1;
+        }
+    }
+    if kept > 0 {
+        format!(" (kept as failed-{attempt}.*)")
+    } else {
+        String::new()
+    }
+}
+
 /// The last `n` lines of `text`, trailing blank lines dropped.
 pub fn tail(text: &str, n: usize) -> String {
     let lines: Vec<&str> = text.trim_end().lines().collect();

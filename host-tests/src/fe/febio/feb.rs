@@ -69,22 +69,11 @@ pub fn write_with_symmetry(
     dt_fraction: f64,
     sym: Symmetry,
 ) -> Result<Feb> {
-    if steps == 0 {
-        bail!("pose {}: 0 load steps", pose.name);
-    }
     if !(dt_fraction > 0.0 && dt_fraction <= 1.0) {
         bail!("pose {}: first time step {dt_fraction} of a load step: must be in (0, 1]", pose.name);
     }
-    let own = pose.symmetry();
-    if (sym.plane_x && !own.plane_x) || (sym.plane_z && !own.plane_z) {
-        bail!("pose {}: asked for a mirror plane the pose does not have", pose.name);
-    }
     let depth = c.loading.depth_mm;
-    let t = mesh::tissue(&c.block, mesh_level, pose, sym, depth);
-    let n = mesh::needle(&c.needle, mesh_level, pose, depth, sym);
-    if t.top_faces.is_empty() || n.faces.is_empty() {
-        bail!("pose {}: the mesh has no contact faces (tissue {}, needle {})", pose.name, t.top_faces.len(), n.faces.len());
-    }
+    let (t, n) = mesh::pose_meshes(c, pose, mesh_level, steps, sym)?;
     let hub = [0, 1, 2].map(|k| n.tip[k] + c.needle.reference_from_tip_mm * n.axis[k]);
     let s = &c.solver.febio;
     let mut w = String::with_capacity(160 * (t.nodes.len() + n.nodes.len()));

@@ -246,22 +246,10 @@ fn pick_steps(records: &[logs::RigidRecord], depth: f64, steps: u32) -> Vec<Opti
         .collect()
 }
 
-/// Copy a failed attempt's logs to `failed-<attempt>.*` in its work folder, where the
-/// retry (which rewrites `pose.*`) leaves them; returns ` (kept as failed-<attempt>.*)`.
+/// Keep a failed FEBio attempt's logs (see [`process::keep_failed_attempt`]).
 fn keep_failed_attempt(job: &Job<'_>) -> String {
-    let attempt = format!("first-step-{}", job.first_increment);
-    let mut kept = 0;
-    for (from, ext) in [(format!("{JOB}.log"), "log"), ("febio.out".to_string(), "out"), (feb::RIGID_LOG.to_string(), "rb.txt")] {
-        let src = job.work_dir.join(from);
-        if src.is_file() && std::fs::copy(&src, job.work_dir.join(format!("failed-{attempt}.{ext}"))).is_ok() {
-            kept += 1;
-        }
-    }
-    if kept > 0 {
-        format!(" (kept as failed-{attempt}.*)")
-    } else {
-        String::new()
-    }
+    let files = [(format!("{JOB}.log"), "log"), ("febio.out".to_string(), "out"), (feb::RIGID_LOG.to_string(), "rb.txt")];
+    process::keep_failed_attempt(job.work_dir, &format!("first-step-{}", job.first_increment), &files)
 }
 
 #[cfg(test)]
