@@ -371,22 +371,11 @@ pub fn punch_deck(c: &Campaign, mesh: &spec::MeshLevel, el: PunchElement, a: f64
     let pose = PoseSpec { name: "punch".into(), role: Role::Centre, x_mm: 0.0, z_mm: 0.0, theta_x_deg: 0.0, theta_z_deg: 0.0 };
     let sym = Symmetry { plane_x: true, plane_z: true };
     let t = mesh::tissue_shaped(&block, mesh, &pose, sym, 0.0, true);
-    let hb = [block.size_x_mm / 2.0, block.depth_mm, block.size_z_mm / 2.0];
     let (nodes, elements) = match el {
         PunchElement::C3D8 => (t.nodes.clone(), t.elements.iter().map(|e| e.to_vec()).collect::<Vec<_>>()),
         PunchElement::C3D20R => quadratic(&t.nodes, &t.elements, a),
     };
-    // node sets from the coordinates (the block's faces are planes)
-    let eps = 1e-6;
-    let pick = |f: &dyn Fn(&P3) -> bool| -> Vec<usize> { (0..nodes.len()).filter(|&i| f(&nodes[i])).collect() };
-    let under = pick(&|p| p[1].abs() < 1e-9 && (p[0] * p[0] + p[2] * p[2]).sqrt() <= a * (1.0 + 1e-6));
-    let bottom = pick(&|p| (p[1] + hb[1]).abs() < eps);
-    let sides = pick(&|p| (p[0].abs() - hb[0]).abs() < eps || (p[2].abs() - hb[2]).abs() < eps);
-    let sym_x = pick(&|p| p[0].abs() < eps);
-    let sym_z = pick(&|p| p[2].abs() < eps);
-    if under.len() < 4 {
-        bail!("punch: only {} nodes under the punch", under.len());
-    }
+    let PunchSets { under, bottom, sides, sym_x, sym_z } = punch_sets(&nodes, &block, a)?;
     let mu = PUNCH_MU_N_PER_MM2;
     let k0 = c.tissue.bulk_to_shear * mu;
     let d1 = 2.0 / k0;
@@ -427,6 +416,43 @@ pub fn punch_deck(c: &Campaign, mesh: &spec::MeshLevel, el: PunchElement, a: f64
     let _ = writeln!(s, "*BOUNDARY\nPUNCH, 1, 1, 0.\nPUNCH, 2, 2, {:.9}\nPUNCH, 3, 3, 0.", -delta);
     let _ = writeln!(s, "*NODE PRINT, NSET=PUNCH\nRF\n*END STEP");
     Ok(PunchDeck { text: s, nodes: nodes.len(), elements: elements.len(), punch_nodes: under.len() })
+}
+
+/// Node sets of a punch block's quarter model (0-based node indices).
+#[derive(Debug, Clone)]
+pub struct PunchSets {
+    /// On the top surface, on and inside the punch's rim (prescribed displacement).
+    pub under: Vec<usize>,
+    /// On the bottom face (encastred).
+    pub bottom: Vec<usize>,
+    /// On the side faces (pinned).
+    pub sides: Vec<usize>,
+    /// On the mirror plane x = 0.
+    pub sym_x: Vec<usize>,
+    /// On the mirror plane z = 0.
+    pub sym_z: Vec<usize>,
+}
+
+/// The node sets of the punch block `block` (already scaled), from the coordinates (the
+/// block's faces are planes), punch radius `a`.
+///
+/// # Errors
+/// Fewer than 4 nodes under the punch (a mesh too coarse for the punch).
+pub fn punch_sets(nodes: &[P3], block: &crate::fe::spec::Block, a: f64) -> Result<PunchSets> {
+    let hb = [block.size_x_mm / 2.0, block.depth_mm, block.size_z_mm / 2.0];
+    let eps = 1e-6;
+    let pick = |f: &dyn Fn(&P3) -> bool| -> Vec<usize> { (0..nodes.len()).filter(|&i| f(&nodes[i])).collect() };
+    let sets = PunchSets {
+        under: pick(&|p| p[1].abs() < 1e-9 && (p[0] * p[0] + p[2] * p[2]).sqrt() <= a * (1.0 + 1e-6)),
+        bottom: pick(&|p| (p[1] + hb[1]).abs() < eps),
+        sides: pick(&|p| (p[0].abs() - hb[0]).abs() < eps || (p[2].abs() - hb[2]).abs() < eps),
+        sym_x: pick(&|p| p[0].abs() < eps),
+        sym_z: pick(&|p| p[2].abs() < eps),
+    };
+    if sets.under.len() < 4 {
+        bail!("punch: only {} nodes under the punch", sets.under.len());
+    }
+    Ok(sets)
 }
 
 /// C3D20 edges (local corner pairs) in CalculiX's order of the mid-side nodes 9..20.

@@ -8,10 +8,10 @@
 //! incompressibility. The force is the sum of FEBio's nodal reactions `Ry` of the punch
 //! nodes (logfile `node_data`), times 4 (quarter model).
 
-use super::punch::{punch_mesh, PUNCH_MU_N_PER_MM2};
+use super::punch::{punch_mesh, punch_sets, PunchSets, PUNCH_MU_N_PER_MM2};
 use crate::fe::febio;
 use crate::fe::febio::logs;
-use crate::fe::mesh::{self, P3};
+use crate::fe::mesh;
 use crate::fe::process;
 use crate::fe::spec::{self, Campaign, PoseSpec, Role, Symmetry};
 use anyhow::{bail, Context, Result};
@@ -51,17 +51,7 @@ pub fn punch_feb(c: &Campaign, mesh_level: &spec::MeshLevel, a: f64, delta: f64,
     let pose = PoseSpec { name: "punch".into(), role: Role::Centre, x_mm: 0.0, z_mm: 0.0, theta_x_deg: 0.0, theta_z_deg: 0.0 };
     let sym = Symmetry { plane_x: true, plane_z: true };
     let t = mesh::tissue_shaped(&block, mesh_level, &pose, sym, 0.0, true);
-    let hb = [block.size_x_mm / 2.0, block.depth_mm, block.size_z_mm / 2.0];
-    let eps = 1e-6;
-    let pick = |f: &dyn Fn(&P3) -> bool| -> Vec<usize> { (0..t.nodes.len()).filter(|&i| f(&t.nodes[i])).collect() };
-    let under = pick(&|p| p[1].abs() < 1e-9 && (p[0] * p[0] + p[2] * p[2]).sqrt() <= a * (1.0 + 1e-6));
-    let bottom = pick(&|p| (p[1] + hb[1]).abs() < eps);
-    let sides = pick(&|p| (p[0].abs() - hb[0]).abs() < eps || (p[2].abs() - hb[2]).abs() < eps);
-    let sym_x = pick(&|p| p[0].abs() < eps);
-    let sym_z = pick(&|p| p[2].abs() < eps);
-    if under.len() < 4 {
-        bail!("punch: only {} nodes under the punch", under.len());
-    }
+    let PunchSets { under, bottom, sides, sym_x, sym_z } = punch_sets(&t.nodes, &block, a)?;
     let mu = PUNCH_MU_N_PER_MM2;
     let k0 = c.tissue.bulk_to_shear * mu;
     let mut s = String::with_capacity(120 * (t.nodes.len() + t.elements.len()));
