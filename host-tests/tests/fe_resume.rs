@@ -31,7 +31,7 @@ fn default_set() -> (tempfile::TempDir, PathBuf) {
 fn run_args<'a>(set: &'a Path, only: &'a str, steps: &'a str) -> Vec<&'a std::ffi::OsStr> {
     let mut v: Vec<&std::ffi::OsStr> = ["fe", "run", "--set"].iter().map(|s| s.as_ref()).collect();
     v.push(set.as_os_str());
-    for a in ["--mesh", "smoke", "--steps", steps, "--only", only] {
+    for a in ["--solver", "ccx", "--mesh", "smoke", "--steps", steps, "--only", only] {
         v.push(a.as_ref());
     }
     v
@@ -109,7 +109,7 @@ fn smoke_campaign_skips_and_resumes_after_a_kill() {
     let centre = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");
     assert_eq!(e.spec_hash, c.run_hash(&centre, "smoke"), "hash of the spec with --steps 2");
     let version = ccx::ccx_version(&ccx::find_ccx().expect("ccx")).expect("version");
-    assert_eq!((e.ccx_version.as_str(), e.mesh.as_str(), e.steps), (version.as_str(), "smoke", 2));
+    assert_eq!((e.engine.as_str(), e.engine_version.as_str(), e.mesh.as_str(), e.steps), ("ccx", version.as_str(), "smoke", 2));
     assert!(e.increments >= 2 && e.iterations >= e.increments && e.wall_s > 0.0, "{e:?}");
     assert!(e.tissue_nodes > 0 && e.tissue_elements > 0 && e.needle_nodes > 0 && e.needle_elements > 0, "{e:?}");
     assert!(e.date.ends_with('Z') && e.date.len() == 20, "{}", e.date);

@@ -59,7 +59,10 @@ pub fn make_set(dir: &Path, skip: &[&str]) {
 fn synthetic_entry(campaign: &spec::Campaign, pose: &PoseSpec) -> ManifestEntry {
     ManifestEntry {
         spec_hash: campaign.run_hash(pose, &campaign.campaign.mesh),
-        ccx_version: "none (synthetic wrench)".into(),
+        engine: "none".into(),
+        engine_version: "none (synthetic wrench)".into(),
+        element: String::new(),
+        solver_settings: String::new(),
         mesh: campaign.campaign.mesh.clone(),
         model: "synthetic".into(),
         tissue_mesh: "none".into(),
