@@ -1,5 +1,6 @@
 //! The FE campaign driver behind `needle fe run`: select the poses, skip the ones whose
-//! result is up to date, solve the others in parallel (one ccx thread per job), write
+//! result is up to date, solve the others in parallel on the set's engine (a
+//! [`Backend`]: FEBio or CalculiX; `jobs` at once, `threads` solver threads each), write
 //! `fe/<pose>.csv` and the manifest atomically, and report.
 //!
 //! Files, in the output folder (default `<set>/fe/`):
@@ -7,8 +8,8 @@
 //!   with [`results::write_atomic`]: a killed run never leaves a half-written CSV.
 //! - `manifest.toml`: one table per finished pose (see [`ManifestEntry`]), sorted by
 //!   pose name, rewritten atomically after each pose.
-//! - `.work/<pose>/`: the deck and ccx's files of a run; removed when the run succeeds,
-//!   kept for debugging when it fails.
+//! - `.work/<pose>/`: the solver's input and files of a run; removed when the run
+//!   succeeds (unless `keep_work`), kept for debugging when it fails.
 //!
 //! A pose is up to date, and skipped, when its CSV exists with `steps + 1` rows and its
 //! manifest entry has the spec hash of the current run ([`Campaign::run_hash`] of the
@@ -16,7 +17,7 @@
 //! is solved its manifest entry is removed, so a CSV is only ever trusted when the entry
 //! written after it says which spec it came from.
 //!
-//! A run that fails (ccx error, no convergence, timeout) or stalls (no output for
+//! A run that fails (solver error, no convergence, timeout) or stalls (no output for
 //! [`RunOptions::stall`]: ccx 2.20 was seen spinning without output at the start of a
 //! step, deterministically, e.g. theta_z = 15 degrees at 5.4 mm) is rerun once with every
 //! load step starting at [`deck::RETRY_FIRST_INCREMENT`] of the step instead of the whole
