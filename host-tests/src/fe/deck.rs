@@ -86,6 +86,20 @@ pub struct Deck {
     pub symmetry: Symmetry,
 }
 
+impl MeshSummary {
+    /// The summary of a pose's tissue and needle meshes with mirror planes `sym`.
+    pub fn of(t: &TissueMesh, n: &NeedleMesh, sym: Symmetry) -> Self {
+        MeshSummary {
+            tissue_nodes: t.nodes.len(),
+            tissue_elements: t.elements.len(),
+            needle_nodes: n.nodes.len(),
+            needle_elements: n.elements.len(),
+            model: model_name(sym).to_string(),
+            tissue_mesh: t.info.clone(),
+        }
+    }
+}
+
 /// Describe the modelled part for a symmetry.
 pub fn model_name(sym: Symmetry) -> &'static str {
     match (sym.plane_x, sym.plane_z) {
@@ -192,14 +206,7 @@ fn write_deck_full(
         .collect();
     Ok(Deck {
         text: s,
-        summary: MeshSummary {
-            tissue_nodes: t.nodes.len(),
-            tissue_elements: t.elements.len(),
-            needle_nodes: n.nodes.len(),
-            needle_elements: n.elements.len(),
-            model: model_name(sym).to_string(),
-            tissue_mesh: t.info.clone(),
-        },
+        summary: MeshSummary::of(&t, &n, sym),
         print_set: PRINT_SET.to_string(),
         steps,
         print_nodes,

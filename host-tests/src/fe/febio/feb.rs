@@ -119,14 +119,7 @@ pub fn write_with_symmetry(
     let _ = writeln!(w, "</febio_spec>");
     Ok(Feb {
         text: w,
-        summary: MeshSummary {
-            tissue_nodes: t.nodes.len(),
-            tissue_elements: t.elements.len(),
-            needle_nodes: n.nodes.len(),
-            needle_elements: n.elements.len(),
-            model: model_name(sym).to_string(),
-            tissue_mesh: t.info.clone(),
-        },
+        summary: MeshSummary::of(&t, &n, sym),
         steps,
         symmetry: sym,
     })

@@ -173,6 +173,26 @@ pub struct PunchRun {
     pub wall_s: [f64; 2],
 }
 
+impl PunchRun {
+    /// The run from the forces on the block as specified and scaled 2x (`f`, N): the
+    /// half-space force by linear extrapolation in a/h, `2 F_2x - F_1x`, and its error
+    /// against Sneddon's `f_sneddon`.
+    pub fn from_forces(element: &str, nodes: [usize; 2], elements: [usize; 2], f: [f64; 2], wall_s: [f64; 2], f_sneddon: f64) -> Self {
+        let f_inf = 2.0 * f[1] - f[0];
+        PunchRun {
+            element: element.to_string(),
+            nodes,
+            elements,
+            force_block_n: f[0],
+            force_block_2x_n: f[1],
+            force_half_space_n: f_inf,
+            error_percent: 100.0 * (f_inf - f_sneddon) / f_sneddon,
+            finite_block_percent: 100.0 * (f[0] - f_inf) / f_inf,
+            wall_s,
+        }
+    }
+}
+
 /// A finite element for the punch block.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PunchElement {
@@ -249,18 +269,7 @@ pub(super) fn punch(c: &Campaign, work: &Path, opts: &VerifyOptions) -> Result<P
             nodes[k] = d.nodes;
             nel[k] = d.elements;
         }
-        let f_inf = 2.0 * f[1] - f[0];
-        runs.push(PunchRun {
-            element: el.name().to_string(),
-            nodes,
-            elements: nel,
-            force_block_n: f[0],
-            force_block_2x_n: f[1],
-            force_half_space_n: f_inf,
-            error_percent: 100.0 * (f_inf - f_sneddon) / f_sneddon,
-            finite_block_percent: 100.0 * (f[0] - f_inf) / f_inf,
-            wall_s: wall,
-        });
+        runs.push(PunchRun::from_forces(el.name(), nodes, nel, f, wall, f_sneddon));
     }
     let check = runs.remove(0);
     let mesh = punch_mesh(a, PUNCH_CORE_ELEMENTS_C3D20R, opts.punch_mesh_scale);
@@ -304,7 +313,6 @@ fn punch_febio(c: &Campaign, work: &Path, opts: &VerifyOptions) -> Result<PunchR
         let (force, w, feb) = solve_punch(&exe, c, opts.punch_mesh_scale, a, delta, scale, &dir)?;
         (f[k], wall[k], nodes[k], nel[k]) = (force, w, feb.nodes, feb.elements);
     }
-    let f_inf = 2.0 * f[1] - f[0];
     let mesh = punch_mesh(a, PUNCH_CORE_ELEMENTS_HEX8, opts.punch_mesh_scale);
     Ok(PunchReport {
         radius_mm: a,
@@ -322,17 +330,7 @@ fn punch_febio(c: &Campaign, work: &Path, opts: &VerifyOptions) -> Result<PunchR
         force_bonded_n: bonded_punch_force(mu, a, delta, nu),
         goal_percent: PUNCH_GOAL_PERCENT,
         solver: format!("febio {version}"),
-        check: PunchRun {
-            element: "FEBio hex8, three-field (the campaign's tissue element)".to_string(),
-            nodes,
-            elements: nel,
-            force_block_n: f[0],
-            force_block_2x_n: f[1],
-            force_half_space_n: f_inf,
-            error_percent: 100.0 * (f_inf - f_sneddon) / f_sneddon,
-            finite_block_percent: 100.0 * (f[0] - f_inf) / f_inf,
-            wall_s: wall,
-        },
+        check: PunchRun::from_forces("FEBio hex8, three-field (the campaign's tissue element)", nodes, nel, f, wall, f_sneddon),
         campaign_element: None,
     })
 }
@@ -364,13 +362,7 @@ pub struct PunchDeck {
 /// # Errors
 /// Fewer than 4 nodes under the punch (a mesh too coarse for the punch).
 pub fn punch_deck(c: &Campaign, mesh: &spec::MeshLevel, el: PunchElement, a: f64, delta: f64, scale: f64) -> Result<PunchDeck> {
-    let mut block = c.block.clone();
-    block.size_x_mm *= scale;
-    block.size_z_mm *= scale;
-    block.depth_mm *= scale;
-    let pose = PoseSpec { name: "punch".into(), role: Role::Centre, x_mm: 0.0, z_mm: 0.0, theta_x_deg: 0.0, theta_z_deg: 0.0 };
-    let sym = Symmetry { plane_x: true, plane_z: true };
-    let t = mesh::tissue_shaped(&block, mesh, &pose, sym, 0.0, true);
+    let (block, t) = punch_block(c, mesh, scale);
     let (nodes, elements) = match el {
         PunchElement::C3D8 => (t.nodes.clone(), t.elements.iter().map(|e| e.to_vec()).collect::<Vec<_>>()),
         PunchElement::C3D20R => quadratic(&t.nodes, &t.elements, a),
@@ -416,6 +408,20 @@ pub fn punch_deck(c: &Campaign, mesh: &spec::MeshLevel, el: PunchElement, a: f64
     let _ = writeln!(s, "*BOUNDARY\nPUNCH, 1, 1, 0.\nPUNCH, 2, 2, {:.9}\nPUNCH, 3, 3, 0.", -delta);
     let _ = writeln!(s, "*NODE PRINT, NSET=PUNCH\nRF\n*END STEP");
     Ok(PunchDeck { text: s, nodes: nodes.len(), elements: elements.len(), punch_nodes: under.len() })
+}
+
+/// The punch block: the spec's block scaled by `scale` in every direction, and its
+/// quarter model (mirror planes x = 0, z = 0) meshed with `mesh` and a round core (the
+/// punch's footprint).
+pub fn punch_block(c: &Campaign, mesh: &spec::MeshLevel, scale: f64) -> (crate::fe::spec::Block, mesh::TissueMesh) {
+    let mut block = c.block.clone();
+    block.size_x_mm *= scale;
+    block.size_z_mm *= scale;
+    block.depth_mm *= scale;
+    let pose = PoseSpec { name: "punch".into(), role: Role::Centre, x_mm: 0.0, z_mm: 0.0, theta_x_deg: 0.0, theta_z_deg: 0.0 };
+    let sym = Symmetry { plane_x: true, plane_z: true };
+    let t = mesh::tissue_shaped(&block, mesh, &pose, sym, 0.0, true);
+    (block, t)
 }
 
 /// Node sets of a punch block's quarter model (0-based node indices).

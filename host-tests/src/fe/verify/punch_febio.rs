@@ -8,12 +8,11 @@
 //! incompressibility. The force is the sum of FEBio's nodal reactions `Ry` of the punch
 //! nodes (logfile `node_data`), times 4 (quarter model).
 
-use super::punch::{punch_mesh, punch_sets, PunchSets, PUNCH_MU_N_PER_MM2};
+use super::punch::{punch_block, punch_mesh, punch_sets, PunchSets, PUNCH_MU_N_PER_MM2};
 use crate::fe::febio;
 use crate::fe::febio::logs;
-use crate::fe::mesh;
 use crate::fe::process;
-use crate::fe::spec::{self, Campaign, PoseSpec, Role, Symmetry};
+use crate::fe::spec::{self, Campaign};
 use anyhow::{bail, Context, Result};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -44,13 +43,7 @@ pub struct PunchFeb {
 /// # Errors
 /// Fewer than 4 nodes under the punch (a mesh too coarse for the punch).
 pub fn punch_feb(c: &Campaign, mesh_level: &spec::MeshLevel, a: f64, delta: f64, scale: f64) -> Result<PunchFeb> {
-    let mut block = c.block.clone();
-    block.size_x_mm *= scale;
-    block.size_z_mm *= scale;
-    block.depth_mm *= scale;
-    let pose = PoseSpec { name: "punch".into(), role: Role::Centre, x_mm: 0.0, z_mm: 0.0, theta_x_deg: 0.0, theta_z_deg: 0.0 };
-    let sym = Symmetry { plane_x: true, plane_z: true };
-    let t = mesh::tissue_shaped(&block, mesh_level, &pose, sym, 0.0, true);
+    let (block, t) = punch_block(c, mesh_level, scale);
     let PunchSets { under, bottom, sides, sym_x, sym_z } = punch_sets(&t.nodes, &block, a)?;
     let mu = PUNCH_MU_N_PER_MM2;
     let k0 = c.tissue.bulk_to_shear * mu;
