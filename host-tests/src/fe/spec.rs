@@ -229,7 +229,9 @@ pub struct FebioSettings {
     pub penalty: f64,
     /// Scale `penalty` by FEBio's estimate from the tissue's modulus and element size.
     pub auto_penalty: bool,
-    /// Relative tolerance of the augmentations (`tolerance`), when `augmented`.
+    /// Relative tolerance of the Lagrange multipliers' change between augmentations
+    /// (`tolerance`), when `augmented`; 0: off (augment only while the largest gap
+    /// exceeds `gap_tolerance_mm`).
     pub aug_tolerance: f64,
     /// Gap tolerance of the augmentations (`gaptol`), mm; 0: off.
     pub gap_tolerance_mm: f64,
@@ -309,7 +311,6 @@ impl FebioSettings {
         }
         for (name, v) in [
             ("penalty", self.penalty),
-            ("aug_tolerance", self.aug_tolerance),
             ("search_tol", self.search_tol),
             ("search_radius_mm", self.search_radius_mm),
             ("dtmin_fraction", self.dtmin_fraction),
@@ -320,6 +321,7 @@ impl FebioSettings {
             }
         }
         for (name, v) in [
+            ("aug_tolerance", self.aug_tolerance),
             ("gap_tolerance_mm", self.gap_tolerance_mm),
             ("dtol", self.dtol),
             ("rtol", self.rtol),
@@ -330,6 +332,9 @@ impl FebioSettings {
             if !(v.is_finite() && v >= 0.0) {
                 bail!("{p}: solver.febio.{name} = {v}: must be finite and >= 0");
             }
+        }
+        if self.augmented && self.aug_tolerance == 0.0 && self.gap_tolerance_mm == 0.0 {
+            bail!("{p}: solver.febio: augmented = true needs aug_tolerance > 0 or gap_tolerance_mm > 0 (with both 0 FEBio skips every augmentation: set augmented = false for a pure penalty)");
         }
         if self.dtmin_fraction > 1.0 {
             bail!("{p}: solver.febio.dtmin_fraction = {}: must be <= 1 (a fraction of one load step)", self.dtmin_fraction);
@@ -741,7 +746,22 @@ pub fn select<'a>(poses: &'a [PoseSpec], pattern: Option<&str>) -> Result<Vec<&'
 
 #[cfg(test)]
 mod tests {
-    use super::{select, PoseSpec, Role};
+    use super::{select, FebioSettings, PoseSpec, Role};
+    use std::path::Path;
+
+    #[test]
+    fn febio_augmentation_needs_one_tolerance() {
+        let p = Path::new("campaign.toml");
+        let gap_only = FebioSettings { aug_tolerance: 0.0, ..FebioSettings::default() };
+        assert!(gap_only.validate(p).is_ok(), "gap tolerance alone stops the augmentations");
+        let neither = FebioSettings { aug_tolerance: 0.0, gap_tolerance_mm: 0.0, ..FebioSettings::default() };
+        let msg = neither.validate(p).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(msg.contains("aug_tolerance > 0 or gap_tolerance_mm > 0"), "{msg}");
+        let penalty = FebioSettings { augmented: false, ..neither };
+        assert!(penalty.validate(p).is_ok(), "a pure penalty needs no tolerance");
+        let negative = FebioSettings { aug_tolerance: -0.1, ..FebioSettings::default() };
+        assert!(negative.validate(p).is_err());
+    }
 
     fn names(poses: &[&PoseSpec]) -> Vec<String> {
         poses.iter().map(|p| p.name.clone()).collect()
