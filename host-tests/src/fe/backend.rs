@@ -36,8 +36,11 @@ pub struct Job<'a> {
     /// Output-silence limit of the solve.
     pub stall: Option<Duration>,
     /// First increment of each load step, as a fraction of the step (1 on the first
-    /// attempt, [`deck::RETRY_FIRST_INCREMENT`] on the retry).
+    /// attempt, [`deck::RETRY_FIRST_INCREMENT`] on the retries).
     pub first_increment: f64,
+    /// Which attempt at the pose this is: 0 first, 1 the retry, 2.. further retries of
+    /// engines that have them ([`Backend::attempts`]).
+    pub attempt: u32,
 }
 
 /// A solved pose.
@@ -89,6 +92,13 @@ pub trait Backend: Sync {
 
     /// The engine's name as the manifest records it (`ccx`, `febio`).
     fn engine(&self) -> &'static str;
+
+    /// How many attempts a pose gets before it is failed (the first and the retries);
+    /// attempt 1 on starts each load step at [`deck::RETRY_FIRST_INCREMENT`], what else a
+    /// later attempt changes is the engine's.
+    fn attempts(&self) -> u32 {
+        2
+    }
 
     /// Solve one pose in `job.work_dir`.
     ///

@@ -19,10 +19,11 @@
 //!
 //! A run that fails (solver error, no convergence, timeout) or stalls (no output for
 //! [`RunOptions::stall`]: ccx 2.20 was seen spinning without output at the start of a
-//! step, deterministically, e.g. theta_z = 15 degrees at 5.4 mm) is rerun once with every
-//! load step starting at [`deck::RETRY_FIRST_INCREMENT`] of the step instead of the whole
-//! step. Same model and loads, another incrementation path; the manifest entry records it
-//! (`first_increment`, `retry`). Only when the retry fails too is the pose failed.
+//! step, deterministically, e.g. theta_z = 15 degrees at 5.4 mm) is rerun with every load
+//! step starting at [`deck::RETRY_FIRST_INCREMENT`] of the step instead of the whole step,
+//! up to the engine's [`Backend::attempts`] in all (ccx: one retry; FEBio: two, the last
+//! with a softer contact penalty). The manifest entry records it (`first_increment`,
+//! `retry`, `solver_settings`). Only when the last attempt fails too is the pose failed.
 //!
 //! The pieces: [`backend`](crate::fe::backend) solves one pose, [`manifest`](crate::fe::manifest)
 //! records how each CSV was made, [`report`](crate::fe::report) is the outcome and
@@ -330,6 +331,7 @@ fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
         timeout: ctx.timeout,
         stall: ctx.stall,
         first_increment: 1.0,
+        attempt: 0,
     };
     let solved = match solve_with_retry(ctx.backend, &job) {
         Ok(s) => s,
@@ -355,25 +357,34 @@ fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
     }
 }
 
-/// Solve `job`; when that fails, once more with [`deck::RETRY_FIRST_INCREMENT`] (module docs).
+/// Solve `job`; when that fails, again with [`deck::RETRY_FIRST_INCREMENT`], up to the
+/// backend's [`Backend::attempts`] (module docs). The failures so far go into the
+/// result's `retry` (or the final failure's message).
 fn solve_with_retry(backend: &dyn Backend, job: &Job<'_>) -> std::result::Result<Solved, SolveFailure> {
-    let first = match backend.solve(job) {
-        Ok(s) => return Ok(s),
-        Err(f) => f,
-    };
-    if process::interrupted() {
-        return Err(first);
-    }
+    let mut failures: Vec<String> = Vec::new();
+    let attempts = backend.attempts().max(1);
     let r = deck::RETRY_FIRST_INCREMENT;
-    eprintln!("{}: {}; retrying with each step's first increment at {r} of the step", job.pose.name, first.message);
-    let retry = Job { first_increment: r, ..*job };
-    match backend.solve(&retry) {
-        Ok(s) => Ok(Solved { retry: Some(first.message), ..s }),
-        Err(f) => Err(SolveFailure {
-            message: format!("{}; retry with first increment {r}: {}", first.message, f.message),
-            log_tail: f.log_tail,
-        }),
+    for attempt in 0..attempts {
+        let this = Job { first_increment: if attempt == 0 { 1.0 } else { r }, attempt, ..*job };
+        match backend.solve(&this) {
+            Ok(s) => return Ok(Solved { retry: (!failures.is_empty()).then(|| failures.join("; ")), ..s }),
+            Err(f) => {
+                let message = if attempt == 0 { f.message } else { format!("retry {attempt} (first increment {r}): {}", f.message) };
+                failures.push(message);
+                if attempt + 1 == attempts || process::interrupted() {
+                    return Err(SolveFailure { message: failures.join("; "), log_tail: f.log_tail });
+                }
+                eprintln!(
+                    "{}: {}; retry {} of {} with each step's first increment at {r} of the step",
+                    job.pose.name,
+                    failures.last().map(String::as_str).unwrap_or_default(),
+                    attempt + 1,
+                    attempts - 1
+                );
+            }
+        }
     }
+    Err(SolveFailure { message: failures.join("; "), log_tail: String::new() })
 }
 
 /// Check the wrenches, write the CSV, then the manifest entry. Returns Fy at the final depth.

@@ -133,9 +133,25 @@ impl Backend for FebioBackend {
         "febio"
     }
 
+    /// The first attempt, the retry (each load step starts at a quarter step, convergence
+    /// on energy and residual), and a last attempt as the retry with the penalty scaled
+    /// by `last_attempt_penalty_scale`.
+    fn attempts(&self) -> u32 {
+        3
+    }
+
     fn solve(&self, job: &Job<'_>) -> std::result::Result<Solved, SolveFailure> {
         let exe = self.exe.as_deref().context("FebioBackend::solve before prepare")?;
-        let feb = feb::write(job.campaign, job.pose, job.mesh, job.steps, job.first_increment).context("writing the FEBio input")?;
+        let softer;
+        let campaign = if job.attempt >= 2 {
+            let mut c = job.campaign.clone();
+            c.solver.febio.penalty *= c.solver.febio.last_attempt_penalty_scale;
+            softer = c;
+            &softer
+        } else {
+            job.campaign
+        };
+        let feb = feb::write(campaign, job.pose, job.mesh, job.steps, job.first_increment).context("writing the FEBio input")?;
         let input = job.work_dir.join(format!("{JOB}.feb"));
         std::fs::write(&input, &feb.text).with_context(|| format!("{}: cannot write", input.display()))?;
         let rb_path = job.work_dir.join(feb::RIGID_LOG);
@@ -202,7 +218,7 @@ impl Backend for FebioBackend {
             first_increment: job.first_increment,
             retry: None,
             element: "hex8, three-field (u-p-J) for the uncoupled Ogden tissue; rigid-body needle".into(),
-            settings: settings_line(&job.campaign.solver.febio, job.campaign.contact.friction, self.threads, job.first_increment < 1.0),
+            settings: settings_line(&campaign.solver.febio, campaign.contact.friction, self.threads, job.first_increment < 1.0),
         })
     }
 
@@ -225,7 +241,11 @@ pub fn settings_line(s: &crate::fe::spec::FebioSettings, friction: f64, threads:
         if s.augmented { "augmented Lagrangian" } else { "pure" },
         s.penalty,
         if s.auto_penalty { " x auto" } else { " N/mm^3" },
-        if s.augmented { format!(" (tolerance {}, at most {} augmentations)", s.aug_tolerance, s.max_aug) } else { String::new() },
+        if s.augmented {
+            format!(" (tolerance {}, gap tolerance {} mm, at most {} augmentations)", s.aug_tolerance, s.gap_tolerance_mm, s.max_aug)
+        } else {
+            String::new()
+        },
         if s.max_ups == 0 { "full Newton".to_string() } else { format!("BFGS {} updates", s.max_ups) },
         s.max_refs,
         dtol,
@@ -248,8 +268,13 @@ fn pick_steps(records: &[logs::RigidRecord], depth: f64, steps: u32) -> Vec<Opti
 
 /// Keep a failed FEBio attempt's logs (see [`process::keep_failed_attempt`]).
 fn keep_failed_attempt(job: &Job<'_>) -> String {
-    let files = [(format!("{JOB}.log"), "log"), ("febio.out".to_string(), "out"), (feb::RIGID_LOG.to_string(), "rb.txt")];
-    process::keep_failed_attempt(job.work_dir, &format!("first-step-{}", job.first_increment), &files)
+    let files = [
+        (format!("{JOB}.feb"), "feb"),
+        (format!("{JOB}.log"), "log"),
+        ("febio.out".to_string(), "out"),
+        (feb::RIGID_LOG.to_string(), "rb.txt"),
+    ];
+    process::keep_failed_attempt(job.work_dir, &format!("attempt-{}", job.attempt + 1), &files)
 }
 
 #[cfg(test)]

@@ -106,6 +106,7 @@ pub(super) fn mesh_convergence(c: &Campaign, work: &Path, threads: usize) -> Res
             timeout: None,
             stall: Some(crate::fe::campaign::DEFAULT_STALL),
             first_increment: 1.0,
+            attempt: 0,
         };
         let start = std::time::Instant::now();
         let solved = backend.solve(&job);
