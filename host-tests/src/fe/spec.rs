@@ -243,6 +243,11 @@ pub struct FebioSettings {
     pub search_tol: f64,
     /// Search radius of the projection, mm (`search_radius`).
     pub search_radius_mm: f64,
+    /// Newton iterations of each augmentation in which the contact projections are
+    /// updated (`seg_up`); later iterations keep the facets found so far. 0: every
+    /// iteration (FEBio's default). A node sliding over a facet edge can otherwise flip
+    /// between two facets from one iteration to the next and stall Newton's method.
+    pub seg_up: u32,
     /// Quasi-Newton updates between stiffness reformations (0: full Newton).
     pub max_ups: u32,
     /// Most stiffness reformations per time step.
@@ -290,6 +295,7 @@ impl Default for FebioSettings {
             two_pass: false,
             search_tol: 0.01,
             search_radius_mm: 1.0,
+            seg_up: 0,
             max_ups: 0,
             max_refs: 15,
             opt_iter: 10,
@@ -366,6 +372,17 @@ pub struct CampaignSettings {
     pub lhs_seed: u64,
     /// Number of Latin hypercube poses.
     pub lhs_count: u32,
+    /// Seed of the Owen scrambling of the Sobol sequence of training poses (role
+    /// `train`); its own seed, so the training poses never coincide with the validation
+    /// hypercube by construction of the seeds.
+    #[serde(default)]
+    pub train_seed: u32,
+    /// Number of training poses, `train-01` .. : the first `train_count` points of the
+    /// scrambled Sobol sequence. Raising it keeps the earlier poses (a prefix of the
+    /// sequence), so solved training runs stay valid and a learning curve can use nested
+    /// prefixes. 0: none.
+    #[serde(default)]
+    pub train_count: u32,
     /// Sweep runs the fitter leaves out, by pose name, each because its FE run cannot be
     /// solved (the reason is written next to the list in campaign.toml). The run stays in
     /// the campaign; the fit needs at least 5 distinct values per sweep without it, and
@@ -399,6 +416,10 @@ pub enum Role {
     Table2,
     /// Latin hypercube validation poses, never fitted.
     Lhs,
+    /// Combined poses of the Sobol training design (generated from
+    /// `campaign.train_seed`), fitted by the coupled model form only: the paper's form
+    /// stays a fit of the sweeps.
+    Train,
 }
 
 impl Role {
@@ -599,6 +620,9 @@ impl Campaign {
             if pose.role == Role::Lhs {
                 bail!("{p}: pose {:?}: role lhs is generated from campaign.lhs_seed, not listed", pose.name);
             }
+            if pose.role == Role::Train {
+                bail!("{p}: pose {:?}: role train is generated from campaign.train_seed, not listed", pose.name);
+            }
         }
         for name in &self.campaign.fit_without {
             match self.pose.iter().find(|q| &q.name == name) {
@@ -622,6 +646,7 @@ impl Campaign {
         let mut out = self.pose.clone();
         let n = self.campaign.lhs_count as usize;
         if n == 0 {
+            out.extend(self.train_poses());
             return out;
         }
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(self.campaign.lhs_seed);
@@ -648,7 +673,37 @@ impl Campaign {
                 theta_z_deg: cols[3][i],
             });
         }
+        out.extend(self.train_poses());
         out
+    }
+
+    /// The `train_count` training poses `train-01`, `train-02`, ...: point i of the
+    /// Owen-scrambled Sobol sequence in four dimensions (seed `train_seed`) mapped onto
+    /// the whole domain, |x|, |z| <= 12 mm and |theta| <= 15 degrees, rounded like the
+    /// hypercube. Every prefix of 2^k points is stratified in each input and in each pair
+    /// of inputs, which is what the learning curve's nested subsets rely on.
+    pub fn train_poses(&self) -> Vec<PoseSpec> {
+        let ranges = [X_MAX_MM, Z_MAX_MM, THETA_MAX_DEG, THETA_MAX_DEG];
+        (0..self.campaign.train_count)
+            .map(|i| {
+                let v: Vec<f64> = ranges
+                    .iter()
+                    .zip(0u32..)
+                    .map(|(half, dim)| {
+                        let u = f64::from(sobol_burley::sample(i, dim, self.campaign.train_seed));
+                        (((-half + 2.0 * half * u) * 100.0).round() / 100.0).clamp(-half, *half)
+                    })
+                    .collect();
+                PoseSpec {
+                    name: format!("train-{:02}", i + 1),
+                    role: Role::Train,
+                    x_mm: v[0],
+                    z_mm: v[1],
+                    theta_x_deg: v[2],
+                    theta_z_deg: v[3],
+                }
+            })
+            .collect()
     }
 
     /// The levels of the mesh study (`campaign.mesh_study`, or the committed level and
@@ -771,6 +826,43 @@ mod tests {
         assert!(penalty.validate(p).is_ok(), "a pure penalty needs no tolerance");
         let negative = FebioSettings { aug_tolerance: -0.1, ..FebioSettings::default() };
         assert!(negative.validate(p).is_err());
+    }
+
+    /// The training design: a prefix of the scrambled Sobol sequence, inside the
+    /// domain, one point per stratum of each input for 8 and 16 points, another seed
+    /// another design.
+    #[test]
+    fn training_poses_are_nested_stratified_sobol_prefixes() {
+        let set = Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default");
+        let Ok((mut c, _)) = super::load(&set) else { panic!("cannot load {}", set.display()) };
+        c.campaign.train_seed = 7;
+        c.campaign.train_count = 16;
+        let sixteen = c.train_poses();
+        c.campaign.train_count = 8;
+        let eight = c.train_poses();
+        assert_eq!(sixteen.len(), 16);
+        assert_eq!(eight[..], sixteen[..8], "raising train_count keeps the earlier poses");
+        assert_eq!(sixteen[15].name, "train-16");
+        assert!(sixteen.iter().all(|p| p.role == Role::Train));
+        for (n, poses) in [(8usize, &eight), (16, &sixteen)] {
+            let ranges = [super::X_MAX_MM, super::Z_MAX_MM, super::THETA_MAX_DEG, super::THETA_MAX_DEG];
+            for (dim, half) in ranges.iter().enumerate() {
+                let mut hit = vec![0u32; n];
+                for p in poses.iter() {
+                    let v = [p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg][dim];
+                    assert!(v.abs() <= *half, "{}: input {dim} = {v} outside +-{half}", p.name);
+                    // stratum of the unrounded point; rounding to 0.01 may move a point
+                    // across a boundary by at most 0.005
+                    let k = (((v + half) / (2.0 * half)) * n as f64).floor().clamp(0.0, n as f64 - 1.0) as usize;
+                    hit[k] += 1;
+                }
+                let empty = hit.iter().filter(|&&h| h == 0).count();
+                assert!(empty <= 1, "{n} points, input {dim}: strata hit {hit:?}");
+            }
+        }
+        c.campaign.train_seed = 8;
+        assert_ne!(c.train_poses(), eight, "the seed scrambles the design");
+        assert!(c.poses().iter().filter(|p| p.role == Role::Train).count() == 8, "poses() lists the training poses");
     }
 
     fn names(poses: &[&PoseSpec]) -> Vec<String> {

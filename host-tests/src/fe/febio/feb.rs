@@ -311,6 +311,7 @@ fn write_contact(w: &mut String, c: &Campaign) {
     let _ = writeln!(w, "      <fric_coeff>{}</fric_coeff>", num(c.contact.friction));
     if s.contact == "sliding-elastic" {
         let _ = writeln!(w, "      <search_radius>{}</search_radius>", num(s.search_radius_mm));
+        let _ = writeln!(w, "      <seg_up>{}</seg_up>", s.seg_up);
         let _ = writeln!(w, "      <symmetric_stiffness>0</symmetric_stiffness>");
     }
     let _ = writeln!(w, "    </contact>");

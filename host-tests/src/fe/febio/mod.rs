@@ -235,7 +235,7 @@ impl Backend for FebioBackend {
 pub fn settings_line(s: &crate::fe::spec::FebioSettings, friction: f64, threads: usize, retry: bool) -> String {
     let (dtol, rtol) = if retry { (s.retry_dtol, s.retry_rtol) } else { (s.dtol, s.rtol) };
     format!(
-        "{} contact, primary {}, {} penalty {}{}{}, friction {friction}; {}, max_refs {}, dtol {} etol {} rtol {}; Pardiso, {threads} thread(s)",
+        "{} contact, primary {}, {} penalty {}{}{}, friction {friction}, projections updated {}; {}, max_refs {}, dtol {} etol {} rtol {}; Pardiso, {threads} thread(s)",
         s.contact,
         s.primary,
         if s.augmented { "augmented Lagrangian" } else { "pure" },
@@ -246,6 +246,7 @@ pub fn settings_line(s: &crate::fe::spec::FebioSettings, friction: f64, threads:
         } else {
             String::new()
         },
+        if s.seg_up == 0 { "every iteration".to_string() } else { format!("in the first {} iterations of each augmentation", s.seg_up) },
         if s.max_ups == 0 { "full Newton".to_string() } else { format!("BFGS {} updates", s.max_ups) },
         s.max_refs,
         dtol,
