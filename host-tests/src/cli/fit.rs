@@ -86,6 +86,9 @@ pub fn fit(a: FitArgs) -> Result<ExitCode> {
     write_atomic(&golden_path, out.golden_csv.as_bytes())?;
     write_atomic(&golden_fixed_path, out.golden_fixed_csv.as_bytes())?;
     print!("{}", fit::summary(&out.model));
+    let coupled = fit::coupled_report::measure(&a.set, &out.model)
+        .with_context(|| format!("needle fit --set {}: measuring the coupled form", a.set.display()))?;
+    print!("{}", fit::coupled_report::to_table(&coupled));
     println!("wrote {} ({} bytes)", model_path.display(), out.model_toml.len());
     println!("wrote {} ({} poses)", golden_path.display(), out.golden_csv.lines().count() - 1);
     println!("wrote {} ({} poses)", golden_fixed_path.display(), out.golden_fixed_csv.lines().count() - 1);

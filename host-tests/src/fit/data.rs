@@ -273,12 +273,25 @@ pub struct Unusable {
 /// The spec or the manifest cannot be loaded, or a present run cannot be read or has the
 /// wrong depths.
 pub fn load_validation_runs(set_dir: &Path) -> Result<(Campaign, Vec<Run>, Vec<Unusable>)> {
+    load_runs_where(set_dir, |r| r.is_validation() || r == Role::Mirror)
+}
+
+/// The training runs of a set (role train, in spec order: `train-01`, ...) and those that
+/// cannot be used (missing or stale).
+///
+/// # Errors
+/// As [`load_validation_runs`].
+pub fn load_training_runs(set_dir: &Path) -> Result<(Campaign, Vec<Run>, Vec<Unusable>)> {
+    load_runs_where(set_dir, |r| r == Role::Train)
+}
+
+fn load_runs_where(set_dir: &Path, keep: impl Fn(Role) -> bool) -> Result<(Campaign, Vec<Run>, Vec<Unusable>)> {
     let (campaign, _) = spec::load(set_dir)?;
     let manifest = read_set_manifest(set_dir)?;
     let mut runs = Vec::new();
     let mut unusable = Vec::new();
     for pose in campaign.poses() {
-        if !(pose.role.is_validation() || pose.role == Role::Mirror) {
+        if !keep(pose.role) {
             continue;
         }
         if !run_path(set_dir, &pose).is_file() {

@@ -11,6 +11,8 @@
 //! whether its errors follow the tilt or the offset.
 
 pub mod contract;
+pub mod coupled;
+pub mod coupled_report;
 pub mod data;
 pub mod error_trend;
 pub mod eval_f32;
