@@ -7,3 +7,4 @@ pub mod fe;
 pub mod firmware;
 pub mod fit;
 pub mod fixed_error;
+pub mod plot;

@@ -12,7 +12,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// FE campaign on CalculiX: run, verify.
+    /// FE campaign (FEBio or CalculiX): run, verify.
     #[command(subcommand)]
     Fe(needle_host::cli::fe::FeCommand),
     /// Fit the paper model to a set's FE sweeps and write model.toml and golden vectors.
@@ -21,6 +21,8 @@ enum Command {
     Eval(needle_host::cli::model::EvalArgs),
     /// Compare the model with the FE runs it was not fitted on.
     Validate(needle_host::cli::fit::ValidateArgs),
+    /// The set's figures as SVG (the paper's Figs 4, 6, 7, 8, parity, FE verification).
+    Plot(needle_host::cli::plot::PlotArgs),
     /// The fixed-point evaluator's error against f64 on a grid and random poses, beside
     /// its generated bound.
     FixedError(needle_host::cli::fixed::FixedErrorArgs),
@@ -38,6 +40,7 @@ fn main() -> ExitCode {
         Command::Fit(a) => needle_host::cli::fit::fit(a),
         Command::Eval(a) => needle_host::cli::model::eval(a),
         Command::Validate(a) => needle_host::cli::fit::validate(a),
+        Command::Plot(a) => needle_host::cli::plot::plot(a),
         Command::Header(a) => needle_host::cli::model::header(a),
         Command::FixedError(a) => needle_host::cli::fixed::fixed_error(a),
         Command::Firmware(c) => needle_host::cli::firmware::run(c),

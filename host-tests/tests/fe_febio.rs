@@ -95,8 +95,10 @@ fn a_bad_febio_path_is_a_clear_error() {
 
 /// A solve that fails (here: a wrapper around the real febio4 that reports an error
 /// termination for one pose, as a crash or a diverged run does) is reported with
-/// FEBio's words and each attempt's log and input kept, is retried twice (the last
-/// time with a softer contact penalty), and the campaign finishes the other poses.
+/// FEBio's words and each attempt's log and input kept, is retried four times (the
+/// ladder of `FebioBackend::attempts`: the other projection rule, quarter first
+/// increments, both, a softer contact penalty), and the campaign finishes the other
+/// poses.
 #[test]
 fn a_failing_run_keeps_its_log_and_the_campaign_goes_on() {
     let (real, _) = require_febio();
@@ -117,24 +119,30 @@ fn a_failing_run_keeps_its_log_and_the_campaign_goes_on() {
     assert_eq!(o.status.code(), Some(1), "{}", show(&o));
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(out.contains("FAILED z+02") && out.contains("Fake divergence for the test."), "{}", show(&o));
-    assert!(out.contains("retry 1 (first increment 0.25)") && out.contains("retry 2 (first increment 0.25)"), "retried twice: {out}");
+    for (n, first) in [(1, "1"), (2, "0.25"), (3, "0.25"), (4, "0.25")] {
+        assert!(out.contains(&format!("retry {n} (first increment {first})")), "retry {n}: {out}");
+    }
     assert!(set.join("fe").join("centre.csv").exists(), "the other pose is solved");
     assert!(!set.join("fe").join("z+02.csv").exists());
     let kept = set.join("fe").join(".work").join("z+02");
-    for attempt in 1..=3 {
+    for attempt in 1..=5 {
         for ext in ["log", "feb"] {
             let f = kept.join(format!("failed-attempt-{attempt}.{ext}"));
             assert!(f.exists(), "{} kept", f.display());
         }
     }
-    let last = std::fs::read_to_string(kept.join("failed-attempt-3.feb")).unwrap_or_default();
-    let first = std::fs::read_to_string(kept.join("failed-attempt-1.feb")).unwrap_or_default();
-    let penalty = |t: &str| {
-        let l = t.lines().find(|l| l.contains("<penalty>"))?;
-        l.trim().trim_start_matches("<penalty>").trim_end_matches("</penalty>").parse::<f64>().ok()
+    let feb = |n: u32| std::fs::read_to_string(kept.join(format!("failed-attempt-{n}.feb"))).unwrap_or_default();
+    let value = |t: &str, tag: &str| {
+        let l = t.lines().find(|l| l.contains(&format!("<{tag}>")))?;
+        l.trim().trim_start_matches(&format!("<{tag}>")).trim_end_matches(&format!("</{tag}>")).parse::<f64>().ok()
     };
-    let (p1, p3) = (penalty(&first), penalty(&last));
-    assert!(matches!((p1, p3), (Some(a), Some(b)) if (b / a - 0.1).abs() < 1e-12), "the last attempt's contact is 10x softer: {p1:?} -> {p3:?}");
+    let (p1, p5) = (value(&feb(1), "penalty"), value(&feb(5), "penalty"));
+    assert!(matches!((p1, p5), (Some(a), Some(b)) if (b / a - 0.1).abs() < 1e-12), "the last attempt's contact is 10x softer: {p1:?} -> {p5:?}");
+    let seg_up: Vec<Option<f64>> = (1..=5).map(|n| value(&feb(n), "seg_up")).collect();
+    assert_eq!(seg_up, [Some(5.0), Some(0.0), Some(5.0), Some(0.0), Some(5.0)], "seg_up of campaign.toml, then retry_seg_up on attempts 2 and 4");
+    let steps: Vec<Option<f64>> = (1..=5).map(|n| value(&feb(n), "time_steps")).collect();
+    let s1 = steps[0].unwrap_or(0.0);
+    assert!(s1 > 0.0 && steps == [Some(s1), Some(s1), Some(4.0 * s1), Some(4.0 * s1), Some(4.0 * s1)], "quarter first increments from attempt 3 on: {steps:?}");
 }
 
 /// Tolerance of the coarse FEBio punch, %. `punch_mesh_scale = 2` (8 hex8 elements across

@@ -5,3 +5,4 @@ pub mod firmware;
 pub mod fit;
 pub mod fixed;
 pub mod model;
+pub mod plot;

@@ -94,10 +94,20 @@ pub trait Backend: Sync {
     fn engine(&self) -> &'static str;
 
     /// How many attempts a pose gets before it is failed (the first and the retries);
-    /// attempt 1 on starts each load step at [`deck::RETRY_FIRST_INCREMENT`], what else a
-    /// later attempt changes is the engine's.
+    /// what each attempt changes is the engine's ([`Backend::first_increment`] and the
+    /// engine's own settings).
     fn attempts(&self) -> u32 {
         2
+    }
+
+    /// The first increment of each load step on `attempt`, as a fraction of the step: the
+    /// whole step on the first attempt, [`deck::RETRY_FIRST_INCREMENT`] on the retries.
+    fn first_increment(&self, attempt: u32) -> f64 {
+        if attempt == 0 {
+            1.0
+        } else {
+            deck::RETRY_FIRST_INCREMENT
+        }
     }
 
     /// Solve one pose in `job.work_dir`.

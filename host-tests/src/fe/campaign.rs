@@ -363,9 +363,9 @@ fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
 fn solve_with_retry(backend: &dyn Backend, job: &Job<'_>) -> std::result::Result<Solved, SolveFailure> {
     let mut failures: Vec<String> = Vec::new();
     let attempts = backend.attempts().max(1);
-    let r = deck::RETRY_FIRST_INCREMENT;
     for attempt in 0..attempts {
-        let this = Job { first_increment: if attempt == 0 { 1.0 } else { r }, attempt, ..*job };
+        let r = backend.first_increment(attempt);
+        let this = Job { first_increment: r, attempt, ..*job };
         match backend.solve(&this) {
             Ok(s) => return Ok(Solved { retry: (!failures.is_empty()).then(|| failures.join("; ")), ..s }),
             Err(f) => {
@@ -375,11 +375,12 @@ fn solve_with_retry(backend: &dyn Backend, job: &Job<'_>) -> std::result::Result
                     return Err(SolveFailure { message: failures.join("; "), log_tail: f.log_tail });
                 }
                 eprintln!(
-                    "{}: {}; retry {} of {} with each step's first increment at {r} of the step",
+                    "{}: {}; retry {} of {} with each step's first increment at {} of the step",
                     job.pose.name,
                     failures.last().map(String::as_str).unwrap_or_default(),
                     attempt + 1,
-                    attempts - 1
+                    attempts - 1,
+                    backend.first_increment(attempt + 1)
                 );
             }
         }

@@ -248,6 +248,11 @@ pub struct FebioSettings {
     /// iteration (FEBio's default). A node sliding over a facet edge can otherwise flip
     /// between two facets from one iteration to the next and stall Newton's method.
     pub seg_up: u32,
+    /// `seg_up` of the retries that try the other projection rule (FEBio attempts 2 and
+    /// 4, see `FebioBackend::attempts`); 0: every iteration. Left out of the run hash
+    /// when 0, so adding it kept the results solved before it existed.
+    #[serde(default, skip_serializing_if = "is_zero_u32")]
+    pub retry_seg_up: u32,
     /// Quasi-Newton updates between stiffness reformations (0: full Newton).
     pub max_ups: u32,
     /// Most stiffness reformations per time step.
@@ -273,7 +278,7 @@ pub struct FebioSettings {
     pub retry_dtol: f64,
     /// `rtol` of the retry.
     pub retry_rtol: f64,
-    /// `penalty` times this on the last attempt (the second retry), in (0, 1]: a softer
+    /// `penalty` times this on the last attempt (the fourth retry), in (0, 1]: a softer
     /// contact for poses whose Newton iterations chatter on the stiff one (seen on the
     /// committed mesh at theta_x = 15 degrees and Table 2's t2-b: "max nr of
     /// reformations" in both earlier attempts). The augmentations still hold the gap
@@ -296,6 +301,7 @@ impl Default for FebioSettings {
             search_tol: 0.01,
             search_radius_mm: 1.0,
             seg_up: 0,
+            retry_seg_up: 0,
             max_ups: 0,
             max_refs: 15,
             opt_iter: 10,
@@ -764,6 +770,10 @@ impl Campaign {
         let json = serde_json::to_string(&key).unwrap_or_default();
         hex(&Sha256::digest(json.as_bytes()))
     }
+}
+
+fn is_zero_u32(v: &u32) -> bool {
+    *v == 0
 }
 
 fn check_pose(pose: &PoseSpec, p: &str) -> Result<()> {
