@@ -1,5 +1,6 @@
 //! The `needle` command line: one module per command group.
 
+pub mod eval_batch;
 pub mod fe;
 pub mod firmware;
 pub mod fit;

@@ -17,21 +17,28 @@ pub struct EvalArgs {
     #[arg(long, value_name = "DIR")]
     pub set: PathBuf,
     /// x of the insertion point on the top surface, mm.
-    #[arg(long, allow_negative_numbers = true)]
-    pub x_mm: f32,
+    #[arg(long, allow_negative_numbers = true, required_unless_present = "poses", conflicts_with = "poses")]
+    pub x_mm: Option<f32>,
     /// z of the insertion point on the top surface, mm.
-    #[arg(long, allow_negative_numbers = true)]
-    pub z_mm: f32,
+    #[arg(long, allow_negative_numbers = true, required_unless_present = "poses", conflicts_with = "poses")]
+    pub z_mm: Option<f32>,
     /// Tilt about x away from vertical, degrees.
-    #[arg(long, allow_negative_numbers = true)]
-    pub theta_x_deg: f32,
+    #[arg(long, allow_negative_numbers = true, required_unless_present = "poses", conflicts_with = "poses")]
+    pub theta_x_deg: Option<f32>,
     /// Tilt about z away from vertical, degrees.
-    #[arg(long, allow_negative_numbers = true)]
-    pub theta_z_deg: f32,
+    #[arg(long, allow_negative_numbers = true, required_unless_present = "poses", conflicts_with = "poses")]
+    pub theta_z_deg: Option<f32>,
     /// Insertion depth along the needle axis, mm.
-    #[arg(long, allow_negative_numbers = true)]
-    pub depth_mm: f32,
-    /// Print one JSON object instead of the table.
+    #[arg(long, allow_negative_numbers = true, required_unless_present = "poses", conflicts_with = "poses")]
+    pub depth_mm: Option<f32>,
+    /// Evaluate every row of this CSV file (columns x_mm, z_mm, theta_x_deg,
+    /// theta_z_deg, depth_mm) instead of one pose; one output row per input row.
+    #[arg(long, value_name = "FILE.csv")]
+    pub poses: Option<PathBuf>,
+    /// With --poses: write the rows to this file instead of standard output.
+    #[arg(long, value_name = "FILE", requires = "poses")]
+    pub out: Option<PathBuf>,
+    /// Print JSON (one object; with --poses an array) instead of the table (CSV).
     #[arg(long)]
     pub json: bool,
 }
@@ -140,13 +147,15 @@ pub fn eval_json(pose: &Pose, e: &Evaluation) -> serde_json::Value {
 /// `--set` is not the set compiled into this build (see [`check_compiled_set`]).
 pub fn eval(a: EvalArgs) -> anyhow::Result<ExitCode> {
     check_compiled_set(&a.set)?;
-    let pose = Pose {
-        x_mm: a.x_mm,
-        z_mm: a.z_mm,
-        theta_x_deg: a.theta_x_deg,
-        theta_z_deg: a.theta_z_deg,
-        depth_mm: a.depth_mm,
+    if let Some(file) = &a.poses {
+        return eval_file(file, a.out.as_deref(), a.json);
+    }
+    let (Some(x_mm), Some(z_mm), Some(theta_x_deg), Some(theta_z_deg), Some(depth_mm)) =
+        (a.x_mm, a.z_mm, a.theta_x_deg, a.theta_z_deg, a.depth_mm)
+    else {
+        bail!("give the five pose values (--x-mm, --z-mm, --theta-x-deg, --theta-z-deg, --depth-mm) or --poses FILE.csv");
     };
+    let pose = Pose { x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm };
     let e = wrench(&pose);
     if a.json {
         println!("{}", serde_json::to_string_pretty(&eval_json(&pose, &e))?);
@@ -170,6 +179,31 @@ pub fn eval(a: EvalArgs) -> anyhow::Result<ExitCode> {
         println!("status  = {:#04x} ({}): {meaning}", e.status.bits(), e.status);
     }
     Ok(if e.status.is_error() { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+/// `needle eval --poses FILE`: every row of the file (see [`super::eval_batch`]). Exit
+/// code 0; the rows with an error status carry it in their status column.
+///
+/// # Errors
+/// The file cannot be read, has a bad header or bad rows (all listed, by line), or the
+/// output cannot be written.
+fn eval_file(file: &Path, out: Option<&Path>, json: bool) -> anyhow::Result<ExitCode> {
+    use super::eval_batch::{evaluate, parse_poses, to_csv, to_json};
+    let text = std::fs::read_to_string(file).with_context(|| format!("{}: cannot read", file.display()))?;
+    let poses = parse_poses(&text, file)?;
+    let evals = evaluate(&poses);
+    let body = if json { serde_json::to_string_pretty(&to_json(&poses, &evals))? + "\n" } else { to_csv(&poses, &evals) };
+    match out {
+        Some(path) => {
+            crate::fe::results::write_atomic(path, body.as_bytes())?;
+            eprintln!("wrote {} ({} poses)", path.display(), poses.len());
+        }
+        None => {
+            use std::io::Write as _;
+            std::io::stdout().lock().write_all(body.as_bytes()).context("writing to standard output")?;
+        }
+    }
+    Ok(ExitCode::SUCCESS)
 }
 
 /// `needle header`: writes the C header generated with the compiled-in tables to

@@ -99,7 +99,7 @@ fn draw_panel(p: &Panel, area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shi
         .y_desc(&p.y_label)
         .x_labels(7)
         .y_labels(7)
-        .y_label_formatter(&|v| format!("{v:.3e}"))
+        .y_label_formatter(&|v| if v.abs() < 1e-12 { "0".to_string() } else { format!("{v:.3e}") })
         .label_style(("sans-serif", 11))
         .draw()
         .map_err(err(&p.title))?;

@@ -1,0 +1,112 @@
+//! `needle eval --poses FILE.csv`: the library's wrench for every row of a pose file.
+//!
+//! Input: a CSV file with a header naming the columns `x_mm`, `z_mm`, `theta_x_deg`,
+//! `theta_z_deg`, `depth_mm` (any order, other columns ignored), one pose per row.
+//! Every row must hold five numbers (NaN and infinities are numbers: the library
+//! answers them with the error status); a row that does not is reported as
+//! `FILE:LINE: column NAME: "TEXT" is not a number`, every such row is listed, and
+//! nothing is written. Output: one row per input row, in input order.
+
+use anyhow::{bail, Context, Result};
+use needle_haptics::{wrench, Evaluation, Pose};
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Input columns, in the order of [`Pose`]'s fields.
+pub const POSE_COLUMNS: [&str; 5] = ["x_mm", "z_mm", "theta_x_deg", "theta_z_deg", "depth_mm"];
+
+/// Output header of the CSV form.
+pub const OUTPUT_HEADER: &str = "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm,status";
+
+/// Most bad rows listed in one error message (the count is always given).
+const MAX_LISTED: usize = 20;
+
+/// Parse the pose file `text` (named `path` in messages).
+///
+/// # Errors
+/// No header or a missing column; rows that are not five numbers (all listed, by line).
+pub fn parse_poses(text: &str, path: &Path) -> Result<Vec<Pose>> {
+    let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).flexible(true).from_reader(text.as_bytes());
+    let header = rdr.headers().with_context(|| format!("{}:1: cannot read the header", path.display()))?.clone();
+    let mut idx = [0usize; 5];
+    for (slot, name) in idx.iter_mut().zip(POSE_COLUMNS) {
+        *slot = header.iter().position(|h| h == name).with_context(|| {
+            format!("{}:1: no column {name:?} in the header (need {})", path.display(), POSE_COLUMNS.join(", "))
+        })?;
+    }
+    let mut poses = Vec::new();
+    let mut bad: Vec<String> = Vec::new();
+    for rec in rdr.records() {
+        let rec = match rec {
+            Ok(r) => r,
+            Err(e) => {
+                let line = e.position().map_or(0, |p| p.line());
+                bad.push(format!("{}:{line}: {e}", path.display()));
+                continue;
+            }
+        };
+        let line = rec.position().map_or(0, |p| p.line());
+        let mut v = [0f32; 5];
+        let mut ok = true;
+        for ((slot, &i), name) in v.iter_mut().zip(&idx).zip(POSE_COLUMNS) {
+            match rec.get(i).map(|t| (t, t.parse::<f32>())) {
+                Some((_, Ok(x))) => *slot = x,
+                Some((t, Err(_))) => {
+                    bad.push(format!("{}:{line}: column {name}: {t:?} is not a number", path.display()));
+                    ok = false;
+                }
+                None => {
+                    bad.push(format!("{}:{line}: column {name}: missing ({} fields in the row)", path.display(), rec.len()));
+                    ok = false;
+                }
+            }
+        }
+        if ok {
+            poses.push(Pose { x_mm: v[0], z_mm: v[1], theta_x_deg: v[2], theta_z_deg: v[3], depth_mm: v[4] });
+        }
+    }
+    if !bad.is_empty() {
+        let shown = bad.iter().take(MAX_LISTED).cloned().collect::<Vec<_>>().join("\n");
+        let more = if bad.len() > MAX_LISTED { format!("\n... and {} more", bad.len() - MAX_LISTED) } else { String::new() };
+        bail!("{} bad row(s), nothing evaluated:\n{shown}{more}", bad.len());
+    }
+    Ok(poses)
+}
+
+/// Evaluate every pose with the library.
+pub fn evaluate(poses: &[Pose]) -> Vec<Evaluation> {
+    poses.iter().map(wrench).collect()
+}
+
+/// The CSV form: [`OUTPUT_HEADER`], then per pose the inputs, the six components
+/// (shortest decimal that reads back to the same f32) and the status byte in hex.
+pub fn to_csv(poses: &[Pose], evals: &[Evaluation]) -> String {
+    let mut s = String::with_capacity(poses.len() * 160);
+    s.push_str(OUTPUT_HEADER);
+    s.push('\n');
+    for (p, e) in poses.iter().zip(evals) {
+        let w = e.wrench.to_array();
+        let _ = writeln!(
+            s,
+            "{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:#04x}",
+            p.x_mm,
+            p.z_mm,
+            p.theta_x_deg,
+            p.theta_z_deg,
+            p.depth_mm,
+            w[0],
+            w[1],
+            w[2],
+            w[3],
+            w[4],
+            w[5],
+            e.status.bits()
+        );
+    }
+    s
+}
+
+/// The JSON form: an array of `needle eval --json` objects.
+pub fn to_json(poses: &[Pose], evals: &[Evaluation]) -> serde_json::Value {
+    serde_json::Value::Array(poses.iter().zip(evals).map(|(p, e)| super::model::eval_json(p, e)).collect())
+}
