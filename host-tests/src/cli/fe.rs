@@ -34,11 +34,11 @@ pub struct RunArgs {
     pub solver: Option<String>,
     /// Number of solver jobs at the same time (memory: about 2.5 GB per ccx job on the
     /// committed mesh).
-    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=256))]
+    #[arg(long, value_name = "N", default_value_t = 1, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=256))]
     pub jobs: u32,
     /// Solver threads per job (FEBio's Pardiso and assembly; ccx always runs on one).
     /// Default: the machine's cores divided by --jobs.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=256))]
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=256))]
     pub threads: Option<u32>,
     /// Only the poses whose name matches this glob, e.g. 'x+*' or 'centre' (quote it), or
     /// any of several comma-separated globs, e.g. 'lhs-09,lhs-1*'.
@@ -97,7 +97,7 @@ pub struct VerifyArgs {
     #[arg(long, value_name = "DIR")]
     pub work: Option<PathBuf>,
     /// Solver threads of each solve (FEBio); default: all cores.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=256))]
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=256))]
     pub threads: Option<u32>,
     /// FE engine of the checks instead of campaign.toml's [solver] engine: febio or ccx.
     #[arg(long, value_name = "ENGINE", value_parser = ["febio", "ccx"])]

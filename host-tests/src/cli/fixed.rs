@@ -13,12 +13,14 @@ pub struct FixedErrorArgs {
     /// The coefficient set folder; must be the set compiled into this build.
     #[arg(long, value_name = "DIR")]
     pub set: PathBuf,
-    /// Grid points per input (edges included): N^5 poses.
-    #[arg(long, default_value_t = 11)]
-    pub grid: usize,
-    /// Random poses (ChaCha8, fixed seed) uniform over the domain, after the grid.
-    #[arg(long, default_value_t = 100_000)]
-    pub random: usize,
+    /// Grid points per input (edges included): N^5 poses; 2 ..= 41 (41^5 = 116 million
+    /// poses, minutes of work).
+    #[arg(long, default_value_t = 11, allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(2..=41))]
+    pub grid: u64,
+    /// Random poses (ChaCha8, fixed seed) uniform over the domain, after the grid; at
+    /// most 100 million.
+    #[arg(long, default_value_t = 100_000, allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(0..=100_000_000))]
+    pub random: u64,
 }
 
 /// `needle fixed-error --set DIR`: evaluate the library's fixed-point and the fitter's
@@ -30,10 +32,10 @@ pub struct FixedErrorArgs {
 /// `DIR` is not the compiled-in set, or its model.toml / campaign.toml is unreadable.
 pub fn fixed_error(a: FixedErrorArgs) -> anyhow::Result<ExitCode> {
     check_compiled_set(&a.set)?;
-    anyhow::ensure!(a.grid >= 2, "--grid must be at least 2 (the domain's edges)");
+
     let (model, lever) = fixed_error::load(&a.set)?;
     let mut stats = ErrorStats::default();
-    stats.add_grid(&model, a.grid);
+    stats.add_grid(&model, usize::try_from(a.grid)?);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x6669_7865_6400_0001);
     let max = [12i64 << 16, 12 << 16, 15 << 16, 15 << 16, 6 << 16];
     for _ in 0..a.random {

@@ -17,19 +17,19 @@ pub struct EvalArgs {
     #[arg(long, value_name = "DIR")]
     pub set: PathBuf,
     /// x of the insertion point on the top surface, mm.
-    #[arg(long, allow_negative_numbers = true, required_unless_present = "poses", conflicts_with = "poses")]
+    #[arg(long, allow_hyphen_values = true, required_unless_present = "poses", conflicts_with = "poses")]
     pub x_mm: Option<f32>,
     /// z of the insertion point on the top surface, mm.
-    #[arg(long, allow_negative_numbers = true, required_unless_present = "poses", conflicts_with = "poses")]
+    #[arg(long, allow_hyphen_values = true, required_unless_present = "poses", conflicts_with = "poses")]
     pub z_mm: Option<f32>,
     /// Tilt about x away from vertical, degrees.
-    #[arg(long, allow_negative_numbers = true, required_unless_present = "poses", conflicts_with = "poses")]
+    #[arg(long, allow_hyphen_values = true, required_unless_present = "poses", conflicts_with = "poses")]
     pub theta_x_deg: Option<f32>,
     /// Tilt about z away from vertical, degrees.
-    #[arg(long, allow_negative_numbers = true, required_unless_present = "poses", conflicts_with = "poses")]
+    #[arg(long, allow_hyphen_values = true, required_unless_present = "poses", conflicts_with = "poses")]
     pub theta_z_deg: Option<f32>,
     /// Insertion depth along the needle axis, mm.
-    #[arg(long, allow_negative_numbers = true, required_unless_present = "poses", conflicts_with = "poses")]
+    #[arg(long, allow_hyphen_values = true, required_unless_present = "poses", conflicts_with = "poses")]
     pub depth_mm: Option<f32>,
     /// Evaluate every row of this CSV file (columns x_mm, z_mm, theta_x_deg,
     /// theta_z_deg, depth_mm) instead of one pose; one output row per input row.
