@@ -360,7 +360,7 @@ fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
 /// Solve `job`; when that fails, again with [`deck::RETRY_FIRST_INCREMENT`], up to the
 /// backend's [`Backend::attempts`] (module docs). The failures so far go into the
 /// result's `retry` (or the final failure's message).
-fn solve_with_retry(backend: &dyn Backend, job: &Job<'_>) -> std::result::Result<Solved, SolveFailure> {
+pub(crate) fn solve_with_retry(backend: &dyn Backend, job: &Job<'_>) -> std::result::Result<Solved, SolveFailure> {
     let mut failures: Vec<String> = Vec::new();
     let attempts = backend.attempts().max(1);
     for attempt in 0..attempts {

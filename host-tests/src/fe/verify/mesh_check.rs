@@ -29,6 +29,9 @@ pub struct LevelRun {
     /// Why the run failed, when it did.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub failure: Option<String>,
+    /// The attempts that failed before the one that solved it (the campaign's retries).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub retry: Option<String>,
 }
 
 /// Mesh-convergence result.
@@ -108,8 +111,10 @@ pub(super) fn mesh_convergence(c: &Campaign, work: &Path, threads: usize) -> Res
             first_increment: 1.0,
             attempt: 0,
         };
+        // the campaign's attempts (Backend::attempts): a level is solved as a pose is;
+        // wall_s counts every attempt, the manifest-style `retry` says which failed
         let start = std::time::Instant::now();
-        let solved = backend.solve(&job);
+        let solved = crate::fe::campaign::solve_with_retry(backend.as_ref(), &job);
         let wall_s = start.elapsed().as_secs_f64();
         let run = match solved {
             Ok(s) => LevelRun {
@@ -120,6 +125,7 @@ pub(super) fn mesh_convergence(c: &Campaign, work: &Path, threads: usize) -> Res
                 wall_s,
                 threads,
                 failure: None,
+                retry: s.retry,
             },
             Err(f) => LevelRun {
                 level: level.clone(),
@@ -129,6 +135,7 @@ pub(super) fn mesh_convergence(c: &Campaign, work: &Path, threads: usize) -> Res
                 wall_s,
                 threads,
                 failure: Some(f.message),
+                retry: None,
             },
         };
         println!(
