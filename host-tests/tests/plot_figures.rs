@@ -53,8 +53,9 @@ fn a_changed_model_makes_the_figures_stale() {
     copy_dir(&default_set(), &set);
     let model = set.join("model.toml");
     let text = std::fs::read_to_string(&model).expect("model.toml");
-    // the Fy baseline's constant term (second [[baseline]]), times 1.01
+    // the Fy baseline's constant term (second [[baseline]]) times 1.01, and its f32 twin
     let mut seen = 0;
+    let mut new_f32: Option<f32> = None;
     let changed: Vec<String> = text
         .lines()
         .map(|l| {
@@ -64,7 +65,14 @@ fn a_changed_model_makes_the_figures_stale() {
                     let inner = l.trim_start_matches("coeffs = [").trim_end_matches(']');
                     let mut v: Vec<f64> = inner.split(',').map(|x| x.trim().parse().expect("number")).collect();
                     v[0] *= 1.01;
+                    new_f32 = Some(v[0] as f32);
                     return format!("coeffs = [{}]", v.iter().map(|x| format!("{x:?}")).collect::<Vec<_>>().join(", "));
+                }
+            }
+            if l.starts_with("coeffs_f32 = [") {
+                if let Some(f) = new_f32.take() {
+                    let rest = &l[l.find(',').expect("five values")..];
+                    return format!("coeffs_f32 = [\"0x{:08x}\"{rest}", f.to_bits());
                 }
             }
             l.to_string()
