@@ -1,6 +1,6 @@
 //! [`Pose`]: where the needle is and how far it has gone in.
 
-/// The needle's pose relative to the tissue block (frame of `design.md` §4: origin at
+/// The needle's pose relative to the tissue block (frame of `docs/architecture.md` §3: origin at
 /// the centre of the block's top surface, y up, the top surface is the x-z plane).
 ///
 /// The model's domain is `|x_mm|, |z_mm| <= 12`, `|theta_x_deg|, |theta_z_deg| <= 15`,

@@ -1,6 +1,6 @@
 //! [`Wrench`]: the reaction force and moment of the tissue on the needle.
 
-/// Reaction wrench of the tissue on the needle, in the block frame (`design.md` §4).
+/// Reaction wrench of the tissue on the needle, in the block frame (`docs/architecture.md` §3).
 ///
 /// Forces in newtons, moments in newton millimetres. The model's moments are about the
 /// needle's reference point: on the needle axis, `needle.reference_from_tip_mm` from the

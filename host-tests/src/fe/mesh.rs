@@ -1,7 +1,7 @@
 //! Hexahedral meshes of the tissue block (an O-grid refined around the needle's path)
 //! and of the needle (an O-grid cross-section swept along the axis, wedge tip).
 //!
-//! Frame (design.md section 4): origin at the centre of the top surface, y up, the
+//! Frame (docs/architecture.md section 3): origin at the centre of the top surface, y up, the
 //! block occupies |x| <= size_x/2, |z| <= size_z/2, -depth <= y <= 0.
 
 use super::spec::{Block, Campaign, MeshLevel, Needle, PoseSpec, Symmetry};

@@ -8,7 +8,7 @@ use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// The domain of the model (design.md section 4); poses outside it are refused.
+/// The domain of the model (docs/architecture.md section 3); poses outside it are refused.
 pub const X_MAX_MM: f64 = 12.0;
 /// Largest |z| of a pose, mm.
 pub const Z_MAX_MM: f64 = 12.0;
