@@ -33,6 +33,17 @@
 //! sweep's mirror, else `+1`. The exact f32 operation order is the contract in
 //! `coeffs/README.md`; [`wrench`] follows it bit for bit.
 //!
+//! A set fitted in the coupled form (`form = "coupled"` in its `model.toml`,
+//! [`model_info::COUPLED`]) adds cross terms to every component after the
+//! superposition:
+//!
+//! ```text
+//! w_c += sum over terms of  m(x/12, z/12, theta_x/15, theta_z/15) * P(u)
+//! ```
+//!
+//! with `m` a product of powers of at least two inputs, chosen so that every term keeps
+//! component c's mirror parities exactly, and `P` a polynomial in depth.
+//!
 //! Without a fitted model (a new set before `needle fit`), the library still builds
 //! (with a cargo warning) and [`wrench`] returns a zero wrench with
 //! `Status::NO_MODEL | Status::ERROR` for every pose ([`model_info::FITTED`] is `false`).
@@ -43,6 +54,7 @@
 mod bit_flags;
 pub mod control;
 pub mod command;
+mod cross_f32;
 mod evaluation;
 pub mod fixed;
 mod horner;

@@ -1,4 +1,5 @@
 //! The paper model in f32: the evaluation algorithm of `coeffs/README.md`, bit-exact.
+use crate::cross_f32::{add_cross, COUPLED, CROSS_SCALES};
 use crate::horner::horner;
 use crate::tables::{BASELINE, DEPTH_MAX_MM, DEVIATION, FITTED, THETA_MAX_DEG, X_MAX_MM, Z_MAX_MM};
 use crate::{Evaluation, Pose, Status, Wrench};
@@ -279,7 +280,9 @@ fn clamp_depth(d: f32, max: f32) -> (f32, bool) {
 /// 3. `u = depth * (1/3) - 1`, and per sweep `t = |v| * (2/V) - 1`;
 /// 4. `w_c = B_c(u)`, then for x, z, theta_x, theta_z in that order
 ///    `w_c = w_c ± D_c(t, u)`, minus when the sweep value is negative and the component
-///    is odd under that sweep's mirror.
+///    is odd under that sweep's mirror;
+/// 5. coupled form only ([`model_info::COUPLED`](crate::model_info::COUPLED)): the cross
+///    terms, `w_c = w_c + m * P(u)` per term with `m` a product of the normalised inputs.
 ///
 /// The wrench is that of the clamped pose; forces in N, moments in N·mm about the
 /// needle's reference point (see [`Wrench`]).
@@ -319,6 +322,10 @@ pub fn wrench(pose: &Pose) -> Evaluation {
     let Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, depth_mm: d } = clamped;
 
     let u = d * ONE_THIRD - 1.0;
-    let w = superpose([x, z, tx, tz], u);
+    let mut w = superpose([x, z, tx, tz], u);
+    if COUPLED {
+        let [rx, rz, rtx, rtz] = CROSS_SCALES;
+        add_cross([x * rx, z * rz, tx * rtx, tz * rtz], u, &mut w);
+    }
     Evaluation { wrench: Wrench::from_array(w), status }
 }

@@ -8,6 +8,8 @@ pub use crate::tables::{
     Z_MAX_MM,
 };
 
+pub use crate::cross_f32::{COUPLED, CROSS_SCALES, CROSS_TERMS, CV_RMS_PCT, CV_SCALE, TRAINING_RUNS};
+
 /// `ODD[k][c]`: wrench component `c` (fx, fy, fz, mx, my, mz) changes sign under the
 /// mirror of sweep `k` (x, z, theta_x, theta_z). Fixed by the geometry (coeffs/README.md);
 /// every model file is checked against it at build time.
@@ -24,3 +26,7 @@ pub const C_HEADER: &str = include_str!(concat!(env!("OUT_DIR"), "/needle_coeffs
 /// The generated Rust source of the tables compiled into this build (for audits and the
 /// regeneration test).
 pub const TABLES_RS: &str = include_str!(concat!(env!("OUT_DIR"), "/tables_f32.rs"));
+
+/// The generated Rust source of the coupled form's cross terms compiled into this build
+/// (for audits and the regeneration test).
+pub const CROSS_RS: &str = include_str!(concat!(env!("OUT_DIR"), "/cross_f32.rs"));

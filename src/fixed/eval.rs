@@ -1,5 +1,6 @@
 //! The fixed-point evaluator: the integer algorithm of `coeffs/README.md`, bit-exact.
 use super::arith::{clamp, horner, normalise};
+use super::cross::{add_cross, cross_input, CROSS_DIVISORS};
 use super::tables::{
     BASELINE, DEPTH_DIVISOR, DEPTH_MAX_MM_Q16, FRAC_BITS, ODD, ROWS, SHIFTS, SWEEP_DIVISORS, THETA_MAX_DEG_Q16,
     X_MAX_MM_Q16, Z_MAX_MM_Q16,
@@ -23,7 +24,9 @@ use crate::Status;
 ///    `A_i ±= h(ROWS[c][k][i], T_k) >> SHIFTS[c][k][i]` (minus when the sweep value is
 ///    negative and c is odd under that sweep's mirror), with `h` a Horner whose products
 ///    are `floor(a * w / 2^15)`;
-/// 4. `W = h(A, U)`, and the result `(W + 2^(G-1)) >> G` in µN or µN·mm
+/// 4. coupled form only: `N_k = sign(v_k) * ((|v_k| + V_k) / (2 V_k))` (Q15) and per cross
+///    term `A_i += (P[i] * M >> 15) >> shift` with `M` the Q15 monomial (generated code);
+/// 5. `W = h(A, U)`, and the result `(W + 2^(G-1)) >> G` in µN or µN·mm
 ///    ([`tables::FRAC_BITS`](super::tables::FRAC_BITS) = G).
 ///
 /// No intermediate can overflow: the code generator bounds every one of them over the
@@ -68,20 +71,24 @@ pub fn wrench(pose: &Pose) -> Evaluation {
     ];
     let negative = [x < 0, z < 0, tx < 0, tz < 0];
 
-    let mut w = [0_i32; 6];
-    let tables = ROWS.iter().zip(SHIFTS.iter()).zip(BASELINE.iter()).zip(ODD.iter()).zip(FRAC_BITS.iter());
-    for (wc, ((((rows, shifts), base), odd), &g)) in w.iter_mut().zip(tables) {
-        let mut a = *base;
+    let mut a = BASELINE;
+    let tables = ROWS.iter().zip(SHIFTS.iter()).zip(ODD.iter());
+    for (ac, ((rows, shifts), odd)) in a.iter_mut().zip(tables) {
         for ((((rows_k, shifts_k), &tk), &neg), &o) in
             rows.iter().zip(shifts.iter()).zip(t.iter()).zip(negative.iter()).zip(odd.iter())
         {
             let flip = neg && o;
-            for ((ai, row), &s) in a.iter_mut().zip(rows_k.iter()).zip(shifts_k.iter()) {
+            for ((ai, row), &s) in ac.iter_mut().zip(rows_k.iter()).zip(shifts_k.iter()) {
                 let r = horner(row, tk).wrapping_shr(s);
                 *ai = if flip { ai.wrapping_sub(r) } else { ai.wrapping_add(r) };
             }
         }
-        let acc = horner(&a, u);
+    }
+    let [cx, cz, ctx, ctz] = CROSS_DIVISORS;
+    add_cross([cross_input(x, cx), cross_input(z, cz), cross_input(tx, ctx), cross_input(tz, ctz)], &mut a);
+    let mut w = [0_i32; 6];
+    for ((wc, ac), &g) in w.iter_mut().zip(a.iter()).zip(FRAC_BITS.iter()) {
+        let acc = horner(ac, u);
         *wc = acc.wrapping_add(1_i32.wrapping_shl(g) >> 1).wrapping_shr(g);
     }
     Evaluation { wrench: Wrench::from_array(w), status }

@@ -27,6 +27,7 @@
 //! `coeffs/<set>/golden-fixed.csv`, which this evaluator reproduces bit for bit.
 
 mod arith;
+mod cross;
 mod eval;
 mod pose;
 pub mod tables;

@@ -41,6 +41,10 @@ pub const ONE_THIRD_F32: f32 = 1.0 / 3.0;
 /// The nearest f32 to `2 / V_k` for each sweep (`t = |v| * s_k - 1`).
 pub const SWEEP_SCALES_F32: [f32; 4] = [2.0 / 12.0, 2.0 / 12.0, 2.0 / 15.0, 2.0 / 15.0];
 
+/// The nearest f32 to `1 / V_k` for each input: the coupled form's cross-term inputs are
+/// `n_k = v_k * CROSS_SCALES_F32[k]` (coeffs/README.md, "The coupled form").
+pub const CROSS_SCALES_F32: [f32; 4] = [1.0 / 12.0, 1.0 / 12.0, 1.0 / 15.0, 1.0 / 15.0];
+
 /// Status bits of the evaluation (name, value), as in the library's `Status`.
 pub const STATUS_BITS: [(&str, u8); 8] = [
     ("OK", 0x00),

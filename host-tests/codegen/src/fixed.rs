@@ -25,6 +25,10 @@ pub const DEPTH_DIVISOR: u32 = 6;
 /// `T_k = (|V_k| + d / 2) / d - 32768` with `d = SWEEP_DIVISORS[k]` (x, z: 12; theta_x,
 /// theta_z: 15): t = |v| * 2 / V - 1 in Q15, rounded to nearest.
 pub const SWEEP_DIVISORS: [u32; 4] = [12, 12, 15, 15];
+/// `N_k = sign(v_k) * ((|v_k| + d / 2) / d)` with `d = CROSS_DIVISORS[k]` (x, z: 24;
+/// theta_x, theta_z: 30): the coupled form's signed input `n = v / V` in Q15, its
+/// magnitude rounded to nearest (coeffs/README.md, "The coupled form").
+pub const CROSS_DIVISORS: [u32; 4] = [24, 24, 30, 30];
 /// Every intermediate of the integer evaluation has a magnitude of at most `2^30`.
 pub const LIMIT: i64 = 1 << 30;
 /// Largest number of fractional bits of any format.
@@ -52,9 +56,25 @@ pub struct FixedRow {
     pub bound: i64,
 }
 
+/// One cross term of the coupled form in fixed point: `A_i += (P[i] * M >> 15) >> shift`
+/// with `M` the Q15 monomial of `exponents`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FixedCross {
+    /// Exponents of `(xi, zeta, alpha, beta)`.
+    pub exponents: [u8; 4],
+    /// Integer coefficients in Q(`frac_bits`) micro-units; `coeffs[i]` goes to `A_i`.
+    pub coeffs: Vec<i32>,
+    /// Fractional bits `F` of the term: the largest in `0..=30` with every `|P[i]| <= 2^30`.
+    pub frac_bits: u32,
+    /// `frac_bits - G` of the component (>= 0).
+    pub shift: u32,
+    /// 1-based line of the `[[cross]]` entry.
+    pub line: usize,
+}
+
 /// One wrench component: its 20 row polynomials, the shifts that align them to the
 /// component's accumulator format, the baseline in that format, and the bounds.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct FixedComponent {
     /// `rows[k][i]`: row `i` (power of u) of sweep `k`'s deviation matrix.
     pub rows: [[FixedRow; 5]; 4],
@@ -70,6 +90,9 @@ pub struct FixedComponent {
     pub horner_bound: i64,
     /// Error bound of the integer result against the f64 evaluation, in micro-units.
     pub error_bound: ErrorBound,
+    /// The coupled form's cross terms of this component, in file order (empty for the
+    /// paper form).
+    pub cross: Vec<FixedCross>,
 }
 
 /// The fixed-point tables of a model.
@@ -92,19 +115,32 @@ fn choose_row(c: &[f64; 5]) -> Option<FixedRow> {
     })
 }
 
+/// The largest `f` in `0..=MAX_FRAC_BITS` with every `|q(c_i, f)| <= LIMIT`: a cross
+/// term's format (its products `P[i] * M >> 15` are then within `LIMIT` too, `|M| <= 2^15`).
+fn choose_cross(c: &[f64]) -> Option<(u32, Vec<i32>)> {
+    (0..=MAX_FRAC_BITS).rev().find_map(|f| {
+        let q: Vec<i64> = c.iter().map(|v| quantize(*v, f)).collect();
+        q.iter().all(|v| v.unsigned_abs() <= LIMIT as u64).then(|| (f, q.iter().map(|v| *v as i32).collect()))
+    })
+}
+
 /// `ceil(s / 2^shift)` for `s >= 0`: the bound of `|r >> shift|` when `|r| <= s`.
 fn shifted_bound(s: i64, shift: u32) -> i64 {
     (s + (1i64 << shift) - 1) >> shift
 }
 
 /// `(a_bounds, horner_bound, baseline)` of a component at accumulator format `g`.
-fn component_bounds(rows: &[[FixedRow; 5]; 4], base: &[f64; 5], g: u32) -> ([i64; 5], i64, [i64; 5]) {
+fn component_bounds(rows: &[[FixedRow; 5]; 4], cross: &[FixedCross], base: &[f64; 5], g: u32) -> ([i64; 5], i64, [i64; 5]) {
     let baseline = base.map(|b| quantize(b, g));
     let mut a = [0i64; 5];
     for (i, ai) in a.iter_mut().enumerate() {
         let mut s = i128::from(baseline[i]).abs();
         for row in rows {
             s += i128::from(shifted_bound(row[i].bound, row[i].frac_bits - g));
+        }
+        for x in cross {
+            let p = x.coeffs.get(i).map_or(0, |v| i64::from(*v).abs());
+            s += i128::from(shifted_bound(p, x.frac_bits - g));
         }
         *ai = s.min(i128::from(i64::MAX)) as i64;
     }
@@ -145,23 +181,48 @@ pub fn fixed_tables(model: &Model, model_path: &Path) -> Result<FixedTables, Cod
                 })?;
             }
         }
-        let max_g = rows.iter().flatten().map(|r| r.frac_bits).min().unwrap_or(MAX_FRAC_BITS);
+        let mut cross = Vec::new();
+        for t in model.cross.iter().filter(|t| t.component == c) {
+            let (frac_bits, coeffs) = choose_cross(&t.coeffs).ok_or_else(|| {
+                at(
+                    t.line,
+                    format!(
+                        "cross {} {:?}: a coefficient does not fit the fixed-point evaluator: |coeffs| up to {:e} {}, over 2^30 = {LIMIT} micro-units even with 0 fractional bits",
+                        COMPONENTS[c],
+                        t.exponents,
+                        t.coeffs.iter().map(|v| v.abs()).fold(0.0, f64::max),
+                        crate::contract::UNITS[c]
+                    ),
+                )
+            })?;
+            cross.push(FixedCross { exponents: t.exponents, coeffs, frac_bits, shift: 0, line: t.line });
+        }
+        let max_g = rows
+            .iter()
+            .flatten()
+            .map(|r| r.frac_bits)
+            .chain(cross.iter().map(|x| x.frac_bits))
+            .min()
+            .unwrap_or(MAX_FRAC_BITS);
         let chosen = (0..=max_g).rev().find_map(|g| {
-            let (a, total, baseline) = component_bounds(&rows, &base.coeffs, g);
+            let (a, total, baseline) = component_bounds(&rows, &cross, &base.coeffs, g);
             (total <= LIMIT).then_some((g, a, total, baseline))
         });
         let Some((g, a_bounds, horner_bound, baseline)) = chosen else {
-            let (_, total, _) = component_bounds(&rows, &base.coeffs, 0);
+            let (_, total, _) = component_bounds(&rows, &cross, &base.coeffs, 0);
             return Err(at(
                 base.line,
                 format!(
-                    "baseline {0}: component {0} does not fit the fixed-point evaluator: the baseline plus the four deviations (matrices x/{0} .. theta_z/{0}) can reach {total} micro-units ({1}) in the domain even with 0 fractional bits, over the limit 2^30 = {LIMIT} of every integer intermediate",
+                    "baseline {0}: component {0} does not fit the fixed-point evaluator: the baseline plus the four deviations (matrices x/{0} .. theta_z/{0}) and its cross terms can reach {total} micro-units ({1}) in the domain even with 0 fractional bits, over the limit 2^30 = {LIMIT} of every integer intermediate",
                     COMPONENTS[c],
                     crate::contract::UNITS[c]
                 ),
             ));
         };
         let shifts = rows.map(|r| r.map(|row| row.frac_bits - g));
+        for x in &mut cross {
+            x.shift = x.frac_bits - g;
+        }
         let mut comp = FixedComponent {
             rows,
             shifts,
@@ -170,6 +231,7 @@ pub fn fixed_tables(model: &Model, model_path: &Path) -> Result<FixedTables, Cod
             a_bounds,
             horner_bound,
             error_bound: ErrorBound::default(),
+            cross,
         };
         comp.error_bound = error_bound(model, c, &comp);
         components.push(comp);

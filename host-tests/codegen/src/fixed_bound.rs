@@ -16,7 +16,10 @@
 //!   `2^-16 * (sup|dw/du| + sum_k sup|dD_k/dt|)`, each `sup` over `[-1, 1]^2` bounded by
 //!   the maximum on a 257 x 257 grid plus (half the grid step) x (a coefficient-sum bound
 //!   of the polynomial's own slopes), so that it is rigorous between grid points;
-//! - *output*: the final rounding to whole micro-units, 0.5.
+//! - *output*: the final rounding to whole micro-units, 0.5;
+//! - *cross terms* (coupled form): per coefficient, its quantisation, `|p_i|` times the
+//!   error of the Q15 monomial, and the floors of the product and the shift (see
+//!   [`error_bound`]).
 use crate::fixed::{FixedComponent, NORM_FRAC_BITS, OUTPUT_SCALE};
 use crate::model::Model;
 
@@ -127,6 +130,24 @@ pub(crate) fn error_bound(model: &Model, c: usize, comp: &FixedComponent) -> Err
         let poly: Poly2 = m.rows.iter().map(|r| r.to_vec()).collect();
         slope_u += sup_abs(&derivative(&poly, true));
         slope_t += sup_abs(&derivative(&poly, false));
+    }
+    // Cross terms (coupled form): per coefficient i, the quantisation of P[i] (times
+    // |M| <= 1), |p_i| times the monomial's error, the floor of the product (2^-F) and of
+    // the shift (2^-G); each then multiplies |u|^i <= 1. The monomial of degree n from
+    // inputs within 2^-16 of n_k (|n_k| <= 1) and n - 1 floored Q15 products is within
+    // n 2^-16 + (n - 1) 2^-15 of the exact product. Its slope in u is bounded by the
+    // coefficient sum sum_i i |p_i| (|m| <= 1, |u| <= 1).
+    for (x, t) in comp.cross.iter().zip(model.cross.iter().filter(|t| t.component == c)) {
+        let degree: i32 = x.exponents.iter().map(|&k| i32::from(k)).sum();
+        let mono_err = f64::from(degree) * pow2(-16) + f64::from(degree - 1) * pow2(-15);
+        for (i, (q, v)) in x.coeffs.iter().zip(&t.coeffs).enumerate() {
+            coefficients += coef_err(*q, x.frac_bits, *v) + v.abs() * OUTPUT_SCALE * mono_err;
+            arithmetic += pow2(-(x.frac_bits as i32));
+            if x.shift > 0 {
+                arithmetic += lsb_g;
+            }
+            slope_u += i as f64 * v.abs();
+        }
     }
     let half_step = pow2(-(NORM_FRAC_BITS as i32) - 1);
     let inputs = (slope_u + slope_t) * OUTPUT_SCALE * half_step;

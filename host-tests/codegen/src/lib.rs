@@ -8,6 +8,9 @@
 //!   exact decimal literal with its bits in a comment, and per polynomial its domain and
 //!   the fit's residual against FE (the model's error bound, libm style);
 //! - [`C_HEADER_FILE`] (`needle_coeffs.h`): the same tables for C users;
+//! - [`RUST_CROSS_FILE`] (`cross_f32.rs`): the coupled form's cross terms as straight-line
+//!   f32 code (empty for the paper form), see `render_cross`, and [`RUST_CROSS_FIXED_FILE`]
+//!   (`cross_fixed.rs`) the same in fixed point;
 //! - [`RUST_FIXED_TABLES_FILE`] (`tables_fixed.rs`): the fixed-point tables ([`fixed`]):
 //!   Q formats chosen from the coefficients so that no integer intermediate can overflow,
 //!   the integer coefficients, and the derived error bound against f64.
@@ -23,18 +26,24 @@ pub mod fixed;
 mod fixed_bound;
 mod model;
 mod render;
+mod render_cross;
 mod render_fixed;
 
 pub use error::{line_of, CodegenError};
-pub use model::{parse_bits, parse_model, parse_model_str, Baseline, Matrix, Model};
+pub use model::{parse_bits, parse_model, parse_model_str, Baseline, Coupled, Cross, Matrix, Model};
 pub use fixed::{fixed_tables, FixedTables};
 pub use render::{f32_literal, render_c_header, render_rust};
+pub use render_cross::{render_c_cross, render_rust_cross, render_rust_cross_fixed};
 pub use render_fixed::render_rust_fixed;
 
 use std::path::{Path, PathBuf};
 
 /// File name of the generated Rust tables in the output folder.
 pub const RUST_TABLES_FILE: &str = "tables_f32.rs";
+/// File name of the generated cross terms of the coupled form (f32) in the output folder.
+pub const RUST_CROSS_FILE: &str = "cross_f32.rs";
+/// File name of the generated cross terms of the coupled form (fixed point).
+pub const RUST_CROSS_FIXED_FILE: &str = "cross_fixed.rs";
 /// File name of the generated fixed-point tables in the output folder.
 pub const RUST_FIXED_TABLES_FILE: &str = "tables_fixed.rs";
 /// File name of the generated C header in the output folder.
@@ -55,6 +64,10 @@ pub struct Generated {
     pub fixed: FixedTables,
     /// Text of `tables_fixed.rs`.
     pub rust_fixed: String,
+    /// Text of `cross_f32.rs`.
+    pub rust_cross: String,
+    /// Text of `cross_fixed.rs`.
+    pub rust_cross_fixed: String,
     /// Where `tables_f32.rs` was written.
     pub rust_path: PathBuf,
     /// Where `needle_coeffs.h` was written.
@@ -89,12 +102,16 @@ fn write_all(model: Model, model_path: &Path, out_dir: &Path) -> Result<Generate
     let rust = render_rust(&model);
     let c_header = render_c_header(&model);
     let rust_fixed = render_rust_fixed(&model, &fixed);
+    let rust_cross = render_rust_cross(&model);
+    let rust_cross_fixed = render_rust_cross_fixed(&model, &fixed);
     let rust_path = out_dir.join(RUST_TABLES_FILE);
     let c_header_path = out_dir.join(C_HEADER_FILE);
     write_if_changed(&rust_path, &rust)?;
     write_if_changed(&c_header_path, &c_header)?;
     write_if_changed(&out_dir.join(RUST_FIXED_TABLES_FILE), &rust_fixed)?;
-    Ok(Generated { model, rust, c_header, fixed, rust_fixed, rust_path, c_header_path })
+    write_if_changed(&out_dir.join(RUST_CROSS_FILE), &rust_cross)?;
+    write_if_changed(&out_dir.join(RUST_CROSS_FIXED_FILE), &rust_cross_fixed)?;
+    Ok(Generated { model, rust, c_header, fixed, rust_fixed, rust_cross, rust_cross_fixed, rust_path, c_header_path })
 }
 
 fn write_if_changed(path: &Path, text: &str) -> Result<(), CodegenError> {

@@ -45,6 +45,37 @@ pub struct Matrix {
     pub line: usize,
 }
 
+/// One cross term of the coupled form, validated: `w_c += m(n) * P(u)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cross {
+    /// Component index (0..5).
+    pub component: usize,
+    /// Exponents of `(xi, zeta, alpha, beta)` = `(x/12, z/12, theta_x/15, theta_z/15)`.
+    pub exponents: [u8; 4],
+    /// f64 coefficients of `P`; `coeffs[i]` multiplies `u^i`.
+    pub coeffs: Vec<f64>,
+    /// The nearest f32 of each coefficient.
+    pub coeffs_f32: Vec<f32>,
+    /// 1-based line of its `[[cross]]` header in the model file.
+    pub line: usize,
+}
+
+/// The coupled form's `[coupled]` table, validated.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Coupled {
+    /// Largest total degree of a cross monomial (2..=4).
+    pub max_degree: u8,
+    /// Degree of every cross term's depth polynomial (2..=4).
+    pub depth_degree: u8,
+    /// Training runs the cross terms were fitted on.
+    pub training_runs: usize,
+    /// Cross-validated RMS error per component, % of `scale`.
+    pub cv_rms_pct: [f64; 6],
+    /// The scale of `cv_rms_pct` per component: peak |Fy| of the training runs (N), times
+    /// the lever arm for the moments (N*mm).
+    pub scale: [f64; 6],
+}
+
 /// A validated model: everything the generators need.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Model {
@@ -58,6 +89,11 @@ pub struct Model {
     pub baseline: Vec<Baseline>,
     /// 24 deviation matrices, sweep-major then component order.
     pub matrices: Vec<Matrix>,
+    /// The coupled form's table (`form = "coupled"`); `None`: the paper form.
+    pub coupled: Option<Coupled>,
+    /// The coupled form's cross terms, component order then file order (empty for the
+    /// paper form).
+    pub cross: Vec<Cross>,
 }
 
 impl Model {
@@ -85,7 +121,15 @@ impl Model {
                 line: 0,
             })
             .collect();
-        Self { fitted: false, set: set.to_string(), fe_sha256: String::new(), baseline, matrices }
+        Self {
+            fitted: false,
+            set: set.to_string(),
+            fe_sha256: String::new(),
+            baseline,
+            matrices,
+            coupled: None,
+            cross: Vec::new(),
+        }
     }
 
     /// The f32 baseline table, `[component][i]`.
@@ -117,8 +161,33 @@ struct RawModel {
     x_max_mm: Spanned<f64>,
     z_max_mm: Spanned<f64>,
     theta_max_deg: Spanned<f64>,
+    #[serde(default)]
+    form: Option<Spanned<String>>,
     baseline: Spanned<Vec<Spanned<RawBaseline>>>,
     matrix: Spanned<Vec<Spanned<RawMatrix>>>,
+    #[serde(default)]
+    coupled: Option<Spanned<RawCoupled>>,
+    #[serde(default)]
+    cross: Vec<Spanned<RawCross>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawCoupled {
+    max_degree: Spanned<i64>,
+    depth_degree: Spanned<i64>,
+    training_runs: Spanned<i64>,
+    cv_rms_pct: Spanned<Vec<Spanned<f64>>>,
+    scale: Spanned<Vec<Spanned<f64>>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawCross {
+    component: Spanned<String>,
+    exponents: Spanned<Vec<Spanned<i64>>>,
+    coeffs: Spanned<Vec<Spanned<f64>>>,
+    coeffs_f32: Spanned<Vec<Spanned<String>>>,
 }
 
 #[derive(Deserialize)]
@@ -240,7 +309,122 @@ impl Checker<'_> {
             matrices.push(Matrix { line, ..self.matrix(n / 6, n % 6, entry.into_inner())? });
         }
 
-        Ok(Model { fitted: true, set: set.clone(), fe_sha256: hash.clone(), baseline, matrices })
+        let (coupled, cross) = self.form(raw.form, raw.coupled, raw.cross)?;
+        Ok(Model { fitted: true, set: set.clone(), fe_sha256: hash.clone(), baseline, matrices, coupled, cross })
+    }
+
+    /// `form`, `[coupled]` and `[[cross]]`: absent or `"paper"` (then neither table), or
+    /// `"coupled"` with both.
+    fn form(
+        &self,
+        form: Option<Spanned<String>>,
+        coupled: Option<Spanned<RawCoupled>>,
+        cross: Vec<Spanned<RawCross>>,
+    ) -> Result<(Option<Coupled>, Vec<Cross>), CodegenError> {
+        let is_coupled = match &form {
+            None => false,
+            Some(f) if f.get_ref() == "paper" => false,
+            Some(f) if f.get_ref() == "coupled" => true,
+            Some(f) => {
+                return Err(self.err(f.span(), format!("form = {:?}: the forms are \"paper\" and \"coupled\"", f.get_ref())))
+            }
+        };
+        if !is_coupled {
+            if let Some(c) = &coupled {
+                return Err(self.err(c.span(), "[coupled] belongs to form = \"coupled\" only"));
+            }
+            if let Some(x) = cross.first() {
+                return Err(self.err(x.span(), "[[cross]] belongs to form = \"coupled\" only"));
+            }
+            return Ok((None, Vec::new()));
+        }
+        let Some(raw) = coupled else {
+            let span = form.map(|f| f.span()).unwrap_or(0..0);
+            return Err(self.err(span, "form = \"coupled\" needs a [coupled] table"));
+        };
+        let raw = raw.into_inner();
+        let degree = |v: &Spanned<i64>, key: &str| -> Result<u8, CodegenError> {
+            match u8::try_from(*v.get_ref()) {
+                Ok(d) if (2..=4).contains(&d) => Ok(d),
+                _ => Err(self.err(v.span(), format!("[coupled] {key} = {}: expected 2, 3 or 4", v.get_ref()))),
+            }
+        };
+        let max_degree = degree(&raw.max_degree, "max_degree")?;
+        let depth_degree = degree(&raw.depth_degree, "depth_degree")?;
+        let training_runs = usize::try_from(*raw.training_runs.get_ref())
+            .map_err(|_| self.err(raw.training_runs.span(), "[coupled] training_runs: expected a count >= 0"))?;
+        let six = |v: &Spanned<Vec<Spanned<f64>>>, key: &str| -> Result<[f64; 6], CodegenError> {
+            let list = v.get_ref();
+            if list.len() != 6 {
+                return Err(self.err(v.span(), format!("[coupled] {key}: {} values, expected 6 (one per component)", list.len())));
+            }
+            let mut out = [0.0; 6];
+            for (o, x) in out.iter_mut().zip(list) {
+                let val = self.finite(x, &format!("[coupled] {key}"))?;
+                if val < 0.0 {
+                    return Err(self.err(x.span(), format!("[coupled] {key}: {val:?} < 0")));
+                }
+                *o = val;
+            }
+            Ok(out)
+        };
+        let cv_rms_pct = six(&raw.cv_rms_pct, "cv_rms_pct")?;
+        let scale = six(&raw.scale, "scale")?;
+        let mut terms = Vec::with_capacity(cross.len());
+        let mut last_component = 0usize;
+        for (n, entry) in cross.into_iter().enumerate() {
+            let line = crate::error::line_of(self.text, entry.span().start);
+            let x = self.cross_term(n, entry.into_inner(), max_degree, depth_degree, last_component)?;
+            last_component = x.component;
+            terms.push(Cross { line, ..x });
+        }
+        Ok((Some(Coupled { max_degree, depth_degree, training_runs, cv_rms_pct, scale }), terms))
+    }
+
+    /// One `[[cross]]` entry: a known component not before `after`, a monomial of total
+    /// degree 2..=`max_degree` in at least two inputs with the component's mirror parities
+    /// (coeffs/README.md, "The coupled form"), `depth_degree + 1` coefficients.
+    fn cross_term(&self, n: usize, raw: RawCross, max_degree: u8, depth_degree: u8, after: usize) -> Result<Cross, CodegenError> {
+        let name = raw.component.get_ref();
+        let Some(c) = COMPONENTS.iter().position(|x| x == name) else {
+            return Err(self.err(raw.component.span(), format!("cross {}: component = {name:?}: unknown (components: {})", n + 1, COMPONENTS.join(", "))));
+        };
+        if c < after {
+            return Err(self.err(
+                raw.component.span(),
+                format!("cross {}: component = {name:?} after {:?}: entries are in component order", n + 1, COMPONENTS[after]),
+            ));
+        }
+        let list = raw.exponents.get_ref();
+        let mut e = [0u8; 4];
+        if list.len() != 4 {
+            return Err(self.err(raw.exponents.span(), format!("cross {} ({name}): {} exponents, expected 4 (x, z, theta_x, theta_z)", n + 1, list.len())));
+        }
+        for (o, v) in e.iter_mut().zip(list) {
+            *o = u8::try_from(*v.get_ref())
+                .ok()
+                .filter(|k| *k <= max_degree)
+                .ok_or_else(|| self.err(v.span(), format!("cross {} ({name}): exponent {} not in 0..={max_degree}", n + 1, v.get_ref())))?;
+        }
+        let total: u8 = e.iter().sum();
+        let inputs = e.iter().filter(|&&k| k > 0).count();
+        let odd_x = (e[0] + e[3]) % 2 == 1;
+        let odd_z = (e[1] + e[2]) % 2 == 1;
+        if !(2..=max_degree).contains(&total) || inputs < 2 || odd_x != ODD[0][c] || odd_z != ODD[1][c] {
+            return Err(self.err(
+                raw.exponents.span(),
+                format!(
+                    "cross {} ({name}): exponents {e:?}: a cross monomial has total degree 2..={max_degree} in at least two inputs, odd in (x, theta_z) exactly when {name} is odd under the x mirror ({}) and odd in (z, theta_x) exactly when it is odd under the z mirror ({})",
+                    n + 1,
+                    ODD[0][c],
+                    ODD[1][c]
+                ),
+            ));
+        }
+        let want = usize::from(depth_degree) + 1;
+        let label = format!("cross {} ({name}, exponents {e:?})", n + 1);
+        let (coeffs, coeffs_f32) = self.list(&raw.coeffs, &raw.coeffs_f32, want, &format!("{label}: coeffs"), &format!("{label}: coeffs_f32"))?;
+        Ok(Cross { component: c, exponents: e, coeffs, coeffs_f32, line: 0 })
     }
 
     fn count<T>(
@@ -315,14 +499,31 @@ impl Checker<'_> {
         what: &str,
         what_f32: &str,
     ) -> Result<([f64; 5], [f32; 5]), CodegenError> {
-        for (list, name) in [(values.get_ref().len(), what), (bits.get_ref().len(), what_f32)] {
-            if list != 5 {
-                let span = if name == what { values.span() } else { bits.span() };
-                return Err(self.err(span, format!("{name} has {list} values, expected 5 (powers 0..=4)")));
-            }
-        }
+        let (v, b) = self.list(values, bits, 5, what, what_f32)?;
         let mut out = [0.0; 5];
         let mut out32 = [0.0; 5];
+        out.copy_from_slice(&v);
+        out32.copy_from_slice(&b);
+        Ok((out, out32))
+    }
+
+    /// `n` finite f64 and their `n` f32 bit strings, each the nearest f32.
+    fn list(
+        &self,
+        values: &Spanned<Vec<Spanned<f64>>>,
+        bits: &Spanned<Vec<Spanned<String>>>,
+        n: usize,
+        what: &str,
+        what_f32: &str,
+    ) -> Result<(Vec<f64>, Vec<f32>), CodegenError> {
+        for (list, name) in [(values.get_ref().len(), what), (bits.get_ref().len(), what_f32)] {
+            if list != n {
+                let span = if name == what { values.span() } else { bits.span() };
+                return Err(self.err(span, format!("{name} has {list} values, expected {n} (powers 0..={})", n - 1)));
+            }
+        }
+        let mut out = vec![0.0; n];
+        let mut out32 = vec![0.0; n];
         for (j, ((v, b), (o, o32))) in values
             .get_ref()
             .iter()

@@ -147,7 +147,8 @@ pub fn render_c_header(model: &Model) -> String {
     let _ = writeln!(w, " *  4. h(p, w) = (((p4*w + p3)*w + p2)*w + p1)*w + p0; B_c = h(NEEDLE_BASELINE[c], u);");
     let _ = writeln!(w, " *     r_i = h(NEEDLE_DEVIATION[k][c][i], t); D_kc = h(r, u);");
     let _ = writeln!(w, " *  5. w_c = B_c, then for k = 0..3: w_c -= D_kc if v_k < 0 and NEEDLE_ODD[k][c],");
-    let _ = writeln!(w, " *     else w_c += D_kc.");
+    let _ = writeln!(w, " *     else w_c += D_kc;");
+    let _ = writeln!(w, " *  6. coupled form only: the cross terms (NEEDLE_CROSS_* below).");
     let _ = writeln!(w, " */");
     let _ = writeln!(w, "#ifndef NEEDLE_COEFFS_H");
     let _ = writeln!(w, "#define NEEDLE_COEFFS_H");
@@ -250,6 +251,8 @@ pub fn render_c_header(model: &Model) -> String {
         let _ = writeln!(w, "    }},");
     }
     let _ = writeln!(w, "}};");
+    let _ = writeln!(w);
+    let _ = write!(w, "{}", crate::render_cross::render_c_cross(model));
     let _ = writeln!(w);
     let _ = writeln!(w, "#endif /* NEEDLE_COEFFS_H */");
     s

@@ -1,5 +1,5 @@
 //! `needle fit`, `needle validate`: fit the model, compare it with FE.
-use crate::fe::results::write_atomic;
+use crate::fe::results::write_all_atomic;
 use crate::fit::{self, validate as val, GOLDEN_FILE, GOLDEN_FIXED_FILE, MODEL_FILE};
 use anyhow::{Context, Result};
 use clap::Args;
@@ -65,7 +65,7 @@ fn check_file(path: &Path, want: &str) -> Result<bool> {
 }
 
 /// `needle fit --set DIR [--check]`: fit the set's FE sweeps and write `model.toml`,
-/// `golden-f32.csv` and `golden-fixed.csv` atomically (or, with `--check`, compare them). Exit code 0 on
+/// `golden-f32.csv` and `golden-fixed.csv` all or nothing ([`write_all_atomic`]) (or, with `--check`, compare them). Exit code 0 on
 /// success, 1 when `--check` finds a difference.
 ///
 /// # Errors
@@ -82,9 +82,11 @@ pub fn fit(a: FitArgs) -> Result<ExitCode> {
         let ok_fixed = check_file(&golden_fixed_path, &out.golden_fixed_csv)?;
         return Ok(if ok_model && ok_golden && ok_fixed { ExitCode::SUCCESS } else { ExitCode::from(1) });
     }
-    write_atomic(&model_path, out.model_toml.as_bytes())?;
-    write_atomic(&golden_path, out.golden_csv.as_bytes())?;
-    write_atomic(&golden_fixed_path, out.golden_fixed_csv.as_bytes())?;
+    write_all_atomic(&[
+        (&model_path, out.model_toml.as_bytes()),
+        (&golden_path, out.golden_csv.as_bytes()),
+        (&golden_fixed_path, out.golden_fixed_csv.as_bytes()),
+    ])?;
     print!("{}", fit::summary(&out.model));
     let coupled = fit::coupled_report::measure(&a.set, &out.model)
         .with_context(|| format!("needle fit --set {}: measuring the coupled form", a.set.display()))?;

@@ -109,6 +109,36 @@ pub fn status_names(status: Status) -> Vec<&'static str> {
 const NAMES: [(&str, &str); 6] =
     [("fx_n", "N"), ("fy_n", "N"), ("fz_n", "N"), ("mx_nmm", "N*mm"), ("my_nmm", "N*mm"), ("mz_nmm", "N*mm")];
 
+/// The compiled-in model's form: `paper` or `coupled`.
+pub fn form_name() -> &'static str {
+    if model_info::COUPLED {
+        "coupled"
+    } else {
+        "paper"
+    }
+}
+
+/// The stated accuracy of the compiled-in model (`[coupled]` of its model.toml): the
+/// cross-validated RMS error per component, in % and in N or N*mm; `null` for the paper
+/// form, whose model.toml records none.
+pub fn accuracy_json() -> serde_json::Value {
+    if !model_info::COUPLED {
+        return serde_json::Value::Null;
+    }
+    let mut pct = serde_json::Map::new();
+    let mut abs = serde_json::Map::new();
+    for (((name, _), p), scale) in NAMES.iter().zip(model_info::CV_RMS_PCT).zip(model_info::CV_SCALE) {
+        pct.insert((*name).to_string(), serde_json::json!(p));
+        abs.insert((*name).to_string(), serde_json::json!(p * scale / 100.0));
+    }
+    serde_json::json!({
+        "method": format!("{}-fold cross-validation over {} training runs (role train)", crate::fit::coupled::FOLDS, model_info::TRAINING_RUNS),
+        "rms_pct_of_scale": pct,
+        "rms": abs,
+        "scale": "peak |Fy| of the training runs (N) for the forces, times the hub lever arm (N*mm) for the moments",
+    })
+}
+
 /// The JSON object `needle eval --json` prints.
 pub fn eval_json(pose: &Pose, e: &Evaluation) -> serde_json::Value {
     let mut wrench = serde_json::Map::new();
@@ -122,6 +152,8 @@ pub fn eval_json(pose: &Pose, e: &Evaluation) -> serde_json::Value {
     serde_json::json!({
         "set": model_info::SET,
         "fe_sha256": model_info::FE_SHA256,
+        "form": form_name(),
+        "accuracy": accuracy_json(),
         "pose": {
             "x_mm": pose.x_mm, "z_mm": pose.z_mm, "theta_x_deg": pose.theta_x_deg,
             "theta_z_deg": pose.theta_z_deg, "depth_mm": pose.depth_mm,
@@ -160,7 +192,7 @@ pub fn eval(a: EvalArgs) -> anyhow::Result<ExitCode> {
     if a.json {
         println!("{}", serde_json::to_string_pretty(&eval_json(&pose, &e))?);
     } else {
-        println!("set {} ({}), f32 paper model", model_info::SET, model_info::SET_DIR);
+        println!("set {} ({}), f32 {} model", model_info::SET, model_info::SET_DIR, form_name());
         println!(
             "pose: x_mm = {} z_mm = {} theta_x_deg = {} theta_z_deg = {} depth_mm = {}",
             pose.x_mm, pose.z_mm, pose.theta_x_deg, pose.theta_z_deg, pose.depth_mm

@@ -82,20 +82,92 @@ pub fn read_csv(path: &Path) -> Result<Vec<Row>> {
 }
 
 /// Write `bytes` to `path` atomically: a temporary file in the same folder, flushed and
-/// synced, then renamed over `path`. A crash leaves either the old file or the new one.
+/// synced, then renamed over `path`. A crash leaves either the old file or the new one;
+/// a failed write removes its temporary.
 ///
 /// # Errors
 /// The folder cannot be written.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let tmp = write_temporary(path, bytes)?;
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        anyhow::anyhow!("{}: cannot rename to {}: {e}", tmp.display(), path.display())
+    })
+}
+
+/// The temporary of `path` for this process: `.<name>.<pid>.tmp` beside it.
+fn temporary_of(path: &Path) -> Result<std::path::PathBuf> {
+    let dir = path.parent().with_context(|| format!("{}: no parent folder", path.display()))?;
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("out");
+    Ok(dir.join(format!(".{name}.{}.tmp", std::process::id())))
+}
+
+/// Write `bytes` to the temporary of `path` (synced); removed again on failure.
+fn write_temporary(path: &Path, bytes: &[u8]) -> Result<std::path::PathBuf> {
     let dir = path.parent().with_context(|| format!("{}: no parent folder", path.display()))?;
     std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
-    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("out");
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    {
+    let tmp = temporary_of(path)?;
+    let written = (|| -> Result<()> {
         let mut f = std::fs::File::create(&tmp).with_context(|| format!("{}: cannot create", tmp.display()))?;
         f.write_all(bytes).with_context(|| format!("{}: cannot write", tmp.display()))?;
         f.sync_all().with_context(|| format!("{}: cannot sync", tmp.display()))?;
+        Ok(())
+    })();
+    if let Err(e) = written {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e);
     }
-    std::fs::rename(&tmp, path).with_context(|| format!("{}: cannot rename to {}", tmp.display(), path.display()))?;
+    Ok(tmp)
+}
+
+/// Remove temporaries `.<name>.<pid>.tmp` of `path` left by processes that are gone
+/// (a crash or kill between write and rename). Linux: a pid is alive while `/proc/<pid>`
+/// exists; elsewhere only this process's own temporary is kept.
+pub fn remove_stale_temporaries(path: &Path) {
+    let (Some(dir), Some(name)) = (path.parent(), path.file_name().and_then(|n| n.to_str())) else { return };
+    let prefix = format!(".{name}.");
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for e in entries.flatten() {
+        let file = e.file_name();
+        let Some(rest) = file.to_str().and_then(|f| f.strip_prefix(&prefix)).and_then(|r| r.strip_suffix(".tmp")) else { continue };
+        let Ok(pid) = rest.parse::<u32>() else { continue };
+        let alive = pid == std::process::id() || (cfg!(target_os = "linux") && Path::new(&format!("/proc/{pid}")).exists());
+        if !alive {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
+/// Write several files all or nothing: every target is checked (not a folder), every
+/// content written to its temporary and synced, and only then are the temporaries
+/// renamed over the targets, one by one. When a check or a write fails, the temporaries
+/// are removed and no target has changed. (The renames are in the same folders and do
+/// not fail on a checked target; a crash between two of them can leave the first ones
+/// new.) Stale temporaries of the targets are removed first.
+///
+/// # Errors
+/// A target is a folder, or a temporary cannot be written.
+pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<()> {
+    for (path, _) in files {
+        remove_stale_temporaries(path);
+        if path.is_dir() {
+            bail!("{}: is a folder, cannot write a file there (nothing written)", path.display());
+        }
+    }
+    let mut temps = Vec::new();
+    for (path, bytes) in files {
+        match write_temporary(path, bytes) {
+            Ok(t) => temps.push(t),
+            Err(e) => {
+                for t in &temps {
+                    let _ = std::fs::remove_file(t);
+                }
+                return Err(e.context("nothing written"));
+            }
+        }
+    }
+    for (tmp, (path, _)) in temps.iter().zip(files) {
+        std::fs::rename(tmp, path).with_context(|| format!("{}: cannot rename to {}", tmp.display(), path.display()))?;
+    }
     Ok(())
 }

@@ -38,6 +38,9 @@ pub struct Campaign {
     /// The FE engine and its settings; absent: CalculiX with the deck's fixed settings.
     #[serde(default)]
     pub solver: Solver,
+    /// What `needle fit` fits; absent: the paper's model.
+    #[serde(default)]
+    pub fit: FitSettings,
     /// The named poses as written (the Latin hypercube poses are added by [`Campaign::poses`]).
     #[serde(rename = "pose", default)]
     pub pose: Vec<PoseSpec>,
@@ -162,6 +165,39 @@ pub struct MeshLevel {
     pub needle_facets_per_quarter: u32,
     /// Needle layer length near the tip, mm.
     pub needle_axial_mm: f64,
+}
+
+/// `[fit]`: the model form `needle fit` writes (coeffs/README.md, "The model" and "The
+/// coupled form"). Not part of any run's hash: changing it refits, it never reruns FE.
+#[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FitSettings {
+    /// The model form.
+    #[serde(default)]
+    pub form: ModelForm,
+}
+
+/// The model forms of `model.toml` (`form = ...`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ModelForm {
+    /// The paper's additive superposition of four single-axis sweeps, fitted on the centre
+    /// and sweep runs.
+    #[default]
+    Paper,
+    /// The paper's superposition plus cross terms fitted on the training runs (role
+    /// `train`), their size chosen by cross-validation.
+    Coupled,
+}
+
+impl ModelForm {
+    /// The name used in campaign.toml and model.toml.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelForm::Paper => "paper",
+            ModelForm::Coupled => "coupled",
+        }
+    }
 }
 
 /// The FE engines a campaign can run on.

@@ -20,6 +20,10 @@ pub fn unit(c: usize) -> &'static str {
 
 /// Largest depth of the domain, mm.
 pub const DEPTH_MAX_MM: f64 = 6.0;
+
+/// A pose in f64: x and z in mm, the tilts in degrees, depth in mm (contract order
+/// `[x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm]`).
+pub type Pose64 = [f64; 5];
 /// Largest |x|, |z| of the domain, mm.
 pub const XZ_MAX_MM: f64 = 12.0;
 /// Largest |theta_x|, |theta_z| of the domain, degrees.

@@ -7,7 +7,8 @@
 //! and component, RMS over the run's depths in % of the run's peak |Fy| (moments: times
 //! the lever arm), and for Table 2 the largest |Fy| error at depths >= 1 mm in % of FE.
 
-use super::coupled::{self, CrossForm, CrossTerms, CvScore};
+use super::coupled::{self, CvScore};
+use super::cross_terms::{CrossForm, CrossTerms};
 use super::data::{load_training_runs, load_validation_runs, Run};
 use super::eval_f64::{eval as eval_paper, Pose64};
 use super::model::Model;

@@ -4,7 +4,7 @@
 use super::contract::{Sweep, DEPTH_MAX_MM, NCOEF};
 use crate::fe::manifest::{read_manifest, Manifest, MANIFEST};
 use crate::fe::results::{read_csv, Row};
-use crate::fe::spec::{self, hex, Campaign, PoseSpec, Role};
+use crate::fe::spec::{self, hex, Campaign, ModelForm, PoseSpec, Role};
 use anyhow::{bail, Context, Result};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
@@ -39,6 +39,9 @@ pub struct FitData {
     /// Per sweep in contract order: the centre run at value 0, then the sweep's runs in
     /// increasing value.
     pub sweeps: [Vec<SweepPoint>; 4],
+    /// The training runs (role train, spec order) when the set fits the coupled form
+    /// (`[fit] form = "coupled"`); empty for the paper form.
+    pub train: Vec<Run>,
     /// SHA-256 (hex) of the FE files read, as coeffs/README.md defines `fe_sha256`.
     pub fe_sha256: String,
 }
@@ -119,7 +122,12 @@ pub fn stale_reason(manifest: &Manifest, campaign: &Campaign, pose: &PoseSpec) -
 /// `campaign.fit_without` (their files make up `fe_sha256`).
 pub fn fitted_poses(campaign: &Campaign) -> Vec<PoseSpec> {
     let left_out = &campaign.campaign.fit_without;
-    campaign.poses().into_iter().filter(|p| p.role.is_fitted() && !left_out.contains(&p.name)).collect()
+    let coupled = campaign.fit.form == ModelForm::Coupled;
+    campaign
+        .poses()
+        .into_iter()
+        .filter(|p| (p.role.is_fitted() && !left_out.contains(&p.name)) || (coupled && p.role == Role::Train))
+        .collect()
 }
 
 /// Load the campaign and every run the fitter uses: the centre and the four sweeps.
@@ -148,7 +156,7 @@ pub fn load_fit_data(set_dir: &Path) -> Result<FitData> {
         .collect();
     if !missing.is_empty() {
         bail!(
-            "{} of the {} fitted FE runs are missing from {}: {}\n(run `needle fe run --set {}` to finish the campaign; the fit needs the centre run and every sweep run not listed in campaign.fit_without)",
+            "{} of the {} fitted FE runs are missing from {}: {}\n(run `needle fe run --set {}` to finish the campaign; the fit needs the centre run, every sweep run not listed in campaign.fit_without and, for [fit] form = \"coupled\", every training run)",
             missing.len(),
             fitted.len(),
             set_dir.join("fe").display(),
@@ -225,8 +233,9 @@ pub fn load_fit_data(set_dir: &Path) -> Result<FitData> {
         }
     }
 
+    let train = fitted.iter().filter(|p| p.role == Role::Train).map(|p| read_run(set_dir, &campaign, p)).collect::<Result<Vec<_>>>()?;
     let fe_sha256 = fitted_fe_sha256(set_dir, &fitted)?;
-    Ok(FitData { campaign, centre, sweeps, fe_sha256 })
+    Ok(FitData { campaign, centre, sweeps, train, fe_sha256 })
 }
 
 /// `fe_sha256` of the runs of `poses` in `set_dir` (their `<pose>.csv` files).

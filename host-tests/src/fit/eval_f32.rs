@@ -14,6 +14,10 @@ pub const ONE_THIRD: f32 = 1.0 / 3.0;
 pub const S_XZ: f32 = 2.0 / 12.0;
 /// The f32 nearest 2/15, the scale of theta_x and theta_z: 0x3e088889.
 pub const S_THETA: f32 = 2.0 / 15.0;
+/// The f32 nearest 1/12, the cross terms' scale of x and z: 0x3daaaaab.
+pub const R_XZ: f32 = 1.0 / 12.0;
+/// The f32 nearest 1/15, the cross terms' scale of theta_x and theta_z: 0x3d888889.
+pub const R_THETA: f32 = 1.0 / 15.0;
 
 /// `ODD[k][c]`: component c changes sign under sweep k's mirror (contract table: sweeps
 /// x and theta_z: fx, my, mz; sweeps z and theta_x: fz, mx, my).
@@ -25,18 +29,26 @@ pub const ODD: [[bool; 6]; 4] = [
 ];
 
 /// The coefficients the firmware uses: every f64 coefficient rounded to the nearest f32.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Tables32 {
     /// `baseline[c][i]` multiplies `u^i`.
     pub baseline: [[f32; NCOEF]; 6],
     /// `rows[k][c][i][j]` multiplies `u^i t^j` for sweep k, component c.
     pub rows: [[[[f32; NCOEF]; NCOEF]; 6]; 4],
+    /// The coupled form's cross terms per component, in file order: exponents of
+    /// `(xi, zeta, alpha, beta)` and the depth polynomial (`p[i]` multiplies `u^i`).
+    /// Empty for the paper form.
+    pub cross: [Vec<([u8; 4], Vec<f32>)>; 6],
 }
 
 impl Tables32 {
     /// Round every coefficient of `model` to the nearest f32 (`as`, round to nearest even).
     pub fn from_model(model: &Model) -> Self {
-        let mut t = Tables32 { baseline: [[0.0; NCOEF]; 6], rows: [[[[0.0; NCOEF]; NCOEF]; 6]; 4] };
+        let cross = std::array::from_fn(|c| match &model.cross {
+            Some(k) => k.terms.terms[c].iter().map(|(e, p)| (*e, p.iter().map(|v| *v as f32).collect())).collect(),
+            None => Vec::new(),
+        });
+        let mut t = Tables32 { baseline: [[0.0; NCOEF]; 6], rows: [[[[0.0; NCOEF]; NCOEF]; 6]; 4], cross };
         for (dst, src) in t.baseline.iter_mut().zip(&model.baseline) {
             for (d, s) in dst.iter_mut().zip(&src.coeffs) {
                 *d = *s as f32;
@@ -136,7 +148,31 @@ pub fn eval(t: &Tables32, pose: [f32; 5]) -> ([f32; 6], u8) {
         }
         w[c] = acc;
     }
+    // 6. cross terms (coupled form)
+    let n = [xc * R_XZ, zc * R_XZ, txc * R_THETA, tzc * R_THETA];
+    for (wc, terms) in w.iter_mut().zip(&t.cross) {
+        for (e, p) in terms {
+            *wc += monomial32(*e, &n) * horner_n32(p, u);
+        }
+    }
     (w, status)
+}
+
+/// `m = n_k1 * n_k2 * ...`: each input `k` in order repeated `e[k]` times, multiplied
+/// left to right starting from the first factor.
+pub fn monomial32(e: [u8; 4], n: &[f32; 4]) -> f32 {
+    let mut factors = e.iter().zip(n).flat_map(|(&k, &v)| std::iter::repeat(v).take(usize::from(k)));
+    let first = factors.next().unwrap_or(1.0);
+    factors.fold(first, |m, v| m * v)
+}
+
+/// Horner over any number of coefficients, highest power first, starting from the last
+/// coefficient: `(p_d * u + p_{d-1}) * u + ... + p_0`.
+pub fn horner_n32(p: &[f32], u: f32) -> f32 {
+    match p.split_last() {
+        Some((last, rest)) => rest.iter().rev().fold(*last, |acc, c| acc * u + c),
+        None => 0.0,
+    }
 }
 
 #[cfg(test)]
@@ -145,10 +181,12 @@ mod tests {
 
     #[test]
     fn constants_are_the_nearest_f32() {
+        assert_eq!(R_XZ.to_bits(), 0x3daa_aaab);
+        assert_eq!(R_THETA.to_bits(), 0x3d88_8889);
         assert_eq!(ONE_THIRD.to_bits(), 0x3eaa_aaab);
         assert_eq!(S_XZ.to_bits(), 0x3e2a_aaab);
         assert_eq!(S_THETA.to_bits(), 0x3e08_8889);
-        for (c, exact) in [(ONE_THIRD, 1.0 / 3.0), (S_XZ, 2.0 / 12.0), (S_THETA, 2.0 / 15.0)] {
+        for (c, exact) in [(ONE_THIRD, 1.0 / 3.0), (S_XZ, 2.0 / 12.0), (S_THETA, 2.0 / 15.0), (R_XZ, 1.0 / 12.0), (R_THETA, 1.0 / 15.0)] {
             let below = f32::from_bits(c.to_bits() - 1) as f64;
             let above = f32::from_bits(c.to_bits() + 1) as f64;
             let e = (c as f64 - exact).abs();

@@ -5,6 +5,7 @@ use super::contract::{
     u_of, Sweep, DEPTH_MAX_MM, NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z,
     STATUS_SAT_X, STATUS_SAT_Z,
 };
+use super::cross_terms::cross_value;
 use super::model::Model;
 
 /// Horner, highest power first: `(((p4 w + p3) w + p2) w + p1) w + p0`.
@@ -25,14 +26,26 @@ pub fn deviation(rows: &[[f64; NCOEF]; NCOEF], t: f64, u: f64) -> f64 {
     horner(&r, u)
 }
 
-/// A pose in f64: x and z in mm, the tilts in degrees, depth in mm (contract order
-/// `[x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm]`).
-pub type Pose64 = [f64; 5];
+pub use super::contract::Pose64;
 
-/// Evaluate the model at `pose`: the wrench `[fx_n, fy_n, fz_n, mx_nmm, my_nmm, mz_nmm]`
+/// Evaluate the model at `pose`, in its form: the paper part ([`eval_paper`]) plus, for
+/// the coupled form, the cross terms ([`cross_value`]) unless the status is an error.
+pub fn eval(model: &Model, pose: Pose64) -> ([f64; 6], u8) {
+    let (mut w, status) = eval_paper(model, pose);
+    if let Some(c) = &model.cross {
+        if status & STATUS_ERROR == 0 {
+            for (a, b) in w.iter_mut().zip(cross_value(&c.terms, pose)) {
+                *a += b;
+            }
+        }
+    }
+    (w, status)
+}
+
+/// Evaluate the paper part of the model at `pose` (all of it for the paper form): the wrench `[fx_n, fy_n, fz_n, mx_nmm, my_nmm, mz_nmm]`
 /// (N, N·mm) and the contract's status byte. NaN or infinite input gives the zero wrench
 /// and status 0x80; inputs outside the domain are clamped and flagged.
-pub fn eval(model: &Model, pose: Pose64) -> ([f64; 6], u8) {
+pub fn eval_paper(model: &Model, pose: Pose64) -> ([f64; 6], u8) {
     if pose.iter().any(|v| !v.is_finite()) {
         return ([0.0; 6], STATUS_ERROR);
     }

@@ -108,6 +108,30 @@ pub fn eval(t: &TablesFixed, pose: [i32; 5]) -> Result<([i32; 6], u8), Overflow>
             }
         }
     }
+    // 6. cross terms of the coupled form: signed Q15 inputs, Q15 monomials, A_i += ...
+    let n: [i64; 4] = std::array::from_fn(|k| {
+        let q = (v[k].abs() + DIVISORS[k]) / (2 * DIVISORS[k]);
+        if v[k] < 0 {
+            -q
+        } else {
+            q
+        }
+    });
+    for (c, terms) in t.cross.iter().enumerate() {
+        for (e, p, f) in terms {
+            let what = || format!("cross {c} {e:?}");
+            let mut factors = e.iter().zip(n).flat_map(|(&k, nk)| std::iter::repeat(nk).take(usize::from(k)));
+            let mut m = factors.next().unwrap_or(0);
+            for nk in factors {
+                m = step(m, nk, 0, &what)?;
+            }
+            for (i, pi) in p.iter().enumerate() {
+                let prod = step(*pi, m, 0, &what)?;
+                let shifted = prod.div_euclid(1i64 << (f - t.acc_frac[c]));
+                a[c][i] = check(a[c][i].checked_add(shifted), || format!("A[{c}][{i}] after cross {e:?}"))?;
+            }
+        }
+    }
     let mut w = [0i32; 6];
     for (c, wc) in w.iter_mut().enumerate() {
         let acc = horner(&a[c], u, &|| format!("Horner in u of component {c}"))?;

@@ -23,6 +23,24 @@ pub struct TablesFixed {
     pub baseline: [[i64; NCOEF]; 6],
     /// Fractional bits `G` of each component's accumulator.
     pub acc_frac: [u32; 6],
+    /// The coupled form's cross terms per component, file order: exponents, integer
+    /// coefficients (`[i]` goes to `A_i`) and their fractional bits `F` (empty for the
+    /// paper form).
+    pub cross: [Vec<([u8; 4], Vec<i64>, u32)>; 6],
+}
+
+/// Largest `f` with every quantised coefficient `|P_i| <= 2^30`: a cross term's format.
+fn cross_format(p: &[f64]) -> Option<(u32, Vec<i64>)> {
+    let mut best = None;
+    for f in 0..=MAX_FRAC {
+        let q: Vec<i64> = p.iter().map(|c| quantise(*c, f)).collect();
+        if q.iter().all(|v| v.checked_abs().is_some_and(|a| a <= LIMIT)) {
+            best = Some((f, q));
+        } else {
+            break;
+        }
+    }
+    best
 }
 
 /// `round(c * 10^6 * 2^f)`, ties away from zero: the f64 product `c * 1e6` rounded once,
@@ -59,7 +77,18 @@ impl TablesFixed {
             row_frac: [[[0; NCOEF]; 6]; 4],
             baseline: [[0; NCOEF]; 6],
             acc_frac: [0; 6],
+            cross: Default::default(),
         };
+        if let Some(k) = &model.cross {
+            for (c, terms) in k.terms.terms.iter().enumerate() {
+                for (e, p) in terms {
+                    let Some((f, q)) = cross_format(p) else {
+                        bail!("cross {} {e:?}: a coefficient does not fit in 2^30 micro-units", COMPONENTS[c]);
+                    };
+                    t.cross[c].push((*e, q, f));
+                }
+            }
+        }
         let mut row_sum = [[[0i64; NCOEF]; 6]; 4];
         for k in Sweep::ALL {
             for c in 0..6 {
@@ -74,7 +103,12 @@ impl TablesFixed {
             }
         }
         for c in 0..6 {
-            let g_max = Sweep::ALL.iter().flat_map(|k| t.row_frac[k.index()][c]).min().unwrap_or(MAX_FRAC);
+            let g_max = Sweep::ALL
+                .iter()
+                .flat_map(|k| t.row_frac[k.index()][c])
+                .chain(t.cross[c].iter().map(|x| x.2))
+                .min()
+                .unwrap_or(MAX_FRAC);
             let bound_at = |g: u32| -> (i64, [i64; NCOEF]) {
                 let base = model.baseline[c].coeffs.map(|b| quantise(b, g));
                 let mut total = 0i64;
@@ -85,6 +119,11 @@ impl TablesFixed {
                         // ceil(sum / 2^shift): the largest |r >> shift| when |r| <= sum
                         let d = 1i64 << shift;
                         a = a.saturating_add((row_sum[k][c][i] + d - 1) / d);
+                    }
+                    for (_, q, f) in &t.cross[c] {
+                        let d = 1i64 << (f - g);
+                        let p = q.get(i).map_or(0, |v| v.abs());
+                        a = a.saturating_add((p + d - 1) / d);
                     }
                     total = total.saturating_add(a);
                 }

@@ -13,6 +13,7 @@
 pub mod contract;
 pub mod coupled;
 pub mod coupled_report;
+pub mod cross_terms;
 pub mod data;
 pub mod error_trend;
 pub mod eval_f32;
@@ -57,7 +58,10 @@ pub struct FitOutput {
 /// (rank-deficient fits); a model too large for the fixed-point evaluator.
 pub fn fit_set(set_dir: &Path) -> Result<FitOutput> {
     let data = data::load_fit_data(set_dir)?;
-    let model = model::fit(&data)?;
+    let mut model = model::fit(&data)?;
+    if data.campaign.fit.form == crate::fe::spec::ModelForm::Coupled {
+        model.cross = Some(coupled::fit_coupled(&model, &data.train, data.campaign.needle.reference_from_tip_mm)?);
+    }
     let model_toml = model_file::to_toml(&model, &data.campaign.campaign.fit_without);
     let golden_csv = golden::to_csv(&eval_f32::Tables32::from_model(&model));
     let golden_fixed_csv = golden_fixed::to_csv(&fixed_formats::TablesFixed::from_model(&model)?)?;

@@ -6,6 +6,7 @@ use super::contract::{u_of, Sweep, COMPONENTS, DEGREE, NCOEF};
 use super::data::{FitData, Run, SweepPoint};
 use super::eval_f64::{deviation, horner};
 use super::lsq::polyfit;
+use super::cross_terms::CrossTerms;
 use anyhow::{Context, Result};
 
 /// The centre run's polynomial in depth for one component.
@@ -43,6 +44,23 @@ pub struct Model {
     pub baseline: [Baseline; 6],
     /// Deviation matrices, `matrices[k][c]` for sweep k and component c.
     pub matrices: [[Deviation; 6]; 4],
+    /// The cross terms of the coupled form (`form = "coupled"`); `None`: the paper form.
+    pub cross: Option<Coupled>,
+}
+
+/// The coupled form's part of a model: its cross terms and their stated accuracy.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Coupled {
+    /// The cross terms (their size chosen by cross-validation).
+    pub terms: CrossTerms,
+    /// Training runs they were fitted on.
+    pub training_runs: usize,
+    /// Cross-validated RMS error of the coupled form per component over the training
+    /// runs, % of `scale` ([`super::coupled::cross_validate`]).
+    pub cv_rms_pct: [f64; 6],
+    /// What the percentages refer to, per component: the training runs' peak |Fy| (N),
+    /// times the lever arm for the moments (N*mm).
+    pub scale: [f64; 6],
 }
 
 /// `+0.0` for a zero of either sign, else `v`: the files never carry `-0.0`.
@@ -163,5 +181,6 @@ pub fn fit(data: &FitData) -> Result<Model> {
         fe_sha256: data.fe_sha256.clone(),
         baseline,
         matrices,
+        cross: None,
     })
 }

@@ -3,7 +3,10 @@
 //! their bits `"0x%08x"`, keys in a fixed order: the same model gives the same bytes.
 
 use super::contract::{Sweep, COMPONENTS, DEPTH_MAX_MM, NCOEF, THETA_MAX_DEG, XZ_MAX_MM};
-use super::model::{Baseline, Deviation, Model};
+use super::coupled::FOLDS;
+use super::cross_terms::{monomials, CrossForm, CrossTerms, Exponents, CANDIDATES};
+use super::model::{Baseline, Coupled, Deviation, Model};
+use crate::fe::spec::ModelForm;
 use anyhow::{bail, Result};
 use serde::Deserialize;
 use std::fmt::Write as _;
@@ -64,6 +67,9 @@ pub fn to_toml(model: &Model, left_out: &[String]) -> String {
     let _ = writeln!(s, "x_max_mm = {}", num(XZ_MAX_MM));
     let _ = writeln!(s, "z_max_mm = {}", num(XZ_MAX_MM));
     let _ = writeln!(s, "theta_max_deg = {}", num(THETA_MAX_DEG));
+    if model.cross.is_some() {
+        let _ = writeln!(s, "form = \"{}\"", ModelForm::Coupled.name());
+    }
     for (c, b) in model.baseline.iter().enumerate() {
         let _ = writeln!(s);
         let _ = writeln!(s, "[[baseline]]");
@@ -94,7 +100,37 @@ pub fn to_toml(model: &Model, left_out: &[String]) -> String {
             let _ = writeln!(s, "residual_max = {}", num(m.residual_max));
         }
     }
+    if let Some(c) = &model.cross {
+        write_coupled(&mut s, c);
+    }
     s
+}
+
+/// The `[coupled]` table and the `[[cross]]` entries of the coupled form.
+fn write_coupled(s: &mut String, c: &Coupled) {
+    let _ = writeln!(s);
+    let _ = writeln!(s, "[coupled]");
+    let _ = writeln!(s, "# Cross terms: W_c += m(x/12, z/12, theta_x/15, theta_z/15) * P(u) per [[cross]] entry, in");
+    let _ = writeln!(s, "# file order; every monomial of total degree 2..=max_degree in at least two inputs with");
+    let _ = writeln!(s, "# the component's mirror parities, P of degree depth_degree (coeffs[i] multiplies u^i).");
+    let _ = writeln!(s, "# Size chosen by {FOLDS}-fold cross-validation over the training runs; cv_rms_pct: the");
+    let _ = writeln!(s, "# coupled form's cross-validated RMS error per component, % of scale (the training runs'");
+    let _ = writeln!(s, "# peak |Fy| in N, times the lever arm in N*mm for the moments).");
+    let _ = writeln!(s, "max_degree = {}", c.terms.form.max_degree);
+    let _ = writeln!(s, "depth_degree = {}", c.terms.form.depth_degree);
+    let _ = writeln!(s, "training_runs = {}", c.training_runs);
+    let _ = writeln!(s, "cv_rms_pct = {}", list(&c.cv_rms_pct));
+    let _ = writeln!(s, "scale = {}", list(&c.scale));
+    for (comp, terms) in c.terms.terms.iter().enumerate() {
+        for (e, p) in terms {
+            let _ = writeln!(s);
+            let _ = writeln!(s, "[[cross]]");
+            let _ = writeln!(s, "component = \"{}\"", COMPONENTS[comp]);
+            let _ = writeln!(s, "exponents = [{}, {}, {}, {}]", e[0], e[1], e[2], e[3]);
+            let _ = writeln!(s, "coeffs = {}", list(p));
+            let _ = writeln!(s, "coeffs_f32 = {}", list32(p));
+        }
+    }
 }
 
 #[derive(Deserialize)]
@@ -107,8 +143,33 @@ struct FileModel {
     x_max_mm: f64,
     z_max_mm: f64,
     theta_max_deg: f64,
+    #[serde(default)]
+    form: Option<String>,
     baseline: Vec<FileBaseline>,
     matrix: Vec<FileMatrix>,
+    #[serde(default)]
+    coupled: Option<FileCoupled>,
+    #[serde(default)]
+    cross: Vec<FileCross>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileCoupled {
+    max_degree: u8,
+    depth_degree: u8,
+    training_runs: usize,
+    cv_rms_pct: Vec<f64>,
+    scale: Vec<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileCross {
+    component: String,
+    exponents: Vec<u8>,
+    coeffs: Vec<f64>,
+    coeffs_f32: Vec<String>,
 }
 
 #[derive(Deserialize)]
@@ -135,10 +196,18 @@ struct FileMatrix {
 
 /// Check one polynomial's f64 and f32 lists; `what` names it in messages.
 fn poly(values: &[f64], bits: &[String], what: &str) -> Result<[f64; NCOEF]> {
-    if values.len() != NCOEF || bits.len() != NCOEF {
-        bail!("{what}: {} f64 and {} f32 values, expected {NCOEF} of each", values.len(), bits.len());
-    }
+    let v = poly_n(values, bits, NCOEF, what)?;
     let mut out = [0.0; NCOEF];
+    out.copy_from_slice(&v);
+    Ok(out)
+}
+
+/// Check a polynomial of `n` coefficients, f64 and f32 lists; `what` names it.
+fn poly_n(values: &[f64], bits: &[String], n: usize, what: &str) -> Result<Vec<f64>> {
+    if values.len() != n || bits.len() != n {
+        bail!("{what}: {} f64 and {} f32 values, expected {n} of each", values.len(), bits.len());
+    }
+    let mut out = vec![0.0; n];
     for (j, (v, b)) in values.iter().zip(bits).enumerate() {
         if !v.is_finite() {
             bail!("{what}[{j}] = {v}: not finite");
@@ -226,7 +295,62 @@ pub fn parse(text: &str, path: &Path) -> Result<Model> {
         residuals(m.residual_rms, m.residual_max, &what)?;
         matrices[k.index()][c] = Deviation { rows, residual_rms: m.residual_rms, residual_max: m.residual_max };
     }
-    Ok(Model { set: f.set, fe_sha256: f.fe_sha256, baseline, matrices })
+    let cross = match f.form.as_deref() {
+        None | Some("paper") => {
+            if f.coupled.is_some() || !f.cross.is_empty() {
+                bail!("{p}: [coupled] and [[cross]] belong to form = \"coupled\" only");
+            }
+            None
+        }
+        Some("coupled") => match &f.coupled {
+            Some(c) => Some(parse_coupled(c, &f.cross, &p.to_string())?),
+            None => bail!("{p}: form = \"coupled\" needs a [coupled] table"),
+        },
+        Some(other) => bail!("{p}: form = {other:?}: the forms are \"paper\" and \"coupled\""),
+    };
+    Ok(Model { set: f.set, fe_sha256: f.fe_sha256, baseline, matrices, cross })
+}
+
+/// Check the coupled form's tables: sizes among the candidates, every monomial of the
+/// form in the fixed order ([`monomials`]), coefficient counts and f32 values.
+fn parse_coupled(c: &FileCoupled, cross: &[FileCross], p: &str) -> Result<Coupled> {
+    let form = CrossForm { max_degree: c.max_degree, depth_degree: c.depth_degree };
+    if !CANDIDATES.contains(&form) {
+        bail!(
+            "{p}: [coupled] max_degree = {}, depth_degree = {}: not one of the forms the fitter chooses from (2..=4 each)",
+            c.max_degree,
+            c.depth_degree
+        );
+    }
+    for (name, v) in [("cv_rms_pct", &c.cv_rms_pct), ("scale", &c.scale)] {
+        if v.len() != 6 || v.iter().any(|x| !x.is_finite() || *x < 0.0) {
+            bail!("{p}: [coupled] {name}: expected 6 finite values >= 0 (one per component), got {v:?}");
+        }
+    }
+    let mut terms: [Vec<(Exponents, Vec<f64>)>; 6] = Default::default();
+    let mut entries = cross.iter().enumerate();
+    for (comp, out) in terms.iter_mut().enumerate() {
+        for e in monomials(comp, form.max_degree) {
+            let Some((n, x)) = entries.next() else {
+                bail!("{p}: {} [[cross]] entries; {} {:?} is missing (entries: per component, monomials in the fitter's order)", cross.len(), COMPONENTS[comp], e);
+            };
+            let what = format!("{p}: cross {} ({}, exponents {:?})", n + 1, x.component, x.exponents);
+            if x.component != COMPONENTS[comp] || x.exponents.as_slice() != e.as_slice() {
+                bail!("{what}: expected {} with exponents {e:?} here (per component, monomials in the fitter's order)", COMPONENTS[comp]);
+            }
+            let coeffs = poly_n(&x.coeffs, &x.coeffs_f32, usize::from(form.depth_degree) + 1, &format!("{what}: coeffs"))?;
+            out.push((e, coeffs));
+        }
+    }
+    if let Some((n, x)) = entries.next() {
+        bail!("{p}: cross {} ({}, exponents {:?}): more entries than the form has ({})", n + 1, x.component, x.exponents, n);
+    }
+    Ok(Coupled {
+        terms: CrossTerms { form, terms },
+        training_runs: c.training_runs,
+        cv_rms_pct: std::array::from_fn(|i| c.cv_rms_pct[i]),
+        scale: std::array::from_fn(|i| c.scale[i]),
+    })
 }
 
 /// Read and check a model file.

@@ -6,9 +6,17 @@
 //! lever arm `needle.reference_from_tip_mm` (the hub, 60 mm for the default set), so that
 //! forces and moments are compared on the same scale.
 //!
-//! Goals (issue 3), checked on both the f64 and the f32 model (the worse counts):
-//! - table2: at every depth >= 1 mm, |Fy_model - Fy_FE| <= 5 % of |Fy_FE| at that depth;
-//! - lhs: for every run and component, RMS error <= 2 % of the run's peak |Fy|.
+//! Goals, checked on both the f64 and the f32 model (the worse counts), by form
+//! ([`Goals::of`]):
+//! - paper form (issue 3): table2: at every depth >= 1 mm, |Fy_model - Fy_FE| <= 5 % of
+//!   |Fy_FE| at that depth; lhs: for every run and component, RMS error <= 2 % of the
+//!   run's peak |Fy|;
+//! - coupled form (issue 16): table2: Fy within 2.5 % at every depth >= 1 mm; table2 and
+//!   lhs: every component's RMS error <= 2 % of peak |Fy| (the 1 % goal is reported, the
+//!   2 % limit decides) and its largest error <= 3 %.
+//!
+//! For the coupled form the paper part of the same model (its sweeps without the cross
+//! terms) is compared on the same runs and printed beside it (no goal).
 //!
 //! Validation poses are never tuned, dropped or refitted on: a missing or stale run is
 //! a missed goal.
@@ -17,7 +25,7 @@ use super::contract::{unit, COMPONENTS};
 use super::error_trend::{trend, ErrorTrend};
 use super::data::{fitted_fe_sha256, fitted_poses, load_validation_runs, run_path, Run};
 use super::eval_f32::{eval as eval32, Tables32};
-use super::eval_f64::eval as eval64;
+use super::eval_f64::{eval as eval64, eval_paper};
 use super::model::{rms_max, Model};
 use super::model_file;
 use crate::fe::spec::Role;
@@ -33,6 +41,55 @@ pub const TABLE2_MIN_DEPTH_MM: f64 = 1.0;
 /// LHS goal: largest RMS error of any component in % of peak |Fy| (moments: of peak |Fy|
 /// times the lever arm).
 pub const LHS_GOAL_PCT: f64 = 2.0;
+
+/// The goals of one model form (module docs).
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct Goals {
+    /// `paper` or `coupled`.
+    pub form: &'static str,
+    /// Table 2: largest |Fy error| / |FE Fy| at depths >= 1 mm, %.
+    pub table2_fy_pct: f64,
+    /// Largest RMS error of any component, % of peak |Fy| (lhs; table2 too when
+    /// `rms_on_table2`).
+    pub rms_pct: f64,
+    /// The stricter RMS goal reported beside the limit (coupled form: 1 %).
+    pub rms_stretch_pct: Option<f64>,
+    /// Largest error of any component at any depth, % of peak |Fy|.
+    pub max_pct: Option<f64>,
+    /// Whether the RMS and max goals apply to the table2 runs as well.
+    pub rms_on_table2: bool,
+}
+
+impl Goals {
+    /// The goals of the form of `model`.
+    pub fn of(model: &Model) -> Goals {
+        if model.cross.is_some() {
+            Goals { form: "coupled", table2_fy_pct: 2.5, rms_pct: 2.0, rms_stretch_pct: Some(1.0), max_pct: Some(3.0), rms_on_table2: true }
+        } else {
+            Goals { form: "paper", table2_fy_pct: TABLE2_GOAL_PCT, rms_pct: LHS_GOAL_PCT, rms_stretch_pct: None, max_pct: None, rms_on_table2: false }
+        }
+    }
+
+    fn met(&self, role: Role, fy_rel_pct: f64, worst_rms_pct: f64, worst_max_pct: f64) -> Option<bool> {
+        let rms_ok = worst_rms_pct <= self.rms_pct && self.max_pct.map_or(true, |m| worst_max_pct <= m);
+        match role {
+            Role::Table2 => Some(fy_rel_pct <= self.table2_fy_pct && (!self.rms_on_table2 || rms_ok)),
+            Role::Lhs => Some(rms_ok),
+            _ => None,
+        }
+    }
+}
+
+/// The paper part's errors on one run, beside the coupled form's (f64).
+#[derive(Debug, Clone, Copy, Serialize, Default)]
+pub struct PaperPart {
+    /// Largest |Fy error| / |FE Fy| at depths >= 1 mm, %.
+    pub fy_rel_max_pct: f64,
+    /// Largest RMS error of any component, % of scale.
+    pub worst_rms_pct: f64,
+    /// Largest error of any component at any depth, % of scale.
+    pub worst_max_pct: f64,
+}
 
 /// Errors of one component over one run's depths.
 #[derive(Debug, Clone, Copy, Serialize, Default)]
@@ -66,6 +123,10 @@ pub struct RunReport {
     pub fy_rel_max_pct: f64,
     /// Largest RMS error of any component in % of scale, worse of f64 and f32.
     pub worst_rms_pct: f64,
+    /// Largest error of any component at any depth in % of scale, worse of f64 and f32.
+    pub worst_max_pct: f64,
+    /// The paper part of a coupled model on the same run; `None` for the paper form.
+    pub paper_part: Option<PaperPart>,
     /// Whether this run meets its role's goal (None for mirror runs: no goal).
     pub goal_met: Option<bool>,
 }
@@ -79,6 +140,8 @@ pub struct Report {
     pub lever_arm_mm: f64,
     /// Whether model.toml's fe_sha256 matches the fitted FE files now in the set.
     pub model_matches_fe: bool,
+    /// The goals of the model's form.
+    pub goals: Goals,
     /// Validation runs (table2, lhs, mirror) in spec order.
     pub runs: Vec<RunReport>,
     /// Validation poses without a usable result, as `name (role, why)`: no result file, or
@@ -116,7 +179,22 @@ fn errors(model_w: &[[f64; 6]], run: &Run, scale: [f64; 6]) -> [CompError; 6] {
     out
 }
 
-/// Compare one run with the model (f64 and f32).
+/// Largest |Fy_model - Fy_FE| / |Fy_FE| at depths >= 1 mm over `models`' rows, %.
+fn fy_rel_max(models: &[&[[f64; 6]]], run: &Run) -> f64 {
+    let mut fy_rel = 0.0f64;
+    for w in models {
+        for (m, r) in w.iter().zip(&run.rows) {
+            if r.depth_mm >= TABLE2_MIN_DEPTH_MM - 1e-9 {
+                let fe = r.wrench[1];
+                let rel = if fe == 0.0 { f64::INFINITY } else { 100.0 * (m[1] - fe).abs() / fe.abs() };
+                fy_rel = fy_rel.max(rel);
+            }
+        }
+    }
+    fy_rel
+}
+
+/// Compare one run with the model (f64 and f32; for the coupled form also its paper part).
 pub fn compare_run(model: &Model, tables: &Tables32, run: &Run, lever_arm_mm: f64) -> (RunReport, f64) {
     let p = &run.pose;
     let pose4 = [p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg];
@@ -134,16 +212,17 @@ pub fn compare_run(model: &Model, tables: &Tables32, run: &Run, lever_arm_mm: f6
     let scale: [f64; 6] = std::array::from_fn(|c| if c < 3 { peak } else { peak * lever_arm_mm });
     let e64 = errors(&w64, run, scale);
     let e32 = errors(&w32, run, scale);
-    let mut fy_rel = 0.0f64;
-    for ((a, b), r) in w64.iter().zip(&w32).zip(&run.rows) {
-        if r.depth_mm >= TABLE2_MIN_DEPTH_MM - 1e-9 {
-            let fe = r.wrench[1];
-            for m in [a[1], b[1]] {
-                let rel = if fe == 0.0 { f64::INFINITY } else { 100.0 * (m - fe).abs() / fe.abs() };
-                fy_rel = fy_rel.max(rel);
-            }
+    let fy_rel = fy_rel_max(&[&w64, &w32], run);
+    let paper_part = model.cross.as_ref().map(|_| {
+        let wp: Vec<[f64; 6]> =
+            run.rows.iter().map(|r| eval_paper(model, [pose4[0], pose4[1], pose4[2], pose4[3], r.depth_mm]).0).collect();
+        let ep = errors(&wp, run, scale);
+        PaperPart {
+            fy_rel_max_pct: fy_rel_max(&[&wp], run),
+            worst_rms_pct: ep.iter().map(|e| e.rms_pct).fold(0.0, f64::max),
+            worst_max_pct: ep.iter().map(|e| e.max_pct).fold(0.0, f64::max),
         }
-    }
+    });
     let mut diff = 0.0f64;
     for (a, b) in w64.iter().zip(&w32) {
         for c in 0..6 {
@@ -151,11 +230,8 @@ pub fn compare_run(model: &Model, tables: &Tables32, run: &Run, lever_arm_mm: f6
         }
     }
     let worst_rms_pct = e64.iter().chain(&e32).map(|e| e.rms_pct).fold(0.0, f64::max);
-    let goal_met = match p.role {
-        Role::Table2 => Some(fy_rel <= TABLE2_GOAL_PCT),
-        Role::Lhs => Some(worst_rms_pct <= LHS_GOAL_PCT),
-        _ => None,
-    };
+    let worst_max_pct = e64.iter().chain(&e32).map(|e| e.max_pct).fold(0.0, f64::max);
+    let goal_met = Goals::of(model).met(p.role, fy_rel, worst_rms_pct, worst_max_pct);
     (
         RunReport {
             name: p.name.clone(),
@@ -166,6 +242,8 @@ pub fn compare_run(model: &Model, tables: &Tables32, run: &Run, lever_arm_mm: f6
             f32_errors: e32,
             fy_rel_max_pct: fy_rel,
             worst_rms_pct,
+            worst_max_pct,
+            paper_part,
             goal_met,
         },
         diff,
@@ -208,6 +286,7 @@ pub fn validate(set_dir: &Path) -> Result<Report> {
         set_dir: set_dir.display().to_string(),
         lever_arm_mm: lever,
         model_matches_fe,
+        goals: Goals::of(&model),
         runs: reports,
         missing: missing.iter().map(|u| format!("{} ({}, {})", u.pose.name, role_name(u.pose.role), u.why)).collect(),
         f32_vs_f64_max_pct: diff,
@@ -250,19 +329,34 @@ pub fn to_table(r: &Report) -> String {
         }
     }
     let _ = writeln!(s);
+    let coupled = r.goals.form == "coupled";
     let _ = writeln!(
         s,
-        "{:<8} {:<7} {:>7} {:>7} {:>7} {:>7} {:>10} {:>14} {:>12}  goal",
-        "run", "role", "x mm", "z mm", "tx deg", "tz deg", "peak|Fy| N", "Fy rel d>=1 %", "worst rms %"
+        "{:<8} {:<7} {:>7} {:>7} {:>7} {:>7} {:>10} {:>14} {:>12} {:>12}{}  goal",
+        "run",
+        "role",
+        "x mm",
+        "z mm",
+        "tx deg",
+        "tz deg",
+        "peak|Fy| N",
+        "Fy rel d>=1 %",
+        "worst rms %",
+        "worst max %",
+        if coupled { format!("  {:>14} {:>12} {:>12}", "paper: Fy rel %", "rms %", "max %") } else { String::new() }
     );
     for run in &r.runs {
         let goal = match run.goal_met {
             Some(b) => pass(b),
             None => "-",
         };
+        let paper = match run.paper_part {
+            Some(pp) => format!("  {:>14.3} {:>12.3} {:>12.3}", pp.fy_rel_max_pct, pp.worst_rms_pct, pp.worst_max_pct),
+            None => String::new(),
+        };
         let _ = writeln!(
             s,
-            "{:<8} {:<7} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>10.4e} {:>14.3} {:>12.3}  {goal}",
+            "{:<8} {:<7} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>10.4e} {:>14.3} {:>12.3} {:>12.3}{paper}  {goal}",
             run.name,
             run.role,
             run.pose[0],
@@ -271,7 +365,8 @@ pub fn to_table(r: &Report) -> String {
             run.pose[3],
             run.peak_fy_n,
             run.fy_rel_max_pct,
-            run.worst_rms_pct
+            run.worst_rms_pct,
+            run.worst_max_pct
         );
     }
     let _ = writeln!(s);
@@ -286,18 +381,48 @@ pub fn to_table(r: &Report) -> String {
             format!("worst {:.3} % over {} runs", v.iter().copied().fold(0.0, f64::max), v.len())
         }
     };
+    let g = &r.goals;
+    let _ = writeln!(s, "goals of the {} form:", g.form);
     let _ = writeln!(
         s,
-        "goal table2: Fy within {TABLE2_GOAL_PCT} % of FE at every depth >= {TABLE2_MIN_DEPTH_MM} mm: {} ({})",
+        "goal table2: Fy within {} % of FE at every depth >= {TABLE2_MIN_DEPTH_MM} mm{}: {} ({})",
+        g.table2_fy_pct,
+        if g.rms_on_table2 { ", and the rms and max goals below" } else { "" },
         pass(r.table2_goal_met),
         worst("table2", |x| x.fy_rel_max_pct)
     );
     let _ = writeln!(
         s,
-        "goal lhs: every component's RMS error <= {LHS_GOAL_PCT} % of peak |Fy|: {} ({})",
+        "goal lhs: every component's RMS error <= {} % of peak |Fy|{}: {} ({}{})",
+        g.rms_pct,
+        g.max_pct.map(|m| format!(", largest error <= {m} %")).unwrap_or_default(),
         pass(r.lhs_goal_met),
-        worst("lhs", |x| x.worst_rms_pct)
+        worst("lhs", |x| x.worst_rms_pct),
+        if g.max_pct.is_some() { format!("; max {}", worst("lhs", |x| x.worst_max_pct)) } else { String::new() }
     );
+    if let Some(stretch) = g.rms_stretch_pct {
+        let all: Vec<f64> = r.runs.iter().filter(|x| x.goal_met.is_some()).map(|x| x.worst_rms_pct).collect();
+        let w = all.iter().copied().fold(0.0, f64::max);
+        let _ = writeln!(
+            s,
+            "goal (reported, not the exit code): every component's RMS <= {stretch} % on table2 and lhs: {} (worst {w:.3} % over {} runs)",
+            pass(w <= stretch),
+            all.len()
+        );
+    }
+    if coupled {
+        let pw = |role: &str, f: fn(&PaperPart) -> f64| -> f64 {
+            r.runs.iter().filter(|x| x.role == role).filter_map(|x| x.paper_part.as_ref().map(f)).fold(0.0, f64::max)
+        };
+        let _ = writeln!(
+            s,
+            "paper part of the same model (no cross terms), same runs: table2 Fy worst {:.3} %, rms worst {:.3} %; lhs rms worst {:.3} %, max worst {:.3} %",
+            pw("table2", |p| p.fy_rel_max_pct),
+            pw("table2", |p| p.worst_rms_pct),
+            pw("lhs", |p| p.worst_rms_pct),
+            pw("lhs", |p| p.worst_max_pct)
+        );
+    }
     let _ = writeln!(s, "mirror runs (symmetry check, no goal): rms {}", worst("mirror", |x| x.worst_rms_pct));
     if let Some(t) = r.error_trend {
         let _ = writeln!(
