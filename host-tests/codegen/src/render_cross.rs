@@ -23,10 +23,23 @@ fn lit(v: f32) -> String {
     format!("{l}_f32")
 }
 
-/// `m`, the monomial of `exponents`, as a left-to-right product.
+/// The factors of the monomial of `exponents`, in the contract's order: each input
+/// repeated by its exponent.
+fn factors(e: [u8; 4]) -> Vec<&'static str> {
+    e.iter().zip(INPUTS).flat_map(|(&k, name)| std::iter::repeat(name).take(usize::from(k))).collect()
+}
+
+/// `m`, the monomial of `exponents`, as a left-to-right f32 product.
 fn monomial(e: [u8; 4]) -> String {
-    let factors: Vec<&str> = e.iter().zip(INPUTS).flat_map(|(&k, name)| std::iter::repeat(name).take(usize::from(k))).collect();
-    factors.join(" * ")
+    factors(e).join(" * ")
+}
+
+/// `M`, the monomial of `exponents`, as left-to-right Q15 products (`mul_q15`).
+fn monomial_q15(e: [u8; 4]) -> String {
+    let f = factors(e);
+    let mut it = f.iter();
+    let first = it.next().map_or_else(|| "0".to_string(), |f| (*f).to_string());
+    it.fold(first, |m, f| format!("mul_q15({m}, {f})"))
 }
 
 /// `q`, Horner over `p` (`p[i]` multiplies `u^i`), highest power first.
@@ -164,14 +177,8 @@ pub fn render_rust_cross_fixed(model: &Model, t: &FixedTables) -> String {
             let _ = writeln!(w, "    // {} (u{}), accumulator Q{}", COMPONENTS[c], UNITS[c], comp.frac_bits);
             let _ = writeln!(w, "    let [a{c}_0, a{c}_1, a{c}_2, a{c}_3, a{c}_4] = a{c};");
             for x in &comp.cross {
-                let factors: Vec<&str> =
-                    x.exponents.iter().zip(INPUTS).flat_map(|(&k, name)| std::iter::repeat(name).take(usize::from(k))).collect();
-                let mut m = factors.first().map_or_else(|| "0".to_string(), |f| (*f).to_string());
-                for f in factors.iter().skip(1) {
-                    m = format!("mul_q15({m}, {f})");
-                }
                 let _ = writeln!(w, "    // exponents {:?}, Q{}, shift {}, model.toml line {}", x.exponents, x.frac_bits, x.shift, x.line);
-                let _ = writeln!(w, "    let m = {m};");
+                let _ = writeln!(w, "    let m = {};", monomial_q15(x.exponents));
                 for (i, p) in x.coeffs.iter().enumerate() {
                     if *p == 0 {
                         continue;

@@ -17,25 +17,13 @@
 //! training runs ([`select`]).
 
 use super::contract::{Pose64, COMPONENTS};
-use super::cross_terms::{cross_value, monomials, mono, normalised, CrossForm, CrossTerms, Exponents, CANDIDATES};
+use super::cross_terms::{monomials, mono, normalised, CrossForm, CrossTerms, Exponents, CANDIDATES};
 use super::data::Run;
-use super::eval_f64::eval_paper;
+use super::eval_f64::{eval_paper, eval_with_cross};
 use super::lsq::lstsq;
 use super::model::{Coupled, Model};
 use anyhow::{bail, Context, Result};
 use nalgebra::{DMatrix, DVector};
-
-/// The coupled model at `pose`: the paper form's wrench and status plus the cross terms.
-pub fn eval(paper: &Model, t: &CrossTerms, pose: Pose64) -> ([f64; 6], u8) {
-    let (mut w, status) = eval_paper(paper, pose);
-    if status & super::contract::STATUS_ERROR == 0 {
-        let x = cross_value(t, pose);
-        for (a, b) in w.iter_mut().zip(x) {
-            *a += b;
-        }
-    }
-    (w, status)
-}
 
 /// Fit the cross terms of size `form` to `FE - paper` over every depth of `runs`.
 ///
@@ -140,7 +128,7 @@ pub fn cross_validate(paper: &Model, runs: &[&Run], form: CrossForm, scale: [f64
         for r in &held {
             let p = &r.pose;
             for row in &r.rows {
-                let w = eval(paper, &t, [p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg, row.depth_mm]).0;
+                let w = eval_with_cross(paper, &t, [p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg, row.depth_mm]).0;
                 for c in 0..6 {
                     s[c] += (w[c] - row.wrench[c]).powi(2);
                 }
@@ -177,6 +165,18 @@ pub fn select(paper: &Model, runs: &[&Run], scale: [f64; 6]) -> Result<(CrossFor
     }
 }
 
+/// [`select`] on `runs`, then [`fit`] the chosen form on all of them: the chosen score,
+/// every candidate's score and the cross terms.
+///
+/// # Errors
+/// As [`select`] and [`fit`].
+pub fn select_and_fit(paper: &Model, runs: &[&Run], scale: [f64; 6]) -> Result<([f64; 6], Vec<CvScore>, CrossTerms)> {
+    let (form, cv) = select(paper, runs, scale)?;
+    let terms = fit(paper, runs, form)?;
+    let chosen = cv.iter().find(|s| s.form == form).and_then(|s| s.rms_pct).context("the chosen form has a score")?;
+    Ok((chosen, cv, terms))
+}
+
 /// The coupled form's part of the model: the size chosen by [`select`] on `train`, its
 /// cross terms fitted on all of `train` ([`fit`]) and its cross-validated error.
 ///
@@ -185,8 +185,6 @@ pub fn select(paper: &Model, runs: &[&Run], scale: [f64; 6]) -> Result<(CrossFor
 pub fn fit_coupled(paper: &Model, train: &[Run], lever_arm_mm: f64) -> Result<Coupled> {
     let runs: Vec<&Run> = train.iter().collect();
     let scale = scales(&runs, lever_arm_mm);
-    let (form, cv) = select(paper, &runs, scale)?;
-    let terms = fit(paper, &runs, form)?;
-    let cv_rms_pct = cv.iter().find(|s| s.form == form).and_then(|s| s.rms_pct).unwrap_or([f64::NAN; 6]);
+    let (cv_rms_pct, _, terms) = select_and_fit(paper, &runs, scale)?;
     Ok(Coupled { terms, training_runs: runs.len(), cv_rms_pct, scale })
 }

@@ -8,9 +8,9 @@
 //! the lever arm), and for Table 2 the largest |Fy| error at depths >= 1 mm in % of FE.
 
 use super::coupled::{self, CvScore};
-use super::cross_terms::{CrossForm, CrossTerms};
+use super::cross_terms::CrossTerms;
 use super::data::{load_training_runs, load_validation_runs, Run};
-use super::eval_f64::{eval as eval_paper, Pose64};
+use super::eval_f64::{eval as eval_paper, eval_with_cross, Pose64};
 use super::model::Model;
 use super::validate::{TABLE2_MIN_DEPTH_MM};
 use crate::fe::spec::Role;
@@ -135,17 +135,12 @@ pub fn measure(set_dir: &Path, paper: &Model) -> Result<CoupledReport> {
         return Ok(report);
     }
     let scale = coupled::scales(&train_refs, lever);
-    let fit_on = |runs: &[&Run]| -> Option<(CrossForm, Vec<CvScore>, CrossTerms)> {
-        let (form, cv) = coupled::select(paper, runs, scale).ok()?;
-        let terms = coupled::fit(paper, runs, form).ok()?;
-        Some((form, cv, terms))
-    };
     for n in curve_sizes(train.len()) {
-        let got = fit_on(&train_refs[..n]);
+        let got = coupled::select_and_fit(paper, &train_refs[..n], scale).ok();
         let point = CurvePoint {
             runs: n,
-            form: got.as_ref().map(|g| (g.0.max_degree, g.0.depth_degree)),
-            held_out: got.as_ref().map(|g| held_out(&held, lever, |p| coupled::eval(paper, &g.2, p).0)),
+            form: got.as_ref().map(|g| (g.2.form.max_degree, g.2.form.depth_degree)),
+            held_out: got.as_ref().map(|g| held_out(&held, lever, |p| eval_with_cross(paper, &g.2, p).0)),
         };
         if n == train.len() {
             if let Some((_, cv, terms)) = got {

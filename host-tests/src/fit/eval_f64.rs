@@ -5,7 +5,7 @@ use super::contract::{
     u_of, Sweep, DEPTH_MAX_MM, NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z,
     STATUS_SAT_X, STATUS_SAT_Z,
 };
-use super::cross_terms::cross_value;
+use super::cross_terms::{cross_value, CrossTerms};
 use super::model::Model;
 
 /// Horner, highest power first: `(((p4 w + p3) w + p2) w + p1) w + p0`.
@@ -29,14 +29,21 @@ pub fn deviation(rows: &[[f64; NCOEF]; NCOEF], t: f64, u: f64) -> f64 {
 pub use super::contract::Pose64;
 
 /// Evaluate the model at `pose`, in its form: the paper part ([`eval_paper`]) plus, for
-/// the coupled form, the cross terms ([`cross_value`]) unless the status is an error.
+/// the coupled form, its cross terms ([`eval_with_cross`]).
 pub fn eval(model: &Model, pose: Pose64) -> ([f64; 6], u8) {
-    let (mut w, status) = eval_paper(model, pose);
-    if let Some(c) = &model.cross {
-        if status & STATUS_ERROR == 0 {
-            for (a, b) in w.iter_mut().zip(cross_value(&c.terms, pose)) {
-                *a += b;
-            }
+    match &model.cross {
+        Some(c) => eval_with_cross(model, &c.terms, pose),
+        None => eval_paper(model, pose),
+    }
+}
+
+/// The paper part of `paper` at `pose` plus the cross terms `t` ([`cross_value`]), unless
+/// the status is an error.
+pub fn eval_with_cross(paper: &Model, t: &CrossTerms, pose: Pose64) -> ([f64; 6], u8) {
+    let (mut w, status) = eval_paper(paper, pose);
+    if status & STATUS_ERROR == 0 {
+        for (a, b) in w.iter_mut().zip(cross_value(t, pose)) {
+            *a += b;
         }
     }
     (w, status)
