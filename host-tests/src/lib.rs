@@ -3,6 +3,7 @@
 #![forbid(unsafe_code)]
 
 pub mod cli;
+pub mod explore;
 pub mod fe;
 pub mod firmware;
 pub mod fit;

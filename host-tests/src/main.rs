@@ -21,6 +21,8 @@ enum Command {
     Eval(needle_host::cli::model::EvalArgs),
     /// Compare the model with the FE runs it was not fitted on.
     Validate(needle_host::cli::fit::ValidateArgs),
+    /// Serve the model explorer (the firmware's evaluator compiled to wasm) on a local port.
+    Explore(needle_host::cli::explore::ExploreArgs),
     /// The set's figures as SVG (the paper's Figs 4, 6, 7, 8, parity, FE verification).
     Plot(needle_host::cli::plot::PlotArgs),
     /// The fixed-point evaluator's error against f64 on a grid and random poses, beside
@@ -40,6 +42,7 @@ fn main() -> ExitCode {
         Command::Fit(a) => needle_host::cli::fit::fit(a),
         Command::Eval(a) => needle_host::cli::model::eval(a),
         Command::Validate(a) => needle_host::cli::fit::validate(a),
+        Command::Explore(a) => needle_host::cli::explore::explore(a),
         Command::Plot(a) => needle_host::cli::plot::plot(a),
         Command::Header(a) => needle_host::cli::model::header(a),
         Command::FixedError(a) => needle_host::cli::fixed::fixed_error(a),

@@ -26,7 +26,8 @@ pub fn examples_dir(core: &Core) -> PathBuf {
 }
 
 /// `cargo` as the outer cargo named it (`$CARGO`), else from `PATH`.
-fn cargo() -> Command {
+#[must_use]
+pub fn nested_cargo() -> Command {
     Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()))
 }
 
@@ -46,7 +47,7 @@ pub fn check_target(target: &str) -> anyhow::Result<()> {
     if !out.status.success() || !lib.is_dir() {
         bail!(
             "the Rust target {target} is not installed ({} does not exist): `rustup target add {target}` \
-             (.ci/run installs thumbv7em-none-eabihf, thumbv7m-none-eabi and thumbv6m-none-eabi)",
+             (.ci/test installs thumbv7em-none-eabihf, thumbv7m-none-eabi, thumbv6m-none-eabi and wasm32-unknown-unknown)",
             lib.display()
         );
     }
@@ -54,7 +55,10 @@ pub fn check_target(target: &str) -> anyhow::Result<()> {
 }
 
 /// Runs a nested cargo build; on failure the error holds the end of cargo's output.
-fn run_cargo(mut cmd: Command, what: &str) -> anyhow::Result<()> {
+///
+/// # Errors
+/// cargo cannot be started or exits with an error (`what` names the build).
+pub fn run_cargo(mut cmd: Command, what: &str) -> anyhow::Result<()> {
     cmd.current_dir(workspace_root()).stdin(Stdio::null());
     eprintln!("firmware: building {what}");
     let out = cmd.output().with_context(|| format!("cannot run cargo to build {what}"))?;
@@ -84,7 +88,7 @@ fn run_cargo(mut cmd: Command, what: &str) -> anyhow::Result<()> {
 /// The target is not installed, or the build fails (the error holds cargo's output).
 pub fn build_examples(core: &Core, examples: &[&str], set: &Path) -> anyhow::Result<Vec<PathBuf>> {
     check_target(core.target)?;
-    let mut cmd = cargo();
+    let mut cmd = nested_cargo();
     cmd.args(["build", "--release", "-p", "needle-haptics", "--target", core.target, "--target-dir"])
         .arg(target_dir())
         .env("NEEDLE_COEFFS", set);
@@ -139,7 +143,7 @@ pub fn feature_combinations(features: &[String]) -> Vec<Vec<String>> {
 /// The target is not installed, or the build fails.
 pub fn build_library(core: &Core, features: &[String], set: &Path) -> anyhow::Result<()> {
     check_target(core.target)?;
-    let mut cmd = cargo();
+    let mut cmd = nested_cargo();
     cmd.args(["build", "--release", "-p", "needle-haptics", "--lib", "--no-default-features", "--target", core.target])
         .arg("--target-dir")
         .arg(target_dir())
