@@ -13,9 +13,13 @@
 //!
 //! A pose is up to date, and skipped, when its CSV exists with `steps + 1` rows and its
 //! manifest entry has the spec hash of the current run ([`Campaign::run_hash`] of the
-//! spec with the `--steps` override applied, the pose and the mesh level). Before a pose
-//! is solved its manifest entry is removed, so a CSV is only ever trusted when the entry
-//! written after it says which spec it came from.
+//! spec with the `--steps` override applied, the pose and the mesh level). A rerun
+//! (stale spec, `--force`) leaves the earlier CSV and its entry alone until it succeeds:
+//! then the new CSV is renamed over the old one and the new entry replaces the old. A
+//! failed or interrupted rerun therefore keeps the earlier result usable. Killed between
+//! the two renames, the new CSV sits beside the old entry: with a stale spec the entry's
+//! hash is not the current one and the pose is rerun; with `--force` both come from the
+//! same spec.
 //!
 //! A run that fails (solver error, no convergence, timeout) or stalls (no output for
 //! [`RunOptions::stall`]: ccx 2.20 was seen spinning without output at the start of a
@@ -313,10 +317,9 @@ fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
             std::fs::remove_dir_all(&wd).with_context(|| format!("{}: cannot clear", wd.display()))?;
         }
         std::fs::create_dir_all(&wd).with_context(|| format!("{}: cannot create", wd.display()))?;
-        // From here on the CSV (if any) is not trusted until the new entry is written.
-        update_manifest(ctx, |m| {
-            m.pose.remove(&pose.name);
-        })
+        // The earlier result and its entry stay until the new ones replace them: a failed
+        // or interrupted rerun (`--force`) costs nothing (module docs).
+        Ok(())
     })();
     if let Err(e) = prepared {
         return fail(format!("{e:#}"), String::new());
@@ -601,14 +604,16 @@ mod tests {
         assert!(t.contains("FAILED x+06: panic while solving: fake panic"), "{t}");
         assert!(fe.join(".work/x+04/pose.log").exists(), "work dir kept on failure");
         assert!(!fe.join("x+06.csv").exists());
-        // the old CSV of x+04 is still there, but its manifest entry is gone...
+        // the failed --force rerun cost nothing: x+04's first CSV and its entry are intact
+        // (issue 18: the entry used to be deleted, and `needle fit` then refused the set)
         let m = read_manifest(&fe.join(MANIFEST)).expect("manifest");
-        assert_eq!(m.pose.keys().cloned().collect::<Vec<_>>(), ["x+02"]);
-        // ...so the next run does not trust it
+        assert_eq!(m.pose.keys().cloned().collect::<Vec<_>>(), ["x+02", "x+04"]);
+        assert_eq!(results::read_csv(&fe.join("x+04.csv")).expect("csv").len(), 3, "the first result's CSV");
+        // so the next run only solves x+06
         let mut ok = Fake::default();
         let r = run_with(&opts(d.path(), "x+0[246]", 2), &mut ok).expect("resume");
-        assert_eq!((r.done(), r.up_to_date(), r.failed()), (2, 1, 0));
-        assert!(!fe.join(".work/x+04").exists());
+        assert_eq!((r.done(), r.up_to_date(), r.failed()), (1, 2, 0), "{}", r.table());
+        assert!(fe.join("x+06.csv").exists());
     }
 
     #[test]
