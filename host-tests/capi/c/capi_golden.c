@@ -120,6 +120,7 @@ int main(int argc, char **argv) {
     for (int c = 0; c < 6; c++) bad |= !same(f32(v[6 + c]), got[c]);
     if (bad) {
       if (mismatches < 10) printf("golden line %d differs (status 0x%02x want 0x%02x)\n", lineno, status, v[5]);
+      if (mismatches < 10 && status & NEEDLE_STATUS_ERROR) printf("  status has %s\n", needle_status_name(NEEDLE_STATUS_ERROR));
       mismatches++;
     }
     rows++;
@@ -131,7 +132,7 @@ int main(int argc, char **argv) {
       loop_checks++;
       int b = check_outputs(&t, f, true, lineno);
       for (int c = 0; c < 3; c++) b += bits_of(t.force_cmd_n[c]) != bits_of(f[c]);
-      b += t.flags != 0 && t.flags != 0x40; /* OK or DUTY_CLIPPED */
+      b += t.flags != 0 && t.flags != NEEDLE_LOOP_DUTY_CLIPPED;
       loop_failures += b != 0;
       memcpy(last_f, f, sizeof f);
       last_pose = p;
@@ -155,8 +156,8 @@ int main(int argc, char **argv) {
     loop_checks++;
     int b = check_outputs(&t, cmd, !zero, -k);
     for (int c = 0; c < 3; c++) b += bits_of(t.force_cmd_n[c]) != bits_of(cmd[c]);
-    b += (t.flags & 0x0021) != 0x0021; /* POSE_STALE | RAMPING */
-    b += zero != ((t.flags & 0x0100) != 0); /* DISABLED once at zero */
+    b += (t.flags & (NEEDLE_LOOP_POSE_STALE | NEEDLE_LOOP_RAMPING)) != (NEEDLE_LOOP_POSE_STALE | NEEDLE_LOOP_RAMPING);
+    b += zero != ((t.flags & NEEDLE_LOOP_DISABLED) != 0); /* once at zero */
     loop_failures += b != 0;
     if (zero) break;
   }
@@ -197,6 +198,11 @@ int main(int argc, char **argv) {
   }
   if (needle_loop_set_force_limit_n(&loop, 30.0f) != NEEDLE_E_CONFIG) command_failures++;
   if (needle_loop_tick(NULL, NULL, NEEDLE_POSE_MISSING, MAX_DUTY, NULL) != NEEDLE_E_NULL) command_failures++;
+  /* The names C users print: error codes, status bits, loop flags. */
+  if (strcmp(needle_strerror(NEEDLE_E_NULL), "NULL pointer argument") != 0) command_failures++;
+  if (strcmp(needle_status_name(NEEDLE_STATUS_SAT_DEPTH), "SAT_DEPTH") != 0) command_failures++;
+  if (needle_status_name(NEEDLE_STATUS_SAT_X | NEEDLE_STATUS_SAT_Z) != NULL) command_failures++;
+  if (strcmp(needle_loop_flag_name(NEEDLE_LOOP_RAMPING), "RAMPING") != 0) command_failures++;
 
   printf("capi-golden set=%s rows=%d wrench_mismatches=%d loop_checks=%d loop_failures=%d command_failures=%d\n",
          (const char *)info.set, rows, mismatches, loop_checks, loop_failures, command_failures);

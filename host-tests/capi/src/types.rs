@@ -146,3 +146,39 @@ pub struct needle_loop_t {
     /// `NEEDLE_LOOP_MAGIC` once initialised.
     pub magic: u32,
 }
+
+/// `needle_wrench` status bit (`needle_haptics::Status::SAT_X`): x was outside the domain
+/// and clamped. Each `NEEDLE_STATUS_*` value is checked against the library's by
+/// `tests/c_program.rs` (`status_and_flag_constants_are_the_librarys`).
+pub const NEEDLE_STATUS_SAT_X: u8 = 0x01;
+/// Status bit: z clamped to the domain.
+pub const NEEDLE_STATUS_SAT_Z: u8 = 0x02;
+/// Status bit: theta_x clamped to the domain.
+pub const NEEDLE_STATUS_SAT_THETA_X: u8 = 0x04;
+/// Status bit: theta_z clamped to the domain.
+pub const NEEDLE_STATUS_SAT_THETA_Z: u8 = 0x08;
+/// Status bit: depth clamped to the domain.
+pub const NEEDLE_STATUS_SAT_DEPTH: u8 = 0x10;
+/// Status bit: the build has no fitted model (the wrench is zero).
+pub const NEEDLE_STATUS_NO_MODEL: u8 = 0x40;
+/// Status bit: no wrench could be computed (NaN input, NULL pose, no model).
+pub const NEEDLE_STATUS_ERROR: u8 = 0x80;
+
+/// `needle_tick_t::flags` bit (`needle_haptics::control::LoopFlags::POSE_STALE`).
+pub const NEEDLE_LOOP_POSE_STALE: u16 = 0x0001;
+/// Loop flag: no pose this tick.
+pub const NEEDLE_LOOP_POSE_MISSING: u16 = 0x0002;
+/// Loop flag: the evaluator returned an error.
+pub const NEEDLE_LOOP_EVAL_ERROR: u16 = 0x0004;
+/// Loop flag: the force exceeded the limit.
+pub const NEEDLE_LOOP_OVER_LIMIT: u16 = 0x0008;
+/// Loop flag: the force was scaled down to the limit.
+pub const NEEDLE_LOOP_FORCE_SATURATED: u16 = 0x0010;
+/// Loop flag: the output is ramping (to zero or back).
+pub const NEEDLE_LOOP_RAMPING: u16 = 0x0020;
+/// Loop flag: a duty cycle was clipped to the channel's range.
+pub const NEEDLE_LOOP_DUTY_CLIPPED: u16 = 0x0040;
+/// Loop flag: a PWM or pin write failed.
+pub const NEEDLE_LOOP_OUTPUT_ERROR: u16 = 0x0080;
+/// Loop flag: the enable pin is low.
+pub const NEEDLE_LOOP_DISABLED: u16 = 0x0100;

@@ -46,7 +46,8 @@ pub struct EvalArgs {
 /// Arguments of `needle header`.
 #[derive(Args, Debug)]
 pub struct HeaderArgs {
-    /// Folder to write needle_coeffs.h into (created if missing).
+    /// Folder to write needle_coeffs.h (the model's tables) and needle.h (the C API) into
+    /// (created if missing).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
 }
@@ -246,7 +247,11 @@ fn eval_file(file: &Path, out: Option<&Path>, json: bool) -> anyhow::Result<Exit
 pub fn header(a: HeaderArgs) -> anyhow::Result<ExitCode> {
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     let path = a.out.join(needle_codegen::C_HEADER_FILE);
-    std::fs::write(&path, model_info::C_HEADER).with_context(|| format!("writing {}", path.display()))?;
+    crate::fe::results::write_atomic(&path, model_info::C_HEADER.as_bytes())?;
+    // the C API's own header (functions, types, NEEDLE_STATUS_* / NEEDLE_LOOP_* constants)
+    let api = a.out.join("needle.h");
+    crate::fe::results::write_atomic(&api, needle_capi::HEADER.as_bytes())?;
+    println!("wrote {} (the C API: link libneedle_capi.a from `cargo build --release -p needle-capi`)", api.display());
     if model_info::FITTED {
         println!("wrote {} (set {}, fe_sha256 {})", path.display(), model_info::SET, model_info::FE_SHA256);
     } else {

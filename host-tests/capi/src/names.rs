@@ -1,0 +1,85 @@
+//! Names for C: `needle_strerror`, `needle_status_name`, `needle_loop_flag_name`.
+//! Static, NUL-terminated strings; the flag names are the library's (`Status::FLAGS`,
+//! `LoopFlags::FLAGS`), checked by this crate's tests.
+use core::ffi::{c_char, CStr};
+
+/// What an `NEEDLE_OK` / `NEEDLE_E_*` return code means, e.g. "NULL pointer argument".
+/// Unknown codes give "unknown needle error code". Never NULL.
+#[no_mangle]
+pub extern "C" fn needle_strerror(code: i32) -> *const c_char {
+    let s: &CStr = match code {
+        crate::types::NEEDLE_OK => c"success",
+        crate::types::NEEDLE_E_NULL => c"NULL pointer argument",
+        crate::types::NEEDLE_E_CONFIG => c"configuration or force limit refused; nothing changed",
+        crate::types::NEEDLE_E_UNINIT => c"loop not initialised with needle_loop_init",
+        crate::types::NEEDLE_E_ARG => c"enumeration argument out of range",
+        _ => c"unknown needle error code",
+    };
+    s.as_ptr()
+}
+
+/// The name of one `NEEDLE_STATUS_*` bit ("SAT_X", ..., "ERROR"), "OK" for 0; NULL for a
+/// value that is not 0 or exactly one known bit (test the bits one by one).
+#[no_mangle]
+pub extern "C" fn needle_status_name(bit: u8) -> *const c_char {
+    let s: Option<&CStr> = match bit {
+        0 => Some(c"OK"),
+        crate::types::NEEDLE_STATUS_SAT_X => Some(c"SAT_X"),
+        crate::types::NEEDLE_STATUS_SAT_Z => Some(c"SAT_Z"),
+        crate::types::NEEDLE_STATUS_SAT_THETA_X => Some(c"SAT_THETA_X"),
+        crate::types::NEEDLE_STATUS_SAT_THETA_Z => Some(c"SAT_THETA_Z"),
+        crate::types::NEEDLE_STATUS_SAT_DEPTH => Some(c"SAT_DEPTH"),
+        crate::types::NEEDLE_STATUS_NO_MODEL => Some(c"NO_MODEL"),
+        crate::types::NEEDLE_STATUS_ERROR => Some(c"ERROR"),
+        _ => None,
+    };
+    s.map_or(core::ptr::null(), CStr::as_ptr)
+}
+
+/// The name of one `NEEDLE_LOOP_*` flag ("POSE_STALE", ..., "DISABLED"), "OK" for 0; NULL
+/// for a value that is not 0 or exactly one known flag.
+#[no_mangle]
+pub extern "C" fn needle_loop_flag_name(flag: u16) -> *const c_char {
+    let s: Option<&CStr> = match flag {
+        0 => Some(c"OK"),
+        crate::types::NEEDLE_LOOP_POSE_STALE => Some(c"POSE_STALE"),
+        crate::types::NEEDLE_LOOP_POSE_MISSING => Some(c"POSE_MISSING"),
+        crate::types::NEEDLE_LOOP_EVAL_ERROR => Some(c"EVAL_ERROR"),
+        crate::types::NEEDLE_LOOP_OVER_LIMIT => Some(c"OVER_LIMIT"),
+        crate::types::NEEDLE_LOOP_FORCE_SATURATED => Some(c"FORCE_SATURATED"),
+        crate::types::NEEDLE_LOOP_RAMPING => Some(c"RAMPING"),
+        crate::types::NEEDLE_LOOP_DUTY_CLIPPED => Some(c"DUTY_CLIPPED"),
+        crate::types::NEEDLE_LOOP_OUTPUT_ERROR => Some(c"OUTPUT_ERROR"),
+        crate::types::NEEDLE_LOOP_DISABLED => Some(c"DISABLED"),
+        _ => None,
+    };
+    s.map_or(core::ptr::null(), CStr::as_ptr)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use needle_haptics::control::LoopFlags;
+    use needle_haptics::Status;
+
+    fn name(p: *const c_char) -> Option<String> {
+        // SAFETY: the functions return NULL or a static NUL-terminated string
+        (!p.is_null()).then(|| unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned())
+    }
+
+    #[test]
+    fn status_and_flag_constants_and_names_are_the_librarys() {
+        for (flag, lib_name) in Status::FLAGS {
+            assert_eq!(name(needle_status_name(flag.bits())).as_deref(), Some(lib_name), "status bit {:#04x}", flag.bits());
+        }
+        assert_eq!(Status::FLAGS.len(), 7, "a new Status flag needs its NEEDLE_STATUS_ constant and name");
+        for (flag, lib_name) in LoopFlags::FLAGS {
+            assert_eq!(name(needle_loop_flag_name(flag.bits())).as_deref(), Some(lib_name), "loop flag {:#06x}", flag.bits());
+        }
+        assert_eq!(LoopFlags::FLAGS.len(), 9, "a new loop flag needs its NEEDLE_LOOP_ constant and name");
+        assert_eq!(name(needle_status_name(0x11)), None, "two bits are not one name");
+        assert_eq!(name(needle_loop_flag_name(0x0200)), None, "unknown flag");
+        assert_eq!(name(needle_strerror(crate::types::NEEDLE_E_NULL)).as_deref(), Some("NULL pointer argument"));
+        assert_eq!(name(needle_strerror(-99)).as_deref(), Some("unknown needle error code"));
+    }
+}

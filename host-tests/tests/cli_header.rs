@@ -1,0 +1,19 @@
+//! `needle header --out DIR` writes both C headers a C user needs: needle_coeffs.h (the
+//! model's tables, from the build) and needle.h (the C API, from needle-capi).
+
+use std::process::Command;
+
+#[test]
+fn header_writes_the_tables_and_the_api_header() {
+    let d = tempfile::tempdir().expect("tempdir");
+    let out_dir = d.path().join("include");
+    let out = Command::new(env!("CARGO_BIN_EXE_needle")).args(["header", "--out"]).arg(&out_dir).output().expect("run needle header");
+    assert!(out.status.success(), "needle header failed: {}", String::from_utf8_lossy(&out.stderr));
+    let coeffs = std::fs::read_to_string(out_dir.join("needle_coeffs.h")).expect("needle_coeffs.h written");
+    assert_eq!(coeffs, needle_haptics::model_info::C_HEADER);
+    let api = std::fs::read_to_string(out_dir.join("needle.h")).expect("needle.h written");
+    assert_eq!(api, needle_capi::HEADER);
+    for item in ["needle_wrench(", "needle_strerror(", "needle_status_name(", "#define NEEDLE_STATUS_SAT_X 1", "#define NEEDLE_LOOP_DISABLED 256"] {
+        assert!(api.contains(item), "needle.h lacks {item}");
+    }
+}
