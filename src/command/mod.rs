@@ -61,6 +61,19 @@ pub enum FrameError {
     Range,
 }
 
+impl core::fmt::Display for FrameError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::Oversize => write!(f, "OVERSIZE: request longer than {FRAME_MAX} bytes"),
+            Self::Malformed(why) => write!(f, "MALFORMED: {why}"),
+            Self::Unknown => f.write_str("UNKNOWN: no such command"),
+            Self::Range => f.write_str("RANGE: a value outside its range"),
+        }
+    }
+}
+
+impl core::error::Error for FrameError {}
+
 impl FrameError {
     /// The reply's code word.
     #[must_use]

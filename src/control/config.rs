@@ -58,6 +58,18 @@ pub enum ConfigError {
     RampStep,
 }
 
+impl core::fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            Self::Gain => "loop config refused: a channel gain (duty per N) is NaN or infinite",
+            Self::ForceLimit => "loop config refused: force_limit_n must be finite, > 0 N and <= force_limit_max_n",
+            Self::RampStep => "loop config refused: ramp_step_n must be > 0 N per tick",
+        })
+    }
+}
+
+impl core::error::Error for ConfigError {}
+
 impl<const N: usize> LoopConfig<N> {
     /// Checks the configuration.
     ///

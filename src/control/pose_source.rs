@@ -12,6 +12,17 @@ pub enum PoseFault {
     Missing,
 }
 
+impl core::fmt::Display for PoseFault {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            Self::Stale => "pose stale: the last pose is older than one tick",
+            Self::Missing => "pose missing: no pose available (encoders not homed or sensor disconnected)",
+        })
+    }
+}
+
+impl core::error::Error for PoseFault {}
+
 /// A source of the needle's pose, implemented by the board from its encoders and
 /// kinematics.
 ///
