@@ -29,6 +29,10 @@ fn out_of_range_counts_are_refused_with_their_range() {
     for (args, want) in [
         (vec!["fe", "run", "--set", &s, "--jobs", "-1"], "invalid value '-1' for '--jobs <N>': -1 is not in 1..=256"),
         (vec!["fe", "run", "--set", &s, "--jobs", "0"], "invalid value '0' for '--jobs <N>': 0 is not in 1..=256"),
+        (vec!["fe", "run", "--set", &s, "--steps", "0"], "0 is not in 1..=10000"),
+        (vec!["fe", "run", "--set", &s, "--timeout-s", "-5"], "-5 s: must be > 0 s"),
+        (vec!["fe", "run", "--set", &s, "--stall-s", "inf"], "inf s: must be > 0 s"),
+        (vec!["fe", "run", "--set", &s, "--timeout-s", "ten"], "\"ten\" is not a number of seconds"),
         (vec!["fixed-error", "--set", &s, "--grid", "100"], "100 is not in 2..=41"),
         (vec!["fixed-error", "--set", &s, "--random", "1000000000"], "1000000000 is not in 0..=100000000"),
     ] {

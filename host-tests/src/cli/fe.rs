@@ -49,7 +49,7 @@ pub struct RunArgs {
     pub mesh: Option<String>,
     /// Number of load steps instead of loading.steps (smoke runs: rows at N+1 depths from 0
     /// to loading.depth_mm). Part of the spec hash: results of other step counts are rerun.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=10_000))]
     pub steps: Option<u32>,
     /// Output folder for <pose>.csv, manifest.toml and .work/; default: <set>/fe.
     #[arg(long, value_name = "DIR")]
@@ -63,11 +63,21 @@ pub struct RunArgs {
     pub keep_work: bool,
     /// Wall-clock limit of one ccx job, in seconds; a job running longer is killed and
     /// reported failed.
-    #[arg(long, value_name = "S")]
+    #[arg(long, value_name = "S", allow_negative_numbers = true, value_parser = positive_seconds)]
     pub timeout_s: Option<f64>,
     /// A ccx job that writes no output (log, .sta, .cvg) for this many seconds is killed as stalled; a failed or stalled job is retried once with a smaller first increment per step
-    #[arg(long, value_name = "S", default_value_t = campaign::DEFAULT_STALL.as_secs_f64())]
+    #[arg(long, value_name = "S", default_value_t = campaign::DEFAULT_STALL.as_secs_f64(), allow_negative_numbers = true, value_parser = positive_seconds)]
     pub stall_s: f64,
+}
+
+/// A duration in seconds on the command line: finite and > 0 (at most 30 days).
+fn positive_seconds(text: &str) -> Result<f64, String> {
+    let v: f64 = text.trim().parse().map_err(|_| format!("{text:?} is not a number of seconds"))?;
+    if v.is_finite() && v > 0.0 && v <= 30.0 * 86_400.0 {
+        Ok(v)
+    } else {
+        Err(format!("{v} s: must be > 0 s and at most 30 days (2592000 s)"))
+    }
 }
 
 /// Arguments of `needle fe verify`.
