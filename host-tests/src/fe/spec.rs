@@ -656,6 +656,8 @@ impl Campaign {
         let mut seen = std::collections::BTreeSet::new();
         for pose in &self.pose {
             check_pose(pose, &p.to_string())?;
+            check_pose_role(pose, &p.to_string())?;
+            check_pose_in_block(pose, &self.block, self.needle.diameter_mm / 2.0, self.loading.depth_mm, &p.to_string())?;
             if !seen.insert(pose.name.clone()) {
                 bail!("{p}: pose {:?} is listed twice", pose.name);
             }
@@ -812,6 +814,42 @@ fn is_zero_u32(v: &u32) -> bool {
     *v == 0
 }
 
+/// A sweep pose varies its own axis only (the centre none): the fitter reads a sweep
+/// run as the deviation along that axis alone.
+fn check_pose_role(pose: &PoseSpec, p: &str) -> Result<()> {
+    let own = match pose.role {
+        Role::Centre => None,
+        Role::SweepX => Some("x_mm"),
+        Role::SweepZ => Some("z_mm"),
+        Role::SweepThetaX => Some("theta_x_deg"),
+        Role::SweepThetaZ => Some("theta_z_deg"),
+        _ => return Ok(()),
+    };
+    for (f, v) in [("x_mm", pose.x_mm), ("z_mm", pose.z_mm), ("theta_x_deg", pose.theta_x_deg), ("theta_z_deg", pose.theta_z_deg)] {
+        if Some(f) != own && v != 0.0 {
+            let what = own.map_or("the centre pose has all four at 0".to_string(), |o| format!("a {:?} pose varies {o} only", pose.role));
+            bail!("{p}: pose {:?}: {f} = {v}: must be 0 ({what})", pose.name);
+        }
+    }
+    Ok(())
+}
+
+/// The needle stays inside the block: at entry and at full depth (after the lateral
+/// travel of the tilt), the needle's axis is at least its radius from each side face.
+fn check_pose_in_block(pose: &PoseSpec, block: &Block, radius_mm: f64, depth_mm: f64, p: &str) -> Result<()> {
+    let (tx, tz) = crate::fe::mesh::lateral_travel(pose, depth_mm);
+    for (f, entry, travel, half) in [("x_mm", pose.x_mm, tx, block.size_x_mm / 2.0), ("z_mm", pose.z_mm, tz, block.size_z_mm / 2.0)] {
+        let reach = entry.abs().max((entry + travel).abs()) + radius_mm;
+        if reach > half {
+            bail!(
+                "{p}: pose {:?}: {f} = {entry} with a lateral travel of {travel:.3} mm at full depth ({depth_mm} mm): the needle (radius {radius_mm} mm) reaches {reach:.3} mm from the centre, beyond the block's side at {half} mm",
+                pose.name
+            );
+        }
+    }
+    Ok(())
+}
+
 fn check_pose(pose: &PoseSpec, p: &str) -> Result<()> {
     if pose.name.is_empty()
         || !pose.name.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '+' | '_'))
@@ -934,5 +972,27 @@ mod tests {
         assert_eq!(two, Some(vec!["lhs-09".into(), "lhs-10".into(), "lhs-13".into()]));
         assert!(select(&poses, Some("lhs-09,,x")).is_err(), "an empty pattern is refused");
         assert!(select(&poses, Some("lhs-[")).is_err(), "a broken glob is refused");
+    }
+
+    /// Issue 18: a pose outside the block and a sweep pose off its axis were accepted.
+    #[test]
+    fn poses_outside_the_block_or_off_their_sweep_axis_are_refused() {
+        let set = Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default");
+        let text = std::fs::read_to_string(set.join("campaign.toml")).expect("campaign.toml");
+        let cases = [
+            // block 10 mm wide: x+06 (the first listed pose beyond 4.5 mm) is outside
+            (
+                text.replace("size_x_mm = 50.0", "size_x_mm = 10.0"),
+                "pose \"x+06\": x_mm = 6 with a lateral travel of 0.000 mm at full depth (6 mm): the needle (radius 0.5 mm) reaches 6.500 mm from the centre, beyond the block's side at 5 mm",
+            ),
+            // a sweep-x pose with z = 3
+            (text.replacen("role = \"sweep-x\"\nx_mm = 2.0", "role = \"sweep-x\"\nx_mm = 2.0\nz_mm = 3.0", 1), "pose \"x+02\": z_mm = 3: must be 0 (a SweepX pose varies x_mm only)"),
+        ];
+        for (spec, want) in cases {
+            assert_ne!(spec, text, "the test's edit did not apply");
+            let msg = super::parse(&spec, Path::new("campaign.toml")).err().map(|e| e.to_string()).unwrap_or_default();
+            assert!(msg.contains(want), "{msg}");
+        }
+        assert!(super::parse(&text, Path::new("campaign.toml")).is_ok(), "the shipped spec passes");
     }
 }
