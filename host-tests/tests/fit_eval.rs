@@ -337,3 +337,34 @@ fn runs_solved_from_another_spec_are_stale_for_the_fit_and_for_validate() {
     let e = needle_host::fit::fit_set(dir.path()).expect_err("no manifest: nothing is current");
     assert!(format!("{e:#}").contains("centre: no entry in fe/manifest.toml"), "{e:#}");
 }
+
+/// Issue 18: a Table 2 run whose Fz (or any component but Fy) is wrong must fail its goal;
+/// the goal used to look at Fy only (1,360 % error in Fz passed).
+#[test]
+fn a_table2_run_with_a_wrong_fz_fails_its_goal() {
+    let (dir, out) = fit_synthetic::fitted();
+    std::fs::write(dir.path().join("model.toml"), &out.model_toml).expect("write model");
+    let r = needle_host::fit::validate::validate(dir.path()).unwrap_or_else(|e| panic!("{e:#}"));
+    let good = r.runs.iter().find(|x| x.role == "table2" && x.goal_met == Some(true)).expect("a table2 run that meets its goal");
+    let name = good.name.clone();
+    let fy_pct = good.fy_rel_max_pct;
+    // Fz + 10 % of the run's peak |Fy| at every depth (Fy untouched)
+    let csv = dir.path().join("fe").join(format!("{name}.csv"));
+    let rows = needle_host::fe::results::read_csv(&csv).expect("read run");
+    let peak_fy = rows.iter().map(|r| r.wrench[1].abs()).fold(0.0, f64::max);
+    let edited: Vec<_> = rows
+        .iter()
+        .map(|r| {
+            let mut w = r.wrench;
+            w[2] += 0.1 * peak_fy;
+            needle_host::fe::results::Row { depth_mm: r.depth_mm, wrench: w }
+        })
+        .collect();
+    std::fs::write(&csv, needle_host::fe::results::to_csv(&edited)).expect("write edited run");
+    let r = needle_host::fit::validate::validate(dir.path()).unwrap_or_else(|e| panic!("{e:#}"));
+    let bad = r.runs.iter().find(|x| x.name == name).expect("the edited run is compared");
+    assert_eq!(bad.fy_rel_max_pct, fy_pct, "Fy was not touched");
+    assert!(bad.worst_rms_pct >= 9.0, "{name}: worst rms {} %", bad.worst_rms_pct);
+    assert_eq!(bad.goal_met, Some(false), "{name}: a wrong Fz must fail the table2 goal");
+    assert!(!r.table2_goal_met && !r.passed);
+}

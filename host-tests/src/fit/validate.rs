@@ -9,8 +9,9 @@
 //! Goals, checked on both the f64 and the f32 model (the worse counts), by form
 //! ([`Goals::of`]):
 //! - paper form (issue 3): table2: at every depth >= 1 mm, |Fy_model - Fy_FE| <= 5 % of
-//!   |Fy_FE| at that depth; lhs: for every run and component, RMS error <= 2 % of the
-//!   run's peak |Fy|;
+//!   |Fy_FE| at that depth; table2 and lhs: for every run and component, RMS error <= 2 %
+//!   of the run's peak |Fy| (on table2 since issue 18: a run with a wrong Fz or moment
+//!   fails, not only one with a wrong Fy);
 //! - coupled form (issue 16): table2: Fy within 2.5 % at every depth >= 1 mm; table2 and
 //!   lhs: every component's RMS error <= 2 % of peak |Fy| (the 1 % goal is reported, the
 //!   2 % limit decides) and its largest error <= 3 %.
@@ -66,7 +67,7 @@ impl Goals {
         if model.cross.is_some() {
             Goals { form: "coupled", table2_fy_pct: 2.5, rms_pct: 2.0, rms_stretch_pct: Some(1.0), max_pct: Some(3.0), rms_on_table2: true }
         } else {
-            Goals { form: "paper", table2_fy_pct: TABLE2_GOAL_PCT, rms_pct: LHS_GOAL_PCT, rms_stretch_pct: None, max_pct: None, rms_on_table2: false }
+            Goals { form: "paper", table2_fy_pct: TABLE2_GOAL_PCT, rms_pct: LHS_GOAL_PCT, rms_stretch_pct: None, max_pct: None, rms_on_table2: true }
         }
     }
 
