@@ -360,11 +360,34 @@ fn a_table2_run_with_a_wrong_fz_fails_its_goal() {
             needle_host::fe::results::Row { depth_mm: r.depth_mm, wrench: w }
         })
         .collect();
-    std::fs::write(&csv, needle_host::fe::results::to_csv(&edited)).expect("write edited run");
+    fit_synthetic::rewrite_run(dir.path(), &name, &edited);
     let r = needle_host::fit::validate::validate(dir.path()).unwrap_or_else(|e| panic!("{e:#}"));
     let bad = r.runs.iter().find(|x| x.name == name).expect("the edited run is compared");
     assert_eq!(bad.fy_rel_max_pct, fy_pct, "Fy was not touched");
     assert!(bad.worst_rms_pct >= 9.0, "{name}: worst rms {} %", bad.worst_rms_pct);
     assert_eq!(bad.goal_met, Some(false), "{name}: a wrong Fz must fail the table2 goal");
     assert!(!r.table2_goal_met && !r.passed);
+}
+
+/// Issue 18: a hand-edited but well-formed FE CSV was fitted and validated silently. The
+/// manifest records each CSV's SHA-256; fit and validate refuse a changed file, naming it.
+#[test]
+fn a_hand_edited_fe_csv_is_refused_by_fit_and_validate() {
+    let (dir, out) = fit_synthetic::fitted();
+    std::fs::write(dir.path().join("model.toml"), &out.model_toml).expect("write model");
+    for run in ["x+02", "t2-a"] {
+        let csv = dir.path().join("fe").join(format!("{run}.csv"));
+        let text = std::fs::read_to_string(&csv).expect("read run");
+        let line = text.lines().nth(5).expect("a sixth line").to_string();
+        let cells: Vec<&str> = line.split(',').collect();
+        let edited_fy = format!("{}", cells[2].parse::<f64>().expect("fy") * 1.01);
+        let edited = line.replacen(cells[2], &edited_fy, 1);
+        std::fs::write(&csv, text.replacen(&line, &edited, 1)).expect("edit");
+    }
+    let e = needle_host::fit::fit_set(dir.path()).expect_err("the fit must refuse the edited x+02");
+    let msg = format!("{e:#}");
+    assert!(msg.contains("x+02.csv: content changed since the FE run wrote it"), "{msg}");
+    let e = needle_host::fit::validate::validate(dir.path()).expect_err("validate must refuse the edited t2-a");
+    let msg = format!("{e:#}");
+    assert!(msg.contains("t2-a.csv: content changed since the FE run wrote it") && msg.contains("needle fe run --force --only t2-a"), "{msg}");
 }

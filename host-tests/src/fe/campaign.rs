@@ -167,14 +167,21 @@ pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> 
     let out_dir = opts.out_dir.clone().unwrap_or_else(|| opts.set_dir.join("fe"));
     std::fs::create_dir_all(&out_dir).with_context(|| format!("{}: cannot create", out_dir.display()))?;
     let manifest_path = out_dir.join(MANIFEST);
-    let manifest = read_manifest(&manifest_path)?;
+    let mut manifest = read_manifest(&manifest_path)?;
+    let hashed = manifest.backfill_csv_hashes(&out_dir);
+    if !hashed.is_empty() {
+        results::write_atomic(&manifest_path, manifest_text(&manifest)?.as_bytes())?;
+        eprintln!("{}: recorded csv_sha256 of {} earlier result(s) ({})", manifest_path.display(), hashed.len(), hashed.join(", "));
+    }
 
     let mut reports: Vec<PoseReport> = Vec::with_capacity(selected.len());
     let mut to_run: Vec<(usize, &PoseSpec)> = Vec::new();
     for pose in &selected {
         let csv = out_dir.join(format!("{}.csv", pose.name));
         let entry = manifest.current_entry(&campaign, pose, &mesh_name).ok();
-        let rows = entry.and_then(|_| results::read_csv(&csv).ok()).filter(|r| r.len() == steps as usize + 1);
+        // a CSV whose content is not what the campaign wrote is not up to date
+        let intact = entry.is_some_and(|e| e.csv_sha256.as_ref().is_none_or(|h| std::fs::read(&csv).is_ok_and(|b| results::content_sha256(&b) == *h)));
+        let rows = entry.filter(|_| intact).and_then(|_| results::read_csv(&csv).ok()).filter(|r| r.len() == steps as usize + 1);
         let mut report = PoseReport {
             pose: pose.name.clone(),
             status: Status::UpToDate,
@@ -404,7 +411,8 @@ fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Res
         rows.push(Row { depth_mm: ctx.campaign.loading.depth_at(k), wrench: *w });
     }
     let csv = ctx.out_dir.join(format!("{}.csv", pose.name));
-    results::write_atomic(&csv, results::to_csv(&rows).as_bytes())?;
+    let text = results::to_csv(&rows);
+    results::write_atomic(&csv, text.as_bytes())?;
     let entry = ManifestEntry {
         spec_hash: ctx.campaign.run_hash(pose, ctx.mesh_name),
         engine: ctx.backend.engine().to_string(),
@@ -412,6 +420,7 @@ fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Res
         element: s.element.clone(),
         solver_settings: s.settings.clone(),
         mesh: ctx.mesh_name.to_string(),
+        csv_sha256: Some(results::content_sha256(text.as_bytes())),
         model: s.summary.model.clone(),
         tissue_mesh: s.summary.tissue_mesh.clone(),
         tissue_nodes: s.summary.tissue_nodes as u64,

@@ -43,6 +43,12 @@ pub struct ManifestEntry {
     pub solver_settings: String,
     /// Mesh level name.
     pub mesh: String,
+    /// SHA-256 of the CSV as the campaign wrote it ([`results::content_sha256`](crate::fe::results::content_sha256)):
+    /// the fitter, validator, plots and explorer refuse a CSV whose content differs
+    /// (`fit::data::read_run`). Entries written before it was recorded get it from
+    /// the next `needle fe run` on their folder ([`Manifest::backfill_csv_hashes`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub csv_sha256: Option<String>,
     /// The model solved, e.g. "half, mirror plane z = 0".
     pub model: String,
     /// The tissue mesh in words.
@@ -111,6 +117,22 @@ impl Manifest {
 }
 
 impl Manifest {
+    /// Records `csv_sha256` for every entry that has none and whose `<pose>.csv` is in
+    /// `out_dir`, from the file as it is now (entries from before the hash was kept);
+    /// returns the poses it added. Entries that have a hash are never changed.
+    pub fn backfill_csv_hashes(&mut self, out_dir: &std::path::Path) -> Vec<String> {
+        let mut added = Vec::new();
+        for (name, e) in &mut self.pose {
+            if e.csv_sha256.is_none() {
+                if let Ok(bytes) = std::fs::read(out_dir.join(format!("{name}.csv"))) {
+                    e.csv_sha256 = Some(crate::fe::results::content_sha256(&bytes));
+                    added.push(name.clone());
+                }
+            }
+        }
+        added
+    }
+
     /// Wall times in s of the recorded runs of `engine` on mesh level `mesh_name` with `steps` load
     /// steps, by model (e.g. "full block, no mirror plane"), for the ETA of a campaign.
     /// Any spec hash counts: a spec change rarely changes the cost much.

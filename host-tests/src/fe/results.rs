@@ -72,6 +72,13 @@ pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<Row>> {
     Ok(rows)
 }
 
+/// SHA-256 of a result file's bytes, 64 hex digits: the manifest's `csv_sha256`.
+#[must_use]
+pub fn content_sha256(bytes: &[u8]) -> String {
+    use sha2::{Digest, Sha256};
+    crate::fe::spec::hex(&Sha256::digest(bytes))
+}
+
 /// Read an FE result file.
 ///
 /// # Errors

@@ -83,6 +83,7 @@ pub fn run_path(set_dir: &Path, pose: &PoseSpec) -> PathBuf {
 /// The file cannot be read or parsed, or its depths are not the spec's.
 pub fn read_run(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Result<Run> {
     let path = run_path(set_dir, pose);
+    check_content(set_dir, pose, &path)?;
     let rows = read_csv(&path)?;
     let steps = campaign.loading.steps;
     if rows.len() != steps as usize + 1 {
@@ -100,6 +101,31 @@ pub fn read_run(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Result<
         }
     }
     Ok(Run { pose: pose.clone(), file_name: format!("{}.csv", pose.name), rows })
+}
+
+/// A run's CSV must be the bytes the campaign wrote: when its manifest entry records a
+/// `csv_sha256`, the file's hash must match (issue 18: a hand-edited CSV was fitted and
+/// validated silently). The original is not kept, so the message gives both hashes.
+///
+/// # Errors
+/// The file cannot be read, or its content differs from the recorded hash.
+fn check_content(set_dir: &Path, pose: &PoseSpec, path: &Path) -> Result<()> {
+    let manifest = read_set_manifest(set_dir)?;
+    let Some(want) = manifest.pose.get(&pose.name).and_then(|e| e.csv_sha256.as_ref()) else {
+        return Ok(());
+    };
+    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let have = crate::fe::results::content_sha256(&bytes);
+    if have != *want {
+        bail!(
+            "{}: content changed since the FE run wrote it (sha256 {} now, {} in fe/manifest.toml): restore it (git checkout) or rerun the pose with `needle fe run --force --only {}`",
+            path.display(),
+            have.get(..16).unwrap_or(&have),
+            want.get(..16).unwrap_or(want),
+            pose.name
+        );
+    }
+    Ok(())
 }
 
 /// The manifest of a set's FE runs (`<set>/fe/manifest.toml`; none is an empty one).

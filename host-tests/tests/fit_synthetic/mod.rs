@@ -5,7 +5,7 @@
 #![allow(dead_code)]
 
 use needle_host::fe::manifest::{manifest_text, Manifest, ManifestEntry, MANIFEST};
-use needle_host::fe::results::{to_csv, Row};
+use needle_host::fe::results::{content_sha256, to_csv, Row};
 use needle_host::fe::spec::{self, PoseSpec};
 use needle_host::fit::{fit_set, FitOutput};
 use std::path::{Path, PathBuf};
@@ -42,14 +42,17 @@ pub fn make_set(dir: &Path, skip: &[&str]) {
         if skip.contains(&pose.name.as_str()) {
             continue;
         }
-        manifest.pose.insert(pose.name.clone(), synthetic_entry(&campaign, &pose));
         let rows: Vec<Row> = (0..=campaign.loading.steps)
             .map(|k| {
                 let d = campaign.loading.depth_at(k);
                 Row { depth_mm: d, wrench: wrench(&pose, d) }
             })
             .collect();
-        std::fs::write(dir.join("fe").join(format!("{}.csv", pose.name)), to_csv(&rows)).expect("write csv");
+        let text = to_csv(&rows);
+        std::fs::write(dir.join("fe").join(format!("{}.csv", pose.name)), &text).expect("write csv");
+        let mut entry = synthetic_entry(&campaign, &pose);
+        entry.csv_sha256 = Some(content_sha256(text.as_bytes()));
+        manifest.pose.insert(pose.name.clone(), entry);
     }
     let text = manifest_text(&manifest).expect("manifest text");
     std::fs::write(dir.join("fe").join(MANIFEST), text).expect("write manifest");
@@ -64,6 +67,7 @@ fn synthetic_entry(campaign: &spec::Campaign, pose: &PoseSpec) -> ManifestEntry 
         element: String::new(),
         solver_settings: String::new(),
         mesh: campaign.campaign.mesh.clone(),
+        csv_sha256: None,
         model: "synthetic".into(),
         tissue_mesh: "none".into(),
         tissue_nodes: 0,
@@ -92,4 +96,15 @@ pub fn fitted() -> (tempfile::TempDir, FitOutput) {
     make_set(dir.path(), &[]);
     let out = fit_set(dir.path()).unwrap_or_else(|e| panic!("fit of the synthetic set: {e:#}"));
     (dir, out)
+}
+
+/// Replace `fe/<pose>.csv` with `rows` and record its new hash in the manifest, as a
+/// rerun of the pose would (a changed FE result, not a hand edit).
+pub fn rewrite_run(dir: &Path, pose: &str, rows: &[Row]) {
+    let text = to_csv(rows);
+    std::fs::write(dir.join("fe").join(format!("{pose}.csv")), &text).expect("write csv");
+    let path = dir.join("fe").join(MANIFEST);
+    let mut m = needle_host::fe::manifest::read_manifest(&path).expect("manifest");
+    m.pose.get_mut(pose).expect("entry").csv_sha256 = Some(content_sha256(text.as_bytes()));
+    std::fs::write(&path, manifest_text(&m).expect("manifest text")).expect("write manifest");
 }
