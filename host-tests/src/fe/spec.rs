@@ -994,5 +994,10 @@ mod tests {
             assert!(msg.contains(want), "{msg}");
         }
         assert!(super::parse(&text, Path::new("campaign.toml")).is_ok(), "the shipped spec passes");
+        // a malformed value: file and line
+        let line = text.lines().position(|l| l.starts_with("bulk_to_shear =")).expect("bulk_to_shear line") + 1;
+        let bad = text.replace("bulk_to_shear = 100.0", "bulk_to_shear = abc");
+        let msg = super::parse(&bad, Path::new("campaign.toml")).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(msg.starts_with(&format!("campaign.toml:{line}: ")), "{msg}");
     }
 }
