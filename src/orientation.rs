@@ -31,6 +31,46 @@ pub struct Tilt {
 
 const DEG_PER_RAD: f32 = 180.0 / core::f32::consts::PI;
 
+/// Why no tilt could be taken from a needle axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum AxisError {
+    /// A component is NaN or infinite, or the squared length overflows.
+    NotFinite,
+    /// The axis (or the quaternion) has zero length.
+    Zero,
+    /// The axis points sideways or downwards (`a_y <= 0`): a tilt of 90 degrees or more,
+    /// outside any needle's reach.
+    NotUpward,
+}
+
+impl core::fmt::Display for AxisError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            Self::NotFinite => "needle axis not finite (NaN or infinite component)",
+            Self::Zero => "needle axis of zero length",
+            Self::NotUpward => "needle axis not upward (a_y <= 0: tilt of 90 degrees or more)",
+        })
+    }
+}
+
+impl core::error::Error for AxisError {}
+
+/// The squared length of `axis` when a tilt can be taken from it.
+fn checked_length2(axis: [f32; 3]) -> Result<f32, AxisError> {
+    let [ax, ay, az] = axis;
+    let n2 = ax * ax + ay * ay + az * az;
+    if !n2.is_finite() || !ay.is_finite() {
+        Err(AxisError::NotFinite)
+    } else if n2 <= 0.0 {
+        Err(AxisError::Zero)
+    } else if ay <= 0.0 {
+        Err(AxisError::NotUpward)
+    } else {
+        Ok(n2)
+    }
+}
+
 /// The unit axis (tip to hub) of the orientation quaternion `q = [w, x, y, z]` (the
 /// rotation from the vertical needle): `q (0, 1, 0) q*`, computed without normalising `q`
 /// first (the tilt functions normalise the axis).
@@ -45,28 +85,27 @@ pub fn axis_of_quaternion(q: [f32; 4]) -> [f32; 3] {
 macro_rules! tilt_impl {
     ($sqrt:path, $asin:path, $atan2:path) => {
         /// The tilts of the needle whose axis (tip to hub, any length) is `axis`.
-        /// `None` when `axis` is zero, not finite, or points downwards or sideways
-        /// (`a_y <= 0`: the tilt would be 90° or more, outside any needle's reach).
-        #[must_use]
-        pub fn tilt_from_axis(axis: [f32; 3]) -> Option<super::Tilt> {
+        ///
+        /// # Errors
+        /// [`super::AxisError`]: `axis` is not finite, zero, or points downwards or
+        /// sideways (`a_y <= 0`: the tilt would be 90° or more, outside any needle's reach).
+        pub fn tilt_from_axis(axis: [f32; 3]) -> Result<super::Tilt, super::AxisError> {
             let [ax, ay, az] = axis;
-            let n2 = ax * ax + ay * ay + az * az;
-            if !(n2.is_finite() && n2 > 0.0 && ay > 0.0) {
-                return None;
-            }
-            let n = $sqrt(n2);
+            let n = $sqrt(super::checked_length2(axis)?);
             let sz = az / n;
             let sz = if sz > 1.0 { 1.0 } else if sz < -1.0 { -1.0 } else { sz };
-            Some(super::Tilt {
+            Ok(super::Tilt {
                 theta_x_deg: $asin(sz) * super::DEG_PER_RAD,
                 theta_z_deg: $atan2(-ax, ay) * super::DEG_PER_RAD,
             })
         }
 
         /// The tilts of the orientation quaternion `q = [w, x, y, z]` (any non-zero
-        /// length), see [`super::axis_of_quaternion`]; `None` as [`tilt_from_axis`].
-        #[must_use]
-        pub fn tilt_from_quaternion(q: [f32; 4]) -> Option<super::Tilt> {
+        /// length), see [`super::axis_of_quaternion`].
+        ///
+        /// # Errors
+        /// As [`tilt_from_axis`].
+        pub fn tilt_from_quaternion(q: [f32; 4]) -> Result<super::Tilt, super::AxisError> {
             tilt_from_axis(super::axis_of_quaternion(q))
         }
     };
@@ -83,23 +122,24 @@ pub mod exact {
 #[cfg(feature = "fast-math")]
 pub mod fast {
     /// As [`super::exact::tilt_from_axis`], with `micromath::F32Ext::atan2`.
-    #[must_use]
-    pub fn tilt_from_axis(axis: [f32; 3]) -> Option<super::Tilt> {
+    ///
+    /// # Errors
+    /// As [`super::exact::tilt_from_axis`].
+    pub fn tilt_from_axis(axis: [f32; 3]) -> Result<super::Tilt, super::AxisError> {
         let [ax, ay, az] = axis;
-        let n2 = ax * ax + ay * ay + az * az;
-        if !(n2.is_finite() && n2 > 0.0 && ay > 0.0) {
-            return None;
-        }
+        super::checked_length2(axis)?;
         let h = libm::sqrtf(ax * ax + ay * ay);
-        Some(super::Tilt {
+        Ok(super::Tilt {
             theta_x_deg: micromath::F32Ext::atan2(az, h) * super::DEG_PER_RAD,
             theta_z_deg: micromath::F32Ext::atan2(-ax, ay) * super::DEG_PER_RAD,
         })
     }
 
     /// As [`super::exact::tilt_from_quaternion`], with [`tilt_from_axis`] above.
-    #[must_use]
-    pub fn tilt_from_quaternion(q: [f32; 4]) -> Option<super::Tilt> {
+    ///
+    /// # Errors
+    /// As [`super::exact::tilt_from_axis`].
+    pub fn tilt_from_quaternion(q: [f32; 4]) -> Result<super::Tilt, super::AxisError> {
         tilt_from_axis(super::axis_of_quaternion(q))
     }
 }
@@ -110,8 +150,10 @@ pub use fast::{tilt_from_axis, tilt_from_quaternion};
 pub use exact::{tilt_from_axis, tilt_from_quaternion};
 
 /// The pose of a needle entering at (`x_mm`, `z_mm`) on the surface with axis `axis` (tip
-/// to hub) at `depth_mm`; `None` as [`tilt_from_axis`].
-#[must_use]
-pub fn pose_from_axis(x_mm: f32, z_mm: f32, axis: [f32; 3], depth_mm: f32) -> Option<Pose> {
+/// to hub) at `depth_mm`.
+///
+/// # Errors
+/// As [`tilt_from_axis`].
+pub fn pose_from_axis(x_mm: f32, z_mm: f32, axis: [f32; 3], depth_mm: f32) -> Result<Pose, AxisError> {
     tilt_from_axis(axis).map(|t| Pose::new(x_mm, z_mm, t.theta_x_deg, t.theta_z_deg, depth_mm))
 }

@@ -83,11 +83,20 @@ fn fast_math_tilt_and_wrench_errors_are_bounded() {
 }
 
 #[test]
-fn degenerate_axes_give_none() {
-    for a in [[0.0, 0.0, 0.0], [0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [f32::NAN, 1.0, 0.0], [0.0, f32::INFINITY, 0.0]] {
-        assert_eq!(exact::tilt_from_axis(a), None, "{a:?}");
-        assert_eq!(fast::tilt_from_axis(a), None, "{a:?}");
+fn degenerate_axes_give_the_reason() {
+    use needle_haptics::orientation::AxisError;
+    for (a, why) in [
+        ([0.0, 0.0, 0.0], AxisError::Zero),
+        ([0.0, -1.0, 0.0], AxisError::NotUpward),
+        ([1.0, 0.0, 0.0], AxisError::NotUpward),
+        ([f32::NAN, 1.0, 0.0], AxisError::NotFinite),
+        ([0.0, f32::INFINITY, 0.0], AxisError::NotFinite),
+        ([1e30, 1e30, 0.0], AxisError::NotFinite),
+    ] {
+        assert_eq!(exact::tilt_from_axis(a), Err(why), "{a:?}");
+        assert_eq!(fast::tilt_from_axis(a), Err(why), "{a:?}");
     }
+    assert!(AxisError::NotUpward.to_string().contains("a_y <= 0"));
     let p = orientation::pose_from_axis(1.0, 2.0, [0.0, 2.0, 0.0], 3.0).expect("vertical");
     assert_eq!(p, Pose::new(1.0, 2.0, 0.0, 0.0, 3.0));
 }
