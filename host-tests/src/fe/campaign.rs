@@ -597,6 +597,68 @@ mod tests {
         assert_eq!((r.done(), r.up_to_date()), (2, 0), "x+02 has 4 rows (3 steps), x+04 has no CSV");
     }
 
+    /// The bytes of every CSV and the manifest in `fe`.
+    fn snapshot(fe: &Path) -> Vec<(String, Vec<u8>)> {
+        let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(fe)
+            .expect("fe folder")
+            .flatten()
+            .filter(|e| e.path().is_file())
+            .map(|e| (e.file_name().to_string_lossy().into_owned(), std::fs::read(e.path()).expect("read")))
+            .collect();
+        files.sort();
+        files
+    }
+
+    /// Issue 18: a solver killed mid-run, an unwritable result file and a corrupted
+    /// manifest each leave every earlier result intact, and the next run completes the set.
+    #[test]
+    fn faults_leave_earlier_results_intact_and_the_next_run_completes_the_set() {
+        let d = set_dir();
+        let fe = d.path().join("fe");
+        run_with(&opts(d.path(), "x+0[24]", 2), &mut Fake::default()).expect("first results");
+        let before = snapshot(&fe);
+        let all = "x+0[2468]";
+
+        // 1. the solver is killed while solving x+06 (and x+08 in the same run finishes)
+        let mut killed = Fake { fail: Some("x+06".into()), ..Fake::default() };
+        let r = run_with(&opts(d.path(), all, 2), &mut killed).expect("run");
+        assert_eq!((r.done(), r.up_to_date(), r.failed()), (1, 2, 1), "{}", r.table());
+        let after: Vec<_> = snapshot(&fe).into_iter().filter(|(n, _)| n != "x+08.csv" && n != MANIFEST).collect();
+        assert_eq!(after, before.iter().filter(|(n, _)| n != MANIFEST).cloned().collect::<Vec<_>>(), "earlier CSVs intact");
+        let m = read_manifest(&fe.join(MANIFEST)).expect("manifest");
+        assert_eq!(m.pose.keys().cloned().collect::<Vec<_>>(), ["x+02", "x+04", "x+08"], "no entry for the killed x+06");
+
+        // 2. x+06's result file cannot be written (a folder is in its place)
+        std::fs::create_dir(fe.join("x+06.csv")).expect("block the CSV path");
+        let r = run_with(&opts(d.path(), all, 2), &mut Fake::default()).expect("run");
+        assert_eq!((r.done(), r.up_to_date(), r.failed()), (0, 3, 1), "{}", r.table());
+        assert!(r.table().contains("x+06.csv"), "the failure names the file:\n{}", r.table());
+        let intact = snapshot(&fe);
+        std::fs::remove_dir(fe.join("x+06.csv")).expect("unblock");
+
+        // 3. the manifest is corrupted: refused before anything is solved or written
+        let manifest = fe.join(MANIFEST);
+        let good = std::fs::read(&manifest).expect("manifest");
+        std::fs::write(&manifest, b"[pose.x+02\nspec_hash = ").expect("corrupt");
+        let mut untouched = Fake::default();
+        let e = run_with(&opts(d.path(), all, 2), &mut untouched).expect_err("corrupt manifest");
+        assert!(format!("{e:#}").contains(MANIFEST), "{e:#}");
+        assert_eq!(untouched.solves.load(Ordering::SeqCst), 0);
+        std::fs::write(&manifest, &good).expect("restore the manifest (from git, say)");
+        assert_eq!(snapshot(&fe), intact, "every result as before the faults");
+
+        // the next run completes the set, solving only x+06
+        let mut last = Fake::default();
+        let r = run_with(&opts(d.path(), all, 2), &mut last).expect("run");
+        assert_eq!((r.done(), r.up_to_date(), r.failed()), (1, 3, 0), "{}", r.table());
+        assert_eq!(last.solves.load(Ordering::SeqCst), 1);
+        for (name, bytes) in &before {
+            if name != MANIFEST {
+                assert_eq!(&std::fs::read(fe.join(name)).expect("read"), bytes, "{name} unchanged through the faults");
+            }
+        }
+    }
+
     #[test]
     fn a_failed_pose_keeps_its_work_dir_and_the_others_finish() {
         let d = set_dir();
