@@ -647,11 +647,23 @@ mod tests {
         std::fs::write(&manifest, &good).expect("restore the manifest (from git, say)");
         assert_eq!(snapshot(&fe), intact, "every result as before the faults");
 
-        // the next run completes the set, solving only x+06
+
+        // temporaries a killed campaign left beside its targets (a pid that is gone)
+        let stale = [fe.join(".x+06.csv.4194303.tmp"), fe.join(format!(".{MANIFEST}.4194303.tmp"))];
+        for t in &stale {
+            std::fs::write(t, b"half").expect("stale temporary");
+        }
+        let intact: Vec<_> = intact.into_iter().chain(stale.iter().map(|t| (t.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(), b"half".to_vec()))).collect();
+        let mut intact = intact;
+        intact.sort();
+        assert_eq!(snapshot(&fe), intact);
+
+        // the next run completes the set, solving only x+06, and removes the temporaries
         let mut last = Fake::default();
         let r = run_with(&opts(d.path(), all, 2), &mut last).expect("run");
         assert_eq!((r.done(), r.up_to_date(), r.failed()), (1, 3, 0), "{}", r.table());
         assert_eq!(last.solves.load(Ordering::SeqCst), 1);
+        assert!(stale.iter().all(|t| !t.exists()), "stale temporaries removed");
         for (name, bytes) in &before {
             if name != MANIFEST {
                 assert_eq!(&std::fs::read(fe.join(name)).expect("read"), bytes, "{name} unchanged through the faults");

@@ -90,11 +90,14 @@ pub fn read_csv(path: &Path) -> Result<Vec<Row>> {
 
 /// Write `bytes` to `path` atomically: a temporary file in the same folder, flushed and
 /// synced, then renamed over `path`. A crash leaves either the old file or the new one;
-/// a failed write removes its temporary.
+/// a failed write removes its temporary; stale temporaries of `path` from processes that
+/// are gone are removed first.
 ///
 /// # Errors
 /// The folder cannot be written.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    // temporaries of `path` left by a killed process go first
+    remove_stale_temporaries(path);
     let tmp = write_temporary(path, bytes)?;
     std::fs::rename(&tmp, path).map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
