@@ -203,6 +203,11 @@ int main(int argc, char **argv) {
   if (strcmp(needle_status_name(NEEDLE_STATUS_SAT_DEPTH), "SAT_DEPTH") != 0) command_failures++;
   if (needle_status_name(NEEDLE_STATUS_SAT_X | NEEDLE_STATUS_SAT_Z) != NULL) command_failures++;
   if (strcmp(needle_loop_flag_name(NEEDLE_LOOP_RAMPING), "RAMPING") != 0) command_failures++;
+  {
+    char text[8];
+    size_t n = needle_status_str(NEEDLE_STATUS_SAT_X | NEEDLE_STATUS_SAT_DEPTH, text, sizeof text);
+    if (n != strlen("SAT_X | SAT_DEPTH") || strcmp(text, "SAT_X |") != 0) command_failures++; /* truncated */
+  }
 
   printf("capi-golden set=%s rows=%d wrench_mismatches=%d loop_checks=%d loop_failures=%d command_failures=%d\n",
          (const char *)info.set, rows, mismatches, loop_checks, loop_failures, command_failures);

@@ -56,6 +56,51 @@ pub extern "C" fn needle_loop_flag_name(flag: u16) -> *const c_char {
     s.map_or(core::ptr::null(), CStr::as_ptr)
 }
 
+/// Writes the library's text of `status` (`Status`'s `Display`: the flag names joined by
+/// " | ", e.g. "SAT_X | SAT_DEPTH"; "OK" for 0; bits no flag names in hex) into `buf`,
+/// NUL-terminated and truncated to `len - 1` bytes. Returns the length of the whole text
+/// without the NUL (as `snprintf`: a return >= `len` means it was truncated). `buf` may be
+/// NULL when `len` is 0 (to ask for the length).
+///
+/// # Safety
+/// `buf` is NULL or points to `len` writable bytes.
+#[no_mangle]
+pub unsafe extern "C" fn needle_status_str(status: u8, buf: *mut c_char, len: usize) -> usize {
+    let out: &mut [u8] = if buf.is_null() || len == 0 {
+        &mut []
+    } else {
+        // SAFETY: the caller passes `len` writable bytes at `buf`
+        unsafe { core::slice::from_raw_parts_mut(buf.cast::<u8>(), len) }
+    };
+    let mut w = Truncating { out, written: 0, total: 0 };
+    let _ = core::fmt::Write::write_fmt(&mut w, format_args!("{}", needle_haptics::Status::from_bits(status)));
+    let end = w.written;
+    if let Some(nul) = w.out.get_mut(end) {
+        *nul = 0;
+    }
+    w.total
+}
+
+/// A `fmt::Write` into a byte buffer that keeps room for a NUL and counts what did not fit.
+struct Truncating<'a> {
+    out: &'a mut [u8],
+    written: usize,
+    total: usize,
+}
+
+impl core::fmt::Write for Truncating<'_> {
+    fn write_str(&mut self, s: &str) -> core::fmt::Result {
+        let room = self.out.len().saturating_sub(1).saturating_sub(self.written);
+        let take = s.len().min(room);
+        if let (Some(dst), Some(src)) = (self.out.get_mut(self.written..self.written + take), s.as_bytes().get(..take)) {
+            dst.copy_from_slice(src);
+            self.written += take;
+        }
+        self.total += s.len();
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -81,5 +126,17 @@ mod tests {
         assert_eq!(name(needle_loop_flag_name(0x0200)), None, "unknown flag");
         assert_eq!(name(needle_strerror(crate::types::NEEDLE_E_NULL)).as_deref(), Some("NULL pointer argument"));
         assert_eq!(name(needle_strerror(-99)).as_deref(), Some("unknown needle error code"));
+        for (status, want) in [(0u8, "OK"), (0x11, "SAT_X | SAT_DEPTH"), (0xa0, "ERROR | 0x20")] {
+            let mut buf = [0x55 as c_char; 32];
+            // SAFETY: 32 writable bytes
+            let n = unsafe { needle_status_str(status, buf.as_mut_ptr(), buf.len()) };
+            assert_eq!((n, name(buf.as_ptr()).as_deref()), (want.len(), Some(want)), "{status:#04x}");
+        }
+        let mut small = [0x55 as c_char; 6];
+        // SAFETY: 6 writable bytes
+        let n = unsafe { needle_status_str(0x11, small.as_mut_ptr(), small.len()) };
+        assert_eq!((n, name(small.as_ptr()).as_deref()), (17, Some("SAT_X")), "truncated, NUL-terminated");
+        // SAFETY: NULL with len 0 asks for the length
+        assert_eq!(unsafe { needle_status_str(0x11, core::ptr::null_mut(), 0) }, 17);
     }
 }
