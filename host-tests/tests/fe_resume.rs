@@ -232,7 +232,7 @@ fn a_timed_out_job_is_reported_and_kept_for_debugging() {
     assert_eq!(out.status.code(), Some(1), "a failed run gives exit status 1\n{}", show(&out));
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("FAILED centre: ccx timed out (killed) after 0 of 2 steps"), "{}", show(&out));
-    assert!(stdout.contains("end of the ccx output:"), "{}", show(&out));
+    assert!(stdout.contains("end of the solver's output:"), "{}", show(&out));
     let fe = set.join("fe");
     assert!(!fe.join("centre.csv").exists());
     let work = fe.join(".work").join("centre");

@@ -12,7 +12,7 @@ pub enum Status {
     /// Result already up to date; nothing run.
     UpToDate,
     /// The run failed; no CSV written. `message` says how (exit status, steps done),
-    /// `log_tail` holds the end of the ccx output (may be empty).
+    /// `log_tail` holds the end of the solver's output (ccx or FEBio; may be empty).
     Failed {
         /// One line: what failed.
         message: String,
@@ -112,7 +112,7 @@ impl Report {
                     s.push_str(&format!("  work folder kept: {}\n", w.display()));
                 }
                 if !log_tail.is_empty() {
-                    s.push_str("  end of the ccx output:\n");
+                    s.push_str("  end of the solver's output:\n");
                     for l in log_tail.lines() {
                         s.push_str(&format!("  | {l}\n"));
                     }
