@@ -180,8 +180,10 @@ pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> 
         let csv = out_dir.join(format!("{}.csv", pose.name));
         let entry = manifest.current_entry(&campaign, pose, &mesh_name).ok();
         // a CSV whose content is not what the campaign wrote is not up to date
-        let intact = entry.is_some_and(|e| e.csv_sha256.as_ref().is_none_or(|h| std::fs::read(&csv).is_ok_and(|b| results::content_sha256(&b) == *h)));
-        let rows = entry.filter(|_| intact).and_then(|_| results::read_csv(&csv).ok()).filter(|r| r.len() == steps as usize + 1);
+        let rows = entry
+            .and_then(|e| std::fs::read_to_string(&csv).ok().filter(|text| e.content_matches(text.as_bytes())))
+            .and_then(|text| results::parse_csv(&text, &csv).ok())
+            .filter(|r| r.len() == steps as usize + 1);
         let mut report = PoseReport {
             pose: pose.name.clone(),
             status: Status::UpToDate,
@@ -653,8 +655,8 @@ mod tests {
         for t in &stale {
             std::fs::write(t, b"half").expect("stale temporary");
         }
-        let intact: Vec<_> = intact.into_iter().chain(stale.iter().map(|t| (t.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(), b"half".to_vec()))).collect();
         let mut intact = intact;
+        intact.extend(stale.iter().map(|t| (t.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(), b"half".to_vec())));
         intact.sort();
         assert_eq!(snapshot(&fe), intact);
 

@@ -116,6 +116,15 @@ impl Manifest {
     }
 }
 
+impl ManifestEntry {
+    /// Whether `bytes` are the CSV this entry was written for: its `csv_sha256` matches,
+    /// or the entry predates the hash.
+    #[must_use]
+    pub fn content_matches(&self, bytes: &[u8]) -> bool {
+        self.csv_sha256.as_ref().is_none_or(|h| *h == crate::fe::results::content_sha256(bytes))
+    }
+}
+
 impl Manifest {
     /// Records `csv_sha256` for every entry that has none and whose `<pose>.csv` is in
     /// `out_dir`, from the file as it is now (entries from before the hash was kept);

@@ -105,12 +105,6 @@ fn orient(n: [usize; 8], xyz: impl Fn(usize) -> P3) -> [usize; 8] {
     }
 }
 
-/// Lateral travel (x, z) of the tip over the whole insertion, mm.
-pub fn lateral_travel(pose: &PoseSpec, depth_mm: f64) -> (f64, f64) {
-    let a = pose.axis();
-    (-a[0] * depth_mm, -a[2] * depth_mm)
-}
-
 struct Pattern {
     pts: Vec<[f64; 2]>,
     key: HashMap<(i64, i64), usize>,
@@ -162,7 +156,7 @@ pub fn tissue(block: &Block, m: &MeshLevel, pose: &PoseSpec, sym: Symmetry, dept
 /// back to squares, so that a circular footprint of radius `core_half_mm` is meshed
 /// exactly (used by the flat-punch verification; needs a pose without tilt).
 pub fn tissue_shaped(block: &Block, m: &MeshLevel, pose: &PoseSpec, sym: Symmetry, depth_mm: f64, round_core: bool) -> TissueMesh {
-    let (tx, tz) = lateral_travel(pose, depth_mm);
+    let (tx, tz) = pose.lateral_travel(depth_mm);
     let (hx, hz) = (block.size_x_mm / 2.0, block.size_z_mm / 2.0);
     let xc = if sym.plane_x { 0.0 } else { pose.x_mm + 0.5 * tx };
     let zc = if sym.plane_z { 0.0 } else { pose.z_mm + 0.5 * tz };

@@ -530,6 +530,12 @@ impl PoseSpec {
         // R = Rz * Rx applied to (0, 1, 0): Rx(0,1,0) = (0, cx, sx); Rz(a,b,c) = (cz a - sz b, sz a + cz b, c)
         [-sz * cx, cz * cx, sx]
     }
+
+    /// Lateral travel (x, z) of the tip over an insertion of `depth_mm` along the axis, mm.
+    pub fn lateral_travel(&self, depth_mm: f64) -> (f64, f64) {
+        let a = self.axis();
+        (-a[0] * depth_mm, -a[2] * depth_mm)
+    }
 }
 
 /// Read and validate a campaign spec.
@@ -837,7 +843,7 @@ fn check_pose_role(pose: &PoseSpec, p: &str) -> Result<()> {
 /// The needle stays inside the block: at entry and at full depth (after the lateral
 /// travel of the tilt), the needle's axis is at least its radius from each side face.
 fn check_pose_in_block(pose: &PoseSpec, block: &Block, radius_mm: f64, depth_mm: f64, p: &str) -> Result<()> {
-    let (tx, tz) = crate::fe::mesh::lateral_travel(pose, depth_mm);
+    let (tx, tz) = pose.lateral_travel(depth_mm);
     for (f, entry, travel, half) in [("x_mm", pose.x_mm, tx, block.size_x_mm / 2.0), ("z_mm", pose.z_mm, tz, block.size_z_mm / 2.0)] {
         let reach = entry.abs().max((entry + travel).abs()) + radius_mm;
         if reach > half {

@@ -3,7 +3,7 @@
 
 use super::contract::{Sweep, DEPTH_MAX_MM, NCOEF};
 use crate::fe::manifest::{read_manifest, Manifest, MANIFEST};
-use crate::fe::results::{read_csv, Row};
+use crate::fe::results::{parse_csv, Row};
 use crate::fe::spec::{self, hex, Campaign, ModelForm, PoseSpec, Role};
 use anyhow::{bail, Context, Result};
 use sha2::{Digest, Sha256};
@@ -83,8 +83,9 @@ pub fn run_path(set_dir: &Path, pose: &PoseSpec) -> PathBuf {
 /// The file cannot be read or parsed, or its depths are not the spec's.
 pub fn read_run(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Result<Run> {
     let path = run_path(set_dir, pose);
-    check_content(set_dir, pose, &path)?;
-    let rows = read_csv(&path)?;
+    let text = std::fs::read_to_string(&path).with_context(|| format!("{}: cannot read", path.display()))?;
+    check_content(set_dir, pose, &path, text.as_bytes())?;
+    let rows = parse_csv(&text, &path)?;
     let steps = campaign.loading.steps;
     if rows.len() != steps as usize + 1 {
         bail!(
@@ -108,15 +109,12 @@ pub fn read_run(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Result<
 /// validated silently). The original is not kept, so the message gives both hashes.
 ///
 /// # Errors
-/// The file cannot be read, or its content differs from the recorded hash.
-fn check_content(set_dir: &Path, pose: &PoseSpec, path: &Path) -> Result<()> {
+/// The manifest cannot be read, or `bytes` (the file at `path`) differ from the recorded hash.
+fn check_content(set_dir: &Path, pose: &PoseSpec, path: &Path, bytes: &[u8]) -> Result<()> {
     let manifest = read_set_manifest(set_dir)?;
-    let Some(want) = manifest.pose.get(&pose.name).and_then(|e| e.csv_sha256.as_ref()) else {
-        return Ok(());
-    };
-    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
-    let have = crate::fe::results::content_sha256(&bytes);
-    if have != *want {
+    let Some(entry) = manifest.pose.get(&pose.name) else { return Ok(()) };
+    if let (false, Some(want)) = (entry.content_matches(bytes), entry.csv_sha256.as_ref()) {
+        let have = crate::fe::results::content_sha256(bytes);
         bail!(
             "{}: content changed since the FE run wrote it (sha256 {} now, {} in fe/manifest.toml): restore it (git checkout) or rerun the pose with `needle fe run --force --only {}`",
             path.display(),

@@ -8,7 +8,7 @@
 //! The exports use only numbers (no allocator, no bindings generator):
 //! - [`needle_eval`] evaluates one pose and returns the status bits; the six wrench
 //!   components (fx, fy, fz in N; mx, my, mz in N*mm) are left, as f32 bit patterns, in
-//!   the seven-word buffer at [`needle_out`] (word 6: the status again);
+//!   the six-word buffer at [`needle_out`];
 //! - [`needle_domain`] the model's domain, [`needle_coupled`] its form.
 #![cfg_attr(target_arch = "wasm32", no_std)]
 #![deny(missing_docs)]
@@ -16,8 +16,8 @@
 use core::sync::atomic::{AtomicU32, Ordering};
 use needle_haptics::{model_info, wrench, Pose};
 
-/// The last evaluation: fx, fy, fz (N), mx, my, mz (N*mm) as f32 bits, then the status.
-static OUT: [AtomicU32; 7] = [const { AtomicU32::new(0) }; 7];
+/// The last evaluation: fx, fy, fz (N), mx, my, mz (N*mm) as f32 bits.
+static OUT: [AtomicU32; 6] = [const { AtomicU32::new(0) }; 6];
 
 /// Evaluates the wrench at `x_mm`, `z_mm` (entry point), `theta_x_deg`, `theta_z_deg`
 /// (tilt) and `depth_mm`, exactly as the firmware's `needle_haptics::wrench`; stores it
@@ -26,17 +26,13 @@ static OUT: [AtomicU32; 7] = [const { AtomicU32::new(0) }; 7];
 #[no_mangle]
 pub extern "C" fn needle_eval(x_mm: f32, z_mm: f32, theta_x_deg: f32, theta_z_deg: f32, depth_mm: f32) -> u32 {
     let e = wrench(&Pose::new(x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm));
-    let status = u32::from(e.status.bits());
     for (slot, v) in OUT.iter().zip(e.wrench.to_array()) {
         slot.store(v.to_bits(), Ordering::Relaxed);
     }
-    if let Some(slot) = OUT.get(6) {
-        slot.store(status, Ordering::Relaxed);
-    }
-    status
+    u32::from(e.status.bits())
 }
 
-/// Address of the seven-word result buffer of [`needle_eval`] in the module's memory.
+/// Address of the six-word result buffer of [`needle_eval`] in the module's memory.
 #[no_mangle]
 pub extern "C" fn needle_out() -> *const AtomicU32 {
     OUT.as_ptr()

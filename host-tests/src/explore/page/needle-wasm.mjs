@@ -38,8 +38,7 @@ export async function load(bytes) {
     evaluate(x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm) {
       const status = e.needle_eval(x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm) >>> 0;
       // the memory may have grown since the last call: take a fresh view each time
-      const words = new Uint32Array(e.memory.buffer, e.needle_out(), 7);
-      const bits = Uint32Array.from(words.subarray(0, 6));
+      const bits = Uint32Array.from(new Uint32Array(e.memory.buffer, e.needle_out(), 6));
       return { status, bits, wrench: new Float32Array(bits.buffer) };
     },
   };
