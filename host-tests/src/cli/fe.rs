@@ -1,5 +1,7 @@
 //! `needle fe ...`: the FE campaign commands.
 use crate::fe::campaign::{self, RunOptions};
+use crate::fe::launcher::slurm::{self, SlurmOptions};
+use crate::fe::launcher::Launched;
 use clap::{Args, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -21,6 +23,24 @@ pub enum FeCommand {
     /// --mirror all three run. Prints the table and writes <set>/fe/verify.toml. Exit
     /// status 1 when a check misses its goal, 2 on an error.
     Verify(VerifyArgs),
+    /// The state of a set's poses: up to date or why not, and with --launcher slurm
+    /// submissions the queue state of each pose's latest array task (squeue) or the cause
+    /// a task that ended without a result states. With --project-nodes, the campaign's
+    /// wall time on that many nodes, projected from the manifest's measured runs.
+    Status(StatusArgs),
+    /// Solve one pose as a local job would (one job; threads from SLURM_CPUS_PER_TASK):
+    /// what each array task of `needle fe run --launcher slurm` runs.
+    #[command(hide = true)]
+    RunOne(RunOneArgs),
+}
+
+/// Where the solver jobs run.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LauncherArg {
+    /// Worker threads of this process (--jobs at once).
+    Local,
+    /// One SLURM job array (sbatch), one task per pose still to solve.
+    Slurm,
 }
 
 /// Arguments of `needle fe run`.
@@ -67,6 +87,95 @@ pub struct RunArgs {
     pub timeout_s: Option<f64>,
     /// A ccx job that writes no output (log, .sta, .cvg) for this many seconds is killed as stalled; a failed or stalled job is retried once with a smaller first increment per step
     #[arg(long, value_name = "S", default_value_t = campaign::DEFAULT_STALL.as_secs_f64(), allow_negative_numbers = true, value_parser = positive_seconds)]
+    pub stall_s: f64,
+    /// Where the solver jobs run: local (this machine, --jobs at once) or slurm (one
+    /// sbatch job array, one task per pose still to solve, on the shared filesystem;
+    /// `needle fe status` follows it, rerunning the command resumes it).
+    #[arg(long, value_enum, default_value_t = LauncherArg::Local)]
+    pub launcher: LauncherArg,
+    /// slurm: sbatch --partition (default: the cluster's default partition).
+    #[arg(long, value_name = "NAME")]
+    pub partition: Option<String>,
+    /// slurm: sbatch --time per task, SLURM's format (minutes, HH:MM:SS, D-HH); default:
+    /// the engine's attempts x the longest measured run on this mesh x 1.5, at least 10 min.
+    #[arg(long, value_name = "TIME")]
+    pub time: Option<String>,
+    /// slurm: sbatch --mem per task (e.g. 4G); default: the largest measured solver peak
+    /// memory on this mesh x 1.5 + 256 MiB.
+    #[arg(long, value_name = "SIZE")]
+    pub mem: Option<String>,
+    /// slurm: sbatch --cpus-per-task, also the solver threads of each task (default 1).
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub cpus_per_task: Option<u32>,
+    /// slurm: one more sbatch argument, passed as given (repeatable), e.g.
+    /// --sbatch-arg=--account=abc.
+    #[arg(long, value_name = "ARG", allow_hyphen_values = true)]
+    pub sbatch_arg: Vec<String>,
+}
+
+/// Arguments of `needle fe status`.
+#[derive(Args, Debug)]
+pub struct StatusArgs {
+    /// Set folder holding campaign.toml, e.g. coeffs/default.
+    #[arg(long, value_name = "DIR")]
+    pub set: PathBuf,
+    /// Output folder of the campaign; default: <set>/fe.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// FE engine instead of campaign.toml's [solver] engine (as given to fe run).
+    #[arg(long, value_name = "ENGINE", value_parser = ["febio", "ccx"])]
+    pub solver: Option<String>,
+    /// Mesh level (as given to fe run); default: campaign.mesh.
+    #[arg(long, value_name = "LEVEL")]
+    pub mesh: Option<String>,
+    /// Load steps (as given to fe run).
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=10_000))]
+    pub steps: Option<u32>,
+    /// Only the poses matching these globs (as fe run --only).
+    #[arg(long, value_name = "PATTERN")]
+    pub only: Option<String>,
+    /// Project the selected poses' campaign wall time on these node counts, e.g. 1,4,16,
+    /// from the measured wall time of each pose (or the median of its model kind).
+    #[arg(long, value_name = "N,N,...", value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub project_nodes: Vec<u32>,
+    /// Tasks at once per node for the projection (cores per node / --cpus-per-task);
+    /// default: this machine's cores.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub tasks_per_node: Option<u32>,
+}
+
+/// Arguments of the hidden `needle fe run-one`.
+#[derive(Args, Debug)]
+pub struct RunOneArgs {
+    /// Set folder holding campaign.toml.
+    #[arg(long, value_name = "DIR")]
+    pub set: PathBuf,
+    /// Output folder.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// The pose, by its exact name.
+    #[arg(long, value_name = "NAME")]
+    pub pose: String,
+    /// FE engine.
+    #[arg(long, value_name = "ENGINE", value_parser = ["febio", "ccx"])]
+    pub solver: String,
+    /// Mesh level.
+    #[arg(long, value_name = "LEVEL")]
+    pub mesh: String,
+    /// Load steps.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=10_000))]
+    pub steps: u32,
+    /// Solve even when the result is up to date.
+    #[arg(long)]
+    pub force: bool,
+    /// Keep the work folder of a successful run.
+    #[arg(long)]
+    pub keep_work: bool,
+    /// Wall-clock limit of one solver job, s.
+    #[arg(long, value_name = "S", value_parser = positive_seconds)]
+    pub timeout_s: Option<f64>,
+    /// Stall limit, s.
+    #[arg(long, value_name = "S", default_value_t = campaign::DEFAULT_STALL.as_secs_f64(), value_parser = positive_seconds)]
     pub stall_s: f64,
 }
 
@@ -123,20 +232,20 @@ pub fn run(c: FeCommand) -> anyhow::Result<ExitCode> {
     match c {
         FeCommand::Run(a) => run_campaign(a),
         FeCommand::Verify(a) => run_verify(a),
+        FeCommand::Status(a) => run_status(a),
+        FeCommand::RunOne(a) => run_one(a),
     }
 }
 
 fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
-    let timeout = match a.timeout_s {
-        None => None,
-        Some(s) if s.is_finite() && s > 0.0 => Some(Duration::from_secs_f64(s)),
-        Some(s) => anyhow::bail!("--timeout-s {s}: must be a number of seconds > 0"),
-    };
-    if !(a.stall_s.is_finite() && a.stall_s > 0.0) {
-        anyhow::bail!("--stall-s {}: must be a number of seconds > 0", a.stall_s);
-    }
+    let timeout = a.timeout_s.map(Duration::from_secs_f64);
     let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
     let jobs = a.jobs as usize;
+    if a.launcher == LauncherArg::Local
+        && (a.partition.is_some() || a.time.is_some() || a.mem.is_some() || a.cpus_per_task.is_some() || !a.sbatch_arg.is_empty())
+    {
+        anyhow::bail!("--partition, --time, --mem, --cpus-per-task and --sbatch-arg are options of --launcher slurm");
+    }
     let opts = RunOptions {
         set_dir: a.set,
         jobs,
@@ -150,6 +259,91 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
         keep_work: a.keep_work,
         timeout,
         stall: Some(Duration::from_secs_f64(a.stall_s)),
+        launcher: Launched::Local,
+    };
+    if a.launcher == LauncherArg::Slurm {
+        let slurm = SlurmOptions {
+            partition: a.partition,
+            time: a.time,
+            mem: a.mem,
+            cpus_per_task: a.cpus_per_task,
+            extra: a.sbatch_arg,
+            needle: None,
+        };
+        let r = slurm::submit(&opts, &slurm)?;
+        print!("{}", submit_summary(&r));
+        return Ok(ExitCode::SUCCESS);
+    }
+    crate::fe::process::stop_jobs_on_termination()?;
+    let report = campaign::run(&opts)?;
+    print!("{}", report.table());
+    if crate::fe::process::interrupted() {
+        return Ok(ExitCode::from(crate::fe::process::EXIT_INTERRUPTED));
+    }
+    Ok(if report.failed() > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+/// What `needle fe run --launcher slurm` prints.
+fn submit_summary(r: &slurm::SubmitReport) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let _ = writeln!(s, "{} pose(s) selected: {} up to date, {} still in the queue", r.selected, r.up_to_date.len(), r.in_queue.len());
+    for (pose, task, state) in &r.in_queue {
+        let _ = writeln!(s, "  {pose}: task {task} {}", state.to_lowercase());
+    }
+    match (&r.submission, &r.resources) {
+        (Some(sub), Some(res)) => {
+            let _ = writeln!(s, "submitted job array {} with {} task(s): {}", sub.job_id, sub.poses.len(), sub.poses.join(", "));
+            for w in &res.why {
+                let _ = writeln!(s, "  {w}");
+            }
+            let _ = writeln!(s, "follow it with: needle fe status (same --set/--out/--mesh/--steps); rerun this command to resubmit what fails");
+        }
+        _ => {
+            let _ = writeln!(s, "nothing to submit");
+        }
+    }
+    s
+}
+
+fn run_status(a: StatusArgs) -> anyhow::Result<ExitCode> {
+    let opts = RunOptions {
+        solver: a.solver.as_deref().map(crate::fe::spec::Engine::parse).transpose()?,
+        only: a.only,
+        mesh: a.mesh,
+        steps: a.steps,
+        out_dir: a.out,
+        ..RunOptions::new(a.set)
+    };
+    let r = crate::fe::launcher::status::status(&opts)?;
+    print!("{}", r.table());
+    if !a.project_nodes.is_empty() {
+        let per_node = a.tasks_per_node.map(|n| n as usize).unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
+        let nodes: Vec<usize> = a.project_nodes.iter().map(|&n| n as usize).collect();
+        print!("{}", crate::fe::launcher::projection::table(&opts, &nodes, per_node)?);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn run_one(a: RunOneArgs) -> anyhow::Result<ExitCode> {
+    if a.pose.contains(',') || a.pose.chars().any(|c| matches!(c, '*' | '?' | '[' | ']')) {
+        anyhow::bail!("--pose {:?}: a pose name, not a pattern", a.pose);
+    }
+    let threads = std::env::var("SLURM_CPUS_PER_TASK").ok().and_then(|v| v.trim().parse::<usize>().ok()).unwrap_or(1).max(1);
+    let opts = RunOptions {
+        jobs: 1,
+        threads,
+        solver: Some(crate::fe::spec::Engine::parse(&a.solver)?),
+        only: Some(a.pose),
+        mesh: Some(a.mesh),
+        steps: Some(a.steps),
+        out_dir: Some(a.out),
+        force: a.force,
+        keep_work: a.keep_work,
+        timeout: a.timeout_s.map(Duration::from_secs_f64),
+        stall: Some(Duration::from_secs_f64(a.stall_s)),
+        launcher: Launched::from_env(),
+        ..RunOptions::new(a.set)
     };
     crate::fe::process::stop_jobs_on_termination()?;
     let report = campaign::run(&opts)?;

@@ -64,6 +64,8 @@ pub struct Solved {
     /// The solver settings that shaped the result, one line (contact enforcement,
     /// threads...).
     pub settings: String,
+    /// The solver process's peak resident memory, MiB (0: not measured).
+    pub peak_rss_mib: f64,
 }
 
 /// Why a pose could not be solved.
@@ -200,6 +202,7 @@ impl Backend for CcxBackend {
             first_increment,
             retry: None,
             element: "C3D8 (fully integrated hexahedron)".into(),
+            peak_rss_mib: r.peak_rss_mib,
             settings: format!(
                 "surface-to-surface penalty contact {} N/mm^3, friction {} (stick slope {} N/mm^3); SPOOLES, 1 thread",
                 job.campaign.contact.penalty_slope_n_per_mm3, job.campaign.contact.friction, job.campaign.contact.stick_slope_n_per_mm3

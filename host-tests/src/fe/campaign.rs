@@ -34,6 +34,7 @@
 //! `progress` the display.
 
 use crate::fe::backend::{backend_for, Backend, Job, Solved, SolveFailure};
+use crate::fe::launcher::Launched;
 use crate::fe::process;
 use crate::fe::deck;
 use crate::fe::manifest::{read_manifest, manifest_text, rfc3339_utc, Manifest, ManifestEntry, MANIFEST};
@@ -76,6 +77,8 @@ pub struct RunOptions {
     pub timeout: Option<Duration>,
     /// A ccx job that writes no output for this long is killed as stalled (then retried).
     pub stall: Option<Duration>,
+    /// How this process was started, recorded in the manifest entries it writes.
+    pub launcher: Launched,
 }
 
 impl RunOptions {
@@ -94,6 +97,7 @@ impl RunOptions {
             force: false,
             timeout: None,
             stall: Some(DEFAULT_STALL),
+            launcher: Launched::Local,
         }
     }
 }
@@ -130,14 +134,50 @@ struct Ctx<'a> {
     solver_version: String,
     manifest_lock: Mutex<()>,
     keep_work: bool,
+    launcher: &'a Launched,
 }
 
-/// [`run`] with a given solver backend (tests use a fake one).
+/// What a campaign run will do, worked out before anything is solved or submitted:
+/// the spec (with the `--solver` and `--steps` overrides applied), the mesh level, the
+/// output folder and, per selected pose, whether its result is up to date. Shared by the
+/// local run ([`run_with`]), the SLURM submission
+/// ([`launcher::slurm`](crate::fe::launcher::slurm)) and `needle fe status`.
+pub struct Plan {
+    /// The spec with the overrides applied.
+    pub campaign: Campaign,
+    /// `campaign.toml`'s path.
+    pub spec_path: PathBuf,
+    /// Mesh level name.
+    pub mesh_name: String,
+    /// Load steps per run.
+    pub steps: u32,
+    /// The output folder (`<set>/fe` unless `--out`).
+    pub out_dir: PathBuf,
+    /// The manifest as read (without the csv_sha256 backfill).
+    pub manifest: Manifest,
+    /// One report per selected pose, in campaign order: [`Status::UpToDate`] (with the
+    /// manifest's figures) or a placeholder for the poses in `to_run`.
+    pub reports: Vec<PoseReport>,
+    /// Indices into `reports` (and the selected poses) of the poses to solve.
+    pub to_run: Vec<usize>,
+    /// The selected poses, in campaign order (same order as `reports`).
+    pub selected: Vec<PoseSpec>,
+}
+
+impl Plan {
+    /// Names of the poses to solve, in campaign order.
+    pub fn to_run_names(&self) -> Vec<String> {
+        self.to_run.iter().filter_map(|&i| self.selected.get(i)).map(|p| p.name.clone()).collect()
+    }
+}
+
+/// Work out what `opts` asks for without changing any file: load and check the spec, pick
+/// the mesh level and the poses, read the manifest, and sort the poses into up to date
+/// and to solve (module docs).
 ///
 /// # Errors
-/// As [`run`].
-pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> {
-    let start = Instant::now();
+/// As [`run`], except solver problems (nothing is solved here).
+pub fn plan(opts: &RunOptions) -> Result<Plan> {
     let (mut campaign, spec_path) = spec::load(&opts.set_dir)?;
     let stability = crate::fe::material::check(&campaign.tissue).with_context(|| {
         format!("{}: the tissue fails the material stability check; nothing was run", spec_path.display())
@@ -154,9 +194,9 @@ pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> 
     }
     let steps = campaign.loading.steps;
     let mesh_name = opts.mesh.clone().unwrap_or_else(|| campaign.campaign.mesh.clone());
-    let mesh = campaign.mesh_level(&mesh_name)?.clone();
+    campaign.mesh_level(&mesh_name)?;
     let all = campaign.poses();
-    let selected = spec::select(&all, opts.only.as_deref())?;
+    let selected: Vec<PoseSpec> = spec::select(&all, opts.only.as_deref())?.into_iter().cloned().collect();
     if selected.is_empty() {
         bail!(
             "--only {:?} matches no pose (poses: {})",
@@ -165,17 +205,9 @@ pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> 
         );
     }
     let out_dir = opts.out_dir.clone().unwrap_or_else(|| opts.set_dir.join("fe"));
-    std::fs::create_dir_all(&out_dir).with_context(|| format!("{}: cannot create", out_dir.display()))?;
-    let manifest_path = out_dir.join(MANIFEST);
-    let mut manifest = read_manifest(&manifest_path)?;
-    let hashed = manifest.backfill_csv_hashes(&out_dir);
-    if !hashed.is_empty() {
-        results::write_atomic(&manifest_path, manifest_text(&manifest)?.as_bytes())?;
-        eprintln!("{}: recorded csv_sha256 of {} earlier result(s) ({})", manifest_path.display(), hashed.len(), hashed.join(", "));
-    }
-
+    let manifest = read_manifest(&out_dir.join(MANIFEST))?;
     let mut reports: Vec<PoseReport> = Vec::with_capacity(selected.len());
-    let mut to_run: Vec<(usize, &PoseSpec)> = Vec::new();
+    let mut to_run: Vec<usize> = Vec::new();
     for pose in &selected {
         let csv = out_dir.join(format!("{}.csv", pose.name));
         let entry = manifest.current_entry(&campaign, pose, &mesh_name).ok();
@@ -198,10 +230,37 @@ pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> 
                 report.increments = Some(e.increments);
                 report.fy_final_n = rows.last().map(|r| r.wrench[1]);
             }
-            _ => to_run.push((reports.len(), pose)),
+            _ => to_run.push(reports.len()),
         }
         reports.push(report);
     }
+    Ok(Plan { campaign, spec_path, mesh_name, steps, out_dir, manifest, reports, to_run, selected })
+}
+
+/// [`run`] with a given solver backend (tests use a fake one).
+///
+/// # Errors
+/// As [`run`].
+pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> {
+    let start = Instant::now();
+    let Plan { campaign, mesh_name, steps, out_dir, mut reports, to_run, selected, .. } = plan(opts)?;
+    let mesh = campaign.mesh_level(&mesh_name)?.clone();
+    std::fs::create_dir_all(&out_dir).with_context(|| format!("{}: cannot create", out_dir.display()))?;
+    let manifest_path = out_dir.join(MANIFEST);
+    let (hashed, manifest) = {
+        let _lock = lock_manifest(&out_dir)?;
+        // read again under the lock: another process may have written it since the plan
+        let mut manifest = read_manifest(&manifest_path)?;
+        let hashed = manifest.backfill_csv_hashes(&out_dir);
+        if !hashed.is_empty() {
+            results::write_atomic(&manifest_path, manifest_text(&manifest)?.as_bytes())?;
+        }
+        (hashed, manifest)
+    };
+    if !hashed.is_empty() {
+        eprintln!("{}: recorded csv_sha256 of {} earlier result(s) ({})", manifest_path.display(), hashed.len(), hashed.join(", "));
+    }
+    let to_run: Vec<(usize, &PoseSpec)> = to_run.iter().filter_map(|&i| selected.get(i).map(|p| (i, p))).collect();
     let skipped = reports.len() - to_run.len();
     let jobs = opts.jobs.clamp(1, to_run.len().max(1));
     eprintln!(
@@ -226,11 +285,34 @@ pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> 
             solver_version,
             manifest_lock: Mutex::new(()),
             keep_work: opts.keep_work,
+            launcher: &opts.launcher,
         };
         let earlier_walls_s = manifest.wall_times_s(ctx.campaign.solver.engine.name(), &mesh_name, steps);
         run_workers(&ctx, &to_run, jobs, earlier_walls_s, &mut reports);
     }
     Ok(Report { poses: reports, mesh: mesh_name, steps, depth_mm: campaign.loading.depth_mm, out_dir, wall: start.elapsed() })
+}
+
+/// Name of the lock file beside the manifest: campaigns in other processes (SLURM array
+/// tasks on other nodes, a second `needle fe run`) update the same manifest.
+pub const MANIFEST_LOCK: &str = "manifest.toml.lock";
+
+/// Hold an exclusive lock on `<out_dir>/manifest.toml.lock` (`flock`; on a shared
+/// filesystem it needs the filesystem's lock support, which NFSv4 and Lustre give) for
+/// the read-change-write of the manifest. Released when the returned file is dropped.
+///
+/// # Errors
+/// The lock file cannot be created or locked.
+pub fn lock_manifest(out_dir: &Path) -> Result<std::fs::File> {
+    let path = out_dir.join(MANIFEST_LOCK);
+    let f = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&path)
+        .with_context(|| format!("{}: cannot create the manifest's lock file", path.display()))?;
+    f.lock().with_context(|| format!("{}: cannot lock", path.display()))?;
+    Ok(f)
 }
 
 enum Event {
@@ -434,6 +516,7 @@ fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Res
         increments: s.increments,
         iterations: s.iterations,
         wall_s,
+        peak_rss_mib: (s.peak_rss_mib > 0.0).then(|| (s.peak_rss_mib * 10.0).round() / 10.0),
         date: rfc3339_utc(SystemTime::now()),
         role: pose.role,
         x_mm: pose.x_mm,
@@ -442,6 +525,8 @@ fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Res
         theta_z_deg: pose.theta_z_deg,
         first_increment: (s.first_increment != 1.0).then_some(s.first_increment),
         retry: s.retry.clone(),
+        launcher: Some(ctx.launcher.name().to_string()),
+        batch_job: ctx.launcher.batch_job(),
     };
     update_manifest(ctx, |m| {
         m.pose.insert(pose.name.clone(), entry);
@@ -453,6 +538,7 @@ fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Res
 /// write it back atomically; under the campaign's manifest lock.
 fn update_manifest(ctx: &Ctx<'_>, f: impl FnOnce(&mut Manifest)) -> Result<()> {
     let _guard = ctx.manifest_lock.lock().unwrap_or_else(|p| p.into_inner());
+    let _lock = lock_manifest(ctx.out_dir)?;
     let path = ctx.out_dir.join(MANIFEST);
     let mut m = read_manifest(&path)?;
     let before = m.clone();
@@ -529,6 +615,7 @@ mod tests {
                 retry: None,
                 element: "fake".into(),
                 settings: "fake".into(),
+                peak_rss_mib: 0.0,
             })
         }
         fn steps_done(&self, _work_dir: &Path) -> u32 {

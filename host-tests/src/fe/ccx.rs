@@ -149,6 +149,8 @@ pub struct JobResult {
     /// `spooles.out` (e.g. "matrix found to be singular") or the last `*ERROR` line of
     /// the log.
     pub cause: Option<String>,
+    /// ccx's peak resident memory, MiB ([`process::Finished::peak_rss_mib`]).
+    pub peak_rss_mib: f64,
 }
 
 impl JobResult {
@@ -192,7 +194,7 @@ pub fn run_job(
         .env("CCX_NPROC_RESULTS", "1");
     let progress_files = [sta_path(work_dir, job), work_dir.join(format!("{job}.cvg"))];
     let done = process::run(cmd, work_dir, &log_path, &progress_files, timeout, stall)?;
-    let (exit, wall, log_text, log_path) = (done.exit, done.wall, done.log_text, done.log_path);
+    let (exit, wall, log_text, log_path, peak_rss_mib) = (done.exit, done.wall, done.log_text, done.log_path, done.peak_rss_mib);
     let sta = std::fs::read_to_string(sta_path(work_dir, job)).map(|t| parse_sta(&t)).unwrap_or_default();
     let mut log_tail = tail(&log_text, LOG_TAIL_LINES);
     // SPOOLES reports a singular matrix in its own file, not on stdout (ccx then exits 255)
@@ -202,7 +204,7 @@ pub fn run_job(
         log_tail.push_str(&tail(&spooles, 3).trim_start().replace('\n', " / "));
     }
     let cause = stated_cause(&log_text, &spooles);
-    Ok(JobResult { exit, wall, sta, log_tail, log_path, cause })
+    Ok(JobResult { exit, wall, sta, log_tail, log_path, cause, peak_rss_mib })
 }
 
 /// ccx's own statement of why it stopped: the last non-blank line of `spooles.out`, else

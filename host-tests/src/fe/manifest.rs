@@ -71,6 +71,11 @@ pub struct ManifestEntry {
     pub iterations: u32,
     /// Wall time of the solve (deck, ccx, reading back), s.
     pub wall_s: f64,
+    /// Peak resident memory of the solver process of the successful attempt, MiB
+    /// (Linux `VmHWM`); none in entries from before it was recorded. The SLURM
+    /// launcher's default `--mem` comes from it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_rss_mib: Option<f64>,
     /// When the run finished, UTC, RFC 3339 (`2025-01-31T12:00:00Z`).
     pub date: String,
     /// Role of the pose.
@@ -90,6 +95,13 @@ pub struct ManifestEntry {
     /// Why the first attempt failed, when this result comes from the retry.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub retry: Option<String>,
+    /// How the run was started: "local" (`needle fe run`) or "slurm" (an array task of
+    /// `needle fe run --launcher slurm`); none in entries from before it was recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub launcher: Option<String>,
+    /// The batch system's job of the run, e.g. "1234_5" (SLURM array job 1234, task 5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub batch_job: Option<String>,
 }
 
 impl Manifest {

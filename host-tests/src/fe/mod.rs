@@ -17,4 +17,5 @@ pub mod manifest;
 pub mod report;
 mod progress;
 pub mod campaign;
+pub mod launcher;
 pub mod verify;

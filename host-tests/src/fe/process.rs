@@ -88,6 +88,16 @@ pub struct Finished {
     pub log_path: PathBuf,
     /// The whole log (lossy UTF-8).
     pub log_text: String,
+    /// The process's peak resident memory (Linux `VmHWM`, read at every poll), MiB; 0
+    /// when it could not be read (a process that ended before the first poll).
+    pub peak_rss_mib: f64,
+}
+
+/// Peak resident set size of process `pid` so far (`VmHWM` of `/proc/<pid>/status`), KiB.
+fn peak_rss_kib(pid: u32) -> Option<u64> {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    line.split_whitespace().nth(1)?.parse().ok()
 }
 
 /// Run `cmd` (program, arguments, environment already set) in `work_dir`, stdin from
@@ -122,7 +132,9 @@ pub fn run(
     watched.extend_from_slice(progress_files);
     let output_bytes = || -> u64 { watched.iter().filter_map(|p| std::fs::metadata(p).ok()).map(|m| m.len()).sum() };
     let (mut last_bytes, mut last_change) = (0u64, Instant::now());
+    let mut peak_kib = 0u64;
     let exit = loop {
+        peak_kib = peak_kib.max(peak_rss_kib(child.id()).unwrap_or(0));
         if let Some(status) = child.try_wait().with_context(|| format!("cannot wait for {program}"))? {
             use std::os::unix::process::ExitStatusExt;
             break match (status.code(), status.signal()) {
@@ -156,7 +168,7 @@ pub fn run(
     };
     let wall = start.elapsed();
     let log_text = std::fs::read(log_path).map(|b| String::from_utf8_lossy(&b).into_owned()).unwrap_or_default();
-    Ok(Finished { exit, wall, log_path: log_path.to_path_buf(), log_text })
+    Ok(Finished { exit, wall, log_path: log_path.to_path_buf(), log_text, peak_rss_mib: peak_kib as f64 / 1024.0 })
 }
 
 /// Copy a failed attempt's files (`(name in work_dir, extension)`) to

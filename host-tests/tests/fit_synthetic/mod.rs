@@ -79,6 +79,7 @@ fn synthetic_entry(campaign: &spec::Campaign, pose: &PoseSpec) -> ManifestEntry 
         increments: 0,
         iterations: 0,
         wall_s: 0.0,
+        peak_rss_mib: None,
         date: "1970-01-01T00:00:00Z".into(),
         role: pose.role,
         x_mm: pose.x_mm,
@@ -87,6 +88,8 @@ fn synthetic_entry(campaign: &spec::Campaign, pose: &PoseSpec) -> ManifestEntry 
         theta_z_deg: pose.theta_z_deg,
         first_increment: None,
         retry: None,
+        launcher: None,
+        batch_job: None,
     }
 }
 

@@ -240,6 +240,7 @@ impl Backend for FebioBackend {
             first_increment: job.first_increment,
             retry: None,
             element: "hex8, three-field (u-p-J) for the uncoupled Ogden tissue; rigid-body needle".into(),
+            peak_rss_mib: done.peak_rss_mib,
             settings: settings_line(&campaign.solver.febio, campaign.contact.friction, self.threads, job.first_increment < 1.0),
         })
     }
