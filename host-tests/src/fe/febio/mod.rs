@@ -9,6 +9,7 @@
 
 pub mod feb;
 pub mod logs;
+pub mod restart;
 
 use crate::fe::backend::{Backend, Job, Solved, SolveFailure};
 use crate::fe::process::{self, ExitKind, LOG_TAIL_LINES};
@@ -177,33 +178,89 @@ impl Backend for FebioBackend {
         let input = job.work_dir.join(format!("{JOB}.feb"));
         std::fs::write(&input, &feb.text).with_context(|| format!("{}: cannot write", input.display()))?;
         let rb_path = job.work_dir.join(feb::RIGID_LOG);
-        if rb_path.exists() {
-            std::fs::remove_file(&rb_path).with_context(|| format!("{}: cannot remove the earlier attempt's", rb_path.display()))?;
-        }
         let log_path = job.work_dir.join(format!("{JOB}.log"));
-        let mut cmd = Command::new(exe);
-        cmd.arg("-nosplash")
-            .arg("-i")
-            .arg(format!("{JOB}.feb"))
-            .arg("-o")
-            .arg(format!("{JOB}.log"))
-            .arg("-p")
-            .arg(format!("{JOB}.xplt"))
-            .env("OMP_NUM_THREADS", self.threads.to_string())
-            .env("MKL_NUM_THREADS", self.threads.to_string());
         let out_path = job.work_dir.join("febio.out");
-        let done = process::run(cmd, job.work_dir, &out_path, &[log_path.clone(), rb_path.clone()], job.timeout, job.stall)?;
-        let log_text = std::fs::read_to_string(&log_path).unwrap_or_default();
-        let run = logs::parse_run_log(if log_text.is_empty() { &done.log_text } else { &log_text });
-        let tail_src = if log_text.trim().is_empty() { &done.log_text } else { &log_text };
-        let log_tail = process::tail(tail_src, LOG_TAIL_LINES);
-        let records = std::fs::read_to_string(&rb_path)
-            .map_err(anyhow::Error::from)
-            .and_then(|t| logs::parse_rigid_log(&t))
-            .with_context(|| format!("{}", rb_path.display()));
+        // files of an earlier attempt in this folder would be taken for this one's
+        for n in 0..=restart::MAX_CONTINUATIONS {
+            remove_if_exists(&restart::segment_log(job.work_dir, n))?;
+        }
+        for f in [rb_path.clone(), job.work_dir.join(restart::DUMP), job.work_dir.join(restart::DUMP_FROM)] {
+            remove_if_exists(&f)?;
+        }
         let depth = job.campaign.loading.depth_mm;
-        let at_steps = records.as_ref().ok().map(|r| pick_steps(r, depth, job.steps));
-        let done_steps = at_steps.as_ref().map(|v| v.iter().take_while(|w| w.is_some()).count()).unwrap_or(0);
+        let step_mm = depth / f64::from(job.steps.max(1));
+        let started = std::time::Instant::now();
+        let mut segments: Vec<logs::RigidRecord> = Vec::new();
+        let mut cont = restart::Continuations::default();
+        let mut totals = logs::RunLog::default();
+        let (done, run, log_tail, at_steps, done_steps) = loop {
+            let mut cmd = Command::new(exe);
+            cmd.arg("-nosplash");
+            if cont.from_mm.is_empty() {
+                cmd.arg("-i").arg(format!("{JOB}.feb")).arg("-p").arg(format!("{JOB}.xplt"));
+            } else {
+                cmd.arg("-r").arg(restart::RESTART_INPUT).arg("-noappend").arg("-p").arg(format!("{JOB}.xplt"));
+            }
+            cmd.arg("-o")
+                .arg(format!("{JOB}.log"))
+                .arg("-dump=3")
+                .arg(restart::DUMP)
+                .env("OMP_NUM_THREADS", self.threads.to_string())
+                .env("MKL_NUM_THREADS", self.threads.to_string());
+            let timeout = job.timeout.map(|t| t.saturating_sub(started.elapsed()));
+            let done = process::run(cmd, job.work_dir, &out_path, &[log_path.clone(), rb_path.clone()], timeout, job.stall)?;
+            let log_text = std::fs::read_to_string(&log_path).unwrap_or_default();
+            let run = logs::parse_run_log(if log_text.is_empty() { &done.log_text } else { &log_text });
+            totals.time_steps += run.time_steps;
+            totals.iterations += run.iterations;
+            totals.retries += run.retries;
+            let tail_src = if log_text.trim().is_empty() { &done.log_text } else { &log_text };
+            let log_tail = process::tail(tail_src, LOG_TAIL_LINES);
+            let records = std::fs::read_to_string(&rb_path)
+                .map_err(anyhow::Error::from)
+                .and_then(|t| logs::parse_rigid_log(&t))
+                .with_context(|| format!("{}", rb_path.display()));
+            let mut all = segments.clone();
+            if let Ok(r) = &records {
+                all.extend_from_slice(r);
+            }
+            let at_steps = pick_steps(&all, depth, job.steps);
+            let done_steps = at_steps.iter().take_while(|w| w.is_some()).count();
+            let solved = done.exit == ExitKind::Code(0) && run.normal_termination && done_steps >= job.steps as usize;
+            // continue from the last must point when the solver gave up (not on a
+            // timeout, stall or stop) and a dump of a converged must point exists
+            let last_mm = done_steps as f64 * step_mm;
+            let next = (!solved && matches!(done.exit, ExitKind::Code(_)) && done_steps > 0 && !process::interrupted())
+                .then(|| cont.next_fraction(last_mm))
+                .flatten()
+                .filter(|_| job.work_dir.join(restart::DUMP).is_file());
+            let Some(fraction) = next else {
+                break (done, run, log_tail, at_steps, done_steps);
+            };
+            let n = cont.from_mm.len() as u32;
+            eprintln!(
+                "{}: febio4 stopped at t = {} mm ({}); continuing from the must point at {last_mm} mm with a first time step of {} mm",
+                job.pose.name,
+                run.last_time,
+                run.cause.as_deref().unwrap_or("no stated cause"),
+                step_mm * fraction
+            );
+            if rb_path.exists() {
+                let seg = restart::segment_log(job.work_dir, n);
+                std::fs::rename(&rb_path, &seg).with_context(|| format!("{}: cannot keep as {}", rb_path.display(), seg.display()))?;
+            }
+            segments = all;
+            let from = job.work_dir.join(restart::DUMP_FROM);
+            std::fs::copy(job.work_dir.join(restart::DUMP), &from).with_context(|| format!("{}: cannot write", from.display()))?;
+            let dtmin = step_mm * campaign.solver.febio.dtmin_fraction * restart::CONTINUE_DTMIN_SCALE;
+            let input = job.work_dir.join(restart::RESTART_INPUT);
+            std::fs::write(&input, restart::restart_input(step_mm * fraction, dtmin)).with_context(|| format!("{}: cannot write", input.display()))?;
+            cont.from_mm.push(last_mm);
+        };
+        // the dumps are large (tens of MB) and only needed while the run goes on
+        for f in [restart::DUMP, restart::DUMP_FROM] {
+            let _ = std::fs::remove_file(job.work_dir.join(f));
+        }
         if done.exit != ExitKind::Code(0) || !run.normal_termination || done_steps < job.steps as usize {
             let how = match done.exit {
                 ExitKind::Code(0) if run.error_termination => "ended with ERROR TERMINATION".to_string(),
@@ -211,21 +268,23 @@ impl Backend for FebioBackend {
                 e => e.to_string(),
             };
             let kept = keep_failed_attempt(job);
+            let continued = cont.describe();
             return Err(SolveFailure {
                 message: format!(
-                    "febio4 {how} after {done_steps} of {} steps (t = {} mm), {} time steps, {} retries, {:.1} s{}{kept}",
+                    "febio4 {how} after {done_steps} of {} steps (t = {} mm), {} time steps, {} retries, {:.1} s{}{}{kept}",
                     job.steps,
                     run.last_time,
-                    run.time_steps,
-                    run.retries,
-                    done.wall.as_secs_f64(),
+                    totals.time_steps,
+                    totals.retries,
+                    started.elapsed().as_secs_f64(),
+                    if continued.is_empty() { String::new() } else { format!(", {continued}") },
                     run.cause.as_deref().map(|c| format!(": {c}")).unwrap_or_default(),
                 ),
                 log_tail,
             });
         }
+        let run = logs::RunLog { time_steps: totals.time_steps, iterations: totals.iterations, ..run };
         let wrenches = at_steps
-            .unwrap_or_default()
             .into_iter()
             .map(|v| {
                 let v = v.unwrap_or([f64::NAN; 6]);
@@ -241,16 +300,23 @@ impl Backend for FebioBackend {
             retry: None,
             element: "hex8, three-field (u-p-J) for the uncoupled Ogden tissue; rigid-body needle".into(),
             peak_rss_mib: done.peak_rss_mib,
-            settings: settings_line(&campaign.solver.febio, campaign.contact.friction, self.threads, job.first_increment < 1.0),
+            settings: {
+                let line = settings_line(&campaign.solver.febio, campaign.contact.friction, self.threads, job.first_increment < 1.0);
+                let continued = cont.describe();
+                if continued.is_empty() {
+                    line
+                } else {
+                    format!("{line}; {continued}")
+                }
+            },
         })
     }
 
+    /// Must points logged so far, over the continued segments' logs too.
     fn steps_done(&self, work_dir: &Path) -> u32 {
-        std::fs::read_to_string(work_dir.join(feb::RIGID_LOG))
-            .ok()
-            .and_then(|t| logs::parse_rigid_log(&t).ok())
-            .map(|r| r.len() as u32)
-            .unwrap_or(0)
+        let count = |p: PathBuf| std::fs::read_to_string(p).ok().and_then(|t| logs::parse_rigid_log(&t).ok()).map(|r| r.len() as u32);
+        let segments: u32 = (0..restart::MAX_CONTINUATIONS).map_while(|n| count(restart::segment_log(work_dir, n))).sum();
+        segments + count(work_dir.join(feb::RIGID_LOG)).unwrap_or(0)
     }
 }
 
@@ -290,6 +356,14 @@ fn pick_steps(records: &[logs::RigidRecord], depth: f64, steps: u32) -> Vec<Opti
         .collect()
 }
 
+fn remove_if_exists(p: &Path) -> Result<()> {
+    match std::fs::remove_file(p) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(e).with_context(|| format!("{}: cannot remove the earlier attempt's", p.display())),
+    }
+}
+
 /// Keep a failed FEBio attempt's logs (see [`process::keep_failed_attempt`]).
 fn keep_failed_attempt(job: &Job<'_>) -> String {
     let files = [
@@ -310,6 +384,87 @@ mod tests {
         assert_eq!(parse_version("compiled on Nov 24 2026\nFEBio version  = 4.11.0\n").as_deref(), Some("4.11.0"));
         assert_eq!(parse_version("  Version  4.11.0  \n").as_deref(), Some("4.11.0"));
         assert_eq!(parse_version("version: unknown"), None);
+    }
+
+    /// A stand-in for febio4 (a shell script; bookkeeping only, no physics): the first
+    /// run logs the must points at 1.5 and 3 mm, dumps and gives up at 3.2 mm; a restart
+    /// (`-r`) checks its input and archive, then logs 4.5 and 6 mm, or (`stuck`) gives up
+    /// again without a new must point.
+    fn fake_febio(dir: &Path, stuck: bool) -> PathBuf {
+        use std::os::unix::fs::PermissionsExt;
+        let rb = |ts: &[(f64, f64)]| -> String {
+            ts.iter().map(|(t, v)| format!("*Step  = 1\\n*Time  = {t}\\n*Data  = Fx;Fy;Fz;Mx;My;Mz\\n2,{v},{v},{v},{v},{v},{v}\\n")).collect()
+        };
+        let restart = if stuck {
+            "printf ' ------- failed to converge at time : 3.1\\n E R R O R   T E R M I N A T I O N\\n' > pose.log; exit 1".to_string()
+        } else {
+            format!(
+                "printf '{}' > needle-rb.txt; printf ' ------- converged at time : 4.5\\n ------- converged at time : 6\\n N O R M A L   T E R M I N A T I O N\\n' > pose.log; exit 0",
+                rb(&[(4.5, 3.0), (6.0, 4.0)])
+            )
+        };
+        let script = format!(
+            "#!/bin/sh\n\
+             case \" $* \" in *\" -r \"*)\n\
+             grep -q '<Archive>pose-from.dmp</Archive>' pose-restart.feb && grep -q 'step_size' pose-restart.feb && [ -f pose-from.dmp ] || exit 3\n\
+             {restart};;\n\
+             esac\n\
+             printf '{}' > needle-rb.txt; echo state > pose.dmp\n\
+             printf ' ------- converged at time : 1.5\\n ------- converged at time : 3\\n ------- failed to converge at time : 3.2\\n E R R O R   T E R M I N A T I O N\\n' > pose.log\n\
+             exit 1\n",
+            rb(&[(1.5, 1.0), (3.0, 2.0)])
+        );
+        let p = dir.join("fake-febio4");
+        std::fs::write(&p, script).expect("write the fake febio4");
+        std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o755)).expect("chmod");
+        p
+    }
+
+    #[test]
+    fn a_run_that_gives_up_continues_from_its_last_must_point() {
+        let d = tempfile::tempdir().expect("tempdir");
+        let set = d.path().join("set");
+        std::fs::create_dir_all(&set).expect("mkdir");
+        std::fs::copy(Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default/campaign.toml"), set.join("campaign.toml")).expect("copy");
+        let (mut c, _) = crate::fe::spec::load(&set).expect("spec");
+        c.loading.steps = 4;
+        let pose = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");
+        let mesh = c.mesh_level("smoke").expect("smoke").clone();
+        for stuck in [false, true] {
+            let work = d.path().join(format!("work-{stuck}"));
+            std::fs::create_dir_all(&work).expect("mkdir");
+            let backend = FebioBackend { exe: Some(fake_febio(d.path(), stuck)), threads: 1 };
+            let job = Job {
+                campaign: &c,
+                pose: &pose,
+                mesh_name: "smoke",
+                mesh: &mesh,
+                steps: 4,
+                work_dir: &work,
+                timeout: None,
+                stall: None,
+                first_increment: 1.0,
+                attempt: 0,
+            };
+            let r = backend.solve(&job);
+            assert!(!work.join(restart::DUMP).exists() && !work.join(restart::DUMP_FROM).exists(), "dumps removed");
+            if stuck {
+                let f = r.err().expect("a continuation without progress, twice: failed");
+                assert!(f.message.contains("after 2 of 4 steps") && f.message.contains("continued 2 time(s) from the last converged must point (3, 3 mm)"), "{}", f.message);
+                let restart = std::fs::read_to_string(work.join(restart::RESTART_INPUT)).expect("restart input");
+                assert!(restart.contains(&format!("<step_size>{:e}</step_size>", 1.5 * restart::CONTINUE_STEP_FRACTION_AGAIN)), "{restart}");
+            } else {
+                let s = r.unwrap_or_else(|f| panic!("continued run: {}", f.message));
+                let fy: Vec<f64> = s.wrenches.iter().map(|w| w[1]).collect();
+                // the fake's values 1, 2 (first run) and 3, 4 (continuation), through the
+                // reaction sign and the quarter model's mirror expansion (x4 for Fy)
+                assert_eq!(fy, vec![-4.0, -8.0, -12.0, -16.0]);
+                assert!(s.settings.ends_with("continued 1 time(s) from the last converged must point (3 mm)"), "{}", s.settings);
+                assert_eq!(backend.steps_done(&work), 4, "the must points of both segments");
+                let restart = std::fs::read_to_string(work.join(restart::RESTART_INPUT)).expect("restart input");
+                assert!(restart.contains(&format!("<step_size>{:e}</step_size>", 1.5 * restart::CONTINUE_STEP_FRACTION)), "{restart}");
+            }
+        }
     }
 
     #[test]
