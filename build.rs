@@ -48,8 +48,7 @@ fn run() -> Result<(), String> {
             set_dir.display()
         ));
     }
-    let set_dir = std::fs::canonicalize(&set_dir)
-        .map_err(|e| format!("{}: cannot resolve the set folder: {e}", set_dir.display()))?;
+    let set_dir = std::fs::canonicalize(&set_dir).map_err(|e| format!("{}: cannot resolve the set folder: {e}", set_dir.display()))?;
     println!("cargo::rustc-env=NEEDLE_SET_DIR={}", set_dir.display());
 
     if model_path.is_file() {
@@ -105,8 +104,7 @@ fn has_examples(dir: &Path) -> bool {
     };
     entries.flatten().any(|e| {
         let path = e.path();
-        (path.is_file() && path.extension().is_some_and(|x| x == "rs"))
-            || path.join("main.rs").is_file()
+        (path.is_file() && path.extension().is_some_and(|x| x == "rs")) || path.join("main.rs").is_file()
     })
 }
 

@@ -38,8 +38,7 @@ mod firmware {
     use core::hint::black_box;
     use needle_haptics::{fixed, model_info, wrench, Pose};
 
-    const HEADER: &str =
-        "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,status,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm";
+    const HEADER: &str = "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,status,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm";
 
     /// The golden file of the set this build compiled in; used in const evaluation only
     /// (it is not in the firmware image).
@@ -120,7 +119,8 @@ mod firmware {
 
     /// The fixed-point golden file of the set (const evaluation only, like [`CSV`]).
     const CSV_FIXED: &[u8] = include_bytes!(concat!(env!("NEEDLE_SET_DIR"), "/golden-fixed.csv"));
-    const HEADER_FIXED: &str = "x_mm_q16,z_mm_q16,theta_x_deg_q16,theta_z_deg_q16,depth_mm_q16,status,fx_un,fy_un,fz_un,mx_unmm,my_unmm,mz_unmm";
+    const HEADER_FIXED: &str =
+        "x_mm_q16,z_mm_q16,theta_x_deg_q16,theta_z_deg_q16,depth_mm_q16,status,fx_un,fy_un,fz_un,mx_unmm,my_unmm,mz_unmm";
     const FIXED_ROWS: usize = count_lines_after(CSV_FIXED, HEADER_FIXED.len() + 1);
     /// The five Q16.16 inputs of every row of golden-fixed.csv, in file order.
     static POSES_FIXED: [[i32; 5]; FIXED_ROWS] = parse_fixed_poses(CSV_FIXED);
@@ -229,13 +229,7 @@ mod firmware {
         let poses: &[[u32; 5]] = black_box(&POSES[..]);
         for p in poses {
             let [x, z, tx, tz, d] = *p;
-            let pose = Pose::new(
-                f32::from_bits(x),
-                f32::from_bits(z),
-                f32::from_bits(tx),
-                f32::from_bits(tz),
-                f32::from_bits(d),
-            );
+            let pose = Pose::new(f32::from_bits(x), f32::from_bits(z), f32::from_bits(tx), f32::from_bits(tz), f32::from_bits(d));
             let e = wrench(black_box(&pose));
             for v in p {
                 out.hex(*v, 8);

@@ -156,8 +156,7 @@ mod firmware {
         // SysTick ticks per millisecond of virtual time (1 ns per instruction).
         let per_ms = (1_000_000 * cal.ticks / cal.instructions) as u32;
         // SAFETY: TELEMETRY is split once, here, before the interrupt starts.
-        let (tx, mut rx): (SampleProducer<'static, QUEUE>, SampleConsumer<'static, QUEUE>) =
-            unsafe { (*addr_of_mut!(TELEMETRY)).split() };
+        let (tx, mut rx): (SampleProducer<'static, QUEUE>, SampleConsumer<'static, QUEUE>) = unsafe { (*addr_of_mut!(TELEMETRY)).split() };
         let channels = [0, 1, 2].map(|i| Channel { pwm: RegPwm(i), dir: RegPin(3 + i) });
         let Ok(l) = ControlLoop::new(CONFIG, Kinematics { t: 0 }, channels, RegPin(6)) else { exit(false) };
         // SAFETY: the interrupt is not enabled yet.

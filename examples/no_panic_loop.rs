@@ -28,9 +28,7 @@ mod firmware {
     use embedded_hal::digital::{ErrorType as PinError, OutputPin};
     use embedded_hal::pwm::{ErrorType as PwmError, SetDutyCycle};
     use needle_haptics::command::{respond, FrameReader};
-    use needle_haptics::control::{
-        Channel, ChannelMap, ControlLoop, LoopConfig, OverLimit, PoseFault, PoseSource,
-    };
+    use needle_haptics::control::{Channel, ChannelMap, ControlLoop, LoopConfig, OverLimit, PoseFault, PoseSource};
     use needle_haptics::telemetry::Telemetry;
 
     /// Opaque poses and faults.

@@ -51,12 +51,7 @@ pub(crate) use flag_bits;
 /// Writes the names of the flags of `named` set in `bits`, in the table's order, joined by
 /// ` | `, then any set bit no name covers in hex (`0x20`, `hex_digits` wide); `OK` when
 /// `bits` is 0.
-pub(crate) fn write_names(
-    f: &mut fmt::Formatter<'_>,
-    bits: u32,
-    named: &[(u32, &str)],
-    hex_digits: usize,
-) -> fmt::Result {
+pub(crate) fn write_names(f: &mut fmt::Formatter<'_>, bits: u32, named: &[(u32, &str)], hex_digits: usize) -> fmt::Result {
     if bits == 0 {
         return f.write_str("OK");
     }

@@ -52,15 +52,15 @@
 #![deny(missing_docs)]
 
 mod bit_flags;
-pub mod control;
 pub mod command;
+pub mod control;
 mod cross_f32;
 mod evaluation;
 pub mod fixed;
 mod horner;
 mod model_f32;
-pub mod orientation;
 pub mod model_info;
+pub mod orientation;
 mod pose;
 mod status;
 mod tables;

@@ -150,14 +150,8 @@ fn superpose(sweeps: [f32; 4], u: f32) -> [f32; 6] {
 fn superpose(sweeps: [f32; 4], u: f32) -> [f32; 6] {
     let [b0, b1, b2, b3, b4, b5] = &BASELINE;
     let [z0, z1, z2, z3, z4, z5] = ZERO_BASELINE;
-    let mut w = [
-        baseline(b0, z0, u),
-        baseline(b1, z1, u),
-        baseline(b2, z2, u),
-        baseline(b3, z3, u),
-        baseline(b4, z4, u),
-        baseline(b5, z5, u),
-    ];
+    let mut w =
+        [baseline(b0, z0, u), baseline(b1, z1, u), baseline(b2, z2, u), baseline(b3, z3, u), baseline(b4, z4, u), baseline(b5, z5, u)];
     let [v0, v1, v2, v3] = sweeps;
     let [s0, s1, s2, s3] = SWEEP_SCALES;
     let [d0, d1, d2, d3] = &DEVIATION;

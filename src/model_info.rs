@@ -3,10 +3,7 @@
 //! Everything here comes from the coefficient set selected at build time
 //! (`NEEDLE_COEFFS`, default `coeffs/default`), through `build.rs` and `needle-codegen`.
 
-pub use crate::tables::{
-    BASELINE, DEPTH_MAX_MM, DEVIATION, FE_SHA256, FITTED, FORMAT, SET, THETA_MAX_DEG, X_MAX_MM,
-    Z_MAX_MM,
-};
+pub use crate::tables::{BASELINE, DEPTH_MAX_MM, DEVIATION, FE_SHA256, FITTED, FORMAT, SET, THETA_MAX_DEG, X_MAX_MM, Z_MAX_MM};
 
 pub use crate::cross_f32::{COUPLED, CROSS_SCALES, CROSS_TERMS, CV_RMS_PCT, CV_SCALE, TRAINING_RUNS};
 

@@ -93,11 +93,14 @@ macro_rules! tilt_impl {
             let [ax, ay, az] = axis;
             let n = $sqrt(super::checked_length2(axis)?);
             let sz = az / n;
-            let sz = if sz > 1.0 { 1.0 } else if sz < -1.0 { -1.0 } else { sz };
-            Ok(super::Tilt {
-                theta_x_deg: $asin(sz) * super::DEG_PER_RAD,
-                theta_z_deg: $atan2(-ax, ay) * super::DEG_PER_RAD,
-            })
+            let sz = if sz > 1.0 {
+                1.0
+            } else if sz < -1.0 {
+                -1.0
+            } else {
+                sz
+            };
+            Ok(super::Tilt { theta_x_deg: $asin(sz) * super::DEG_PER_RAD, theta_z_deg: $atan2(-ax, ay) * super::DEG_PER_RAD })
         }
 
         /// The tilts of the orientation quaternion `q = [w, x, y, z]` (any non-zero
@@ -144,10 +147,10 @@ pub mod fast {
     }
 }
 
-#[cfg(feature = "fast-math")]
-pub use fast::{tilt_from_axis, tilt_from_quaternion};
 #[cfg(not(feature = "fast-math"))]
 pub use exact::{tilt_from_axis, tilt_from_quaternion};
+#[cfg(feature = "fast-math")]
+pub use fast::{tilt_from_axis, tilt_from_quaternion};
 
 /// The pose of a needle entering at (`x_mm`, `z_mm`) on the surface with axis `axis` (tip
 /// to hub) at `depth_mm`.

@@ -67,9 +67,6 @@ fn main() {
     println!("needle-haptics f32 paper model, set {:?} ({})", model_info::SET, model_info::SET_DIR);
     println!("  {:.1} ns per 6-axis wrench (best of {rounds} rounds of {} evaluations)", best, per_round * poses.len());
     println!("  {:.3e} wrench evaluations per second", per_s);
-    println!(
-        "  paper (MATLAB): {PAPER_MATLAB_S} s per evaluation -> {:.2e} times faster here",
-        PAPER_MATLAB_S * per_s
-    );
+    println!("  paper (MATLAB): {PAPER_MATLAB_S} s per evaluation -> {:.2e} times faster here", PAPER_MATLAB_S * per_s);
     println!("  haptic budget at 1 kHz / 10 kHz: {:.4} % / {:.4} % of one core", best / 1e4, best / 1e3);
 }

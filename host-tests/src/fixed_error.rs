@@ -53,9 +53,8 @@ impl ErrorStats {
 
     /// Every pose of an `n`-point-per-axis grid over the domain (edges included).
     pub fn add_grid(&mut self, model: &Model, n: usize) {
-        let axis: Vec<Vec<i32>> = (0..5)
-            .map(|i| (0..n).map(|m| (MIN_Q16[i] + (MAX_Q16[i] - MIN_Q16[i]) * m as i64 / (n as i64 - 1)) as i32).collect())
-            .collect();
+        let axis: Vec<Vec<i32>> =
+            (0..5).map(|i| (0..n).map(|m| (MIN_Q16[i] + (MAX_Q16[i] - MIN_Q16[i]) * m as i64 / (n as i64 - 1)) as i32).collect()).collect();
         for &x in &axis[0] {
             for &z in &axis[1] {
                 for &tx in &axis[2] {

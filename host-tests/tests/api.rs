@@ -96,10 +96,7 @@ fn saturation_flags_and_clamped_values() {
     let inside = wrench(&Pose::new(-12.0, 12.0, -15.0, 15.0, 6.0));
     assert_eq!(inside.status, Status::OK, "the domain's edges are inside");
     let outside = wrench(&Pose::new(-40.0, 12.5, -15.01, 1e30, 9.0));
-    assert_eq!(
-        outside.status,
-        Status::SAT_X | Status::SAT_Z | Status::SAT_THETA_X | Status::SAT_THETA_Z | Status::SAT_DEPTH
-    );
+    assert_eq!(outside.status, Status::SAT_X | Status::SAT_Z | Status::SAT_THETA_X | Status::SAT_THETA_Z | Status::SAT_DEPTH);
     assert_eq!(outside.wrench.to_array().map(f32::to_bits), inside.wrench.to_array().map(f32::to_bits));
     let shallow = wrench(&Pose::new(0.0, 0.0, 0.0, 0.0, -1.0));
     assert_eq!(shallow.status, Status::SAT_DEPTH);
@@ -112,10 +109,7 @@ fn saturation_flags_and_clamped_values() {
 
 #[test]
 fn model_info_describes_the_domain() {
-    assert_eq!(
-        (model_info::X_MAX_MM, model_info::Z_MAX_MM, model_info::THETA_MAX_DEG, model_info::DEPTH_MAX_MM),
-        (12.0, 12.0, 15.0, 6.0)
-    );
+    assert_eq!((model_info::X_MAX_MM, model_info::Z_MAX_MM, model_info::THETA_MAX_DEG, model_info::DEPTH_MAX_MM), (12.0, 12.0, 15.0, 6.0));
     assert_eq!(model_info::FORMAT, 1);
     assert!(model_info::C_HEADER.contains("#define NEEDLE_STATUS_NO_MODEL 0x40u"));
     if model_info::FITTED {

@@ -13,7 +13,9 @@ fn header_writes_the_tables_and_the_api_header() {
     assert_eq!(coeffs, needle_haptics::model_info::C_HEADER);
     let api = std::fs::read_to_string(out_dir.join("needle.h")).expect("needle.h written");
     assert_eq!(api, needle_capi::HEADER);
-    for item in ["needle_wrench(", "needle_strerror(", "needle_status_name(", "#define NEEDLE_STATUS_SAT_X 1", "#define NEEDLE_LOOP_DISABLED 256"] {
+    for item in
+        ["needle_wrench(", "needle_strerror(", "needle_status_name(", "#define NEEDLE_STATUS_SAT_X 1", "#define NEEDLE_LOOP_DISABLED 256"]
+    {
         assert!(api.contains(item), "needle.h lacks {item}");
     }
 }

@@ -15,7 +15,22 @@ fn set() -> String {
 #[test]
 fn negative_and_infinite_pose_values_are_values() {
     let s = set();
-    let o = needle(&["eval", "--set", &s, "--x-mm", "-3", "--z-mm", "-1e0", "--theta-x-deg", "-2.5", "--theta-z-deg", "0", "--depth-mm", "-inf", "--json"]);
+    let o = needle(&[
+        "eval",
+        "--set",
+        &s,
+        "--x-mm",
+        "-3",
+        "--z-mm",
+        "-1e0",
+        "--theta-x-deg",
+        "-2.5",
+        "--theta-z-deg",
+        "0",
+        "--depth-mm",
+        "-inf",
+        "--json",
+    ]);
     let out = String::from_utf8_lossy(&o.stdout);
     assert_eq!(o.status.code(), Some(1), "an infinite depth is an error status, exit 1: {out}{}", String::from_utf8_lossy(&o.stderr));
     assert!(out.contains("\"x_mm\": -3.0") && out.contains("\"ERROR\""), "{out}");

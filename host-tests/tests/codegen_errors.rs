@@ -124,8 +124,7 @@ fn wrong_matrix_shapes_name_the_line() {
     let text = valid_model();
     // 4 rows: drop the last row of matrix 5's `rows`.
     let rows = matrix_line(&text, 5, "rows =");
-    let bad: String =
-        text.lines().enumerate().filter(|(i, _)| *i + 1 != rows + 5).map(|(_, l)| format!("{l}\n")).collect();
+    let bad: String = text.lines().enumerate().filter(|(i, _)| *i + 1 != rows + 5).map(|(_, l)| format!("{l}\n")).collect();
     expect_error(&bad, rows, &["matrix x/mz_nmm", "4 rows", "expected 5"]);
     // 6 columns: one more value in row 2 of matrix 7's `rows`.
     let line = matrix_line(&text, 7, "rows =") + 3;
@@ -164,9 +163,7 @@ fn wrong_component_or_sweep_order_names_the_line() {
     // Swap the components of matrices 2 and 3 (x/fz_n, x/mx_nmm).
     let l2 = matrix_line(&text, 2, "component =");
     let l3 = matrix_line(&text, 3, "component =");
-    let bad = edit_line(&edit_line(&text, l2, |_| "component = \"mx_nmm\"".into()), l3, |_| {
-        "component = \"fz_n\"".into()
-    });
+    let bad = edit_line(&edit_line(&text, l2, |_| "component = \"mx_nmm\"".into()), l3, |_| "component = \"fz_n\"".into());
     expect_error(&bad, l2, &["\"mx_nmm\"", "out of order", "expected \"fz_n\""]);
     // Baselines out of order.
     let l = line_starting(&text, "component =", 0);
@@ -191,9 +188,7 @@ fn hex_bits_that_are_not_the_nearest_f32_name_the_line() {
     let l = line_starting(&ints, "coeffs =", 0);
     let ints = edit_line(&ints, l, |_| "coeffs = [0, 1, 0.0, 0.125, -0.0625]".into());
     let l = line_starting(&ints, "coeffs_f32 =", 0);
-    let ints = edit_line(&ints, l, |_| {
-        format!("coeffs_f32 = {}", list32(&[0.0, 1.0, 0.0, 0.125, -0.0625]))
-    });
+    let ints = edit_line(&ints, l, |_| format!("coeffs_f32 = {}", list32(&[0.0, 1.0, 0.0, 0.125, -0.0625])));
     parse_model_str(&ints, Path::new("m.toml")).unwrap_or_else(|e| panic!("{e}"));
     // One ulp off in matrix 9's rows_f32[1][2].
     let line = matrix_line(&text, 9, "rows_f32 =") + 2;

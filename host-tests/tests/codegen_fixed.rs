@@ -17,10 +17,8 @@ fn model(base_fy: f64, a: f64) -> String {
         "format = 1\nset = \"fixed-test\"\nfe_sha256 = \"{}\"\ndepth_max_mm = 6.0\nx_max_mm = 12.0\nz_max_mm = 12.0\ntheta_max_deg = 15.0",
         "cd".repeat(32)
     );
-    let baseline = |c: usize| Part {
-        coeffs: if c == 1 { [base_fy, 0.5, 0.0, 0.0, 0.0] } else { [0.125, 0.0, 0.0, 0.0, 0.0] },
-        residual: (0.0, 0.0),
-    };
+    let baseline =
+        |c: usize| Part { coeffs: if c == 1 { [base_fy, 0.5, 0.0, 0.0, 0.0] } else { [0.125, 0.0, 0.0, 0.0, 0.0] }, residual: (0.0, 0.0) };
     let matrix = |k: usize, c: usize| {
         let row = |i: usize| if k == 1 && c == 1 && i == 2 { [a, a, 0.0, 0.0, 0.0] } else { [0.25, 0.25, 0.0, 0.0, 0.0] };
         Part { coeffs: [row(0), row(1), row(2), row(3), row(4)], residual: (0.0, 0.0) }

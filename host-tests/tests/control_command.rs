@@ -52,7 +52,10 @@ fn every_command_and_its_reply() {
     assert_eq!(r[4], "OK MODE SAT\n");
 
     let r = talk(&mut c, b"LIMIT 2500\r\nMODE RAMP\nSTATUS\n");
-    assert_eq!(r, ["OK LIMIT limit_mn=2500\n", "OK MODE RAMP\n", "OK STATUS tick=2 flags=0x0021 model=0x00 limit_mn=2500 mode=RAMP dropped=7\n"]);
+    assert_eq!(
+        r,
+        ["OK LIMIT limit_mn=2500\n", "OK MODE RAMP\n", "OK STATUS tick=2 flags=0x0021 model=0x00 limit_mn=2500 mode=RAMP dropped=7\n"]
+    );
     assert_eq!(c.config().force_limit_n, 2.5);
     assert_eq!(c.config().over_limit, OverLimit::RampToZero);
     let r = talk(&mut c, b"LIMIT 4000\nLIMIT 1\nMODE SAT\n");
@@ -129,8 +132,8 @@ fn random_bytes_never_panic_and_only_ok_replies_change_the_loop() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(6);
     // Pieces of valid and invalid frames, so that both kinds occur.
     let pieces: [&[u8]; 16] = [
-        b"PING", b"STATUS", b"MODEL", b"LIMIT", b"MODE", b"SAT", b"RAMP", b"2500", b"0", b"99999", b" ", b"\n", b"\n",
-        b"\r", b"\x00", b"\xff",
+        b"PING", b"STATUS", b"MODEL", b"LIMIT", b"MODE", b"SAT", b"RAMP", b"2500", b"0", b"99999", b" ", b"\n", b"\n", b"\r", b"\x00",
+        b"\xff",
     ];
     let mut c = core();
     let mut reader = FrameReader::new();

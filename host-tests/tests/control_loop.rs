@@ -10,9 +10,7 @@ use common::{channel_c, duty_of, golden_in_domain, GoldenRow, Script};
 use embedded_hal_mock::eh1::digital::{Mock as PinMock, State, Transaction as PinT};
 use embedded_hal_mock::eh1::pwm::{Mock as PwmMock, Transaction as PwmT};
 use embedded_hal_mock::eh1::MockError;
-use needle_haptics::control::{
-    Channel, ChannelMap, ConfigError, ControlLoop, LoopConfig, LoopFlags, OverLimit, PoseFault, Sample,
-};
+use needle_haptics::control::{Channel, ChannelMap, ConfigError, ControlLoop, LoopConfig, LoopFlags, OverLimit, PoseFault, Sample};
 use needle_haptics::{Pose, Status};
 
 const GAINS: [[f32; 3]; 3] = [[20.0, 0.0, 0.0], [0.0, -10.0, 0.0], [0.0, 0.0, 20.0]];
@@ -102,12 +100,7 @@ fn golden_poses_give_the_documented_duties_and_pins() {
         expects.push(e);
         clipped_flags.push(clipped);
     }
-    let samples = run(
-        config(10.0, OverLimit::Saturate, 0.01),
-        Script::new(rows.iter().map(|r| Ok(r.pose))),
-        &expects,
-        &[],
-    );
+    let samples = run(config(10.0, OverLimit::Saturate, 0.01), Script::new(rows.iter().map(|r| Ok(r.pose))), &expects, &[]);
     let mut nonzero = 0;
     for (k, ((r, s), clipped)) in rows.iter().zip(&samples).zip(&clipped_flags).enumerate() {
         assert_eq!(s.tick, k as u32 + 1);
@@ -127,11 +120,7 @@ fn golden_poses_give_the_documented_duties_and_pins() {
 #[test]
 fn force_above_the_limit_saturates_at_the_limit() {
     let rows = golden_in_domain(40);
-    let r = rows
-        .iter()
-        .max_by(|a, b| a.wrench.fy_n.abs().total_cmp(&b.wrench.fy_n.abs()))
-        .copied()
-        .expect("rows");
+    let r = rows.iter().max_by(|a, b| a.wrench.fy_n.abs().total_cmp(&b.wrench.fy_n.abs())).copied().expect("rows");
     let f = forces(&r);
     let norm2 = f[0] * f[0] + f[1] * f[1] + f[2] * f[2];
     let limit = norm2.sqrt() * 0.5;
@@ -169,7 +158,15 @@ fn full_scale_command_is_clipped_and_flagged() {
 
 /// The ramp the docs promise: each component towards zero by at most `step` a tick.
 fn ramp(f: [f32; 3], step: f32) -> [f32; 3] {
-    f.map(|c| if c > step { c - step } else if c < -step { c + step } else { 0.0 })
+    f.map(|c| {
+        if c > step {
+            c - step
+        } else if c < -step {
+            c + step
+        } else {
+            0.0
+        }
+    })
 }
 
 /// A good tick on golden row `r`, then `fault` until the ramp reaches zero (enable low,
@@ -196,7 +193,7 @@ fn ramp_case(fault: Result<Pose, PoseFault>, flag: LoopFlags, cfg: LoopConfig<3>
         expects.push(expect_for(*c, enable).0);
     }
     let mut script = vec![Ok(r.pose)];
-    script.extend(std::iter::repeat(fault).take(fault_ticks));
+    script.extend(std::iter::repeat_n(fault, fault_ticks));
     script.push(Ok(r.pose));
     let samples = run(cfg, Script::new(script), &expects, &[]);
     assert!(samples[0].flags.is_ok(), "{:?}", samples[0].flags);
@@ -206,7 +203,12 @@ fn ramp_case(fault: Result<Pose, PoseFault>, flag: LoopFlags, cfg: LoopConfig<3>
         if cmds[k] == [0.0; 3] {
             want |= LoopFlags::DISABLED;
         }
-        assert!(s.flags.contains(want) && s.flags.bits() & !(want | LoopFlags::OVER_LIMIT).bits() == 0, "tick {}: {:?}, want {want:?}", s.tick, s.flags);
+        assert!(
+            s.flags.contains(want) && s.flags.bits() & !(want | LoopFlags::OVER_LIMIT).bits() == 0,
+            "tick {}: {:?}, want {want:?}",
+            s.tick,
+            s.flags
+        );
         if let Some(m) = model {
             assert_eq!(s.model, m);
         }
@@ -259,12 +261,7 @@ fn first_tick_without_a_pose_disables_at_once() {
 fn failed_pwm_write_is_flagged_and_the_other_outputs_still_written() {
     let rows = golden_in_domain(10);
     let expects: Vec<Expect> = rows.iter().take(2).map(|r| expect_for(forces(r), true).0).collect();
-    let samples = run(
-        config(10.0, OverLimit::Saturate, 0.01),
-        Script::new(rows.iter().take(2).map(|r| Ok(r.pose))),
-        &expects,
-        &[(0, 1)],
-    );
+    let samples = run(config(10.0, OverLimit::Saturate, 0.01), Script::new(rows.iter().take(2).map(|r| Ok(r.pose))), &expects, &[(0, 1)]);
     assert!(samples[0].flags.contains(LoopFlags::OUTPUT_ERROR));
     assert!(!samples[1].flags.contains(LoopFlags::OUTPUT_ERROR), "the flag is per tick");
 }

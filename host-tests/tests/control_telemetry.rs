@@ -4,7 +4,7 @@
 mod common;
 
 use common::{golden_in_domain, Script};
-use needle_haptics::control::{LoopConfig, LoopCore, LoopFlags, OverLimit, PoseFault, Sample, ChannelMap};
+use needle_haptics::control::{ChannelMap, LoopConfig, LoopCore, LoopFlags, OverLimit, PoseFault, Sample};
 use needle_haptics::telemetry::Telemetry;
 
 fn sample(tick: u32) -> Sample {

@@ -69,5 +69,9 @@ fn bad_rows_are_named_by_line_and_nothing_is_written() {
     assert!(!out.exists(), "nothing written");
     std::fs::write(&file, "x_mm,z_mm,theta_x_deg,depth_mm\n1,2,3,4\n").expect("write");
     let o = needle(&["eval", "--set", &set.to_string_lossy(), "--poses", &file.to_string_lossy()]);
-    assert!(String::from_utf8_lossy(&o.stderr).contains(&format!("{name}:1: no column \"theta_z_deg\"")), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains(&format!("{name}:1: no column \"theta_z_deg\"")),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
 }

@@ -108,11 +108,7 @@ fn missing_set_names_the_sets_present() {
 
 /// Line number (1-based) and text of the first node line of the file.
 fn first_node_line(text: &str) -> (usize, String) {
-    text.lines()
-        .enumerate()
-        .find(|(_, l)| l.trim_start().starts_with("1000"))
-        .map(|(i, l)| (i + 1, l.to_string()))
-        .expect("a node line")
+    text.lines().enumerate().find(|(_, l)| l.trim_start().starts_with("1000")).map(|(i, l)| (i + 1, l.to_string())).expect("a node line")
 }
 
 fn replace_line(text: &str, n: usize, new: &str) -> String {

@@ -8,8 +8,8 @@
 use needle_host::fe::febio;
 use needle_host::fe::manifest::{read_manifest, MANIFEST};
 use needle_host::fe::results;
-use needle_host::fe::verify::{self, VerifyOptions};
 use needle_host::fe::spec::Engine;
+use needle_host::fe::verify::{self, VerifyOptions};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
@@ -43,12 +43,7 @@ fn needle(args: &[&str], set: &Path, env: &[(&str, &str)]) -> Output {
 }
 
 fn show(o: &Output) -> String {
-    format!(
-        "status {:?}\n--- stdout\n{}\n--- stderr\n{}",
-        o.status,
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
+    format!("status {:?}\n--- stdout\n{}\n--- stderr\n{}", o.status, String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
 }
 
 /// Smoke campaign: three poses (quarter and two half models) on the smoke mesh, 10 load
@@ -59,7 +54,11 @@ fn show(o: &Output) -> String {
 fn smoke_campaign_on_febio() {
     let (_, version) = require_febio();
     let (_d, set) = default_set();
-    let o = needle(&["--solver", "febio", "--mesh", "smoke", "--steps", "10", "--only", "centre,z+02,tx+04", "--jobs", "2", "--threads", "1"], &set, &[]);
+    let o = needle(
+        &["--solver", "febio", "--mesh", "smoke", "--steps", "10", "--only", "centre,z+02,tx+04", "--jobs", "2", "--threads", "1"],
+        &set,
+        &[],
+    );
     assert!(o.status.success(), "{}", show(&o));
     let m = read_manifest(&set.join("fe").join(MANIFEST)).expect("manifest");
     assert_eq!(m.pose.keys().cloned().collect::<Vec<_>>(), ["centre", "tx+04", "z+02"]);
@@ -86,7 +85,8 @@ fn smoke_campaign_on_febio() {
 #[test]
 fn a_bad_febio_path_is_a_clear_error() {
     let (_d, set) = default_set();
-    let o = needle(&["--solver", "febio", "--mesh", "smoke", "--steps", "2", "--only", "centre"], &set, &[("FEBIO", "/nonexistent/febio4")]);
+    let o =
+        needle(&["--solver", "febio", "--mesh", "smoke", "--steps", "2", "--only", "centre"], &set, &[("FEBIO", "/nonexistent/febio4")]);
     assert_eq!(o.status.code(), Some(2), "{}", show(&o));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("FEBIO=/nonexistent/febio4: not an executable"), "{err}");
@@ -115,7 +115,11 @@ fn a_failing_run_keeps_its_log_and_the_campaign_goes_on() {
     use std::os::unix::fs::PermissionsExt;
     std::fs::set_permissions(&wrapper, std::fs::Permissions::from_mode(0o755)).expect("chmod");
     let w = wrapper.to_string_lossy().into_owned();
-    let o = needle(&["--solver", "febio", "--mesh", "smoke", "--steps", "10", "--only", "centre,z+02", "--threads", "1"], &set, &[("FEBIO", &w)]);
+    let o = needle(
+        &["--solver", "febio", "--mesh", "smoke", "--steps", "10", "--only", "centre,z+02", "--threads", "1"],
+        &set,
+        &[("FEBIO", &w)],
+    );
     assert_eq!(o.status.code(), Some(1), "{}", show(&o));
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(out.contains("FAILED z+02") && out.contains("Fake divergence for the test."), "{}", show(&o));
@@ -137,12 +141,22 @@ fn a_failing_run_keeps_its_log_and_the_campaign_goes_on() {
         l.trim().trim_start_matches(&format!("<{tag}>")).trim_end_matches(&format!("</{tag}>")).parse::<f64>().ok()
     };
     let (p1, p5) = (value(&feb(1), "penalty"), value(&feb(5), "penalty"));
-    assert!(matches!((p1, p5), (Some(a), Some(b)) if (b / a - 0.1).abs() < 1e-12), "the last attempt's contact is 10x softer: {p1:?} -> {p5:?}");
+    assert!(
+        matches!((p1, p5), (Some(a), Some(b)) if (b / a - 0.1).abs() < 1e-12),
+        "the last attempt's contact is 10x softer: {p1:?} -> {p5:?}"
+    );
     let seg_up: Vec<Option<f64>> = (1..=5).map(|n| value(&feb(n), "seg_up")).collect();
-    assert_eq!(seg_up, [Some(5.0), Some(0.0), Some(5.0), Some(0.0), Some(5.0)], "seg_up of campaign.toml, then retry_seg_up on attempts 2 and 4");
+    assert_eq!(
+        seg_up,
+        [Some(5.0), Some(0.0), Some(5.0), Some(0.0), Some(5.0)],
+        "seg_up of campaign.toml, then retry_seg_up on attempts 2 and 4"
+    );
     let steps: Vec<Option<f64>> = (1..=5).map(|n| value(&feb(n), "time_steps")).collect();
     let s1 = steps[0].unwrap_or(0.0);
-    assert!(s1 > 0.0 && steps == [Some(s1), Some(s1), Some(4.0 * s1), Some(4.0 * s1), Some(4.0 * s1)], "quarter first increments from attempt 3 on: {steps:?}");
+    assert!(
+        s1 > 0.0 && steps == [Some(s1), Some(s1), Some(4.0 * s1), Some(4.0 * s1), Some(4.0 * s1)],
+        "quarter first increments from attempt 3 on: {steps:?}"
+    );
 }
 
 /// Tolerance of the coarse FEBio punch, %. `punch_mesh_scale = 2` (8 hex8 elements across

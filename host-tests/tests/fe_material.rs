@@ -9,13 +9,7 @@ fn repo() -> PathBuf {
 }
 
 fn tissue(mu: &[f64], alpha: &[f64]) -> Tissue {
-    Tissue {
-        mu_n_per_mm2: mu.to_vec(),
-        alpha: alpha.to_vec(),
-        bulk_to_shear: 100.0,
-        stretch_min: 0.4,
-        stretch_max: 2.5,
-    }
+    Tissue { mu_n_per_mm2: mu.to_vec(), alpha: alpha.to_vec(), bulk_to_shear: 100.0, stretch_min: 0.4, stretch_max: 2.5 }
 }
 
 /// Spacing of the log-spaced stretch grid of the check, as a ratio.
@@ -26,11 +20,7 @@ fn grid_ratio(t: &Tissue) -> f64 {
 /// Uniaxial nominal stress T(l) = sum 2 mu_i / alpha_i (l^(a-1) - l^(-a/2-1)), written
 /// out independently of the module.
 fn uniaxial_nominal(t: &Tissue, l: f64) -> f64 {
-    t.mu_n_per_mm2
-        .iter()
-        .zip(&t.alpha)
-        .map(|(&mu, &a)| 2.0 * mu / a * (l.powf(a - 1.0) - l.powf(-a / 2.0 - 1.0)))
-        .sum()
+    t.mu_n_per_mm2.iter().zip(&t.alpha).map(|(&mu, &a)| 2.0 * mu / a * (l.powf(a - 1.0) - l.powf(-a / 2.0 - 1.0))).sum()
 }
 
 /// d(sigma)/d(ln l) with sigma = l T(l), by central differences.

@@ -47,19 +47,12 @@ fn needle(args: &[&std::ffi::OsStr], env: &[(&str, &str)]) -> Output {
 }
 
 fn show(o: &Output) -> String {
-    format!(
-        "status {:?}\n--- stdout\n{}\n--- stderr\n{}",
-        o.status,
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
+    format!("status {:?}\n--- stdout\n{}\n--- stderr\n{}", o.status, String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
 }
 
 fn files_in(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .expect("read_dir")
-        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
-        .collect();
+    let mut v: Vec<String> =
+        std::fs::read_dir(dir).expect("read_dir").map(|e| e.expect("entry").file_name().to_string_lossy().into_owned()).collect();
     v.sort();
     v
 }
@@ -78,10 +71,7 @@ fn check_csv(fe: &Path, pose: &str, steps: usize) {
     let last = fy[steps];
     // The centred needle at 6 mm gives about 0.1 N on the smoke and committed meshes; a
     // value near zero means ccx found no needle-tissue contact.
-    assert!(
-        last.abs() > 1e-3,
-        "{pose}: Fy at 6 mm = {last:e} N: no needle-tissue contact on the smoke mesh (Fy at all depths: {fy:?})"
-    );
+    assert!(last.abs() > 1e-3, "{pose}: Fy at 6 mm = {last:e} N: no needle-tissue contact on the smoke mesh (Fy at all depths: {fy:?})");
     assert!(last.abs() > fy[steps - 1].abs(), "{pose}: |Fy| grows with depth: {fy:?}");
 }
 

@@ -14,9 +14,10 @@ const POSES: &str = "centre,x+04,z+04";
 
 /// Fail unless sbatch is installed and the controller answers.
 fn require_cluster() {
-    let out = Command::new("sinfo").args(["-h", "-o", "%t"]).output().unwrap_or_else(|e| {
-        panic!("sinfo: {e}: these tests need a running SLURM cluster: start one with .ci/slurm-cluster start")
-    });
+    let out = Command::new("sinfo")
+        .args(["-h", "-o", "%t"])
+        .output()
+        .unwrap_or_else(|e| panic!("sinfo: {e}: these tests need a running SLURM cluster: start one with .ci/slurm-cluster start"));
     let states = String::from_utf8_lossy(&out.stdout);
     assert!(
         out.status.success() && states.lines().any(|s| matches!(s.trim(), "idle" | "mix" | "alloc")),
@@ -93,12 +94,7 @@ fn status(set: &str, steps: &str) -> String {
 
 /// The state column of `pose` in `needle fe status`.
 fn state_of(table: &str, pose: &str) -> String {
-    table
-        .lines()
-        .find(|l| l.split_whitespace().next() == Some(pose))
-        .and_then(|l| l.split_whitespace().nth(1))
-        .unwrap_or("")
-        .to_string()
+    table.lines().find(|l| l.split_whitespace().next() == Some(pose)).and_then(|l| l.split_whitespace().nth(1)).unwrap_or("").to_string()
 }
 
 /// Every file under `dir` with its bytes, sorted by path.
@@ -158,7 +154,11 @@ fn a_campaign_through_sbatch_equals_a_local_run() {
     // the whole campaign is up to date: nothing to submit
     let (again, out) = submit(s, "2");
     assert!(again.is_empty(), "{}", show(&out));
-    assert!(String::from_utf8_lossy(&out.stdout).contains("3 up to date") && String::from_utf8_lossy(&out.stdout).contains("nothing to submit"), "{}", show(&out));
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("3 up to date") && String::from_utf8_lossy(&out.stdout).contains("nothing to submit"),
+        "{}",
+        show(&out)
+    );
 }
 
 #[test]

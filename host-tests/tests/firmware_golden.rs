@@ -37,14 +37,7 @@ fn golden_on(name: &str) {
         f.mismatches.iter().take(10).cloned().collect::<Vec<_>>().join("\n")
     );
     println!("{} ({}): {} fixed-point golden rows exactly", core.core, core.machine, f.rows);
-    println!(
-        "{} ({}): {} golden rows bit for bit in {:.1} s ({})",
-        core.core,
-        core.machine,
-        c.rows,
-        run.run_time.as_secs_f64(),
-        c.banner
-    );
+    println!("{} ({}): {} golden rows bit for bit in {:.1} s ({})", core.core, core.machine, c.rows, run.run_time.as_secs_f64(), c.banner);
 }
 
 #[test]
@@ -72,7 +65,8 @@ fn comparison_catches_one_bit_and_allows_nan_payloads() {
          0x00000000,0x00000000,0x00000000,0x00000000,0x40000000,0x00,0x3f800000,0x80000000,0x7fc00000,0x00000000,0x00000000,0x00000000\n"
     );
     let out = |row: &str| format!("needle-golden target=t set=s fe_sha256=ab rows=1\n{h}\n{row}\nneedle-golden end rows=1\n");
-    let ok = "0x00000000,0x00000000,0x00000000,0x00000000,0x40000000,0x00,0x3f800000,0x80000000,0x7fc00001,0x00000000,0x00000000,0x00000000";
+    let ok =
+        "0x00000000,0x00000000,0x00000000,0x00000000,0x40000000,0x00,0x3f800000,0x80000000,0x7fc00001,0x00000000,0x00000000,0x00000000";
     let c = golden::compare(&out(ok), &csv, "ab").expect("well-formed");
     assert!(c.mismatches.is_empty(), "{:?}", c.mismatches);
     for bad in [

@@ -56,11 +56,8 @@ fn insertion_trace_at_1_khz_follows_the_model() {
     let (mut rows, mut max_depth, mut stale, mut saturated) = (0, 0.0f32, 0, 0);
     let mut last_depth_end = f32::NAN;
     for l in out.lines().filter(|l| l.starts_with("needle-insertion t_ms=")) {
-        let bits: Vec<u32> = field(l, "bits")
-            .expect("bits")
-            .split(',')
-            .map(|b| u32::from_str_radix(b.trim_start_matches("0x"), 16).expect("hex"))
-            .collect();
+        let bits: Vec<u32> =
+            field(l, "bits").expect("bits").split(',').map(|b| u32::from_str_radix(b.trim_start_matches("0x"), 16).expect("hex")).collect();
         assert_eq!(bits.len(), 6, "{l}");
         let flags = u16::from_str_radix(field(l, "flags").expect("flags").trim_start_matches("0x"), 16).expect("flags");
         let pose = needle_haptics::Pose::new(

@@ -33,15 +33,7 @@ fn no_panic_firmware_links_and_runs_on_every_core() {
             .unwrap_or_else(|e| panic!("no_panic, no_panic_fixed for {} ({}): {e:#}", core.core, core.target));
         for elf in &elfs {
             let run = qemu::run(core, elf, false, Duration::from_secs(60)).unwrap_or_else(|e| panic!("{e:#}"));
-            assert!(
-                run.status.success(),
-                "{} on {} exited with {}: {}{}",
-                elf.display(),
-                core.core,
-                run.status,
-                run.stdout,
-                run.stderr
-            );
+            assert!(run.status.success(), "{} on {} exited with {}: {}{}", elf.display(), core.core, run.status, run.stdout, run.stderr);
         }
         println!("{} ({}): no_panic and no_panic_fixed link and run", core.core, core.target);
     }
@@ -64,8 +56,7 @@ fn fixed_point_evaluator_has_no_floating_point_on_any_core() {
         );
         // Nothing in the whole fixed-point image is floating point.
         let report = size::measure(core, &elfs[1], "fixed").unwrap_or_else(|e| panic!("{e:#}"));
-        let helpers: Vec<&str> =
-            report.runtime.iter().map(|s| s.name.as_str()).filter(|n| float_check::is_float_helper(n)).collect();
+        let helpers: Vec<&str> = report.runtime.iter().map(|s| s.name.as_str()).filter(|n| float_check::is_float_helper(n)).collect();
         assert!(helpers.is_empty(), "{}: the fixed-point firmware links float helpers {helpers:?}", core.core);
         // The same check on the f32 evaluator does see floating point (soft float on the
         // M0 and M3, FPU instructions on the M4F): it can fail.

@@ -389,5 +389,8 @@ fn a_hand_edited_fe_csv_is_refused_by_fit_and_validate() {
     assert!(msg.contains("x+02.csv: content changed since the FE run wrote it"), "{msg}");
     let e = needle_host::fit::validate::validate(dir.path()).expect_err("validate must refuse the edited t2-a");
     let msg = format!("{e:#}");
-    assert!(msg.contains("t2-a.csv: content changed since the FE run wrote it") && msg.contains("needle fe run --force --only t2-a"), "{msg}");
+    assert!(
+        msg.contains("t2-a.csv: content changed since the FE run wrote it") && msg.contains("needle fe run --force --only t2-a"),
+        "{msg}"
+    );
 }

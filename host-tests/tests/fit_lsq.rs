@@ -1,8 +1,8 @@
 //! The least-squares core of the fitter: exact recovery of polynomials, clear errors on
 //! degenerate input.
 
-use needle_host::fit::lsq::{lstsq, polyfit, vandermonde};
 use nalgebra::{DMatrix, DVector};
+use needle_host::fit::lsq::{lstsq, polyfit, vandermonde};
 
 fn eval(p: &[f64], w: f64) -> f64 {
     p.iter().rev().fold(0.0, |acc, c| acc * w + c)

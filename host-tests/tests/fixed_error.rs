@@ -12,7 +12,9 @@ use std::sync::OnceLock;
 fn set() -> &'static (needle_host::fit::model::Model, f64) {
     static S: OnceLock<(needle_host::fit::model::Model, f64)> = OnceLock::new();
     S.get_or_init(|| {
-        assert!(model_info::FITTED, "no fitted model compiled in: run `needle fit`");
+        if !model_info::FITTED {
+            panic!("no fitted model compiled in: run `needle fit`");
+        }
         fixed_error::load(Path::new(model_info::SET_DIR)).unwrap_or_else(|e| panic!("{e:#}"))
     })
 }

@@ -18,7 +18,9 @@ use std::sync::OnceLock;
 fn fitter_tables() -> &'static TablesFixed {
     static T: OnceLock<TablesFixed> = OnceLock::new();
     T.get_or_init(|| {
-        assert!(model_info::FITTED, "no fitted model compiled in: run `needle fit`");
+        if !model_info::FITTED {
+            panic!("no fitted model compiled in: run `needle fit`");
+        }
         let model = model_file::read(&Path::new(model_info::SET_DIR).join("model.toml")).unwrap_or_else(|e| panic!("{e:#}"));
         TablesFixed::from_model(&model).unwrap_or_else(|e| panic!("{e:#}"))
     })

@@ -7,20 +7,16 @@
 use needle_haptics::{model_info, wrench, Pose};
 use std::path::Path;
 
-const HEADER: &str =
-    "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,status,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm";
+const HEADER: &str = "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,status,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm";
 const COMPONENTS: [&str; 6] = ["fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"];
 
 /// `0x` and 8 lower-case hex digits.
 fn f32_bits(field: &str, line: usize) -> u32 {
-    needle_codegen::parse_bits(field)
-        .unwrap_or_else(|| panic!("golden-f32.csv:{line}: {field:?} is not 0x and 8 lower-case hex digits"))
+    needle_codegen::parse_bits(field).unwrap_or_else(|| panic!("golden-f32.csv:{line}: {field:?} is not 0x and 8 lower-case hex digits"))
 }
 
 fn status_bits(field: &str, line: usize) -> u8 {
-    let ok = field.len() == 4
-        && field.starts_with("0x")
-        && field[2..].chars().all(|c| c.is_ascii_digit() || ('a'..='f').contains(&c));
+    let ok = field.len() == 4 && field.starts_with("0x") && field[2..].chars().all(|c| c.is_ascii_digit() || ('a'..='f').contains(&c));
     assert!(ok, "golden-f32.csv:{line}: status {field:?} is not 0x and 2 lower-case hex digits");
     u8::from_str_radix(&field[2..], 16).unwrap()
 }
@@ -80,11 +76,7 @@ fn library_matches_golden_vectors_bit_for_bit() {
         }
         for ((name, w), g) in COMPONENTS.iter().zip(&want).zip(got.wrench.to_array()) {
             if !same(*w, g) {
-                diffs.push(format!(
-                    "{name} want {w:#010x} ({:?}) got {:#010x} ({g:?})",
-                    f32::from_bits(*w),
-                    g.to_bits()
-                ));
+                diffs.push(format!("{name} want {w:#010x} ({:?}) got {:#010x} ({g:?})", f32::from_bits(*w), g.to_bits()));
             }
         }
         if !diffs.is_empty() {

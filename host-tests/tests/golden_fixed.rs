@@ -8,11 +8,9 @@ use std::path::Path;
 
 #[test]
 fn library_matches_fixed_golden_vectors_exactly() {
-    assert!(
-        model_info::FITTED,
-        "the library was built without a fitted model: run `needle fit --set {}`",
-        model_info::SET_DIR
-    );
+    if !model_info::FITTED {
+        panic!("the library was built without a fitted model: run `needle fit --set {}`", model_info::SET_DIR);
+    }
     let path = Path::new(model_info::SET_DIR).join("golden-fixed.csv");
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| {
         panic!("{}: cannot read ({e}); `needle fit --set {}` writes it; this test never skips", path.display(), model_info::SET_DIR)

@@ -43,12 +43,7 @@ where
     ///
     /// # Errors
     /// The configuration is invalid ([`LoopConfig::validate`]).
-    pub fn new(
-        config: LoopConfig<N>,
-        source: P,
-        channels: [Channel<PWM, DIR>; N],
-        enable: EN,
-    ) -> Result<Self, ConfigError> {
+    pub fn new(config: LoopConfig<N>, source: P, channels: [Channel<PWM, DIR>; N], enable: EN) -> Result<Self, ConfigError> {
         let core = LoopCore::new(config)?;
         let max_duty = channels.each_ref().map(|c| c.pwm.max_duty_cycle());
         Ok(Self { core, source, channels, max_duty, enable })

@@ -2,8 +2,7 @@
 use super::arith::{clamp, horner, normalise};
 use super::cross::{add_cross, cross_input, CROSS_DIVISORS};
 use super::tables::{
-    BASELINE, DEPTH_DIVISOR, DEPTH_MAX_MM_Q16, FRAC_BITS, ODD, ROWS, SHIFTS, SWEEP_DIVISORS, THETA_MAX_DEG_Q16,
-    X_MAX_MM_Q16, Z_MAX_MM_Q16,
+    BASELINE, DEPTH_DIVISOR, DEPTH_MAX_MM_Q16, FRAC_BITS, ODD, ROWS, SHIFTS, SWEEP_DIVISORS, THETA_MAX_DEG_Q16, X_MAX_MM_Q16, Z_MAX_MM_Q16,
 };
 use super::{Evaluation, Pose, Wrench};
 use crate::tables::FITTED;
@@ -53,13 +52,8 @@ pub fn wrench(pose: &Pose) -> Evaluation {
     let (tx, sat_tx) = clamp(pose.theta_x_deg_q16, -THETA_MAX_DEG_Q16, THETA_MAX_DEG_Q16);
     let (tz, sat_tz) = clamp(pose.theta_z_deg_q16, -THETA_MAX_DEG_Q16, THETA_MAX_DEG_Q16);
     let (d, sat_d) = clamp(pose.depth_mm_q16, 0, DEPTH_MAX_MM_Q16);
-    let status = Status::from_bits(
-        u8::from(sat_x)
-            | u8::from(sat_z) << 1
-            | u8::from(sat_tx) << 2
-            | u8::from(sat_tz) << 3
-            | u8::from(sat_d) << 4,
-    );
+    let status =
+        Status::from_bits(u8::from(sat_x) | u8::from(sat_z) << 1 | u8::from(sat_tx) << 2 | u8::from(sat_tz) << 3 | u8::from(sat_d) << 4);
 
     let u = normalise(d.unsigned_abs(), DEPTH_DIVISOR);
     let [dx, dz, dtx, dtz] = SWEEP_DIVISORS;
@@ -74,9 +68,7 @@ pub fn wrench(pose: &Pose) -> Evaluation {
     let mut a = BASELINE;
     let tables = ROWS.iter().zip(SHIFTS.iter()).zip(ODD.iter());
     for (ac, ((rows, shifts), odd)) in a.iter_mut().zip(tables) {
-        for ((((rows_k, shifts_k), &tk), &neg), &o) in
-            rows.iter().zip(shifts.iter()).zip(t.iter()).zip(negative.iter()).zip(odd.iter())
-        {
+        for ((((rows_k, shifts_k), &tk), &neg), &o) in rows.iter().zip(shifts.iter()).zip(t.iter()).zip(negative.iter()).zip(odd.iter()) {
             let flip = neg && o;
             for ((ai, row), &s) in ac.iter_mut().zip(rows_k.iter()).zip(shifts_k.iter()) {
                 let r = horner(row, tk).wrapping_shr(s);

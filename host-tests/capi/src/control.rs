@@ -94,8 +94,7 @@ pub unsafe extern "C" fn needle_loop_tick(
         Err(e) => return e,
     };
     // SAFETY: the caller's contract: NULL or NEEDLE_CHANNELS readable values.
-    let (Some(max_duty), Some(out)) = (unsafe { max_duty.cast::<[u16; NEEDLE_CHANNELS]>().as_ref() }, unsafe { out.as_mut() })
-    else {
+    let (Some(max_duty), Some(out)) = (unsafe { max_duty.cast::<[u16; NEEDLE_CHANNELS]>().as_ref() }, unsafe { out.as_mut() }) else {
         return NEEDLE_E_NULL;
     };
     let reading = match pose_state {

@@ -140,7 +140,20 @@ fn arm_c_program_links_and_runs_on_cortex_m4f() {
     let out = run(
         // coreutils' timeout: a faulting firmware spins in a handler instead of exiting.
         Command::new("timeout")
-            .args(["300", "qemu-system-arm", "-cpu", "cortex-m4", "-machine", "mps2-an386", "-display", "none", "-monitor", "none", "-serial", "null"])
+            .args([
+                "300",
+                "qemu-system-arm",
+                "-cpu",
+                "cortex-m4",
+                "-machine",
+                "mps2-an386",
+                "-display",
+                "none",
+                "-monitor",
+                "none",
+                "-serial",
+                "null",
+            ])
             .args(["-semihosting-config", &semihosting, "-kernel"])
             .arg(&elf),
         "capi_golden on QEMU mps2-an386",

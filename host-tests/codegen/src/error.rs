@@ -24,11 +24,7 @@ impl CodegenError {
 
     /// An error at byte `offset` of `text`, the contents of `path`.
     pub fn at(path: &Path, text: &str, offset: usize, message: impl Into<String>) -> Self {
-        Self {
-            path: path.to_path_buf(),
-            line: Some(line_of(text, offset)),
-            message: one_line(&message.into()),
-        }
+        Self { path: path.to_path_buf(), line: Some(line_of(text, offset)), message: one_line(&message.into()) }
     }
 }
 

@@ -107,11 +107,7 @@ fn choose_row(c: &[f64; 5]) -> Option<FixedRow> {
     (0..=MAX_FRAC_BITS).rev().find_map(|f| {
         let q = c.map(|v| quantize(v, f));
         let bound = q.iter().map(|v| i128::from(*v).abs()).sum::<i128>();
-        (bound <= i128::from(LIMIT)).then(|| FixedRow {
-            coeffs: q.map(|v| v as i32),
-            frac_bits: f,
-            bound: bound as i64,
-        })
+        (bound <= i128::from(LIMIT)).then(|| FixedRow { coeffs: q.map(|v| v as i32), frac_bits: f, bound: bound as i64 })
     })
 }
 
@@ -155,11 +151,7 @@ fn component_bounds(rows: &[[FixedRow; 5]; 4], cross: &[FixedCross], base: &[f64
 /// no fractional bits (coefficients of the order of 1,000 N or N·mm); the error names
 /// the matrix (or baseline), its line in `model_path` and the bound that is exceeded.
 pub fn fixed_tables(model: &Model, model_path: &Path) -> Result<FixedTables, CodegenError> {
-    let at = |line: usize, message: String| CodegenError {
-        path: model_path.to_path_buf(),
-        line: (line > 0).then_some(line),
-        message,
-    };
+    let at = |line: usize, message: String| CodegenError { path: model_path.to_path_buf(), line: (line > 0).then_some(line), message };
     let zero_row = FixedRow { coeffs: [0; 5], frac_bits: 0, bound: 0 };
     let mut components = Vec::with_capacity(6);
     for (c, base) in model.baseline.iter().enumerate() {
@@ -197,13 +189,7 @@ pub fn fixed_tables(model: &Model, model_path: &Path) -> Result<FixedTables, Cod
             })?;
             cross.push(FixedCross { exponents: t.exponents, coeffs, frac_bits, shift: 0, line: t.line });
         }
-        let max_g = rows
-            .iter()
-            .flatten()
-            .map(|r| r.frac_bits)
-            .chain(cross.iter().map(|x| x.frac_bits))
-            .min()
-            .unwrap_or(MAX_FRAC_BITS);
+        let max_g = rows.iter().flatten().map(|r| r.frac_bits).chain(cross.iter().map(|x| x.frac_bits)).min().unwrap_or(MAX_FRAC_BITS);
         let chosen = (0..=max_g).rev().find_map(|g| {
             let (a, total, baseline) = component_bounds(&rows, &cross, &base.coeffs, g);
             (total <= LIMIT).then_some((g, a, total, baseline))
@@ -236,7 +222,6 @@ pub fn fixed_tables(model: &Model, model_path: &Path) -> Result<FixedTables, Cod
         comp.error_bound = error_bound(model, c, &comp);
         components.push(comp);
     }
-    let components: [FixedComponent; 6] =
-        components.try_into().map_err(|_| at(0, "the model does not have 6 components".into()))?;
+    let components: [FixedComponent; 6] = components.try_into().map_err(|_| at(0, "the model does not have 6 components".into()))?;
     Ok(FixedTables { components })
 }

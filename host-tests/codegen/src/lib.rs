@@ -30,8 +30,8 @@ mod render_cross;
 mod render_fixed;
 
 pub use error::{line_of, CodegenError};
-pub use model::{parse_bits, parse_model, parse_model_str, Baseline, Coupled, Cross, Matrix, Model};
 pub use fixed::{fixed_tables, FixedTables};
+pub use model::{parse_bits, parse_model, parse_model_str, Baseline, Coupled, Cross, Matrix, Model};
 pub use render::{f32_literal, render_c_header, render_rust};
 pub use render_cross::{render_c_cross, render_rust_cross, render_rust_cross_fixed};
 pub use render_fixed::render_rust_fixed;

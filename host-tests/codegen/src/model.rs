@@ -100,14 +100,7 @@ impl Model {
     /// The placeholder of a set without a fitted model: zero tables, `fitted == false`.
     pub fn unfitted(set: &str) -> Self {
         let baseline = (0..6)
-            .map(|c| Baseline {
-                component: c,
-                coeffs: [0.0; 5],
-                coeffs_f32: [0.0; 5],
-                residual_rms: 0.0,
-                residual_max: 0.0,
-                line: 0,
-            })
+            .map(|c| Baseline { component: c, coeffs: [0.0; 5], coeffs_f32: [0.0; 5], residual_rms: 0.0, residual_max: 0.0, line: 0 })
             .collect();
         let matrices = (0..24)
             .map(|n| Matrix {
@@ -121,15 +114,7 @@ impl Model {
                 line: 0,
             })
             .collect();
-        Self {
-            fitted: false,
-            set: set.to_string(),
-            fe_sha256: String::new(),
-            baseline,
-            matrices,
-            coupled: None,
-            cross: Vec::new(),
-        }
+        Self { fitted: false, set: set.to_string(), fe_sha256: String::new(), baseline, matrices, coupled: None, cross: Vec::new() }
     }
 
     /// The f32 baseline table, `[component][i]`.
@@ -218,8 +203,7 @@ struct RawMatrix {
 /// An unreadable file, invalid TOML, or any departure from the format of
 /// `coeffs/README.md`, with the line it is on.
 pub fn parse_model(path: &Path) -> Result<Model, CodegenError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| CodegenError::file(path, format!("cannot read the model file: {e}")))?;
+    let text = std::fs::read_to_string(path).map_err(|e| CodegenError::file(path, format!("cannot read the model file: {e}")))?;
     parse_model_str(&text, path)
 }
 
@@ -251,27 +235,18 @@ impl Checker<'_> {
         if *raw.format.get_ref() != FORMAT {
             return Err(self.err(
                 raw.format.span(),
-                format!(
-                    "format = {}: this build reads model format {FORMAT} (coeffs/README.md)",
-                    raw.format.get_ref()
-                ),
+                format!("format = {}: this build reads model format {FORMAT} (coeffs/README.md)", raw.format.get_ref()),
             ));
         }
         let set = raw.set.get_ref();
-        if set.is_empty()
-            || !set.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'))
-        {
-            return Err(self.err(
-                raw.set.span(),
-                format!("set = {set:?}: a set name is a folder name of ASCII letters, digits, '-', '_' and '.'"),
-            ));
+        if set.is_empty() || !set.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.')) {
+            return Err(
+                self.err(raw.set.span(), format!("set = {set:?}: a set name is a folder name of ASCII letters, digits, '-', '_' and '.'"))
+            );
         }
         let hash = raw.fe_sha256.get_ref();
         if hash.len() != 64 || !hash.chars().all(|c| c.is_ascii_digit() || ('a'..='f').contains(&c)) {
-            return Err(self.err(
-                raw.fe_sha256.span(),
-                format!("fe_sha256 = {hash:?}: expected 64 lower-case hex digits (a SHA-256)"),
-            ));
+            return Err(self.err(raw.fe_sha256.span(), format!("fe_sha256 = {hash:?}: expected 64 lower-case hex digits (a SHA-256)")));
         }
         let domain = [
             (&raw.depth_max_mm, "depth_max_mm", DEPTH_MAX_MM, "0 <= depth <= 6 mm"),
@@ -325,9 +300,7 @@ impl Checker<'_> {
             None => false,
             Some(f) if f.get_ref() == "paper" => false,
             Some(f) if f.get_ref() == "coupled" => true,
-            Some(f) => {
-                return Err(self.err(f.span(), format!("form = {:?}: the forms are \"paper\" and \"coupled\"", f.get_ref())))
-            }
+            Some(f) => return Err(self.err(f.span(), format!("form = {:?}: the forms are \"paper\" and \"coupled\"", f.get_ref()))),
         };
         if !is_coupled {
             if let Some(c) = &coupled {
@@ -387,7 +360,10 @@ impl Checker<'_> {
     fn cross_term(&self, n: usize, raw: RawCross, max_degree: u8, depth_degree: u8, after: usize) -> Result<Cross, CodegenError> {
         let name = raw.component.get_ref();
         let Some(c) = COMPONENTS.iter().position(|x| x == name) else {
-            return Err(self.err(raw.component.span(), format!("cross {}: component = {name:?}: unknown (components: {})", n + 1, COMPONENTS.join(", "))));
+            return Err(self.err(
+                raw.component.span(),
+                format!("cross {}: component = {name:?}: unknown (components: {})", n + 1, COMPONENTS.join(", ")),
+            ));
         };
         if c < after {
             return Err(self.err(
@@ -398,7 +374,10 @@ impl Checker<'_> {
         let list = raw.exponents.get_ref();
         let mut e = [0u8; 4];
         if list.len() != 4 {
-            return Err(self.err(raw.exponents.span(), format!("cross {} ({name}): {} exponents, expected 4 (x, z, theta_x, theta_z)", n + 1, list.len())));
+            return Err(self.err(
+                raw.exponents.span(),
+                format!("cross {} ({name}): {} exponents, expected 4 (x, z, theta_x, theta_z)", n + 1, list.len()),
+            ));
         }
         for (o, v) in e.iter_mut().zip(list) {
             *o = u8::try_from(*v.get_ref())
@@ -423,17 +402,12 @@ impl Checker<'_> {
         }
         let want = usize::from(depth_degree) + 1;
         let label = format!("cross {} ({name}, exponents {e:?})", n + 1);
-        let (coeffs, coeffs_f32) = self.list(&raw.coeffs, &raw.coeffs_f32, want, &format!("{label}: coeffs"), &format!("{label}: coeffs_f32"))?;
+        let (coeffs, coeffs_f32) =
+            self.list(&raw.coeffs, &raw.coeffs_f32, want, &format!("{label}: coeffs"), &format!("{label}: coeffs_f32"))?;
         Ok(Cross { component: c, exponents: e, coeffs, coeffs_f32, line: 0 })
     }
 
-    fn count<T>(
-        &self,
-        entries: &[Spanned<T>],
-        want: usize,
-        what: &str,
-        all: Range<usize>,
-    ) -> Result<(), CodegenError> {
+    fn count<T>(&self, entries: &[Spanned<T>], want: usize, what: &str, all: Range<usize>) -> Result<(), CodegenError> {
         if entries.len() == want {
             return Ok(());
         }
@@ -441,10 +415,7 @@ impl Checker<'_> {
             // One too many: point at the first extra entry.
             Some(extra) => (extra.span().start, ""),
             // Too few: point at the end of the last one (a truncated file ends there).
-            None => (
-                entries.last().map_or(all.start, |e| e.span().end.saturating_sub(1)),
-                " (truncated file?)",
-            ),
+            None => (entries.last().map_or(all.start, |e| e.span().end.saturating_sub(1)), " (truncated file?)"),
         };
         Err(CodegenError::at(
             self.path,
@@ -454,24 +425,14 @@ impl Checker<'_> {
         ))
     }
 
-    fn name_at(
-        &self,
-        value: &Spanned<String>,
-        key: &str,
-        names: &[&str],
-        want: usize,
-        order: &str,
-    ) -> Result<(), CodegenError> {
+    fn name_at(&self, value: &Spanned<String>, key: &str, names: &[&str], want: usize, order: &str) -> Result<(), CodegenError> {
         let got = value.get_ref();
         let expected = names.get(want).copied().unwrap_or_default();
         if got == expected {
             return Ok(());
         }
         let known = if names.contains(&got.as_str()) { "out of order" } else { "unknown" };
-        Err(self.err(
-            value.span(),
-            format!("{key} = {got:?} ({known}): expected {expected:?} here; the order is {order}"),
-        ))
+        Err(self.err(value.span(), format!("{key} = {got:?} ({known}): expected {expected:?} here; the order is {order}")))
     }
 
     fn finite(&self, v: &Spanned<f64>, what: &str) -> Result<f64, CodegenError> {
@@ -524,13 +485,7 @@ impl Checker<'_> {
         }
         let mut out = vec![0.0; n];
         let mut out32 = vec![0.0; n];
-        for (j, ((v, b), (o, o32))) in values
-            .get_ref()
-            .iter()
-            .zip(bits.get_ref())
-            .zip(out.iter_mut().zip(out32.iter_mut()))
-            .enumerate()
-        {
+        for (j, ((v, b), (o, o32))) in values.get_ref().iter().zip(bits.get_ref()).zip(out.iter_mut().zip(out32.iter_mut())).enumerate() {
             let x = self.finite(v, &format!("{what}[{j}]"))?;
             let nearest = x as f32;
             if !nearest.is_finite() {
@@ -538,10 +493,7 @@ impl Checker<'_> {
             }
             let text = b.get_ref();
             let parsed = parse_bits(text).ok_or_else(|| {
-                self.err(
-                    b.span(),
-                    format!("{what_f32}[{j}] = {text:?}: expected \"0x\" and 8 lower-case hex digits (f32 bits)"),
-                )
+                self.err(b.span(), format!("{what_f32}[{j}] = {text:?}: expected \"0x\" and 8 lower-case hex digits (f32 bits)"))
             })?;
             if parsed != nearest.to_bits() {
                 return Err(self.err(
@@ -562,12 +514,8 @@ impl Checker<'_> {
     fn baseline(&self, c: usize, raw: RawBaseline) -> Result<Baseline, CodegenError> {
         self.name_at(&raw.component, "component", &COMPONENTS, c, &COMPONENTS.join(", "))?;
         let name = COMPONENTS[c];
-        let (coeffs, coeffs_f32) = self.five(
-            &raw.coeffs,
-            &raw.coeffs_f32,
-            &format!("baseline {name}: coeffs"),
-            &format!("baseline {name}: coeffs_f32"),
-        )?;
+        let (coeffs, coeffs_f32) =
+            self.five(&raw.coeffs, &raw.coeffs_f32, &format!("baseline {name}: coeffs"), &format!("baseline {name}: coeffs_f32"))?;
         Ok(Baseline {
             component: c,
             coeffs,
@@ -593,26 +541,19 @@ impl Checker<'_> {
                 ),
             ));
         }
-        for (n, name, span) in [
-            (raw.rows.get_ref().len(), "rows", raw.rows.span()),
-            (raw.rows_f32.get_ref().len(), "rows_f32", raw.rows_f32.span()),
-        ] {
+        for (n, name, span) in
+            [(raw.rows.get_ref().len(), "rows", raw.rows.span()), (raw.rows_f32.get_ref().len(), "rows_f32", raw.rows_f32.span())]
+        {
             if n != 5 {
                 return Err(self.err(span, format!("{label}: {name} has {n} rows, expected 5 (powers of u 0..=4)")));
             }
         }
         let mut rows = [[0.0; 5]; 5];
         let mut rows_f32 = [[0.0; 5]; 5];
-        for (i, ((r, b), (o, o32))) in raw
-            .rows
-            .get_ref()
-            .iter()
-            .zip(raw.rows_f32.get_ref())
-            .zip(rows.iter_mut().zip(rows_f32.iter_mut()))
-            .enumerate()
+        for (i, ((r, b), (o, o32))) in
+            raw.rows.get_ref().iter().zip(raw.rows_f32.get_ref()).zip(rows.iter_mut().zip(rows_f32.iter_mut())).enumerate()
         {
-            let (row, row32) =
-                self.five(r, b, &format!("{label}: rows[{i}]"), &format!("{label}: rows_f32[{i}]"))?;
+            let (row, row32) = self.five(r, b, &format!("{label}: rows[{i}]"), &format!("{label}: rows_f32[{i}]"))?;
             // A deviation is zero at t = -1 (sweep value 0), in f64 up to rounding.
             let at_zero: f64 = row.iter().zip([1.0, -1.0, 1.0, -1.0, 1.0]).map(|(a, s)| a * s).sum();
             let scale: f64 = row.iter().map(|a| a.abs()).sum();

@@ -1,8 +1,8 @@
 //! Rendering a validated [`Model`] as Rust tables and as a C header. Output depends only
 //! on the model (no paths, dates or host details), so a rebuild anywhere gives the same text.
 use crate::contract::{
-    COMPONENTS, DEPTH_MAX_MM, FORMAT, HALF_RANGES, ODD, ONE_THIRD_F32, STATUS_BITS, SWEEPS,
-    SWEEP_INPUTS, SWEEP_SCALES_F32, SWEEP_UNITS, UNITS,
+    COMPONENTS, DEPTH_MAX_MM, FORMAT, HALF_RANGES, ODD, ONE_THIRD_F32, STATUS_BITS, SWEEPS, SWEEP_INPUTS, SWEEP_SCALES_F32, SWEEP_UNITS,
+    UNITS,
 };
 use crate::model::Model;
 use std::fmt::Write as _;
@@ -173,12 +173,7 @@ pub fn render_c_header(model: &Model) -> String {
     }
     let _ = writeln!(w);
     let _ = writeln!(w, "/* Normalisation constants: the nearest f32 to 1/3 and to 2/V_k. */");
-    let _ = writeln!(
-        w,
-        "#define NEEDLE_ONE_THIRD {}f /* {} */",
-        f32_literal(ONE_THIRD_F32),
-        bits(ONE_THIRD_F32)
-    );
+    let _ = writeln!(w, "#define NEEDLE_ONE_THIRD {}f /* {} */", f32_literal(ONE_THIRD_F32), bits(ONE_THIRD_F32));
     let _ = writeln!(w, "static const float NEEDLE_SWEEP_SCALE[4] = {{");
     for (k, v) in SWEEP_SCALES_F32.iter().enumerate() {
         let _ = writeln!(w, "    {}f, /* {} 2/{} ({}) */", f32_literal(*v), bits(*v), HALF_RANGES[k], SWEEPS[k]);

@@ -26,7 +26,7 @@ fn lit(v: f32) -> String {
 /// The factors of the monomial of `exponents`, in the contract's order: each input
 /// repeated by its exponent.
 fn factors(e: [u8; 4]) -> Vec<&'static str> {
-    e.iter().zip(INPUTS).flat_map(|(&k, name)| std::iter::repeat(name).take(usize::from(k))).collect()
+    e.iter().zip(INPUTS).flat_map(|(&k, name)| std::iter::repeat_n(name, usize::from(k))).collect()
 }
 
 /// `m`, the monomial of `exponents`, as a left-to-right f32 product.
@@ -94,10 +94,7 @@ pub fn render_rust_cross(model: &Model) -> String {
             let _ = writeln!(
                 w,
                 "    // {} ({}), exponents {:?}, model.toml line {}",
-                COMPONENTS[t.component],
-                UNITS[t.component],
-                t.exponents,
-                t.line
+                COMPONENTS[t.component], UNITS[t.component], t.exponents, t.line
             );
             let _ = writeln!(w, "    *w{c} = *w{c} + ({}) * {};", monomial(t.exponents), horner(&t.coeffs_f32), c = t.component);
         }

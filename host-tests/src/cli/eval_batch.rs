@@ -30,9 +30,10 @@ pub fn parse_poses(text: &str, path: &Path) -> Result<Vec<Pose>> {
     let header = rdr.headers().with_context(|| format!("{}:1: cannot read the header", path.display()))?.clone();
     let mut idx = [0usize; 5];
     for (slot, name) in idx.iter_mut().zip(POSE_COLUMNS) {
-        *slot = header.iter().position(|h| h == name).with_context(|| {
-            format!("{}:1: no column {name:?} in the header (need {})", path.display(), POSE_COLUMNS.join(", "))
-        })?;
+        *slot = header
+            .iter()
+            .position(|h| h == name)
+            .with_context(|| format!("{}:1: no column {name:?} in the header (need {})", path.display(), POSE_COLUMNS.join(", ")))?;
     }
     let mut poses = Vec::new();
     let mut bad: Vec<String> = Vec::new();

@@ -34,7 +34,12 @@ pub fn explore(a: ExploreArgs) -> Result<ExitCode> {
     let wasm_path = explore::wasm::build(&set)?;
     let wasm = std::fs::read(&wasm_path).with_context(|| format!("{}: cannot read", wasm_path.display()))?;
     let explorer = Explorer::bind(SocketAddr::new(a.host, a.port), Content { wasm, set_json: set_json.to_string() })?;
-    println!("needle explore: set {} ({runs} FE runs), evaluator {} ({} bytes)", a.set.display(), wasm_path.display(), std::fs::metadata(&wasm_path).map_or(0, |m| m.len()));
+    println!(
+        "needle explore: set {} ({runs} FE runs), evaluator {} ({} bytes)",
+        a.set.display(),
+        wasm_path.display(),
+        std::fs::metadata(&wasm_path).map_or(0, |m| m.len())
+    );
     println!("open {}   (Ctrl-C stops)", explorer.url());
     explorer.serve();
     Ok(ExitCode::SUCCESS)

@@ -297,7 +297,10 @@ fn submit_summary(r: &slurm::SubmitReport) -> String {
             for w in &res.why {
                 let _ = writeln!(s, "  {w}");
             }
-            let _ = writeln!(s, "follow it with: needle fe status (same --set/--out/--mesh/--steps); rerun this command to resubmit what fails");
+            let _ = writeln!(
+                s,
+                "follow it with: needle fe status (same --set/--out/--mesh/--steps); rerun this command to resubmit what fails"
+            );
         }
         _ => {
             let _ = writeln!(s, "nothing to submit");
@@ -318,7 +321,8 @@ fn run_status(a: StatusArgs) -> anyhow::Result<ExitCode> {
     let r = crate::fe::launcher::status::status(&opts)?;
     print!("{}", r.table());
     if !a.project_nodes.is_empty() {
-        let per_node = a.tasks_per_node.map(|n| n as usize).unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
+        let per_node =
+            a.tasks_per_node.map(|n| n as usize).unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
         let nodes: Vec<usize> = a.project_nodes.iter().map(|&n| n as usize).collect();
         print!("{}", crate::fe::launcher::projection::table(&opts, &nodes, per_node)?);
     }

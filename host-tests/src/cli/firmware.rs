@@ -148,7 +148,11 @@ fn bench_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
         );
         if let Some(q) = f.pose("typical", "fixed") {
             let m0_goal = if f.core.name == "m0" {
-                format!("; <= {} instructions on the M0: {}", goals.m0_fixed_instructions, goal(q.instructions <= goals.m0_fixed_instructions))
+                format!(
+                    "; <= {} instructions on the M0: {}",
+                    goals.m0_fixed_instructions,
+                    goal(q.instructions <= goals.m0_fixed_instructions)
+                )
             } else {
                 String::new()
             };

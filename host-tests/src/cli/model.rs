@@ -76,12 +76,8 @@ pub fn check_compiled_set(dir: &Path) -> anyhow::Result<()> {
         bail!("{}: no such file: --set names a coefficient set folder holding model.toml", model_path.display());
     }
     let model = needle_codegen::parse_model(&model_path).map_err(anyhow::Error::new)?;
-    let built = format!(
-        "this build has set {:?} compiled in, from {} (fe_sha256 {})",
-        model_info::SET,
-        model_info::SET_DIR,
-        model_info::FE_SHA256
-    );
+    let built =
+        format!("this build has set {:?} compiled in, from {} (fe_sha256 {})", model_info::SET, model_info::SET_DIR, model_info::FE_SHA256);
     if model.fe_sha256 != model_info::FE_SHA256 {
         bail!(
             "{} is fitted on other FE data (fe_sha256 {}) than the compiled-in model: {built}; {rebuild}",
@@ -91,13 +87,15 @@ pub fn check_compiled_set(dir: &Path) -> anyhow::Result<()> {
     }
     let same_bits = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
     let base_same = model.baseline_f32().iter().zip(model_info::BASELINE.iter()).all(|(a, b)| same_bits(a, b));
-    let dev_same = model.deviation_f32().iter().flatten().flatten().zip(model_info::DEVIATION.iter().flatten().flatten())
+    let dev_same = model
+        .deviation_f32()
+        .iter()
+        .flatten()
+        .flatten()
+        .zip(model_info::DEVIATION.iter().flatten().flatten())
         .all(|(a, b)| same_bits(a, b));
     if !(base_same && dev_same) {
-        bail!(
-            "{} has other coefficients than the compiled-in model (same FE data, refitted?): {built}; {rebuild}",
-            model_path.display()
-        );
+        bail!("{} has other coefficients than the compiled-in model (same FE data, refitted?): {built}; {rebuild}", model_path.display());
     }
     Ok(())
 }
@@ -107,8 +105,7 @@ pub fn status_names(status: Status) -> Vec<&'static str> {
     Status::FLAGS.iter().filter(|(f, _)| status.contains(*f)).map(|(_, n)| *n).collect()
 }
 
-const NAMES: [(&str, &str); 6] =
-    [("fx_n", "N"), ("fy_n", "N"), ("fz_n", "N"), ("mx_nmm", "N*mm"), ("my_nmm", "N*mm"), ("mz_nmm", "N*mm")];
+const NAMES: [(&str, &str); 6] = [("fx_n", "N"), ("fy_n", "N"), ("fz_n", "N"), ("mx_nmm", "N*mm"), ("my_nmm", "N*mm"), ("mz_nmm", "N*mm")];
 
 /// The compiled-in model's form: `paper` or `coupled`.
 pub fn form_name() -> &'static str {
@@ -148,8 +145,7 @@ pub fn eval_json(pose: &Pose, e: &Evaluation) -> serde_json::Value {
         wrench.insert((*name).to_string(), serde_json::json!(v));
         bits.insert((*name).to_string(), serde_json::json!(format!("{:#010x}", v.to_bits())));
     }
-    let pose_bits = [pose.x_mm, pose.z_mm, pose.theta_x_deg, pose.theta_z_deg, pose.depth_mm]
-        .map(|v| format!("{:#010x}", v.to_bits()));
+    let pose_bits = [pose.x_mm, pose.z_mm, pose.theta_x_deg, pose.theta_z_deg, pose.depth_mm].map(|v| format!("{:#010x}", v.to_bits()));
     serde_json::json!({
         "set": model_info::SET,
         "fe_sha256": model_info::FE_SHA256,

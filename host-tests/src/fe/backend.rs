@@ -153,8 +153,8 @@ impl Backend for CcxBackend {
     fn solve(&self, job: &Job<'_>) -> std::result::Result<Solved, SolveFailure> {
         let first_increment = job.first_increment;
         let ccx_path = self.ccx.as_deref().context("CcxBackend::solve before prepare")?;
-        let deck = deck::write_deck_first_increment(job.campaign, job.pose, job.mesh, job.steps, first_increment)
-            .context("writing the deck")?;
+        let deck =
+            deck::write_deck_first_increment(job.campaign, job.pose, job.mesh, job.steps, first_increment).context("writing the deck")?;
         if deck.steps != job.steps {
             return Err(anyhow::anyhow!("the deck has {} steps, {} were asked for", deck.steps, job.steps).into());
         }
@@ -178,19 +178,14 @@ impl Backend for CcxBackend {
         }
         let fail = |e: anyhow::Error| SolveFailure { message: format!("{e:#}"), log_tail: r.log_tail.clone() };
         let dat_path = job.work_dir.join(format!("{JOB}.dat"));
-        let text = std::fs::read_to_string(&dat_path)
-            .with_context(|| format!("{}: cannot read", dat_path.display()))
-            .map_err(fail)?;
-        let blocks = dat::parse_rf(&text, &deck.print_set)
-            .with_context(|| format!("{}", dat_path.display()))
-            .map_err(fail)?;
+        let text = std::fs::read_to_string(&dat_path).with_context(|| format!("{}: cannot read", dat_path.display())).map_err(fail)?;
+        let blocks = dat::parse_rf(&text, &deck.print_set).with_context(|| format!("{}", dat_path.display())).map_err(fail)?;
         check_step_times(&blocks, job.steps).with_context(|| format!("{}", dat_path.display())).map_err(fail)?;
         let wrenches = blocks
             .iter()
             .enumerate()
             .map(|(k, b)| {
-                wrench::reduce(&deck, job.pose, job.campaign, &b.nodes)
-                    .with_context(|| format!("reducing the reactions of step {}", k + 1))
+                wrench::reduce(&deck, job.pose, job.campaign, &b.nodes).with_context(|| format!("reducing the reactions of step {}", k + 1))
             })
             .collect::<Result<Vec<_>>>()
             .map_err(fail)?;

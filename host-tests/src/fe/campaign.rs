@@ -33,20 +33,20 @@
 //! records how each CSV was made, [`report`](crate::fe::report) is the outcome and
 //! `progress` the display.
 
-use crate::fe::backend::{backend_for, Backend, Job, Solved, SolveFailure};
-use crate::fe::launcher::Launched;
-use crate::fe::process;
+use crate::fe::backend::{backend_for, Backend, Job, SolveFailure, Solved};
 use crate::fe::deck;
-use crate::fe::manifest::{read_manifest, manifest_text, rfc3339_utc, Manifest, ManifestEntry, MANIFEST};
+use crate::fe::launcher::Launched;
+use crate::fe::manifest::{manifest_text, read_manifest, rfc3339_utc, Manifest, ManifestEntry, MANIFEST};
+use crate::fe::process;
 use crate::fe::progress::Progress;
 use crate::fe::report::{PoseReport, Report, Status};
 use crate::fe::results::{self, Row};
 use crate::fe::spec::{self, Campaign, Engine, MeshLevel, PoseSpec};
 use anyhow::{bail, Context, Result};
 use std::collections::BTreeMap;
+use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 use std::sync::{mpsc, Mutex};
-use std::collections::VecDeque;
 use std::time::{Duration, Instant, SystemTime};
 
 /// What `needle fe run` was asked to do.
@@ -179,9 +179,8 @@ impl Plan {
 /// As [`run`], except solver problems (nothing is solved here).
 pub fn plan(opts: &RunOptions) -> Result<Plan> {
     let (mut campaign, spec_path) = spec::load(&opts.set_dir)?;
-    let stability = crate::fe::material::check(&campaign.tissue).with_context(|| {
-        format!("{}: the tissue fails the material stability check; nothing was run", spec_path.display())
-    })?;
+    let stability = crate::fe::material::check(&campaign.tissue)
+        .with_context(|| format!("{}: the tissue fails the material stability check; nothing was run", spec_path.display()))?;
     eprintln!("material check passed: {}", stability.to_string().replace('\n', "\n  "));
     if let Some(engine) = opts.solver {
         campaign.solver.engine = engine;
@@ -347,15 +346,14 @@ fn run_workers(
                 if tx.send(Event::Started(i)).is_err() {
                     break;
                 }
-                let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| solve_pose(ctx, pose)))
-                    .unwrap_or_else(|panic| {
-                        let what = panic
-                            .downcast_ref::<String>()
-                            .cloned()
-                            .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
-                            .unwrap_or_default();
-                        failed_report(pose, ctx, format!("panic while solving: {what}"), String::new())
-                    });
+                let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| solve_pose(ctx, pose))).unwrap_or_else(|panic| {
+                    let what = panic
+                        .downcast_ref::<String>()
+                        .cloned()
+                        .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                        .unwrap_or_default();
+                    failed_report(pose, ctx, format!("panic while solving: {what}"), String::new())
+                });
                 if tx.send(Event::Finished(i, r)).is_err() {
                     break;
                 }
@@ -374,9 +372,7 @@ fn run_workers(
                 Err(mpsc::RecvTimeoutError::Timeout) => {}
                 Err(mpsc::RecvTimeoutError::Disconnected) => break,
             }
-            progress.tick(|i| {
-                to_run.get(i).map(|(_, p)| ctx.backend.steps_done(&work_dir(ctx.out_dir, &p.name))).unwrap_or(0)
-            });
+            progress.tick(|i| to_run.get(i).map(|(_, p)| ctx.backend.steps_done(&work_dir(ctx.out_dir, &p.name))).unwrap_or(0));
         }
     });
     progress.finish();
@@ -736,14 +732,14 @@ mod tests {
         std::fs::write(&manifest, &good).expect("restore the manifest (from git, say)");
         assert_eq!(snapshot(&fe), intact, "every result as before the faults");
 
-
         // temporaries a killed campaign left beside its targets (a pid that is gone)
         let stale = [fe.join(".x+06.csv.4194303.tmp"), fe.join(format!(".{MANIFEST}.4194303.tmp"))];
         for t in &stale {
             std::fs::write(t, b"half").expect("stale temporary");
         }
         let mut intact = intact;
-        intact.extend(stale.iter().map(|t| (t.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(), b"half".to_vec())));
+        intact
+            .extend(stale.iter().map(|t| (t.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(), b"half".to_vec())));
         intact.sort();
         assert_eq!(snapshot(&fe), intact);
 
@@ -810,9 +806,7 @@ mod tests {
         let mut fake = Fake::default();
         let e = run_with(&opts(d.path(), "nothing*", 2), &mut fake).expect_err("no pose").to_string();
         assert!(e.contains("matches no pose"), "{e}");
-        let e = run_with(&RunOptions { mesh: Some("huge".into()), ..opts(d.path(), "x+02", 2) }, &mut fake)
-            .expect_err("mesh")
-            .to_string();
+        let e = run_with(&RunOptions { mesh: Some("huge".into()), ..opts(d.path(), "x+02", 2) }, &mut fake).expect_err("mesh").to_string();
         assert!(e.contains("huge"), "{e}");
         let e = run_with(&opts(d.path(), "x+02", 0), &mut fake).expect_err("steps").to_string();
         assert!(e.contains("--steps 0"), "{e}");

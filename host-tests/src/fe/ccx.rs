@@ -11,7 +11,6 @@ use std::time::Duration;
 /// Environment variable that names the `ccx` binary to use instead of the one on `PATH`.
 pub const CCX_ENV: &str = "NEEDLE_CCX";
 
-
 /// Find the `ccx` binary: `$NEEDLE_CCX` if set, else the first `ccx` on `PATH`.
 ///
 /// # Errors
@@ -40,11 +39,8 @@ pub fn find_ccx() -> Result<PathBuf> {
 /// # Errors
 /// The binary cannot be started, or its output has no "Version" word.
 pub fn ccx_version(ccx: &Path) -> Result<String> {
-    let out = Command::new(ccx)
-        .arg("-v")
-        .stdin(Stdio::null())
-        .output()
-        .with_context(|| format!("{}: cannot run `ccx -v`", ccx.display()))?;
+    let out =
+        Command::new(ccx).arg("-v").stdin(Stdio::null()).output().with_context(|| format!("{}: cannot run `ccx -v`", ccx.display()))?;
     let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
     parse_version(&text).with_context(|| format!("{} -v: no version in its output {:?}", ccx.display(), text.trim()))
 }
@@ -60,8 +56,8 @@ pub fn parse_version(text: &str) -> Option<String> {
     None
 }
 
-pub use crate::fe::process::{interrupted, stop_jobs_on_termination, tail, ExitKind, EXIT_INTERRUPTED, LOG_TAIL_LINES};
 use crate::fe::process::which;
+pub use crate::fe::process::{interrupted, stop_jobs_on_termination, tail, ExitKind, EXIT_INTERRUPTED, LOG_TAIL_LINES};
 
 /// Increments and iterations of a job, from its `.sta` file.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -106,8 +102,7 @@ pub fn parse_sta(text: &str) -> StaSummary {
             Some(a) => (a, true),
             None => (*att, false),
         };
-        let (Ok(_), Ok(itrs), Some(tot)) = (att.parse::<u32>(), itrs.parse::<u32>(), crate::fe::dat::parse_fortran(tot))
-        else {
+        let (Ok(_), Ok(itrs), Some(tot)) = (att.parse::<u32>(), itrs.parse::<u32>(), crate::fe::dat::parse_fortran(tot)) else {
             continue;
         };
         s.iterations += itrs;
@@ -172,13 +167,7 @@ impl JobResult {
 /// # Errors
 /// The log file cannot be created, or ccx cannot be started or waited for. A job that
 /// starts and then fails is not an error: see [`JobResult::exit`].
-pub fn run_job(
-    ccx: &Path,
-    work_dir: &Path,
-    job: &str,
-    timeout: Option<Duration>,
-    stall: Option<Duration>,
-) -> Result<JobResult> {
+pub fn run_job(ccx: &Path, work_dir: &Path, job: &str, timeout: Option<Duration>, stall: Option<Duration>) -> Result<JobResult> {
     let log_path = work_dir.join(format!("{job}.log"));
     // a spooles.out left by an earlier attempt in this folder would be taken for this one's
     let spooles_path = work_dir.join("spooles.out");
@@ -223,7 +212,6 @@ mod tests {
         assert_eq!(parse_version("\nThis is Version 2.20\n\n").as_deref(), Some("2.20"));
         assert_eq!(parse_version("nothing"), None);
     }
-
 
     /// A stand-in for ccx (a shell script): `silent` writes a line then sleeps silently.
     fn fake_ccx(dir: &Path, body: &str) -> PathBuf {

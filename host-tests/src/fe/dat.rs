@@ -66,9 +66,7 @@ pub fn parse_rf(text: &str, set: &str) -> Result<Vec<StepRf>> {
             let first = trimmed.split_whitespace().next().unwrap_or("");
             if first.bytes().all(|b| b.is_ascii_digit()) {
                 let node = parse_node_line(trimmed).map_err(|why| {
-                    anyhow::anyhow!(
-                        "line {n}: {why} in the forces block of set {set} (header at line {hline}): {line:?}"
-                    )
+                    anyhow::anyhow!("line {n}: {why} in the forces block of set {set} (header at line {hline}): {line:?}")
                 })?;
                 block.nodes.push(node);
                 current = Some((hline, block));
@@ -95,8 +93,8 @@ pub fn parse_rf(text: &str, set: &str) -> Result<Vec<StepRf>> {
             continue;
         }
         let time_text = time_text.trim();
-        let total_time = parse_fortran(time_text)
-            .ok_or_else(|| anyhow::anyhow!("line {n}: time {time_text:?} is not a number: {line:?}"))?;
+        let total_time =
+            parse_fortran(time_text).ok_or_else(|| anyhow::anyhow!("line {n}: time {time_text:?} is not a number: {line:?}"))?;
         current = Some((n, StepRf { total_time, nodes: Vec::new() }));
     }
     if let Some((h, b)) = current.take() {
@@ -147,9 +145,9 @@ pub fn parse_fortran(s: &str) -> Option<f64> {
     }
     // Mantissa followed directly by a signed exponent: insert the E before the sign.
     let bytes = s.as_bytes();
-    let pos = (1..bytes.len()).rev().find(|&k| {
-        matches!(bytes.get(k), Some(b'+' | b'-')) && bytes.get(k - 1).is_some_and(|b| b.is_ascii_digit() || *b == b'.')
-    })?;
+    let pos = (1..bytes.len())
+        .rev()
+        .find(|&k| matches!(bytes.get(k), Some(b'+' | b'-')) && bytes.get(k - 1).is_some_and(|b| b.is_ascii_digit() || *b == b'.'))?;
     let (mantissa, exponent) = s.split_at(pos);
     if !exponent[1..].bytes().all(|b| b.is_ascii_digit()) || exponent.len() < 2 {
         return None;

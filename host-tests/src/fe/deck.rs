@@ -130,13 +130,7 @@ pub const RETRY_FIRST_INCREMENT: f64 = 0.25;
 ///
 /// # Errors
 /// As [`write_deck`]; `first_increment` not in (0, 1].
-pub fn write_deck_first_increment(
-    c: &Campaign,
-    pose: &PoseSpec,
-    mesh_level: &MeshLevel,
-    steps: u32,
-    first_increment: f64,
-) -> Result<Deck> {
+pub fn write_deck_first_increment(c: &Campaign, pose: &PoseSpec, mesh_level: &MeshLevel, steps: u32, first_increment: f64) -> Result<Deck> {
     write_deck_full(c, pose, mesh_level, steps, pose.symmetry(), first_increment)
 }
 
@@ -145,24 +139,11 @@ pub fn write_deck_first_increment(
 ///
 /// # Errors
 /// As [`write_deck`]; a mirror plane the pose does not have.
-pub fn write_deck_with_symmetry(
-    c: &Campaign,
-    pose: &PoseSpec,
-    mesh_level: &MeshLevel,
-    steps: u32,
-    sym: Symmetry,
-) -> Result<Deck> {
+pub fn write_deck_with_symmetry(c: &Campaign, pose: &PoseSpec, mesh_level: &MeshLevel, steps: u32, sym: Symmetry) -> Result<Deck> {
     write_deck_full(c, pose, mesh_level, steps, sym, 1.0)
 }
 
-fn write_deck_full(
-    c: &Campaign,
-    pose: &PoseSpec,
-    mesh_level: &MeshLevel,
-    steps: u32,
-    sym: Symmetry,
-    first_increment: f64,
-) -> Result<Deck> {
+fn write_deck_full(c: &Campaign, pose: &PoseSpec, mesh_level: &MeshLevel, steps: u32, sym: Symmetry, first_increment: f64) -> Result<Deck> {
     if !(first_increment > 1e-5 && first_increment <= 1.0) {
         bail!("pose {}: first increment {first_increment} of a step: must be in (1e-5, 1]", pose.name);
     }
@@ -199,11 +180,7 @@ fn write_deck_full(
         let _ = writeln!(w, "*END STEP");
     }
     let reference_mm = [0, 1, 2].map(|k| n.tip[k] + c.needle.reference_from_tip_mm * axis[k]);
-    let print_nodes = n
-        .surface_nodes
-        .iter()
-        .map(|&i| ((ids.node0 + i) as u32, n.nodes[i]))
-        .collect();
+    let print_nodes = n.surface_nodes.iter().map(|&i| ((ids.node0 + i) as u32, n.nodes[i])).collect();
     Ok(Deck {
         text: s,
         summary: MeshSummary::of(&t, &n, sym),
@@ -275,12 +252,8 @@ fn write_material(w: &mut String, c: &Campaign) {
     let d1 = 2.0 / k0;
     let n = t.mu_n_per_mm2.len();
     let _ = writeln!(w, "*MATERIAL, NAME=TISSUE");
-    let _ = writeln!(
-        w,
-        "** Ogden N={n}: mu_i [N/mm^2], alpha_i, then D_i = 2/K0; mu0 = {:e} N/mm^2, K0 = {:e} N/mm^2",
-        t.mu0_n_per_mm2(),
-        k0
-    );
+    let _ =
+        writeln!(w, "** Ogden N={n}: mu_i [N/mm^2], alpha_i, then D_i = 2/K0; mu0 = {:e} N/mm^2, K0 = {:e} N/mm^2", t.mu0_n_per_mm2(), k0);
     let _ = writeln!(w, "*HYPERELASTIC, OGDEN, N={n}");
     let mut vals: Vec<String> = Vec::new();
     for (m, a) in t.mu_n_per_mm2.iter().zip(&t.alpha) {

@@ -198,9 +198,7 @@ pub fn read_manifest(path: &Path) -> Result<Manifest> {
 pub fn manifest_text(m: &Manifest) -> Result<String> {
     let body = toml::to_string(m).context("cannot serialize the manifest")?;
     let nl = if body.ends_with('\n') { "" } else { "\n" };
-    Ok(format!(
-        "# Written by `needle fe run`, one table per pose whose fe/<pose>.csv is current. Do not edit.\n\n{body}{nl}"
-    ))
+    Ok(format!("# Written by `needle fe run`, one table per pose whose fe/<pose>.csv is current. Do not edit.\n\n{body}{nl}"))
 }
 
 /// `t` as an RFC 3339 UTC timestamp with whole seconds, e.g. `2025-01-31T12:00:00Z`.
@@ -218,12 +216,7 @@ pub fn rfc3339_utc(t: SystemTime) -> String {
     let day = doy - (153 * mp + 2) / 5 + 1;
     let month = if mp < 10 { mp + 3 } else { mp - 9 };
     let year = yoe + era * 400 + i64::from(month <= 2);
-    format!(
-        "{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z",
-        rem / 3_600,
-        rem % 3_600 / 60,
-        rem % 60
-    )
+    format!("{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z", rem / 3_600, rem % 3_600 / 60, rem % 60)
 }
 
 #[cfg(test)]

@@ -233,10 +233,7 @@ pub fn check(t: &Tissue) -> Result<StabilityReport> {
     let r = evaluate(t)?;
     let mu0 = r.mu0_n_per_mm2;
     if mu0.is_nan() || mu0 <= 0.0 {
-        let mut msg = format!(
-            "tissue is unstable: initial shear modulus mu0 = sum mu_i = {} N/mm^2 <= 0",
-            num(mu0)
-        );
+        let mut msg = format!("tissue is unstable: initial shear modulus mu0 = sum mu_i = {} N/mm^2 <= 0", num(mu0));
         msg.push_str(&negative_terms_note(t, &r.negative_terms));
         msg.push_str(
             " (Abaqus/CalculiX Ogden convention W = sum 2 mu_i / alpha_i^2 (l1^a_i + l2^a_i + l3^a_i - 3), \
@@ -270,12 +267,7 @@ pub fn check(t: &Tissue) -> Result<StabilityReport> {
         .collect();
     if !failures.is_empty() {
         let mut msg = format!("tissue is unstable: Drucker check fails in {}", failures.join("; also in "));
-        msg.push_str(&format!(
-            " (checked over stretch {} .. {}, mu0 = {} N/mm^2)",
-            num(r.stretch_min),
-            num(r.stretch_max),
-            num(mu0)
-        ));
+        msg.push_str(&format!(" (checked over stretch {} .. {}, mu0 = {} N/mm^2)", num(r.stretch_min), num(r.stretch_max), num(mu0)));
         msg.push_str(&negative_terms_note(t, &r.negative_terms));
         bail!(msg);
     }
@@ -291,18 +283,11 @@ pub fn check(t: &Tissue) -> Result<StabilityReport> {
 pub fn evaluate(t: &Tissue) -> Result<StabilityReport> {
     let n = t.mu_n_per_mm2.len();
     if n == 0 || n != t.alpha.len() {
-        bail!(
-            "tissue: mu_n_per_mm2 has {} terms and alpha {}; they must match and be non-empty",
-            n,
-            t.alpha.len()
-        );
+        bail!("tissue: mu_n_per_mm2 has {} terms and alpha {}; they must match and be non-empty", n, t.alpha.len());
     }
     for (i, (&mu, &a)) in t.mu_n_per_mm2.iter().zip(&t.alpha).enumerate() {
         if !mu.is_finite() || !a.is_finite() || a == 0.0 {
-            bail!(
-                "tissue: term {}: mu = {mu} N/mm^2, alpha = {a}: both must be finite and alpha != 0",
-                i + 1
-            );
+            bail!("tissue: term {}: mu = {mu} N/mm^2, alpha = {a}: both must be finite and alpha != 0", i + 1);
         }
     }
     if !t.bulk_to_shear.is_finite() {
@@ -316,13 +301,7 @@ pub fn evaluate(t: &Tissue) -> Result<StabilityReport> {
     let mu0 = t.mu0_n_per_mm2();
     let k0 = t.k0_n_per_mm2();
     let stretches: Vec<f64> = (0..SAMPLES)
-        .map(|k| {
-            if k + 1 == SAMPLES {
-                hi
-            } else {
-                (lo.ln() + (hi / lo).ln() * k as f64 / (SAMPLES - 1) as f64).exp()
-            }
-        })
+        .map(|k| if k + 1 == SAMPLES { hi } else { (lo.ln() + (hi / lo).ln() * k as f64 / (SAMPLES - 1) as f64).exp() })
         .collect();
     let modes = Mode::ALL.iter().map(|&m| scan(t, m, &stretches)).collect();
     Ok(StabilityReport {
@@ -399,18 +378,10 @@ fn negative_terms_note(t: &Tissue, idx: &[usize]) -> String {
         .iter()
         .map(|&i| {
             let (mu, a) = (t.mu_n_per_mm2[i], t.alpha[i]);
-            format!(
-                "term {k}: mu_{k} = {} N/mm^2, alpha_{k} = {a}, mu_{k}*alpha_{k} = {} N/mm^2",
-                num(mu),
-                num(mu * a),
-                k = i + 1
-            )
+            format!("term {k}: mu_{k} = {} N/mm^2, alpha_{k} = {a}, mu_{k}*alpha_{k} = {} N/mm^2", num(mu), num(mu * a), k = i + 1)
         })
         .collect();
-    format!(
-        "; terms with mu_i < 0 (informational: one negative term is not unstable by itself): {}",
-        terms.join(", ")
-    )
+    format!("; terms with mu_i < 0 (informational: one negative term is not unstable by itself): {}", terms.join(", "))
 }
 
 /// Four significant digits, trailing zeros trimmed: plain decimals for

@@ -12,8 +12,7 @@ use std::collections::HashMap;
 pub type P3 = [f64; 3];
 
 /// Face numbering of a C3D8 element (CalculiX/Abaqus): local node indices of faces S1..S6.
-pub const FACES: [[usize; 4]; 6] =
-    [[0, 1, 2, 3], [4, 7, 6, 5], [0, 4, 5, 1], [1, 5, 6, 2], [2, 6, 7, 3], [3, 7, 4, 0]];
+pub const FACES: [[usize; 4]; 6] = [[0, 1, 2, 3], [4, 7, 6, 5], [0, 4, 5, 1], [1, 5, 6, 2], [2, 6, 7, 3], [3, 7, 4, 0]];
 
 /// The tissue mesh. Node `i` of `nodes` has CalculiX id `i + 1`, element `e` id `e + 1`.
 #[derive(Debug, Clone, Default)]
@@ -200,12 +199,7 @@ pub fn tissue_shaped(block: &Block, m: &MeshLevel, pose: &PoseSpec, sym: Symmetr
     let core: Vec<Vec<usize>> = (0..=ncx)
         .map(|i| {
             (0..=ncz)
-                .map(|j| {
-                    pat.node(
-                        xc + cx * (-1.0 + 2.0 * i as f64 / ncx as f64),
-                        zc + cz * (-1.0 + 2.0 * j as f64 / ncz as f64),
-                    )
-                })
+                .map(|j| pat.node(xc + cx * (-1.0 + 2.0 * i as f64 / ncx as f64), zc + cz * (-1.0 + 2.0 * j as f64 / ncz as f64)))
                 .collect()
         })
         .collect();
@@ -258,7 +252,8 @@ pub fn tissue_shaped(block: &Block, m: &MeshLevel, pose: &PoseSpec, sym: Symmetr
         .filter(|q| {
             let cxq = q.iter().map(|&i| pts[i][0]).sum::<f64>() / 4.0;
             let czq = q.iter().map(|&i| pts[i][1]).sum::<f64>() / 4.0;
-            !(sym.plane_z && czq < 0.0) && !(sym.plane_x && cxq < 0.0)
+            let mirrored_away = (sym.plane_z && czq < 0.0) || (sym.plane_x && cxq < 0.0);
+            !mirrored_away
         })
         .collect();
     let mut used: Vec<usize> = quads.iter().flatten().copied().collect();
@@ -313,15 +308,8 @@ pub fn tissue_shaped(block: &Block, m: &MeshLevel, pose: &PoseSpec, sym: Symmetr
             mesh.plane_z.push(i);
         }
     }
-    mesh.info = format!(
-        "O-grid core {:.3} x {:.3} mm / {} x {} elements, {} rings, {} layers",
-        2.0 * cx,
-        2.0 * cz,
-        ncx,
-        ncz,
-        rings,
-        ny - 1
-    );
+    mesh.info =
+        format!("O-grid core {:.3} x {:.3} mm / {} x {} elements, {} rings, {} layers", 2.0 * cx, 2.0 * cz, ncx, ncz, rings, ny - 1);
     mesh
 }
 
@@ -445,11 +433,7 @@ pub fn needle(nd: &Needle, m: &MeshLevel, pose: &PoseSpec, depth_mm: f64, sym: S
         p[1] -= ymin;
         p[2] += pose.z_mm;
     }
-    let mut mesh = NeedleMesh {
-        tip: [pose.x_mm, -ymin, pose.z_mm],
-        axis: rot([0.0, 1.0, 0.0]),
-        ..Default::default()
-    };
+    let mut mesh = NeedleMesh { tip: [pose.x_mm, -ymin, pose.z_mm], axis: rot([0.0, 1.0, 0.0]), ..Default::default() };
     let nid = |l: usize, c: usize| l * ncs + c;
     let margin = 0.5 * r;
     let mut on_surface = vec![false; pts.len()];

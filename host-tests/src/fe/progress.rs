@@ -43,11 +43,9 @@ impl Progress {
         let total_steps = names.len() as u64 * u64::from(steps);
         let bar = std::io::stderr().is_terminal().then(|| {
             let bar = ProgressBar::with_draw_target(Some(total_steps), ProgressDrawTarget::stderr_with_hz(4));
-            let style = ProgressStyle::with_template(
-                "[{elapsed_precise}] {bar:30.cyan/blue} {percent:>3}% | {prefix}\n  {wide_msg}",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> ");
+            let style = ProgressStyle::with_template("[{elapsed_precise}] {bar:30.cyan/blue} {percent:>3}% | {prefix}\n  {wide_msg}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> ");
             bar.set_style(style);
             bar
         });
@@ -94,11 +92,7 @@ impl Progress {
         if self.running.is_empty() {
             return "-".into();
         }
-        self.running
-            .iter()
-            .map(|(&i, &(k, _))| format!("{} step {k}/{}", self.name(i), self.steps))
-            .collect::<Vec<_>>()
-            .join(", ")
+        self.running.iter().map(|(&i, &(k, _))| format!("{} step {k}/{}", self.name(i), self.steps)).collect::<Vec<_>>().join(", ")
     }
 
     fn steps_done_total(&self) -> u64 {
@@ -189,11 +183,8 @@ impl Progress {
     /// `ETA ~N s (median run times of each model)`, or from the load steps when a run's
     /// model has no measured time.
     fn eta_text(&self) -> String {
-        let running: Option<Vec<(f64, f64, u32)>> = self
-            .running
-            .iter()
-            .map(|(&i, &(k, t))| self.typical_s(i).map(|typ| (typ, t.elapsed().as_secs_f64(), k)))
-            .collect();
+        let running: Option<Vec<(f64, f64, u32)>> =
+            self.running.iter().map(|(&i, &(k, t))| self.typical_s(i).map(|typ| (typ, t.elapsed().as_secs_f64(), k))).collect();
         let left: Option<Vec<f64>> = self.left().map(|i| self.typical_s(i)).collect();
         if let (Some(running), Some(left)) = (running, left) {
             let eta = eta_s(self.jobs, &running, self.steps, &left);

@@ -72,14 +72,8 @@ impl Report {
     /// The summary table (pose, status, wall time, increments, Fy at the final depth),
     /// then one paragraph per failure with its log tail.
     pub fn table(&self) -> String {
-        let mut s = format!(
-            "{:<10} {:<10} {:>9} {:>10} {:>14}\n",
-            "pose",
-            "status",
-            "wall_s",
-            "increments",
-            format!("fy_n@{}mm", self.depth_mm)
-        );
+        let mut s =
+            format!("{:<10} {:<10} {:>9} {:>10} {:>14}\n", "pose", "status", "wall_s", "increments", format!("fy_n@{}mm", self.depth_mm));
         let opt = |v: Option<String>| v.unwrap_or_else(|| "-".into());
         for p in &self.poses {
             let status = match p.status {

@@ -58,10 +58,7 @@ pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<Row>> {
         }
         let mut v = [0.0f64; 7];
         for (k, f) in fields.iter().enumerate() {
-            let x: f64 = f
-                .trim()
-                .parse()
-                .with_context(|| format!("{}:{n}: field {} = {f:?} is not a number", path.display(), k + 1))?;
+            let x: f64 = f.trim().parse().with_context(|| format!("{}:{n}: field {} = {f:?} is not a number", path.display(), k + 1))?;
             if !x.is_finite() {
                 bail!("{}:{n}: field {} = {f:?} is not finite", path.display(), k + 1);
             }

@@ -467,10 +467,7 @@ pub enum Role {
 impl Role {
     /// Whether the fitter may use runs of this role.
     pub fn is_fitted(self) -> bool {
-        matches!(
-            self,
-            Role::Centre | Role::SweepX | Role::SweepZ | Role::SweepThetaX | Role::SweepThetaZ
-        )
+        matches!(self, Role::Centre | Role::SweepX | Role::SweepZ | Role::SweepThetaX | Role::SweepThetaZ)
     }
     /// Whether the run is a validation run (never fitted).
     pub fn is_validation(self) -> bool {
@@ -516,10 +513,7 @@ impl PoseSpec {
     /// the double-bevel wedge about both of its own mid-planes, so a pose keeps plane
     /// x = 0 when x = 0 and theta_z = 0, and plane z = 0 when z = 0 and theta_x = 0.
     pub fn symmetry(&self) -> Symmetry {
-        Symmetry {
-            plane_x: self.x_mm == 0.0 && self.theta_z_deg == 0.0,
-            plane_z: self.z_mm == 0.0 && self.theta_x_deg == 0.0,
-        }
+        Symmetry { plane_x: self.x_mm == 0.0 && self.theta_z_deg == 0.0, plane_z: self.z_mm == 0.0 && self.theta_x_deg == 0.0 }
     }
 
     /// Unit vector along the needle axis from the tip towards the hub (at theta = 0: +y).
@@ -545,8 +539,7 @@ impl PoseSpec {
 /// and line), or a value is out of range (the message names the field and the value).
 pub fn load(set_dir: &Path) -> Result<(Campaign, PathBuf)> {
     let path = set_dir.join("campaign.toml");
-    let text = std::fs::read_to_string(&path)
-        .with_context(|| format!("{}: cannot read the campaign spec", path.display()))?;
+    let text = std::fs::read_to_string(&path).with_context(|| format!("{}: cannot read the campaign spec", path.display()))?;
     let campaign = parse(&text, &path)?;
     Ok((campaign, path))
 }
@@ -557,10 +550,7 @@ pub fn load(set_dir: &Path) -> Result<(Campaign, PathBuf)> {
 /// As [`load`].
 pub fn parse(text: &str, path: &Path) -> Result<Campaign> {
     let campaign: Campaign = toml::from_str(text).map_err(|e| {
-        let line = e
-            .span()
-            .map(|s| text[..s.start.min(text.len())].lines().count().max(1))
-            .unwrap_or(0);
+        let line = e.span().map(|s| text[..s.start.min(text.len())].lines().count().max(1)).unwrap_or(0);
         anyhow::anyhow!("{}:{}: {}", path.display(), line, e.message())
     })?;
     campaign.validate(path)?;
@@ -597,10 +587,7 @@ impl Campaign {
             }
         }
         if self.needle.wedge_half_angle_deg >= 90.0 {
-            bail!(
-                "{p}: needle.wedge_half_angle_deg = {}: must be < 90",
-                self.needle.wedge_half_angle_deg
-            );
+            bail!("{p}: needle.wedge_half_angle_deg = {}: must be < 90", self.needle.wedge_half_angle_deg);
         }
         if !(self.contact.friction.is_finite() && self.contact.friction >= 0.0) {
             bail!("{p}: contact.friction = {}: must be finite and >= 0", self.contact.friction);
@@ -616,20 +603,14 @@ impl Campaign {
             );
         }
         if self.contact.kind != "surface-to-surface" {
-            bail!(
-                "{p}: contact.type = {:?}: only \"surface-to-surface\" converges (node-to-surface did not)",
-                self.contact.kind
-            );
+            bail!("{p}: contact.type = {:?}: only \"surface-to-surface\" converges (node-to-surface did not)", self.contact.kind);
         }
         for (name, m) in &self.mesh {
             if m.core_elements < 2 || m.core_elements % 2 != 0 {
                 bail!("{p}: mesh.{name}.core_elements = {}: must be even and >= 2", m.core_elements);
             }
             if m.needle_facets_per_quarter < 2 {
-                bail!(
-                    "{p}: mesh.{name}.needle_facets_per_quarter = {}: must be >= 2",
-                    m.needle_facets_per_quarter
-                );
+                bail!("{p}: mesh.{name}.needle_facets_per_quarter = {}: must be >= 2", m.needle_facets_per_quarter);
             }
             for (f, v) in [
                 ("core_half_mm", m.core_half_mm),
@@ -677,10 +658,9 @@ impl Campaign {
         for name in &self.campaign.fit_without {
             match self.pose.iter().find(|q| &q.name == name) {
                 None => bail!("{p}: campaign.fit_without: {name:?} is not a listed pose"),
-                Some(q) if !q.role.is_fitted() || q.role == Role::Centre => bail!(
-                    "{p}: campaign.fit_without: pose {name:?} has role {:?}; only sweep runs can be left out of the fit",
-                    q.role
-                ),
+                Some(q) if !q.role.is_fitted() || q.role == Role::Centre => {
+                    bail!("{p}: campaign.fit_without: pose {name:?} has role {:?}; only sweep runs can be left out of the fit", q.role)
+                }
                 Some(_) => {}
             }
         }
@@ -772,10 +752,7 @@ impl Campaign {
     /// No such level in `[mesh.*]`.
     pub fn mesh_level(&self, name: &str) -> Result<&MeshLevel> {
         self.mesh.get(name).with_context(|| {
-            format!(
-                "no mesh level {name:?} in the spec (levels: {})",
-                self.mesh.keys().cloned().collect::<Vec<_>>().join(", ")
-            )
+            format!("no mesh level {name:?} in the spec (levels: {})", self.mesh.keys().cloned().collect::<Vec<_>>().join(", "))
         })
     }
 
@@ -857,9 +834,7 @@ fn check_pose_in_block(pose: &PoseSpec, block: &Block, radius_mm: f64, depth_mm:
 }
 
 fn check_pose(pose: &PoseSpec, p: &str) -> Result<()> {
-    if pose.name.is_empty()
-        || !pose.name.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '+' | '_'))
-    {
+    if pose.name.is_empty() || !pose.name.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '+' | '_')) {
         bail!("{p}: pose name {:?}: use letters, digits, '-', '+', '_' only", pose.name);
     }
     for (f, v, max, unit) in [
@@ -963,14 +938,7 @@ mod tests {
     fn select_takes_comma_separated_globs_in_spec_order() {
         let poses: Vec<PoseSpec> = ["centre", "lhs-03", "lhs-09", "lhs-10", "lhs-13"]
             .iter()
-            .map(|n| PoseSpec {
-                name: (*n).to_owned(),
-                role: Role::Lhs,
-                x_mm: 0.0,
-                z_mm: 0.0,
-                theta_x_deg: 0.0,
-                theta_z_deg: 0.0,
-            })
+            .map(|n| PoseSpec { name: (*n).to_owned(), role: Role::Lhs, x_mm: 0.0, z_mm: 0.0, theta_x_deg: 0.0, theta_z_deg: 0.0 })
             .collect();
         let all = select(&poses, None).map(|v| names(&v)).ok();
         assert_eq!(all.map(|v| v.len()), Some(5));

@@ -57,9 +57,8 @@ pub fn parse(core: &Core, output: &str) -> anyhow::Result<CoreFigures> {
     if field(head, "deterministic") != Some("yes") {
         bail!("the bench ran without QEMU -icount shift=0 (two equal loops took different SysTick ticks): {head:?}");
     }
-    let num = |k: &str| -> anyhow::Result<u64> {
-        field(head, k).and_then(|v| v.parse().ok()).with_context(|| format!("no {k} in {head:?}"))
-    };
+    let num =
+        |k: &str| -> anyhow::Result<u64> { field(head, k).and_then(|v| v.parse().ok()).with_context(|| format!("no {k} in {head:?}")) };
     let calibration = (num("calibration_instructions")?, num("calibration_ticks")?);
     let mut poses = Vec::new();
     let mut ended = false;
@@ -71,17 +70,14 @@ pub fn parse(core: &Core, output: &str) -> anyhow::Result<CoreFigures> {
         let ctx = || format!("bench line {line:?}");
         let pose = field(line, "pose").with_context(ctx)?.to_string();
         let evaluator = field(line, "evaluator").with_context(ctx)?.to_string();
-        let instructions: f64 =
-            field(line, "instructions_per_wrench").and_then(|v| v.parse().ok()).with_context(ctx)?;
+        let instructions: f64 = field(line, "instructions_per_wrench").and_then(|v| v.parse().ok()).with_context(ctx)?;
         let stack = field(line, "stack_bytes").with_context(ctx)?;
         if stack.starts_with(">=") {
             bail!("{}: the stack use of one wrench filled the whole painted window ({stack} bytes)", core.core);
         }
         let stack_bytes = stack.parse().ok().with_context(ctx)?;
-        let status = field(line, "status")
-            .and_then(|s| s.strip_prefix("0x"))
-            .and_then(|s| u8::from_str_radix(s, 16).ok())
-            .with_context(ctx)?;
+        let status =
+            field(line, "status").and_then(|s| s.strip_prefix("0x")).and_then(|s| u8::from_str_radix(s, 16).ok()).with_context(ctx)?;
         poses.push(PoseFigures { pose, evaluator, instructions, stack_bytes, status });
     }
     if !ended || poses.is_empty() {

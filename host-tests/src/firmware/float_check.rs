@@ -13,8 +13,7 @@ pub fn is_float_helper(name: &str) -> bool {
     let aeabi_float = name.starts_with("__aeabi_f")
         || name.starts_with("__aeabi_d")
         || (name.starts_with("__aeabi_") && (name.ends_with("2f") || name.ends_with("2d")));
-    let libgcc = ["sf3", "df3", "sf2", "df2"].iter().any(|s| name.ends_with(s))
-        && name.starts_with("__")
+    let libgcc = ["sf3", "df3", "sf2", "df2"].iter().any(|s| name.ends_with(s)) && name.starts_with("__")
         || name.starts_with("__float")
         || name.starts_with("__fix");
     aeabi_float || libgcc || name.contains("compiler_builtins::float")

@@ -11,13 +11,10 @@ use std::path::Path;
 use std::time::Duration;
 
 /// The golden file's header line.
-pub const HEADER: &str =
-    "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,status,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm";
+pub const HEADER: &str = "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,status,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm";
 
-const COLUMNS: [&str; 12] = [
-    "x_mm", "z_mm", "theta_x_deg", "theta_z_deg", "depth_mm", "status", "fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm",
-    "mz_nmm",
-];
+const COLUMNS: [&str; 12] =
+    ["x_mm", "z_mm", "theta_x_deg", "theta_z_deg", "depth_mm", "status", "fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"];
 
 /// Result of comparing one firmware run with the golden file.
 #[derive(Debug)]
@@ -101,14 +98,7 @@ pub fn compare(output: &str, csv: &str, fe_sha256: &str) -> anyhow::Result<Compa
                 bail!("golden line {line}, {}: {:?} / firmware {:?} is not 0x and 8 hex digits", COLUMNS[c], wf[c], gf[c]);
             };
             if !same_f32(a, b) {
-                diffs.push(format!(
-                    "{} want {} ({:e}) got {} ({:e})",
-                    COLUMNS[c],
-                    wf[c],
-                    f32::from_bits(a),
-                    gf[c],
-                    f32::from_bits(b)
-                ));
+                diffs.push(format!("{} want {} ({:e}) got {} ({:e})", COLUMNS[c], wf[c], f32::from_bits(a), gf[c], f32::from_bits(b)));
             }
         }
         if !diffs.is_empty() {
@@ -146,8 +136,7 @@ pub fn run(core: &Core, set: &Path) -> anyhow::Result<CoreRun> {
     let golden = set.join("golden-f32.csv");
     let csv = std::fs::read_to_string(&golden).with_context(|| format!("cannot read {}", golden.display()))?;
     let golden_fixed = set.join("golden-fixed.csv");
-    let csv_fixed =
-        std::fs::read_to_string(&golden_fixed).with_context(|| format!("cannot read {}", golden_fixed.display()))?;
+    let csv_fixed = std::fs::read_to_string(&golden_fixed).with_context(|| format!("cannot read {}", golden_fixed.display()))?;
     let model_path = set.join(needle_codegen::MODEL_FILE);
     let model = needle_codegen::parse_model(&model_path).map_err(anyhow::Error::new)?;
     let elf = build::build_examples(core, &["golden"], set)?.remove(0);
@@ -163,8 +152,8 @@ pub fn run(core: &Core, set: &Path) -> anyhow::Result<CoreRun> {
             run.stderr.trim()
         );
     }
-    let comparison = compare(&run.stdout, &csv, &model.fe_sha256)
-        .with_context(|| format!("golden firmware on {} ({})", core.core, core.machine))?;
+    let comparison =
+        compare(&run.stdout, &csv, &model.fe_sha256).with_context(|| format!("golden firmware on {} ({})", core.core, core.machine))?;
     let fixed = super::golden_fixed::compare(&run.stdout, &csv_fixed)
         .with_context(|| format!("golden firmware on {} ({}), fixed point", core.core, core.machine))?;
     Ok(CoreRun { core: *core, comparison, fixed, run_time: run.elapsed })

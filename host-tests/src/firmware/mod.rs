@@ -38,13 +38,7 @@ pub struct Core {
 
 /// The three reference cores, in report order.
 pub const CORES: [Core; 3] = [
-    Core {
-        name: "m4f",
-        core: "Cortex-M4F",
-        target: "thumbv7em-none-eabihf",
-        machine: "mps2-an386",
-        cpu: "cortex-m4",
-    },
+    Core { name: "m4f", core: "Cortex-M4F", target: "thumbv7em-none-eabihf", machine: "mps2-an386", cpu: "cortex-m4" },
     Core { name: "m3", core: "Cortex-M3", target: "thumbv7m-none-eabi", machine: "mps2-an385", cpu: "cortex-m3" },
     Core { name: "m0", core: "Cortex-M0", target: "thumbv6m-none-eabi", machine: "microbit", cpu: "cortex-m0" },
 ];
@@ -92,8 +86,7 @@ pub fn compiled_set() -> PathBuf {
 /// The folder, its `model.toml`, `golden-f32.csv` or `golden-fixed.csv` is missing: the firmware would
 /// hold the unfitted placeholder model, whose figures mean nothing.
 pub fn fitted_set(set: &Path) -> anyhow::Result<PathBuf> {
-    let dir = std::fs::canonicalize(set)
-        .map_err(|e| anyhow::anyhow!("{}: not a coefficient set folder ({e})", set.display()))?;
+    let dir = std::fs::canonicalize(set).map_err(|e| anyhow::anyhow!("{}: not a coefficient set folder ({e})", set.display()))?;
     for file in [needle_codegen::MODEL_FILE, "golden-f32.csv", "golden-fixed.csv"] {
         if !dir.join(file).is_file() {
             anyhow::bail!(

@@ -26,17 +26,13 @@ use std::process::Command;
 /// # Errors
 /// Neither is on `PATH`.
 pub fn binutil(name: &str) -> anyhow::Result<PathBuf> {
-    find_on_path(&format!("arm-none-eabi-{name}")).or_else(|| find_on_path(name)).ok_or_else(|| {
-        anyhow::anyhow!("neither arm-none-eabi-{name} nor {name} is on PATH: `apt-get install binutils-arm-none-eabi`")
-    })
+    find_on_path(&format!("arm-none-eabi-{name}"))
+        .or_else(|| find_on_path(name))
+        .ok_or_else(|| anyhow::anyhow!("neither arm-none-eabi-{name} nor {name} is on PATH: `apt-get install binutils-arm-none-eabi`"))
 }
 
 fn output(program: &Path, args: &[&str], elf: &Path) -> anyhow::Result<String> {
-    let out = Command::new(program)
-        .args(args)
-        .arg(elf)
-        .output()
-        .with_context(|| format!("cannot run {}", program.display()))?;
+    let out = Command::new(program).args(args).arg(elf).output().with_context(|| format!("cannot run {}", program.display()))?;
     if !out.status.success() {
         bail!("{} {} {}: {}", program.display(), args.join(" "), elf.display(), String::from_utf8_lossy(&out.stderr));
     }
@@ -168,8 +164,7 @@ pub fn measure(core: &Core, elf: &Path, evaluator: &'static str) -> anyhow::Resu
     let tables = section_size(&sysv, ".rodata");
     let symbols = parse_nm(&output(&nm, &["-S", "-C"], elf)?);
     let code = |s: &&Symbol| matches!(s.kind, 't' | 'T' | 'W' | 'w');
-    let evaluator_code =
-        symbols.iter().filter(code).filter(|s| s.name.starts_with("needle_haptics::")).cloned().collect();
+    let evaluator_code = symbols.iter().filter(code).filter(|s| s.name.starts_with("needle_haptics::")).cloned().collect();
     let which = evaluator;
     let runtime = symbols.iter().filter(code).filter(|s| is_runtime(&s.name)).cloned().collect();
     let rodata_start = symbols.iter().find(|s| s.name == "__srodata").map(|s| s.addr);

@@ -17,7 +17,7 @@
 //! training runs ([`select`]).
 
 use super::contract::{Pose64, COMPONENTS};
-use super::cross_terms::{monomials, mono, normalised, CrossForm, CrossTerms, Exponents, CANDIDATES};
+use super::cross_terms::{mono, monomials, normalised, CrossForm, CrossTerms, Exponents, CANDIDATES};
 use super::data::Run;
 use super::eval_f64::{eval_paper, eval_with_cross};
 use super::lsq::lstsq;
@@ -150,11 +150,7 @@ pub fn select(paper: &Model, runs: &[&Run], scale: [f64; 6]) -> Result<(CrossFor
         bail!("the coupled form needs training runs (role train): {} found", runs.len());
     }
     let scores: Vec<CvScore> = CANDIDATES.iter().map(|&f| cross_validate(paper, runs, f, scale)).collect();
-    let best = scores
-        .iter()
-        .filter(|s| s.rms_pct.is_some())
-        .min_by(|a, b| a.worst().total_cmp(&b.worst()))
-        .map(|s| s.form);
+    let best = scores.iter().filter(|s| s.rms_pct.is_some()).min_by(|a, b| a.worst().total_cmp(&b.worst())).map(|s| s.form);
     match best {
         Some(f) => Ok((f, scores)),
         None => bail!(

@@ -12,7 +12,7 @@ use super::cross_terms::CrossTerms;
 use super::data::{load_training_runs, load_validation_runs, Run};
 use super::eval_f64::{eval as eval_paper, eval_with_cross, Pose64};
 use super::model::Model;
-use super::validate::{TABLE2_MIN_DEPTH_MM};
+use super::validate::TABLE2_MIN_DEPTH_MM;
 use crate::fe::spec::Role;
 use anyhow::Result;
 use serde::Serialize;
@@ -90,10 +90,7 @@ pub fn held_out(runs: &[&Run], lever_arm_mm: f64, model: impl Fn(Pose64) -> [f64
             }
         }
         let n = r.rows.len().max(1) as f64;
-        let worst = (0..6)
-            .filter(|&c| scale[c] > 0.0)
-            .map(|c| 100.0 * (s[c] / n).sqrt() / scale[c])
-            .fold(0.0, f64::max);
+        let worst = (0..6).filter(|&c| scale[c] > 0.0).map(|c| 100.0 * (s[c] / n).sqrt() / scale[c]).fold(0.0, f64::max);
         match r.pose.role {
             Role::Lhs => h.lhs_worst_rms_pct = h.lhs_worst_rms_pct.max(worst),
             Role::Table2 => h.table2_worst_rms_pct = h.table2_worst_rms_pct.max(worst),
@@ -169,8 +166,13 @@ pub fn to_table(r: &CoupledReport) -> String {
         r.held_out_runs
     );
     if !r.cv.is_empty() {
-        let _ = writeln!(s, "{}-fold cross-validation on the training runs (RMS, % of their peak |Fy|; moments x lever arm):", coupled::FOLDS);
-        let _ = writeln!(s, "  {:>10} {:>10}  {:>6} {:>6} {:>6} {:>6} {:>6} {:>6}  worst", "pose deg", "depth deg", "fx", "fy", "fz", "mx", "my", "mz");
+        let _ =
+            writeln!(s, "{}-fold cross-validation on the training runs (RMS, % of their peak |Fy|; moments x lever arm):", coupled::FOLDS);
+        let _ = writeln!(
+            s,
+            "  {:>10} {:>10}  {:>6} {:>6} {:>6} {:>6} {:>6} {:>6}  worst",
+            "pose deg", "depth deg", "fx", "fy", "fz", "mx", "my", "mz"
+        );
         for c in &r.cv {
             match c.rms_pct {
                 Some(e) => {
@@ -190,7 +192,13 @@ pub fn to_table(r: &CoupledReport) -> String {
                     );
                 }
                 None => {
-                    let _ = writeln!(s, "  {:>10} {:>10}  not fitted: {}", c.form.max_degree, c.form.depth_degree, c.failure.as_deref().unwrap_or(""));
+                    let _ = writeln!(
+                        s,
+                        "  {:>10} {:>10}  not fitted: {}",
+                        c.form.max_degree,
+                        c.form.depth_degree,
+                        c.failure.as_deref().unwrap_or("")
+                    );
                 }
             }
         }

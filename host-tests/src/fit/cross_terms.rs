@@ -14,8 +14,8 @@
 //! when `c` is odd under the first mirror, and its degree in `(zeta, alpha)` likewise
 //! under the second; every kept term then has `c`'s parities, for every coefficient value.
 
-use super::contract::{u_of, Sweep, DEPTH_MAX_MM};
 use super::contract::Pose64;
+use super::contract::{u_of, Sweep, DEPTH_MAX_MM};
 
 /// Exponents of `(xi, zeta, alpha, beta)` in one cross monomial.
 pub type Exponents = [u8; 4];
@@ -106,8 +106,8 @@ pub fn cross_value(t: &CrossTerms, pose: Pose64) -> [f64; 6] {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
     use super::super::contract::COMPONENTS;
+    use super::*;
 
     /// Every monomial flips exactly like its component under both mirrors.
     #[test]

@@ -62,12 +62,7 @@ pub fn sweep_of(role: Role) -> Option<Sweep> {
 fn sweep_value(pose: &PoseSpec, k: Sweep) -> (f64, f64) {
     let all = [pose.x_mm, pose.z_mm, pose.theta_x_deg, pose.theta_z_deg];
     let v = all[k.index()];
-    let others = all
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| *i != k.index())
-        .map(|(_, v)| v.abs())
-        .fold(0.0, f64::max);
+    let others = all.iter().enumerate().filter(|(i, _)| *i != k.index()).map(|(_, v)| v.abs()).fold(0.0, f64::max);
     (v, others)
 }
 
@@ -88,12 +83,7 @@ pub fn read_run(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Result<
     let rows = parse_csv(&text, &path)?;
     let steps = campaign.loading.steps;
     if rows.len() != steps as usize + 1 {
-        bail!(
-            "{}: {} depth rows, expected loading.steps + 1 = {} (an unfinished or failed run?)",
-            path.display(),
-            rows.len(),
-            steps + 1
-        );
+        bail!("{}: {} depth rows, expected loading.steps + 1 = {} (an unfinished or failed run?)", path.display(), rows.len(), steps + 1);
     }
     for (k, r) in (0u32..).zip(&rows) {
         let want = campaign.loading.depth_at(k);
@@ -173,11 +163,7 @@ pub fn load_fit_data(set_dir: &Path) -> Result<FitData> {
         );
     }
     let fitted = fitted_poses(&campaign);
-    let missing: Vec<&str> = fitted
-        .iter()
-        .filter(|p| !run_path(set_dir, p).is_file())
-        .map(|p| p.name.as_str())
-        .collect();
+    let missing: Vec<&str> = fitted.iter().filter(|p| !run_path(set_dir, p).is_file()).map(|p| p.name.as_str()).collect();
     if !missing.is_empty() {
         bail!(
             "{} of the {} fitted FE runs are missing from {}: {}\n(run `needle fe run --set {}` to finish the campaign; the fit needs the centre run, every sweep run not listed in campaign.fit_without and, for [fit] form = \"coupled\", every training run)",
@@ -190,10 +176,8 @@ pub fn load_fit_data(set_dir: &Path) -> Result<FitData> {
     }
 
     let manifest = read_set_manifest(set_dir)?;
-    let stale: Vec<String> = fitted
-        .iter()
-        .filter_map(|p| stale_reason(&manifest, &campaign, p).map(|why| format!("{}: {why}", p.name)))
-        .collect();
+    let stale: Vec<String> =
+        fitted.iter().filter_map(|p| stale_reason(&manifest, &campaign, p).map(|why| format!("{}: {why}", p.name))).collect();
     if !stale.is_empty() {
         bail!(
             "{} of the {} fitted FE runs in {} are stale:\n  {}\n(run `needle fe run --set {}`: it solves exactly the poses whose result is not current)",
@@ -267,8 +251,7 @@ pub fn load_fit_data(set_dir: &Path) -> Result<FitData> {
 /// # Errors
 /// A file cannot be read.
 pub fn fitted_fe_sha256(set_dir: &Path, poses: &[PoseSpec]) -> Result<String> {
-    let mut files: Vec<(String, PathBuf)> =
-        poses.iter().map(|p| (format!("{}.csv", p.name), run_path(set_dir, p))).collect();
+    let mut files: Vec<(String, PathBuf)> = poses.iter().map(|p| (format!("{}.csv", p.name), run_path(set_dir, p))).collect();
     fe_sha256(&mut files)
 }
 

@@ -27,11 +27,7 @@ pub fn trend(poses: &[[f64; 4]], worst_pct: &[f64]) -> Option<ErrorTrend> {
     }
     let tilt: Vec<f64> = poses.iter().map(|p| p[2].abs() + p[3].abs()).collect();
     let offset: Vec<f64> = poses.iter().map(|p| p[0].abs() + p[1].abs()).collect();
-    Some(ErrorTrend {
-        runs: poses.len(),
-        tilt_rho: spearman(&tilt, worst_pct)?,
-        offset_rho: spearman(&offset, worst_pct)?,
-    })
+    Some(ErrorTrend { runs: poses.len(), tilt_rho: spearman(&tilt, worst_pct)?, offset_rho: spearman(&offset, worst_pct)? })
 }
 
 /// Ranks 1..=n, ties given their mean rank.

@@ -3,9 +3,7 @@
 //! not call the `needle-haptics` library. Every operation is a plain binary32 `*`, `+`
 //! or `-` (Rust never fuses them), each rounded to nearest even on its own.
 
-use super::contract::{
-    NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z,
-};
+use super::contract::{NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z};
 use super::model::Model;
 
 /// The f32 nearest 1/3 (IEEE division is correctly rounded): 0x3eaaaaab.
@@ -161,7 +159,7 @@ pub fn eval(t: &Tables32, pose: [f32; 5]) -> ([f32; 6], u8) {
 /// `m = n_k1 * n_k2 * ...`: each input `k` in order repeated `e[k]` times, multiplied
 /// left to right starting from the first factor.
 pub fn monomial32(e: [u8; 4], n: &[f32; 4]) -> f32 {
-    let mut factors = e.iter().zip(n).flat_map(|(&k, &v)| std::iter::repeat(v).take(usize::from(k)));
+    let mut factors = e.iter().zip(n).flat_map(|(&k, &v)| std::iter::repeat_n(v, usize::from(k)));
     let first = factors.next().unwrap_or(1.0);
     factors.fold(first, |m, v| m * v)
 }

@@ -2,8 +2,7 @@
 //! the reference for validation and for the f32 evaluator's error.
 
 use super::contract::{
-    u_of, Sweep, DEPTH_MAX_MM, NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z,
-    STATUS_SAT_X, STATUS_SAT_Z,
+    u_of, Sweep, DEPTH_MAX_MM, NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z,
 };
 use super::cross_terms::{cross_value, CrossTerms};
 use super::model::Model;

@@ -7,9 +7,7 @@
 //! [`Overflow`] (the library, which computes in wrapping i32, would have produced garbage
 //! there). Products are floored with `div_euclid`, not shifts.
 
-use super::contract::{
-    Sweep, NCOEF, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z,
-};
+use super::contract::{Sweep, NCOEF, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z};
 use super::fixed_formats::{TablesFixed, LIMIT};
 use std::fmt;
 
@@ -120,7 +118,7 @@ pub fn eval(t: &TablesFixed, pose: [i32; 5]) -> Result<([i32; 6], u8), Overflow>
     for (c, terms) in t.cross.iter().enumerate() {
         for (e, p, f) in terms {
             let what = || format!("cross {c} {e:?}");
-            let mut factors = e.iter().zip(n).flat_map(|(&k, nk)| std::iter::repeat(nk).take(usize::from(k)));
+            let mut factors = e.iter().zip(n).flat_map(|(&k, nk)| std::iter::repeat_n(nk, usize::from(k)));
             let mut m = factors.next().unwrap_or(0);
             for nk in factors {
                 m = step(m, nk, 0, &what)?;

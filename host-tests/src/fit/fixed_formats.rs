@@ -26,8 +26,12 @@ pub struct TablesFixed {
     /// The coupled form's cross terms per component, file order: exponents, integer
     /// coefficients (`[i]` goes to `A_i`) and their fractional bits `F` (empty for the
     /// paper form).
-    pub cross: [Vec<([u8; 4], Vec<i64>, u32)>; 6],
+    pub cross: [Vec<CrossTermFixed>; 6],
 }
+
+/// One cross term in fixed point: exponents of (x, z, theta_x, theta_z), integer
+/// coefficients (`[i]` goes to `A_i`), fractional bits `F`.
+pub type CrossTermFixed = ([u8; 4], Vec<i64>, u32);
 
 /// Largest `f` with every quantised coefficient `|P_i| <= 2^30`: a cross term's format.
 fn cross_format(p: &[f64]) -> Option<(u32, Vec<i64>)> {
@@ -103,12 +107,8 @@ impl TablesFixed {
             }
         }
         for c in 0..6 {
-            let g_max = Sweep::ALL
-                .iter()
-                .flat_map(|k| t.row_frac[k.index()][c])
-                .chain(t.cross[c].iter().map(|x| x.2))
-                .min()
-                .unwrap_or(MAX_FRAC);
+            let g_max =
+                Sweep::ALL.iter().flat_map(|k| t.row_frac[k.index()][c]).chain(t.cross[c].iter().map(|x| x.2)).min().unwrap_or(MAX_FRAC);
             let bound_at = |g: u32| -> (i64, [i64; NCOEF]) {
                 let base = model.baseline[c].coeffs.map(|b| quantise(b, g));
                 let mut total = 0i64;

@@ -15,8 +15,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 /// Header line of golden-fixed.csv.
-pub const HEADER: &str =
-    "x_mm_q16,z_mm_q16,theta_x_deg_q16,theta_z_deg_q16,depth_mm_q16,status,fx_un,fy_un,fz_un,mx_unmm,my_unmm,mz_unmm";
+pub const HEADER: &str = "x_mm_q16,z_mm_q16,theta_x_deg_q16,theta_z_deg_q16,depth_mm_q16,status,fx_un,fy_un,fz_un,mx_unmm,my_unmm,mz_unmm";
 
 /// Seed of the random poses (ChaCha8).
 pub const GOLDEN_FIXED_SEED: u64 = 0x6e65_6564_6c65_0002;
@@ -44,9 +43,7 @@ pub fn poses() -> Vec<[i32; 5]> {
     let (min, max) = bounds();
     let mut out = Vec::with_capacity(4600);
     // 1. grid 5^5 with the edges (the bounds are multiples of 4)
-    let g: Vec<[i32; 5]> = (0..5)
-        .map(|i| std::array::from_fn(|n| (min[i] + (max[i] - min[i]) * n as i64 / 4) as i32))
-        .collect();
+    let g: Vec<[i32; 5]> = (0..5).map(|i| std::array::from_fn(|n| (min[i] + (max[i] - min[i]) * n as i64 / 4) as i32)).collect();
     out.extend(super::golden::grid(&g));
     // 2. random poses, uniform over the domain
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(GOLDEN_FIXED_SEED);

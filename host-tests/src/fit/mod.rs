@@ -75,27 +75,11 @@ pub fn summary(m: &model::Model) -> String {
     let _ = writeln!(s, "fit residuals (model - FE over the fitted runs and all depths)");
     let _ = writeln!(s, "{:<10} {:<8} {:>12} {:>12}  unit", "sweep", "comp", "rms", "max");
     for (c, b) in m.baseline.iter().enumerate() {
-        let _ = writeln!(
-            s,
-            "{:<10} {:<8} {:>12.4e} {:>12.4e}  {}",
-            "baseline",
-            COMPONENTS[c],
-            b.residual_rms,
-            b.residual_max,
-            unit(c)
-        );
+        let _ = writeln!(s, "{:<10} {:<8} {:>12.4e} {:>12.4e}  {}", "baseline", COMPONENTS[c], b.residual_rms, b.residual_max, unit(c));
     }
     for k in Sweep::ALL {
         for (c, d) in m.matrices[k.index()].iter().enumerate() {
-            let _ = writeln!(
-                s,
-                "{:<10} {:<8} {:>12.4e} {:>12.4e}  {}",
-                k.name(),
-                COMPONENTS[c],
-                d.residual_rms,
-                d.residual_max,
-                unit(c)
-            );
+            let _ = writeln!(s, "{:<10} {:<8} {:>12.4e} {:>12.4e}  {}", k.name(), COMPONENTS[c], d.residual_rms, d.residual_max, unit(c));
         }
     }
     s

@@ -3,10 +3,10 @@
 //! a 4th-order polynomial in the swept value; then the deviation shift; and the baseline.
 
 use super::contract::{u_of, Sweep, COMPONENTS, DEGREE, NCOEF};
+use super::cross_terms::CrossTerms;
 use super::data::{FitData, Run, SweepPoint};
 use super::eval_f64::{deviation, horner};
 use super::lsq::polyfit;
-use super::cross_terms::CrossTerms;
 use anyhow::{Context, Result};
 
 /// The centre run's polynomial in depth for one component.
@@ -91,8 +91,7 @@ pub fn rms_max(errors: impl IntoIterator<Item = f64>) -> (f64, f64) {
 fn depth_fit(run: &Run, c: usize) -> Result<[f64; NCOEF]> {
     let u: Vec<f64> = run.rows.iter().map(|r| u_of(r.depth_mm)).collect();
     let y: Vec<f64> = run.rows.iter().map(|r| r.wrench[c]).collect();
-    let p = polyfit(&u, &y, DEGREE)
-        .with_context(|| format!("depth fit of {} in {}", COMPONENTS[c], run.file_name))?;
+    let p = polyfit(&u, &y, DEGREE).with_context(|| format!("depth fit of {} in {}", COMPONENTS[c], run.file_name))?;
     Ok(to_array(&p))
 }
 
@@ -155,8 +154,7 @@ pub fn fit_baseline(centre: &Run, c: usize) -> Result<Baseline> {
     for v in coeffs.iter_mut() {
         *v = no_neg_zero(*v);
     }
-    let (residual_rms, residual_max) =
-        rms_max(centre.rows.iter().map(|r| horner(&coeffs, u_of(r.depth_mm)) - r.wrench[c]));
+    let (residual_rms, residual_max) = rms_max(centre.rows.iter().map(|r| horner(&coeffs, u_of(r.depth_mm)) - r.wrench[c]));
     Ok(Baseline { coeffs, residual_rms, residual_max })
 }
 
@@ -176,11 +174,5 @@ pub fn fit(data: &FitData) -> Result<Model> {
             matrices[k.index()][c] = fit_deviation(k, c, &data.sweeps[k.index()], &baseline[c].coeffs)?;
         }
     }
-    Ok(Model {
-        set: data.campaign.set.name.clone(),
-        fe_sha256: data.fe_sha256.clone(),
-        baseline,
-        matrices,
-        cross: None,
-    })
+    Ok(Model { set: data.campaign.set.name.clone(), fe_sha256: data.fe_sha256.clone(), baseline, matrices, cross: None })
 }

@@ -52,11 +52,7 @@ pub fn to_toml(model: &Model, left_out: &[String]) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "{HEADER_COMMENT}");
     if !left_out.is_empty() {
-        let _ = writeln!(
-            s,
-            "# Not fitted (campaign.toml, campaign.fit_without; the reason is written there): {}",
-            left_out.join(", ")
-        );
+        let _ = writeln!(s, "# Not fitted (campaign.toml, campaign.fit_without; the reason is written there): {}", left_out.join(", "));
     }
     let _ = writeln!(s, "# Format and evaluation algorithm: coeffs/README.md. Forces in N, moments in N*mm.");
     let _ = writeln!(s, "# u = depth_mm / 3 - 1; t = |v| * 2 / V - 1 with V = 12 mm (x, z) or 15 deg (theta_x, theta_z).");
@@ -276,11 +272,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Model> {
         let (k, c) = (Sweep::ALL[n / 6], n % 6);
         let what = format!("{p}: matrix {} (sweep {}, {})", n + 1, k.name(), COMPONENTS[c]);
         if m.sweep != k.name() || m.component != COMPONENTS[c] {
-            bail!(
-                "{what}: sweep = {:?}, component = {:?}: entries are sweep-major in contract order",
-                m.sweep,
-                m.component
-            );
+            bail!("{what}: sweep = {:?}, component = {:?}: entries are sweep-major in contract order", m.sweep, m.component);
         }
         if m.odd != k.is_odd(c) {
             bail!("{what}: odd = {}, the contract says {}", m.odd, k.is_odd(c));
@@ -332,7 +324,12 @@ fn parse_coupled(c: &FileCoupled, cross: &[FileCross], p: &str) -> Result<Couple
     for (comp, out) in terms.iter_mut().enumerate() {
         for e in monomials(comp, form.max_degree) {
             let Some((n, x)) = entries.next() else {
-                bail!("{p}: {} [[cross]] entries; {} {:?} is missing (entries: per component, monomials in the fitter's order)", cross.len(), COMPONENTS[comp], e);
+                bail!(
+                    "{p}: {} [[cross]] entries; {} {:?} is missing (entries: per component, monomials in the fitter's order)",
+                    cross.len(),
+                    COMPONENTS[comp],
+                    e
+                );
             };
             let what = format!("{p}: cross {} ({}, exponents {:?})", n + 1, x.component, x.exponents);
             if x.component != COMPONENTS[comp] || x.exponents.as_slice() != e.as_slice() {

@@ -23,8 +23,8 @@
 //! a missed goal.
 
 use super::contract::{unit, COMPONENTS};
-use super::error_trend::{trend, ErrorTrend};
 use super::data::{fitted_fe_sha256, fitted_poses, load_validation_runs, run_path, Run};
+use super::error_trend::{trend, ErrorTrend};
 use super::eval_f32::{eval as eval32, Tables32};
 use super::eval_f64::{eval as eval64, eval_paper};
 use super::model::{rms_max, Model};
@@ -69,7 +69,7 @@ impl Goals {
     }
 
     fn met(&self, role: Role, fy_rel_pct: f64, worst_rms_pct: f64, worst_max_pct: f64) -> Option<bool> {
-        let rms_ok = worst_rms_pct <= self.rms_pct && self.max_pct.map_or(true, |m| worst_max_pct <= m);
+        let rms_ok = worst_rms_pct <= self.rms_pct && self.max_pct.is_none_or(|m| worst_max_pct <= m);
         match role {
             Role::Table2 => Some(fy_rel_pct <= self.table2_fy_pct && rms_ok),
             Role::Lhs => Some(rms_ok),
@@ -196,8 +196,7 @@ fn fy_rel_max(models: &[&[[f64; 6]]], run: &Run) -> f64 {
 pub fn compare_run(model: &Model, tables: &Tables32, run: &Run, lever_arm_mm: f64) -> (RunReport, f64) {
     let p = &run.pose;
     let pose4 = [p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg];
-    let w64: Vec<[f64; 6]> =
-        run.rows.iter().map(|r| eval64(model, [pose4[0], pose4[1], pose4[2], pose4[3], r.depth_mm]).0).collect();
+    let w64: Vec<[f64; 6]> = run.rows.iter().map(|r| eval64(model, [pose4[0], pose4[1], pose4[2], pose4[3], r.depth_mm]).0).collect();
     let w32: Vec<[f64; 6]> = run
         .rows
         .iter()
@@ -276,10 +275,8 @@ pub fn validate(set_dir: &Path) -> Result<Report> {
     let table2_goal_met = goal(Role::Table2);
     let lhs_goal_met = goal(Role::Lhs);
     let judged: Vec<&RunReport> = reports.iter().filter(|r| r.goal_met.is_some()).collect();
-    let error_trend = trend(
-        &judged.iter().map(|r| r.pose).collect::<Vec<_>>(),
-        &judged.iter().map(|r| r.worst_rms_pct).collect::<Vec<_>>(),
-    );
+    let error_trend =
+        trend(&judged.iter().map(|r| r.pose).collect::<Vec<_>>(), &judged.iter().map(|r| r.worst_rms_pct).collect::<Vec<_>>());
     Ok(Report {
         set_dir: set_dir.display().to_string(),
         lever_arm_mm: lever,
@@ -322,7 +319,14 @@ pub fn to_table(r: &Report) -> String {
             let _ = writeln!(
                 s,
                 "{:<8} {:<7} {:<7} {:>11.3e} {:>11.3e} {:<5} {:>8.3} {:>8.3}",
-                run.name, run.role, COMPONENTS[c], e.rms, e.max, unit(c), e.rms_pct, e.max_pct
+                run.name,
+                run.role,
+                COMPONENTS[c],
+                e.rms,
+                e.max,
+                unit(c),
+                e.rms_pct,
+                e.max_pct
             );
         }
     }

@@ -7,11 +7,11 @@
 //! ([`crate::fit::eval_f64`]), FE points its current runs.
 
 use super::panel::{Panel, Series, Style, COMPONENT_COLOURS};
+use crate::fe::spec::Role;
 use crate::fit::contract::{unit, Sweep, COMPONENTS, DEPTH_MAX_MM};
 use crate::fit::data::{load_fit_data, load_validation_runs, Run};
 use crate::fit::eval_f64::eval;
 use crate::fit::model::Model;
-use crate::fe::spec::Role;
 use anyhow::Result;
 use plotters::style::RGBColor;
 use std::path::Path;
@@ -73,12 +73,22 @@ fn sweeps(model: &Model, sweep_runs: &[Vec<&Run>; 4], comps: [usize; 3]) -> Vec<
                         (v, eval(model, pose).0[c])
                     })
                     .collect();
-                series.push(Series { label: format!("{} model", COMPONENTS[c]), colour: COMPONENT_COLOURS[c], style: Style::Line, data: line });
+                series.push(Series {
+                    label: format!("{} model", COMPONENTS[c]),
+                    colour: COMPONENT_COLOURS[c],
+                    style: Style::Line,
+                    data: line,
+                });
                 let points = sweep_runs[k.index()]
                     .iter()
                     .filter_map(|r| r.rows.last().map(|last| (pose_of(r)[k.index()], last.wrench[c])))
                     .collect();
-                series.push(Series { label: format!("{} FE", COMPONENTS[c]), colour: COMPONENT_COLOURS[c], style: Style::Points, data: points });
+                series.push(Series {
+                    label: format!("{} FE", COMPONENTS[c]),
+                    colour: COMPONENT_COLOURS[c],
+                    style: Style::Points,
+                    data: points,
+                });
             }
             let unit = if comps[0] < 3 { "N" } else { "N*mm" };
             Panel {
@@ -108,7 +118,12 @@ fn fig8(model: &Model, table2: &[&Run]) -> Vec<Panel> {
                         style: Style::Line,
                         data: depth_grid().into_iter().map(|d| (d, eval(model, [p[0], p[1], p[2], p[3], d]).0[1])).collect(),
                     },
-                    Series { label: "FE".into(), colour: GREY, style: Style::Points, data: r.rows.iter().map(|x| (x.depth_mm, x.wrench[1])).collect() },
+                    Series {
+                        label: "FE".into(),
+                        colour: GREY,
+                        style: Style::Points,
+                        data: r.rows.iter().map(|x| (x.depth_mm, x.wrench[1])).collect(),
+                    },
                 ],
             }
         })
@@ -138,12 +153,22 @@ fn parity(model: &Model, held: &[&Run], lever_arm_mm: f64) -> Vec<Panel> {
                     hi = hi.max(f.max(m));
                 }
                 let pct = if scale > 0.0 { 100.0 * rms / scale } else { 0.0 };
-                series.push(Series { label: format!("{} (RMS {pct:.2} % of peak)", COMPONENTS[c]), colour: COMPONENT_COLOURS[c], style: Style::Points, data: pts });
+                series.push(Series {
+                    label: format!("{} (RMS {pct:.2} % of peak)", COMPONENTS[c]),
+                    colour: COMPONENT_COLOURS[c],
+                    style: Style::Points,
+                    data: pts,
+                });
             }
             if lo.is_finite() {
                 series.insert(0, Series { label: "model = FE".into(), colour: GREY, style: Style::Dashed, data: vec![(lo, lo), (hi, hi)] });
             }
-            Panel { title: format!("{what}: {} validation runs, every depth", held.len()), x_label: format!("FE ({u})"), y_label: format!("model ({u})"), series }
+            Panel {
+                title: format!("{what}: {} validation runs, every depth", held.len()),
+                x_label: format!("FE ({u})"),
+                y_label: format!("model ({u})"),
+                series,
+            }
         })
         .collect()
 }
@@ -172,7 +197,12 @@ fn verification(verify: &toml::Table) -> Vec<Panel> {
             y_label: "punch force (N)".into(),
             series: vec![
                 Series { label: "Sneddon (half-space)".into(), colour: GREY, style: Style::Dashed, data: vec![(0.0, fs), (1.0, fs)] },
-                Series { label: "FE, extrapolated to s -> inf".into(), colour: COMPONENT_COLOURS[1], style: Style::Points, data: vec![(1.0, f1), (0.5, f2), (0.0, fh)] },
+                Series {
+                    label: "FE, extrapolated to s -> inf".into(),
+                    colour: COMPONENT_COLOURS[1],
+                    style: Style::Points,
+                    data: vec![(1.0, f1), (0.5, f2), (0.0, fh)],
+                },
             ],
         });
     }
@@ -182,7 +212,8 @@ fn verification(verify: &toml::Table) -> Vec<Panel> {
             .filter_map(|l| Some((l.get("element_mm")?.as_float()?, l.get("fy_n")?.as_float()?)))
             .filter(|p| p.1.is_finite())
             .collect();
-        let mut series = vec![Series { label: "FE, centred needle".into(), colour: COMPONENT_COLOURS[1], style: Style::Points, data: pts.clone() }];
+        let mut series =
+            vec![Series { label: "FE, centred needle".into(), colour: COMPONENT_COLOURS[1], style: Style::Points, data: pts.clone() }];
         if let Some(r) = num(verify, &["mesh", "richardson_fy_n"]) {
             series.push(Series { label: "Richardson estimate (h -> 0)".into(), colour: GREY, style: Style::Points, data: vec![(0.0, r)] });
         }
@@ -231,18 +262,48 @@ pub fn figures(set_dir: &Path, model: &Model) -> Result<Vec<Figure>> {
     let table2: Vec<&Run> = validation.iter().filter(|r| r.pose.role == Role::Table2).collect();
     let held: Vec<&Run> = validation.iter().filter(|r| r.pose.role.is_validation()).collect();
     let mut out = vec![
-        Figure { file: "fig4-centre.svg", caption: format!("Set {set}: the six wrench components against depth, centred vertical needle (cf. the paper's Fig 4)"), panels: fig4(model, &data.centre), cols: 3 },
-        Figure { file: "fig6-forces.svg", caption: format!("Set {set}: forces at full depth against position and tilt (cf. Fig 6)"), panels: sweeps(model, &sweep_runs, [0, 1, 2]), cols: 2 },
-        Figure { file: "fig7-moments.svg", caption: format!("Set {set}: moments about the hub at full depth against position and tilt (cf. Fig 7)"), panels: sweeps(model, &sweep_runs, [3, 4, 5]), cols: 2 },
-        Figure { file: "fig8-validation.svg", caption: format!("Set {set}: Fy against depth at the Table 2 poses, FE and model (cf. Fig 8)"), panels: fig8(model, &table2), cols: 2 },
-        Figure { file: "parity.svg", caption: format!("Set {set}: model against FE, held-out runs (Table 2 and Latin hypercube)"), panels: parity(model, &held, campaign.needle.reference_from_tip_mm), cols: 2 },
+        Figure {
+            file: "fig4-centre.svg",
+            caption: format!("Set {set}: the six wrench components against depth, centred vertical needle (cf. the paper's Fig 4)"),
+            panels: fig4(model, &data.centre),
+            cols: 3,
+        },
+        Figure {
+            file: "fig6-forces.svg",
+            caption: format!("Set {set}: forces at full depth against position and tilt (cf. Fig 6)"),
+            panels: sweeps(model, &sweep_runs, [0, 1, 2]),
+            cols: 2,
+        },
+        Figure {
+            file: "fig7-moments.svg",
+            caption: format!("Set {set}: moments about the hub at full depth against position and tilt (cf. Fig 7)"),
+            panels: sweeps(model, &sweep_runs, [3, 4, 5]),
+            cols: 2,
+        },
+        Figure {
+            file: "fig8-validation.svg",
+            caption: format!("Set {set}: Fy against depth at the Table 2 poses, FE and model (cf. Fig 8)"),
+            panels: fig8(model, &table2),
+            cols: 2,
+        },
+        Figure {
+            file: "parity.svg",
+            caption: format!("Set {set}: model against FE, held-out runs (Table 2 and Latin hypercube)"),
+            panels: parity(model, &held, campaign.needle.reference_from_tip_mm),
+            cols: 2,
+        },
     ];
     let verify_path = set_dir.join("fe").join("verify.toml");
     if let Ok(text) = std::fs::read_to_string(&verify_path) {
         let t: toml::Table = text.parse().map_err(|e| anyhow::anyhow!("{}: {e}", verify_path.display()))?;
         let panels = verification(&t);
         if !panels.is_empty() {
-            out.push(Figure { file: "fe-verification.svg", caption: format!("Set {set}: FE verification (fe/verify.toml)"), panels, cols: 2 });
+            out.push(Figure {
+                file: "fe-verification.svg",
+                caption: format!("Set {set}: FE verification (fe/verify.toml)"),
+                panels,
+                cols: 2,
+            });
         }
     }
     Ok(out)

@@ -47,8 +47,7 @@ pub fn golden_rows() -> Vec<GoldenRow> {
 /// `count` golden rows inside the domain (status OK) with a non-zero force, spread over
 /// the file.
 pub fn golden_in_domain(count: usize) -> Vec<GoldenRow> {
-    let ok: Vec<GoldenRow> =
-        golden_rows().into_iter().filter(|r| r.status.is_ok() && r.wrench.fy_n.abs() > 1e-3).collect();
+    let ok: Vec<GoldenRow> = golden_rows().into_iter().filter(|r| r.status.is_ok() && r.wrench.fy_n.abs() > 1e-3).collect();
     assert!(ok.len() >= count, "only {} in-domain golden rows with |fy| > 1 mN", ok.len());
     let stride = ok.len() / count;
     ok.into_iter().step_by(stride).take(count).collect()

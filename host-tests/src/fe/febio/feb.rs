@@ -110,19 +110,12 @@ pub fn write_with_symmetry(
     write_load_data(&mut w, depth, steps);
     let _ = writeln!(w, "  <Output>");
     let _ = writeln!(w, "    <logfile>");
-    let _ = writeln!(
-        w,
-        r#"      <rigid_body_data data="Fx;Fy;Fz;Mx;My;Mz" file="{RIGID_LOG}" delim=",">{NEEDLE_MAT_ID}</rigid_body_data>"#
-    );
+    let _ =
+        writeln!(w, r#"      <rigid_body_data data="Fx;Fy;Fz;Mx;My;Mz" file="{RIGID_LOG}" delim=",">{NEEDLE_MAT_ID}</rigid_body_data>"#);
     let _ = writeln!(w, "    </logfile>");
     let _ = writeln!(w, "  </Output>");
     let _ = writeln!(w, "</febio_spec>");
-    Ok(Feb {
-        text: w,
-        summary: MeshSummary::of(&t, &n, sym),
-        steps,
-        symmetry: sym,
-    })
+    Ok(Feb { text: w, summary: MeshSummary::of(&t, &n, sym), steps, symmetry: sym })
 }
 
 fn write_control(w: &mut String, s: &FebioSettings, depth: f64, steps: u32, dt_fraction: f64) {

@@ -11,7 +11,7 @@ pub mod feb;
 pub mod logs;
 pub mod restart;
 
-use crate::fe::backend::{Backend, Job, Solved, SolveFailure};
+use crate::fe::backend::{Backend, Job, SolveFailure, Solved};
 use crate::fe::process::{self, ExitKind, LOG_TAIL_LINES};
 use crate::fe::wrench::expand_mirrors;
 use anyhow::{bail, Context, Result};
@@ -62,9 +62,8 @@ pub fn find_febio() -> Result<PathBuf> {
             return Ok(c);
         }
     }
-    process::which(Path::new("febio4")).context(
-        "febio4 not found: run .ci/install-febio (builds FEBio 4.11 into ~/.cache/needle-haptics), or set FEBIO to your febio4",
-    )
+    process::which(Path::new("febio4"))
+        .context("febio4 not found: run .ci/install-febio (builds FEBio 4.11 into ~/.cache/needle-haptics), or set FEBIO to your febio4")
 }
 
 /// The version `febio4 -info -norun` prints ("FEBio version  = 4.11.0"; with stdin
@@ -79,9 +78,8 @@ pub fn febio_version(exe: &Path) -> Result<String> {
         .output()
         .with_context(|| format!("{}: cannot start", exe.display()))?;
     let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
-    parse_version(&text).with_context(|| {
-        format!("{} -info: no FEBio version in its output ({}): is it febio4?", exe.display(), process::tail(&text, 5))
-    })
+    parse_version(&text)
+        .with_context(|| format!("{} -info: no FEBio version in its output ({}): is it febio4?", exe.display(), process::tail(&text, 5)))
 }
 
 /// The version in FEBio's banner or `-info` output: the word after "version".
@@ -254,7 +252,8 @@ impl Backend for FebioBackend {
             std::fs::copy(job.work_dir.join(restart::DUMP), &from).with_context(|| format!("{}: cannot write", from.display()))?;
             let dtmin = step_mm * campaign.solver.febio.dtmin_fraction * restart::CONTINUE_DTMIN_SCALE;
             let input = job.work_dir.join(restart::RESTART_INPUT);
-            std::fs::write(&input, restart::restart_input(step_mm * fraction, dtmin)).with_context(|| format!("{}: cannot write", input.display()))?;
+            std::fs::write(&input, restart::restart_input(step_mm * fraction, dtmin))
+                .with_context(|| format!("{}: cannot write", input.display()))?;
             cont.from_mm.push(last_mm);
         };
         // the dumps are large (tens of MB) and only needed while the run goes on
@@ -393,7 +392,9 @@ mod tests {
     fn fake_febio(dir: &Path, stuck: bool) -> PathBuf {
         use std::os::unix::fs::PermissionsExt;
         let rb = |ts: &[(f64, f64)]| -> String {
-            ts.iter().map(|(t, v)| format!("*Step  = 1\\n*Time  = {t}\\n*Data  = Fx;Fy;Fz;Mx;My;Mz\\n2,{v},{v},{v},{v},{v},{v}\\n")).collect()
+            ts.iter()
+                .map(|(t, v)| format!("*Step  = 1\\n*Time  = {t}\\n*Data  = Fx;Fy;Fz;Mx;My;Mz\\n2,{v},{v},{v},{v},{v},{v}\\n"))
+                .collect()
         };
         let restart = if stuck {
             "printf ' ------- failed to converge at time : 3.1\\n E R R O R   T E R M I N A T I O N\\n' > pose.log; exit 1".to_string()
@@ -425,7 +426,8 @@ mod tests {
         let d = tempfile::tempdir().expect("tempdir");
         let set = d.path().join("set");
         std::fs::create_dir_all(&set).expect("mkdir");
-        std::fs::copy(Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default/campaign.toml"), set.join("campaign.toml")).expect("copy");
+        std::fs::copy(Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default/campaign.toml"), set.join("campaign.toml"))
+            .expect("copy");
         let (mut c, _) = crate::fe::spec::load(&set).expect("spec");
         c.loading.steps = 4;
         let pose = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");
@@ -449,10 +451,18 @@ mod tests {
             let r = backend.solve(&job);
             assert!(!work.join(restart::DUMP).exists() && !work.join(restart::DUMP_FROM).exists(), "dumps removed");
             if stuck {
-                let f = r.err().expect("a continuation without progress, twice: failed");
-                assert!(f.message.contains("after 2 of 4 steps") && f.message.contains("continued 2 time(s) from the last converged must point (3, 3 mm)"), "{}", f.message);
+                let f = r.expect_err("a continuation without progress, twice: failed");
+                assert!(
+                    f.message.contains("after 2 of 4 steps")
+                        && f.message.contains("continued 2 time(s) from the last converged must point (3, 3 mm)"),
+                    "{}",
+                    f.message
+                );
                 let restart = std::fs::read_to_string(work.join(restart::RESTART_INPUT)).expect("restart input");
-                assert!(restart.contains(&format!("<step_size>{:e}</step_size>", 1.5 * restart::CONTINUE_STEP_FRACTION_AGAIN)), "{restart}");
+                assert!(
+                    restart.contains(&format!("<step_size>{:e}</step_size>", 1.5 * restart::CONTINUE_STEP_FRACTION_AGAIN)),
+                    "{restart}"
+                );
             } else {
                 let s = r.unwrap_or_else(|f| panic!("continued run: {}", f.message));
                 let fy: Vec<f64> = s.wrenches.iter().map(|w| w[1]).collect();

@@ -70,7 +70,8 @@ pub fn human(s: f64) -> String {
 pub fn table(opts: &RunOptions, nodes: &[usize], tasks_per_node: usize) -> Result<String> {
     let plan = campaign::plan(opts)?;
     let engine = plan.campaign.solver.engine.name();
-    let measured = |e: &&crate::fe::manifest::ManifestEntry| e.engine == engine && e.mesh == plan.mesh_name && e.steps == plan.steps && e.wall_s > 0.0;
+    let measured =
+        |e: &&crate::fe::manifest::ManifestEntry| e.engine == engine && e.mesh == plan.mesh_name && e.steps == plan.steps && e.wall_s > 0.0;
     let by_kind = plan.manifest.wall_times_s(engine, &plan.mesh_name, plan.steps);
     let median = |v: &Vec<f64>| {
         let mut v = v.clone();
@@ -125,7 +126,7 @@ mod tests {
         // the longest run bounds it from below, the mean load too
         let w: Vec<f64> = (1..=40).map(f64::from).collect();
         let m = makespan_s(&w, 4);
-        assert!(m >= 820.0 / 4.0 && m <= 820.0 / 4.0 + 40.0, "{m}");
+        assert!((820.0 / 4.0..=820.0 / 4.0 + 40.0).contains(&m), "{m}");
         let p = project(&w, &[1, 2], 2);
         assert_eq!((p[0].slots, p[1].slots), (2, 4));
         assert!(p[1].speedup > p[0].speedup);

@@ -138,12 +138,8 @@ impl Resources {
     /// level, left to the partition's defaults. The options override them.
     pub fn defaults(plan: &Plan, attempts: u32, slurm: &SlurmOptions) -> Resources {
         let engine = plan.campaign.solver.engine.name();
-        let runs: Vec<_> = plan
-            .manifest
-            .pose
-            .values()
-            .filter(|e| e.engine == engine && e.mesh == plan.mesh_name && e.steps == plan.steps)
-            .collect();
+        let runs: Vec<_> =
+            plan.manifest.pose.values().filter(|e| e.engine == engine && e.mesh == plan.mesh_name && e.steps == plan.steps).collect();
         let mut why = Vec::new();
         let max_wall = runs.iter().map(|e| e.wall_s).filter(|w| w.is_finite()).fold(0.0_f64, f64::max);
         let time = match &slurm.time {
@@ -158,7 +154,10 @@ impl Resources {
                 Some(min.to_string())
             }
             None => {
-                why.push(format!("--time: the partition's default (no measured {engine} run on mesh {} with {} steps)", plan.mesh_name, plan.steps));
+                why.push(format!(
+                    "--time: the partition's default (no measured {engine} run on mesh {} with {} steps)",
+                    plan.mesh_name, plan.steps
+                ));
                 None
             }
         };
@@ -167,7 +166,9 @@ impl Resources {
             Some(m) => Some(m.clone()),
             None if max_rss > 0.0 => {
                 let mib = ((max_rss * MEM_FACTOR + MEM_NEEDLE_MIB) / 64.0).ceil() as u64 * 64;
-                why.push(format!("--mem {mib}M: the largest measured solver peak ({max_rss:.0} MiB) x {MEM_FACTOR} + {MEM_NEEDLE_MIB} MiB"));
+                why.push(format!(
+                    "--mem {mib}M: the largest measured solver peak ({max_rss:.0} MiB) x {MEM_FACTOR} + {MEM_NEEDLE_MIB} MiB"
+                ));
                 Some(format!("{mib}M"))
             }
             None => {
@@ -212,7 +213,8 @@ pub fn submit(opts: &RunOptions, slurm: &SlurmOptions) -> Result<SubmitReport> {
     let earlier = read_submissions(&plan.out_dir)?;
     let queued = queue_states(&earlier)?;
     let latest = earlier.latest_tasks();
-    let mut report = SubmitReport { selected: plan.selected.len(), up_to_date: Vec::new(), in_queue: Vec::new(), submission: None, resources: None };
+    let mut report =
+        SubmitReport { selected: plan.selected.len(), up_to_date: Vec::new(), in_queue: Vec::new(), submission: None, resources: None };
     let to_run = plan.to_run_names();
     for p in &plan.selected {
         if !to_run.contains(&p.name) {
@@ -390,7 +392,10 @@ pub struct QueueState {
 impl QueueState {
     /// Pending, running or about to run: a resubmission must not submit its pose again.
     pub fn is_active(&self) -> bool {
-        !matches!(self.state.as_str(), "COMPLETED" | "FAILED" | "CANCELLED" | "TIMEOUT" | "OUT_OF_MEMORY" | "NODE_FAIL" | "PREEMPTED" | "BOOT_FAIL" | "DEADLINE")
+        !matches!(
+            self.state.as_str(),
+            "COMPLETED" | "FAILED" | "CANCELLED" | "TIMEOUT" | "OUT_OF_MEMORY" | "NODE_FAIL" | "PREEMPTED" | "BOOT_FAIL" | "DEADLINE"
+        )
     }
 }
 

@@ -16,9 +16,8 @@ pub mod punch_febio;
 pub use mesh_check::{richardson, LevelRun, MeshReport, MESH_GOAL_PERCENT};
 pub use mirror::MirrorReport;
 pub use punch::{
-    bonded_punch_force, poisson, punch_deck, punch_mesh, sneddon_force, PunchDeck, PunchElement, PunchReport,
-    PunchRun, PUNCH_CORE_ELEMENTS_C3D20R, PUNCH_CORE_ELEMENTS_C3D8, PUNCH_GOAL_PERCENT, PUNCH_GROWTH,
-    PUNCH_MU_N_PER_MM2,
+    bonded_punch_force, poisson, punch_deck, punch_mesh, sneddon_force, PunchDeck, PunchElement, PunchReport, PunchRun,
+    PUNCH_CORE_ELEMENTS_C3D20R, PUNCH_CORE_ELEMENTS_C3D8, PUNCH_GOAL_PERCENT, PUNCH_GROWTH, PUNCH_MU_N_PER_MM2,
 };
 
 use super::results;
@@ -108,7 +107,14 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
             println!(
                 "  campaign element {}: F(block) = {:.5e} N, F(2x block) = {:.5e} N, F(half-space) = {:.5e} N: {:+.2}% \
                  (no goal: volumetric locking of the fully integrated C3D8 at K0/mu0 = {}); ccx {:.0} s + {:.0} s",
-                r.element, r.force_block_n, r.force_block_2x_n, r.force_half_space_n, r.error_percent, p.bulk_to_shear, r.wall_s[0], r.wall_s[1]
+                r.element,
+                r.force_block_n,
+                r.force_block_2x_n,
+                r.force_half_space_n,
+                r.error_percent,
+                p.bulk_to_shear,
+                r.wall_s[0],
+                r.wall_s[1]
             );
         }
         ok &= p.check.error_percent.abs() <= p.goal_percent;

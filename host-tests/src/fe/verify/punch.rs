@@ -373,7 +373,8 @@ pub fn punch_deck(c: &Campaign, mesh: &spec::MeshLevel, el: PunchElement, a: f64
     let d1 = 2.0 / k0;
     let mut s = String::with_capacity(120 * (nodes.len() + elements.len()));
     let _ = writeln!(s, "** needle-haptics flat-punch verification: radius {a} mm, indentation {delta} mm, block scaled {scale}x");
-    let _ = writeln!(s, "** quarter model (mirror planes x = 0, z = 0), bonded rigid punch: the nodes under it have a prescribed displacement");
+    let _ =
+        writeln!(s, "** quarter model (mirror planes x = 0, z = 0), bonded rigid punch: the nodes under it have a prescribed displacement");
     let _ = writeln!(s, "** tissue mesh: {}; {} {} elements; units mm, N, N/mm^2", t.info, elements.len(), el.name());
     let _ = writeln!(s, "*NODE, NSET=NBLOCK");
     for (i, p) in nodes.iter().enumerate() {
@@ -399,7 +400,10 @@ pub fn punch_deck(c: &Campaign, mesh: &spec::MeshLevel, el: PunchElement, a: f64
         }
     }
     let _ = writeln!(s, "** neo-Hookean, mu = {mu:e} N/mm^2, K0 = {k0:e} N/mm^2: C10 = mu/2, D1 = 2/K0");
-    let _ = writeln!(s, "** (the same energy as Ogden N=1, alpha=2; ccx's Ogden law does not converge here, see host-tests/src/fe/verify/punch.rs)");
+    let _ = writeln!(
+        s,
+        "** (the same energy as Ogden N=1, alpha=2; ccx's Ogden law does not converge here, see host-tests/src/fe/verify/punch.rs)"
+    );
     let _ = writeln!(s, "*MATERIAL, NAME=BLOCK\n*HYPERELASTIC, NEO HOOKE\n{:e}, {d1:e}", mu / 2.0);
     let _ = writeln!(s, "*SOLID SECTION, ELSET=BLOCK, MATERIAL=BLOCK");
     let _ = writeln!(s, "** bottom encastred, sides pinned, mirror planes");
@@ -462,8 +466,7 @@ pub fn punch_sets(nodes: &[P3], block: &crate::fe::spec::Block, a: f64) -> Resul
 }
 
 /// C3D20 edges (local corner pairs) in CalculiX's order of the mid-side nodes 9..20.
-const EDGES20: [(usize, usize); 12] =
-    [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7)];
+const EDGES20: [(usize, usize); 12] = [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7)];
 
 /// 20-node elements from 8-node ones: a mid-side node on every edge, at the edge's
 /// midpoint, except on the punch's rim: an edge whose both ends lie on the cylinder of

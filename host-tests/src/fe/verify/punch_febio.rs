@@ -80,7 +80,13 @@ pub fn punch_feb(c: &Campaign, mesh_level: &spec::MeshLevel, a: f64, delta: f64,
         let _ = writeln!(s, "    </NodeSet>");
     }
     let _ = writeln!(s, "  </Mesh>\n  <MeshDomains>\n    <SolidDomain name=\"block\" mat=\"block\"/>\n  </MeshDomains>\n  <Boundary>");
-    for (name, set, xyz) in [("bottom", "bottom", [1, 1, 1]), ("sides", "sides", [1, 1, 1]), ("sym_x", "sym_x", [1, 0, 0]), ("sym_z", "sym_z", [0, 0, 1]), ("punch_xz", "punch", [1, 0, 1])] {
+    for (name, set, xyz) in [
+        ("bottom", "bottom", [1, 1, 1]),
+        ("sides", "sides", [1, 1, 1]),
+        ("sym_x", "sym_x", [1, 0, 0]),
+        ("sym_z", "sym_z", [0, 0, 1]),
+        ("punch_xz", "punch", [1, 0, 1]),
+    ] {
         let _ = writeln!(
             s,
             "    <bc name=\"{name}\" node_set=\"{set}\" type=\"zero displacement\">\n      <x_dof>{}</x_dof>\n      <y_dof>{}</y_dof>\n      <z_dof>{}</z_dof>\n    </bc>",
@@ -121,7 +127,13 @@ pub fn solve_punch(exe: &Path, c: &Campaign, mesh_scale: f64, a: f64, delta: f64
     let done = process::run(cmd, dir, &dir.join("febio.out"), &[dir.join("punch.log")], None, Some(crate::fe::campaign::DEFAULT_STALL))?;
     let run = logs::parse_run_log(&std::fs::read_to_string(dir.join("punch.log")).unwrap_or_default());
     if done.exit != process::ExitKind::Code(0) || !run.normal_termination {
-        bail!("punch (block {scale}x): febio4 {} {}; last lines of {}:\n{}", done.exit, run.cause.unwrap_or_default(), dir.join("punch.log").display(), process::tail(&done.log_text, 20));
+        bail!(
+            "punch (block {scale}x): febio4 {} {}; last lines of {}:\n{}",
+            done.exit,
+            run.cause.unwrap_or_default(),
+            dir.join("punch.log").display(),
+            process::tail(&done.log_text, 20)
+        );
     }
     let text = std::fs::read_to_string(&log_path).with_context(|| format!("{}: cannot read", log_path.display()))?;
     let ry = node_sum_at_end(&text).with_context(|| format!("{}", log_path.display()))?;
