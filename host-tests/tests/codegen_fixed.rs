@@ -34,7 +34,7 @@ fn nth_line(text: &str, prefix: &str, nth: usize) -> usize {
 fn formats_follow_the_rules() {
     let text = model(0.08, 0.001);
     let m = parse_model_str(&text, Path::new("m.toml")).unwrap_or_else(|e| panic!("{e}"));
-    let t = fixed::fixed_tables(&m, Path::new("m.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let t = needle_codegen::fixed_tables(&m, Path::new("m.toml")).unwrap_or_else(|e| panic!("{e}"));
     for (c, comp) in t.components.iter().enumerate() {
         for (k, rows) in comp.rows.iter().enumerate() {
             for (i, r) in rows.iter().enumerate() {
@@ -63,7 +63,7 @@ fn a_row_too_large_is_refused_naming_the_matrix_and_line() {
     let text = model(0.08, 600.0);
     let path = Path::new("/sets/huge/model.toml");
     let m = parse_model_str(&text, path).unwrap_or_else(|e| panic!("{e}"));
-    let e = fixed::fixed_tables(&m, path).expect_err("must not fit");
+    let e = needle_codegen::fixed_tables(&m, path).expect_err("must not fit");
     let line = nth_line(&text, "[[matrix]]", 7); // matrix 7: z / fy_n
     assert_eq!(e.line, Some(line), "{e}");
     for w in ["matrix z/fy_n", "row u^2", "2^30", "does not fit"] {
@@ -78,7 +78,7 @@ fn a_component_too_large_is_refused_naming_the_baseline() {
     let text = model(1000.0, 300.0);
     let path = Path::new("/sets/big/model.toml");
     let m = parse_model_str(&text, path).unwrap_or_else(|e| panic!("{e}"));
-    let e = fixed::fixed_tables(&m, path).expect_err("must not fit");
+    let e = needle_codegen::fixed_tables(&m, path).expect_err("must not fit");
     let line = nth_line(&text, "[[baseline]]", 1);
     assert_eq!(e.line, Some(line), "{e}");
     assert!(e.message.contains("baseline fy_n") && e.message.contains("2^30"), "{e}");

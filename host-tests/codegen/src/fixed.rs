@@ -11,7 +11,6 @@
 //! picks the same formats and integers.
 use crate::contract::{COMPONENTS, SWEEPS};
 use crate::error::CodegenError;
-use crate::fixed_bound::{error_bound, ErrorBound};
 use crate::model::Model;
 use std::path::Path;
 
@@ -144,13 +143,14 @@ fn component_bounds(rows: &[[FixedRow; 5]; 4], cross: &[FixedCross], base: &[f64
     (a, total, baseline)
 }
 
-/// Chooses every format of `model` and quantises its coefficients.
+/// Chooses every format of `model` and quantises its coefficients; the error bounds are
+/// left at zero for [`fixed_tables`](crate::fixed_bound::fixed_tables) to fill in.
 ///
 /// # Errors
 /// A row polynomial or a component cannot be represented within [`LIMIT`] even with
 /// no fractional bits (coefficients of the order of 1,000 N or N·mm); the error names
 /// the matrix (or baseline), its line in `model_path` and the bound that is exceeded.
-pub fn fixed_tables(model: &Model, model_path: &Path) -> Result<FixedTables, CodegenError> {
+pub fn fixed_formats(model: &Model, model_path: &Path) -> Result<FixedTables, CodegenError> {
     let at = |line: usize, message: String| CodegenError { path: model_path.to_path_buf(), line: (line > 0).then_some(line), message };
     let zero_row = FixedRow { coeffs: [0; 5], frac_bits: 0, bound: 0 };
     let mut components = Vec::with_capacity(6);
@@ -209,7 +209,7 @@ pub fn fixed_tables(model: &Model, model_path: &Path) -> Result<FixedTables, Cod
         for x in &mut cross {
             x.shift = x.frac_bits - g;
         }
-        let mut comp = FixedComponent {
+        let comp = FixedComponent {
             rows,
             shifts,
             baseline: baseline.map(|v| v as i32),
@@ -219,9 +219,36 @@ pub fn fixed_tables(model: &Model, model_path: &Path) -> Result<FixedTables, Cod
             error_bound: ErrorBound::default(),
             cross,
         };
-        comp.error_bound = error_bound(model, c, &comp);
         components.push(comp);
     }
     let components: [FixedComponent; 6] = components.try_into().map_err(|_| at(0, "the model does not have 6 components".into()))?;
     Ok(FixedTables { components })
+}
+
+/// The error bound of one component, term by term, in micro-units (µN or µN·mm).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ErrorBound {
+    /// Rounding of the integer arithmetic (Horner floors, alignment shifts).
+    pub arithmetic: f64,
+    /// Rounding of the f64 coefficients to integers.
+    pub coefficients: f64,
+    /// Rounding of the normalised inputs `U`, `T_k` to Q15.
+    pub inputs: f64,
+    /// Rounding of the result to whole micro-units.
+    pub output: f64,
+}
+
+impl ErrorBound {
+    /// The whole bound, raised by a relative `1e-9` for the f64 arithmetic of the bound
+    /// itself.
+    #[must_use]
+    pub fn total(&self) -> f64 {
+        (self.arithmetic + self.coefficients + self.inputs + self.output) * (1.0 + 1e-9)
+    }
+
+    /// The whole bound in whole micro-units, rounded up.
+    #[must_use]
+    pub fn total_micro(&self) -> u32 {
+        self.total().ceil() as u32
+    }
 }

@@ -20,36 +20,10 @@
 //! - *cross terms* (coupled form): per coefficient, its quantisation, `|p_i|` times the
 //!   error of the Q15 monomial, and the floors of the product and the shift (see
 //!   [`error_bound`]).
-use crate::fixed::{FixedComponent, NORM_FRAC_BITS, OUTPUT_SCALE};
+use crate::error::CodegenError;
+use crate::fixed::{fixed_formats, ErrorBound, FixedComponent, FixedTables, NORM_FRAC_BITS, OUTPUT_SCALE};
 use crate::model::Model;
-
-/// The error bound of one component, term by term, in micro-units (µN or µN·mm).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct ErrorBound {
-    /// Rounding of the integer arithmetic (Horner floors, alignment shifts).
-    pub arithmetic: f64,
-    /// Rounding of the f64 coefficients to integers.
-    pub coefficients: f64,
-    /// Rounding of the normalised inputs `U`, `T_k` to Q15.
-    pub inputs: f64,
-    /// Rounding of the result to whole micro-units.
-    pub output: f64,
-}
-
-impl ErrorBound {
-    /// The whole bound, raised by a relative `1e-9` for the f64 arithmetic of the bound
-    /// itself.
-    #[must_use]
-    pub fn total(&self) -> f64 {
-        (self.arithmetic + self.coefficients + self.inputs + self.output) * (1.0 + 1e-9)
-    }
-
-    /// The whole bound in whole micro-units, rounded up.
-    #[must_use]
-    pub fn total_micro(&self) -> u32 {
-        self.total().ceil() as u32
-    }
-}
+use std::path::Path;
 
 /// Grid intervals per axis of the slope bounds.
 const GRID: usize = 256;
@@ -152,4 +126,18 @@ pub(crate) fn error_bound(model: &Model, c: usize, comp: &FixedComponent) -> Err
     let half_step = pow2(-(NORM_FRAC_BITS as i32) - 1);
     let inputs = (slope_u + slope_t) * OUTPUT_SCALE * half_step;
     ErrorBound { arithmetic, coefficients, inputs, output: 0.5 }
+}
+
+/// Chooses every format of `model`, quantises its coefficients ([`fixed_formats`]) and
+/// bounds each component's error ([`error_bound`]): the fixed-point tables the generator
+/// writes.
+///
+/// # Errors
+/// As [`fixed_formats`].
+pub fn fixed_tables(model: &Model, model_path: &Path) -> Result<FixedTables, CodegenError> {
+    let mut t = fixed_formats(model, model_path)?;
+    for (c, comp) in t.components.iter_mut().enumerate() {
+        comp.error_bound = error_bound(model, c, comp);
+    }
+    Ok(t)
 }

@@ -24,15 +24,18 @@ pub mod contract;
 mod error;
 pub mod fixed;
 mod fixed_bound;
+mod literal;
 mod model;
 mod render;
 mod render_cross;
 mod render_fixed;
 
 pub use error::{line_of, CodegenError};
-pub use fixed::{fixed_tables, FixedTables};
+pub use fixed::FixedTables;
+pub use fixed_bound::fixed_tables;
+pub use literal::f32_literal;
 pub use model::{parse_bits, parse_model, parse_model_str, Baseline, Coupled, Cross, Matrix, Model};
-pub use render::{f32_literal, render_c_header, render_rust};
+pub use render::{render_c_header, render_rust};
 pub use render_cross::{render_c_cross, render_rust_cross, render_rust_cross_fixed};
 pub use render_fixed::render_rust_fixed;
 

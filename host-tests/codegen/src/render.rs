@@ -7,11 +7,7 @@ use crate::contract::{
 use crate::model::Model;
 use std::fmt::Write as _;
 
-/// An f32 as a decimal literal that parses back to the same bits (Rust's shortest
-/// round-trip form, `1.0`, `-0.25`, `1e-7`).
-pub fn f32_literal(v: f32) -> String {
-    format!("{v:?}")
-}
+use crate::literal::f32_literal;
 
 fn bits(v: f32) -> String {
     format!("{:#010x}", v.to_bits())

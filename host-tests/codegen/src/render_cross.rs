@@ -11,8 +11,8 @@
 //! `u` over the term's coefficients, highest power first, starting from the highest.
 use crate::contract::{COMPONENTS, CROSS_SCALES_F32, HALF_RANGES, SWEEPS, UNITS};
 use crate::fixed::{FixedTables, CROSS_DIVISORS};
+use crate::literal::f32_literal;
 use crate::model::Model;
-use crate::render::f32_literal;
 use std::fmt::Write as _;
 
 /// Names of the normalised inputs in the generated code.

@@ -106,8 +106,3 @@ pub fn to_csv(poses: &[Pose], evals: &[Evaluation]) -> String {
     }
     s
 }
-
-/// The JSON form: an array of `needle eval --json` objects.
-pub fn to_json(poses: &[Pose], evals: &[Evaluation]) -> serde_json::Value {
-    serde_json::Value::Array(poses.iter().zip(evals).map(|(p, e)| super::model::eval_json(p, e)).collect())
-}

@@ -137,6 +137,11 @@ pub fn accuracy_json() -> serde_json::Value {
     })
 }
 
+/// The JSON form of `needle eval --poses FILE --json`: an array of [`eval_json`] objects.
+pub fn to_json(poses: &[Pose], evals: &[Evaluation]) -> serde_json::Value {
+    serde_json::Value::Array(poses.iter().zip(evals).map(|(p, e)| eval_json(p, e)).collect())
+}
+
 /// The JSON object `needle eval --json` prints.
 pub fn eval_json(pose: &Pose, e: &Evaluation) -> serde_json::Value {
     let mut wrench = serde_json::Map::new();
@@ -217,7 +222,7 @@ pub fn eval(a: EvalArgs) -> anyhow::Result<ExitCode> {
 /// The file cannot be read, has a bad header or bad rows (all listed, by line), or the
 /// output cannot be written.
 fn eval_file(file: &Path, out: Option<&Path>, json: bool) -> anyhow::Result<ExitCode> {
-    use super::eval_batch::{evaluate, parse_poses, to_csv, to_json};
+    use super::eval_batch::{evaluate, parse_poses, to_csv};
     let text = std::fs::read_to_string(file).with_context(|| format!("{}: cannot read", file.display()))?;
     let poses = parse_poses(&text, file)?;
     let evals = evaluate(&poses);

@@ -1,12 +1,12 @@
 //! The solver side of a campaign: the [`Backend`] trait (one pose in, wrenches out),
 //! [`CcxBackend`], which writes the deck, runs CalculiX, reads the `.dat` back and reduces
-//! the needle's nodal reactions to the wrench, and [`backend_for`], the engine of a run.
+//! the needle's nodal reactions to the wrench, (the engine of a run: [`engines::backend_for`](crate::fe::engines::backend_for)).
 //! FEBio's backend is `fe::febio::FebioBackend`. Tests inject other backends.
 
 use crate::fe::ccx;
 use crate::fe::dat;
 use crate::fe::deck::{self, MeshSummary};
-use crate::fe::spec::{Campaign, Engine, MeshLevel, PoseSpec};
+use crate::fe::spec::{Campaign, MeshLevel, PoseSpec};
 use crate::fe::wrench;
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
@@ -120,15 +120,6 @@ pub trait Backend: Sync {
 
     /// Steps completed so far by the job running in `work_dir` (for the progress bar).
     fn steps_done(&self, work_dir: &Path) -> u32;
-}
-
-/// The backend of `engine`, its jobs each on `threads` solver threads (ccx always runs
-/// on one: its SPOOLES factorisation is serial in Debian's build).
-pub fn backend_for(engine: Engine, threads: usize) -> Box<dyn Backend> {
-    match engine {
-        Engine::Ccx => Box::new(CcxBackend::default()),
-        Engine::Febio => Box::new(crate::fe::febio::FebioBackend::new(threads)),
-    }
 }
 
 /// The real backend: the project's deck writer, CalculiX, the `.dat` reader and the

@@ -33,8 +33,9 @@
 //! records how each CSV was made, [`report`](crate::fe::report) is the outcome and
 //! `progress` the display.
 
-use crate::fe::backend::{backend_for, Backend, Job, SolveFailure, Solved};
+use crate::fe::backend::{Backend, Job, SolveFailure, Solved};
 use crate::fe::deck;
+use crate::fe::engines::backend_for;
 use crate::fe::launcher::Launched;
 use crate::fe::manifest::{manifest_text, read_manifest, rfc3339_utc, Manifest, ManifestEntry, MANIFEST};
 use crate::fe::process;

@@ -20,12 +20,8 @@ use anyhow::{bail, Result};
 use serde::Serialize;
 use std::fmt::Write;
 
-/// Version of the mesh and deck generator; part of every run's spec hash, so that a
-/// change of the generator reruns the campaign.
-///
-/// History: 1, tissue surface as contact slave; 2, needle surface as contact slave (v1 lost
-/// contact when the wedge's edge landed between tissue nodes, the theta_z sweep).
-pub const GENERATOR_VERSION: u32 = 2;
+/// Version of the mesh and deck generator ([`versions::CCX_DECK`](crate::fe::versions::CCX_DECK)).
+pub use crate::fe::versions::CCX_DECK as GENERATOR_VERSION;
 
 /// CalculiX ids of the needle's first node and first element: right after the tissue's
 /// (tissue ids start at 1). The ids are contiguous on purpose: ccx sizes its per-node and

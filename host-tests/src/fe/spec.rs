@@ -783,8 +783,8 @@ impl Campaign {
             mesh: self.mesh.get(mesh_name),
             pose,
             generator: match self.solver.engine {
-                Engine::Ccx => crate::fe::deck::GENERATOR_VERSION,
-                Engine::Febio => crate::fe::febio::GENERATOR_VERSION,
+                Engine::Ccx => crate::fe::versions::CCX_DECK,
+                Engine::Febio => crate::fe::versions::FEBIO_INPUT,
             },
             solver: (self.solver.engine != Engine::Ccx).then_some(&self.solver),
         };

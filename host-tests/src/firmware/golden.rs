@@ -16,27 +16,7 @@ pub const HEADER: &str = "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,status,fx_n
 const COLUMNS: [&str; 12] =
     ["x_mm", "z_mm", "theta_x_deg", "theta_z_deg", "depth_mm", "status", "fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"];
 
-/// Result of comparing one firmware run with the golden file.
-#[derive(Debug)]
-pub struct Comparison {
-    /// The firmware's first line (target, set, fe_sha256, rows).
-    pub banner: String,
-    /// Rows compared.
-    pub rows: usize,
-    /// Rows that differ, one description each (`line N: ...`, line of the golden file).
-    pub mismatches: Vec<String>,
-}
-
-/// `true` when the golden bits `want` and the printed `got` are the same value under the
-/// contract: NaN matches NaN of any payload, anything else compares by bits.
-#[must_use]
-pub fn same_f32(want: u32, got: u32) -> bool {
-    if f32::from_bits(want).is_nan() {
-        f32::from_bits(got).is_nan()
-    } else {
-        want == got
-    }
-}
+pub use super::comparison::{same_f32, Comparison};
 
 fn bits(field: &str) -> Option<u32> {
     needle_codegen::parse_bits(field)

@@ -1,6 +1,6 @@
 //! The `golden` firmware's fixed-point section against the set's `golden-fixed.csv`:
 //! inputs, status and every wrench integer exactly.
-use super::golden::Comparison;
+use super::comparison::Comparison;
 use anyhow::bail;
 
 /// The fixed-point golden file's header line.

@@ -13,6 +13,7 @@
 
 pub mod bench;
 pub mod build;
+pub mod comparison;
 pub mod float_check;
 pub mod golden;
 pub mod golden_fixed;

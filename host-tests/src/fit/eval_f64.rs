@@ -2,28 +2,12 @@
 //! the reference for validation and for the f32 evaluator's error.
 
 use super::contract::{
-    u_of, Sweep, DEPTH_MAX_MM, NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z,
+    u_of, Sweep, DEPTH_MAX_MM, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z,
 };
 use super::cross_terms::{cross_value, CrossTerms};
 use super::model::Model;
 
-/// Horner, highest power first: `(((p4 w + p3) w + p2) w + p1) w + p0`.
-pub fn horner(p: &[f64; NCOEF], w: f64) -> f64 {
-    let mut acc = p[NCOEF - 1];
-    for c in p[..NCOEF - 1].iter().rev() {
-        acc = acc * w + c;
-    }
-    acc
-}
-
-/// `D(t, u)`: `r_i = h(rows[i], t)`, then `h(r, u)`.
-pub fn deviation(rows: &[[f64; NCOEF]; NCOEF], t: f64, u: f64) -> f64 {
-    let mut r = [0.0; NCOEF];
-    for (ri, row) in r.iter_mut().zip(rows) {
-        *ri = horner(row, t);
-    }
-    horner(&r, u)
-}
+pub use super::poly::{deviation, horner};
 
 pub use super::contract::Pose64;
 

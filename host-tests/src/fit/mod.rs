@@ -25,6 +25,7 @@ pub mod golden_fixed;
 pub mod lsq;
 pub mod model;
 pub mod model_file;
+pub mod poly;
 pub mod validate;
 
 use anyhow::Result;

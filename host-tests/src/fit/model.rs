@@ -5,8 +5,8 @@
 use super::contract::{u_of, Sweep, COMPONENTS, DEGREE, NCOEF};
 use super::cross_terms::CrossTerms;
 use super::data::{FitData, Run, SweepPoint};
-use super::eval_f64::{deviation, horner};
 use super::lsq::polyfit;
+use super::poly::{deviation, horner};
 use anyhow::{Context, Result};
 
 /// The centre run's polynomial in depth for one component.

@@ -18,8 +18,8 @@ use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// Version of the FEBio input generator; part of every FEBio run's spec hash.
-pub const GENERATOR_VERSION: u32 = 1;
+/// Version of the FEBio input generator ([`versions::FEBIO_INPUT`](crate::fe::versions::FEBIO_INPUT)).
+pub use crate::fe::versions::FEBIO_INPUT as GENERATOR_VERSION;
 
 /// Environment variable naming the `febio4` to use.
 pub const FEBIO_ENV: &str = "FEBIO";

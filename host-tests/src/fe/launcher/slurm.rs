@@ -235,7 +235,7 @@ pub fn submit(opts: &RunOptions, slurm: &SlurmOptions) -> Result<SubmitReport> {
     if poses.is_empty() {
         return Ok(report);
     }
-    let attempts = crate::fe::backend::backend_for(plan.campaign.solver.engine, 1).attempts();
+    let attempts = crate::fe::engines::backend_for(plan.campaign.solver.engine, 1).attempts();
     let res = Resources::defaults(&plan, attempts, slurm);
     let out_abs = absolute(&plan.out_dir)?;
     let slurm_dir = out_abs.join(SLURM_DIR);

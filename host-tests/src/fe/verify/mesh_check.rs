@@ -5,7 +5,8 @@
 //! (goal 2 %), and, with three or more levels, Richardson's estimate of the converged
 //! value from the finest three.
 
-use crate::fe::backend::{backend_for, Job};
+use crate::fe::backend::Job;
+use crate::fe::engines::backend_for;
 use crate::fe::spec::{Campaign, Role};
 use anyhow::{bail, Context, Result};
 use serde::Serialize;

@@ -85,7 +85,10 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
         }
     }
     if opts.punch {
-        let p = punch::punch(&c, &work, opts)?;
+        let p = match c.solver.engine {
+            crate::fe::spec::Engine::Febio => punch_febio::punch(&c, &work, opts)?,
+            crate::fe::spec::Engine::Ccx => punch::punch(&c, &work, opts)?,
+        };
         println!(
             "flat punch a = {} mm, delta = {} mm, nu = {:.4}, {}: F(block) = {:.5e} N, F(2x block) = {:.5e} N, \
              F(half-space, extrapolated) = {:.5e} N, Sneddon {:.5e} N: error {:+.2}% (goal within {}%); {} {:.0} s + {:.0} s",

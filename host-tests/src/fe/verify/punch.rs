@@ -213,9 +213,6 @@ impl PunchElement {
 }
 
 pub(super) fn punch(c: &Campaign, work: &Path, opts: &VerifyOptions) -> Result<PunchReport> {
-    if c.solver.engine == crate::fe::spec::Engine::Febio {
-        return punch_febio(c, work, opts);
-    }
     let a = c.needle.diameter_mm / 2.0;
     let delta = a / 100.0;
     // Sneddon's force is linear in mu; the punch uses mu = 1 N/mm^2 (and the tissue's
@@ -291,47 +288,6 @@ pub(super) fn punch(c: &Campaign, work: &Path, opts: &VerifyOptions) -> Result<P
         solver: format!("ccx {}", ccx::ccx_version(&ccx::find_ccx()?)?),
         check,
         campaign_element: runs.pop(),
-    })
-}
-
-/// The check with the FEBio campaign's element (module `punch_febio`).
-fn punch_febio(c: &Campaign, work: &Path, opts: &VerifyOptions) -> Result<PunchReport> {
-    use super::punch_febio::{febio, solve_punch, PUNCH_CORE_ELEMENTS_HEX8};
-    let a = c.needle.diameter_mm / 2.0;
-    let delta = a / 100.0;
-    let mu = PUNCH_MU_N_PER_MM2;
-    let nu = poisson(c.tissue.bulk_to_shear);
-    let f_sneddon = sneddon_force(mu, a, delta, nu);
-    let (exe, version) = febio()?;
-    let mut f = [0.0; 2];
-    let mut wall = [0.0; 2];
-    let mut nodes = [0; 2];
-    let mut nel = [0; 2];
-    for (k, scale) in [1.0, 2.0].into_iter().enumerate() {
-        let dir = work.join(format!("punch-febio-hex8-{scale}x"));
-        println!("solving the flat punch with FEBio hex8 (three-field) on the block scaled {scale}x ...");
-        let (force, w, feb) = solve_punch(&exe, c, opts.punch_mesh_scale, a, delta, scale, &dir)?;
-        (f[k], wall[k], nodes[k], nel[k]) = (force, w, feb.nodes, feb.elements);
-    }
-    let mesh = punch_mesh(a, PUNCH_CORE_ELEMENTS_HEX8, opts.punch_mesh_scale);
-    Ok(PunchReport {
-        radius_mm: a,
-        delta_mm: delta,
-        mu_n_per_mm2: mu,
-        bulk_to_shear: c.tissue.bulk_to_shear,
-        nu,
-        material: "uncoupled Ogden N=1, alpha = 2, c1 = 2 mu (the neo-Hookean energy), k = K0".to_string(),
-        mesh: format!(
-            "quarter model, round-core O-grid: {} elements across the punch diameter, fine size {:.4} mm over {} mm depth, growth {}",
-            mesh.core_elements, mesh.fine_size_mm, mesh.fine_depth_mm, mesh.growth
-        ),
-        mesh_scale: opts.punch_mesh_scale,
-        force_sneddon_n: f_sneddon,
-        force_bonded_n: bonded_punch_force(mu, a, delta, nu),
-        goal_percent: PUNCH_GOAL_PERCENT,
-        solver: format!("febio {version}"),
-        check: PunchRun::from_forces("FEBio hex8, three-field (the campaign's tissue element)", nodes, nel, f, wall, f_sneddon),
-        campaign_element: None,
     })
 }
 

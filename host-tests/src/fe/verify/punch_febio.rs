@@ -8,7 +8,11 @@
 //! incompressibility. The force is the sum of FEBio's nodal reactions `Ry` of the punch
 //! nodes (logfile `node_data`), times 4 (quarter model).
 
-use super::punch::{punch_block, punch_mesh, punch_sets, PunchSets, PUNCH_MU_N_PER_MM2};
+use super::punch::{
+    bonded_punch_force, poisson, punch_block, punch_mesh, punch_sets, sneddon_force, PunchReport, PunchRun, PunchSets, PUNCH_GOAL_PERCENT,
+    PUNCH_MU_N_PER_MM2,
+};
+use super::VerifyOptions;
 use crate::fe::febio;
 use crate::fe::febio::logs;
 use crate::fe::process;
@@ -186,4 +190,44 @@ mod tests {
         assert_eq!(super::node_sum_at_end(t).ok(), Some(-0.75));
         assert!(super::node_sum_at_end("1,2\n").is_err());
     }
+}
+
+/// The check with the FEBio campaign's element (module docs).
+pub(super) fn punch(c: &Campaign, work: &Path, opts: &VerifyOptions) -> Result<PunchReport> {
+    let a = c.needle.diameter_mm / 2.0;
+    let delta = a / 100.0;
+    let mu = PUNCH_MU_N_PER_MM2;
+    let nu = poisson(c.tissue.bulk_to_shear);
+    let f_sneddon = sneddon_force(mu, a, delta, nu);
+    let (exe, version) = febio()?;
+    let mut f = [0.0; 2];
+    let mut wall = [0.0; 2];
+    let mut nodes = [0; 2];
+    let mut nel = [0; 2];
+    for (k, scale) in [1.0, 2.0].into_iter().enumerate() {
+        let dir = work.join(format!("punch-febio-hex8-{scale}x"));
+        println!("solving the flat punch with FEBio hex8 (three-field) on the block scaled {scale}x ...");
+        let (force, w, feb) = solve_punch(&exe, c, opts.punch_mesh_scale, a, delta, scale, &dir)?;
+        (f[k], wall[k], nodes[k], nel[k]) = (force, w, feb.nodes, feb.elements);
+    }
+    let mesh = punch_mesh(a, PUNCH_CORE_ELEMENTS_HEX8, opts.punch_mesh_scale);
+    Ok(PunchReport {
+        radius_mm: a,
+        delta_mm: delta,
+        mu_n_per_mm2: mu,
+        bulk_to_shear: c.tissue.bulk_to_shear,
+        nu,
+        material: "uncoupled Ogden N=1, alpha = 2, c1 = 2 mu (the neo-Hookean energy), k = K0".to_string(),
+        mesh: format!(
+            "quarter model, round-core O-grid: {} elements across the punch diameter, fine size {:.4} mm over {} mm depth, growth {}",
+            mesh.core_elements, mesh.fine_size_mm, mesh.fine_depth_mm, mesh.growth
+        ),
+        mesh_scale: opts.punch_mesh_scale,
+        force_sneddon_n: f_sneddon,
+        force_bonded_n: bonded_punch_force(mu, a, delta, nu),
+        goal_percent: PUNCH_GOAL_PERCENT,
+        solver: format!("febio {version}"),
+        check: PunchRun::from_forces("FEBio hex8, three-field (the campaign's tissue element)", nodes, nel, f, wall, f_sneddon),
+        campaign_element: None,
+    })
 }
