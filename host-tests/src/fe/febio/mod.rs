@@ -451,17 +451,12 @@ mod tests {
             let r = backend.solve(&job);
             assert!(!work.join(restart::DUMP).exists() && !work.join(restart::DUMP_FROM).exists(), "dumps removed");
             if stuck {
-                let f = r.expect_err("a continuation without progress, twice: failed");
+                let f = r.expect_err("a continuation without progress: failed");
                 assert!(
                     f.message.contains("after 2 of 4 steps")
-                        && f.message.contains("continued 2 time(s) from the last converged must point (3, 3 mm)"),
+                        && f.message.contains("continued 1 time(s) from the last converged must point (3 mm)"),
                     "{}",
                     f.message
-                );
-                let restart = std::fs::read_to_string(work.join(restart::RESTART_INPUT)).expect("restart input");
-                assert!(
-                    restart.contains(&format!("<step_size>{:e}</step_size>", 1.5 * restart::CONTINUE_STEP_FRACTION_AGAIN)),
-                    "{restart}"
                 );
             } else {
                 let s = r.unwrap_or_else(|f| panic!("continued run: {}", f.message));

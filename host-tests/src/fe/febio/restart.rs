@@ -5,11 +5,15 @@
 //! inside a step (an element inverted in an iterate, or contact chattering between two
 //! states at a time step near `dtmin`), the run restarts from that dump with a
 //! `febio_restart` input whose first time step is a fraction of a load step
-//! ([`CONTINUE_STEP_FRACTION`], then [`CONTINUE_STEP_FRACTION_AGAIN`] when a
-//! continuation made no progress), the time stepper's lower limit a tenth of the run's,
-//! and otherwise the same model and settings. Seen on `t2-b`: the campaign's last attempt
-//! stopped at 3.79 mm; continued from its dump at 3.6 mm with a 0.02 mm first step it
-//! passed that point.
+//! ([`CONTINUE_STEP_FRACTION`]), the time stepper's lower limit a tenth of the run's, and
+//! otherwise the same model and settings; a run continues again only from a later must
+//! point. Measured 2026-11-25 (needle8, one thread): `t2-b` with the campaign's last
+//! attempt stopped at 3.79 mm, continued from its dump at 3.6 mm it passed that point
+//! and reached 4.95 mm; but in the campaign the continuations of `t2-b` (attempts 2, 3)
+//! and `tx+15` (attempts 1, 2) stopped again at the same depth (1.78, 1.47, 0.80,
+//! 5.82 mm) with first steps of 1/16 and 1/64 of a load step: those are limit points of
+//! the static equilibrium path, which no step size passes. A second continuation from
+//! the same point is therefore not tried.
 //!
 //! The equilibrium at each must point is the same problem's: only the path between must
 //! points (the time step sizes) changes, as it does between the campaign's attempts.
@@ -22,17 +26,14 @@ use std::path::{Path, PathBuf};
 
 /// First time step of a continuation, as a fraction of one load step.
 pub const CONTINUE_STEP_FRACTION: f64 = 1.0 / 16.0;
-/// First time step of a second continuation from the same must point (the first made no
-/// progress), as a fraction of one load step.
-pub const CONTINUE_STEP_FRACTION_AGAIN: f64 = 1.0 / 64.0;
 /// The time stepper's lower limit in a continuation, as a fraction of the run's.
 pub const CONTINUE_DTMIN_SCALE: f64 = 0.1;
 /// Retries of a time step in a continuation (the run's deck has its own).
 pub const CONTINUE_MAX_RETRIES: u32 = 12;
 /// Continuations of one attempt at most.
 pub const MAX_CONTINUATIONS: u32 = 12;
-/// Continuations from the same must point at most (each with a smaller first step).
-pub const MAX_FROM_SAME_POINT: u32 = 2;
+/// Continuations from the same must point at most: one (module docs).
+pub const MAX_FROM_SAME_POINT: u32 = 1;
 
 /// The dump file FEBio writes at each must point.
 pub const DUMP: &str = "pose.dmp";
@@ -90,7 +91,7 @@ impl Continuations {
         if n >= MAX_CONTINUATIONS || same >= MAX_FROM_SAME_POINT {
             return None;
         }
-        Some(if same == 0 { CONTINUE_STEP_FRACTION } else { CONTINUE_STEP_FRACTION_AGAIN })
+        Some(CONTINUE_STEP_FRACTION)
     }
 }
 
@@ -103,10 +104,8 @@ mod tests {
         let mut c = Continuations::default();
         assert_eq!(c.next_fraction(3.6), Some(CONTINUE_STEP_FRACTION));
         c.from_mm.push(3.6);
-        assert_eq!(c.next_fraction(3.6), Some(CONTINUE_STEP_FRACTION_AGAIN), "no progress: a smaller step");
-        assert_eq!(c.next_fraction(3.9), Some(CONTINUE_STEP_FRACTION), "progress: the usual step");
-        c.from_mm.push(3.6);
-        assert_eq!(c.next_fraction(3.6), None, "twice from the same point is the end");
+        assert_eq!(c.next_fraction(3.6), None, "no progress since the last continuation: the end");
+        assert_eq!(c.next_fraction(3.9), Some(CONTINUE_STEP_FRACTION), "progress: continue again");
         c.from_mm = (0..MAX_CONTINUATIONS).map(f64::from).collect();
         assert_eq!(c.next_fraction(100.0), None);
         assert!(Continuations { from_mm: vec![3.6, 4.5] }.describe().contains("2 time(s)"));
