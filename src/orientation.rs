@@ -34,6 +34,7 @@ const DEG_PER_RAD: f32 = 180.0 / core::f32::consts::PI;
 /// Why no tilt could be taken from a needle axis.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum AxisError {
     /// A component is NaN or infinite, or the squared length overflows.
     NotFinite,

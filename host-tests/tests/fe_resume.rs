@@ -3,29 +3,20 @@
 //! interrupted halfway through a solve. These tests need `ccx` (Debian `calculix-ccx`);
 //! without it they fail, they are not skipped.
 
+mod fe_common;
+use fe_common::{default_set, needle, show, NEEDLE};
+
 use needle_host::fe::manifest::{read_manifest, MANIFEST};
 use needle_host::fe::{ccx, results, spec};
 use std::os::unix::process::CommandExt;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::path::Path;
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
-
-const NEEDLE: &str = env!("CARGO_BIN_EXE_needle");
 
 fn require_ccx() {
     let p = ccx::find_ccx().unwrap_or_else(|e| panic!("{e:#}: these tests run CalculiX"));
     let v = ccx::ccx_version(&p).unwrap_or_else(|e| panic!("{e:#}"));
     assert!(v.starts_with("2."), "ccx version {v}");
-}
-
-/// A copy of coeffs/default/campaign.toml in a fresh temporary folder: (tempdir, set dir).
-fn default_set() -> (tempfile::TempDir, PathBuf) {
-    let d = tempfile::tempdir().expect("tempdir");
-    let set = d.path().join("set");
-    std::fs::create_dir_all(&set).expect("mkdir");
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default/campaign.toml");
-    std::fs::copy(&src, set.join("campaign.toml")).expect("copy the default spec");
-    (d, set)
 }
 
 fn run_args<'a>(set: &'a Path, only: &'a str, steps: &'a str) -> Vec<&'a std::ffi::OsStr> {
@@ -35,19 +26,6 @@ fn run_args<'a>(set: &'a Path, only: &'a str, steps: &'a str) -> Vec<&'a std::ff
         v.push(a.as_ref());
     }
     v
-}
-
-fn needle(args: &[&std::ffi::OsStr], env: &[(&str, &str)]) -> Output {
-    let mut c = Command::new(NEEDLE);
-    c.args(args).stdin(Stdio::null());
-    for (k, v) in env {
-        c.env(k, v);
-    }
-    c.output().expect("run needle")
-}
-
-fn show(o: &Output) -> String {
-    format!("status {:?}\n--- stdout\n{}\n--- stderr\n{}", o.status, String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
 }
 
 fn files_in(dir: &Path) -> Vec<String> {

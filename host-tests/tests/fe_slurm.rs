@@ -4,12 +4,14 @@
 //! resubmitted alone, and the clear errors that leave the set unchanged. Without a
 //! running cluster these tests fail, they are not skipped.
 
+mod fe_common;
+use fe_common::{default_set, needle, show};
+
 use needle_host::fe::manifest::{read_manifest, MANIFEST};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
-const NEEDLE: &str = env!("CARGO_BIN_EXE_needle");
 const POSES: &str = "centre,x+04,z+04";
 
 /// Fail unless sbatch is installed and the controller answers.
@@ -24,29 +26,6 @@ fn require_cluster() {
         "no usable SLURM node (sinfo: {states:?}, {}): start the cluster with .ci/slurm-cluster start",
         String::from_utf8_lossy(&out.stderr)
     );
-}
-
-/// A copy of coeffs/default/campaign.toml in a fresh temporary folder.
-fn default_set() -> (tempfile::TempDir, PathBuf) {
-    let d = tempfile::tempdir().expect("tempdir");
-    let set = d.path().join("set");
-    std::fs::create_dir_all(&set).expect("mkdir");
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default/campaign.toml");
-    std::fs::copy(&src, set.join("campaign.toml")).expect("copy the default spec");
-    (d, set)
-}
-
-fn needle(args: &[&str], env: &[(&str, &str)]) -> Output {
-    let mut c = Command::new(NEEDLE);
-    c.args(args).stdin(Stdio::null());
-    for (k, v) in env {
-        c.env(k, v);
-    }
-    c.output().expect("run needle")
-}
-
-fn show(o: &Output) -> String {
-    format!("status {:?}\n--- stdout\n{}\n--- stderr\n{}", o.status, String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
 }
 
 fn spec_args<'a>(set: &'a str, steps: &'a str) -> Vec<&'a str> {

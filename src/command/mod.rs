@@ -50,6 +50,7 @@ pub const REPLY_MAX: usize = 128;
 /// Why a request was refused (the `ERR` code of its reply).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum FrameError {
     /// Longer than [`FRAME_MAX`].
     Oversize,

@@ -5,6 +5,7 @@ use crate::control::OverLimit;
 /// A parsed request (see the frame format in [`crate::command`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum Command {
     /// `PING`.
     Ping,

@@ -4,6 +4,7 @@
 /// above the device force limit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum OverLimit {
     /// Command the model's force scaled down to the limit (same direction,
     /// `F * (limit / |F|)`); flags `OVER_LIMIT | FORCE_SATURATED`.
@@ -49,6 +50,7 @@ pub struct LoopConfig<const N: usize> {
 /// Why a [`LoopConfig`] (or a new force limit) was refused.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum ConfigError {
     /// A gain is NaN or infinite.
     Gain,

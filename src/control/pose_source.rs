@@ -4,6 +4,7 @@ use crate::Pose;
 /// Why a [`PoseSource`] has no fresh pose this tick.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum PoseFault {
     /// The last pose is too old (for example an encoder read that timed out, or a
     /// kinematics update that did not arrive since the previous tick).

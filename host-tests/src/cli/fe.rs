@@ -43,23 +43,16 @@ pub enum LauncherArg {
     Slurm,
 }
 
-/// Arguments of `needle fe run`.
+/// What a campaign command works on: the set, its engine, mesh level, steps, poses and
+/// output folder (shared by `fe run` and `fe status`).
 #[derive(Args, Debug)]
-pub struct RunArgs {
+pub struct SpecArgs {
     /// Set folder holding campaign.toml, e.g. coeffs/default.
     #[arg(long, value_name = "DIR")]
     pub set: PathBuf,
-    /// FE engine of this run instead of campaign.toml's [solver] engine: febio or ccx.
+    /// FE engine instead of campaign.toml's [solver] engine: febio or ccx.
     #[arg(long, value_name = "ENGINE", value_parser = ["febio", "ccx"])]
     pub solver: Option<String>,
-    /// Number of solver jobs at the same time (memory: about 2.5 GB per ccx job on the
-    /// committed mesh).
-    #[arg(long, value_name = "N", default_value_t = 1, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=256))]
-    pub jobs: u32,
-    /// Solver threads per job (FEBio's Pardiso and assembly; ccx always runs on one).
-    /// Default: the machine's cores divided by --jobs.
-    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=256))]
-    pub threads: Option<u32>,
     /// Only the poses whose name matches this glob, e.g. 'x+*' or 'centre' (quote it), or
     /// any of several comma-separated globs, e.g. 'lhs-09,lhs-1*'.
     #[arg(long, value_name = "PATTERN")]
@@ -74,6 +67,21 @@ pub struct RunArgs {
     /// Output folder for <pose>.csv, manifest.toml and .work/; default: <set>/fe.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+}
+
+/// Arguments of `needle fe run`.
+#[derive(Args, Debug)]
+pub struct RunArgs {
+    #[command(flatten)]
+    pub spec: SpecArgs,
+    /// Number of solver jobs at the same time (memory: about 2.5 GB per ccx job on the
+    /// committed mesh).
+    #[arg(long, value_name = "N", default_value_t = 1, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub jobs: u32,
+    /// Solver threads per job (FEBio's Pardiso and assembly; ccx always runs on one).
+    /// Default: the machine's cores divided by --jobs.
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub threads: Option<u32>,
     /// Rerun the selected poses even when their results are up to date.
     #[arg(long)]
     pub force: bool,
@@ -116,24 +124,8 @@ pub struct RunArgs {
 /// Arguments of `needle fe status`.
 #[derive(Args, Debug)]
 pub struct StatusArgs {
-    /// Set folder holding campaign.toml, e.g. coeffs/default.
-    #[arg(long, value_name = "DIR")]
-    pub set: PathBuf,
-    /// Output folder of the campaign; default: <set>/fe.
-    #[arg(long, value_name = "DIR")]
-    pub out: Option<PathBuf>,
-    /// FE engine instead of campaign.toml's [solver] engine (as given to fe run).
-    #[arg(long, value_name = "ENGINE", value_parser = ["febio", "ccx"])]
-    pub solver: Option<String>,
-    /// Mesh level (as given to fe run); default: campaign.mesh.
-    #[arg(long, value_name = "LEVEL")]
-    pub mesh: Option<String>,
-    /// Load steps (as given to fe run).
-    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=10_000))]
-    pub steps: Option<u32>,
-    /// Only the poses matching these globs (as fe run --only).
-    #[arg(long, value_name = "PATTERN")]
-    pub only: Option<String>,
+    #[command(flatten)]
+    pub spec: SpecArgs,
     /// Project the selected poses' campaign wall time on these node counts, e.g. 1,4,16,
     /// from the measured wall time of each pose (or the median of its model kind).
     #[arg(long, value_name = "N,N,...", value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=100_000))]
@@ -247,19 +239,14 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
         anyhow::bail!("--partition, --time, --mem, --cpus-per-task and --sbatch-arg are options of --launcher slurm");
     }
     let opts = RunOptions {
-        set_dir: a.set,
         jobs,
         threads: a.threads.map(|t| t as usize).unwrap_or((cores / jobs).max(1)),
-        solver: a.solver.as_deref().map(crate::fe::spec::Engine::parse).transpose()?,
-        only: a.only,
-        mesh: a.mesh,
-        steps: a.steps,
-        out_dir: a.out,
         force: a.force,
         keep_work: a.keep_work,
         timeout,
         stall: Some(Duration::from_secs_f64(a.stall_s)),
         launcher: Launched::Local,
+        ..spec_options(a.spec)?
     };
     if a.launcher == LauncherArg::Slurm {
         let slurm = SlurmOptions {
@@ -310,14 +297,7 @@ fn submit_summary(r: &slurm::SubmitReport) -> String {
 }
 
 fn run_status(a: StatusArgs) -> anyhow::Result<ExitCode> {
-    let opts = RunOptions {
-        solver: a.solver.as_deref().map(crate::fe::spec::Engine::parse).transpose()?,
-        only: a.only,
-        mesh: a.mesh,
-        steps: a.steps,
-        out_dir: a.out,
-        ..RunOptions::new(a.set)
-    };
+    let opts = spec_options(a.spec)?;
     let r = crate::fe::launcher::status::status(&opts)?;
     print!("{}", r.table());
     if !a.project_nodes.is_empty() {
@@ -327,6 +307,18 @@ fn run_status(a: StatusArgs) -> anyhow::Result<ExitCode> {
         print!("{}", crate::fe::launcher::projection::table(&opts, &nodes, per_node)?);
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The run options of `spec`, the others at their defaults.
+fn spec_options(spec: SpecArgs) -> anyhow::Result<RunOptions> {
+    Ok(RunOptions {
+        solver: spec.solver.as_deref().map(crate::fe::spec::Engine::parse).transpose()?,
+        only: spec.only,
+        mesh: spec.mesh,
+        steps: spec.steps,
+        out_dir: spec.out,
+        ..RunOptions::new(spec.set)
+    })
 }
 
 fn run_one(a: RunOneArgs) -> anyhow::Result<ExitCode> {

@@ -788,7 +788,9 @@ impl Campaign {
             },
             solver: (self.solver.engine != Engine::Ccx).then_some(&self.solver),
         };
-        let json = serde_json::to_string(&key).unwrap_or_default();
+        // plain data with string keys: serialising cannot fail; if it ever did, an empty
+        // key would give every run the same hash, so fail loudly instead
+        let json = serde_json::to_string(&key).unwrap_or_else(|e| panic!("the spec hash key does not serialise: {e}"));
         hex(&Sha256::digest(json.as_bytes()))
     }
 }

@@ -182,16 +182,6 @@ pub fn febio() -> Result<(std::path::PathBuf, String)> {
     Ok((exe, v))
 }
 
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn sums_the_last_block() {
-        let t = "*Step = 1\n*Time = 0.5\n*Data = Ry\n1,1.0\n2,2.0\n*Step = 2\n*Time = 1\n*Data = Ry\n1,-0.5\n2,-0.25\n";
-        assert_eq!(super::node_sum_at_end(t).ok(), Some(-0.75));
-        assert!(super::node_sum_at_end("1,2\n").is_err());
-    }
-}
-
 /// The check with the FEBio campaign's element (module docs).
 pub(super) fn punch(c: &Campaign, work: &Path, opts: &VerifyOptions) -> Result<PunchReport> {
     let a = c.needle.diameter_mm / 2.0;
@@ -230,4 +220,14 @@ pub(super) fn punch(c: &Campaign, work: &Path, opts: &VerifyOptions) -> Result<P
         check: PunchRun::from_forces("FEBio hex8, three-field (the campaign's tissue element)", nodes, nel, f, wall, f_sneddon),
         campaign_element: None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn sums_the_last_block() {
+        let t = "*Step = 1\n*Time = 0.5\n*Data = Ry\n1,1.0\n2,2.0\n*Step = 2\n*Time = 1\n*Data = Ry\n1,-0.5\n2,-0.25\n";
+        assert_eq!(super::node_sum_at_end(t).ok(), Some(-0.75));
+        assert!(super::node_sum_at_end("1,2\n").is_err());
+    }
 }
