@@ -6,6 +6,7 @@
 mod fe_common;
 use fe_common::{default_set, needle, show, NEEDLE};
 
+use needle_host::fe::campaign::MANIFEST_LOCK;
 use needle_host::fe::manifest::{read_manifest, MANIFEST};
 use needle_host::fe::{ccx, results, spec};
 use std::os::unix::process::CommandExt;
@@ -68,7 +69,11 @@ fn smoke_campaign_skips_and_resumes_after_a_kill() {
     let out = needle(&run_args(&set, "centre", "2"), &[]);
     assert!(out.status.success(), "{}", show(&out));
     check_csv(&fe, "centre", 2);
-    assert_eq!(files_in(&fe), [".work", "centre.csv", MANIFEST], "work folder of a good run removed");
+    assert_eq!(
+        files_in(&fe),
+        [".work", "centre.csv", MANIFEST, MANIFEST_LOCK],
+        "work folder of a good run removed (the manifest's lock file stays)"
+    );
     assert_eq!(files_in(&fe.join(".work")), Vec::<String>::new());
     let m = read_manifest(&fe.join(MANIFEST)).expect("manifest");
     let e = m.pose.get("centre").expect("manifest entry of centre");
@@ -133,7 +138,7 @@ fn smoke_campaign_skips_and_resumes_after_a_kill() {
         std::thread::sleep(Duration::from_millis(50));
     }
     assert!(ccx::steps_done(&work, "pose") < 3, "ccx was interrupted before its last step");
-    assert_eq!(files_in(&fe), [".work", "centre.csv", MANIFEST], "no CSV (or temporary file) of the interrupted pose");
+    assert_eq!(files_in(&fe), [".work", "centre.csv", MANIFEST, MANIFEST_LOCK], "no CSV (or temporary file) of the interrupted pose");
     let m = read_manifest(&fe.join(MANIFEST)).expect("manifest");
     assert_eq!(m.pose.keys().collect::<Vec<_>>(), ["centre"]);
     assert_eq!(std::fs::read(fe.join("centre.csv")).expect("csv"), csv_before, "finished poses are kept");

@@ -8,6 +8,8 @@
 //!   with [`results::write_atomic`]: a killed run never leaves a half-written CSV.
 //! - `manifest.toml`: one table per finished pose (see [`ManifestEntry`]), sorted by
 //!   pose name, rewritten atomically after each pose.
+//! - `manifest.toml.lock`: the lock ([`lock_manifest`]) under which every process
+//!   (this one's jobs, SLURM array tasks, another `needle fe run`) rewrites the manifest.
 //! - `.work/<pose>/`: the solver's input and files of a run; removed when the run
 //!   succeeds (unless `keep_work`), kept for debugging when it fails.
 //!
