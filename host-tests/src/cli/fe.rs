@@ -69,19 +69,9 @@ pub struct SpecArgs {
     pub out: Option<PathBuf>,
 }
 
-/// Arguments of `needle fe run`.
+/// How each pose is solved (shared by `fe run` and the array tasks' `fe run-one`).
 #[derive(Args, Debug)]
-pub struct RunArgs {
-    #[command(flatten)]
-    pub spec: SpecArgs,
-    /// Number of solver jobs at the same time (memory: about 2.5 GB per ccx job on the
-    /// committed mesh).
-    #[arg(long, value_name = "N", default_value_t = 1, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=256))]
-    pub jobs: u32,
-    /// Solver threads per job (FEBio's Pardiso and assembly; ccx always runs on one).
-    /// Default: the machine's cores divided by --jobs.
-    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=256))]
-    pub threads: Option<u32>,
+pub struct SolveArgs {
     /// Rerun the selected poses even when their results are up to date.
     #[arg(long)]
     pub force: bool,
@@ -96,6 +86,34 @@ pub struct RunArgs {
     /// A ccx job that writes no output (log, .sta, .cvg) for this many seconds is killed as stalled; a failed or stalled job is retried once with a smaller first increment per step
     #[arg(long, value_name = "S", default_value_t = campaign::DEFAULT_STALL.as_secs_f64(), allow_negative_numbers = true, value_parser = positive_seconds)]
     pub stall_s: f64,
+}
+
+/// The solve options of `a` applied to `opts`.
+fn with_solve(opts: RunOptions, a: &SolveArgs) -> RunOptions {
+    RunOptions {
+        force: a.force,
+        keep_work: a.keep_work,
+        timeout: a.timeout_s.map(Duration::from_secs_f64),
+        stall: Some(Duration::from_secs_f64(a.stall_s)),
+        ..opts
+    }
+}
+
+/// Arguments of `needle fe run`.
+#[derive(Args, Debug)]
+pub struct RunArgs {
+    #[command(flatten)]
+    pub spec: SpecArgs,
+    /// Number of solver jobs at the same time (memory: about 2.5 GB per ccx job on the
+    /// committed mesh).
+    #[arg(long, value_name = "N", default_value_t = 1, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub jobs: u32,
+    /// Solver threads per job (FEBio's Pardiso and assembly; ccx always runs on one).
+    /// Default: the machine's cores divided by --jobs.
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub threads: Option<u32>,
+    #[command(flatten)]
+    pub solve: SolveArgs,
     /// Where the solver jobs run: local (this machine, --jobs at once) or slurm (one
     /// sbatch job array, one task per pose still to solve, on the shared filesystem;
     /// `needle fe status` follows it, rerunning the command resumes it).
@@ -136,39 +154,17 @@ pub struct StatusArgs {
     pub tasks_per_node: Option<u32>,
 }
 
-/// Arguments of the hidden `needle fe run-one`.
+/// Arguments of the hidden `needle fe run-one`: the spec options of `fe run` (the batch
+/// script passes them all) and the one pose.
 #[derive(Args, Debug)]
 pub struct RunOneArgs {
-    /// Set folder holding campaign.toml.
-    #[arg(long, value_name = "DIR")]
-    pub set: PathBuf,
-    /// Output folder.
-    #[arg(long, value_name = "DIR")]
-    pub out: PathBuf,
+    #[command(flatten)]
+    pub spec: SpecArgs,
+    #[command(flatten)]
+    pub solve: SolveArgs,
     /// The pose, by its exact name.
     #[arg(long, value_name = "NAME")]
     pub pose: String,
-    /// FE engine.
-    #[arg(long, value_name = "ENGINE", value_parser = ["febio", "ccx"])]
-    pub solver: String,
-    /// Mesh level.
-    #[arg(long, value_name = "LEVEL")]
-    pub mesh: String,
-    /// Load steps.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=10_000))]
-    pub steps: u32,
-    /// Solve even when the result is up to date.
-    #[arg(long)]
-    pub force: bool,
-    /// Keep the work folder of a successful run.
-    #[arg(long)]
-    pub keep_work: bool,
-    /// Wall-clock limit of one solver job, s.
-    #[arg(long, value_name = "S", value_parser = positive_seconds)]
-    pub timeout_s: Option<f64>,
-    /// Stall limit, s.
-    #[arg(long, value_name = "S", default_value_t = campaign::DEFAULT_STALL.as_secs_f64(), value_parser = positive_seconds)]
-    pub stall_s: f64,
 }
 
 /// A duration in seconds on the command line: finite and > 0 (at most 30 days).
@@ -230,7 +226,6 @@ pub fn run(c: FeCommand) -> anyhow::Result<ExitCode> {
 }
 
 fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
-    let timeout = a.timeout_s.map(Duration::from_secs_f64);
     let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
     let jobs = a.jobs as usize;
     if a.launcher == LauncherArg::Local
@@ -238,16 +233,10 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
     {
         anyhow::bail!("--partition, --time, --mem, --cpus-per-task and --sbatch-arg are options of --launcher slurm");
     }
-    let opts = RunOptions {
-        jobs,
-        threads: a.threads.map(|t| t as usize).unwrap_or((cores / jobs).max(1)),
-        force: a.force,
-        keep_work: a.keep_work,
-        timeout,
-        stall: Some(Duration::from_secs_f64(a.stall_s)),
-        launcher: Launched::Local,
-        ..spec_options(a.spec)?
-    };
+    let opts = with_solve(
+        RunOptions { jobs, threads: a.threads.map(|t| t as usize).unwrap_or((cores / jobs).max(1)), ..spec_options(a.spec)? },
+        &a.solve,
+    );
     if a.launcher == LauncherArg::Slurm {
         let slurm = SlurmOptions {
             partition: a.partition,
@@ -297,14 +286,14 @@ fn submit_summary(r: &slurm::SubmitReport) -> String {
 }
 
 fn run_status(a: StatusArgs) -> anyhow::Result<ExitCode> {
-    let opts = spec_options(a.spec)?;
-    let r = crate::fe::launcher::status::status(&opts)?;
+    let plan = campaign::plan(&spec_options(a.spec)?)?;
+    let r = crate::fe::launcher::status::status(&plan)?;
     print!("{}", r.table());
     if !a.project_nodes.is_empty() {
         let per_node =
             a.tasks_per_node.map(|n| n as usize).unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
         let nodes: Vec<usize> = a.project_nodes.iter().map(|&n| n as usize).collect();
-        print!("{}", crate::fe::launcher::projection::table(&opts, &nodes, per_node)?);
+        print!("{}", crate::fe::launcher::projection::table(&plan, &nodes, per_node));
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -322,25 +311,12 @@ fn spec_options(spec: SpecArgs) -> anyhow::Result<RunOptions> {
 }
 
 fn run_one(a: RunOneArgs) -> anyhow::Result<ExitCode> {
-    if a.pose.contains(',') || a.pose.chars().any(|c| matches!(c, '*' | '?' | '[' | ']')) {
-        anyhow::bail!("--pose {:?}: a pose name, not a pattern", a.pose);
+    if a.pose.contains(',') || a.pose.chars().any(|c| matches!(c, '*' | '?' | '[' | ']')) || a.spec.only.is_some() {
+        anyhow::bail!("--pose {:?}: one pose name, not a pattern (and no --only)", a.pose);
     }
     let threads = std::env::var("SLURM_CPUS_PER_TASK").ok().and_then(|v| v.trim().parse::<usize>().ok()).unwrap_or(1).max(1);
-    let opts = RunOptions {
-        jobs: 1,
-        threads,
-        solver: Some(crate::fe::spec::Engine::parse(&a.solver)?),
-        only: Some(a.pose),
-        mesh: Some(a.mesh),
-        steps: Some(a.steps),
-        out_dir: Some(a.out),
-        force: a.force,
-        keep_work: a.keep_work,
-        timeout: a.timeout_s.map(Duration::from_secs_f64),
-        stall: Some(Duration::from_secs_f64(a.stall_s)),
-        launcher: Launched::from_env(),
-        ..RunOptions::new(a.set)
-    };
+    let only = Some(a.pose.clone());
+    let opts = with_solve(RunOptions { jobs: 1, threads, only, launcher: Launched::from_env(), ..spec_options(a.spec)? }, &a.solve);
     crate::fe::process::stop_jobs_on_termination()?;
     let report = campaign::run(&opts)?;
     print!("{}", report.table());

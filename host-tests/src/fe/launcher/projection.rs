@@ -4,9 +4,8 @@
 //! slots that free up), and the projection is the time the last slot finishes. It counts
 //! neither queue waiting nor the slower cores a cluster may have.
 
-use crate::fe::campaign::{self, RunOptions};
+use crate::fe::campaign::Plan;
 use crate::fe::deck;
-use anyhow::Result;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
@@ -60,15 +59,11 @@ pub fn human(s: f64) -> String {
     }
 }
 
-/// The projection table of the poses `opts` selects (`needle fe status --project-nodes`):
+/// The projection table of the poses `plan` selects (`needle fe status --project-nodes`):
 /// each pose's measured wall time on this engine, mesh and step count from the manifest,
 /// or the median of the measured runs of its model kind (quarter, half, full block) when
 /// it has none.
-///
-/// # Errors
-/// The spec or the manifest cannot be read.
-pub fn table(opts: &RunOptions, nodes: &[usize], tasks_per_node: usize) -> Result<String> {
-    let plan = campaign::plan(opts)?;
+pub fn table(plan: &Plan, nodes: &[usize], tasks_per_node: usize) -> String {
     let engine = plan.campaign.solver.engine.name();
     let measured =
         |e: &&crate::fe::manifest::ManifestEntry| e.engine == engine && e.mesh == plan.mesh_name && e.steps == plan.steps && e.wall_s > 0.0;
@@ -108,7 +103,7 @@ pub fn table(opts: &RunOptions, nodes: &[usize], tasks_per_node: usize) -> Resul
     for r in project(&walls, nodes, tasks_per_node) {
         let _ = writeln!(s, "{:>6}  {:>6}  {:>14}  {:>7.1}x", r.nodes, r.slots, human(r.wall_s), r.speedup);
     }
-    Ok(s)
+    s
 }
 
 #[cfg(test)]

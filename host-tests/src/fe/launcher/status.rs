@@ -2,9 +2,8 @@
 //! solved) beside the queue state of its latest SLURM array task (`squeue`) and, for a
 //! task that left the queue without a result, the cause its output states.
 
-use crate::fe::campaign::{self, RunOptions};
+use crate::fe::campaign::Plan;
 use crate::fe::launcher::slurm::{self, QueueState, SLURM_DIR};
-use crate::fe::report::Status;
 use anyhow::Result;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -72,13 +71,12 @@ impl StatusReport {
     }
 }
 
-/// The status of the poses of `opts` (set, output folder, mesh, steps, `--only`).
+/// The status of the poses of `plan` ([`campaign::plan`](crate::fe::campaign::plan)).
 ///
 /// # Errors
-/// The spec or the manifest cannot be read. A queue that cannot be read is not an error:
+/// The submissions record cannot be read. A queue that cannot be read is not an error:
 /// the report says so in [`StatusReport::queue_error`].
-pub fn status(opts: &RunOptions) -> Result<StatusReport> {
-    let plan = campaign::plan(opts)?;
+pub fn status(plan: &Plan) -> Result<StatusReport> {
     let subs = slurm::read_submissions(&plan.out_dir)?;
     let latest = subs.latest_tasks();
     let (queue, queue_error) = if subs.submission.is_empty() {
@@ -91,7 +89,7 @@ pub fn status(opts: &RunOptions) -> Result<StatusReport> {
     };
     let mut poses = Vec::new();
     for (i, pose) in plan.selected.iter().enumerate() {
-        let done = plan.reports.get(i).is_some_and(|r| r.status == Status::UpToDate) && !plan.to_run.contains(&i);
+        let done = !plan.to_run.contains(&i);
         let result = if done {
             String::new()
         } else {
