@@ -1,6 +1,7 @@
 //! Firmware example `golden`: evaluates every pose of the compiled-in set's
 //! `golden-f32.csv` on the target and prints the results' bits, then every pose of its
-//! `golden-fixed.csv` with the fixed-point evaluator and prints the integers, for the
+//! `golden-fixed.csv` with the fixed-point evaluator and prints the integers, then the
+//! stiffness of every pose of `golden-f32.csv` (`wrench_and_stiffness`), for the
 //! host to compare with the golden files (host-tests/tests/firmware_golden.rs,
 //! `needle firmware golden`).
 //!
@@ -19,6 +20,9 @@
 //! needle-golden-fixed rows=<FIXED_ROWS>
 //! <one row per pose in golden-fixed.csv's format: inputs as read, status and wrench as computed>
 //! needle-golden-fixed end rows=<FIXED_ROWS>
+//! needle-golden-stiffness rows=<ROWS>
+//! <one row per pose of golden-f32.csv in golden-stiffness-f32.csv's format: inputs, status, 18 rates>
+//! needle-golden-stiffness end rows=<ROWS> wrench_differs=<rows whose wrench_and_stiffness wrench is not wrench()'s>
 //! ```
 //!
 //! ```text
@@ -36,7 +40,7 @@ mod common;
 mod firmware {
     use crate::common::{exit, Out};
     use core::hint::black_box;
-    use needle_haptics::{fixed, model_info, wrench, Pose};
+    use needle_haptics::{fixed, model_info, wrench, wrench_and_stiffness, Pose};
 
     const HEADER: &str = "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,status,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm";
 
@@ -210,6 +214,45 @@ mod firmware {
         out.nl();
     }
 
+    /// Evaluates the wrench and stiffness of every pose of golden-f32.csv and prints the
+    /// status and the 18 rates per row (golden-stiffness-f32.csv's format, same poses);
+    /// the end line counts the rows whose wrench differs in any bit from [`wrench`]'s.
+    fn stiffness_rows(out: &mut Out) {
+        out.str("needle-golden-stiffness rows=");
+        out.dec(ROWS as u64);
+        out.nl();
+        let poses: &[[u32; 5]] = black_box(&POSES[..]);
+        let mut wrench_differs = 0u64;
+        for p in poses {
+            let [x, z, tx, tz, d] = *p;
+            let pose = Pose::new(f32::from_bits(x), f32::from_bits(z), f32::from_bits(tx), f32::from_bits(tz), f32::from_bits(d));
+            let e = wrench_and_stiffness(black_box(&pose));
+            let plain = wrench(black_box(&pose));
+            let bits = |w: [f32; 6]| w.map(f32::to_bits);
+            if plain.status != e.status || bits(plain.wrench.to_array()) != bits(e.wrench.to_array()) {
+                wrench_differs += 1;
+            }
+            for v in p {
+                out.hex(*v, 8);
+                out.str(",");
+            }
+            out.hex(u32::from(e.status.bits()), 2);
+            let s = e.stiffness;
+            for rates in [s.by_depth, s.by_x, s.by_z] {
+                for r in rates.to_array() {
+                    out.str(",");
+                    out.hex(r.to_bits(), 8);
+                }
+            }
+            out.nl();
+        }
+        out.str("needle-golden-stiffness end rows=");
+        out.dec(poses.len() as u64);
+        out.str(" wrench_differs=");
+        out.dec(wrench_differs);
+        out.nl();
+    }
+
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut out = Out::new();
@@ -246,6 +289,7 @@ mod firmware {
         out.dec(poses.len() as u64);
         out.nl();
         fixed_rows(&mut out);
+        stiffness_rows(&mut out);
         out.flush();
         exit(true)
     }

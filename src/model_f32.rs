@@ -32,13 +32,13 @@ const fn is_plus_zero(p: &[f32; 5]) -> bool {
 }
 
 /// Whether every coefficient of the 5x5 matrix `m` is `+0.0`.
-const fn is_plus_zero_matrix(m: &[[f32; 5]; 5]) -> bool {
+pub(crate) const fn is_plus_zero_matrix(m: &[[f32; 5]; 5]) -> bool {
     let [r0, r1, r2, r3, r4] = m;
     is_plus_zero(r0) && is_plus_zero(r1) && is_plus_zero(r2) && is_plus_zero(r3) && is_plus_zero(r4)
 }
 
 /// `ZERO_BASELINE[c]`: every coefficient of `B_c` is `+0.0`.
-const ZERO_BASELINE: [bool; 6] = {
+pub(crate) const ZERO_BASELINE: [bool; 6] = {
     let [b0, b1, b2, b3, b4, b5] = &BASELINE;
     [is_plus_zero(b0), is_plus_zero(b1), is_plus_zero(b2), is_plus_zero(b3), is_plus_zero(b4), is_plus_zero(b5)]
 };
@@ -86,7 +86,7 @@ const fn starts_not_neg_zero(b: &[f32; 5]) -> bool {
 /// `B_c(u)`: `+0.0` without evaluating it when every coefficient is `+0.0` (exact,
 /// see [`skip_sweep`]).
 #[inline(always)]
-fn baseline(b: &[f32; 5], zero: bool, u: f32) -> f32 {
+pub(crate) fn baseline(b: &[f32; 5], zero: bool, u: f32) -> f32 {
     if zero {
         0.0
     } else {
@@ -104,7 +104,7 @@ fn deviation(m: &[[f32; 5]; 5], t: f32, u: f32) -> f32 {
 
 /// `t = |v| * s - 1` of one sweep (step 3 of the contract).
 #[inline(always)]
-fn sweep_t(v: f32, s: f32) -> f32 {
+pub(crate) fn sweep_t(v: f32, s: f32) -> f32 {
     abs(v) * s - 1.0
 }
 
@@ -262,6 +262,26 @@ fn clamp_depth(d: f32, max: f32) -> (f32, bool) {
     }
 }
 
+/// Steps 1 and 2 of the contract: `None` when an input is NaN or infinite, else the
+/// pose clamped to the domain and its saturation flags.
+///
+/// Fast path, the usual case in a control loop: every input inside its domain, so no
+/// clamp changes anything and no status bit is set. NaN and the infinities fail these
+/// tests too and take the general path ([`saturate`]).
+#[inline(always)]
+pub(crate) fn clamp_to_domain(pose: &Pose) -> Option<(Pose, Status)> {
+    let inside = within(pose.x_mm, X_MAX_MM)
+        & within(pose.z_mm, Z_MAX_MM)
+        & within(pose.theta_x_deg, THETA_MAX_DEG)
+        & within(pose.theta_z_deg, THETA_MAX_DEG)
+        & within_depth(pose.depth_mm, DEPTH_MAX_MM);
+    if inside {
+        Some((*pose, Status::OK))
+    } else {
+        saturate(pose)
+    }
+}
+
 /// The reaction wrench of the compiled-in set's f32 paper model at `pose`.
 ///
 /// Implements the evaluation algorithm of `coeffs/README.md` exactly, so the result has
@@ -297,21 +317,8 @@ pub fn wrench(pose: &Pose) -> Evaluation {
     if !FITTED {
         return Evaluation { wrench: Wrench::ZERO, status: Status::NO_MODEL | Status::ERROR };
     }
-    // Steps 1 and 2. Fast path, the usual case in a control loop: every input inside
-    // its domain, so no clamp changes anything and no status bit is set. NaN and the
-    // infinities fail these tests too and take the general path.
-    let inside = within(pose.x_mm, X_MAX_MM)
-        & within(pose.z_mm, Z_MAX_MM)
-        & within(pose.theta_x_deg, THETA_MAX_DEG)
-        & within(pose.theta_z_deg, THETA_MAX_DEG)
-        & within_depth(pose.depth_mm, DEPTH_MAX_MM);
-    let (clamped, status) = if inside {
-        (*pose, Status::OK)
-    } else {
-        match saturate(pose) {
-            Some(c) => c,
-            None => return Evaluation { wrench: Wrench::ZERO, status: Status::ERROR },
-        }
+    let Some((clamped, status)) = clamp_to_domain(pose) else {
+        return Evaluation { wrench: Wrench::ZERO, status: Status::ERROR };
     };
     let Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, depth_mm: d } = clamped;
 

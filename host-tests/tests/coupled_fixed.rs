@@ -5,59 +5,16 @@
 //! formats; the fitter's integer evaluation never leaves 2^30 and stays within the
 //! generated error bound of the f64 coupled model; the f32 evaluation stays close to it;
 //! the paper part is unchanged. Not a fitted model: nothing here goes under coeffs/.
-use needle_host::fit::cross_terms::monomials;
+mod made_up_model;
+
 use needle_host::fit::eval_f32::{eval as eval32, Tables32};
 use needle_host::fit::eval_f64::{eval as eval64, eval_paper};
 use needle_host::fit::eval_fixed::eval as eval_fixed;
 use needle_host::fit::fixed_formats::TablesFixed;
-use needle_host::fit::model_file::{hex32, parse};
-use std::fmt::Write as _;
+use needle_host::fit::model_file::parse;
 use std::path::Path;
 
 const COMPONENTS: [&str; 6] = ["fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"];
-
-/// The default model.toml with `form = "coupled"` and made-up cross terms (degree <= 3
-/// in the pose, 2 in depth): a deterministic pattern of +-0.5 mN (forces) and +-30 mN*mm
-/// (moments), about 5 % of the default set's peak Fy.
-fn coupled_text() -> String {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default/model.toml");
-    let paper = std::fs::read_to_string(&path).expect("coeffs/default/model.toml");
-    assert!(!paper.contains("form = "), "the default set is already coupled: use it instead");
-    let mut s = String::new();
-    for line in paper.lines() {
-        let _ = writeln!(s, "{line}");
-        if line.starts_with("theta_max_deg") {
-            let _ = writeln!(s, "form = \"coupled\"");
-        }
-    }
-    let _ = writeln!(s, "\n[coupled]\nmax_degree = 3\ndepth_degree = 2\ntraining_runs = 0");
-    let _ = writeln!(s, "cv_rms_pct = [0.1, 0.1, 0.1, 0.1, 0.1, 0.1]\nscale = [0.07, 0.07, 0.07, 4.2, 4.2, 4.2]");
-    let mut k = 0u32;
-    for (c, name) in COMPONENTS.iter().enumerate() {
-        let size = if c < 3 { 5e-4 } else { 3e-2 };
-        for e in monomials(c, 3) {
-            let p: Vec<f64> = (0..3)
-                .map(|i| {
-                    k += 1;
-                    size * (f64::from(k) * 0.7 + f64::from(i)).sin()
-                })
-                .collect();
-            let f64s: Vec<String> = p.iter().map(|v| format!("{v:?}")).collect();
-            let f32s: Vec<String> = p.iter().map(|v| format!("\"{}\"", hex32(*v as f32))).collect();
-            let _ = writeln!(
-                s,
-                "\n[[cross]]\ncomponent = \"{name}\"\nexponents = [{}, {}, {}, {}]\ncoeffs = [{}]\ncoeffs_f32 = [{}]",
-                e[0],
-                e[1],
-                e[2],
-                e[3],
-                f64s.join(", "),
-                f32s.join(", ")
-            );
-        }
-    }
-    s
-}
 
 /// A deterministic spread of Q16.16 poses over the whole domain, edges included.
 fn poses() -> Vec<[i32; 5]> {
@@ -80,7 +37,7 @@ fn poses() -> Vec<[i32; 5]> {
 
 #[test]
 fn generator_and_fitter_agree_and_the_bound_holds() {
-    let text = coupled_text();
+    let text = made_up_model::coupled_default_text();
     let path = Path::new("made-up-coupled/model.toml");
     let model = parse(&text, path).unwrap_or_else(|e| panic!("{e:#}"));
     let cross = model.cross.as_ref().expect("coupled");
@@ -130,7 +87,7 @@ fn a_paper_file_reads_back_without_cross_terms() {
     let text = std::fs::read_to_string(&path).expect("model.toml");
     let model = parse(&text, &path).unwrap_or_else(|e| panic!("{e:#}"));
     assert!(model.cross.is_none());
-    let coupled = parse(&coupled_text(), Path::new("m.toml")).expect("coupled");
+    let coupled = parse(&made_up_model::coupled_default_text(), Path::new("m.toml")).expect("coupled");
     let pose = [2.0, -1.0, 7.0, -4.0, 4.5];
     assert_eq!(eval_paper(&coupled, pose), eval64(&model, pose), "the coupled file's paper part is the paper model");
     assert_ne!(eval64(&coupled, pose).0, eval64(&model, pose).0);

@@ -2,12 +2,13 @@
 //! vectors of the set compiled into the library (`NEEDLE_COEFFS`, default
 //! coeffs/default): every status and wrench bit of every row must be the golden file's
 //! (NaN by class, signed zeros by bits), and every integer of the fixed-point evaluator
-//! the one in golden-fixed.csv. Soft-float add and multiply are correctly
+//! the one in golden-fixed.csv, and every stiffness rate the one in
+//! golden-stiffness-f32.csv. Soft-float add and multiply are correctly
 //! rounded, so the M3 and M0 must match as well as the M4F's FPU.
 //!
 //! Nothing skips: a missing QEMU, rustup target, model.toml or golden file fails with a
 //! message that says what to install or run.
-use needle_host::firmware::{self, golden, golden_fixed};
+use needle_host::firmware::{self, golden, golden_fixed, golden_stiffness};
 
 fn golden_on(name: &str) {
     let core = firmware::core(name).unwrap_or_else(|e| panic!("{e:#}"));
@@ -36,6 +37,18 @@ fn golden_on(name: &str) {
         core.target,
         f.mismatches.iter().take(10).cloned().collect::<Vec<_>>().join("\n")
     );
+    let s = &run.stiffness;
+    assert!(s.rows >= 2000, "{}: only {} stiffness golden rows", set.display(), s.rows);
+    assert!(
+        s.mismatches.is_empty(),
+        "{} of {} stiffness golden rows differ on {} ({}); first ones:\n{}",
+        s.mismatches.len(),
+        s.rows,
+        core.core,
+        core.target,
+        s.mismatches.iter().take(10).cloned().collect::<Vec<_>>().join("\n")
+    );
+    println!("{} ({}): {} stiffness golden rows bit for bit, wrench_and_stiffness's wrench = wrench's", core.core, core.machine, s.rows);
     println!("{} ({}): {} fixed-point golden rows exactly", core.core, core.machine, f.rows);
     println!("{} ({}): {} golden rows bit for bit in {:.1} s ({})", core.core, core.machine, c.rows, run.run_time.as_secs_f64(), c.banner);
 }
@@ -102,4 +115,33 @@ fn fixed_comparison_catches_one_bit() {
     }
     assert!(golden_fixed::compare("needle-golden end rows=9\n", &csv).is_err(), "no fixed section");
     assert!(golden_fixed::compare(&out(row).replace("needle-golden-fixed end rows=1\n", ""), &csv).is_err(), "truncated");
+}
+
+/// The stiffness comparison on hand-made output: one flipped bit of one rate, a status,
+/// a wrench the firmware found different from `wrench`'s, a missing and a truncated
+/// section are all caught.
+#[test]
+fn stiffness_comparison_catches_one_bit_and_a_differing_wrench() {
+    let h = needle_host::fit::golden_stiffness::header();
+    let inputs = "0x00000000,0x00000000,0x00000000,0x00000000,0x40400000";
+    let rates: Vec<String> = (0..18).map(|i| format!("0x3c{i:06x}")).collect();
+    let row = format!("{inputs},0x00,{}", rates.join(","));
+    let csv = format!("{h}\n{row}\n");
+    let out = |r: &str, differs: u32| {
+        format!("needle-golden-fixed end rows=1\nneedle-golden-stiffness rows=1\n{r}\nneedle-golden-stiffness end rows=1 wrench_differs={differs}\n")
+    };
+    let c = golden_stiffness::compare(&out(&row, 0), &csv).expect("well-formed");
+    assert!(c.mismatches.is_empty(), "{:?}", c.mismatches);
+    let mut flipped = rates.clone();
+    flipped[7] = "0x3c000006".to_string(); // dfy_dx one bit off (0x3c000007 ^ 1)
+    for bad in [format!("{inputs},0x00,{}", flipped.join(",")), format!("{inputs},0x10,{}", rates.join(","))] {
+        let c = golden_stiffness::compare(&out(&bad, 0), &csv).expect("well-formed");
+        assert_eq!(c.mismatches.len(), 1, "{bad}");
+    }
+    assert!(golden_stiffness::compare(&out(&row, 1), &csv).is_err(), "a wrench differing from wrench()'s");
+    assert!(golden_stiffness::compare("needle-golden-fixed end rows=1\n", &csv).is_err(), "no stiffness section");
+    assert!(
+        golden_stiffness::compare(&out(&row, 0).replace("needle-golden-stiffness end rows=1 wrench_differs=0\n", ""), &csv).is_err(),
+        "truncated"
+    );
 }

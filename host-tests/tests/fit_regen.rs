@@ -2,7 +2,7 @@
 //! set reproduces the committed files byte for byte (unicode-ident style). Never skipped:
 //! a missing file is a failure that says how to make it.
 
-use needle_host::fit::{fit_set, GOLDEN_FILE, GOLDEN_FIXED_FILE, MODEL_FILE};
+use needle_host::fit::{fit_set, GOLDEN_FILE, GOLDEN_FIXED_FILE, GOLDEN_STIFFNESS_FILE, MODEL_FILE};
 use std::path::PathBuf;
 
 fn set_dir() -> PathBuf {
@@ -17,14 +17,14 @@ fn first_difference(a: &str, b: &str) -> usize {
 fn committed_model_and_golden_vectors_are_reproducible() {
     let set = set_dir();
     let mut committed = Vec::new();
-    for name in [MODEL_FILE, GOLDEN_FILE, GOLDEN_FIXED_FILE] {
+    for name in [MODEL_FILE, GOLDEN_FILE, GOLDEN_FIXED_FILE, GOLDEN_STIFFNESS_FILE] {
         let path = set.join(name);
         match std::fs::read_to_string(&path) {
             Ok(t) => committed.push(t),
             Err(e) => panic!(
                 "{}: cannot read ({e}). The shipped set has no fitted model yet: once the FE campaign \
                  is complete, run `cargo run --release -p needle-host -- fit --set coeffs/default` and commit \
-                 coeffs/default/{MODEL_FILE}, {GOLDEN_FILE} and {GOLDEN_FIXED_FILE}.",
+                 coeffs/default/{MODEL_FILE}, {GOLDEN_FILE}, {GOLDEN_FIXED_FILE} and {GOLDEN_STIFFNESS_FILE}.",
                 path.display()
             ),
         }
@@ -33,8 +33,9 @@ fn committed_model_and_golden_vectors_are_reproducible() {
         Ok(o) => o,
         Err(e) => panic!("regenerating the fit of {} failed: {e:#}", set.display()),
     };
-    let regenerated = [&out.model_toml, &out.golden_csv, &out.golden_fixed_csv];
-    for ((name, have), want) in [MODEL_FILE, GOLDEN_FILE, GOLDEN_FIXED_FILE].iter().zip(&committed).zip(regenerated) {
+    let regenerated = [&out.model_toml, &out.golden_csv, &out.golden_fixed_csv, &out.golden_stiffness_csv];
+    for ((name, have), want) in [MODEL_FILE, GOLDEN_FILE, GOLDEN_FIXED_FILE, GOLDEN_STIFFNESS_FILE].iter().zip(&committed).zip(regenerated)
+    {
         if have != want {
             panic!(
                 "coeffs/default/{name} differs from what `needle fit` regenerates from coeffs/default/fe \

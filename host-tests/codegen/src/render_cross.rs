@@ -52,6 +52,29 @@ fn horner(p: &[f32]) -> String {
     s
 }
 
+/// `q'`, Horner over the derivative coefficients of `p` (`k * p[k]` rounded to f32, the
+/// contract's "Stiffness" rule), highest power first; `None` for a constant `p`.
+fn horner_rate(p: &[f32]) -> Option<String> {
+    let q: Vec<f32> = p.iter().enumerate().skip(1).map(|(k, v)| k as f32 * v).collect();
+    (!q.is_empty()).then(|| horner(&q))
+}
+
+/// `e_k * (m / n_k)`: the monomial's partial derivative by input `k` (`None` when the
+/// monomial does not hold it), the reduced monomial multiplied left to right, `1.0` when
+/// it is empty.
+fn monomial_rate(e: [u8; 4], k: usize) -> Option<String> {
+    let ek = *e.get(k)?;
+    if ek == 0 {
+        return None;
+    }
+    let mut reduced = e;
+    if let Some(r) = reduced.get_mut(k) {
+        *r -= 1;
+    }
+    let m = if reduced.iter().all(|&r| r == 0) { lit(1.0) } else { monomial(reduced) };
+    Some(format!("{} * ({m})", lit(f32::from(ek))))
+}
+
 /// The Rust source of `cross_f32.rs`, to be `include!`d in a module.
 pub fn render_rust_cross(model: &Model) -> String {
     let mut s = String::new();
@@ -100,7 +123,43 @@ pub fn render_rust_cross(model: &Model) -> String {
         }
     }
     let _ = writeln!(w, "}}");
+    render_rust_cross_rates(w, model);
     s
+}
+
+/// `add_cross_rates`: the cross terms' part of the stiffness (coeffs/README.md,
+/// "Stiffness"), per term in file order into the rate by depth, x and z.
+fn render_rust_cross_rates(w: &mut String, model: &Model) {
+    let third = lit(1.0 / 3.0);
+    let [rx, rz, _, _] = CROSS_SCALES_F32.map(lit);
+    let _ = writeln!(w);
+    let _ = writeln!(w, "/// The cross terms' rates: `d[c] += (m * P'(u)) * (1/3)`, `x[c] += ((e_x * m/xi) * P(u)) * (1/12)`,");
+    let _ = writeln!(w, "/// `z[c]` likewise, per term in file order (coeffs/README.md, \"Stiffness\").");
+    let _ = writeln!(w, "#[inline(always)]");
+    let _ = writeln!(w, "pub(crate) fn add_cross_rates(n: [f32; 4], u: f32, d: &mut [f32; 6], x: &mut [f32; 6], z: &mut [f32; 6]) {{");
+    if model.cross.is_empty() {
+        let _ = writeln!(w, "    let _ = (n, u, d, x, z);");
+    } else {
+        let _ = writeln!(w, "    let [xi, zeta, alpha, beta] = n;");
+        let _ = writeln!(w, "    let _ = (xi, zeta, alpha, beta);");
+        let _ = writeln!(w, "    let [d0, d1, d2, d3, d4, d5] = d;");
+        let _ = writeln!(w, "    let [x0, x1, x2, x3, x4, x5] = x;");
+        let _ = writeln!(w, "    let [z0, z1, z2, z3, z4, z5] = z;");
+        let _ = writeln!(w, "    let _ = (&d0, &d1, &d2, &d3, &d4, &d5, &x0, &x1, &x2, &x3, &x4, &x5, &z0, &z1, &z2, &z3, &z4, &z5);");
+        for t in &model.cross {
+            let c = t.component;
+            let _ = writeln!(w, "    // {} ({}), exponents {:?}, model.toml line {}", COMPONENTS[c], UNITS[c], t.exponents, t.line);
+            if let Some(q) = horner_rate(&t.coeffs_f32) {
+                let _ = writeln!(w, "    *d{c} = *d{c} + (({}) * {q}) * {third};", monomial(t.exponents));
+            }
+            for (acc, k, scale) in [("x", 0, &rx), ("z", 1, &rz)] {
+                if let Some(m) = monomial_rate(t.exponents, k) {
+                    let _ = writeln!(w, "    *{acc}{c} = *{acc}{c} + (({m}) * {}) * {scale};", horner(&t.coeffs_f32));
+                }
+            }
+        }
+    }
+    let _ = writeln!(w, "}}");
 }
 
 /// The cross-term section of `needle_coeffs.h` (empty tables for the paper form).

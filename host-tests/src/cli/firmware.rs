@@ -19,7 +19,7 @@ pub enum FirmwareCommand {
     Bench(FirmwareArgs),
     /// Run the `golden` example on each core's QEMU board and compare every printed bit
     /// with the set's golden-f32.csv, and every fixed-point integer with its
-    /// golden-fixed.csv. Exit status 1 when a bit differs.
+    /// golden-fixed.csv, and every stiffness rate with its golden-stiffness-f32.csv. Exit status 1 when a bit differs.
     Golden(FirmwareArgs),
     /// Build the library for each core with every combination of its features, and the
     /// `no_panic` and `no_panic_fixed` examples (link only if the evaluators have no panic
@@ -191,7 +191,12 @@ fn golden_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
         for line in mf.iter().take(10) {
             println!("  {line}");
         }
-        failed |= !m.is_empty() || !mf.is_empty();
+        let ms = &run.stiffness.mismatches;
+        println!("{} ({}): {} of {} stiffness golden rows differ", c.core, c.target, ms.len(), run.stiffness.rows);
+        for line in ms.iter().take(10) {
+            println!("  {line}");
+        }
+        failed |= !m.is_empty() || !mf.is_empty() || !ms.is_empty();
     }
     Ok(if failed { ExitCode::from(1) } else { ExitCode::SUCCESS })
 }

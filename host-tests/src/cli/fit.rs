@@ -1,6 +1,6 @@
 //! `needle fit`, `needle validate`: fit the model, compare it with FE.
 use crate::fe::results::write_all_atomic;
-use crate::fit::{self, validate as val, GOLDEN_FILE, GOLDEN_FIXED_FILE, MODEL_FILE};
+use crate::fit::{self, validate as val, GOLDEN_FILE, GOLDEN_FIXED_FILE, GOLDEN_STIFFNESS_FILE, MODEL_FILE};
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -65,7 +65,7 @@ fn check_file(path: &Path, want: &str) -> Result<bool> {
 }
 
 /// `needle fit --set DIR [--check]`: fit the set's FE sweeps and write `model.toml`,
-/// `golden-f32.csv` and `golden-fixed.csv` all or nothing ([`write_all_atomic`]) (or, with `--check`, compare them). Exit code 0 on
+/// `golden-f32.csv`, `golden-fixed.csv` and `golden-stiffness-f32.csv` all or nothing ([`write_all_atomic`]) (or, with `--check`, compare them). Exit code 0 on
 /// success, 1 when `--check` finds a difference.
 ///
 /// # Errors
@@ -76,16 +76,19 @@ pub fn fit(a: FitArgs) -> Result<ExitCode> {
     let model_path = a.set.join(MODEL_FILE);
     let golden_path = a.set.join(GOLDEN_FILE);
     let golden_fixed_path = a.set.join(GOLDEN_FIXED_FILE);
+    let golden_stiffness_path = a.set.join(GOLDEN_STIFFNESS_FILE);
     if a.check {
         let ok_model = check_file(&model_path, &out.model_toml)?;
         let ok_golden = check_file(&golden_path, &out.golden_csv)?;
         let ok_fixed = check_file(&golden_fixed_path, &out.golden_fixed_csv)?;
-        return Ok(if ok_model && ok_golden && ok_fixed { ExitCode::SUCCESS } else { ExitCode::from(1) });
+        let ok_stiffness = check_file(&golden_stiffness_path, &out.golden_stiffness_csv)?;
+        return Ok(if ok_model && ok_golden && ok_fixed && ok_stiffness { ExitCode::SUCCESS } else { ExitCode::from(1) });
     }
     write_all_atomic(&[
         (&model_path, out.model_toml.as_bytes()),
         (&golden_path, out.golden_csv.as_bytes()),
         (&golden_fixed_path, out.golden_fixed_csv.as_bytes()),
+        (&golden_stiffness_path, out.golden_stiffness_csv.as_bytes()),
     ])?;
     print!("{}", fit::summary(&out.model));
     let coupled = fit::coupled_report::measure(&a.set, &out.model)
@@ -94,6 +97,7 @@ pub fn fit(a: FitArgs) -> Result<ExitCode> {
     println!("wrote {} ({} bytes)", model_path.display(), out.model_toml.len());
     println!("wrote {} ({} poses)", golden_path.display(), out.golden_csv.lines().count() - 1);
     println!("wrote {} ({} poses)", golden_fixed_path.display(), out.golden_fixed_csv.lines().count() - 1);
+    println!("wrote {} ({} poses)", golden_stiffness_path.display(), out.golden_stiffness_csv.lines().count() - 1);
     Ok(ExitCode::SUCCESS)
 }
 

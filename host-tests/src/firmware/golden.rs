@@ -101,13 +101,16 @@ pub struct CoreRun {
     pub comparison: Comparison,
     /// The comparison of the fixed-point section with golden-fixed.csv.
     pub fixed: Comparison,
+    /// The comparison of the stiffness section with golden-stiffness-f32.csv.
+    pub stiffness: Comparison,
     /// Wall-clock time of the QEMU run.
     pub run_time: Duration,
 }
 
 /// Builds the `golden` example of the fitted set `set` (absolute path) for `core`, runs
-/// it under QEMU and compares its output with `set/golden-f32.csv` and its fixed-point
-/// section with `set/golden-fixed.csv`.
+/// it under QEMU and compares its output with `set/golden-f32.csv`, its fixed-point
+/// section with `set/golden-fixed.csv` and its stiffness section with
+/// `set/golden-stiffness-f32.csv`.
 ///
 /// # Errors
 /// Build, QEMU run or output structure failed (see [`compare`]); mismatching values are
@@ -115,6 +118,9 @@ pub struct CoreRun {
 pub fn run(core: &Core, set: &Path) -> anyhow::Result<CoreRun> {
     let golden = set.join("golden-f32.csv");
     let csv = std::fs::read_to_string(&golden).with_context(|| format!("cannot read {}", golden.display()))?;
+    let golden_stiffness = set.join(crate::fit::GOLDEN_STIFFNESS_FILE);
+    let csv_stiffness =
+        std::fs::read_to_string(&golden_stiffness).with_context(|| format!("cannot read {}", golden_stiffness.display()))?;
     let golden_fixed = set.join("golden-fixed.csv");
     let csv_fixed = std::fs::read_to_string(&golden_fixed).with_context(|| format!("cannot read {}", golden_fixed.display()))?;
     let model_path = set.join(needle_codegen::MODEL_FILE);
@@ -136,5 +142,7 @@ pub fn run(core: &Core, set: &Path) -> anyhow::Result<CoreRun> {
         compare(&run.stdout, &csv, &model.fe_sha256).with_context(|| format!("golden firmware on {} ({})", core.core, core.machine))?;
     let fixed = super::golden_fixed::compare(&run.stdout, &csv_fixed)
         .with_context(|| format!("golden firmware on {} ({}), fixed point", core.core, core.machine))?;
-    Ok(CoreRun { core: *core, comparison, fixed, run_time: run.elapsed })
+    let stiffness = super::golden_stiffness::compare(&run.stdout, &csv_stiffness)
+        .with_context(|| format!("golden firmware on {} ({}), stiffness", core.core, core.machine))?;
+    Ok(CoreRun { core: *core, comparison, fixed, stiffness, run_time: run.elapsed })
 }

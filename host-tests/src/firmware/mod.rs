@@ -17,6 +17,7 @@ pub mod comparison;
 pub mod float_check;
 pub mod golden;
 pub mod golden_fixed;
+pub mod golden_stiffness;
 pub mod qemu;
 pub mod size;
 

@@ -19,9 +19,12 @@ pub mod error_trend;
 pub mod eval_f32;
 pub mod eval_f64;
 pub mod eval_fixed;
+pub mod eval_rate_f32;
+pub mod eval_rate_f64;
 pub mod fixed_formats;
 pub mod golden;
 pub mod golden_fixed;
+pub mod golden_stiffness;
 pub mod lsq;
 pub mod model;
 pub mod model_file;
@@ -38,6 +41,8 @@ pub const MODEL_FILE: &str = "model.toml";
 pub const GOLDEN_FILE: &str = "golden-f32.csv";
 /// Name of the fixed-point golden-vector file inside a set folder.
 pub const GOLDEN_FIXED_FILE: &str = "golden-fixed.csv";
+/// Name of the stiffness golden-vector file inside a set folder.
+pub const GOLDEN_STIFFNESS_FILE: &str = "golden-stiffness-f32.csv";
 
 /// What `needle fit` produces for a set, in memory.
 #[derive(Debug, Clone)]
@@ -50,6 +55,8 @@ pub struct FitOutput {
     pub golden_csv: String,
     /// The text of `golden-fixed.csv`.
     pub golden_fixed_csv: String,
+    /// The text of `golden-stiffness-f32.csv`.
+    pub golden_stiffness_csv: String,
 }
 
 /// Fit the set in `set_dir` and render the three output files, without writing anything.
@@ -64,9 +71,11 @@ pub fn fit_set(set_dir: &Path) -> Result<FitOutput> {
         model.cross = Some(coupled::fit_coupled(&model, &data.train, data.campaign.needle.reference_from_tip_mm)?);
     }
     let model_toml = model_file::to_toml(&model, &data.campaign.campaign.fit_without);
-    let golden_csv = golden::to_csv(&eval_f32::Tables32::from_model(&model));
+    let tables = eval_f32::Tables32::from_model(&model);
+    let golden_csv = golden::to_csv(&tables);
+    let golden_stiffness_csv = golden_stiffness::to_csv(&tables);
     let golden_fixed_csv = golden_fixed::to_csv(&fixed_formats::TablesFixed::from_model(&model)?)?;
-    Ok(FitOutput { model, model_toml, golden_csv, golden_fixed_csv })
+    Ok(FitOutput { model, model_toml, golden_csv, golden_fixed_csv, golden_stiffness_csv })
 }
 
 /// A plain-text table of the fit residuals (RMS and max, in N or N·mm).

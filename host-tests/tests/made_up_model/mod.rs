@@ -4,6 +4,7 @@
 #![allow(dead_code)]
 
 use std::fmt::Write as _;
+use std::path::Path;
 
 /// Component names in contract order.
 pub const COMPONENTS: [&str; 6] = ["fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"];
@@ -65,6 +66,49 @@ pub fn model_text(
                 let _ = writeln!(w, "  {},", list32(r));
             }
             let _ = writeln!(w, "]\nresidual_rms = {:?}\nresidual_max = {:?}", m.residual.0, m.residual.1);
+        }
+    }
+    s
+}
+
+/// The default model.toml with `form = "coupled"` and made-up cross terms (degree <= 3
+/// in the pose, 2 in depth): a deterministic pattern of +-0.5 mN (forces) and +-30 mN*mm
+/// (moments), about 5 % of the default set's peak Fy.
+pub fn coupled_default_text() -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default/model.toml");
+    let paper = std::fs::read_to_string(&path).expect("coeffs/default/model.toml");
+    assert!(!paper.contains("form = "), "the default set is already coupled: use it instead");
+    let mut s = String::new();
+    for line in paper.lines() {
+        let _ = writeln!(s, "{line}");
+        if line.starts_with("theta_max_deg") {
+            let _ = writeln!(s, "form = \"coupled\"");
+        }
+    }
+    let _ = writeln!(s, "\n[coupled]\nmax_degree = 3\ndepth_degree = 2\ntraining_runs = 0");
+    let _ = writeln!(s, "cv_rms_pct = [0.1, 0.1, 0.1, 0.1, 0.1, 0.1]\nscale = [0.07, 0.07, 0.07, 4.2, 4.2, 4.2]");
+    let mut k = 0u32;
+    for (c, name) in COMPONENTS.iter().enumerate() {
+        let size = if c < 3 { 5e-4 } else { 3e-2 };
+        for e in needle_host::fit::cross_terms::monomials(c, 3) {
+            let p: Vec<f64> = (0..3)
+                .map(|i| {
+                    k += 1;
+                    size * (f64::from(k) * 0.7 + f64::from(i)).sin()
+                })
+                .collect();
+            let f64s: Vec<String> = p.iter().map(|v| format!("{v:?}")).collect();
+            let f32s: Vec<String> = p.iter().map(|v| format!("\"{}\"", needle_host::fit::model_file::hex32(*v as f32))).collect();
+            let _ = writeln!(
+                s,
+                "\n[[cross]]\ncomponent = \"{name}\"\nexponents = [{}, {}, {}, {}]\ncoeffs = [{}]\ncoeffs_f32 = [{}]",
+                e[0],
+                e[1],
+                e[2],
+                e[3],
+                f64s.join(", "),
+                f32s.join(", ")
+            );
         }
     }
     s
