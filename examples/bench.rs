@@ -16,7 +16,9 @@
 //!   folded at compile time), minus the same loop without the call, divided by `CALLS`.
 //!   The figure includes the call, the return and the store of the 28-byte result. Both
 //!   evaluators run in the same firmware, one after the other, on the same poses (the
-//!   fixed-point pose is the f32 one in Q16.16).
+//!   fixed-point pose is the f32 one in Q16.16). Evaluator `f32+k` is
+//!   [`needle_haptics::wrench_and_stiffness`] (the wrench and its 18 rates; its result is
+//!   100 bytes).
 //! - **Stack**: the 4 KiB below the caller's stack pointer is painted with a pattern,
 //!   one evaluation runs, and the deepest overwritten word gives the bytes used.
 //!
@@ -24,7 +26,7 @@
 //!
 //! ```text
 //! needle-bench target=<triple> calls=<CALLS> calibration_instructions=<n> calibration_ticks=<n> deterministic=<yes|no>
-//! needle-bench pose=<name> evaluator=<f32|fixed> instructions_per_wrench=<n.n> stack_bytes=<n> status=0x<ss>
+//! needle-bench pose=<name> evaluator=<f32|f32+k|fixed> instructions_per_wrench=<n.n> stack_bytes=<n> status=0x<ss>
 //! ...
 //! needle-bench end
 //! ```
@@ -40,7 +42,7 @@ mod firmware {
     use core::arch::asm;
     use core::hint::black_box;
     use cortex_m::peripheral::SYST;
-    use needle_haptics::{fixed, wrench, Pose};
+    use needle_haptics::{fixed, wrench, wrench_and_stiffness, Pose};
 
     /// Evaluations per timed loop.
     const CALLS: u32 = 256;
@@ -155,11 +157,15 @@ mod firmware {
 
         let eval: fn(&Pose) -> needle_haptics::Evaluation = black_box(wrench);
         let eval_fixed: fn(&fixed::Pose) -> fixed::Evaluation = black_box(fixed::wrench);
+        let eval_stiffness: fn(&Pose) -> needle_haptics::StiffnessEvaluation = black_box(wrench_and_stiffness);
         let per_call = |tw: u32, te: u32| -> u64 { cal.tenths_per_call(tw, te, CALLS) };
         for (name, pose) in POSES.iter() {
             let tenths = per_call(loop_wrench(eval, pose, black_box(CALLS)), loop_empty(pose, black_box(CALLS)));
             let stack = stack_use(eval, pose);
             report(&mut out, name, "f32", tenths, stack, eval(pose).status.bits());
+            let tenths = per_call(loop_wrench(eval_stiffness, pose, black_box(CALLS)), loop_empty(pose, black_box(CALLS)));
+            let stack = stack_use(eval_stiffness, pose);
+            report(&mut out, name, "f32+k", tenths, stack, eval_stiffness(pose).status.bits());
             if let Some((_, q)) = POSES_FIXED.iter().find(|(n, _)| n == name) {
                 let tenths = per_call(loop_wrench(eval_fixed, q, black_box(CALLS)), loop_empty(q, black_box(CALLS)));
                 let stack = stack_use(eval_fixed, q);

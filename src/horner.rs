@@ -8,19 +8,18 @@ pub(crate) fn horner(p: &[f32; 5], w: f32) -> f32 {
     (((p4 * w + p3) * w + p2) * w + p1) * w + p0
 }
 
-/// `g(q, w) = ((q3*w + q2)*w + q1)*w + q0`: the derivative of a quartic `p` when
-/// `q = [p1, 2*p2, 3*p3, 4*p4]` (each product rounded to f32, see [`rate_coeffs`]).
+/// `h(p, w)` and `h'(p, w)` together (coeffs/README.md, "Stiffness"): the value by the
+/// operations of [`horner`] (the same bits), the derivative accumulated alongside,
+/// `d = p4`, then `d = d*w + b` after each of the value's steps for `p3`, `p2`, `p1`
+/// (`b` the value so far), 3 multiplies and 3 adds more, no further coefficient loads.
 #[inline(always)]
-pub(crate) fn horner_rate(q: &[f32; 4], w: f32) -> f32 {
-    let [q0, q1, q2, q3] = *q;
-    ((q3 * w + q2) * w + q1) * w + q0
-}
-
-/// The coefficients of `d p / d w` for the quartic `p`: `[p1, 2*p2, 3*p3, 4*p4]`, each
-/// product an f32 multiply rounded to nearest (the same bits in const evaluation as at
-/// run time).
-#[inline(always)]
-pub(crate) const fn rate_coeffs(p: &[f32; 5]) -> [f32; 4] {
-    let [_, p1, p2, p3, p4] = *p;
-    [p1, 2.0 * p2, 3.0 * p3, 4.0 * p4]
+pub(crate) fn horner_with_rate(p: &[f32; 5], w: f32) -> (f32, f32) {
+    let [p0, p1, p2, p3, p4] = *p;
+    let b3 = p4 * w + p3;
+    let d3 = p4 * w + b3;
+    let b2 = b3 * w + p2;
+    let d2 = d3 * w + b2;
+    let b1 = b2 * w + p1;
+    let d1 = d2 * w + b1;
+    (b1 * w + p0, d1)
 }

@@ -1,38 +1,11 @@
 //! The wrench and its stiffness in f32: the evaluation algorithm of `coeffs/README.md`
 //! ("Stiffness") bit for bit, sharing the wrench's operations.
 use crate::cross_f32::{add_cross, add_cross_rates, COUPLED, CROSS_SCALES};
-use crate::horner::{horner, horner_rate, rate_coeffs};
-use crate::model_f32::{baseline, clamp_to_domain, is_plus_zero_matrix, sweep_t, ODD, ONE_THIRD, SWEEP_SCALES, ZERO_BASELINE};
+use crate::horner::{horner, horner_with_rate};
+use crate::model_f32::{clamp_to_domain, is_plus_zero_matrix, sweep_t, ODD, ONE_THIRD, SWEEP_SCALES, ZERO_BASELINE};
 use crate::stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
 use crate::tables::{BASELINE, DEVIATION, FITTED};
 use crate::{Pose, Status, Wrench};
-
-/// `BASELINE_RATE[c]`: the coefficients of `B_c'(u)` ([`rate_coeffs`]).
-const BASELINE_RATE: [[f32; 4]; 6] = {
-    let [b0, b1, b2, b3, b4, b5] = &BASELINE;
-    [rate_coeffs(b0), rate_coeffs(b1), rate_coeffs(b2), rate_coeffs(b3), rate_coeffs(b4), rate_coeffs(b5)]
-};
-
-/// The t-derivative coefficients of the five rows of one deviation matrix.
-const fn row_rates(m: &[[f32; 5]; 5]) -> [[f32; 4]; 5] {
-    let [r0, r1, r2, r3, r4] = m;
-    [rate_coeffs(r0), rate_coeffs(r1), rate_coeffs(r2), rate_coeffs(r3), rate_coeffs(r4)]
-}
-
-/// The t-derivative coefficients of one sweep's six matrices (`[c][i]`: row i of `D_c`).
-type RowRates = [[[f32; 4]; 5]; 6];
-
-/// `ROW_RATE[k][c][i]`: the coefficients of `d r_i / d t` of `D_kc` for the sweeps x
-/// (`k = 0`) and z (`k = 1`), the inputs the stiffness is taken along.
-const ROW_RATE: [RowRates; 2] = {
-    let [dx, dz, _, _] = &DEVIATION;
-    let [x0, x1, x2, x3, x4, x5] = dx;
-    let [z0, z1, z2, z3, z4, z5] = dz;
-    [
-        [row_rates(x0), row_rates(x1), row_rates(x2), row_rates(x3), row_rates(x4), row_rates(x5)],
-        [row_rates(z0), row_rates(z1), row_rates(z2), row_rates(z3), row_rates(z4), row_rates(z5)],
-    ]
-};
 
 /// Whether neither `B(u)` nor `B'(u)` of the baseline `b` can be `-0.0`: their last
 /// additions add `b0` and `b1`, and a rounded sum is `-0.0` only when both addends are.
@@ -101,29 +74,34 @@ pub fn wrench_and_stiffness(pose: &Pose) -> StiffnessEvaluation {
     };
     let Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, depth_mm: d } = clamped;
     let u = d * ONE_THIRD - 1.0;
-    let mut w = [0.0_f32; 6];
-    let mut a = [0.0_f32; 6];
-    for ((((wc, ac), b), br), &zero) in
-        w.iter_mut().zip(a.iter_mut()).zip(BASELINE.iter()).zip(BASELINE_RATE.iter()).zip(ZERO_BASELINE.iter())
-    {
-        *wc = baseline(b, zero, u);
-        *ac = if zero { 0.0 } else { horner_rate(br, u) };
-    }
-    let mut gx = [0.0_f32; 6];
-    let mut gz = [0.0_f32; 6];
     let [sx, sz, stx, stz] = SWEEP_SCALES;
-    let [dx, dz, dtx, dtz] = &DEVIATION;
-    let [ox, oz, otx, otz] = &ODD;
-    let [kx, kz, ktx, ktz] = &SKIP;
-    let [rx, rz] = &ROW_RATE;
-    let mut acc = Accumulators { w: &mut w, a: &mut a };
-    add_sweep(&mut acc, Some((&mut gx, rx)), dx, ox, kx, x, sx, u);
-    add_sweep(&mut acc, Some((&mut gz, rz)), dz, oz, kz, z, sz, u);
-    add_sweep(&mut acc, None, dtx, otx, ktx, tx, stx, u);
-    add_sweep(&mut acc, None, dtz, otz, ktz, tz, stz, u);
-    let mut by_depth = a.map(|ac| ac * ONE_THIRD);
-    let mut by_x = gx.map(|gc| gc * sx);
-    let mut by_z = gz.map(|gc| gc * sz);
+    let at = At {
+        t: [sweep_t(x, sx), sweep_t(z, sz), sweep_t(tx, stx), sweep_t(tz, stz)],
+        sign: [x, z, tx, tz].map(|v| if v < 0.0 { -1.0_f32 } else { 1.0 }),
+        u,
+    };
+    // Component by component (the contract's order within each component: baseline,
+    // then the sweeps x, z, theta_x, theta_z), written out with constant indices so the
+    // tables, parities and skip flags are constants in straight-line code and only one
+    // component's four accumulators are live at a time.
+    let mut w = [0.0_f32; 6];
+    let mut by_depth = [0.0_f32; 6];
+    let mut by_x = [0.0_f32; 6];
+    let mut by_z = [0.0_f32; 6];
+    let columns = [
+        component_of::<0>(&at),
+        component_of::<1>(&at),
+        component_of::<2>(&at),
+        component_of::<3>(&at),
+        component_of::<4>(&at),
+        component_of::<5>(&at),
+    ];
+    for ((((r, wc), dc), xc), zc) in columns.iter().zip(w.iter_mut()).zip(by_depth.iter_mut()).zip(by_x.iter_mut()).zip(by_z.iter_mut()) {
+        *wc = r.w;
+        *dc = r.a * ONE_THIRD;
+        *xc = r.gx * sx;
+        *zc = r.gz * sz;
+    }
     if COUPLED {
         let [cx, cz, ctx, ctz] = CROSS_SCALES;
         let n = [x * cx, z * cz, tx * ctx, tz * ctz];
@@ -142,53 +120,129 @@ pub fn wrench_and_stiffness(pose: &Pose) -> StiffnessEvaluation {
     }
 }
 
-/// The wrench and depth-rate accumulators of the six components.
-struct Accumulators<'a> {
-    /// `w_c`.
-    w: &'a mut [f32; 6],
-    /// `a_c`, the rate by `u`.
-    a: &'a mut [f32; 6],
+/// Where the polynomials are evaluated: `t` and the sign (`-1` for a negative value) of
+/// each sweep, and `u`.
+struct At {
+    t: [f32; 4],
+    sign: [f32; 4],
+    u: f32,
 }
 
-/// Adds one sweep's six deviations and their rates by `u` to `acc`, and when `along` is
-/// given (sweeps x and z: the accumulator `g` and the row-rate tables of that sweep) the
-/// rates by `t` with the sign of the chain rule through `|v|`.
+/// One component's accumulators: the wrench `w`, and the rates by `u`, by `t_x`, by `t_z`
+/// (before the chain rule's scale).
+#[derive(Clone, Copy)]
+struct Component {
+    w: f32,
+    a: f32,
+    gx: f32,
+    gz: f32,
+}
+
+/// One component's tables: its baseline (and whether it is all `+0.0`), and per sweep
+/// its deviation matrix, parity and skip flag.
+struct ComponentTables {
+    baseline: [f32; 5],
+    zero: bool,
+    mats: [[[f32; 5]; 5]; 4],
+    odd: [bool; 4],
+    skip: [bool; 4],
+}
+
+/// The tables of component `c` (`c < 6`; const evaluation only).
+#[allow(clippy::indexing_slicing)]
+const fn component_tables(c: usize) -> ComponentTables {
+    ComponentTables {
+        baseline: BASELINE[c],
+        zero: ZERO_BASELINE[c],
+        mats: [DEVIATION[0][c], DEVIATION[1][c], DEVIATION[2][c], DEVIATION[3][c]],
+        odd: [ODD[0][c], ODD[1][c], ODD[2][c], ODD[3][c]],
+        skip: [SKIP[0][c], SKIP[1][c], SKIP[2][c], SKIP[3][c]],
+    }
+}
+
+/// The tables of component `C` as an associated constant (evaluated at compile time per
+/// `C`; an index out of range is a compile error, not a run-time panic).
+struct Column<const C: usize>;
+
+impl<const C: usize> Column<C> {
+    const TABLES: ComponentTables = component_tables(C);
+}
+
+/// Component `C` with its tables as constants, not inlined: each component is scheduled
+/// on its own, so the FPU's 32 registers hold one component's work (measured on the M4F
+/// for wrench and stiffness: inlined, the compiler interleaved the six components and
+/// spilled, 1,320 instructions and 540 B of stack; with the tables passed at run time,
+/// 1,437; this way 1,255 and 300 B).
+#[inline(never)]
+fn component_of<const C: usize>(at: &At) -> Component {
+    let ComponentTables { baseline, zero, mats, odd, skip } = &Column::<C>::TABLES;
+    let [m0, m1, m2, m3] = mats;
+    component(baseline, *zero, [m0, m1, m2, m3], *odd, *skip, at)
+}
+
+/// One component: the baseline and its rate, then per sweep `w ± D`, `a ± dD/du`, and for
+/// x and z `g ± dD/dt`. `w + sign * D` is `w - D` for `sign = -1` (the product is exact,
+/// and `w + (-D)` is `w - D` by definition; `+0 + -0 = +0 = +0 - +0`): one multiply-add
+/// on the FPU and no branch.
+#[inline(always)]
+fn component(b: &[f32; 5], zero: bool, mats: [&[[f32; 5]; 5]; 4], odd: [bool; 4], skip: [bool; 4], at: &At) -> Component {
+    let u = at.u;
+    let (w, a) = if zero { (0.0, 0.0) } else { horner_with_rate(b, u) };
+    let mut c = Component { w, a, gx: 0.0, gz: 0.0 };
+    let [mx, mz, mtx, mtz] = mats;
+    let [ox, oz, otx, otz] = odd;
+    let [kx, kz, ktx, ktz] = skip;
+    let [tx, tz, ttx, ttz] = at.t;
+    let [sx, sz, stx, stz] = at.sign;
+    if !kx {
+        c.gx = add_along(&mut c.w, &mut c.a, c.gx, mx, ox, sx, tx, u);
+    }
+    if !kz {
+        c.gz = add_along(&mut c.w, &mut c.a, c.gz, mz, oz, sz, tz, u);
+    }
+    if !ktx {
+        add_across(&mut c.w, &mut c.a, mtx, otx, stx, ttx, u);
+    }
+    if !ktz {
+        add_across(&mut c.w, &mut c.a, mtz, otz, stz, ttz, u);
+    }
+    c
+}
+
+/// A theta sweep: `w ± D`, `a ± dD/du`.
+#[inline(always)]
+fn add_across(w: &mut f32, a: &mut f32, m: &[[f32; 5]; 5], odd: bool, sign: f32, t: f32, u: f32) {
+    let [m0, m1, m2, m3, m4] = m;
+    let (dev, du) = horner_with_rate(&[horner(m0, t), horner(m1, t), horner(m2, t), horner(m3, t), horner(m4, t)], u);
+    if odd {
+        *w += sign * dev;
+        *a += sign * du;
+    } else {
+        *w += dev;
+        *a += du;
+    }
+}
+
+/// The x or z sweep: as [`add_across`], and `g ± dD/dt` returned, each row evaluated once
+/// with its t-rate ([`horner_with_rate`]).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn add_sweep(
-    acc: &mut Accumulators<'_>,
-    along: Option<(&mut [f32; 6], &RowRates)>,
-    mats: &[[[f32; 5]; 5]; 6],
-    odd: &[bool; 6],
-    skip: &[bool; 6],
-    v: f32,
-    s: f32,
-    u: f32,
-) {
-    let t = sweep_t(v, s);
-    let negative = v < 0.0;
-    let (mut g, rates) = match along {
-        Some((g, rates)) => (Some(g.iter_mut()), Some(rates.iter())),
-        None => (None, None),
-    };
-    let components = acc.w.iter_mut().zip(acc.a.iter_mut()).zip(mats.iter()).zip(odd.iter()).zip(skip.iter());
-    let mut rates = rates;
-    for ((((wc, ac), m), &o), &skip) in components {
-        let gc = g.as_mut().and_then(Iterator::next);
-        let rr = rates.as_mut().and_then(Iterator::next);
-        if skip {
-            continue;
-        }
-        let [m0, m1, m2, m3, m4] = m;
-        let r = [horner(m0, t), horner(m1, t), horner(m2, t), horner(m3, t), horner(m4, t)];
-        let dev = horner(&r, u);
-        let du = horner_rate(&rate_coeffs(&r), u);
-        let minus = negative && o;
-        *wc = if minus { *wc - dev } else { *wc + dev };
-        *ac = if minus { *ac - du } else { *ac + du };
-        if let (Some(gc), Some([q0, q1, q2, q3, q4])) = (gc, rr) {
-            let dt = horner(&[horner_rate(q0, t), horner_rate(q1, t), horner_rate(q2, t), horner_rate(q3, t), horner_rate(q4, t)], u);
-            *gc = if negative && !o { *gc - dt } else { *gc + dt };
-        }
+fn add_along(w: &mut f32, a: &mut f32, g: f32, m: &[[f32; 5]; 5], odd: bool, sign: f32, t: f32, u: f32) -> f32 {
+    let [m0, m1, m2, m3, m4] = m;
+    let (r0, q0) = horner_with_rate(m0, t);
+    let (r1, q1) = horner_with_rate(m1, t);
+    let (r2, q2) = horner_with_rate(m2, t);
+    let (r3, q3) = horner_with_rate(m3, t);
+    let (r4, q4) = horner_with_rate(m4, t);
+    let (dev, du) = horner_with_rate(&[r0, r1, r2, r3, r4], u);
+    let dt = horner(&[q0, q1, q2, q3, q4], u);
+    if odd {
+        *w += sign * dev;
+        *a += sign * du;
+        g + dt
+    } else {
+        *w += dev;
+        *a += du;
+        g + sign * dt
     }
 }

@@ -146,6 +146,15 @@ fn bench_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
             t.instructions,
             goal(max_stack <= 512)
         );
+        if let Some(k) = f.pose("typical", "f32+k") {
+            let ratio = k.instructions / t.instructions;
+            println!(
+                "stiffness {}: {:.1} instructions per wrench and stiffness (typical pose), {ratio:.2}x the wrench alone; <= 1.6x: {}",
+                f.core.core,
+                k.instructions,
+                goal(ratio <= 1.6)
+            );
+        }
         if let Some(q) = f.pose("typical", "fixed") {
             let m0_goal = if f.core.name == "m0" {
                 format!(

@@ -10,7 +10,7 @@ use std::time::Duration;
 pub struct PoseFigures {
     /// The firmware's name of the pose (`typical`, `positive`, `saturated`, `nan-input`).
     pub pose: String,
-    /// The evaluator timed: `f32` or `fixed`.
+    /// The evaluator timed: `f32`, `f32+k` (wrench and stiffness) or `fixed`.
     pub evaluator: String,
     /// Executed instructions per `wrench` call (call, return and result store included).
     pub instructions: f64,
@@ -32,7 +32,7 @@ pub struct CoreFigures {
 }
 
 impl CoreFigures {
-    /// The figures of the pose named `name` with the evaluator `evaluator` (`f32`, `fixed`).
+    /// The figures of the pose named `name` with the evaluator `evaluator` (`f32`, `f32+k`, `fixed`).
     #[must_use]
     pub fn pose(&self, name: &str, evaluator: &str) -> Option<&PoseFigures> {
         self.poses.iter().find(|p| p.pose == name && p.evaluator == evaluator)

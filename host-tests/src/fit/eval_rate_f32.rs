@@ -7,17 +7,18 @@
 use super::contract::{NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_X, STATUS_SAT_Z};
 use super::eval_f32::{eval, h32, horner_n32, monomial32, Tables32, ODD, ONE_THIRD, R_THETA, R_XZ, S_THETA, S_XZ};
 
-/// `[p1, 2*p2, 3*p3, 4*p4]`: the coefficients of `p'`, each product rounded to f32.
-pub fn rate_coeffs32(p: &[f32; NCOEF]) -> [f32; NCOEF - 1] {
-    [p[1], 2.0 * p[2], 3.0 * p[3], 4.0 * p[4]]
-}
-
-/// `g(q, w) = ((q3*w + q2)*w + q1)*w + q0` in f32, written out.
-pub fn g32(q: &[f32; NCOEF - 1], w: f32) -> f32 {
-    let [q0, q1, q2, q3] = *q;
-    let a = q3 * w + q2;
-    let b = a * w + q1;
-    b * w + q0
+/// `(h(p, w), h'(p, w))` in f32: the value by [`h32`]'s operations, the derivative
+/// accumulated alongside (`d = p4`, then `d = d*w + b` after the steps for p3, p2, p1,
+/// `b` the value so far), written out.
+pub fn hd32(p: &[f32; NCOEF], w: f32) -> (f32, f32) {
+    let [p0, p1, p2, p3, p4] = *p;
+    let mut b = p4;
+    let mut d = p4;
+    for c in [p3, p2, p1] {
+        b = b * w + c;
+        d = d * w + b;
+    }
+    (b * w + p0, d)
 }
 
 /// The wrench's rates at `pose = [x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm]`:
@@ -38,21 +39,20 @@ pub fn eval_rates(t: &Tables32, pose: [f32; 5]) -> ([[f32; 6]; 3], u8) {
     let mut a = [0.0f32; 6];
     let mut g = [[0.0f32; 6]; 2];
     for c in 0..6 {
-        a[c] = g32(&rate_coeffs32(&t.baseline[c]), u);
+        a[c] = hd32(&t.baseline[c], u).1;
         for k in 0..4 {
             let tt = vals[k].abs() * scales[k] - 1.0;
             let negative = vals[k] < 0.0;
             let m = &t.rows[k][c];
-            let r: [f32; NCOEF] = std::array::from_fn(|i| h32(&m[i], tt));
-            let du = g32(&rate_coeffs32(&r), u);
+            let rows: [(f32, f32); NCOEF] = std::array::from_fn(|i| hd32(&m[i], tt));
+            let du = hd32(&rows.map(|(r, _)| r), u).1;
             if negative && ODD[k][c] {
                 a[c] -= du;
             } else {
                 a[c] += du;
             }
             if k < 2 {
-                let rt: [f32; NCOEF] = std::array::from_fn(|i| g32(&rate_coeffs32(&m[i]), tt));
-                let dt = h32(&rt, u);
+                let dt = h32(&rows.map(|(_, q)| q), u);
                 if negative && !ODD[k][c] {
                     g[k][c] -= dt;
                 } else {
