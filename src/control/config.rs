@@ -58,6 +58,8 @@ pub enum ConfigError {
     ForceLimit,
     /// The ramp step is NaN or not > 0.
     RampStep,
+    /// The passivity guard's damping or period is not finite and > 0.
+    Passivity,
 }
 
 impl core::fmt::Display for ConfigError {
@@ -66,6 +68,7 @@ impl core::fmt::Display for ConfigError {
             Self::Gain => "loop config refused: a channel gain (duty per N) is NaN or infinite",
             Self::ForceLimit => "loop config refused: force_limit_n must be finite, > 0 N and <= force_limit_max_n",
             Self::RampStep => "loop config refused: ramp_step_n must be > 0 N per tick",
+            Self::Passivity => "passivity guard refused: damping_n_s_per_mm and period_s must be finite and > 0",
         })
     }
 }

@@ -2,8 +2,9 @@
 //! command and channel commands out. [`ControlLoop`](super::ControlLoop) wraps it with
 //! embedded-hal outputs; the C API drives it directly.
 use super::config::check_limit;
-use super::{ConfigError, LoopConfig, LoopFlags, OverLimit, PoseFault, Sample};
-use crate::{Pose, Wrench};
+use super::passivity::Guard;
+use super::{ConfigError, LoopConfig, LoopFlags, OverLimit, Passivity, PoseFault, Sample};
+use crate::{Pose, Status, Wrench};
 
 /// One channel's command: a duty fraction and a direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -35,6 +36,8 @@ pub struct LoopCore<const N: usize> {
     config: LoopConfig<N>,
     last: Sample,
     commands: [ChannelCommand; N],
+    passivity: Option<Passivity>,
+    guard: Guard,
 }
 
 impl<const N: usize> LoopCore<N> {
@@ -46,7 +49,13 @@ impl<const N: usize> LoopCore<N> {
         config.validate()?;
         let rest = ChannelCommand { fraction: 0.0, direction_high: false };
         let commands = config.channels.map(|ch| ChannelCommand { direction_high: !ch.direction_inverted, ..rest });
-        Ok(Self { config, last: Sample { flags: LoopFlags::DISABLED, ..Sample::default() }, commands })
+        Ok(Self {
+            config,
+            last: Sample { flags: LoopFlags::DISABLED, ..Sample::default() },
+            commands,
+            passivity: None,
+            guard: Guard::default(),
+        })
     }
 
     /// The configuration.
@@ -74,6 +83,32 @@ impl<const N: usize> LoopCore<N> {
         Ok(())
     }
 
+    /// Turns the passivity guard on with `Some` (the device's damping and the loop period)
+    /// or off with `None` (takes effect at the next tick; the guard starts without
+    /// history). With the guard on, each tick evaluates
+    /// [`wrench_and_stiffness`](crate::wrench_and_stiffness) instead of
+    /// [`wrench`](crate::wrench) (the same wrench) and applies the rule of
+    /// [`Passivity`](super::Passivity)'s module.
+    ///
+    /// # Errors
+    /// [`ConfigError::Passivity`] for a damping or period that is not finite and > 0; the
+    /// guard is then unchanged.
+    pub fn set_passivity(&mut self, passivity: Option<Passivity>) -> Result<(), ConfigError> {
+        if let Some(p) = &passivity {
+            p.validate()?;
+        }
+        self.passivity = passivity;
+        self.guard.reset();
+        Ok(())
+    }
+
+    /// The passivity guard's configuration (`None`: off).
+    #[inline]
+    #[must_use]
+    pub const fn passivity(&self) -> Option<&Passivity> {
+        self.passivity.as_ref()
+    }
+
     /// Sets what happens above the force limit (takes effect at the next tick).
     #[inline]
     pub fn set_over_limit(&mut self, over_limit: OverLimit) {
@@ -86,7 +121,9 @@ impl<const N: usize> LoopCore<N> {
     /// 2. a stale or missing pose is a fault (`POSE_STALE` / `POSE_MISSING`), the model is
     ///    not evaluated; otherwise `wrench(pose)`, and an `ERROR` status is a fault
     ///    (`EVAL_ERROR`);
-    /// 3. with `F = (fx, fy, fz)`: if `fx² + fy² + fz² > limit²` (`OVER_LIMIT`),
+    /// 3. with the passivity guard on ([`set_passivity`](Self::set_passivity)), `F` is the
+    ///    guarded force (`STIFFNESS_LIMITED` when the model's stiffness was above the
+    ///    guard's), else the model's `(fx, fy, fz)`; then with `F`: if `fx² + fy² + fz² > limit²` (`OVER_LIMIT`),
     ///    [`OverLimit::Saturate`] commands `F * (limit / |F|)` (`FORCE_SATURATED`) and
     ///    [`OverLimit::RampToZero`] makes it a fault; else the command is `F`;
     /// 4. on a fault each component of the previous command moves towards zero by at
@@ -103,17 +140,29 @@ impl<const N: usize> LoopCore<N> {
             Err(PoseFault::Missing) => Some(LoopFlags::POSE_MISSING),
             Ok(pose) => {
                 s.pose = pose;
-                let e = crate::wrench(&pose);
-                s.model = e.status;
-                if e.status.is_error() {
+                let (wrench, status, stiffness) = self.evaluate(&pose);
+                s.model = status;
+                if status.is_error() {
                     Some(LoopFlags::EVAL_ERROR)
                 } else {
-                    s.wrench = e.wrench;
-                    self.limit(&e.wrench, &mut s)
+                    s.wrench = wrench;
+                    let f = [wrench.fx_n, wrench.fy_n, wrench.fz_n];
+                    let f = match (&self.passivity, stiffness) {
+                        (Some(p), Some(k)) => {
+                            let (guarded, limited) = self.guard.apply(p, f, k);
+                            if limited {
+                                s.flags |= LoopFlags::STIFFNESS_LIMITED;
+                            }
+                            guarded
+                        }
+                        _ => f,
+                    };
+                    self.limit(f, &mut s)
                 }
             }
         };
         if let Some(f) = fault {
+            self.guard.reset();
             s.flags |= f | LoopFlags::RAMPING;
             s.force_cmd_n = ramp(self.last.force_cmd_n, self.config.ramp_step_n);
             if s.force_cmd_n == [0.0; 3] {
@@ -151,11 +200,25 @@ impl<const N: usize> LoopCore<N> {
         self.last.flags |= flags;
     }
 
-    /// Step 3 of [`step`](Self::step): the command for a valid wrench, or the fault.
-    fn limit(&self, w: &Wrench, s: &mut Sample) -> Option<LoopFlags> {
-        let f = [w.fx_n, w.fy_n, w.fz_n];
+    /// The model at `pose`: the wrench, its status and, with the passivity guard on, the
+    /// stiffness along the insertion `|dF/d depth|` (N/mm).
+    fn evaluate(&self, pose: &Pose) -> (Wrench, Status, Option<f32>) {
+        if self.passivity.is_some() {
+            let e = crate::wrench_and_stiffness(pose);
+            let r = e.stiffness.by_depth;
+            let k2 = r.dfx_n_per_mm * r.dfx_n_per_mm + r.dfy_n_per_mm * r.dfy_n_per_mm + r.dfz_n_per_mm * r.dfz_n_per_mm;
+            (e.wrench, e.status, Some(libm::sqrtf(k2)))
+        } else {
+            let e = crate::wrench(pose);
+            (e.wrench, e.status, None)
+        }
+    }
+
+    /// Step 3 of [`step`](Self::step): the command for a valid force `f` (N), or the fault.
+    fn limit(&self, f: [f32; 3], s: &mut Sample) -> Option<LoopFlags> {
+        let [fx, fy, fz] = f;
         let limit = self.config.force_limit_n;
-        let norm2 = w.fx_n * w.fx_n + w.fy_n * w.fy_n + w.fz_n * w.fz_n;
+        let norm2 = fx * fx + fy * fy + fz * fz;
         if norm2 <= limit * limit {
             s.force_cmd_n = f;
             return None;

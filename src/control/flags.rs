@@ -15,6 +15,7 @@ use core::fmt;
 /// | [`DUTY_CLIPPED`](Self::DUTY_CLIPPED) | `0x0040` | a channel's command was beyond full scale and was clipped to the maximum duty |
 /// | [`OUTPUT_ERROR`](Self::OUTPUT_ERROR) | `0x0080` | a PWM or pin write returned an error (the other outputs were still written) |
 /// | [`DISABLED`](Self::DISABLED) | `0x0100` | the enable pin is low: a fault holds and the ramp has reached zero |
+/// | [`STIFFNESS_LIMITED`](Self::STIFFNESS_LIMITED) | `0x0200` | the model's stiffness was above the passivity guard's: its force changes entered the command scaled down ([`Passivity`](super::Passivity)) |
 ///
 /// A tick is a *fault* tick when any of `POSE_STALE`, `POSE_MISSING`, `EVAL_ERROR`, or
 /// `OVER_LIMIT` with [`OverLimit::RampToZero`](super::OverLimit::RampToZero) is set.
@@ -42,9 +43,11 @@ impl LoopFlags {
     pub const OUTPUT_ERROR: Self = Self(0x0080);
     /// The enable pin is low.
     pub const DISABLED: Self = Self(0x0100);
+    /// The passivity guard limited the rendered stiffness.
+    pub const STIFFNESS_LIMITED: Self = Self(0x0200);
 
     /// Every flag with its name, in bit order.
-    pub const FLAGS: [(Self, &'static str); 9] = [
+    pub const FLAGS: [(Self, &'static str); 10] = [
         (Self::POSE_STALE, "POSE_STALE"),
         (Self::POSE_MISSING, "POSE_MISSING"),
         (Self::EVAL_ERROR, "EVAL_ERROR"),
@@ -54,6 +57,7 @@ impl LoopFlags {
         (Self::DUTY_CLIPPED, "DUTY_CLIPPED"),
         (Self::OUTPUT_ERROR, "OUTPUT_ERROR"),
         (Self::DISABLED, "DISABLED"),
+        (Self::STIFFNESS_LIMITED, "STIFFNESS_LIMITED"),
     ];
 
     /// `true` when no flag is set.

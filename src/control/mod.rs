@@ -4,6 +4,7 @@
 //! - [`PoseSource`]: the board's pose (from encoders and kinematics), or why there is none;
 //! - [`LoopConfig`]: the linear map from force to each channel's command, the device force
 //!   limit, what happens above it ([`OverLimit`]), the ramp step of the safety ramp;
+//! - [`Passivity`]: the optional guard that keeps the rendered stiffness passive;
 //! - [`LoopCore`]: the control law of one tick, no hardware (the C API drives it);
 //! - [`ControlLoop`]: the law wired to `SetDutyCycle` / `OutputPin` outputs;
 //! - [`Sample`] and [`LoopFlags`]: what each tick did and why.
@@ -51,6 +52,7 @@ mod config;
 mod core;
 mod flags;
 mod hal_loop;
+mod passivity;
 mod pose_source;
 mod sample;
 
@@ -58,5 +60,6 @@ pub use self::core::{ChannelCommand, LoopCore};
 pub use config::{ChannelMap, ConfigError, LoopConfig, OverLimit};
 pub use flags::LoopFlags;
 pub use hal_loop::{Channel, ControlLoop};
+pub use passivity::{Passivity, GUARD_FRACTION};
 pub use pose_source::{PoseFault, PoseSource};
 pub use sample::Sample;

@@ -36,7 +36,7 @@ pub extern "C" fn needle_status_name(bit: u8) -> *const c_char {
     s.map_or(core::ptr::null(), CStr::as_ptr)
 }
 
-/// The name of one `NEEDLE_LOOP_*` flag ("POSE_STALE", ..., "DISABLED"), "OK" for 0; NULL
+/// The name of one `NEEDLE_LOOP_*` flag ("POSE_STALE", ..., "STIFFNESS_LIMITED"), "OK" for 0; NULL
 /// for a value that is not 0 or exactly one known flag.
 #[no_mangle]
 pub extern "C" fn needle_loop_flag_name(flag: u16) -> *const c_char {
@@ -51,6 +51,7 @@ pub extern "C" fn needle_loop_flag_name(flag: u16) -> *const c_char {
         crate::types::NEEDLE_LOOP_DUTY_CLIPPED => Some(c"DUTY_CLIPPED"),
         crate::types::NEEDLE_LOOP_OUTPUT_ERROR => Some(c"OUTPUT_ERROR"),
         crate::types::NEEDLE_LOOP_DISABLED => Some(c"DISABLED"),
+        crate::types::NEEDLE_LOOP_STIFFNESS_LIMITED => Some(c"STIFFNESS_LIMITED"),
         _ => None,
     };
     s.map_or(core::ptr::null(), CStr::as_ptr)
@@ -121,9 +122,9 @@ mod tests {
         for (flag, lib_name) in LoopFlags::FLAGS {
             assert_eq!(name(needle_loop_flag_name(flag.bits())).as_deref(), Some(lib_name), "loop flag {:#06x}", flag.bits());
         }
-        assert_eq!(LoopFlags::FLAGS.len(), 9, "a new loop flag needs its NEEDLE_LOOP_ constant and name");
+        assert_eq!(LoopFlags::FLAGS.len(), 10, "a new loop flag needs its NEEDLE_LOOP_ constant and name");
         assert_eq!(name(needle_status_name(0x11)), None, "two bits are not one name");
-        assert_eq!(name(needle_loop_flag_name(0x0200)), None, "unknown flag");
+        assert_eq!(name(needle_loop_flag_name(0x0400)), None, "unknown flag");
         assert_eq!(name(needle_strerror(crate::types::NEEDLE_E_NULL)).as_deref(), Some("NULL pointer argument"));
         assert_eq!(name(needle_strerror(-99)).as_deref(), Some("unknown needle error code"));
         for (status, want) in [(0u8, "OK"), (0x11, "SAT_X | SAT_DEPTH"), (0xa0, "ERROR | 0x20")] {

@@ -182,3 +182,5 @@ pub const NEEDLE_LOOP_DUTY_CLIPPED: u16 = 0x0040;
 pub const NEEDLE_LOOP_OUTPUT_ERROR: u16 = 0x0080;
 /// Loop flag: the enable pin is low.
 pub const NEEDLE_LOOP_DISABLED: u16 = 0x0100;
+/// Loop flag: the passivity guard limited the rendered stiffness.
+pub const NEEDLE_LOOP_STIFFNESS_LIMITED: u16 = 0x0200;

@@ -1,0 +1,103 @@
+//! [`Passivity`]: the guard that keeps the rendered stiffness inside the bound of a
+//! sampled haptic loop.
+//!
+//! A force field of stiffness `K` rendered by a zero-order hold at period `T` on a device
+//! with physical damping `b` is passive only while `K * T / 2 < b` (Colgate and
+//! Schenkel): above it, each oscillation of the hand gains energy from the loop. The
+//! model knows its stiffness exactly ([`wrench_and_stiffness`](crate::wrench_and_stiffness)),
+//! so the loop can check the bound every tick.
+//!
+//! **The rule** (each tick with a valid model wrench `F_k` and its depth rate `dF/dd`):
+//!
+//! - `K = |dF/dd| = sqrt(dfx² + dfy² + dfz²)` (N/mm): the stiffness along the insertion,
+//!   an upper bound of the stiffness along any direction the needle moves in depth;
+//! - `K_g = GUARD_FRACTION * 2 * b / T`: the guard keeps the rendered stiffness at half
+//!   the bound, so the device's damping always dominates what the sampling generates (at
+//!   the bound itself the loop is only marginally passive);
+//! - when `K > K_g`: flag `STIFFNESS_LIMITED`, and the change of the model force since the
+//!   last tick enters the command scaled by `K_g / K`: the guard's offset grows by
+//!   `(1 - K_g / K) * (F_k - F_{k-1})` and the command is `F_k - offset`. The rendered
+//!   force's rate along the depth is then `min(K, K_g)`: it is a function of the path in
+//!   depth (the same force when the hand comes back to the same depth), so the guard adds
+//!   no energy of its own;
+//! - when `K <= K_g` the offset is kept (the command follows the model's changes one to
+//!   one); it is cleared when the model force is exactly zero and after any fault (the
+//!   first valid tick then follows the model again).
+use super::ConfigError;
+
+/// The fraction of Colgate's bound `2 b / T` the guard renders at most.
+pub const GUARD_FRACTION: f32 = 0.5;
+
+/// The device's physical damping and the loop period: the passivity guard's configuration.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Passivity {
+    /// Physical damping of the device along the insertion, N·s/mm (finite, > 0).
+    pub damping_n_s_per_mm: f32,
+    /// The control loop's period, s (finite, > 0; 0.001 at 1 kHz).
+    pub period_s: f32,
+}
+
+impl Passivity {
+    /// Checks the configuration.
+    ///
+    /// # Errors
+    /// [`ConfigError::Passivity`] unless both values are finite and > 0.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let ok = |v: f32| v.is_finite() && v > 0.0;
+        if ok(self.damping_n_s_per_mm) && ok(self.period_s) && ok(self.guard_stiffness_n_per_mm()) {
+            Ok(())
+        } else {
+            Err(ConfigError::Passivity)
+        }
+    }
+
+    /// Colgate's bound `2 b / T`, N/mm: the largest stiffness the loop renders passively
+    /// (`+inf` for a zero period, which [`validate`](Self::validate) refuses).
+    #[must_use]
+    pub fn stiffness_bound_n_per_mm(&self) -> f32 {
+        2.0 * self.damping_n_s_per_mm / self.period_s
+    }
+
+    /// The stiffness the guard renders at most, `GUARD_FRACTION * 2 b / T`, N/mm.
+    #[must_use]
+    pub fn guard_stiffness_n_per_mm(&self) -> f32 {
+        GUARD_FRACTION * self.stiffness_bound_n_per_mm()
+    }
+}
+
+/// The guard's state: the offset between model and command, and the last model force.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub(crate) struct Guard {
+    offset_n: [f32; 3],
+    last_model_n: Option<[f32; 3]>,
+}
+
+impl Guard {
+    /// Forget the history (after a fault): the next tick follows the model.
+    pub(crate) fn reset(&mut self) {
+        *self = Self::default();
+    }
+
+    /// The guarded force for the model force `f_n` of stiffness `k_n_per_mm` (the module's
+    /// rule), and whether the stiffness was limited.
+    pub(crate) fn apply(&mut self, p: &Passivity, f_n: [f32; 3], k_n_per_mm: f32) -> ([f32; 3], bool) {
+        let k_g = p.guard_stiffness_n_per_mm();
+        // `k > k_g > 0` (validated), so the division is by a positive, finite number.
+        let limited = k_n_per_mm > k_g;
+        if let (Some(last), true) = (self.last_model_n, limited) {
+            let keep = 1.0 - k_g / k_n_per_mm;
+            for ((o, f), l) in self.offset_n.iter_mut().zip(f_n).zip(last) {
+                *o += keep * (f - l);
+            }
+        }
+        if f_n == [0.0; 3] {
+            self.offset_n = [0.0; 3];
+        }
+        self.last_model_n = Some(f_n);
+        let [o0, o1, o2] = self.offset_n;
+        let [f0, f1, f2] = f_n;
+        ([f0 - o0, f1 - o1, f2 - o2], limited)
+    }
+}
