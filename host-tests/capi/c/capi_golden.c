@@ -1,6 +1,6 @@
 /* capi_golden.c: the C API of needle-haptics against the golden vectors.
  *
- *   capi_golden <golden-f32.csv>
+ *   capi_golden <golden-f32.csv> [<golden-stiffness-f32.csv>]
  *
  * 1. needle_wrench() on every golden row: status and the six wrench components bit
  *    for bit (NaN matches NaN).
@@ -8,13 +8,17 @@
  *    duties and direction pins of the documented linear map applied to the golden
  *    forces; then stale ticks ramp the command to zero and disable the output.
  * 3. Host-link commands: PING, LIMIT, and refused frames that change nothing.
+ * 4. With the second file: needle_wrench_and_stiffness() on every row: status and the
+ *    18 rates bit for bit, and the wrench the bits of needle_wrench().
  *
  * Prints "capi-golden rows=N wrench_mismatches=M loop_checks=K loop_failures=F command_failures=C"
+ * (and with the second file "capi-golden-stiffness rows=N mismatches=M")
  * and exits 0 only when every check passed. Compile with -ffp-contract=off.
  * Builds with host gcc and with arm-none-eabi-gcc (newlib, semihosting file I/O).
  */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include "needle.h"
 
@@ -64,6 +68,57 @@ static int check_outputs(const needle_tick_t *t, const float f[3], bool enable, 
     bad++;
   }
   return bad;
+}
+
+/* Section 4: every row of golden-stiffness-f32.csv through needle_wrench_and_stiffness;
+ * returns the number of mismatching rows, or -1 when the file is unreadable or malformed. */
+static int check_stiffness(const char *path, int *rows_out) {
+  FILE *fp = fopen(path, "r");
+  if (!fp) {
+    printf("cannot open %s\n", path);
+    return -1;
+  }
+  char line[1024];
+  int rows = 0, mismatches = 0, lineno = 1;
+  if (!fgets(line, sizeof line, fp)) {
+    fclose(fp);
+    return -1;
+  }
+  while (fgets(line, sizeof line, fp)) {
+    lineno++;
+    unsigned int v[24];
+    char *at = line;
+    for (int i = 0; i < 24; i++) {
+      char *end;
+      v[i] = (unsigned int)strtoul(at, &end, 16); /* "0x..." fields, status included */
+      if (end == at || (i < 23 && *end != ',')) {
+        printf("golden-stiffness line %d: malformed\n", lineno);
+        fclose(fp);
+        return -1;
+      }
+      at = end + 1;
+    }
+    needle_pose_t p = {f32(v[0]), f32(v[1]), f32(v[2]), f32(v[3]), f32(v[4])};
+    needle_wrench_t w, plain;
+    needle_stiffness_t k;
+    uint8_t status = needle_wrench_and_stiffness(&p, &w, &k);
+    uint8_t plain_status = needle_wrench(&p, &plain);
+    int bad = status != v[5] || status != plain_status;
+    for (int c = 0; c < 6; c++) {
+      bad |= !same(f32(v[6 + c]), k.by_depth[c]);
+      bad |= !same(f32(v[12 + c]), k.by_x[c]);
+      bad |= !same(f32(v[18 + c]), k.by_z[c]);
+    }
+    bad |= memcmp(&w, &plain, sizeof w) != 0;
+    if (bad) {
+      if (mismatches < 10) printf("golden-stiffness line %d differs\n", lineno);
+      mismatches++;
+    }
+    rows++;
+  }
+  fclose(fp);
+  *rows_out = rows;
+  return mismatches;
 }
 
 int main(int argc, char **argv) {
@@ -211,5 +266,12 @@ int main(int argc, char **argv) {
 
   printf("capi-golden set=%s rows=%d wrench_mismatches=%d loop_checks=%d loop_failures=%d command_failures=%d\n",
          (const char *)info.set, rows, mismatches, loop_checks, loop_failures, command_failures);
-  return (mismatches || loop_failures || command_failures || rows < 2000) ? 1 : 0;
+  int stiffness_failed = 0;
+  if (argc > 2) {
+    int stiffness_rows = 0;
+    int stiffness_mismatches = check_stiffness(argv[2], &stiffness_rows);
+    printf("capi-golden-stiffness rows=%d mismatches=%d\n", stiffness_rows, stiffness_mismatches);
+    stiffness_failed = stiffness_mismatches != 0 || stiffness_rows < 2000;
+  }
+  return (mismatches || loop_failures || command_failures || rows < 2000 || stiffness_failed) ? 1 : 0;
 }

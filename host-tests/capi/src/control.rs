@@ -3,7 +3,7 @@
 //! The C loop is `needle_haptics::control::LoopCore<3>` kept in the opaque storage of a
 //! [`needle_loop_t`]: C reads the pose itself, passes it to the tick, and applies the
 //! duties and pin levels the tick returns to its own PWM and GPIO.
-use crate::eval::{pose_in, pose_out, wrench_out};
+use crate::eval::{pose_in, pose_out, wrench_out_of};
 use crate::types::*;
 use core::mem::{align_of, size_of};
 use needle_haptics::control::{ChannelMap, LoopConfig, LoopCore, OverLimit, PoseFault};
@@ -118,7 +118,7 @@ pub unsafe extern "C" fn needle_loop_tick(
     *out = needle_tick_t {
         tick: s.tick,
         pose: pose_out(&s.pose),
-        wrench: wrench_out(&s.wrench),
+        wrench: wrench_out_of(&s.wrench),
         force_cmd_n: s.force_cmd_n,
         duty,
         flags: s.flags.bits(),

@@ -1,6 +1,6 @@
-//! The evaluator: `needle_wrench`, `needle_model_info`.
-use crate::types::{needle_model_info_t, needle_pose_t, needle_wrench_t};
-use needle_haptics::{model_info, wrench, Pose, Status, Wrench};
+//! The evaluator: `needle_wrench`, `needle_wrench_and_stiffness`, `needle_model_info`.
+use crate::types::{needle_model_info_t, needle_pose_t, needle_stiffness_t, needle_wrench_t};
+use needle_haptics::{model_info, wrench, wrench_and_stiffness, Pose, Status, Wrench};
 
 pub(crate) fn pose_in(p: &needle_pose_t) -> Pose {
     Pose::new(p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg, p.depth_mm)
@@ -10,7 +10,7 @@ pub(crate) fn pose_out(p: &Pose) -> needle_pose_t {
     needle_pose_t { x_mm: p.x_mm, z_mm: p.z_mm, theta_x_deg: p.theta_x_deg, theta_z_deg: p.theta_z_deg, depth_mm: p.depth_mm }
 }
 
-pub(crate) fn wrench_out(w: &Wrench) -> needle_wrench_t {
+pub(crate) fn wrench_out_of(w: &Wrench) -> needle_wrench_t {
     needle_wrench_t { fx_n: w.fx_n, fy_n: w.fy_n, fz_n: w.fz_n, mx_nmm: w.mx_nmm, my_nmm: w.my_nmm, mz_nmm: w.mz_nmm }
 }
 
@@ -31,7 +31,42 @@ pub unsafe extern "C" fn needle_wrench(pose: *const needle_pose_t, out: *mut nee
     };
     // SAFETY: as above.
     if let Some(o) = unsafe { out.as_mut() } {
-        *o = wrench_out(&e.wrench);
+        *o = wrench_out_of(&e.wrench);
+    }
+    e.status.bits()
+}
+
+/// The wrench at `*pose` into `*wrench_out` (the bits of `needle_wrench`) and its partial
+/// derivatives by depth, x and z into `*stiffness_out`; returns the status bits.
+///
+/// Bit for bit the Rust `needle_haptics::wrench_and_stiffness`, hence
+/// `golden-stiffness-f32.csv` (coeffs/README.md, "Stiffness"). A NULL `pose` returns
+/// `0x80` (ERROR) and writes zeros to the outputs that are not NULL; a NULL output is
+/// skipped.
+///
+/// # Safety
+/// Each pointer is NULL or a valid, aligned pointer to its type.
+#[no_mangle]
+pub unsafe extern "C" fn needle_wrench_and_stiffness(
+    pose: *const needle_pose_t,
+    wrench_out: *mut needle_wrench_t,
+    stiffness_out: *mut needle_stiffness_t,
+) -> u8 {
+    // SAFETY: the caller passes NULL or a valid pointer.
+    let e = match unsafe { pose.as_ref() } {
+        Some(p) => wrench_and_stiffness(&pose_in(p)),
+        None => {
+            needle_haptics::StiffnessEvaluation { wrench: Wrench::ZERO, stiffness: needle_haptics::Stiffness::ZERO, status: Status::ERROR }
+        }
+    };
+    // SAFETY: as above.
+    if let Some(o) = unsafe { wrench_out.as_mut() } {
+        *o = wrench_out_of(&e.wrench);
+    }
+    // SAFETY: as above.
+    if let Some(o) = unsafe { stiffness_out.as_mut() } {
+        let s = e.stiffness;
+        *o = needle_stiffness_t { by_depth: s.by_depth.to_array(), by_x: s.by_x.to_array(), by_z: s.by_z.to_array() };
     }
     e.status.bits()
 }

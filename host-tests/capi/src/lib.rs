@@ -25,7 +25,7 @@ mod types;
 
 pub use command::needle_loop_command;
 pub use control::{needle_loop_init, needle_loop_set_force_limit_n, needle_loop_tick};
-pub use eval::{needle_model_info, needle_wrench};
+pub use eval::{needle_model_info, needle_wrench, needle_wrench_and_stiffness};
 pub use names::{needle_loop_flag_name, needle_status_name, needle_status_str, needle_strerror};
 pub use types::*;
 

@@ -65,6 +65,19 @@ pub struct needle_wrench_t {
     pub mz_nmm: f32,
 }
 
+/// The wrench's partial derivatives (`needle_wrench_and_stiffness`): each array holds the
+/// rates of fx, fy, fz (N/mm) and mx, my, mz (N·mm/mm), in that order.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct needle_stiffness_t {
+    /// d wrench / d depth_mm.
+    pub by_depth: [f32; 6],
+    /// d wrench / d x_mm.
+    pub by_x: [f32; 6],
+    /// d wrench / d z_mm.
+    pub by_z: [f32; 6],
+}
+
 /// Identity and domain of the compiled-in model.
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]

@@ -92,9 +92,12 @@ fn host_c_program_checks_golden_vectors_loop_and_commands() {
             .arg(&exe),
         "gcc capi_golden.c",
     );
-    let out = run(Command::new(&exe).arg(golden_csv()), "capi_golden");
+    let stiffness = Path::new(needle_haptics::model_info::SET_DIR).join("golden-stiffness-f32.csv");
+    assert!(stiffness.is_file(), "{}: no stiffness golden vectors; run `needle fit`", stiffness.display());
+    let out = run(Command::new(&exe).arg(golden_csv()).arg(&stiffness), "capi_golden");
     println!("{out}");
     assert!(out.contains("wrench_mismatches=0 ") && out.contains("loop_failures=0 ") && out.contains("command_failures=0"), "{out}");
+    assert!(out.contains("capi-golden-stiffness rows=") && out.contains(" mismatches=0\n"), "{out}");
 }
 
 #[test]
