@@ -78,7 +78,7 @@ const fn skip_sweep(mats: &[[[f32; 5]; 5]; 6]) -> [bool; 6] {
 
 /// Whether `h(b, u)` is never `-0.0`: its last operation adds `b[0]`, and the sum is
 /// `-0.0` only when `b[0]` is.
-const fn starts_not_neg_zero(b: &[f32; 5]) -> bool {
+pub(crate) const fn starts_not_neg_zero(b: &[f32; 5]) -> bool {
     let [b0, ..] = *b;
     b0.to_bits() != 0x8000_0000
 }

@@ -2,16 +2,17 @@
 //! ("Stiffness") bit for bit, sharing the wrench's operations.
 use crate::cross_f32::{add_cross, add_cross_rates, COUPLED, CROSS_SCALES};
 use crate::horner::{horner, horner_with_rate};
-use crate::model_f32::{clamp_to_domain, is_plus_zero_matrix, sweep_t, ODD, ONE_THIRD, SWEEP_SCALES, ZERO_BASELINE};
+use crate::model_f32::{clamp_to_domain, is_plus_zero_matrix, starts_not_neg_zero, sweep_t, ODD, ONE_THIRD, SWEEP_SCALES, ZERO_BASELINE};
 use crate::stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
 use crate::tables::{BASELINE, DEVIATION, FITTED};
 use crate::{Pose, Status, Wrench};
 
-/// Whether neither `B(u)` nor `B'(u)` of the baseline `b` can be `-0.0`: their last
-/// additions add `b0` and `b1`, and a rounded sum is `-0.0` only when both addends are.
+/// Whether neither `B(u)` nor `B'(u)` of the baseline `b` can be `-0.0`: `B` as for the
+/// wrench ([`starts_not_neg_zero`]), and `B'`'s last addition adds `b1` (a rounded sum is
+/// `-0.0` only when both addends are).
 const fn rates_not_neg_zero(b: &[f32; 5]) -> bool {
-    let [b0, b1, ..] = *b;
-    b0.to_bits() != 0x8000_0000 && b1.to_bits() != 0x8000_0000
+    let [_, b1, ..] = *b;
+    starts_not_neg_zero(b) && b1.to_bits() != 0x8000_0000
 }
 
 /// One sweep's row of [`SKIP`].

@@ -77,7 +77,7 @@ pub fn h32(p: &[f32; NCOEF], w: f32) -> f32 {
 
 /// Clamp to `[lo, hi]` by comparison: a value inside (either zero sign included) is
 /// returned unchanged.
-fn clamp32(v: f32, lo: f32, hi: f32) -> f32 {
+pub fn clamp32(v: f32, lo: f32, hi: f32) -> f32 {
     if v < lo {
         lo
     } else if v > hi {

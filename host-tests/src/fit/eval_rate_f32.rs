@@ -5,7 +5,7 @@
 //! every derivative coefficient at run time.
 
 use super::contract::{NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_X, STATUS_SAT_Z};
-use super::eval_f32::{eval, h32, horner_n32, monomial32, Tables32, ODD, ONE_THIRD, R_THETA, R_XZ, S_THETA, S_XZ};
+use super::eval_f32::{clamp32, eval, h32, horner_n32, monomial32, Tables32, ODD, ONE_THIRD, R_THETA, R_XZ, S_THETA, S_XZ};
 
 /// `(h(p, w), h'(p, w))` in f32: the value by [`h32`]'s operations, the derivative
 /// accumulated alongside (`d = p4`, then `d = d*w + b` after the steps for p3, p2, p1,
@@ -30,9 +30,9 @@ pub fn eval_rates(t: &Tables32, pose: [f32; 5]) -> ([[f32; 6]; 3], u8) {
         return ([[0.0; 6]; 3], status);
     }
     let [x, z, tx, tz, d] = pose;
-    let clamp = |v: f32, m: f32| v.clamp(-m, m);
+    let clamp = |v: f32, m: f32| clamp32(v, -m, m);
     let (xc, zc, txc, tzc) = (clamp(x, 12.0), clamp(z, 12.0), clamp(tx, 15.0), clamp(tz, 15.0));
-    let dc = d.clamp(0.0, 6.0);
+    let dc = clamp32(d, 0.0, 6.0);
     let u = dc * ONE_THIRD - 1.0;
     let vals = [xc, zc, txc, tzc];
     let scales = [S_XZ, S_XZ, S_THETA, S_THETA];
