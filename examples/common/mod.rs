@@ -8,6 +8,8 @@
 
 pub mod device;
 pub mod icount;
+pub mod script;
+pub mod trace;
 
 use core::panic::PanicInfo;
 use cortex_m_semihosting::{debug, hio};

@@ -58,8 +58,16 @@ pub fn check_target(target: &str) -> anyhow::Result<()> {
 ///
 /// # Errors
 /// cargo cannot be started or exits with an error (`what` names the build).
-pub fn run_cargo(mut cmd: Command, what: &str) -> anyhow::Result<()> {
-    cmd.current_dir(workspace_root()).stdin(Stdio::null());
+pub fn run_cargo(cmd: Command, what: &str) -> anyhow::Result<()> {
+    run_cargo_in(cmd, &workspace_root(), what)
+}
+
+/// [`run_cargo`] in `dir` (cargo reads the `.cargo/config.toml` files from there up).
+///
+/// # Errors
+/// As [`run_cargo`].
+pub fn run_cargo_in(mut cmd: Command, dir: &Path, what: &str) -> anyhow::Result<()> {
+    cmd.current_dir(dir).stdin(Stdio::null());
     eprintln!("firmware: building {what}");
     let out = cmd.output().with_context(|| format!("cannot run cargo to build {what}"))?;
     if out.status.success() {

@@ -12,6 +12,7 @@
 //! in the release profile, with `NEEDLE_COEFFS` set to the absolute path of the set.
 
 pub mod bench;
+pub mod board;
 pub mod build;
 pub mod comparison;
 pub mod float_check;
