@@ -1,9 +1,10 @@
 //! The board crates in `examples/<board>/`: firmware with its own workspace,
 //! `.cargo/config.toml` (target, runner) and memory map, depending on the library by
 //! path. Built by a nested release `cargo build` run in the crate's folder (so its
-//! config applies) into `<target dir>/firmware/<board>`.
+//! config applies) into `<target dir>/firmware/<board>`; a build with a warning is an
+//! error.
 use super::build::{check_target, nested_cargo, run_cargo_in, target_dir};
-use super::{workspace_root, Core};
+use super::{size, workspace_root, Core};
 use anyhow::bail;
 use std::path::{Path, PathBuf};
 
@@ -20,6 +21,10 @@ pub struct Board {
 
 /// The RTIC 2 application on QEMU's Stellaris LM3S6965 (examples/rtic-lm3s6965).
 pub const RTIC_LM3S6965: Board = Board { dir: "rtic-lm3s6965", bin: "needle-rtic-lm3s6965", target: "thumbv7m-none-eabi" };
+
+/// The real-board example: NUCLEO-F401RE with stm32f4xx-hal, defmt over RTT, flashed
+/// by probe-rs (examples/nucleo-f401re). Built, never run, here.
+pub const NUCLEO_F401RE: Board = Board { dir: "nucleo-f401re", bin: "needle-nucleo-f401re", target: "thumbv7em-none-eabihf" };
 
 /// The QEMU board [`RTIC_LM3S6965`] runs on.
 pub const LM3S6965: Core = Core {
@@ -47,11 +52,33 @@ impl Board {
         let out = target_dir().join(self.dir);
         let mut cmd = nested_cargo();
         cmd.args(["build", "--release", "--target", self.target, "--target-dir"]).arg(&out).env("NEEDLE_COEFFS", set);
-        run_cargo_in(cmd, &self.path(), &format!("examples/{} for {}", self.dir, self.target))?;
+        let stderr = run_cargo_in(cmd, &self.path(), &format!("examples/{} for {}", self.dir, self.target))?;
+        let warnings: Vec<&str> = stderr.lines().filter(|l| l.starts_with("warning")).collect();
+        if !warnings.is_empty() {
+            bail!("examples/{} builds with warnings:\n{stderr}", self.dir);
+        }
         let elf = out.join(self.target).join("release").join(self.bin);
         if !elf.is_file() {
             bail!("{}: cargo built no such file", elf.display());
         }
         Ok(elf)
     }
+}
+
+/// Flash and static RAM of a firmware image, bytes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ImageSize {
+    /// `.text` + `.rodata` + vector table (`size`'s text) plus `.data`'s initial values.
+    pub flash: u64,
+    /// `.data` + `.bss` (the stack comes on top).
+    pub ram: u64,
+}
+
+/// The flash and RAM of `elf` (binutils `size`).
+///
+/// # Errors
+/// binutils missing or their output unexpected.
+pub fn image_size(elf: &Path) -> anyhow::Result<ImageSize> {
+    let (text, data, bss) = size::berkeley(elf)?;
+    Ok(ImageSize { flash: text + data, ram: data + bss })
 }

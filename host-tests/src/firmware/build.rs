@@ -59,21 +59,22 @@ pub fn check_target(target: &str) -> anyhow::Result<()> {
 /// # Errors
 /// cargo cannot be started or exits with an error (`what` names the build).
 pub fn run_cargo(cmd: Command, what: &str) -> anyhow::Result<()> {
-    run_cargo_in(cmd, &workspace_root(), what)
+    run_cargo_in(cmd, &workspace_root(), what).map(drop)
 }
 
-/// [`run_cargo`] in `dir` (cargo reads the `.cargo/config.toml` files from there up).
+/// [`run_cargo`] in `dir` (cargo reads the `.cargo/config.toml` files from there up);
+/// returns cargo's stderr (its warnings, replayed from the cache on a rebuild).
 ///
 /// # Errors
 /// As [`run_cargo`].
-pub fn run_cargo_in(mut cmd: Command, dir: &Path, what: &str) -> anyhow::Result<()> {
+pub fn run_cargo_in(mut cmd: Command, dir: &Path, what: &str) -> anyhow::Result<String> {
     cmd.current_dir(dir).stdin(Stdio::null());
     eprintln!("firmware: building {what}");
     let out = cmd.output().with_context(|| format!("cannot run cargo to build {what}"))?;
-    if out.status.success() {
-        return Ok(());
-    }
     let stderr = String::from_utf8_lossy(&out.stderr);
+    if out.status.success() {
+        return Ok(stderr.into_owned());
+    }
     let tail: Vec<&str> = stderr.lines().rev().take(60).collect::<Vec<_>>().into_iter().rev().collect();
     let hint = if stderr.contains(NO_PANIC_SYMBOL) {
         format!(

@@ -116,6 +116,14 @@ pub fn parse_berkeley(text: &str) -> anyhow::Result<(u64, u64, u64)> {
     }
 }
 
+/// (text, data, bss) of `elf` from `size -B`: flash holds text + data, RAM data + bss.
+///
+/// # Errors
+/// binutils missing or their output unexpected.
+pub fn berkeley(elf: &Path) -> anyhow::Result<(u64, u64, u64)> {
+    parse_berkeley(&output(&binutil("size")?, &["-B"], elf)?)
+}
+
 /// The size of `section` in `size -A` output (0 when absent).
 #[must_use]
 pub fn section_size(sysv: &str, section: &str) -> u64 {
