@@ -5,19 +5,14 @@ use crate::tables::{BASELINE, DEPTH_MAX_MM, DEVIATION, FITTED, THETA_MAX_DEG, X_
 use crate::{Evaluation, Pose, Status, Wrench};
 
 /// The nearest f32 to 1/3 (`u = depth * (1/3) - 1`).
-pub(crate) const ONE_THIRD: f32 = 1.0 / 3.0;
+pub(crate) const ONE_THIRD: f32 = needle_contract::ONE_THIRD_F32;
 
 /// The nearest f32 to `2 / V_k` per sweep (x, z, theta_x, theta_z).
-pub(crate) const SWEEP_SCALES: [f32; 4] = [2.0 / 12.0, 2.0 / 12.0, 2.0 / 15.0, 2.0 / 15.0];
+pub(crate) const SWEEP_SCALES: [f32; 4] = needle_contract::SWEEP_SCALES_F32;
 
 /// `ODD[k][c]`: component c (fx, fy, fz, mx, my, mz) changes sign under sweep k's mirror
-/// (x -> -x maps (x, theta_z) to (-x, -theta_z); z -> -z maps (z, theta_x) to (-z, -theta_x)).
-pub(crate) const ODD: [[bool; 6]; 4] = [
-    [true, false, false, false, true, true],
-    [false, false, true, true, true, false],
-    [false, false, true, true, true, false],
-    [true, false, false, false, true, true],
-];
+/// (the contract's table, `needle_contract::ODD`).
+pub(crate) const ODD: [[bool; 6]; 4] = needle_contract::ODD;
 
 /// `|v|`, exactly (clears the sign bit).
 #[inline(always)]

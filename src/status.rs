@@ -20,25 +20,25 @@ pub struct Status(u8);
 
 impl Status {
     /// Nothing to report: the pose was in the domain.
-    pub const OK: Self = Self(0x00);
+    pub const OK: Self = Self(needle_contract::status::OK);
     /// `x_mm` was clamped to `±X_MAX_MM`.
-    pub const SAT_X: Self = Self(0x01);
+    pub const SAT_X: Self = Self(needle_contract::status::SAT_X);
     /// `z_mm` was clamped to `±Z_MAX_MM`.
-    pub const SAT_Z: Self = Self(0x02);
+    pub const SAT_Z: Self = Self(needle_contract::status::SAT_Z);
     /// `theta_x_deg` was clamped to `±THETA_MAX_DEG`.
-    pub const SAT_THETA_X: Self = Self(0x04);
+    pub const SAT_THETA_X: Self = Self(needle_contract::status::SAT_THETA_X);
     /// `theta_z_deg` was clamped to `±THETA_MAX_DEG`.
-    pub const SAT_THETA_Z: Self = Self(0x08);
+    pub const SAT_THETA_Z: Self = Self(needle_contract::status::SAT_THETA_Z);
     /// `depth_mm` was clamped to `0..=DEPTH_MAX_MM`.
-    pub const SAT_DEPTH: Self = Self(0x10);
+    pub const SAT_DEPTH: Self = Self(needle_contract::status::SAT_DEPTH);
     /// The library has no fitted model (its set had no `model.toml` at build time).
     /// Always reported together with [`ERROR`](Self::ERROR).
-    pub const NO_MODEL: Self = Self(0x40);
+    pub const NO_MODEL: Self = Self(needle_contract::status::NO_MODEL);
     /// No wrench could be computed; the wrench is zero. Alone when an input was NaN or
     /// infinite, with [`NO_MODEL`](Self::NO_MODEL) when there is no model.
-    pub const ERROR: Self = Self(0x80);
+    pub const ERROR: Self = Self(needle_contract::status::ERROR);
     /// All five saturation flags.
-    pub const SATURATION: Self = Self(0x1f);
+    pub const SATURATION: Self = Self(needle_contract::status::SATURATION);
 
     /// Every flag with its name, in bit order (for printing).
     pub const FLAGS: [(Self, &'static str); 7] = [

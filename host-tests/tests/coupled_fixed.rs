@@ -14,7 +14,7 @@ use needle_host::fit::fixed_formats::TablesFixed;
 use needle_host::fit::model_file::parse;
 use std::path::Path;
 
-const COMPONENTS: [&str; 6] = ["fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"];
+use needle_contract::COMPONENTS;
 
 /// A deterministic spread of Q16.16 poses over the whole domain, edges included.
 fn poses() -> Vec<[i32; 5]> {

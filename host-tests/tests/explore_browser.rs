@@ -22,7 +22,7 @@ impl Drop for Killed {
     }
 }
 
-const COMPONENTS: [&str; 6] = ["fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"];
+use needle_contract::COMPONENTS;
 
 /// Starts `needle explore --port 0` and returns it with the URL it printed.
 fn start_explorer() -> (Killed, String) {

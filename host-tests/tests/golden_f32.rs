@@ -8,7 +8,7 @@ use needle_haptics::{model_info, wrench, Pose};
 use std::path::Path;
 
 const HEADER: &str = "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,status,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm";
-const COMPONENTS: [&str; 6] = ["fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"];
+use needle_contract::COMPONENTS;
 
 /// `0x` and 8 lower-case hex digits.
 fn f32_bits(field: &str, line: usize) -> u32 {

@@ -1,33 +1,17 @@
 //! The fixed vocabulary of the model contract (coeffs/README.md): component and sweep
 //! order, half-ranges, which components are odd under which sweep's mirror, status bits.
-
-/// Polynomial degree in depth and in each swept variable.
-pub const DEGREE: usize = 4;
-/// Coefficients per polynomial (`DEGREE + 1`).
-pub const NCOEF: usize = DEGREE + 1;
-
-/// Wrench components, in contract order (index c = 0..5). Forces in N, moments in N·mm.
-pub const COMPONENTS: [&str; 6] = ["fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"];
+//!
+//! The constants are the `needle-contract` crate's, where each is defined once.
+pub use needle_contract::{COMPONENTS, DEGREE, DEPTH_MAX_MM, TERMS as NCOEF, THETA_MAX_DEG, XZ_MAX_MM};
 
 /// Unit of component `c`: `"N"` for forces (c < 3), `"N*mm"` for moments.
 pub fn unit(c: usize) -> &'static str {
-    if c < 3 {
-        "N"
-    } else {
-        "N*mm"
-    }
+    needle_contract::UNITS.get(c).copied().unwrap_or("?")
 }
-
-/// Largest depth of the domain, mm.
-pub const DEPTH_MAX_MM: f64 = 6.0;
 
 /// A pose in f64: x and z in mm, the tilts in degrees, depth in mm (contract order
 /// `[x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm]`).
 pub type Pose64 = [f64; 5];
-/// Largest |x|, |z| of the domain, mm.
-pub const XZ_MAX_MM: f64 = 12.0;
-/// Largest |theta_x|, |theta_z| of the domain, degrees.
-pub const THETA_MAX_DEG: f64 = 15.0;
 
 /// One of the four single-axis sweeps, in contract order (index k = 0..3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -53,37 +37,23 @@ impl Sweep {
 
     /// The name used in model.toml: `x`, `z`, `theta_x`, `theta_z`.
     pub fn name(self) -> &'static str {
-        match self {
-            Sweep::X => "x",
-            Sweep::Z => "z",
-            Sweep::ThetaX => "theta_x",
-            Sweep::ThetaZ => "theta_z",
-        }
+        needle_contract::SWEEPS[self.index()]
     }
 
     /// Half-range `V_k` of the swept variable (mm for x and z, degrees for the tilts).
     pub fn half_range(self) -> f64 {
-        match self {
-            Sweep::X | Sweep::Z => XZ_MAX_MM,
-            Sweep::ThetaX | Sweep::ThetaZ => THETA_MAX_DEG,
-        }
+        needle_contract::HALF_RANGES[self.index()]
     }
 
     /// Unit of the swept variable.
     pub fn unit(self) -> &'static str {
-        match self {
-            Sweep::X | Sweep::Z => "mm",
-            Sweep::ThetaX | Sweep::ThetaZ => "deg",
-        }
+        needle_contract::SWEEP_UNITS[self.index()]
     }
 
     /// Whether component `c` changes sign under this sweep's mirror: x and theta_z
     /// (mirror x -> -x): fx, my, mz; z and theta_x (mirror z -> -z): fz, mx, my.
     pub fn is_odd(self, c: usize) -> bool {
-        match self {
-            Sweep::X | Sweep::ThetaZ => matches!(c, 0 | 4 | 5),
-            Sweep::Z | Sweep::ThetaX => matches!(c, 2..=4),
-        }
+        needle_contract::ODD[self.index()].get(c).copied().unwrap_or(false)
     }
 
     /// Normalised sweep variable of the fit, `t = |v| * 2 / V_k - 1` (f64).
@@ -97,15 +67,7 @@ pub fn u_of(depth_mm: f64) -> f64 {
     depth_mm / 3.0 - 1.0
 }
 
-/// Status bit: x was clamped to the domain.
-pub const STATUS_SAT_X: u8 = 0x01;
-/// Status bit: z was clamped.
-pub const STATUS_SAT_Z: u8 = 0x02;
-/// Status bit: theta_x was clamped.
-pub const STATUS_SAT_THETA_X: u8 = 0x04;
-/// Status bit: theta_z was clamped.
-pub const STATUS_SAT_THETA_Z: u8 = 0x08;
-/// Status bit: depth was clamped.
-pub const STATUS_SAT_DEPTH: u8 = 0x10;
-/// Status: an input was NaN or infinite; the wrench is zero and no other bit is set.
-pub const STATUS_ERROR: u8 = 0x80;
+pub use needle_contract::status::{
+    ERROR as STATUS_ERROR, SAT_DEPTH as STATUS_SAT_DEPTH, SAT_THETA_X as STATUS_SAT_THETA_X, SAT_THETA_Z as STATUS_SAT_THETA_Z,
+    SAT_X as STATUS_SAT_X, SAT_Z as STATUS_SAT_Z,
+};

@@ -7,24 +7,18 @@ use super::contract::{NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X,
 use super::model::Model;
 
 /// The f32 nearest 1/3 (IEEE division is correctly rounded): 0x3eaaaaab.
-pub const ONE_THIRD: f32 = 1.0 / 3.0;
+pub const ONE_THIRD: f32 = needle_contract::ONE_THIRD_F32;
 /// The f32 nearest 2/12, the scale of x and z: 0x3e2aaaab.
-pub const S_XZ: f32 = 2.0 / 12.0;
+pub const S_XZ: f32 = needle_contract::SWEEP_SCALES_F32[0];
 /// The f32 nearest 2/15, the scale of theta_x and theta_z: 0x3e088889.
-pub const S_THETA: f32 = 2.0 / 15.0;
+pub const S_THETA: f32 = needle_contract::SWEEP_SCALES_F32[2];
 /// The f32 nearest 1/12, the cross terms' scale of x and z: 0x3daaaaab.
-pub const R_XZ: f32 = 1.0 / 12.0;
+pub const R_XZ: f32 = needle_contract::CROSS_SCALES_F32[0];
 /// The f32 nearest 1/15, the cross terms' scale of theta_x and theta_z: 0x3d888889.
-pub const R_THETA: f32 = 1.0 / 15.0;
+pub const R_THETA: f32 = needle_contract::CROSS_SCALES_F32[2];
 
-/// `ODD[k][c]`: component c changes sign under sweep k's mirror (contract table: sweeps
-/// x and theta_z: fx, my, mz; sweeps z and theta_x: fz, mx, my).
-pub const ODD: [[bool; 6]; 4] = [
-    [true, false, false, false, true, true],
-    [false, false, true, true, true, false],
-    [false, false, true, true, true, false],
-    [true, false, false, false, true, true],
-];
+/// `ODD[k][c]`: component c changes sign under sweep k's mirror (the contract's table).
+pub use needle_contract::ODD;
 
 /// The coefficients the firmware uses: every f64 coefficient rounded to the nearest f32.
 #[derive(Debug, Clone, PartialEq)]

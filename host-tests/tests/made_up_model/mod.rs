@@ -6,17 +6,8 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// Component names in contract order.
-pub const COMPONENTS: [&str; 6] = ["fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"];
-/// Sweep names in contract order.
-pub const SWEEPS: [&str; 4] = ["x", "z", "theta_x", "theta_z"];
-/// Which (sweep, component) matrices are odd in the swept variable (coeffs/README.md).
-pub const ODD: [[bool; 6]; 4] = [
-    [true, false, false, false, true, true],
-    [false, false, true, true, true, false],
-    [false, false, true, true, true, false],
-    [true, false, false, false, true, true],
-];
+/// Component and sweep names and mirror parities in contract order (coeffs/README.md).
+pub use needle_contract::{COMPONENTS, ODD, SWEEPS};
 
 /// `[a, b, ...]` with each value's shortest round-trip f64 text.
 pub fn list(values: &[f64]) -> String {

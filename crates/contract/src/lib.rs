@@ -1,0 +1,90 @@
+//! The fixed part of the model contract of `coeffs/README.md`, defined once: the
+//! library (`src/`), the code generator, the fitter, the C API's checks and the tests
+//! all read these constants, and a `model.toml` must agree with them.
+//!
+//! Changing one of them is changing the contract: the model format version
+//! ([`MODEL_FORMAT`]), the golden vectors and every fitted set change with it.
+#![no_std]
+
+/// Format version of `model.toml`.
+pub const MODEL_FORMAT: i64 = 1;
+
+/// Polynomial degree in depth and in each swept variable.
+pub const DEGREE: usize = 4;
+/// Coefficients per polynomial (`DEGREE + 1`).
+pub const TERMS: usize = DEGREE + 1;
+
+/// Wrench components in the contract's order (index `c = 0..5`): forces in N, moments
+/// in N·mm about the hub.
+pub const COMPONENTS: [&str; 6] = ["fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"];
+/// Unit of each component (ASCII: `N*mm` is newton millimetre).
+pub const UNITS: [&str; 6] = ["N", "N", "N", "N*mm", "N*mm", "N*mm"];
+
+/// The four single-axis sweeps in the contract's order (index `k = 0..3`), as named in
+/// `model.toml`.
+pub const SWEEPS: [&str; 4] = ["x", "z", "theta_x", "theta_z"];
+/// The pose input each sweep varies (the `Pose` field).
+pub const SWEEP_INPUTS: [&str; 4] = ["x_mm", "z_mm", "theta_x_deg", "theta_z_deg"];
+/// Unit of each sweep's variable.
+pub const SWEEP_UNITS: [&str; 4] = ["mm", "mm", "deg", "deg"];
+
+/// Largest `|x|` and `|z|` of the domain, mm.
+pub const XZ_MAX_MM: f64 = 12.0;
+/// Largest `|theta_x|` and `|theta_z|` of the domain, degrees.
+pub const THETA_MAX_DEG: f64 = 15.0;
+/// Largest depth of the domain, mm (the domain is `0 <= depth <= 6`).
+pub const DEPTH_MAX_MM: f64 = 6.0;
+/// Half-range `V_k` of each sweep (mm, mm, deg, deg): the domain is `|v| <= V_k`.
+pub const HALF_RANGES: [f64; 4] = [XZ_MAX_MM, XZ_MAX_MM, THETA_MAX_DEG, THETA_MAX_DEG];
+
+/// `ODD[k][c]`: component `c` changes sign under sweep `k`'s mirror. The mirror x -> -x
+/// maps (x, theta_z) to (-x, -theta_z) and flips fx, my, mz; z -> -z maps (z, theta_x)
+/// to (-z, -theta_x) and flips fz, mx, my.
+pub const ODD: [[bool; 6]; 4] = [
+    [true, false, false, false, true, true],
+    [false, false, true, true, true, false],
+    [false, false, true, true, true, false],
+    [true, false, false, false, true, true],
+];
+
+/// The nearest f32 to 1/3: the normalised depth is `u = depth * (1/3) - 1`.
+pub const ONE_THIRD_F32: f32 = 1.0 / 3.0;
+/// The nearest f32 to `2 / V_k` per sweep: `t = |v| * SWEEP_SCALES_F32[k] - 1`.
+pub const SWEEP_SCALES_F32: [f32; 4] = [2.0 / 12.0, 2.0 / 12.0, 2.0 / 15.0, 2.0 / 15.0];
+/// The nearest f32 to `1 / V_k` per input: the coupled form's cross-term inputs are
+/// `n_k = v_k * CROSS_SCALES_F32[k]`.
+pub const CROSS_SCALES_F32: [f32; 4] = [1.0 / 12.0, 1.0 / 12.0, 1.0 / 15.0, 1.0 / 15.0];
+
+/// The status bits of an evaluation (`needle_haptics::Status`, the C API's
+/// `NEEDLE_STATUS_*`, the golden files' `status` column).
+pub mod status {
+    /// Nothing to report.
+    pub const OK: u8 = 0x00;
+    /// x was outside the domain and clamped.
+    pub const SAT_X: u8 = 0x01;
+    /// z was clamped.
+    pub const SAT_Z: u8 = 0x02;
+    /// theta_x was clamped.
+    pub const SAT_THETA_X: u8 = 0x04;
+    /// theta_z was clamped.
+    pub const SAT_THETA_Z: u8 = 0x08;
+    /// depth was clamped.
+    pub const SAT_DEPTH: u8 = 0x10;
+    /// The build has no fitted model (always with [`ERROR`]).
+    pub const NO_MODEL: u8 = 0x40;
+    /// No wrench: an input was NaN or infinite, or there is no model.
+    pub const ERROR: u8 = 0x80;
+    /// The five saturation bits.
+    pub const SATURATION: u8 = SAT_X | SAT_Z | SAT_THETA_X | SAT_THETA_Z | SAT_DEPTH;
+    /// Every bit with its name, `OK` first, then in bit order.
+    pub const NAMES: [(&str, u8); 8] = [
+        ("OK", OK),
+        ("SAT_X", SAT_X),
+        ("SAT_Z", SAT_Z),
+        ("SAT_THETA_X", SAT_THETA_X),
+        ("SAT_THETA_Z", SAT_THETA_Z),
+        ("SAT_DEPTH", SAT_DEPTH),
+        ("NO_MODEL", NO_MODEL),
+        ("ERROR", ERROR),
+    ];
+}
