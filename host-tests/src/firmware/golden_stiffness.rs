@@ -2,7 +2,7 @@
 //! `golden-stiffness-f32.csv`: inputs and status exactly, every rate by its bits (NaN by
 //! class), and the firmware's own count of rows whose `wrench_and_stiffness` wrench is
 //! not `wrench`'s must be 0.
-use super::comparison::{same_f32, Comparison};
+use super::comparison::{same_f32, Comparison, Section};
 use crate::fit::golden_stiffness::{header, RATE_COLUMNS};
 use anyhow::bail;
 
@@ -15,53 +15,26 @@ use anyhow::bail;
 /// [`Comparison::mismatches`].
 pub fn compare(output: &str, csv: &str) -> anyhow::Result<Comparison> {
     let header = header();
-    let mut want = csv.lines();
-    if want.next() != Some(header.as_str()) {
-        bail!("golden-stiffness-f32.csv: the first line is not the header {header:?}");
-    }
-    let want: Vec<&str> = want.collect();
-    let mut got = output.lines().skip_while(|l| !l.starts_with("needle-golden-stiffness rows="));
-    let banner = got.next().unwrap_or_default().to_string();
-    if banner.is_empty() {
-        bail!("the firmware printed no stiffness section (no `needle-golden-stiffness rows=` line)");
-    }
-    if banner != format!("needle-golden-stiffness rows={}", want.len()) {
-        bail!("the firmware holds another number of poses than golden-stiffness-f32.csv's {}: {banner:?}", want.len());
-    }
-    let mut mismatches = Vec::new();
-    for (i, w) in want.iter().enumerate() {
-        let line = i + 2;
-        let Some(g) = got.next() else {
-            bail!("the firmware's stiffness output stops before golden-stiffness line {line}");
-        };
-        let wf: Vec<&str> = w.split(',').collect();
-        let gf: Vec<&str> = g.split(',').collect();
-        if wf.len() != 24 || gf.len() != 24 {
-            bail!("golden-stiffness line {line}: {} fields in the file, {} from the firmware ({g:?}); expected 24", wf.len(), gf.len());
-        }
-        if wf[..5] != gf[..5] {
-            bail!("firmware row for golden-stiffness line {line} has other inputs: {g:?} (golden {w:?})");
-        }
+    let section = Section {
+        file: "golden-stiffness-f32.csv",
+        tag: "needle-golden-stiffness",
+        header: &header,
+        fields: 6 + RATE_COLUMNS.len(),
+        end_suffix: " wrench_differs=0",
+    };
+    section.compare(output, csv, |line, want, got| {
         let mut diffs = Vec::new();
-        if wf[5] != gf[5] {
-            diffs.push(format!("status want {} got {}", wf[5], gf[5]));
+        if want.get(5) != got.get(5) {
+            diffs.push(format!("status want {:?} got {:?}", want.get(5), got.get(5)));
         }
-        for (name, (a, b)) in RATE_COLUMNS.iter().zip(wf[6..].iter().zip(&gf[6..])) {
+        for (name, (a, b)) in RATE_COLUMNS.iter().zip(want.iter().zip(got).skip(6)) {
             let (Some(x), Some(y)) = (needle_codegen::parse_bits(a), needle_codegen::parse_bits(b)) else {
-                bail!("golden-stiffness line {line}, {name}: {a:?} / firmware {b:?} is not 0x and 8 hex digits");
+                bail!("golden-stiffness-f32.csv line {line}, {name}: {a:?} / firmware {b:?} is not 0x and 8 hex digits");
             };
             if !same_f32(x, y) {
                 diffs.push(format!("{name} want {a} ({:e}) got {b} ({:e})", f32::from_bits(x), f32::from_bits(y)));
             }
         }
-        if !diffs.is_empty() {
-            mismatches.push(format!("line {line} (pose {}): {}", wf[..5].join(","), diffs.join("; ")));
-        }
-    }
-    let end = got.next().unwrap_or_default();
-    let want_end = format!("needle-golden-stiffness end rows={} wrench_differs=0", want.len());
-    if end != want_end {
-        bail!("the firmware's stiffness output does not end with {want_end:?}: {end:?}");
-    }
-    Ok(Comparison { banner, rows: want.len(), mismatches })
+        Ok(diffs)
+    })
 }
