@@ -204,13 +204,14 @@ pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<GoldenRow>> {
     .map(|rows| rows.into_iter().map(|(pose, status, wrench)| GoldenRow { pose, status, wrench }).collect())
 }
 
-/// The golden-file layout both golden files share: `header`, then rows of 12 fields
-/// `5 pose values, status (0x + 2 hex digits), 6 wrench values`. `values` reads the pose
-/// and the wrench of one row from its 12 fields; its second argument is the row's
-/// `path:line` for messages.
+/// The layout every golden file shares: `header`, then rows of `fields` fields (as many
+/// as the header has) `5 pose values, status (0x + 2 hex digits), the outputs`. `values`
+/// reads the pose and the outputs of one row from its fields; its second argument is
+/// the row's `path:line` for messages.
 ///
 /// # Errors
-/// Wrong header, a row without 12 fields, a malformed status, or `values`' error.
+/// Wrong header, a row with another number of fields, a malformed status, or `values`'
+/// error.
 #[allow(clippy::type_complexity)]
 pub(crate) fn parse_rows<P, W>(
     text: &str,
@@ -218,6 +219,7 @@ pub(crate) fn parse_rows<P, W>(
     header: &str,
     values: impl Fn(&[&str], &str) -> Result<(P, W)>,
 ) -> Result<Vec<(P, u8, W)>> {
+    let fields = header.split(',').count();
     let p = path.display();
     let mut lines = text.lines();
     if lines.next() != Some(header) {
@@ -227,8 +229,8 @@ pub(crate) fn parse_rows<P, W>(
     for (n, line) in lines.enumerate() {
         let at = format!("{p}:{}", n + 2);
         let f: Vec<&str> = line.split(',').collect();
-        if f.len() != 12 {
-            bail!("{at}: {} fields, expected 12", f.len());
+        if f.len() != fields {
+            bail!("{at}: {} fields, expected {fields}", f.len());
         }
         let status = f[5]
             .strip_prefix("0x")

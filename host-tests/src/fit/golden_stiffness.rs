@@ -6,7 +6,7 @@ use super::eval_f32::Tables32;
 use super::eval_rate_f32::eval_rates;
 use super::golden::poses;
 use super::model_file::{hex32, parse_hex32};
-use anyhow::{bail, Result};
+use anyhow::Result;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -74,34 +74,17 @@ pub struct StiffnessRow {
 /// # Errors
 /// Wrong header, a row without 24 fields, a malformed hex field or status (`path:line`).
 pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<StiffnessRow>> {
-    let p = path.display();
-    let mut lines = text.lines();
-    let header = header();
-    if lines.next() != Some(header.as_str()) {
-        bail!("{p}:1: expected the header {header:?}");
-    }
-    let mut rows = Vec::new();
-    for (n, line) in lines.enumerate() {
-        let at = format!("{p}:{}", n + 2);
-        let f: Vec<&str> = line.split(',').collect();
-        if f.len() != 24 {
-            bail!("{at}: {} fields, expected 24", f.len());
-        }
+    super::golden::parse_rows(text, path, &header(), |field, at| {
         let value = |s: &str| parse_hex32(s).ok_or_else(|| anyhow::anyhow!("{at}: field {s:?} is not 0x + 8 hex digits"));
-        let status = f[5]
-            .strip_prefix("0x")
-            .filter(|h| h.len() == 2)
-            .and_then(|h| u8::from_str_radix(h, 16).ok())
-            .ok_or_else(|| anyhow::anyhow!("{at}: status {:?} is not 0x + 2 hex digits", f[5]))?;
         let mut pose = [0.0f32; 5];
-        for (dst, s) in pose.iter_mut().zip(&f[..5]) {
+        for (dst, s) in pose.iter_mut().zip(field) {
             *dst = value(s)?;
         }
         let mut rates = [[0.0f32; 6]; 3];
-        for (dst, s) in rates.iter_mut().flatten().zip(&f[6..]) {
+        for (dst, s) in rates.iter_mut().flatten().zip(field.iter().skip(6)) {
             *dst = value(s)?;
         }
-        rows.push(StiffnessRow { pose, status, rates });
-    }
-    Ok(rows)
+        Ok((pose, rates))
+    })
+    .map(|rows| rows.into_iter().map(|(pose, status, rates)| StiffnessRow { pose, status, rates }).collect())
 }

@@ -16,29 +16,22 @@ pub struct GoldenRow {
     pub wrench: Wrench,
 }
 
-fn bits(field: &str, line: usize) -> u32 {
-    needle_codegen::parse_bits(field).unwrap_or_else(|| panic!("golden-f32.csv:{line}: bad field {field:?}"))
-}
-
-/// Every row of `<set>/golden-f32.csv` (fails, never skips, when the file is missing).
+/// Every row of `<set>/golden-f32.csv` (fails, never skips, when the file is missing),
+/// read by the fitter's golden-file reader.
 pub fn golden_rows() -> Vec<GoldenRow> {
     let path = Path::new(model_info::SET_DIR).join("golden-f32.csv");
     let text = std::fs::read_to_string(&path)
         .unwrap_or_else(|e| panic!("{}: {e}: run `needle fit --set {}`", path.display(), model_info::SET_DIR));
-    text.lines()
+    let rows = needle_host::fit::golden::parse_csv(&text, &path).unwrap_or_else(|e| panic!("{e:#}"));
+    rows.into_iter()
         .enumerate()
-        .skip(1)
-        .map(|(i, l)| {
-            let line = i + 1;
-            let f: Vec<&str> = l.split(',').collect();
-            assert_eq!(f.len(), 12, "golden-f32.csv:{line}");
-            let v: Vec<f32> = f.iter().enumerate().filter(|(k, _)| *k != 5).map(|(_, s)| f32::from_bits(bits(s, line))).collect();
-            let status = u8::from_str_radix(f[5].trim_start_matches("0x"), 16).expect("status");
+        .map(|(i, r)| {
+            let [x, z, tx, tz, d] = r.pose;
             GoldenRow {
-                line,
-                pose: Pose::new(v[0], v[1], v[2], v[3], v[4]),
-                status: Status::from_bits(status),
-                wrench: Wrench::from_array([v[5], v[6], v[7], v[8], v[9], v[10]]),
+                line: i + 2,
+                pose: Pose::new(x, z, tx, tz, d),
+                status: Status::from_bits(r.status),
+                wrench: Wrench::from_array(r.wrench),
             }
         })
         .collect()
