@@ -10,7 +10,7 @@
 use super::coupled::{self, CvScore};
 use super::cross_terms::CrossTerms;
 use super::data::{load_training_runs, load_validation_runs, Run};
-use super::eval_f64::{eval as eval_paper, eval_with_cross, Pose64};
+use super::eval_f64::{eval_paper, eval_with_cross, Pose64};
 use super::model::Model;
 use super::validate::TABLE2_MIN_DEPTH_MM;
 use crate::fe::spec::Role;
@@ -107,7 +107,15 @@ pub fn curve_sizes(n: usize) -> Vec<usize> {
     v
 }
 
-/// Measure the coupled form of the set in `set_dir` against its paper form `paper`.
+/// Held-out errors of the paper part of `model` alone (its cross terms, if any, left
+/// out): the paper form's row of the report, also when `model` is the fitted coupled
+/// model.
+pub fn paper_held_out(runs: &[&Run], lever_arm_mm: f64, model: &Model) -> HeldOut {
+    held_out(runs, lever_arm_mm, |p| eval_paper(model, p).0)
+}
+
+/// Measure the coupled form of the set in `set_dir` against its paper form: the paper
+/// part of `paper` (a fitted coupled model may be passed; its cross terms are ignored).
 ///
 /// # Errors
 /// The spec, the manifest or a run cannot be read.
@@ -117,7 +125,7 @@ pub fn measure(set_dir: &Path, paper: &Model) -> Result<CoupledReport> {
     let lever = campaign.needle.reference_from_tip_mm;
     let held: Vec<&Run> = validation.iter().filter(|r| r.pose.role.is_validation()).collect();
     let train_refs: Vec<&Run> = train.iter().collect();
-    let paper_errors = held_out(&held, lever, |p| eval_paper(paper, p).0);
+    let paper_errors = paper_held_out(&held, lever, paper);
     let mut report = CoupledReport {
         training_runs: train.len(),
         unusable: unusable.iter().map(|u| format!("{} ({})", u.pose.name, u.why)).collect(),
@@ -238,4 +246,41 @@ pub fn to_table(r: &CoupledReport) -> String {
         row("coupled", c);
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fe::results::Row;
+    use crate::fe::spec::{PoseSpec, Role};
+    use crate::fit::cross_terms::{CrossForm, CrossTerms};
+    use crate::fit::model::Coupled;
+
+    /// The paper row of the report is the paper part alone: with cross terms in the
+    /// model (as `needle fit` passes the fitted coupled model), a run equal to the paper
+    /// part has zero paper error and a nonzero coupled one. (It once evaluated the whole
+    /// model, so both rows of `needle fit` showed the coupled form's errors.)
+    #[test]
+    fn the_paper_row_leaves_the_cross_terms_out() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default/model.toml");
+        let mut model = crate::fit::model_file::read(&path).unwrap_or_else(|e| panic!("{e:#}"));
+        assert!(model.cross.is_none(), "the default set is the paper form");
+        let pose = PoseSpec { name: "lhs-test".into(), role: Role::Lhs, x_mm: 6.0, z_mm: 0.0, theta_x_deg: 0.0, theta_z_deg: 9.0 };
+        let rows: Vec<Row> = (1..=20)
+            .map(|i| {
+                let depth_mm = 0.3 * f64::from(i);
+                Row { depth_mm, wrench: eval_paper(&model, [pose.x_mm, pose.z_mm, pose.theta_x_deg, pose.theta_z_deg, depth_mm]).0 }
+            })
+            .collect();
+        let run = Run { pose, file_name: "lhs-test.csv".into(), rows };
+        // fy += 0.01 N * (x/12) * (theta_z/15): nonzero at this pose.
+        let mut terms: [Vec<([u8; 4], Vec<f64>)>; 6] = Default::default();
+        terms[1].push(([1, 0, 0, 1], vec![0.01, 0.0, 0.0]));
+        let terms = CrossTerms { form: CrossForm { max_degree: 2, depth_degree: 2 }, terms };
+        model.cross = Some(Coupled { terms: terms.clone(), training_runs: 1, cv_rms_pct: [0.0; 6], scale: [1.0; 6] });
+        let paper = paper_held_out(&[&run], 60.0, &model);
+        let coupled = held_out(&[&run], 60.0, |p| eval_with_cross(&model, &terms, p).0);
+        assert_eq!(paper.lhs_worst_rms_pct, 0.0, "the paper row must not include the cross terms");
+        assert!(coupled.lhs_worst_rms_pct > 1.0, "the cross term shows in the coupled row: {}", coupled.lhs_worst_rms_pct);
+    }
 }
