@@ -113,6 +113,8 @@ pub fn render_rust_cross(model: &Model) -> String {
         let _ = writeln!(w, "    let [xi, zeta, alpha, beta] = n;");
         let _ = writeln!(w, "    let _ = (xi, zeta, alpha, beta);");
         let _ = writeln!(w, "    let [w0, w1, w2, w3, w4, w5] = w;");
+        // A component may have no cross terms (none of degree 2 for fx, fz, mx, mz).
+        let _ = writeln!(w, "    let _ = (&w0, &w1, &w2, &w3, &w4, &w5);");
         for t in &model.cross {
             let _ = writeln!(
                 w,

@@ -13,8 +13,13 @@
 //! The paper part is the sweep fit as it is ([`super::model::fit`]); the cross terms are
 //! fitted by least squares ([`lstsq`], QR) to what it leaves, `FE - paper`, over every
 //! depth of the training runs (sweep runs add nothing: every cross monomial is zero on
-//! them). `max_degree` and `depth_degree` are chosen by k-fold cross-validation over the
-//! training runs ([`select`]).
+//! them). The size is chosen *per component* by k-fold cross-validation over the
+//! training runs ([`select`]): each component takes the candidate `(max_degree,
+//! depth_degree)` with the smallest cross-validated error, or no cross terms at all when
+//! the paper form alone does better on the training runs (its error there is out of
+//! sample too: the paper part is fitted on the sweeps). The file keeps one form for all
+//! components (the largest chosen degrees); a component's terms outside its own choice
+//! are written as zeros ([`fit_chosen`]).
 
 use super::contract::{Pose64, COMPONENTS};
 use super::cross_terms::{mono, monomials, normalised, CrossForm, CrossTerms, Exponents, CANDIDATES};
@@ -35,6 +40,11 @@ pub fn fit(paper: &Model, runs: &[&Run], form: CrossForm) -> Result<CrossTerms> 
     let nd = usize::from(form.depth_degree) + 1;
     for (c, out) in terms.iter_mut().enumerate() {
         let ms = monomials(c, form.max_degree);
+        if ms.is_empty() {
+            // No monomial of this degree has the component's mirror parities (fx, mz at
+            // degree 2): it gets no cross terms in this form, the others are still fitted.
+            continue;
+        }
         let rows: Vec<(Pose64, f64)> = runs
             .iter()
             .flat_map(|r| {
@@ -140,47 +150,130 @@ pub fn cross_validate(paper: &Model, runs: &[&Run], form: CrossForm, scale: [f64
     CvScore { form, rms_pct: Some(rms), failure: None }
 }
 
-/// Cross-validate every candidate and pick the one with the smallest worst-component
-/// error (ties: the fewer coefficients, i.e. the earlier candidate).
+/// What cross-validation chose for each component: a candidate, or `None` for no cross
+/// terms (the paper form alone).
+pub type Choices = [Option<CrossForm>; 6];
+
+/// The outcome of [`select`]: the choice and score of each component, every
+/// candidate's cross-validation and the paper form's error on the training runs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Selection {
+    /// Per component: the chosen candidate, or `None` (no cross terms).
+    pub choices: Choices,
+    /// Per component: the chosen candidate's cross-validated RMS (or the paper form's
+    /// error), % of the scale.
+    pub rms_pct: [f64; 6],
+    /// Every candidate's cross-validation.
+    pub cv: Vec<CvScore>,
+    /// The paper form's RMS on the training runs per component, % of the scale.
+    pub paper_rms_pct: [f64; 6],
+}
+
+/// Cross-validate every candidate and choose per component (module docs): the candidate
+/// with the smallest cross-validated RMS of that component, if it is below the paper
+/// form's error on the training runs; ties go to the fewer coefficients (the earlier
+/// candidate) and to no cross terms.
 ///
 /// # Errors
-/// No candidate could be fitted (too few training runs).
-pub fn select(paper: &Model, runs: &[&Run], scale: [f64; 6]) -> Result<(CrossForm, Vec<CvScore>)> {
+/// Fewer than 2 training runs, or no candidate could be fitted (too few training runs).
+pub fn select(paper: &Model, runs: &[&Run], scale: [f64; 6]) -> Result<Selection> {
     if runs.len() < 2 {
         bail!("the coupled form needs training runs (role train): {} found", runs.len());
     }
-    let scores: Vec<CvScore> = CANDIDATES.iter().map(|&f| cross_validate(paper, runs, f, scale)).collect();
-    let best = scores.iter().filter(|s| s.rms_pct.is_some()).min_by(|a, b| a.worst().total_cmp(&b.worst())).map(|s| s.form);
-    match best {
-        Some(f) => Ok((f, scores)),
-        None => bail!(
+    let cv: Vec<CvScore> = CANDIDATES.iter().map(|&f| cross_validate(paper, runs, f, scale)).collect();
+    if cv.iter().all(|s| s.rms_pct.is_none()) {
+        bail!(
             "no coupled form could be fitted on {} training runs: {}",
             runs.len(),
-            scores.iter().filter_map(|s| s.failure.clone()).collect::<Vec<_>>().join("; ")
-        ),
+            cv.iter().filter_map(|s| s.failure.clone()).collect::<Vec<_>>().join("; ")
+        );
+    }
+    let paper_rms_pct = rms_pct(runs, scale, |p| eval_paper(paper, p).0);
+    let mut choices: Choices = [None; 6];
+    let mut chosen_rms = paper_rms_pct;
+    for c in 0..6 {
+        for score in &cv {
+            // A form without monomials for this component adds nothing to it.
+            if monomials(c, score.form.max_degree).is_empty() {
+                continue;
+            }
+            if let Some(e) = score.rms_pct {
+                if e[c] < chosen_rms[c] {
+                    chosen_rms[c] = e[c];
+                    choices[c] = Some(score.form);
+                }
+            }
+        }
+    }
+    Ok(Selection { choices, rms_pct: chosen_rms, cv, paper_rms_pct })
+}
+
+/// The form the file holds for `choices`: the largest chosen degrees (the smallest
+/// candidate when no component has cross terms).
+pub fn file_form(choices: &Choices) -> CrossForm {
+    let chosen = choices.iter().flatten();
+    match (chosen.clone().map(|f| f.max_degree).max(), chosen.map(|f| f.depth_degree).max()) {
+        (Some(max_degree), Some(depth_degree)) => CrossForm { max_degree, depth_degree },
+        _ => CANDIDATES[0],
     }
 }
 
-/// [`select`] on `runs`, then [`fit`] the chosen form on all of them: the chosen score,
-/// every candidate's score and the cross terms.
+/// The cross terms of `choices` fitted on `runs`: each component's terms fitted in its
+/// chosen form ([`fit`]), written in [`file_form`] with zeros for the monomials and
+/// depth powers outside its choice (all zeros for a component without cross terms).
+///
+/// # Errors
+/// As [`fit`].
+pub fn fit_chosen(paper: &Model, runs: &[&Run], choices: &Choices) -> Result<CrossTerms> {
+    let form = file_form(choices);
+    let nd = usize::from(form.depth_degree) + 1;
+    let mut fitted: Vec<(CrossForm, CrossTerms)> = Vec::new();
+    let mut terms: [Vec<(Exponents, Vec<f64>)>; 6] = Default::default();
+    for (c, out) in terms.iter_mut().enumerate() {
+        let own: Vec<(Exponents, Vec<f64>)> = match choices[c] {
+            None => Vec::new(),
+            Some(f) => {
+                if !fitted.iter().any(|(g, _)| *g == f) {
+                    fitted.push((f, fit(paper, runs, f)?));
+                }
+                fitted.iter().find(|(g, _)| *g == f).map(|(_, t)| t.terms[c].clone()).unwrap_or_default()
+            }
+        };
+        *out = monomials(c, form.max_degree)
+            .into_iter()
+            .map(|e| {
+                let mut p = vec![0.0; nd];
+                if let Some((_, q)) = own.iter().find(|(m, _)| *m == e) {
+                    for (dst, v) in p.iter_mut().zip(q) {
+                        *dst = *v;
+                    }
+                }
+                (e, p)
+            })
+            .collect();
+    }
+    Ok(CrossTerms { form, terms })
+}
+
+/// [`select`] on `runs`, then [`fit_chosen`] on all of them.
 ///
 /// # Errors
 /// As [`select`] and [`fit`].
-pub fn select_and_fit(paper: &Model, runs: &[&Run], scale: [f64; 6]) -> Result<([f64; 6], Vec<CvScore>, CrossTerms)> {
-    let (form, cv) = select(paper, runs, scale)?;
-    let terms = fit(paper, runs, form)?;
-    let chosen = cv.iter().find(|s| s.form == form).and_then(|s| s.rms_pct).context("the chosen form has a score")?;
-    Ok((chosen, cv, terms))
+pub fn select_and_fit(paper: &Model, runs: &[&Run], scale: [f64; 6]) -> Result<(Selection, CrossTerms)> {
+    let selection = select(paper, runs, scale)?;
+    let terms = fit_chosen(paper, runs, &selection.choices)?;
+    Ok((selection, terms))
 }
 
-/// The coupled form's part of the model: the size chosen by [`select`] on `train`, its
-/// cross terms fitted on all of `train` ([`fit`]) and its cross-validated error.
+/// The coupled form's part of the model: the sizes chosen by [`select`] on `train`, the
+/// cross terms fitted on all of `train` ([`fit_chosen`]) and each component's
+/// cross-validated error (the paper form's, for a component without cross terms).
 ///
 /// # Errors
 /// Fewer than 2 training runs, or no candidate can be fitted on them.
 pub fn fit_coupled(paper: &Model, train: &[Run], lever_arm_mm: f64) -> Result<Coupled> {
     let runs: Vec<&Run> = train.iter().collect();
     let scale = scales(&runs, lever_arm_mm);
-    let (cv_rms_pct, _, terms) = select_and_fit(paper, &runs, scale)?;
-    Ok(Coupled { terms, training_runs: runs.len(), cv_rms_pct, scale })
+    let (selection, terms) = select_and_fit(paper, &runs, scale)?;
+    Ok(Coupled { terms, training_runs: runs.len(), cv_rms_pct: selection.rms_pct, scale })
 }

@@ -7,7 +7,7 @@
 //! and component, RMS over the run's depths in % of the run's peak |Fy| (moments: times
 //! the lever arm), and for Table 2 the largest |Fy| error at depths >= 1 mm in % of FE.
 
-use super::coupled::{self, CvScore};
+use super::coupled::{self, Selection};
 use super::cross_terms::CrossTerms;
 use super::data::{load_training_runs, load_validation_runs, Run};
 use super::eval_f64::{eval_paper, eval_with_cross, Pose64};
@@ -52,8 +52,9 @@ pub struct CoupledReport {
     pub unusable: Vec<String>,
     /// Held-out runs compared.
     pub held_out_runs: usize,
-    /// Cross-validation of every candidate on all training runs.
-    pub cv: Vec<CvScore>,
+    /// Cross-validation of every candidate on all training runs, the paper form's error
+    /// there and each component's choice; `None` when nothing could be fitted.
+    pub selection: Option<Selection>,
     /// The chosen cross terms, fitted on all training runs.
     pub terms: Option<CrossTerms>,
     /// The paper form's held-out errors.
@@ -130,7 +131,7 @@ pub fn measure(set_dir: &Path, paper: &Model) -> Result<CoupledReport> {
         training_runs: train.len(),
         unusable: unusable.iter().map(|u| format!("{} ({})", u.pose.name, u.why)).collect(),
         held_out_runs: held.len(),
-        cv: Vec::new(),
+        selection: None,
         terms: None,
         paper: paper_errors,
         coupled: None,
@@ -144,13 +145,13 @@ pub fn measure(set_dir: &Path, paper: &Model) -> Result<CoupledReport> {
         let got = coupled::select_and_fit(paper, &train_refs[..n], scale).ok();
         let point = CurvePoint {
             runs: n,
-            form: got.as_ref().map(|g| (g.2.form.max_degree, g.2.form.depth_degree)),
-            held_out: got.as_ref().map(|g| held_out(&held, lever, |p| eval_with_cross(paper, &g.2, p).0)),
+            form: got.as_ref().map(|g| (g.1.form.max_degree, g.1.form.depth_degree)),
+            held_out: got.as_ref().map(|g| held_out(&held, lever, |p| eval_with_cross(paper, &g.1, p).0)),
         };
         if n == train.len() {
-            if let Some((_, cv, terms)) = got {
+            if let Some((selection, terms)) = got {
                 report.coupled = point.held_out;
-                report.cv = cv;
+                report.selection = Some(selection);
                 report.terms = Some(terms);
             }
         }
@@ -173,31 +174,22 @@ pub fn to_table(r: &CoupledReport) -> String {
         },
         r.held_out_runs
     );
-    if !r.cv.is_empty() {
+    if let Some(sel) = &r.selection {
         let _ =
             writeln!(s, "{}-fold cross-validation on the training runs (RMS, % of their peak |Fy|; moments x lever arm):", coupled::FOLDS);
         let _ = writeln!(
             s,
-            "  {:>10} {:>10}  {:>6} {:>6} {:>6} {:>6} {:>6} {:>6}  worst",
+            "  {:>10} {:>10}  {:>6} {:>6} {:>6} {:>6} {:>6} {:>6}",
             "pose deg", "depth deg", "fx", "fy", "fz", "mx", "my", "mz"
         );
-        for c in &r.cv {
+        let cells = |e: &[f64; 6], form: Option<super::cross_terms::CrossForm>| -> String {
+            (0..6).map(|c| format!(" {:>6.3}{}", e[c], if sel.choices[c] == form { "*" } else { " " })).collect()
+        };
+        let _ = writeln!(s, "  {:>10} {:>10} {}  (paper form alone, out of sample)", "none", "-", cells(&sel.paper_rms_pct, None));
+        for c in &sel.cv {
             match c.rms_pct {
                 Some(e) => {
-                    let _ = writeln!(
-                        s,
-                        "  {:>10} {:>10}  {:>6.3} {:>6.3} {:>6.3} {:>6.3} {:>6.3} {:>6.3}  {:.3}{}",
-                        c.form.max_degree,
-                        c.form.depth_degree,
-                        e[0],
-                        e[1],
-                        e[2],
-                        e[3],
-                        e[4],
-                        e[5],
-                        c.worst(),
-                        if r.terms.as_ref().map(|t| t.form) == Some(c.form) { "  <- chosen" } else { "" }
-                    );
+                    let _ = writeln!(s, "  {:>10} {:>10} {}", c.form.max_degree, c.form.depth_degree, cells(&e, Some(c.form)));
                 }
                 None => {
                     let _ = writeln!(
@@ -210,6 +202,16 @@ pub fn to_table(r: &CoupledReport) -> String {
                 }
             }
         }
+        let names: Vec<String> = sel
+            .choices
+            .iter()
+            .zip(crate::fit::contract::COMPONENTS)
+            .map(|(f, name)| match f {
+                Some(f) => format!("{name} {}/{}", f.max_degree, f.depth_degree),
+                None => format!("{name} none"),
+            })
+            .collect();
+        let _ = writeln!(s, "  chosen per component (*): {}", names.join(", "));
     }
     let _ = writeln!(s, "learning curve (held-out errors of the coupled form fitted on the first n training runs):");
     let _ = writeln!(s, "  {:>4} {:>8}  {:>12} {:>12} {:>12} {:>10}", "n", "form", "lhs rms %", "t2 rms %", "t2 Fy max %", "max %");
