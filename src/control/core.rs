@@ -147,15 +147,15 @@ impl<const N: usize> LoopCore<N> {
                 } else {
                     s.wrench = wrench;
                     let f = [wrench.fx_n, wrench.fy_n, wrench.fz_n];
-                    let f = match (&self.passivity, stiffness) {
-                        (Some(p), Some(k)) => {
-                            let (guarded, limited) = self.guard.apply(p, f, k);
+                    let f = match stiffness {
+                        Some((p, k)) => {
+                            let (guarded, limited) = self.guard.apply(&p, f, k);
                             if limited {
                                 s.flags |= LoopFlags::STIFFNESS_LIMITED;
                             }
                             guarded
                         }
-                        _ => f,
+                        None => f,
                     };
                     self.limit(f, &mut s)
                 }
@@ -201,16 +201,19 @@ impl<const N: usize> LoopCore<N> {
     }
 
     /// The model at `pose`: the wrench, its status and, with the passivity guard on, the
-    /// stiffness along the insertion `|dF/d depth|` (N/mm).
-    fn evaluate(&self, pose: &Pose) -> (Wrench, Status, Option<f32>) {
-        if self.passivity.is_some() {
-            let e = crate::wrench_and_stiffness(pose);
-            let r = e.stiffness.by_depth;
-            let k2 = r.dfx_n_per_mm * r.dfx_n_per_mm + r.dfy_n_per_mm * r.dfy_n_per_mm + r.dfz_n_per_mm * r.dfz_n_per_mm;
-            (e.wrench, e.status, Some(libm::sqrtf(k2)))
-        } else {
-            let e = crate::wrench(pose);
-            (e.wrench, e.status, None)
+    /// guard's configuration with the stiffness along the insertion `|dF/d depth|` (N/mm).
+    fn evaluate(&self, pose: &Pose) -> (Wrench, Status, Option<(Passivity, f32)>) {
+        match self.passivity {
+            Some(p) => {
+                let e = crate::wrench_and_stiffness(pose);
+                let r = e.stiffness.by_depth;
+                let k2 = r.dfx_n_per_mm * r.dfx_n_per_mm + r.dfy_n_per_mm * r.dfy_n_per_mm + r.dfz_n_per_mm * r.dfz_n_per_mm;
+                (e.wrench, e.status, Some((p, libm::sqrtf(k2))))
+            }
+            None => {
+                let e = crate::wrench(pose);
+                (e.wrench, e.status, None)
+            }
         }
     }
 

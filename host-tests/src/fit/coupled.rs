@@ -227,18 +227,17 @@ pub fn file_form(choices: &Choices) -> CrossForm {
 pub fn fit_chosen(paper: &Model, runs: &[&Run], choices: &Choices) -> Result<CrossTerms> {
     let form = file_form(choices);
     let nd = usize::from(form.depth_degree) + 1;
-    let mut fitted: Vec<(CrossForm, CrossTerms)> = Vec::new();
+    // Each chosen form fitted once (a `CrossTerms` knows its form).
+    let mut fitted: Vec<CrossTerms> = Vec::new();
+    for &f in choices.iter().flatten() {
+        if !fitted.iter().any(|t| t.form == f) {
+            fitted.push(fit(paper, runs, f)?);
+        }
+    }
     let mut terms: [Vec<(Exponents, Vec<f64>)>; 6] = Default::default();
     for (c, out) in terms.iter_mut().enumerate() {
-        let own: Vec<(Exponents, Vec<f64>)> = match choices[c] {
-            None => Vec::new(),
-            Some(f) => {
-                if !fitted.iter().any(|(g, _)| *g == f) {
-                    fitted.push((f, fit(paper, runs, f)?));
-                }
-                fitted.iter().find(|(g, _)| *g == f).map(|(_, t)| t.terms[c].clone()).unwrap_or_default()
-            }
-        };
+        let own: &[(Exponents, Vec<f64>)] =
+            choices[c].and_then(|f| fitted.iter().find(|t| t.form == f)).map_or(&[], |t| t.terms[c].as_slice());
         *out = monomials(c, form.max_degree)
             .into_iter()
             .map(|e| {
