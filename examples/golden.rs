@@ -1,7 +1,8 @@
 //! Firmware example `golden`: evaluates every pose of the compiled-in set's
 //! `golden-f32.csv` on the target and prints the results' bits, then every pose of its
 //! `golden-fixed.csv` with the fixed-point evaluator and prints the integers, then the
-//! stiffness of every pose of `golden-f32.csv` (`wrench_and_stiffness`), for the
+//! stiffness of every pose of `golden-f32.csv` (`wrench_and_stiffness`) and of every pose
+//! of `golden-fixed.csv` (`fixed::wrench_and_stiffness`), for the
 //! host to compare with the golden files (host-tests/tests/firmware_golden.rs,
 //! `needle firmware golden`).
 //!
@@ -23,6 +24,9 @@
 //! needle-golden-stiffness rows=<ROWS>
 //! <one row per pose of golden-f32.csv in golden-stiffness-f32.csv's format: inputs, status, 18 rates>
 //! needle-golden-stiffness end rows=<ROWS> wrench_differs=<rows whose wrench_and_stiffness wrench is not wrench()'s>
+//! needle-golden-stiffness-fixed rows=<FIXED_ROWS>
+//! <one row per pose of golden-fixed.csv in golden-stiffness-fixed.csv's format: inputs, status, 18 integer rates>
+//! needle-golden-stiffness-fixed end rows=<FIXED_ROWS> wrench_differs=<rows whose fixed::wrench_and_stiffness wrench is not fixed::wrench()'s>
 //! ```
 //!
 //! ```text
@@ -253,6 +257,45 @@ mod firmware {
         out.nl();
     }
 
+    /// Evaluates the fixed-point wrench and stiffness of every pose of golden-fixed.csv
+    /// and prints the status and the 18 integer rates per row (golden-stiffness-fixed.csv's
+    /// format, same poses); the end line counts the rows whose wrench or status differs
+    /// from [`fixed::wrench`]'s.
+    fn stiffness_fixed_rows(out: &mut Out) {
+        out.str("needle-golden-stiffness-fixed rows=");
+        out.dec(FIXED_ROWS as u64);
+        out.nl();
+        let poses: &[[i32; 5]] = black_box(&POSES_FIXED[..]);
+        let mut wrench_differs = 0u64;
+        for p in poses {
+            let [x, z, tx, tz, d] = *p;
+            let pose = fixed::Pose::new(x, z, tx, tz, d);
+            let e = fixed::wrench_and_stiffness(black_box(&pose));
+            let plain = fixed::wrench(black_box(&pose));
+            if plain.status != e.status || plain.wrench != e.wrench {
+                wrench_differs += 1;
+            }
+            for v in p {
+                int(out, *v);
+                out.str(",");
+            }
+            out.hex(u32::from(e.status.bits()), 2);
+            let s = e.stiffness;
+            for rates in [s.by_depth, s.by_x, s.by_z] {
+                for r in rates.to_array() {
+                    out.str(",");
+                    int(out, r);
+                }
+            }
+            out.nl();
+        }
+        out.str("needle-golden-stiffness-fixed end rows=");
+        out.dec(poses.len() as u64);
+        out.str(" wrench_differs=");
+        out.dec(wrench_differs);
+        out.nl();
+    }
+
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut out = Out::new();
@@ -290,6 +333,7 @@ mod firmware {
         out.nl();
         fixed_rows(&mut out);
         stiffness_rows(&mut out);
+        stiffness_fixed_rows(&mut out);
         out.flush();
         exit(true)
     }

@@ -1,7 +1,8 @@
 //! Firmware example `no_panic_fixed`: the fixed-point evaluator alone, with a panic
 //! handler that cannot link (see `no_panic`): the firmware links only if nothing reachable
-//! from `main` ([`needle_haptics::fixed::wrench`] through an opaque function pointer on an
-//! opaque pose, so it is compiled for every input) can panic.
+//! from `main` ([`needle_haptics::fixed::wrench`] and
+//! [`needle_haptics::fixed::wrench_and_stiffness`] through opaque function pointers on an
+//! opaque pose, so they are compiled for every input) can panic.
 //!
 //! It holds no floating-point code at all, so it also shows that the fixed-point path is
 //! integer-only (host-tests/tests/firmware_no_panic.rs disassembles it: no soft-float
@@ -28,6 +29,9 @@ mod firmware {
         let pose = black_box(Pose::new(3 * one, -2 * one, 5 * one, -7 * one, 9 * one / 2));
         let e = eval(&pose);
         black_box((e.status.bits(), e.status.is_error(), e.status.saturated(), e.wrench.to_array()));
+        let eval_stiffness: fn(&Pose) -> fixed::StiffnessEvaluation = black_box(fixed::wrench_and_stiffness);
+        let f = eval_stiffness(&pose);
+        black_box((f.status.bits(), f.wrench.to_array(), f.stiffness.by_depth.to_array(), f.stiffness.by_x, f.stiffness.by_z));
         crate::panic_gate::exit_success()
     }
 }

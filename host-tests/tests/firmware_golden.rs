@@ -3,17 +3,26 @@
 //! coeffs/default): every status and wrench bit of every row must be the golden file's
 //! (NaN by class, signed zeros by bits), and every integer of the fixed-point evaluator
 //! the one in golden-fixed.csv, and every stiffness rate the one in
-//! golden-stiffness-f32.csv. Soft-float add and multiply are correctly
+//! golden-stiffness-f32.csv and golden-stiffness-fixed.csv. Soft-float add and multiply are correctly
 //! rounded, so the M3 and M0 must match as well as the M4F's FPU.
 //!
 //! Nothing skips: a missing QEMU, rustup target, model.toml or golden file fails with a
 //! message that says what to install or run.
 use needle_host::firmware::{self, golden, golden_fixed, golden_stiffness};
+use needle_host::fit::{eval_f32::Tables32, fixed_formats::TablesFixed, model_file};
+use std::path::Path;
+
+mod made_up_model;
 
 fn golden_on(name: &str) {
-    let core = firmware::core(name).unwrap_or_else(|e| panic!("{e:#}"));
     let set = firmware::fitted_set(&firmware::compiled_set()).unwrap_or_else(|e| panic!("{e:#}"));
-    let run = golden::run(&core, &set).unwrap_or_else(|e| panic!("{} ({}): {e:#}", core.core, core.target));
+    golden_of_set_on(name, &set);
+}
+
+/// Every section of the `golden` firmware of the set at `set` on core `name`.
+fn golden_of_set_on(name: &str, set: &Path) {
+    let core = firmware::core(name).unwrap_or_else(|e| panic!("{e:#}"));
+    let run = golden::run(&core, set).unwrap_or_else(|e| panic!("{} ({}): {e:#}", core.core, core.target));
     let c = &run.comparison;
     assert!(c.rows >= 2000, "{}: only {} golden rows (the contract asks for >= 2,000)", set.display(), c.rows);
     assert!(
@@ -48,7 +57,19 @@ fn golden_on(name: &str) {
         core.target,
         s.mismatches.iter().take(10).cloned().collect::<Vec<_>>().join("\n")
     );
+    let sf = &run.stiffness_fixed;
+    assert!(sf.rows >= 2000, "{}: only {} fixed-point stiffness golden rows", set.display(), sf.rows);
+    assert!(
+        sf.mismatches.is_empty(),
+        "{} of {} fixed-point stiffness golden rows differ on {} ({}); first ones:\n{}",
+        sf.mismatches.len(),
+        sf.rows,
+        core.core,
+        core.target,
+        sf.mismatches.iter().take(10).cloned().collect::<Vec<_>>().join("\n")
+    );
     println!("{} ({}): {} stiffness golden rows bit for bit, wrench_and_stiffness's wrench = wrench's", core.core, core.machine, s.rows);
+    println!("{} ({}): {} fixed-point stiffness golden rows exactly, its wrench = fixed::wrench's", core.core, core.machine, sf.rows);
     println!("{} ({}): {} fixed-point golden rows exactly", core.core, core.machine, f.rows);
     println!("{} ({}): {} golden rows bit for bit in {:.1} s ({})", core.core, core.machine, c.rows, run.run_time.as_secs_f64(), c.banner);
 }
@@ -66,6 +87,35 @@ fn golden_bits_on_cortex_m3_mps2_an385() {
 #[test]
 fn golden_bits_on_cortex_m0_microbit() {
     golden_on("m0");
+}
+
+/// The coupled form's generated code (cross terms and their rates, f32 and fixed point)
+/// on the M4F, while the shipped set is still the paper form: a set folder with the
+/// default model plus made-up cross terms (`made_up_model`) and golden files written by
+/// the fitter's own implementations, compiled into the `golden` firmware. Not a fitted
+/// model: it lives in a temporary folder, never under coeffs/.
+#[test]
+fn golden_bits_of_a_coupled_model_on_cortex_m4f_mps2_an386() {
+    use needle_host::fit::{golden as g32, golden_fixed as gfixed, golden_stiffness as gs32, golden_stiffness_fixed as gsfixed};
+    let dir = tempfile::tempdir().expect("temporary set folder");
+    let set = dir.path().join("made-up-coupled");
+    std::fs::create_dir(&set).expect("set folder");
+    let text = made_up_model::coupled_default_text();
+    let model = model_file::parse(&text, &set.join("model.toml")).unwrap_or_else(|e| panic!("{e:#}"));
+    assert!(model.cross.as_ref().is_some_and(|c| c.terms.terms.iter().all(|t| !t.is_empty())), "cross terms in every component");
+    let t32 = Tables32::from_model(&model);
+    let tfixed = TablesFixed::from_model(&model).unwrap_or_else(|e| panic!("{e:#}"));
+    let files = [
+        ("model.toml", text),
+        ("golden-f32.csv", g32::to_csv(&t32)),
+        ("golden-stiffness-f32.csv", gs32::to_csv(&t32)),
+        ("golden-fixed.csv", gfixed::to_csv(&tfixed).unwrap_or_else(|e| panic!("{e:#}"))),
+        ("golden-stiffness-fixed.csv", gsfixed::to_csv(&tfixed).unwrap_or_else(|e| panic!("{e:#}"))),
+    ];
+    for (name, body) in files {
+        std::fs::write(set.join(name), body).unwrap_or_else(|e| panic!("{name}: {e}"));
+    }
+    golden_of_set_on("m4f", &set);
 }
 
 /// The comparison itself, on hand-made output: one flipped bit, a sign of zero, a
@@ -144,4 +194,31 @@ fn stiffness_comparison_catches_one_bit_and_a_differing_wrench() {
         golden_stiffness::compare(&out(&row, 0).replace("needle-golden-stiffness end rows=1 wrench_differs=0\n", ""), &csv).is_err(),
         "truncated"
     );
+}
+
+/// The fixed-point stiffness section's comparison: one integer off, another status, a
+/// wrench the firmware found differing, a missing or truncated section are all caught.
+#[test]
+fn fixed_stiffness_comparison_catches_one_unit_and_a_differing_wrench() {
+    let h = needle_host::fit::golden_stiffness_fixed::header();
+    let inputs = "0,0,0,0,196608";
+    let rates: Vec<String> = (0..18).map(|i| format!("{}", 1000 * i - 7000)).collect();
+    let row = format!("{inputs},0x00,{}", rates.join(","));
+    let csv = format!("{h}\n{row}\n");
+    let tag = "needle-golden-stiffness-fixed";
+    let out = |r: &str, differs: u32| {
+        format!("needle-golden-stiffness end rows=1 wrench_differs=0\n{tag} rows=1\n{r}\n{tag} end rows=1 wrench_differs={differs}\n")
+    };
+    let c = golden_fixed::compare_stiffness(&out(&row, 0), &csv).expect("well-formed");
+    assert!(c.mismatches.is_empty(), "{:?}", c.mismatches);
+    let mut off = rates.clone();
+    off[7] = "1".to_string(); // dfy_dx: 0 in the file
+    for bad in [format!("{inputs},0x00,{}", off.join(",")), format!("{inputs},0x10,{}", rates.join(","))] {
+        let c = golden_fixed::compare_stiffness(&out(&bad, 0), &csv).expect("well-formed");
+        assert_eq!(c.mismatches.len(), 1, "{bad}");
+    }
+    assert!(golden_fixed::compare_stiffness(&out(&row, 1), &csv).is_err(), "a wrench differing from fixed::wrench()'s");
+    assert!(golden_fixed::compare_stiffness("needle-golden-stiffness end rows=1\n", &csv).is_err(), "no section");
+    let truncated = out(&row, 0).replace(&format!("{tag} end rows=1 wrench_differs=0\n"), "");
+    assert!(golden_fixed::compare_stiffness(&truncated, &csv).is_err(), "truncated");
 }

@@ -64,3 +64,22 @@ pub(crate) fn horner(p: &[i32; 5], w: i32) -> i32 {
     let a = mul_q15(a, w).wrapping_add(p1);
     mul_q15(a, w).wrapping_add(p0)
 }
+
+/// `h3(p, w) = ((p3 w + p2) w + p1) w + p0` with every product [`mul_q15`]: the Horner
+/// of a cubic (a quartic's derivative) in Q15.
+#[inline(always)]
+pub(crate) fn horner3(p: &[i32; 4], w: i32) -> i32 {
+    let [p0, p1, p2, p3] = *p;
+    let a = mul_q15(p3, w).wrapping_add(p2);
+    let a = mul_q15(a, w).wrapping_add(p1);
+    mul_q15(a, w).wrapping_add(p0)
+}
+
+/// `floor((n + d / 2) / d)`: `n / d` rounded half up, for an even divisor `d > 0` (the
+/// generated rate divisors `3 * 2^(G-3)` and `6 * 2^(G-3)`, `G >= 4`); `0` for `d = 0`.
+#[inline(always)]
+pub(crate) fn div_round(n: i32, d: i32) -> i32 {
+    // `checked_div_euclid` keeps the no-panic guarantee (zero divisor, `MIN / -1`)
+    // without relying on the generator's `G >= 4`.
+    n.wrapping_add(d >> 1).checked_div_euclid(d).unwrap_or_default()
+}

@@ -47,28 +47,70 @@ pub fn wrench(pose: &Pose) -> Evaluation {
     if !FITTED {
         return Evaluation { wrench: Wrench::ZERO, status: Status::NO_MODEL | Status::ERROR };
     }
-    let (x, sat_x) = clamp(pose.x_mm_q16, -X_MAX_MM_Q16, X_MAX_MM_Q16);
-    let (z, sat_z) = clamp(pose.z_mm_q16, -Z_MAX_MM_Q16, Z_MAX_MM_Q16);
-    let (tx, sat_tx) = clamp(pose.theta_x_deg_q16, -THETA_MAX_DEG_Q16, THETA_MAX_DEG_Q16);
-    let (tz, sat_tz) = clamp(pose.theta_z_deg_q16, -THETA_MAX_DEG_Q16, THETA_MAX_DEG_Q16);
-    let (d, sat_d) = clamp(pose.depth_mm_q16, 0, DEPTH_MAX_MM_Q16);
-    let status =
-        Status::from_bits(u8::from(sat_x) | u8::from(sat_z) << 1 | u8::from(sat_tx) << 2 | u8::from(sat_tz) << 3 | u8::from(sat_d) << 4);
+    let at = Inputs::of(pose);
+    let a = accumulators(&at);
+    Evaluation { wrench: Wrench::from_array(output(&a, at.u)), status: at.status }
+}
 
-    let u = normalise(d.unsigned_abs(), DEPTH_DIVISOR);
-    let [dx, dz, dtx, dtz] = SWEEP_DIVISORS;
-    let t = [
-        normalise(x.unsigned_abs(), dx),
-        normalise(z.unsigned_abs(), dz),
-        normalise(tx.unsigned_abs(), dtx),
-        normalise(tz.unsigned_abs(), dtz),
-    ];
-    let negative = [x < 0, z < 0, tx < 0, tz < 0];
+/// Steps 2 and 3: the clamped inputs, the status, `U`, the `T_k` and the signs.
+pub(super) struct Inputs {
+    /// The clamped x, z, theta_x, theta_z (Q16.16).
+    pub v: [i32; 4],
+    /// `T_k` (Q15).
+    pub t: [i32; 4],
+    /// `V_k < 0`.
+    pub negative: [bool; 4],
+    /// `U` (Q15).
+    pub u: i32,
+    /// The saturation flags.
+    pub status: Status,
+}
 
+impl Inputs {
+    #[inline(always)]
+    pub(super) fn of(pose: &Pose) -> Self {
+        let (x, sat_x) = clamp(pose.x_mm_q16, -X_MAX_MM_Q16, X_MAX_MM_Q16);
+        let (z, sat_z) = clamp(pose.z_mm_q16, -Z_MAX_MM_Q16, Z_MAX_MM_Q16);
+        let (tx, sat_tx) = clamp(pose.theta_x_deg_q16, -THETA_MAX_DEG_Q16, THETA_MAX_DEG_Q16);
+        let (tz, sat_tz) = clamp(pose.theta_z_deg_q16, -THETA_MAX_DEG_Q16, THETA_MAX_DEG_Q16);
+        let (d, sat_d) = clamp(pose.depth_mm_q16, 0, DEPTH_MAX_MM_Q16);
+        let status = Status::from_bits(
+            u8::from(sat_x) | u8::from(sat_z) << 1 | u8::from(sat_tx) << 2 | u8::from(sat_tz) << 3 | u8::from(sat_d) << 4,
+        );
+        let [dx, dz, dtx, dtz] = SWEEP_DIVISORS;
+        Self {
+            v: [x, z, tx, tz],
+            t: [
+                normalise(x.unsigned_abs(), dx),
+                normalise(z.unsigned_abs(), dz),
+                normalise(tx.unsigned_abs(), dtx),
+                normalise(tz.unsigned_abs(), dtz),
+            ],
+            negative: [x < 0, z < 0, tx < 0, tz < 0],
+            u: normalise(d.unsigned_abs(), DEPTH_DIVISOR),
+            status,
+        }
+    }
+
+    /// Step 6's signed cross-term inputs `N_k` (Q15).
+    #[inline(always)]
+    pub(super) fn cross_inputs(&self) -> [i32; 4] {
+        let [x, z, tx, tz] = self.v;
+        let [cx, cz, ctx, ctz] = CROSS_DIVISORS;
+        [cross_input(x, cx), cross_input(z, cz), cross_input(tx, ctx), cross_input(tz, ctz)]
+    }
+}
+
+/// Steps 4-6: every component's accumulators `A_i` (baseline, the four sweeps' rows, the
+/// cross terms), each in its Q(G).
+#[inline(always)]
+pub(super) fn accumulators(at: &Inputs) -> [[i32; 5]; 6] {
     let mut a = BASELINE;
     let tables = ROWS.iter().zip(SHIFTS.iter()).zip(ODD.iter());
     for (ac, ((rows, shifts), odd)) in a.iter_mut().zip(tables) {
-        for ((((rows_k, shifts_k), &tk), &neg), &o) in rows.iter().zip(shifts.iter()).zip(t.iter()).zip(negative.iter()).zip(odd.iter()) {
+        for ((((rows_k, shifts_k), &tk), &neg), &o) in
+            rows.iter().zip(shifts.iter()).zip(at.t.iter()).zip(at.negative.iter()).zip(odd.iter())
+        {
             let flip = neg && o;
             for ((ai, row), &s) in ac.iter_mut().zip(rows_k.iter()).zip(shifts_k.iter()) {
                 let r = horner(row, tk).wrapping_shr(s);
@@ -76,12 +118,17 @@ pub fn wrench(pose: &Pose) -> Evaluation {
             }
         }
     }
-    let [cx, cz, ctx, ctz] = CROSS_DIVISORS;
-    add_cross([cross_input(x, cx), cross_input(z, cz), cross_input(tx, ctx), cross_input(tz, ctz)], &mut a);
+    add_cross(at.cross_inputs(), &mut a);
+    a
+}
+
+/// Step 7: `W = h(A, U)` per component, rounded half up to whole µN or µN·mm.
+#[inline(always)]
+pub(super) fn output(a: &[[i32; 5]; 6], u: i32) -> [i32; 6] {
     let mut w = [0_i32; 6];
     for ((wc, ac), &g) in w.iter_mut().zip(a.iter()).zip(FRAC_BITS.iter()) {
         let acc = horner(ac, u);
         *wc = acc.wrapping_add(1_i32.wrapping_shl(g) >> 1).wrapping_shr(g);
     }
-    Evaluation { wrench: Wrench::from_array(w), status }
+    w
 }

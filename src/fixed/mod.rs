@@ -4,7 +4,8 @@
 //! - Input: [`Pose`], five `i32` in Q16.16 (mm or degrees × 65536).
 //! - Output: [`Wrench`], six `i32` in µN and µN·mm, with the same [`Status`](crate::Status)
 //!   saturation flags as the f32 evaluator (there is no NaN in integers).
-//! - [`wrench`] evaluates it; [`tables`] holds the generated integer tables, their Q
+//! - [`wrench`] evaluates it, [`wrench_and_stiffness`] with its derivatives by depth, x
+//!   and z ([`Stiffness`], µN/mm); [`tables`] holds the generated integer tables, their Q
 //!   formats and the error bound against the f64 model, per component.
 //!
 //! ```
@@ -29,10 +30,14 @@
 mod arith;
 mod cross;
 mod eval;
+mod eval_stiffness;
 mod pose;
+mod stiffness;
 pub mod tables;
 mod wrench;
 
 pub use eval::wrench;
+pub use eval_stiffness::wrench_and_stiffness;
 pub use pose::Pose;
+pub use stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
 pub use wrench::{Evaluation, Wrench};

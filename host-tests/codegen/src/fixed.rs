@@ -30,6 +30,14 @@ pub const SWEEP_DIVISORS: [u32; 4] = [12, 12, 15, 15];
 pub const CROSS_DIVISORS: [u32; 4] = [24, 24, 30, 30];
 /// Every intermediate of the integer evaluation has a magnitude of at most `2^30`.
 pub const LIMIT: i64 = 1 << 30;
+/// The fixed-point stiffness differentiates coefficients shifted right by `RATE_SHIFT`
+/// (`A_i >> 3`, `P_j >> 3`): a derivative's coefficients `i * a_i` sum to at most 4 times
+/// the polynomial's, so the rates are computed in Q(G - 3) and stay within [`LIMIT`]
+/// (coeffs/README.md, "Fixed-point stiffness").
+pub const RATE_SHIFT: u32 = 3;
+/// Smallest accumulator format `G` the fixed-point stiffness accepts: its rounding of
+/// the depth rate adds `3 * 2^(G - 4)`.
+pub const MIN_RATE_FRAC_BITS: u32 = 4;
 /// Largest number of fractional bits of any format.
 pub const MAX_FRAC_BITS: u32 = 30;
 /// Output unit: micro-newtons and micro-newton millimetres (coefficients are scaled by 10^6).
@@ -92,6 +100,12 @@ pub struct FixedComponent {
     /// The coupled form's cross terms of this component, in file order (empty for the
     /// paper form).
     pub cross: Vec<FixedCross>,
+    /// `rate_rows[k][i]` (sweeps x and z): the t-derivative of row `rows[k][i]`,
+    /// `[(j + 1) * (P[j + 1] >> RATE_SHIFT)]` for `j = 0..4`, in Q(f - 3).
+    pub rate_rows: [[[i32; 4]; 5]; 2],
+    /// Bounds of the stiffness's Horner intermediates: by depth, by x, by z (each
+    /// `<= LIMIT`, checked by [`fixed_formats`]).
+    pub rate_bounds: [i64; 3],
 }
 
 /// The fixed-point tables of a model.
@@ -141,6 +155,43 @@ fn component_bounds(rows: &[[FixedRow; 5]; 4], cross: &[FixedCross], base: &[f64
     }
     let total = a.iter().map(|v| i128::from(*v)).sum::<i128>().min(i128::from(i64::MAX)) as i64;
     (a, total, baseline)
+}
+
+/// The t-derivative of a row for the fixed-point stiffness: `(j + 1) * (p[j + 1] >> 3)`.
+/// No overflow: `|p[j] >> 3| <= 2^27`, times at most 4.
+#[must_use]
+pub fn rate_row(p: &[i32; 5]) -> [i32; 4] {
+    let [_, p1, p2, p3, p4] = *p;
+    [p1 >> RATE_SHIFT, 2 * (p2 >> RATE_SHIFT), 3 * (p3 >> RATE_SHIFT), 4 * (p4 >> RATE_SHIFT)]
+}
+
+/// The bounds of every intermediate of the fixed-point stiffness (coeffs/README.md,
+/// "Fixed-point stiffness"), `[by depth, by x, by z]`:
+/// - by depth: the Horner of `E_i = (i + 1) * (A_(i+1) >> 3)` is bounded by `sum |E_i|`,
+///   `|A_i >> 3| <= ceil(a_bounds[i] / 8)`;
+/// - by x (z): per `i`, the row's rate Horner `sum_j |rate_rows[k][i][j]|` shifted by
+///   `shifts[k][i]`, plus per cross term with exponent `e >= 1` of that input
+///   `e * ceil(ceil(|P[i]| / 8) / 2^(shift + 1))`; the Horner in `u` of those sums is
+///   bounded by their total (each row's own Horner by its coefficient sum, which is
+///   smaller than `LIMIT` by construction: `4 * 2^27`).
+fn rate_bounds(a_bounds: &[i64; 5], rate_rows: &[[[i32; 4]; 5]; 2], shifts: &[[u32; 5]; 4], cross: &[FixedCross]) -> [i64; 3] {
+    let depth = a_bounds.iter().enumerate().skip(1).map(|(i, a)| i as i64 * shifted_bound(*a, RATE_SHIFT)).sum();
+    let along = |k: usize| -> i64 {
+        let mut total = 0i64;
+        for i in 0..5 {
+            let row: i64 = rate_rows[k][i].iter().map(|p| i64::from(*p).abs()).sum();
+            total += shifted_bound(row, shifts[k][i]);
+            for x in cross {
+                let e = i64::from(x.exponents[k]);
+                let p = x.coeffs.get(i).map_or(0, |v| i64::from(*v).abs());
+                if e > 0 {
+                    total += e * shifted_bound(shifted_bound(p, RATE_SHIFT), x.shift + 1);
+                }
+            }
+        }
+        total
+    };
+    [depth, along(0), along(1)]
 }
 
 /// Chooses every format of `model` and quantises its coefficients; the error bounds are
@@ -209,6 +260,19 @@ pub fn fixed_formats(model: &Model, model_path: &Path) -> Result<FixedTables, Co
         for x in &mut cross {
             x.shift = x.frac_bits - g;
         }
+        let [rows_x, rows_z, _, _] = &rows;
+        let rate_rows = [rows_x.map(|r| rate_row(&r.coeffs)), rows_z.map(|r| rate_row(&r.coeffs))];
+        let rate_bounds = rate_bounds(&a_bounds, &rate_rows, &shifts, &cross);
+        if g < MIN_RATE_FRAC_BITS || rate_bounds.iter().any(|b| *b > LIMIT) {
+            return Err(at(
+                base.line,
+                format!(
+                    "baseline {0}: component {0} does not fit the fixed-point stiffness: accumulator format Q{g} (needs Q{MIN_RATE_FRAC_BITS} or more), Horner bounds of the rates by depth, x, z {rate_bounds:?} micro-units ({1}) against the limit 2^30 = {LIMIT}",
+                    COMPONENTS[c],
+                    crate::contract::UNITS[c]
+                ),
+            ));
+        }
         let comp = FixedComponent {
             rows,
             shifts,
@@ -218,6 +282,8 @@ pub fn fixed_formats(model: &Model, model_path: &Path) -> Result<FixedTables, Co
             horner_bound,
             error_bound: ErrorBound::default(),
             cross,
+            rate_rows,
+            rate_bounds,
         };
         components.push(comp);
     }

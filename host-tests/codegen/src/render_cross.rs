@@ -10,7 +10,7 @@
 //! (each input repeated by its exponent, starting from the first factor), `q` Horner in
 //! `u` over the term's coefficients, highest power first, starting from the highest.
 use crate::contract::{COMPONENTS, CROSS_SCALES_F32, HALF_RANGES, SWEEPS, UNITS};
-use crate::fixed::{FixedTables, CROSS_DIVISORS};
+use crate::fixed::{FixedTables, CROSS_DIVISORS, RATE_SHIFT};
 use crate::literal::f32_literal;
 use crate::model::Model;
 use std::fmt::Write as _;
@@ -247,5 +247,63 @@ pub fn render_rust_cross_fixed(model: &Model, t: &FixedTables) -> String {
         }
     }
     let _ = writeln!(w, "}}");
+    render_rust_cross_rates_fixed(w, t);
     s
+}
+
+/// `M` reduced by one factor of input `k` (`e_k * M / n_k` without the `e_k`), as Q15
+/// products; `32768` (1.0 in Q15) when no factor is left. `None` when `e_k` is 0.
+fn reduced_monomial_q15(e: [u8; 4], k: usize) -> Option<String> {
+    let ek = *e.get(k)?;
+    if ek == 0 {
+        return None;
+    }
+    let mut reduced = e;
+    if let Some(r) = reduced.get_mut(k) {
+        *r -= 1;
+    }
+    Some(if reduced.iter().all(|&r| r == 0) { "32768".to_string() } else { monomial_q15(reduced) })
+}
+
+/// `add_cross_rates` in fixed point (coeffs/README.md, "Fixed-point stiffness"): per
+/// cross term with `e_x >= 1`, `gx[c][i] += e_x * (mul_q15(P[i] >> 3, R) >> (shift + 1))`
+/// with `R` the monomial reduced by one factor of `xi` (the `+ 1` turns the rate per unit
+/// of `n_x = x / 12` into the rate per unit of `t_x`, the rows' variable); z likewise.
+fn render_rust_cross_rates_fixed(w: &mut String, t: &FixedTables) {
+    let _ = writeln!(w);
+    let _ = writeln!(w, "/// Adds every cross term's x and z rates to `gx[c][i]`, `gz[c][i]` (Q(G - {RATE_SHIFT}) per unit of t_x, t_z).");
+    let _ = writeln!(w, "#[inline(always)]");
+    let _ = writeln!(w, "#[allow(unused_variables)]");
+    let _ = writeln!(w, "pub(crate) fn add_cross_rates(n: [i32; 4], gx: &mut [[i32; 5]; 6], gz: &mut [[i32; 5]; 6]) {{");
+    let any = t.components.iter().any(|c| c.cross.iter().any(|x| x.exponents[0] > 0 || x.exponents[1] > 0));
+    if !any {
+        let _ = writeln!(w, "    let _ = (n, gx, gz);");
+    } else {
+        let _ = writeln!(w, "    let [xi, zeta, alpha, beta] = n;");
+        for (acc, k) in [("gx", 0), ("gz", 1)] {
+            let _ = writeln!(w, "    let [{acc}0, {acc}1, {acc}2, {acc}3, {acc}4, {acc}5] = {acc};");
+            for (c, comp) in t.components.iter().enumerate() {
+                for x in &comp.cross {
+                    let Some(r) = reduced_monomial_q15(x.exponents, k) else { continue };
+                    let e = x.exponents[k];
+                    let _ = writeln!(
+                        w,
+                        "    // {} exponents {:?}, Q{}, shift {}, model.toml line {}",
+                        COMPONENTS[c], x.exponents, x.frac_bits, x.shift, x.line
+                    );
+                    let _ = writeln!(w, "    let r = {r};");
+                    for (i, p) in x.coeffs.iter().enumerate() {
+                        let p3 = p >> RATE_SHIFT;
+                        if p3 == 0 {
+                            continue;
+                        }
+                        let term = format!("(mul_q15({p3}, r) >> {})", x.shift + 1);
+                        let term = if e == 1 { term } else { format!("{e}_i32.wrapping_mul{term}") };
+                        let _ = writeln!(w, "    {acc}{c}[{i}] = {acc}{c}[{i}].wrapping_add({term});");
+                    }
+                }
+            }
+        }
+    }
+    let _ = writeln!(w, "}}");
 }

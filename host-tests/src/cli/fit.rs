@@ -1,6 +1,6 @@
 //! `needle fit`, `needle validate`: fit the model, compare it with FE.
 use crate::fe::results::write_all_atomic;
-use crate::fit::{self, validate as val, GOLDEN_FILE, GOLDEN_FIXED_FILE, GOLDEN_STIFFNESS_FILE, MODEL_FILE};
+use crate::fit::{self, validate as val};
 use anyhow::{Context, Result};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -9,8 +9,9 @@ use std::process::ExitCode;
 /// Arguments of `needle fit`.
 #[derive(Args)]
 pub struct FitArgs {
-    /// The set folder (holds campaign.toml and fe/); model.toml, golden-f32.csv and
-    /// golden-fixed.csv are written there.
+    /// The set folder (holds campaign.toml and fe/); model.toml and the golden vectors
+    /// (golden-f32.csv, golden-fixed.csv, golden-stiffness-f32.csv,
+    /// golden-stiffness-fixed.csv) are written there.
     #[arg(long, value_name = "DIR")]
     pub set: PathBuf,
     /// Regenerate in memory and compare with the files in the set: exit 1 if they differ,
@@ -64,40 +65,37 @@ fn check_file(path: &Path, want: &str) -> Result<bool> {
     }
 }
 
-/// `needle fit --set DIR [--check]`: fit the set's FE sweeps and write `model.toml`,
-/// `golden-f32.csv`, `golden-fixed.csv` and `golden-stiffness-f32.csv` all or nothing ([`write_all_atomic`]) (or, with `--check`, compare them). Exit code 0 on
-/// success, 1 when `--check` finds a difference.
+/// `needle fit --set DIR [--check]`: fit the set's FE sweeps and write `model.toml` and
+/// the golden vectors ([`fit::FitOutput::files`]) all or nothing ([`write_all_atomic`])
+/// (or, with `--check`, compare them). Exit code 0 on success, 1 when `--check` finds a
+/// difference.
 ///
 /// # Errors
 /// A fitted run is missing (every missing pose is named) or malformed, the spec is
 /// invalid, a fit is rank deficient, or a file cannot be written.
 pub fn fit(a: FitArgs) -> Result<ExitCode> {
     let out = fit::fit_set(&a.set).with_context(|| format!("needle fit --set {}", a.set.display()))?;
-    let model_path = a.set.join(MODEL_FILE);
-    let golden_path = a.set.join(GOLDEN_FILE);
-    let golden_fixed_path = a.set.join(GOLDEN_FIXED_FILE);
-    let golden_stiffness_path = a.set.join(GOLDEN_STIFFNESS_FILE);
+    let files: Vec<(PathBuf, &str)> = out.files().iter().map(|(name, text)| (a.set.join(name), *text)).collect();
     if a.check {
-        let ok_model = check_file(&model_path, &out.model_toml)?;
-        let ok_golden = check_file(&golden_path, &out.golden_csv)?;
-        let ok_fixed = check_file(&golden_fixed_path, &out.golden_fixed_csv)?;
-        let ok_stiffness = check_file(&golden_stiffness_path, &out.golden_stiffness_csv)?;
-        return Ok(if ok_model && ok_golden && ok_fixed && ok_stiffness { ExitCode::SUCCESS } else { ExitCode::from(1) });
+        let mut same = true;
+        for (path, text) in &files {
+            same &= check_file(path, text)?;
+        }
+        return Ok(if same { ExitCode::SUCCESS } else { ExitCode::from(1) });
     }
-    write_all_atomic(&[
-        (&model_path, out.model_toml.as_bytes()),
-        (&golden_path, out.golden_csv.as_bytes()),
-        (&golden_fixed_path, out.golden_fixed_csv.as_bytes()),
-        (&golden_stiffness_path, out.golden_stiffness_csv.as_bytes()),
-    ])?;
+    let writes: Vec<(&Path, &[u8])> = files.iter().map(|(path, text)| (path.as_path(), text.as_bytes())).collect();
+    write_all_atomic(&writes)?;
     print!("{}", fit::summary(&out.model));
     let coupled = fit::coupled_report::measure(&a.set, &out.model)
         .with_context(|| format!("needle fit --set {}: measuring the coupled form", a.set.display()))?;
     print!("{}", fit::coupled_report::to_table(&coupled));
-    println!("wrote {} ({} bytes)", model_path.display(), out.model_toml.len());
-    println!("wrote {} ({} poses)", golden_path.display(), out.golden_csv.lines().count() - 1);
-    println!("wrote {} ({} poses)", golden_fixed_path.display(), out.golden_fixed_csv.lines().count() - 1);
-    println!("wrote {} ({} poses)", golden_stiffness_path.display(), out.golden_stiffness_csv.lines().count() - 1);
+    for (path, text) in &files {
+        if path.extension().is_some_and(|e| e == "csv") {
+            println!("wrote {} ({} poses)", path.display(), text.lines().count().saturating_sub(1));
+        } else {
+            println!("wrote {} ({} bytes)", path.display(), text.len());
+        }
+    }
     Ok(ExitCode::SUCCESS)
 }
 

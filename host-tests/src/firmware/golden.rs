@@ -103,14 +103,16 @@ pub struct CoreRun {
     pub fixed: Comparison,
     /// The comparison of the stiffness section with golden-stiffness-f32.csv.
     pub stiffness: Comparison,
+    /// The comparison of the fixed-point stiffness section with golden-stiffness-fixed.csv.
+    pub stiffness_fixed: Comparison,
     /// Wall-clock time of the QEMU run.
     pub run_time: Duration,
 }
 
 /// Builds the `golden` example of the fitted set `set` (absolute path) for `core`, runs
 /// it under QEMU and compares its output with `set/golden-f32.csv`, its fixed-point
-/// section with `set/golden-fixed.csv` and its stiffness section with
-/// `set/golden-stiffness-f32.csv`.
+/// section with `set/golden-fixed.csv`, its stiffness sections with
+/// `set/golden-stiffness-f32.csv` and `set/golden-stiffness-fixed.csv`.
 ///
 /// # Errors
 /// Build, QEMU run or output structure failed (see [`compare`]); mismatching values are
@@ -121,6 +123,9 @@ pub fn run(core: &Core, set: &Path) -> anyhow::Result<CoreRun> {
     let golden_stiffness = set.join(crate::fit::GOLDEN_STIFFNESS_FILE);
     let csv_stiffness =
         std::fs::read_to_string(&golden_stiffness).with_context(|| format!("cannot read {}", golden_stiffness.display()))?;
+    let golden_stiffness_fixed = set.join(crate::fit::GOLDEN_STIFFNESS_FIXED_FILE);
+    let csv_stiffness_fixed =
+        std::fs::read_to_string(&golden_stiffness_fixed).with_context(|| format!("cannot read {}", golden_stiffness_fixed.display()))?;
     let golden_fixed = set.join("golden-fixed.csv");
     let csv_fixed = std::fs::read_to_string(&golden_fixed).with_context(|| format!("cannot read {}", golden_fixed.display()))?;
     let model_path = set.join(needle_codegen::MODEL_FILE);
@@ -144,5 +149,7 @@ pub fn run(core: &Core, set: &Path) -> anyhow::Result<CoreRun> {
         .with_context(|| format!("golden firmware on {} ({}), fixed point", core.core, core.machine))?;
     let stiffness = super::golden_stiffness::compare(&run.stdout, &csv_stiffness)
         .with_context(|| format!("golden firmware on {} ({}), stiffness", core.core, core.machine))?;
-    Ok(CoreRun { core: *core, comparison, fixed, stiffness, run_time: run.elapsed })
+    let stiffness_fixed = super::golden_fixed::compare_stiffness(&run.stdout, &csv_stiffness_fixed)
+        .with_context(|| format!("golden firmware on {} ({}), fixed-point stiffness", core.core, core.machine))?;
+    Ok(CoreRun { core: *core, comparison, fixed, stiffness, stiffness_fixed, run_time: run.elapsed })
 }

@@ -3,7 +3,7 @@
 //! class), and the firmware's own count of rows whose `wrench_and_stiffness` wrench is
 //! not `wrench`'s must be 0.
 use super::comparison::{same_f32, Comparison, Section};
-use crate::fit::golden_stiffness::{header, RATE_COLUMNS};
+use crate::fit::golden_stiffness::{header, rate_columns};
 use anyhow::bail;
 
 /// Compares the stiffness section of the `golden` firmware's stdout `output` (after its
@@ -15,11 +15,12 @@ use anyhow::bail;
 /// [`Comparison::mismatches`].
 pub fn compare(output: &str, csv: &str) -> anyhow::Result<Comparison> {
     let header = header();
+    let columns = rate_columns(false);
     let section = Section {
         file: "golden-stiffness-f32.csv",
         tag: "needle-golden-stiffness",
         header: &header,
-        fields: 6 + RATE_COLUMNS.len(),
+        fields: 6 + columns.len(),
         end_suffix: " wrench_differs=0",
     };
     section.compare(output, csv, |line, want, got| {
@@ -27,7 +28,7 @@ pub fn compare(output: &str, csv: &str) -> anyhow::Result<Comparison> {
         if want.get(5) != got.get(5) {
             diffs.push(format!("status want {:?} got {:?}", want.get(5), got.get(5)));
         }
-        for (name, (a, b)) in RATE_COLUMNS.iter().zip(want.iter().zip(got).skip(6)) {
+        for (name, (a, b)) in columns.iter().zip(want.iter().zip(got).skip(6)) {
             let (Some(x), Some(y)) = (needle_codegen::parse_bits(a), needle_codegen::parse_bits(b)) else {
                 bail!("golden-stiffness-f32.csv line {line}, {name}: {a:?} / firmware {b:?} is not 0x and 8 hex digits");
             };

@@ -90,12 +90,13 @@ pub fn compiled_set() -> PathBuf {
 /// hold the unfitted placeholder model, whose figures mean nothing.
 pub fn fitted_set(set: &Path) -> anyhow::Result<PathBuf> {
     let dir = std::fs::canonicalize(set).map_err(|e| anyhow::anyhow!("{}: not a coefficient set folder ({e})", set.display()))?;
-    for file in [needle_codegen::MODEL_FILE, "golden-f32.csv", "golden-fixed.csv"] {
+    use crate::fit::{GOLDEN_FILE, GOLDEN_FIXED_FILE, GOLDEN_STIFFNESS_FILE, GOLDEN_STIFFNESS_FIXED_FILE};
+    for file in [needle_codegen::MODEL_FILE, GOLDEN_FILE, GOLDEN_FIXED_FILE, GOLDEN_STIFFNESS_FILE, GOLDEN_STIFFNESS_FIXED_FILE] {
         if !dir.join(file).is_file() {
             anyhow::bail!(
                 "{}: no {file}: the set is not fitted yet, so the firmware would hold the unfitted \
                  placeholder (every evaluation returns NO_MODEL | ERROR). Run `needle fit --set {}` \
-                 (it writes model.toml, golden-f32.csv and golden-fixed.csv) and retry",
+                 (it writes model.toml and the golden files) and retry",
                 dir.display(),
                 dir.display()
             );

@@ -67,12 +67,34 @@ fn normalise(n: i64, d: i64) -> i64 {
     (n + d / 2) / d - Q15
 }
 
-/// Evaluate at the Q16.16 pose `[x, z, theta_x, theta_z, depth]`: the wrench in µN and
-/// µN·mm `[fx, fy, fz, mx, my, mz]` and the status byte.
-///
-/// # Errors
-/// An intermediate leaves `|v| <= 2^30` (the tables do not meet the contract).
-pub fn eval(t: &TablesFixed, pose: [i32; 5]) -> Result<([i32; 6], u8), Overflow> {
+/// Steps 1-6 at one pose: the clamped inputs, `U`, `T_k`, `N_k`, the status and the
+/// accumulators `A[c][i]`.
+struct Accumulated {
+    v: [i64; 4],
+    u: i64,
+    tk: [i64; 4],
+    n: [i64; 4],
+    status: u8,
+    a: [[i64; NCOEF]; 6],
+}
+
+/// The factors of the monomial of exponents `e` over the inputs `n`, in input order, each
+/// repeated by its exponent.
+fn factors(e: &[u8; 4], n: [i64; 4]) -> impl Iterator<Item = i64> + '_ {
+    e.iter().zip(n).flat_map(|(&k, nk)| std::iter::repeat_n(nk, usize::from(k)))
+}
+
+/// The Q15 monomial: the factors multiplied left to right (each product floored), `none`
+/// when there is no factor.
+fn monomial(mut factors: impl Iterator<Item = i64>, none: i64, what: &dyn Fn() -> String) -> Result<i64, Overflow> {
+    let Some(mut m) = factors.next() else { return Ok(none) };
+    for nk in factors {
+        m = step(m, nk, 0, what)?;
+    }
+    Ok(m)
+}
+
+fn accumulate(t: &TablesFixed, pose: [i32; 5]) -> Result<Accumulated, Overflow> {
     let p = pose.map(i64::from);
     let sat_bits = [STATUS_SAT_X, STATUS_SAT_Z, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z];
     let mut status = 0u8;
@@ -118,11 +140,7 @@ pub fn eval(t: &TablesFixed, pose: [i32; 5]) -> Result<([i32; 6], u8), Overflow>
     for (c, terms) in t.cross.iter().enumerate() {
         for (e, p, f) in terms {
             let what = || format!("cross {c} {e:?}");
-            let mut factors = e.iter().zip(n).flat_map(|(&k, nk)| std::iter::repeat_n(nk, usize::from(k)));
-            let mut m = factors.next().unwrap_or(0);
-            for nk in factors {
-                m = step(m, nk, 0, &what)?;
-            }
+            let m = monomial(factors(e, n), 0, &what)?;
             for (i, pi) in p.iter().enumerate() {
                 let prod = step(*pi, m, 0, &what)?;
                 let shifted = prod.div_euclid(1i64 << (f - t.acc_frac[c]));
@@ -130,15 +148,113 @@ pub fn eval(t: &TablesFixed, pose: [i32; 5]) -> Result<([i32; 6], u8), Overflow>
             }
         }
     }
+    Ok(Accumulated { v, u, tk, n, status, a })
+}
+
+/// Evaluate at the Q16.16 pose `[x, z, theta_x, theta_z, depth]`: the wrench in µN and
+/// µN·mm `[fx, fy, fz, mx, my, mz]` and the status byte.
+///
+/// # Errors
+/// An intermediate leaves `|v| <= 2^30` (the tables do not meet the contract).
+pub fn eval(t: &TablesFixed, pose: [i32; 5]) -> Result<([i32; 6], u8), Overflow> {
+    let acc = accumulate(t, pose)?;
     let mut w = [0i32; 6];
     for (c, wc) in w.iter_mut().enumerate() {
-        let acc = horner(&a[c], u, &|| format!("Horner in u of component {c}"))?;
+        let h = horner(&acc.a[c], acc.u, &|| format!("Horner in u of component {c}"))?;
         let g = t.acc_frac[c];
         let half = (1i64 << g) / 2;
-        let out = (acc + half).div_euclid(1i64 << g);
+        let out = (h + half).div_euclid(1i64 << g);
         *wc = i32::try_from(out).map_err(|_| Overflow { what: format!("output {c}"), value: Some(out) })?;
     }
-    Ok((w, status))
+    Ok((w, acc.status))
+}
+
+/// The rates are computed on coefficients divided by `2^RATE_SHIFT` (floor).
+pub const RATE_SHIFT: u32 = 3;
+
+/// `n / d` rounded half up (`floor((n + d/2) / d)`, `d` even and positive), as an i32.
+fn div_round(n: i64, d: i64, what: &dyn Fn() -> String) -> Result<i32, Overflow> {
+    let q = (n + d / 2).div_euclid(d);
+    i32::try_from(q).map_err(|_| Overflow { what: what(), value: Some(q) })
+}
+
+/// Horner in Q15 of any length (highest power first), every intermediate checked.
+fn horner_n(p: &[i64], w: i64, what: &dyn Fn() -> String) -> Result<i64, Overflow> {
+    let Some((last, rest)) = p.split_last() else { return Ok(0) };
+    let mut acc = check(Some(*last), what)?;
+    for c in rest.iter().rev() {
+        acc = step(acc, w, *c, what)?;
+    }
+    Ok(acc)
+}
+
+/// The derivative's coefficients of `p` (`p[j]` multiplies `w^j`) on `p >> 3`:
+/// `[(j + 1) * floor(p[j + 1] / 8)]`, checked.
+fn rate_coefficients(p: &[i64; NCOEF], what: &dyn Fn() -> String) -> Result<Vec<i64>, Overflow> {
+    p.iter().enumerate().skip(1).map(|(j, pj)| check(Some(j as i64 * pj.div_euclid(1 << RATE_SHIFT)), what)).collect()
+}
+
+/// The wrench (µN, µN·mm), the rates `[by depth, by x, by z]` (each `[fx .. mz]`) and
+/// the status byte of [`eval_rates`].
+pub type RatesFixed = ([i32; 6], [[i32; 6]; 3], u8);
+
+/// The wrench, its rates `[by depth, by x, by z]` (each `[fx .. mz]`, µN/mm and
+/// µN·mm/mm) and the status at the Q16.16 pose, by coeffs/README.md, "Fixed-point
+/// stiffness".
+///
+/// # Errors
+/// An intermediate leaves `|v| <= 2^30`, or a component's format `G` is below 4 (the
+/// tables do not meet the contract).
+pub fn eval_rates(t: &TablesFixed, pose: [i32; 5]) -> Result<RatesFixed, Overflow> {
+    let (w, status) = eval(t, pose)?;
+    let acc = accumulate(t, pose)?;
+    let mut rates = [[0i32; 6]; 3];
+    for c in 0..6 {
+        let g = t.acc_frac[c];
+        if g < 4 {
+            return Err(Overflow { what: format!("component {c}: accumulator format Q{g} below Q4"), value: None });
+        }
+        let unit = 1i64 << (g - RATE_SHIFT);
+        // by depth: E_i = (i + 1) * (A_(i+1) >> 3), D = h(E, U), rate = round(D / (3 * 2^(G-3)))
+        let what = || format!("rate by depth of component {c}");
+        let e = rate_coefficients(&acc.a[c], &what)?;
+        let d = horner_n(&e, acc.u, &what)?;
+        rates[0][c] = div_round(d, 3 * unit, &what)?;
+        // by x and z: row rates (sign by the chain rule through |v|), cross-term rates
+        for (slot, k) in [(1, Sweep::X), (2, Sweep::Z)] {
+            let ki = k.index();
+            let what = || format!("rate by {} of component {c}", k.name());
+            let minus = acc.v[ki] < 0 && !k.is_odd(c);
+            let mut g_i = [0i64; NCOEF];
+            for (i, gi) in g_i.iter_mut().enumerate() {
+                let r = horner_n(&rate_coefficients(&t.rows[ki][c][i], &what)?, acc.tk[ki], &what)?;
+                let shifted = r.div_euclid(1i64 << (t.row_frac[ki][c][i] - g));
+                *gi = check(if minus { gi.checked_sub(shifted) } else { gi.checked_add(shifted) }, what)?;
+            }
+            for (e, p, f) in &t.cross[c] {
+                let ek = i64::from(e[ki]);
+                if ek == 0 {
+                    continue;
+                }
+                let mut reduced = *e;
+                reduced[ki] -= 1;
+                let r = monomial(factors(&reduced, acc.n), 1 << 15, &what)?;
+                for (i, pi) in p.iter().enumerate() {
+                    let prod = step(pi.div_euclid(1 << RATE_SHIFT), r, 0, &what)?;
+                    let term = check(Some(ek * prod.div_euclid(1i64 << (f - g + 1))), what)?;
+                    g_i[i] = check(g_i[i].checked_add(term), what)?;
+                }
+            }
+            let h = horner_n(&g_i, acc.u, &what)?;
+            rates[slot][c] = div_round(h, 6 * unit, &what)?;
+        }
+    }
+    for (slot, bit) in [(0, STATUS_SAT_DEPTH), (1, STATUS_SAT_X), (2, STATUS_SAT_Z)] {
+        if status & bit != 0 {
+            rates[slot] = [0; 6];
+        }
+    }
+    Ok((w, rates, status))
 }
 
 #[cfg(test)]

@@ -2,6 +2,7 @@
 //! `golden-f32.csv`, in the same order, the status and the 18 rates of this crate's own
 //! evaluator ([`super::eval_rate_f32`]): by depth, by x, by z, each fx .. mz.
 
+use super::contract::COMPONENTS;
 use super::eval_f32::Tables32;
 use super::eval_rate_f32::eval_rates;
 use super::golden::poses;
@@ -10,32 +11,28 @@ use anyhow::Result;
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// Columns after the five inputs and the status: rate of each component (fx .. mz) by
-/// depth, by x, by z; N/mm for forces, N·mm/mm for moments.
-pub const RATE_COLUMNS: [&str; 18] = [
-    "dfx_ddepth_n_per_mm",
-    "dfy_ddepth_n_per_mm",
-    "dfz_ddepth_n_per_mm",
-    "dmx_ddepth_nmm_per_mm",
-    "dmy_ddepth_nmm_per_mm",
-    "dmz_ddepth_nmm_per_mm",
-    "dfx_dx_n_per_mm",
-    "dfy_dx_n_per_mm",
-    "dfz_dx_n_per_mm",
-    "dmx_dx_nmm_per_mm",
-    "dmy_dx_nmm_per_mm",
-    "dmz_dx_nmm_per_mm",
-    "dfx_dz_n_per_mm",
-    "dfy_dz_n_per_mm",
-    "dfz_dz_n_per_mm",
-    "dmx_dz_nmm_per_mm",
-    "dmy_dz_nmm_per_mm",
-    "dmz_dz_nmm_per_mm",
-];
+/// The inputs the rates are taken by, in column order.
+const RATE_INPUTS: [&str; 3] = ["ddepth", "dx", "dz"];
 
-/// The header line: the five inputs, `status`, then [`RATE_COLUMNS`].
+/// Columns after the five inputs and the status: rate of each component (fx .. mz) by
+/// depth, by x, by z (`dfx_ddepth_n_per_mm` .. `dmz_dz_nmm_per_mm`); N/mm for forces,
+/// N·mm/mm for moments, or with `micro` µN/mm and µN·mm/mm (`dfx_ddepth_un_per_mm` ..).
+pub fn rate_columns(micro: bool) -> Vec<String> {
+    let prefix = if micro { "u" } else { "" };
+    RATE_INPUTS
+        .iter()
+        .flat_map(|by| {
+            COMPONENTS.iter().map(move |c| {
+                let (name, unit) = c.split_once('_').unwrap_or((c, ""));
+                format!("d{name}_{by}_{prefix}{unit}_per_mm")
+            })
+        })
+        .collect()
+}
+
+/// The header line: the five inputs, `status`, then [`rate_columns`].
 pub fn header() -> String {
-    format!("x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,status,{}", RATE_COLUMNS.join(","))
+    format!("x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,status,{}", rate_columns(false).join(","))
 }
 
 /// The text of golden-stiffness-f32.csv for the f32 tables `t`.

@@ -1,5 +1,6 @@
-//! The fitter: FE sweeps -> `model.toml`, `golden-f32.csv` and `golden-fixed.csv`
-//! (coeffs/README.md), and the
+//! The fitter: FE sweeps -> `model.toml` and the golden vectors (`golden-f32.csv`,
+//! `golden-fixed.csv`, `golden-stiffness-f32.csv`, `golden-stiffness-fixed.csv`;
+//! coeffs/README.md), and the
 //! validation of a fitted model against the FE runs it was not fitted on.
 //!
 //! Pipeline: [`data::load_fit_data`] reads the centre and sweep runs, [`model::fit`] fits
@@ -25,6 +26,7 @@ pub mod fixed_formats;
 pub mod golden;
 pub mod golden_fixed;
 pub mod golden_stiffness;
+pub mod golden_stiffness_fixed;
 pub mod lsq;
 pub mod model;
 pub mod model_file;
@@ -43,6 +45,8 @@ pub const GOLDEN_FILE: &str = "golden-f32.csv";
 pub const GOLDEN_FIXED_FILE: &str = "golden-fixed.csv";
 /// Name of the stiffness golden-vector file inside a set folder.
 pub const GOLDEN_STIFFNESS_FILE: &str = "golden-stiffness-f32.csv";
+/// Name of the fixed-point stiffness golden-vector file inside a set folder.
+pub const GOLDEN_STIFFNESS_FIXED_FILE: &str = "golden-stiffness-fixed.csv";
 
 /// What `needle fit` produces for a set, in memory.
 #[derive(Debug, Clone)]
@@ -57,9 +61,25 @@ pub struct FitOutput {
     pub golden_fixed_csv: String,
     /// The text of `golden-stiffness-f32.csv`.
     pub golden_stiffness_csv: String,
+    /// The text of `golden-stiffness-fixed.csv`.
+    pub golden_stiffness_fixed_csv: String,
 }
 
-/// Fit the set in `set_dir` and render the three output files, without writing anything.
+impl FitOutput {
+    /// Every file `needle fit` writes into the set folder (name, text), model first.
+    pub fn files(&self) -> [(&'static str, &str); 5] {
+        [
+            (MODEL_FILE, &self.model_toml),
+            (GOLDEN_FILE, &self.golden_csv),
+            (GOLDEN_FIXED_FILE, &self.golden_fixed_csv),
+            (GOLDEN_STIFFNESS_FILE, &self.golden_stiffness_csv),
+            (GOLDEN_STIFFNESS_FIXED_FILE, &self.golden_stiffness_fixed_csv),
+        ]
+    }
+}
+
+/// Fit the set in `set_dir` and render its output files ([`FitOutput::files`]), without
+/// writing anything.
 ///
 /// # Errors
 /// As [`data::load_fit_data`] (missing or malformed runs, bad spec) and [`model::fit`]
@@ -74,8 +94,10 @@ pub fn fit_set(set_dir: &Path) -> Result<FitOutput> {
     let tables = eval_f32::Tables32::from_model(&model);
     let golden_csv = golden::to_csv(&tables);
     let golden_stiffness_csv = golden_stiffness::to_csv(&tables);
-    let golden_fixed_csv = golden_fixed::to_csv(&fixed_formats::TablesFixed::from_model(&model)?)?;
-    Ok(FitOutput { model, model_toml, golden_csv, golden_fixed_csv, golden_stiffness_csv })
+    let fixed = fixed_formats::TablesFixed::from_model(&model)?;
+    let golden_fixed_csv = golden_fixed::to_csv(&fixed)?;
+    let golden_stiffness_fixed_csv = golden_stiffness_fixed::to_csv(&fixed)?;
+    Ok(FitOutput { model, model_toml, golden_csv, golden_fixed_csv, golden_stiffness_csv, golden_stiffness_fixed_csv })
 }
 
 /// A plain-text table of the fit residuals (RMS and max, in N or N·mm).

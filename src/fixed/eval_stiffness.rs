@@ -1,0 +1,98 @@
+//! The fixed-point wrench and its stiffness: the integer algorithm of `coeffs/README.md`
+//! ("Fixed-point stiffness"), bit-exact, sharing the wrench's steps.
+use super::arith::{div_round, horner, horner3};
+use super::cross::add_cross_rates;
+use super::eval::{accumulators, output, Inputs};
+use super::stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
+use super::tables::{FRAC_BITS, ODD, RATE_ROWS, RATE_SHIFT, SHIFTS};
+use super::{Pose, Wrench};
+use crate::tables::FITTED;
+use crate::Status;
+
+/// The wrench of [`wrench`](super::wrench) (the same integers) and its partial
+/// derivatives by depth, x and z in µN/mm and µN·mm/mm, in integer arithmetic only: the
+/// stiffness a haptic loop on a core without an FPU needs for its passivity guard.
+///
+/// Implements "Fixed-point stiffness" of `coeffs/README.md` exactly, so the result has
+/// the same bits as the fitter's independent implementation
+/// (`golden-stiffness-fixed.csv`) on every core. With the wrench's `A_i` (Q(G)), `U`,
+/// `T_k`:
+///
+/// - by depth: `E_i = (i + 1) * (A_(i+1) >> 3)`, `D = h3(E, U)` (Q(G-3) per unit of u),
+///   rate `round(D / (3 * 2^(G-3)))` (u = depth/3 - 1);
+/// - by x (z likewise): per row `i` of the x sweep, `h3(RATE_ROWS, T_x) >> SHIFTS`, added to
+///   `gx_i`, subtracted when `x < 0` and the component is *even* under the x mirror (the
+///   chain rule through `|x|`); the cross terms add their rates (generated code); rate
+///   `round(h(gx, U) / (6 * 2^(G-3)))` (t = |x|/6 - 1);
+/// - `round` is half up; a rate along a clamped input (its `SAT_*` flag) is 0.
+///
+/// At `x = 0` the rate by x is the one for `x -> 0+`, as in
+/// [`crate::wrench_and_stiffness`]. The rates approximate the f64 model's derivatives
+/// (the formats lose 3 bits and round; the wrench's error bound does not cover them).
+///
+/// No intermediate can overflow: the code generator bounds the rates' Horner
+/// intermediates by 2^30 over the whole domain, or refuses the model.
+///
+/// # Panics
+/// Never (no indexing, checked division, wrapping arithmetic that the generator's
+/// bounds keep from wrapping).
+#[must_use]
+pub fn wrench_and_stiffness(pose: &Pose) -> StiffnessEvaluation {
+    if !FITTED {
+        return StiffnessEvaluation { wrench: Wrench::ZERO, stiffness: Stiffness::ZERO, status: Status::NO_MODEL | Status::ERROR };
+    }
+    let at = Inputs::of(pose);
+    let a = accumulators(&at);
+    let w = output(&a, at.u);
+
+    let mut by_depth = [0_i32; 6];
+    for ((r, ac), &g) in by_depth.iter_mut().zip(a.iter()).zip(FRAC_BITS.iter()) {
+        let [_, a1, a2, a3, a4] = *ac;
+        let e =
+            [a1 >> RATE_SHIFT, (a2 >> RATE_SHIFT).wrapping_mul(2), (a3 >> RATE_SHIFT).wrapping_mul(3), (a4 >> RATE_SHIFT).wrapping_mul(4)];
+        *r = div_round(horner3(&e, at.u), 3_i32.wrapping_shl(g.wrapping_sub(RATE_SHIFT)));
+    }
+
+    let mut gx = [[0_i32; 5]; 6];
+    let mut gz = [[0_i32; 5]; 6];
+    let [tx, tz, _, _] = at.t;
+    let [neg_x, neg_z, _, _] = at.negative;
+    let tables = RATE_ROWS.iter().zip(SHIFTS.iter()).zip(ODD.iter());
+    for ((gxc, gzc), ((rate_rows, shifts), odd)) in gx.iter_mut().zip(gz.iter_mut()).zip(tables) {
+        let [rows_x, rows_z] = rate_rows;
+        let [shifts_x, shifts_z, _, _] = shifts;
+        let [odd_x, odd_z, _, _] = *odd;
+        add_row_rates(gxc, rows_x, shifts_x, tx, neg_x && !odd_x);
+        add_row_rates(gzc, rows_z, shifts_z, tz, neg_z && !odd_z);
+    }
+    add_cross_rates(at.cross_inputs(), &mut gx, &mut gz);
+    let mut by_x = [0_i32; 6];
+    let mut by_z = [0_i32; 6];
+    for ((((rx, rz), gxc), gzc), &g) in by_x.iter_mut().zip(by_z.iter_mut()).zip(gx.iter()).zip(gz.iter()).zip(FRAC_BITS.iter()) {
+        let d = 6_i32.wrapping_shl(g.wrapping_sub(RATE_SHIFT));
+        *rx = div_round(horner(gxc, at.u), d);
+        *rz = div_round(horner(gzc, at.u), d);
+    }
+
+    let status = at.status;
+    let along = |flag: Status, r: [i32; 6]| if status.contains(flag) { WrenchRate::ZERO } else { WrenchRate::from_array(r) };
+    StiffnessEvaluation {
+        wrench: Wrench::from_array(w),
+        stiffness: Stiffness {
+            by_depth: along(Status::SAT_DEPTH, by_depth),
+            by_x: along(Status::SAT_X, by_x),
+            by_z: along(Status::SAT_Z, by_z),
+        },
+        status,
+    }
+}
+
+/// One sweep's row rates into `g`: `g_i = g_i ± (h3(rows[i], t) >> shifts[i])`, minus
+/// when `minus` (negative input, component even under the mirror).
+#[inline(always)]
+fn add_row_rates(g: &mut [i32; 5], rows: &[[i32; 4]; 5], shifts: &[u32; 5], t: i32, minus: bool) {
+    for ((gi, row), &s) in g.iter_mut().zip(rows.iter()).zip(shifts.iter()) {
+        let r = horner3(row, t).wrapping_shr(s);
+        *gi = if minus { gi.wrapping_sub(r) } else { gi.wrapping_add(r) };
+    }
+}
