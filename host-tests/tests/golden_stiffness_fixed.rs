@@ -56,3 +56,46 @@ fn library_fixed_stiffness_matches_golden_vectors_exactly() {
         mismatches[..mismatches.len().min(10)].join("\n")
     );
 }
+
+/// The fixed-point rates approximate the f64 model's exact derivatives (eval_rate_f64,
+/// itself checked against central differences in stiffness_f64.rs) at every golden pose
+/// inside the domain (x, z != 0: at 0 the rates are one-sided by rule): within
+/// `1e-4 * max|rate| + 3 µN/mm` per rate and component. Why that tolerance: the contract
+/// computes rates on coefficients shifted right by 3 and rounds each to whole µN/mm; no
+/// bound is generated for the rates (unlike the wrench's ERROR_BOUND_MICRO). Measured on
+/// the default set (2026-11-25): worst 67.9 µN·mm/mm of 1.6e6 (dmz by depth, 4.3e-5
+/// relative), 1.5 µN/mm absolute for the forces; a wrong sign or scale in the contract
+/// shows as 100 % or more.
+#[test]
+fn fixed_rates_follow_the_f64_derivatives() {
+    let path = Path::new(model_info::SET_DIR).join("model.toml");
+    let model = needle_host::fit::model_file::read(&path).unwrap_or_else(|e| panic!("{e:#}"));
+    let mut rows = Vec::new();
+    for p in needle_host::fit::golden_fixed::poses() {
+        let exact = p.map(|v| f64::from(v) / 65536.0);
+        let (want, status) = needle_host::fit::eval_rate_f64::eval_rates(&model, exact);
+        if status != 0 || exact[0] == 0.0 || exact[1] == 0.0 {
+            continue;
+        }
+        let s = fixed::wrench_and_stiffness(&fixed::Pose::new(p[0], p[1], p[2], p[3], p[4])).stiffness;
+        rows.push((p, want, [s.by_depth.to_array(), s.by_x.to_array(), s.by_z.to_array()]));
+    }
+    assert!(rows.len() > 3000, "only {} golden poses inside the domain", rows.len());
+    let columns = rate_columns(true);
+    let mut max_rate = [[0.0f64; 6]; 3];
+    for (_, want, _) in &rows {
+        for (m, w) in max_rate.iter_mut().flatten().zip(want.iter().flatten()) {
+            *m = m.max((w * 1e6).abs());
+        }
+    }
+    let mut worst = 0.0f64;
+    for (p, want, have) in &rows {
+        for (((name, w), h), m) in columns.iter().zip(want.iter().flatten()).zip(have.iter().flatten()).zip(max_rate.iter().flatten()) {
+            let err = (f64::from(*h) - w * 1e6).abs();
+            let tol = 1e-4 * m + 3.0;
+            worst = worst.max(err / tol);
+            assert!(err <= tol, "{name} at {p:?}: fixed {h} vs f64 {:.3} (error {err:.3} > {tol:.3})", w * 1e6);
+        }
+    }
+    println!("{} poses: worst error {:.3} of the tolerance", rows.len(), worst);
+}

@@ -1,6 +1,6 @@
 /* capi_golden.c: the C API of needle-haptics against the golden vectors.
  *
- *   capi_golden <golden-f32.csv> [<golden-stiffness-f32.csv>]
+ *   capi_golden <golden-f32.csv> [<golden-stiffness-f32.csv> [<golden-fixed.csv> <golden-stiffness-fixed.csv>]]
  *
  * 1. needle_wrench() on every golden row: status and the six wrench components bit
  *    for bit (NaN matches NaN).
@@ -10,9 +10,13 @@
  * 3. Host-link commands: PING, LIMIT, and refused frames that change nothing.
  * 4. With the second file: needle_wrench_and_stiffness() on every row: status and the
  *    18 rates bit for bit, and the wrench the bits of needle_wrench().
+ * 5. With the third and fourth files (same poses, row by row): needle_fixed_wrench() and
+ *    needle_fixed_wrench_and_stiffness() on every row: status, the six wrench integers
+ *    and the 18 rates exactly, and both calls' wrench and status the same.
  *
  * Prints "capi-golden rows=N wrench_mismatches=M loop_checks=K loop_failures=F command_failures=C"
- * (and with the second file "capi-golden-stiffness rows=N mismatches=M")
+ * (and with the second file "capi-golden-stiffness rows=N mismatches=M", with the third
+ * and fourth "capi-golden-fixed rows=N mismatches=M")
  * and exits 0 only when every check passed. Compile with -ffp-contract=off.
  * Builds with host gcc and with arm-none-eabi-gcc (newlib, semihosting file I/O).
  */
@@ -119,6 +123,71 @@ static int check_stiffness(const char *path, int *rows_out) {
   fclose(fp);
   *rows_out = rows;
   return mismatches;
+}
+
+/* Parses `n` comma-separated integers (decimal, or 0x-prefixed hex for the status) from
+ * `line`; returns 0 on success. */
+static int parse_ints(const char *line, long *v, int n) {
+  const char *at = line;
+  for (int i = 0; i < n; i++) {
+    char *end;
+    v[i] = strtol(at, &end, 0);
+    if (end == at || (i < n - 1 && *end != ',')) return -1;
+    at = end + 1;
+  }
+  return 0;
+}
+
+/* Section 5: golden-fixed.csv and golden-stiffness-fixed.csv row by row through
+ * needle_fixed_wrench and needle_fixed_wrench_and_stiffness; returns the number of
+ * mismatching rows, or -1 when a file is unreadable or malformed. */
+static int check_fixed(const char *wrench_path, const char *stiffness_path, int *rows_out) {
+  FILE *fw = fopen(wrench_path, "r");
+  FILE *fs = fopen(stiffness_path, "r");
+  int result = -1, rows = 0, mismatches = 0, lineno = 1;
+  char lw[512], ls[1024];
+  if (!fw || !fs) {
+    printf("cannot open %s or %s\n", wrench_path, stiffness_path);
+    goto done;
+  }
+  if (!fgets(lw, sizeof lw, fw) || !fgets(ls, sizeof ls, fs)) goto done;
+  for (;;) {
+    char *gw = fgets(lw, sizeof lw, fw);
+    char *gs = fgets(ls, sizeof ls, fs);
+    if (!gw && !gs) break;
+    lineno++;
+    long w[12], k[24];
+    if (!gw || !gs || parse_ints(lw, w, 12) || parse_ints(ls, k, 24)) {
+      printf("golden-fixed line %d: malformed or the files differ in length\n", lineno);
+      goto done;
+    }
+    if (memcmp(w, k, 5 * sizeof w[0]) != 0) {
+      printf("golden-fixed line %d: the two files hold other poses\n", lineno);
+      goto done;
+    }
+    needle_fixed_pose_t p = {(int32_t)w[0], (int32_t)w[1], (int32_t)w[2], (int32_t)w[3], (int32_t)w[4]};
+    needle_fixed_wrench_t plain, both;
+    needle_fixed_stiffness_t r;
+    uint8_t plain_status = needle_fixed_wrench(&p, &plain);
+    uint8_t status = needle_fixed_wrench_and_stiffness(&p, &both, &r);
+    int32_t pw[6] = {plain.fx_un, plain.fy_un, plain.fz_un, plain.mx_unmm, plain.my_unmm, plain.mz_unmm};
+    int bad = plain_status != w[5] || status != k[5] || memcmp(&plain, &both, sizeof plain) != 0;
+    for (int c = 0; c < 6; c++) {
+      bad |= pw[c] != w[6 + c];
+      bad |= r.by_depth[c] != k[6 + c] || r.by_x[c] != k[12 + c] || r.by_z[c] != k[18 + c];
+    }
+    if (bad) {
+      if (mismatches < 10) printf("golden-fixed line %d differs\n", lineno);
+      mismatches++;
+    }
+    rows++;
+  }
+  *rows_out = rows;
+  result = mismatches;
+done:
+  if (fw) fclose(fw);
+  if (fs) fclose(fs);
+  return result;
 }
 
 int main(int argc, char **argv) {
@@ -273,5 +342,12 @@ int main(int argc, char **argv) {
     printf("capi-golden-stiffness rows=%d mismatches=%d\n", stiffness_rows, stiffness_mismatches);
     stiffness_failed = stiffness_mismatches != 0 || stiffness_rows < 2000;
   }
-  return (mismatches || loop_failures || command_failures || rows < 2000 || stiffness_failed) ? 1 : 0;
+  int fixed_failed = 0;
+  if (argc > 4) {
+    int fixed_rows = 0;
+    int fixed_mismatches = check_fixed(argv[3], argv[4], &fixed_rows);
+    printf("capi-golden-fixed rows=%d mismatches=%d\n", fixed_rows, fixed_mismatches);
+    fixed_failed = fixed_mismatches != 0 || fixed_rows < 2000;
+  }
+  return (mismatches || loop_failures || command_failures || rows < 2000 || stiffness_failed || fixed_failed) ? 1 : 0;
 }

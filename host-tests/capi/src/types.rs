@@ -78,6 +78,54 @@ pub struct needle_stiffness_t {
     pub by_z: [f32; 6],
 }
 
+/// The needle's pose in fixed point, as `needle_haptics::fixed::Pose`: each input in
+/// Q16.16 (mm or degrees times 65536).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct needle_fixed_pose_t {
+    /// x of the insertion point, mm × 65536.
+    pub x_mm_q16: i32,
+    /// z of the insertion point, mm × 65536.
+    pub z_mm_q16: i32,
+    /// Tilt about x, degrees × 65536.
+    pub theta_x_deg_q16: i32,
+    /// Tilt about z, degrees × 65536.
+    pub theta_z_deg_q16: i32,
+    /// Depth along the needle, mm × 65536.
+    pub depth_mm_q16: i32,
+}
+
+/// The reaction wrench in integers (µN, µN·mm), as `needle_haptics::fixed::Wrench`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct needle_fixed_wrench_t {
+    /// Force along x, µN.
+    pub fx_un: i32,
+    /// Force along y, µN.
+    pub fy_un: i32,
+    /// Force along z, µN.
+    pub fz_un: i32,
+    /// Moment about x, µN·mm.
+    pub mx_unmm: i32,
+    /// Moment about y, µN·mm.
+    pub my_unmm: i32,
+    /// Moment about z, µN·mm.
+    pub mz_unmm: i32,
+}
+
+/// The fixed-point wrench's partial derivatives (`needle_fixed_wrench_and_stiffness`):
+/// each array holds the rates of fx, fy, fz (µN/mm) and mx, my, mz (µN·mm/mm).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct needle_fixed_stiffness_t {
+    /// d wrench / d depth.
+    pub by_depth: [i32; 6],
+    /// d wrench / d x.
+    pub by_x: [i32; 6],
+    /// d wrench / d z.
+    pub by_z: [i32; 6],
+}
+
 /// Identity and domain of the compiled-in model.
 #[repr(C)]
 #[derive(Clone, Copy, Debug)]

@@ -1,5 +1,6 @@
 //! The C API from C: `c/capi_golden.c`, compiled with the host's gcc against this build's
-//! `libneedle_capi.a` and the generated `needle.h`, checks every golden vector, the loop's
+//! `libneedle_capi.a` and the generated `needle.h`, checks every golden vector (f32 and
+//! fixed point, wrench and stiffness), the loop's
 //! duties, pins and ramp, and the commands; and the same program compiled and linked with
 //! arm-none-eabi-gcc (newlib, semihosting) for the Cortex-M4F against the
 //! thumbv7em-none-eabihf staticlib, then run under QEMU (mps2-an386) on the same golden
@@ -64,6 +65,9 @@ fn staticlib(target: Option<&str>) -> PathBuf {
 fn header_declares_the_api() {
     for item in [
         "needle_wrench(",
+        "needle_fixed_wrench(",
+        "needle_fixed_wrench_and_stiffness(",
+        "} needle_fixed_stiffness_t;",
         "needle_model_info(",
         "needle_loop_init(",
         "needle_loop_tick(",
@@ -92,12 +96,18 @@ fn host_c_program_checks_golden_vectors_loop_and_commands() {
             .arg(&exe),
         "gcc capi_golden.c",
     );
-    let stiffness = Path::new(needle_haptics::model_info::SET_DIR).join("golden-stiffness-f32.csv");
-    assert!(stiffness.is_file(), "{}: no stiffness golden vectors; run `needle fit`", stiffness.display());
-    let out = run(Command::new(&exe).arg(golden_csv()).arg(&stiffness), "capi_golden");
+    let set = Path::new(needle_haptics::model_info::SET_DIR);
+    let others = ["golden-stiffness-f32.csv", "golden-fixed.csv", "golden-stiffness-fixed.csv"].map(|f| set.join(f));
+    for f in &others {
+        assert!(f.is_file(), "{}: no golden vectors; run `needle fit`", f.display());
+    }
+    let out = run(Command::new(&exe).arg(golden_csv()).args(&others), "capi_golden");
     println!("{out}");
     assert!(out.contains("wrench_mismatches=0 ") && out.contains("loop_failures=0 ") && out.contains("command_failures=0"), "{out}");
-    assert!(out.contains("capi-golden-stiffness rows=") && out.contains(" mismatches=0\n"), "{out}");
+    for section in ["capi-golden-stiffness", "capi-golden-fixed"] {
+        let line = out.lines().find(|l| l.starts_with(&format!("{section} rows="))).unwrap_or_else(|| panic!("no {section} line:\n{out}"));
+        assert!(line.ends_with(" mismatches=0"), "{line}");
+    }
 }
 
 #[test]
