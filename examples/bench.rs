@@ -18,7 +18,8 @@
 //!   evaluators run in the same firmware, one after the other, on the same poses (the
 //!   fixed-point pose is the f32 one in Q16.16). Evaluator `f32+k` is
 //!   [`needle_haptics::wrench_and_stiffness`] (the wrench and its 18 rates; its result is
-//!   100 bytes).
+//!   100 bytes), `fixed+k` [`needle_haptics::fixed::wrench_and_stiffness`] (the same in
+//!   integers).
 //! - **Stack**: the 4 KiB below the caller's stack pointer is painted with a pattern,
 //!   one evaluation runs, and the deepest overwritten word gives the bytes used.
 //!
@@ -26,7 +27,7 @@
 //!
 //! ```text
 //! needle-bench target=<triple> calls=<CALLS> calibration_instructions=<n> calibration_ticks=<n> deterministic=<yes|no>
-//! needle-bench pose=<name> evaluator=<f32|f32+k|fixed> instructions_per_wrench=<n.n> stack_bytes=<n> status=0x<ss>
+//! needle-bench pose=<name> evaluator=<f32|f32+k|fixed|fixed+k> instructions_per_wrench=<n.n> stack_bytes=<n> status=0x<ss>
 //! ...
 //! needle-bench end
 //! ```
@@ -158,6 +159,7 @@ mod firmware {
         let eval: fn(&Pose) -> needle_haptics::Evaluation = black_box(wrench);
         let eval_fixed: fn(&fixed::Pose) -> fixed::Evaluation = black_box(fixed::wrench);
         let eval_stiffness: fn(&Pose) -> needle_haptics::StiffnessEvaluation = black_box(wrench_and_stiffness);
+        let eval_fixed_k: fn(&fixed::Pose) -> fixed::StiffnessEvaluation = black_box(fixed::wrench_and_stiffness);
         let per_call = |tw: u32, te: u32| -> u64 { cal.tenths_per_call(tw, te, CALLS) };
         for (name, pose) in POSES.iter() {
             let tenths = per_call(loop_wrench(eval, pose, black_box(CALLS)), loop_empty(pose, black_box(CALLS)));
@@ -170,6 +172,9 @@ mod firmware {
                 let tenths = per_call(loop_wrench(eval_fixed, q, black_box(CALLS)), loop_empty(q, black_box(CALLS)));
                 let stack = stack_use(eval_fixed, q);
                 report(&mut out, name, "fixed", tenths, stack, eval_fixed(q).status.bits());
+                let tenths = per_call(loop_wrench(eval_fixed_k, q, black_box(CALLS)), loop_empty(q, black_box(CALLS)));
+                let stack = stack_use(eval_fixed_k, q);
+                report(&mut out, name, "fixed+k", tenths, stack, eval_fixed_k(q).status.bits());
             }
         }
         out.str("needle-bench end\n");

@@ -265,23 +265,23 @@ fn reduced_monomial_q15(e: [u8; 4], k: usize) -> Option<String> {
     Some(if reduced.iter().all(|&r| r == 0) { "32768".to_string() } else { monomial_q15(reduced) })
 }
 
-/// `add_cross_rates` in fixed point (coeffs/README.md, "Fixed-point stiffness"): per
-/// cross term with `e_x >= 1`, `gx[c][i] += e_x * (mul_q15(P[i] >> 3, R) >> (shift + 1))`
+/// `add_cross_rates_x` and `_z` in fixed point (coeffs/README.md, "Fixed-point
+/// stiffness"): per cross term with `e_x >= 1`, `g[c][i] += e_x * (mul_q15(P[i] >> 3, R) >> (shift + 1))`
 /// with `R` the monomial reduced by one factor of `xi` (the `+ 1` turns the rate per unit
 /// of `n_x = x / 12` into the rate per unit of `t_x`, the rows' variable); z likewise.
 fn render_rust_cross_rates_fixed(w: &mut String, t: &FixedTables) {
-    let _ = writeln!(w);
-    let _ = writeln!(w, "/// Adds every cross term's x and z rates to `gx[c][i]`, `gz[c][i]` (Q(G - {RATE_SHIFT}) per unit of t_x, t_z).");
-    let _ = writeln!(w, "#[inline(always)]");
-    let _ = writeln!(w, "#[allow(unused_variables)]");
-    let _ = writeln!(w, "pub(crate) fn add_cross_rates(n: [i32; 4], gx: &mut [[i32; 5]; 6], gz: &mut [[i32; 5]; 6]) {{");
-    let any = t.components.iter().any(|c| c.cross.iter().any(|x| x.exponents[0] > 0 || x.exponents[1] > 0));
-    if !any {
-        let _ = writeln!(w, "    let _ = (n, gx, gz);");
-    } else {
-        let _ = writeln!(w, "    let [xi, zeta, alpha, beta] = n;");
-        for (acc, k) in [("gx", 0), ("gz", 1)] {
-            let _ = writeln!(w, "    let [{acc}0, {acc}1, {acc}2, {acc}3, {acc}4, {acc}5] = {acc};");
+    for (name, k) in [("x", 0), ("z", 1)] {
+        let _ = writeln!(w);
+        let _ = writeln!(w, "/// Adds every cross term's {name} rates to `g[c][i]` (Q(G - {RATE_SHIFT}) per unit of t_{name}).");
+        let _ = writeln!(w, "#[inline(always)]");
+        let _ = writeln!(w, "#[allow(unused_variables)]");
+        let _ = writeln!(w, "pub(crate) fn add_cross_rates_{name}(n: [i32; 4], g: &mut [[i32; 5]; 6]) {{");
+        let any = t.components.iter().any(|c| c.cross.iter().any(|x| x.exponents[k] > 0));
+        if !any {
+            let _ = writeln!(w, "    let _ = (n, g);");
+        } else {
+            let _ = writeln!(w, "    let [xi, zeta, alpha, beta] = n;");
+            let _ = writeln!(w, "    let [g0, g1, g2, g3, g4, g5] = g;");
             for (c, comp) in t.components.iter().enumerate() {
                 for x in &comp.cross {
                     let Some(r) = reduced_monomial_q15(x.exponents, k) else { continue };
@@ -299,11 +299,11 @@ fn render_rust_cross_rates_fixed(w: &mut String, t: &FixedTables) {
                         }
                         let term = format!("(mul_q15({p3}, r) >> {})", x.shift + 1);
                         let term = if e == 1 { term } else { format!("{e}_i32.wrapping_mul{term}") };
-                        let _ = writeln!(w, "    {acc}{c}[{i}] = {acc}{c}[{i}].wrapping_add({term});");
+                        let _ = writeln!(w, "    g{c}[{i}] = g{c}[{i}].wrapping_add({term});");
                     }
                 }
             }
         }
+        let _ = writeln!(w, "}}");
     }
-    let _ = writeln!(w, "}}");
 }

@@ -172,6 +172,14 @@ fn bench_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
                 q.instructions,
                 t.instructions / q.instructions
             );
+            if let Some(qk) = f.pose("typical", "fixed+k") {
+                println!(
+                    "fixed-point stiffness {}: {:.1} instructions per wrench and stiffness (typical pose), {:.2}x the fixed-point wrench alone",
+                    f.core.core,
+                    qk.instructions,
+                    qk.instructions / q.instructions
+                );
+            }
         }
     }
     Ok(ExitCode::SUCCESS)
