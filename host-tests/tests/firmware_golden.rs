@@ -19,59 +19,32 @@ fn golden_on(name: &str) {
     golden_of_set_on(name, &set);
 }
 
-/// Every section of the `golden` firmware of the set at `set` on core `name`.
+/// Every section of the `golden` firmware of the set at `set` on core `name`: at least
+/// 2,000 rows each (the contract's minimum), none differing.
 fn golden_of_set_on(name: &str, set: &Path) {
     let core = firmware::core(name).unwrap_or_else(|e| panic!("{e:#}"));
     let run = golden::run(&core, set).unwrap_or_else(|e| panic!("{} ({}): {e:#}", core.core, core.target));
-    let c = &run.comparison;
-    assert!(c.rows >= 2000, "{}: only {} golden rows (the contract asks for >= 2,000)", set.display(), c.rows);
-    assert!(
-        c.mismatches.is_empty(),
-        "{} of {} golden rows differ on {} ({}, QEMU {}); first ones:\n{}",
-        c.mismatches.len(),
-        c.rows,
-        core.core,
-        core.target,
-        core.machine,
-        c.mismatches.iter().take(10).cloned().collect::<Vec<_>>().join("\n")
-    );
-    let f = &run.fixed;
-    assert!(f.rows >= 2000, "{}: only {} fixed-point golden rows", set.display(), f.rows);
-    assert!(
-        f.mismatches.is_empty(),
-        "{} of {} fixed-point golden rows differ on {} ({}); first ones:\n{}",
-        f.mismatches.len(),
-        f.rows,
-        core.core,
-        core.target,
-        f.mismatches.iter().take(10).cloned().collect::<Vec<_>>().join("\n")
-    );
-    let s = &run.stiffness;
-    assert!(s.rows >= 2000, "{}: only {} stiffness golden rows", set.display(), s.rows);
-    assert!(
-        s.mismatches.is_empty(),
-        "{} of {} stiffness golden rows differ on {} ({}); first ones:\n{}",
-        s.mismatches.len(),
-        s.rows,
-        core.core,
-        core.target,
-        s.mismatches.iter().take(10).cloned().collect::<Vec<_>>().join("\n")
-    );
-    let sf = &run.stiffness_fixed;
-    assert!(sf.rows >= 2000, "{}: only {} fixed-point stiffness golden rows", set.display(), sf.rows);
-    assert!(
-        sf.mismatches.is_empty(),
-        "{} of {} fixed-point stiffness golden rows differ on {} ({}); first ones:\n{}",
-        sf.mismatches.len(),
-        sf.rows,
-        core.core,
-        core.target,
-        sf.mismatches.iter().take(10).cloned().collect::<Vec<_>>().join("\n")
-    );
-    println!("{} ({}): {} stiffness golden rows bit for bit, wrench_and_stiffness's wrench = wrench's", core.core, core.machine, s.rows);
-    println!("{} ({}): {} fixed-point stiffness golden rows exactly, its wrench = fixed::wrench's", core.core, core.machine, sf.rows);
-    println!("{} ({}): {} fixed-point golden rows exactly", core.core, core.machine, f.rows);
-    println!("{} ({}): {} golden rows bit for bit in {:.1} s ({})", core.core, core.machine, c.rows, run.run_time.as_secs_f64(), c.banner);
+    let sections = [
+        ("golden-f32.csv", &run.comparison),
+        ("golden-fixed.csv", &run.fixed),
+        ("golden-stiffness-f32.csv", &run.stiffness),
+        ("golden-stiffness-fixed.csv", &run.stiffness_fixed),
+    ];
+    for (file, c) in sections {
+        assert!(c.rows >= 2000, "{}: only {} rows of {file} (the contract asks for >= 2,000)", set.display(), c.rows);
+        assert!(
+            c.mismatches.is_empty(),
+            "{} of {} rows of {file} differ on {} ({}, QEMU {}); first ones:\n{}",
+            c.mismatches.len(),
+            c.rows,
+            core.core,
+            core.target,
+            core.machine,
+            c.mismatches.iter().take(10).cloned().collect::<Vec<_>>().join("\n")
+        );
+        println!("{} ({}): {} rows of {file} exactly", core.core, core.machine, c.rows);
+    }
+    println!("{} ({}): golden firmware ran {:.1} s ({})", core.core, core.machine, run.run_time.as_secs_f64(), run.comparison.banner);
 }
 
 #[test]

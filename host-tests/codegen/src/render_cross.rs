@@ -59,20 +59,22 @@ fn horner_rate(p: &[f32]) -> Option<String> {
     (!q.is_empty()).then(|| horner(&q))
 }
 
+/// The exponents with input `k`'s lowered by one (`None` when the monomial does not hold
+/// input `k`): the monomial's partial derivative by `n_k` is `e_k` times that monomial.
+fn reduced(e: [u8; 4], k: usize) -> Option<[u8; 4]> {
+    let mut r = e;
+    let ek = r.get_mut(k).filter(|ek| **ek > 0)?;
+    *ek -= 1;
+    Some(r)
+}
+
 /// `e_k * (m / n_k)`: the monomial's partial derivative by input `k` (`None` when the
 /// monomial does not hold it), the reduced monomial multiplied left to right, `1.0` when
 /// it is empty.
 fn monomial_rate(e: [u8; 4], k: usize) -> Option<String> {
-    let ek = *e.get(k)?;
-    if ek == 0 {
-        return None;
-    }
-    let mut reduced = e;
-    if let Some(r) = reduced.get_mut(k) {
-        *r -= 1;
-    }
-    let m = if reduced.iter().all(|&r| r == 0) { lit(1.0) } else { monomial(reduced) };
-    Some(format!("{} * ({m})", lit(f32::from(ek))))
+    let r = reduced(e, k)?;
+    let m = if r.iter().all(|&v| v == 0) { lit(1.0) } else { monomial(r) };
+    Some(format!("{} * ({m})", lit(f32::from(*e.get(k)?))))
 }
 
 /// The Rust source of `cross_f32.rs`, to be `include!`d in a module.
@@ -254,15 +256,8 @@ pub fn render_rust_cross_fixed(model: &Model, t: &FixedTables) -> String {
 /// `M` reduced by one factor of input `k` (`e_k * M / n_k` without the `e_k`), as Q15
 /// products; `32768` (1.0 in Q15) when no factor is left. `None` when `e_k` is 0.
 fn reduced_monomial_q15(e: [u8; 4], k: usize) -> Option<String> {
-    let ek = *e.get(k)?;
-    if ek == 0 {
-        return None;
-    }
-    let mut reduced = e;
-    if let Some(r) = reduced.get_mut(k) {
-        *r -= 1;
-    }
-    Some(if reduced.iter().all(|&r| r == 0) { "32768".to_string() } else { monomial_q15(reduced) })
+    let r = reduced(e, k)?;
+    Some(if r.iter().all(|&v| v == 0) { "32768".to_string() } else { monomial_q15(r) })
 }
 
 /// `add_cross_rates_x` and `_z` in fixed point (coeffs/README.md, "Fixed-point
