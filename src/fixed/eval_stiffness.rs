@@ -41,30 +41,24 @@ pub fn wrench_and_stiffness(pose: &Pose) -> StiffnessEvaluation {
     if !FITTED {
         return StiffnessEvaluation { wrench: Wrench::ZERO, stiffness: Stiffness::ZERO, status: Status::NO_MODEL | Status::ERROR };
     }
-    let at = Inputs::of(pose);
-    let (w, by_depth) = wrench_and_depth_rates(&at);
-    let by_x = along::<0>(&at);
-    let by_z = along::<1>(&at);
-    let status = at.status;
-    let clamped = |flag: Status, r: [i32; 6]| if status.contains(flag) { WrenchRate::ZERO } else { WrenchRate::from_array(r) };
-    StiffnessEvaluation {
-        wrench: Wrench::from_array(w),
-        stiffness: Stiffness {
-            by_depth: clamped(Status::SAT_DEPTH, by_depth),
-            by_x: clamped(Status::SAT_X, by_x),
-            by_z: clamped(Status::SAT_Z, by_z),
-        },
-        status,
-    }
+    // Each child takes the pose and computes the inputs itself (a few integer divisions
+    // again), so this frame holds only the result (measured stack on the M0: 520 B with
+    // the inputs kept here).
+    let mut e = StiffnessEvaluation { wrench: Wrench::ZERO, stiffness: Stiffness::ZERO, status: Status::OK };
+    wrench_and_depth_rates(pose, &mut e);
+    along::<0>(pose, &mut e.stiffness.by_x);
+    along::<1>(pose, &mut e.stiffness.by_z);
+    e
 }
 
-/// The wrench and its rates by depth from the accumulators `A_i`: `E_i = (i + 1) *
-/// (A_(i+1) >> 3)`, `D = h3(E, U)`, rate `round(D / (3 * 2^(G-3)))`. Not inlined: each
-/// input's rates get their own stack frame, so the accumulators of one are dead while
-/// the next are computed (measured stack, M0: 704 B with all three sets of
-/// accumulators live).
+/// The wrench, the status and the rates by depth (left zero when the depth was clamped)
+/// into `e`, from the accumulators `A_i`: `E_i = (i + 1) * (A_(i+1) >> 3)`,
+/// `D = h3(E, U)`, rate `round(D / (3 * 2^(G-3)))`. Not inlined: each input's rates get
+/// their own stack frame, so the accumulators of one are dead while the next are
+/// computed (measured stack, M0: 704 B with all three sets of accumulators live).
 #[inline(never)]
-fn wrench_and_depth_rates(at: &Inputs) -> ([i32; 6], [i32; 6]) {
+fn wrench_and_depth_rates(pose: &Pose, e: &mut StiffnessEvaluation) {
+    let at = &Inputs::of(pose);
     let a = accumulators(at);
     let w = output(&a, at.u);
     let mut by_depth = [0_i32; 6];
@@ -74,14 +68,20 @@ fn wrench_and_depth_rates(at: &Inputs) -> ([i32; 6], [i32; 6]) {
             [a1 >> RATE_SHIFT, (a2 >> RATE_SHIFT).wrapping_mul(2), (a3 >> RATE_SHIFT).wrapping_mul(3), (a4 >> RATE_SHIFT).wrapping_mul(4)];
         *r = div_round(horner3(&e, at.u), 3_i32.wrapping_shl(g.wrapping_sub(RATE_SHIFT)));
     }
-    (w, by_depth)
+    e.wrench = Wrench::from_array(w);
+    e.status = at.status;
+    if !at.status.contains(Status::SAT_DEPTH) {
+        e.stiffness.by_depth = WrenchRate::from_array(by_depth);
+    }
 }
 
 /// The rates by x (`K = 0`) or z (`K = 1`): per component `g_i` from the sweep's row
 /// rates (signed by the chain rule through `|v|`) and the cross terms' rates, then
-/// `round(h(g, U) / (6 * 2^(G-3)))`.
+/// `round(h(g, U) / (6 * 2^(G-3)))`, into `out` unless that input was clamped (then
+/// `out` stays zero).
 #[inline(never)]
-fn along<const K: usize>(at: &Inputs) -> [i32; 6] {
+fn along<const K: usize>(pose: &Pose, out: &mut WrenchRate) {
+    let at = &Inputs::of(pose);
     let [tx, tz, _, _] = at.t;
     let [neg_x, neg_z, _, _] = at.negative;
     let (t, negative) = if K == 0 { (tx, neg_x) } else { (tz, neg_z) };
@@ -106,7 +106,9 @@ fn along<const K: usize>(at: &Inputs) -> [i32; 6] {
     for ((r, gc), &bits) in rates.iter_mut().zip(g.iter()).zip(FRAC_BITS.iter()) {
         *r = div_round(horner(gc, at.u), 6_i32.wrapping_shl(bits.wrapping_sub(RATE_SHIFT)));
     }
-    rates
+    if !at.status.contains(if K == 0 { Status::SAT_X } else { Status::SAT_Z }) {
+        *out = WrenchRate::from_array(rates);
+    }
 }
 
 /// One sweep's row rates into `g`: `g_i = g_i ± (h3(rows[i], t) >> shifts[i])`, minus
