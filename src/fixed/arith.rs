@@ -75,11 +75,11 @@ pub(crate) fn horner3(p: &[i32; 4], w: i32) -> i32 {
     mul_q15(a, w).wrapping_add(p0)
 }
 
-/// `floor((n + d / 2) / d)`: `n / d` rounded half up, for an even divisor `d > 0` (the
-/// generated rate divisors `3 * 2^(G-3)` and `6 * 2^(G-3)`, `G >= 4`); `0` for `d = 0`.
+/// `floor((n + (d >> 1)) / d)`: `n / d` rounded to nearest (ties up for an even `d`), for
+/// the rate divisors `3 * 2^(G-R)` and `6 * 2^(G-R)` (never zero); `0` for `d = 0`.
 #[inline(always)]
 pub(crate) fn div_round(n: i32, d: i32) -> i32 {
     // `checked_div_euclid` keeps the no-panic guarantee (zero divisor, `MIN / -1`)
-    // without relying on the generator's `G >= 4`.
+    // without relying on the generated divisors.
     n.wrapping_add(d >> 1).checked_div_euclid(d).unwrap_or_default()
 }

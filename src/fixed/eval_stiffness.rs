@@ -4,7 +4,7 @@ use super::arith::{div_round, horner, horner3};
 use super::cross::{add_cross_rates_x, add_cross_rates_z};
 use super::eval::{accumulators, output, Inputs};
 use super::stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
-use super::tables::{FRAC_BITS, ODD, RATE_ROWS, RATE_SHIFT, SHIFTS};
+use super::tables::{FRAC_BITS, ODD, RATE_ROWS, RATE_SHIFTS, SHIFTS};
 use super::{Pose, Wrench};
 use crate::tables::FITTED;
 use crate::Status;
@@ -18,17 +18,19 @@ use crate::Status;
 /// (`golden-stiffness-fixed.csv`) on every core. With the wrench's `A_i` (Q(G)), `U`,
 /// `T_k`:
 ///
-/// - by depth: `E_i = (i + 1) * (A_(i+1) >> 3)`, `D = h3(E, U)` (Q(G-3) per unit of u),
-///   rate `round(D / (3 * 2^(G-3)))` (u = depth/3 - 1);
+/// - by depth: with `R = min(3, G)` ([`RATE_SHIFTS`](super::tables::RATE_SHIFTS)),
+///   `E_i = (i + 1) * (A_(i+1) >> R)`, `D = h3(E, U)` (Q(G-R) per unit of u), rate
+///   `round(D / (3 * 2^(G-R)))` (u = depth/3 - 1);
 /// - by x (z likewise): per row `i` of the x sweep, `h3(RATE_ROWS, T_x) >> SHIFTS`, added to
 ///   `gx_i`, subtracted when `x < 0` and the component is *even* under the x mirror (the
 ///   chain rule through `|x|`); the cross terms add their rates (generated code); rate
-///   `round(h(gx, U) / (6 * 2^(G-3)))` (t = |x|/6 - 1);
-/// - `round` is half up; a rate along a clamped input (its `SAT_*` flag) is 0.
+///   `round(h(gx, U) / (6 * 2^(G-R)))` (t = |x|/6 - 1);
+/// - `round(n / d)` is `floor((n + (d >> 1)) / d)`; a rate along a clamped input (its `SAT_*` flag) is 0.
 ///
 /// At `x = 0` the rate by x is the one for `x -> 0+`, as in
 /// [`crate::wrench_and_stiffness`]. The rates approximate the f64 model's derivatives
-/// (the formats lose 3 bits and round; the wrench's error bound does not cover them).
+/// (the formats lose up to 3 bits and round; the wrench's error bound does not cover
+/// them).
 ///
 /// No intermediate can overflow: the code generator bounds the rates' Horner
 /// intermediates by 2^30 over the whole domain, or refuses the model.
@@ -52,8 +54,8 @@ pub fn wrench_and_stiffness(pose: &Pose) -> StiffnessEvaluation {
 }
 
 /// The wrench, the status and the rates by depth (left zero when the depth was clamped)
-/// into `e`, from the accumulators `A_i`: `E_i = (i + 1) * (A_(i+1) >> 3)`,
-/// `D = h3(E, U)`, rate `round(D / (3 * 2^(G-3)))`. Not inlined: each input's rates get
+/// into `e`, from the accumulators `A_i`: `E_i = (i + 1) * (A_(i+1) >> R)`,
+/// `D = h3(E, U)`, rate `round(D / (3 * 2^(G-R)))`. Not inlined: each input's rates get
 /// their own stack frame, so the accumulators of one are dead while the next are
 /// computed (measured stack, M0: 704 B with all three sets of accumulators live).
 #[inline(never)]
@@ -62,11 +64,10 @@ fn wrench_and_depth_rates(pose: &Pose, e: &mut StiffnessEvaluation) {
     let a = accumulators(at);
     let w = output(&a, at.u);
     let mut by_depth = [0_i32; 6];
-    for ((r, ac), &g) in by_depth.iter_mut().zip(a.iter()).zip(FRAC_BITS.iter()) {
+    for (((r, ac), &g), &rs) in by_depth.iter_mut().zip(a.iter()).zip(FRAC_BITS.iter()).zip(RATE_SHIFTS.iter()) {
         let [_, a1, a2, a3, a4] = *ac;
-        let e =
-            [a1 >> RATE_SHIFT, (a2 >> RATE_SHIFT).wrapping_mul(2), (a3 >> RATE_SHIFT).wrapping_mul(3), (a4 >> RATE_SHIFT).wrapping_mul(4)];
-        *r = div_round(horner3(&e, at.u), 3_i32.wrapping_shl(g.wrapping_sub(RATE_SHIFT)));
+        let coeffs = [a1 >> rs, (a2 >> rs).wrapping_mul(2), (a3 >> rs).wrapping_mul(3), (a4 >> rs).wrapping_mul(4)];
+        *r = div_round(horner3(&coeffs, at.u), 3_i32.wrapping_shl(g.wrapping_sub(rs)));
     }
     e.wrench = Wrench::from_array(w);
     e.status = at.status;
@@ -77,7 +78,7 @@ fn wrench_and_depth_rates(pose: &Pose, e: &mut StiffnessEvaluation) {
 
 /// The rates by x (`K = 0`) or z (`K = 1`): per component `g_i` from the sweep's row
 /// rates (signed by the chain rule through `|v|`) and the cross terms' rates, then
-/// `round(h(g, U) / (6 * 2^(G-3)))`, into `out` unless that input was clamped (then
+/// `round(h(g, U) / (6 * 2^(G-R)))`, into `out` unless that input was clamped (then
 /// `out` stays zero).
 #[inline(never)]
 fn along<const K: usize>(pose: &Pose, out: &mut WrenchRate) {
@@ -103,8 +104,8 @@ fn along<const K: usize>(pose: &Pose, out: &mut WrenchRate) {
         add_cross_rates_z(at.cross_inputs(), &mut g);
     }
     let mut rates = [0_i32; 6];
-    for ((r, gc), &bits) in rates.iter_mut().zip(g.iter()).zip(FRAC_BITS.iter()) {
-        *r = div_round(horner(gc, at.u), 6_i32.wrapping_shl(bits.wrapping_sub(RATE_SHIFT)));
+    for (((r, gc), &bits), &rs) in rates.iter_mut().zip(g.iter()).zip(FRAC_BITS.iter()).zip(RATE_SHIFTS.iter()) {
+        *r = div_round(horner(gc, at.u), 6_i32.wrapping_shl(bits.wrapping_sub(rs)));
     }
     if !at.status.contains(if K == 0 { Status::SAT_X } else { Status::SAT_Z }) {
         *out = WrenchRate::from_array(rates);

@@ -30,14 +30,11 @@ pub const SWEEP_DIVISORS: [u32; 4] = [12, 12, 15, 15];
 pub const CROSS_DIVISORS: [u32; 4] = [24, 24, 30, 30];
 /// Every intermediate of the integer evaluation has a magnitude of at most `2^30`.
 pub const LIMIT: i64 = 1 << 30;
-/// The fixed-point stiffness differentiates coefficients shifted right by `RATE_SHIFT`
-/// (`A_i >> 3`, `P_j >> 3`): a derivative's coefficients `i * a_i` sum to at most 4 times
-/// the polynomial's, so the rates are computed in Q(G - 3) and stay within [`LIMIT`]
-/// (coeffs/README.md, "Fixed-point stiffness").
-pub const RATE_SHIFT: u32 = 3;
-/// Smallest accumulator format `G` the fixed-point stiffness accepts: its rounding of
-/// the depth rate adds `3 * 2^(G - 4)`.
-pub const MIN_RATE_FRAC_BITS: u32 = 4;
+/// The fixed-point stiffness differentiates coefficients shifted right by
+/// `R = min(MAX_RATE_SHIFT, G)` (`A_i >> R`, `P_j >> R`): a derivative's coefficients
+/// `i * a_i` sum to at most 4 times the polynomial's, so the rates are computed in
+/// Q(G - R) and stay within [`LIMIT`] (coeffs/README.md, "Fixed-point stiffness").
+pub const MAX_RATE_SHIFT: u32 = 3;
 /// Largest number of fractional bits of any format.
 pub const MAX_FRAC_BITS: u32 = 30;
 /// Output unit: micro-newtons and micro-newton millimetres (coefficients are scaled by 10^6).
@@ -100,8 +97,10 @@ pub struct FixedComponent {
     /// The coupled form's cross terms of this component, in file order (empty for the
     /// paper form).
     pub cross: Vec<FixedCross>,
+    /// `R = min(MAX_RATE_SHIFT, frac_bits)`: the stiffness's coefficient shift.
+    pub rate_shift: u32,
     /// `rate_rows[k][i]` (sweeps x and z): the t-derivative of row `rows[k][i]`,
-    /// `[(j + 1) * (P[j + 1] >> RATE_SHIFT)]` for `j = 0..4`, in Q(f - 3).
+    /// `[(j + 1) * (P[j + 1] >> R)]` for `j = 0..4`, in Q(f - R).
     pub rate_rows: [[[i32; 4]; 5]; 2],
     /// Bounds of the stiffness's Horner intermediates: by depth, by x, by z (each
     /// `<= LIMIT`, checked by [`fixed_formats`]).
@@ -157,25 +156,25 @@ fn component_bounds(rows: &[[FixedRow; 5]; 4], cross: &[FixedCross], base: &[f64
     (a, total, baseline)
 }
 
-/// The t-derivative of a row for the fixed-point stiffness: `(j + 1) * (p[j + 1] >> 3)`.
-/// No overflow: `|p[j] >> 3| <= 2^27`, times at most 4.
-#[must_use]
-pub fn rate_row(p: &[i32; 5]) -> [i32; 4] {
-    let [_, p1, p2, p3, p4] = *p;
-    [p1 >> RATE_SHIFT, 2 * (p2 >> RATE_SHIFT), 3 * (p3 >> RATE_SHIFT), 4 * (p4 >> RATE_SHIFT)]
+/// The t-derivative of a row for the fixed-point stiffness: `(j + 1) * (p[j + 1] >> r)`
+/// (`r <= 3`), `None` when a coefficient would leave [`LIMIT`] (`r < 3` only).
+fn rate_row(p: &[i32; 5], r: u32) -> Option<[i32; 4]> {
+    let [_, p1, p2, p3, p4] = p.map(|v| i64::from(v >> r));
+    let d = [p1, 2 * p2, 3 * p3, 4 * p4];
+    d.iter().all(|v| v.abs() <= LIMIT).then(|| d.map(|v| v as i32))
 }
 
 /// The bounds of every intermediate of the fixed-point stiffness (coeffs/README.md,
 /// "Fixed-point stiffness"), `[by depth, by x, by z]`:
-/// - by depth: the Horner of `E_i = (i + 1) * (A_(i+1) >> 3)` is bounded by `sum |E_i|`,
-///   `|A_i >> 3| <= ceil(a_bounds[i] / 8)`;
+/// - by depth: the Horner of `E_i = (i + 1) * (A_(i+1) >> r)` is bounded by `sum |E_i|`,
+///   `|A_i >> r| <= ceil(a_bounds[i] / 2^r)`;
 /// - by x (z): per `i`, the row's rate Horner `sum_j |rate_rows[k][i][j]|` shifted by
 ///   `shifts[k][i]`, plus per cross term with exponent `e >= 1` of that input
-///   `e * ceil(ceil(|P[i]| / 8) / 2^(shift + 1))`; the Horner in `u` of those sums is
-///   bounded by their total (each row's own Horner by its coefficient sum, which is
-///   smaller than `LIMIT` by construction: `4 * 2^27`).
-fn rate_bounds(a_bounds: &[i64; 5], rate_rows: &[[[i32; 4]; 5]; 2], shifts: &[[u32; 5]; 4], cross: &[FixedCross]) -> [i64; 3] {
-    let depth = a_bounds.iter().enumerate().skip(1).map(|(i, a)| i as i64 * shifted_bound(*a, RATE_SHIFT)).sum();
+///   `e * ceil(ceil(|P[i]| / 2^r) / 2^(shift + 1))`; the Horner in `u` of those sums is
+///   bounded by their total (each row's own Horner by its coefficient sum, below
+///   `LIMIT` for `r = 3` by construction: `4 * 2^27`).
+fn rate_bounds(a_bounds: &[i64; 5], r: u32, rate_rows: &[[[i32; 4]; 5]; 2], shifts: &[[u32; 5]; 4], cross: &[FixedCross]) -> [i64; 3] {
+    let depth = a_bounds.iter().enumerate().skip(1).map(|(i, a)| i as i64 * shifted_bound(*a, r)).sum();
     let along = |k: usize| -> i64 {
         let mut total = 0i64;
         for i in 0..5 {
@@ -185,7 +184,7 @@ fn rate_bounds(a_bounds: &[i64; 5], rate_rows: &[[[i32; 4]; 5]; 2], shifts: &[[u
                 let e = i64::from(x.exponents[k]);
                 let p = x.coeffs.get(i).map_or(0, |v| i64::from(*v).abs());
                 if e > 0 {
-                    total += e * shifted_bound(shifted_bound(p, RATE_SHIFT), x.shift + 1);
+                    total += e * shifted_bound(shifted_bound(p, r), x.shift + 1);
                 }
             }
         }
@@ -260,19 +259,24 @@ pub fn fixed_formats(model: &Model, model_path: &Path) -> Result<FixedTables, Co
         for x in &mut cross {
             x.shift = x.frac_bits - g;
         }
+        let rate_shift = g.min(MAX_RATE_SHIFT);
         let [rows_x, rows_z, _, _] = &rows;
-        let rate_rows = [rows_x.map(|r| rate_row(&r.coeffs)), rows_z.map(|r| rate_row(&r.coeffs))];
-        let rate_bounds = rate_bounds(&a_bounds, &rate_rows, &shifts, &cross);
-        if g < MIN_RATE_FRAC_BITS || rate_bounds.iter().any(|b| *b > LIMIT) {
+        let rate_of = |rows: &[FixedRow; 5]| -> Option<[[i32; 4]; 5]> {
+            let r: Vec<[i32; 4]> = rows.iter().map(|row| rate_row(&row.coeffs, rate_shift)).collect::<Option<_>>()?;
+            r.try_into().ok()
+        };
+        let rate_rows = rate_of(rows_x).zip(rate_of(rows_z)).map(|(x, z)| [x, z]);
+        let rate_bounds = rate_rows.map(|rr| rate_bounds(&a_bounds, rate_shift, &rr, &shifts, &cross));
+        let (Some(rate_rows), Some(rate_bounds)) = (rate_rows, rate_bounds.filter(|b| b.iter().all(|v| *v <= LIMIT))) else {
             return Err(at(
                 base.line,
                 format!(
-                    "baseline {0}: component {0} does not fit the fixed-point stiffness: accumulator format Q{g} (needs Q{MIN_RATE_FRAC_BITS} or more), Horner bounds of the rates by depth, x, z {rate_bounds:?} micro-units ({1}) against the limit 2^30 = {LIMIT}",
+                    "baseline {0}: component {0} does not fit the fixed-point stiffness: with accumulator format Q{g} and coefficient shift {rate_shift}, a rate row or a Horner bound of its rates by depth, x, z {rate_bounds:?} exceeds the limit 2^30 = {LIMIT} micro-units ({1})",
                     COMPONENTS[c],
                     crate::contract::UNITS[c]
                 ),
             ));
-        }
+        };
         let comp = FixedComponent {
             rows,
             shifts,
@@ -282,6 +286,7 @@ pub fn fixed_formats(model: &Model, model_path: &Path) -> Result<FixedTables, Co
             horner_bound,
             error_bound: ErrorBound::default(),
             cross,
+            rate_shift,
             rate_rows,
             rate_bounds,
         };

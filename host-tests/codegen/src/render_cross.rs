@@ -10,7 +10,7 @@
 //! (each input repeated by its exponent, starting from the first factor), `q` Horner in
 //! `u` over the term's coefficients, highest power first, starting from the highest.
 use crate::contract::{COMPONENTS, CROSS_SCALES_F32, HALF_RANGES, SWEEPS, UNITS};
-use crate::fixed::{FixedTables, CROSS_DIVISORS, RATE_SHIFT};
+use crate::fixed::{FixedTables, CROSS_DIVISORS};
 use crate::literal::f32_literal;
 use crate::model::Model;
 use std::fmt::Write as _;
@@ -267,7 +267,7 @@ fn reduced_monomial_q15(e: [u8; 4], k: usize) -> Option<String> {
 fn render_rust_cross_rates_fixed(w: &mut String, t: &FixedTables) {
     for (name, k) in [("x", 0), ("z", 1)] {
         let _ = writeln!(w);
-        let _ = writeln!(w, "/// Adds every cross term's {name} rates to `g[c][i]` (Q(G - {RATE_SHIFT}) per unit of t_{name}).");
+        let _ = writeln!(w, "/// Adds every cross term's {name} rates to `g[c][i]` (Q(G - R) per unit of t_{name}, `R = RATE_SHIFTS[c]`).");
         let _ = writeln!(w, "#[inline(always)]");
         let _ = writeln!(w, "#[allow(unused_variables)]");
         let _ = writeln!(w, "pub(crate) fn add_cross_rates_{name}(n: [i32; 4], g: &mut [[i32; 5]; 6]) {{");
@@ -288,7 +288,7 @@ fn render_rust_cross_rates_fixed(w: &mut String, t: &FixedTables) {
                     );
                     let _ = writeln!(w, "    let r = {r};");
                     for (i, p) in x.coeffs.iter().enumerate() {
-                        let p3 = p >> RATE_SHIFT;
+                        let p3 = p >> comp.rate_shift;
                         if p3 == 0 {
                             continue;
                         }

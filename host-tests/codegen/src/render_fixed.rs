@@ -1,7 +1,7 @@
 //! Rendering the fixed-point tables ([`FixedTables`]) as Rust (`tables_fixed.rs`). Like
 //! the f32 tables, the text depends only on the model.
 use crate::contract::{COMPONENTS, DEPTH_MAX_MM, HALF_RANGES, ODD, SWEEPS, UNITS};
-use crate::fixed::{FixedTables, DEPTH_DIVISOR, LIMIT, NORM_FRAC_BITS, POSE_FRAC_BITS, RATE_SHIFT, SWEEP_DIVISORS};
+use crate::fixed::{FixedTables, DEPTH_DIVISOR, LIMIT, MAX_RATE_SHIFT, NORM_FRAC_BITS, POSE_FRAC_BITS, SWEEP_DIVISORS};
 use crate::model::Model;
 use std::fmt::Write as _;
 
@@ -137,12 +137,14 @@ pub fn render_rust_fixed(model: &Model, t: &FixedTables) -> String {
 /// The fixed-point stiffness's tables (coeffs/README.md, "Fixed-point stiffness").
 fn render_rate_tables(w: &mut String, t: &FixedTables) {
     let _ = writeln!(w);
-    let _ = writeln!(w, "/// The stiffness differentiates coefficients shifted right by `RATE_SHIFT` (`A_i >> 3`, `P_j >> 3`),");
-    let _ = writeln!(w, "/// so every rate is computed in Q(G - 3) and its Horner intermediates stay within 2^30.");
-    let _ = writeln!(w, "pub const RATE_SHIFT: u32 = {RATE_SHIFT};");
+    let _ = writeln!(w, "/// The stiffness differentiates coefficients shifted right by `R = RATE_SHIFTS[c]`");
+    let _ = writeln!(w, "/// (`min({MAX_RATE_SHIFT}, G)`: `A_i >> R`, `P_j >> R`), so every rate is computed in Q(G - R) and its Horner");
+    let _ = writeln!(w, "/// intermediates stay within 2^30.");
+    let r: Vec<String> = t.components.iter().map(|c| c.rate_shift.to_string()).collect();
+    let _ = writeln!(w, "pub const RATE_SHIFTS: [u32; 6] = [{}];", r.join(", "));
     let _ = writeln!(w, "/// Row t-derivatives of the x and z sweeps `[component][sweep][i][j]`:");
-    let _ = writeln!(w, "/// `RATE_ROWS[c][k][i][j] = (j + 1) * (ROWS[c][k][i][j + 1] >> RATE_SHIFT)` multiplies `t_k^j`,");
-    let _ = writeln!(w, "/// in the row's Q(f - 3) (aligned to Q(G - 3) by the same `SHIFTS[c][k][i]`).");
+    let _ = writeln!(w, "/// `RATE_ROWS[c][k][i][j] = (j + 1) * (ROWS[c][k][i][j + 1] >> RATE_SHIFTS[c])` multiplies `t_k^j`,");
+    let _ = writeln!(w, "/// in the row's Q(f - R) (aligned to Q(G - R) by the same `SHIFTS[c][k][i]`).");
     let _ = writeln!(w, "pub const RATE_ROWS: [[[[i32; 4]; 5]; 2]; 6] = [");
     for (c, comp) in t.components.iter().enumerate() {
         let [d, x, z] = comp.rate_bounds;

@@ -169,10 +169,10 @@ pub fn eval(t: &TablesFixed, pose: [i32; 5]) -> Result<([i32; 6], u8), Overflow>
     Ok((w, acc.status))
 }
 
-/// The rates are computed on coefficients divided by `2^RATE_SHIFT` (floor).
-pub const RATE_SHIFT: u32 = 3;
+/// The rates are computed on coefficients divided by `2^R` (floor), `R = min(3, G)`.
+pub const MAX_RATE_SHIFT: u32 = 3;
 
-/// `n / d` rounded half up (`floor((n + d/2) / d)`, `d` even and positive), as an i32.
+/// `n / d` rounded to nearest (`floor((n + floor(d/2)) / d)`, `d > 0`), as an i32.
 fn div_round(n: i64, d: i64, what: &dyn Fn() -> String) -> Result<i32, Overflow> {
     let q = (n + d / 2).div_euclid(d);
     i32::try_from(q).map_err(|_| Overflow { what: what(), value: Some(q) })
@@ -188,10 +188,10 @@ fn horner_n(p: &[i64], w: i64, what: &dyn Fn() -> String) -> Result<i64, Overflo
     Ok(acc)
 }
 
-/// The derivative's coefficients of `p` (`p[j]` multiplies `w^j`) on `p >> 3`:
-/// `[(j + 1) * floor(p[j + 1] / 8)]`, checked.
-fn rate_coefficients(p: &[i64; NCOEF], what: &dyn Fn() -> String) -> Result<Vec<i64>, Overflow> {
-    p.iter().enumerate().skip(1).map(|(j, pj)| check(Some(j as i64 * pj.div_euclid(1 << RATE_SHIFT)), what)).collect()
+/// The derivative's coefficients of `p` (`p[j]` multiplies `w^j`) on `p >> r`:
+/// `[(j + 1) * floor(p[j + 1] / 2^r)]`, checked.
+fn rate_coefficients(p: &[i64; NCOEF], r: u32, what: &dyn Fn() -> String) -> Result<Vec<i64>, Overflow> {
+    p.iter().enumerate().skip(1).map(|(j, pj)| check(Some(j as i64 * pj.div_euclid(1 << r)), what)).collect()
 }
 
 /// The wrench (µN, µN·mm), the rates `[by depth, by x, by z]` (each `[fx .. mz]`) and
@@ -203,21 +203,18 @@ pub type RatesFixed = ([i32; 6], [[i32; 6]; 3], u8);
 /// stiffness".
 ///
 /// # Errors
-/// An intermediate leaves `|v| <= 2^30`, or a component's format `G` is below 4 (the
-/// tables do not meet the contract).
+/// An intermediate leaves `|v| <= 2^30` (the tables do not meet the contract).
 pub fn eval_rates(t: &TablesFixed, pose: [i32; 5]) -> Result<RatesFixed, Overflow> {
     let (w, status) = eval(t, pose)?;
     let acc = accumulate(t, pose)?;
     let mut rates = [[0i32; 6]; 3];
     for c in 0..6 {
         let g = t.acc_frac[c];
-        if g < 4 {
-            return Err(Overflow { what: format!("component {c}: accumulator format Q{g} below Q4"), value: None });
-        }
-        let unit = 1i64 << (g - RATE_SHIFT);
-        // by depth: E_i = (i + 1) * (A_(i+1) >> 3), D = h(E, U), rate = round(D / (3 * 2^(G-3)))
+        let rs = g.min(MAX_RATE_SHIFT);
+        let unit = 1i64 << (g - rs);
+        // by depth: E_i = (i + 1) * (A_(i+1) >> R), D = h(E, U), rate = round(D / (3 * 2^(G-R)))
         let what = || format!("rate by depth of component {c}");
-        let e = rate_coefficients(&acc.a[c], &what)?;
+        let e = rate_coefficients(&acc.a[c], rs, &what)?;
         let d = horner_n(&e, acc.u, &what)?;
         rates[0][c] = div_round(d, 3 * unit, &what)?;
         // by x and z: row rates (sign by the chain rule through |v|), cross-term rates
@@ -227,7 +224,7 @@ pub fn eval_rates(t: &TablesFixed, pose: [i32; 5]) -> Result<RatesFixed, Overflo
             let minus = acc.v[ki] < 0 && !k.is_odd(c);
             let mut g_i = [0i64; NCOEF];
             for (i, gi) in g_i.iter_mut().enumerate() {
-                let r = horner_n(&rate_coefficients(&t.rows[ki][c][i], &what)?, acc.tk[ki], &what)?;
+                let r = horner_n(&rate_coefficients(&t.rows[ki][c][i], rs, &what)?, acc.tk[ki], &what)?;
                 let shifted = r.div_euclid(1i64 << (t.row_frac[ki][c][i] - g));
                 *gi = check(if minus { gi.checked_sub(shifted) } else { gi.checked_add(shifted) }, what)?;
             }
@@ -240,7 +237,7 @@ pub fn eval_rates(t: &TablesFixed, pose: [i32; 5]) -> Result<RatesFixed, Overflo
                 reduced[ki] -= 1;
                 let r = monomial(factors(&reduced, acc.n), 1 << 15, &what)?;
                 for (i, pi) in p.iter().enumerate() {
-                    let prod = step(pi.div_euclid(1 << RATE_SHIFT), r, 0, &what)?;
+                    let prod = step(pi.div_euclid(1 << rs), r, 0, &what)?;
                     let term = check(Some(ek * prod.div_euclid(1i64 << (f - g + 1))), what)?;
                     g_i[i] = check(g_i[i].checked_add(term), what)?;
                 }
