@@ -1,5 +1,5 @@
 //! The explorer's wasm evaluator reproduces the set's golden vectors bit for bit: the
-//! module `needle explore` serves (host-tests/wasm, built for wasm32-unknown-unknown with
+//! module `needle explore` serves (crates/wasm, built for wasm32-unknown-unknown with
 //! the default set) replays every row of coeffs/default/golden-f32.csv under Node, through
 //! the same glue the page uses (src/explore/page/needle-wasm.mjs). Node and the wasm32
 //! target are required (`.ci/test` installs both); missing, the test fails.

@@ -1,4 +1,4 @@
-//! Build of the explorer's WebAssembly evaluator (`host-tests/wasm`) for one set.
+//! Build of the explorer's WebAssembly evaluator (`crates/wasm`) for one set.
 
 use crate::firmware::build::{check_target, nested_cargo, run_cargo, target_dir};
 use anyhow::{bail, Result};

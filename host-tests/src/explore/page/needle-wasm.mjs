@@ -1,4 +1,4 @@
-// The needle-haptics f32 evaluator (host-tests/wasm, the firmware's own no_std source)
+// The needle-haptics f32 evaluator (crates/wasm, the firmware's own no_std source)
 // as a JavaScript object. Shared by the explorer page and the Node golden check
 // (host-tests/tests/explore/golden.mjs), so both run the same glue.
 //
