@@ -4,7 +4,6 @@
 
 pub mod cli;
 pub mod explore;
-pub mod fe;
 pub mod firmware;
 pub mod fit;
 pub mod fixed_error;

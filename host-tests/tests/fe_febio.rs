@@ -5,11 +5,11 @@
 //! on. They need `febio4` (`.ci/install-febio`, which `.ci/test` runs first); without it
 //! they fail, they are not skipped.
 
-use needle_host::fe::febio;
-use needle_host::fe::manifest::{read_manifest, MANIFEST};
-use needle_host::fe::results;
-use needle_host::fe::spec::Engine;
-use needle_host::fe::verify::{self, VerifyOptions};
+use needle_fe::febio;
+use needle_fe::manifest::{read_manifest, MANIFEST};
+use needle_fe::results;
+use needle_fe::spec::Engine;
+use needle_fe::verify::{self, VerifyOptions};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 

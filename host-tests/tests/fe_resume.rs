@@ -6,9 +6,9 @@
 mod fe_common;
 use fe_common::{default_set, needle, show, NEEDLE};
 
-use needle_host::fe::campaign::MANIFEST_LOCK;
-use needle_host::fe::manifest::{read_manifest, MANIFEST};
-use needle_host::fe::{ccx, results, spec};
+use needle_fe::campaign::MANIFEST_LOCK;
+use needle_fe::manifest::{read_manifest, MANIFEST};
+use needle_fe::{ccx, results, spec};
 use std::os::unix::process::CommandExt;
 use std::path::Path;
 use std::process::{Command, Stdio};

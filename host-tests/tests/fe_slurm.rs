@@ -7,7 +7,7 @@
 mod fe_common;
 use fe_common::{default_set, needle, show};
 
-use needle_host::fe::manifest::{read_manifest, MANIFEST};
+use needle_fe::manifest::{read_manifest, MANIFEST};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
@@ -152,7 +152,7 @@ fn a_cancelled_task_is_resubmitted_alone_and_nothing_finished_is_redone() {
     let work = set.join("fe/.work/x+04");
     let start = Instant::now();
     loop {
-        if needle_host::fe::ccx::steps_done(&work, "pose") >= 1 {
+        if needle_fe::ccx::steps_done(&work, "pose") >= 1 {
             break;
         }
         assert!(start.elapsed() < Duration::from_secs(240), "x+04 never finished a step: {:?}", queued(&job));

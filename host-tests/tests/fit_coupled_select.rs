@@ -2,8 +2,8 @@
 //! coeffs/README.md "The coupled form"): on training runs made from the default set's
 //! paper model with a known cross term in fy and an unrepresentable wiggle in fx, fy
 //! gets its term back and every other component none.
-use needle_host::fe::results::Row;
-use needle_host::fe::spec::{PoseSpec, Role};
+use needle_fe::results::Row;
+use needle_fe::spec::{PoseSpec, Role};
 use needle_host::fit::contract::COMPONENTS;
 use needle_host::fit::coupled::{scales, select_and_fit};
 use needle_host::fit::data::Run;

@@ -303,7 +303,7 @@ fn fit_without_accepts_only_listed_sweep_runs() {
         (r#"["t2-a"]"#, "only sweep runs can be left out"),
     ] {
         set_fit_without(dir.path(), list);
-        let e = needle_host::fe::spec::load(dir.path()).expect_err(list);
+        let e = needle_fe::spec::load(dir.path()).expect_err(list);
         let msg = format!("{e:#}");
         assert!(msg.contains("campaign.fit_without") && msg.contains(want), "{list}: {msg}");
     }
@@ -350,14 +350,14 @@ fn a_table2_run_with_a_wrong_fz_fails_its_goal() {
     let fy_pct = good.fy_rel_max_pct;
     // Fz + 10 % of the run's peak |Fy| at every depth (Fy untouched)
     let csv = dir.path().join("fe").join(format!("{name}.csv"));
-    let rows = needle_host::fe::results::read_csv(&csv).expect("read run");
+    let rows = needle_fe::results::read_csv(&csv).expect("read run");
     let peak_fy = rows.iter().map(|r| r.wrench[1].abs()).fold(0.0, f64::max);
     let edited: Vec<_> = rows
         .iter()
         .map(|r| {
             let mut w = r.wrench;
             w[2] += 0.1 * peak_fy;
-            needle_host::fe::results::Row { depth_mm: r.depth_mm, wrench: w }
+            needle_fe::results::Row { depth_mm: r.depth_mm, wrench: w }
         })
         .collect();
     fit_synthetic::rewrite_run(dir.path(), &name, &edited);

@@ -1,8 +1,8 @@
 //! `needle fe ...`: the FE campaign commands.
-use crate::fe::campaign::{self, RunOptions};
-use crate::fe::launcher::slurm::{self, SlurmOptions};
-use crate::fe::launcher::Launched;
 use clap::{Args, Subcommand};
+use needle_fe::campaign::{self, RunOptions};
+use needle_fe::launcher::slurm::{self, SlurmOptions};
+use needle_fe::launcher::Launched;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
@@ -250,11 +250,11 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
         print!("{}", submit_summary(&r));
         return Ok(ExitCode::SUCCESS);
     }
-    crate::fe::process::stop_jobs_on_termination()?;
+    needle_fe::process::stop_jobs_on_termination()?;
     let report = campaign::run(&opts)?;
     print!("{}", report.table());
-    if crate::fe::process::interrupted() {
-        return Ok(ExitCode::from(crate::fe::process::EXIT_INTERRUPTED));
+    if needle_fe::process::interrupted() {
+        return Ok(ExitCode::from(needle_fe::process::EXIT_INTERRUPTED));
     }
     Ok(if report.failed() > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS })
 }
@@ -287,13 +287,13 @@ fn submit_summary(r: &slurm::SubmitReport) -> String {
 
 fn run_status(a: StatusArgs) -> anyhow::Result<ExitCode> {
     let plan = campaign::plan(&spec_options(a.spec)?)?;
-    let r = crate::fe::launcher::status::status(&plan)?;
+    let r = needle_fe::launcher::status::status(&plan)?;
     print!("{}", r.table());
     if !a.project_nodes.is_empty() {
         let per_node =
             a.tasks_per_node.map(|n| n as usize).unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
         let nodes: Vec<usize> = a.project_nodes.iter().map(|&n| n as usize).collect();
-        print!("{}", crate::fe::launcher::projection::table(&plan, &nodes, per_node));
+        print!("{}", needle_fe::launcher::projection::table(&plan, &nodes, per_node));
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -301,7 +301,7 @@ fn run_status(a: StatusArgs) -> anyhow::Result<ExitCode> {
 /// The run options of `spec`, the others at their defaults.
 fn spec_options(spec: SpecArgs) -> anyhow::Result<RunOptions> {
     Ok(RunOptions {
-        solver: spec.solver.as_deref().map(crate::fe::spec::Engine::parse).transpose()?,
+        solver: spec.solver.as_deref().map(needle_fe::spec::Engine::parse).transpose()?,
         only: spec.only,
         mesh: spec.mesh,
         steps: spec.steps,
@@ -317,11 +317,11 @@ fn run_one(a: RunOneArgs) -> anyhow::Result<ExitCode> {
     let threads = std::env::var("SLURM_CPUS_PER_TASK").ok().and_then(|v| v.trim().parse::<usize>().ok()).unwrap_or(1).max(1);
     let only = Some(a.pose.clone());
     let opts = with_solve(RunOptions { jobs: 1, threads, only, launcher: Launched::from_env(), ..spec_options(a.spec)? }, &a.solve);
-    crate::fe::process::stop_jobs_on_termination()?;
+    needle_fe::process::stop_jobs_on_termination()?;
     let report = campaign::run(&opts)?;
     print!("{}", report.table());
-    if crate::fe::process::interrupted() {
-        return Ok(ExitCode::from(crate::fe::process::EXIT_INTERRUPTED));
+    if needle_fe::process::interrupted() {
+        return Ok(ExitCode::from(needle_fe::process::EXIT_INTERRUPTED));
     }
     Ok(if report.failed() > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS })
 }
@@ -331,7 +331,7 @@ fn run_verify(a: VerifyArgs) -> anyhow::Result<ExitCode> {
         anyhow::bail!("--punch-mesh-scale {}: must be a number >= 1", a.punch_mesh_scale);
     }
     let all = !(a.punch || a.mesh || a.mirror);
-    let opts = crate::fe::verify::VerifyOptions {
+    let opts = needle_fe::verify::VerifyOptions {
         set_dir: a.set,
         punch: a.punch || all,
         mesh: a.mesh || all,
@@ -340,10 +340,10 @@ fn run_verify(a: VerifyArgs) -> anyhow::Result<ExitCode> {
         punch_mesh_scale: a.punch_mesh_scale,
         punch_campaign_element: !a.no_campaign_element,
         threads: a.threads.map(|t| t as usize).unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)),
-        engine: a.solver.as_deref().map(crate::fe::spec::Engine::parse).transpose()?,
+        engine: a.solver.as_deref().map(needle_fe::spec::Engine::parse).transpose()?,
     };
-    crate::fe::process::stop_jobs_on_termination()?;
-    let (_, ok) = crate::fe::verify::run(&opts)?;
+    needle_fe::process::stop_jobs_on_termination()?;
+    let (_, ok) = needle_fe::verify::run(&opts)?;
     if !ok {
         eprintln!("needle fe verify: a check missed its goal");
     }

@@ -229,7 +229,7 @@ fn eval_file(file: &Path, out: Option<&Path>, json: bool) -> anyhow::Result<Exit
     let body = if json { serde_json::to_string_pretty(&to_json(&poses, &evals))? + "\n" } else { to_csv(&poses, &evals) };
     match out {
         Some(path) => {
-            crate::fe::results::write_atomic(path, body.as_bytes())?;
+            needle_fe::results::write_atomic(path, body.as_bytes())?;
             eprintln!("wrote {} ({} poses)", path.display(), poses.len());
         }
         None => {
@@ -248,10 +248,10 @@ fn eval_file(file: &Path, out: Option<&Path>, json: bool) -> anyhow::Result<Exit
 pub fn header(a: HeaderArgs) -> anyhow::Result<ExitCode> {
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     let path = a.out.join(needle_codegen::C_HEADER_FILE);
-    crate::fe::results::write_atomic(&path, model_info::C_HEADER.as_bytes())?;
+    needle_fe::results::write_atomic(&path, model_info::C_HEADER.as_bytes())?;
     // the C API's own header (functions, types, NEEDLE_STATUS_* / NEEDLE_LOOP_* constants)
     let api = a.out.join("needle.h");
-    crate::fe::results::write_atomic(&api, needle_capi::HEADER.as_bytes())?;
+    needle_fe::results::write_atomic(&api, needle_capi::HEADER.as_bytes())?;
     println!("wrote {} (the C API: link libneedle_capi.a from `cargo build --release -p needle-capi`)", api.display());
     if model_info::FITTED {
         println!("wrote {} (set {}, fe_sha256 {})", path.display(), model_info::SET, model_info::FE_SHA256);

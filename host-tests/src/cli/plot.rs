@@ -1,8 +1,8 @@
 //! `needle plot`: write (or check) the figures of a set.
 
-use crate::fe::results::write_atomic;
 use anyhow::{Context, Result};
 use clap::Args;
+use needle_fe::results::write_atomic;
 use std::path::PathBuf;
 use std::process::ExitCode;
 

@@ -13,8 +13,8 @@ use super::data::{load_training_runs, load_validation_runs, Run};
 use super::eval_f64::{eval_paper, eval_with_cross, Pose64};
 use super::model::Model;
 use super::validate::TABLE2_MIN_DEPTH_MM;
-use crate::fe::spec::Role;
 use anyhow::Result;
+use needle_fe::spec::Role;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -253,10 +253,10 @@ pub fn to_table(r: &CoupledReport) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fe::results::Row;
-    use crate::fe::spec::{PoseSpec, Role};
     use crate::fit::cross_terms::{CrossForm, CrossTerms};
     use crate::fit::model::Coupled;
+    use needle_fe::results::Row;
+    use needle_fe::spec::{PoseSpec, Role};
 
     /// The paper row of the report is the paper part alone: with cross terms in the
     /// model (as `needle fit` passes the fitted coupled model), a run equal to the paper

@@ -2,10 +2,10 @@
 //! validation runs, read from `<set>/fe/<pose>.csv` as the campaign spec names them.
 
 use super::contract::{Sweep, DEPTH_MAX_MM, NCOEF};
-use crate::fe::manifest::{read_manifest, Manifest, MANIFEST};
-use crate::fe::results::{parse_csv, Row};
-use crate::fe::spec::{self, hex, Campaign, ModelForm, PoseSpec, Role};
 use anyhow::{bail, Context, Result};
+use needle_fe::manifest::{read_manifest, Manifest, MANIFEST};
+use needle_fe::results::{parse_csv, Row};
+use needle_fe::spec::{self, hex, Campaign, ModelForm, PoseSpec, Role};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
@@ -104,7 +104,7 @@ fn check_content(set_dir: &Path, pose: &PoseSpec, path: &Path, bytes: &[u8]) -> 
     let manifest = read_set_manifest(set_dir)?;
     let Some(entry) = manifest.pose.get(&pose.name) else { return Ok(()) };
     if let (false, Some(want)) = (entry.content_matches(bytes), entry.csv_sha256.as_ref()) {
-        let have = crate::fe::results::content_sha256(bytes);
+        let have = needle_fe::results::content_sha256(bytes);
         bail!(
             "{}: content changed since the FE run wrote it (sha256 {} now, {} in fe/manifest.toml): restore it (git checkout) or rerun the pose with `needle fe run --force --only {}`",
             path.display(),

@@ -67,7 +67,7 @@ pub struct FitOutput {
 pub fn fit_set(set_dir: &Path) -> Result<FitOutput> {
     let data = data::load_fit_data(set_dir)?;
     let mut model = model::fit(&data)?;
-    if data.campaign.fit.form == crate::fe::spec::ModelForm::Coupled {
+    if data.campaign.fit.form == needle_fe::spec::ModelForm::Coupled {
         model.cross = Some(coupled::fit_coupled(&model, &data.train, data.campaign.needle.reference_from_tip_mm)?);
     }
     let model_toml = model_file::to_toml(&model, &data.campaign.campaign.fit_without);

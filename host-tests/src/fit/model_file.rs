@@ -6,8 +6,8 @@ use super::contract::{Sweep, COMPONENTS, DEPTH_MAX_MM, NCOEF, THETA_MAX_DEG, XZ_
 use super::coupled::FOLDS;
 use super::cross_terms::{monomials, CrossForm, CrossTerms, Exponents, CANDIDATES};
 use super::model::{Baseline, Coupled, Deviation, Model};
-use crate::fe::spec::ModelForm;
 use anyhow::{bail, Result};
+use needle_fe::spec::ModelForm;
 use serde::Deserialize;
 use std::fmt::Write as _;
 use std::path::Path;

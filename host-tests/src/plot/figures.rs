@@ -7,12 +7,12 @@
 //! ([`crate::fit::eval_f64`]), FE points its current runs.
 
 use super::panel::{Panel, Series, Style, COMPONENT_COLOURS};
-use crate::fe::spec::Role;
 use crate::fit::contract::{unit, Sweep, COMPONENTS, DEPTH_MAX_MM};
 use crate::fit::data::{load_fit_data, load_validation_runs, Run};
 use crate::fit::eval_f64::eval;
 use crate::fit::model::Model;
 use anyhow::Result;
+use needle_fe::spec::Role;
 use plotters::style::RGBColor;
 use std::path::Path;
 

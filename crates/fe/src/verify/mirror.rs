@@ -2,8 +2,8 @@
 //! mirrored counterpart, with the sign flips of coeffs/README.md (goal 1% of peak |Fy|).
 //! No solve: it reads `fe/<pose>.csv`.
 
-use crate::fe::results;
-use crate::fe::spec::{Campaign, PoseSpec, Role};
+use crate::results;
+use crate::spec::{Campaign, PoseSpec, Role};
 use anyhow::{bail, Result};
 use serde::Serialize;
 use std::path::Path;
@@ -84,7 +84,7 @@ pub(super) fn mirror_checks(c: &Campaign, fe: &Path) -> Result<Vec<MirrorReport>
             pose: m.name.clone(),
             counterpart: cp.name.clone(),
             max_difference: worst,
-            component: crate::fit::contract::COMPONENTS[comp].to_string(),
+            component: needle_contract::COMPONENTS[comp].to_string(),
             percent_of_peak_fy: if peak > 0.0 { 100.0 * worst_rel / peak } else { f64::INFINITY },
         });
     }

@@ -4,8 +4,8 @@
 //! slots that free up), and the projection is the time the last slot finishes. It counts
 //! neither queue waiting nor the slower cores a cluster may have.
 
-use crate::fe::campaign::Plan;
-use crate::fe::deck;
+use crate::campaign::Plan;
+use crate::deck;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
@@ -66,7 +66,7 @@ pub fn human(s: f64) -> String {
 pub fn table(plan: &Plan, nodes: &[usize], tasks_per_node: usize) -> String {
     let engine = plan.campaign.solver.engine.name();
     let measured =
-        |e: &&crate::fe::manifest::ManifestEntry| e.engine == engine && e.mesh == plan.mesh_name && e.steps == plan.steps && e.wall_s > 0.0;
+        |e: &&crate::manifest::ManifestEntry| e.engine == engine && e.mesh == plan.mesh_name && e.steps == plan.steps && e.wall_s > 0.0;
     let by_kind = plan.manifest.wall_times_s(engine, &plan.mesh_name, plan.steps);
     let median = |v: &Vec<f64>| {
         let mut v = v.clone();

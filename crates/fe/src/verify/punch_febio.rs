@@ -13,10 +13,10 @@ use super::punch::{
     PUNCH_MU_N_PER_MM2,
 };
 use super::VerifyOptions;
-use crate::fe::febio;
-use crate::fe::febio::logs;
-use crate::fe::process;
-use crate::fe::spec::{self, Campaign};
+use crate::febio;
+use crate::febio::logs;
+use crate::process;
+use crate::spec::{self, Campaign};
 use anyhow::{bail, Context, Result};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -128,7 +128,7 @@ pub fn solve_punch(exe: &Path, c: &Campaign, mesh_scale: f64, a: f64, delta: f64
     let _ = std::fs::remove_file(&log_path);
     let mut cmd = std::process::Command::new(exe);
     cmd.args(["-nosplash", "-i", "punch.feb", "-o", "punch.log", "-p", "punch.xplt"]).env("OMP_NUM_THREADS", "1");
-    let done = process::run(cmd, dir, &dir.join("febio.out"), &[dir.join("punch.log")], None, Some(crate::fe::campaign::DEFAULT_STALL))?;
+    let done = process::run(cmd, dir, &dir.join("febio.out"), &[dir.join("punch.log")], None, Some(crate::campaign::DEFAULT_STALL))?;
     let run = logs::parse_run_log(&std::fs::read_to_string(dir.join("punch.log")).unwrap_or_default());
     if done.exit != process::ExitKind::Code(0) || !run.normal_termination {
         bail!(

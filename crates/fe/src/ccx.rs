@@ -2,7 +2,7 @@
 //! with one thread, a wall-clock timeout, and the job's `.sta` status file (increments,
 //! iterations, and the last completed step while the job runs).
 
-use crate::fe::process;
+use crate::process;
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -56,8 +56,8 @@ pub fn parse_version(text: &str) -> Option<String> {
     None
 }
 
-use crate::fe::process::which;
-pub use crate::fe::process::{interrupted, stop_jobs_on_termination, tail, ExitKind, EXIT_INTERRUPTED, LOG_TAIL_LINES};
+use crate::process::which;
+pub use crate::process::{interrupted, stop_jobs_on_termination, tail, ExitKind, EXIT_INTERRUPTED, LOG_TAIL_LINES};
 
 /// Increments and iterations of a job, from its `.sta` file.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -102,7 +102,7 @@ pub fn parse_sta(text: &str) -> StaSummary {
             Some(a) => (a, true),
             None => (*att, false),
         };
-        let (Ok(_), Ok(itrs), Some(tot)) = (att.parse::<u32>(), itrs.parse::<u32>(), crate::fe::dat::parse_fortran(tot)) else {
+        let (Ok(_), Ok(itrs), Some(tot)) = (att.parse::<u32>(), itrs.parse::<u32>(), crate::dat::parse_fortran(tot)) else {
             continue;
         };
         s.iterations += itrs;

@@ -51,7 +51,7 @@
 //! instability, so check 2 covers it. As in Abaqus, only principal strain increments
 //! are tested.
 
-use crate::fe::spec::Tissue;
+use crate::spec::Tissue;
 use anyhow::{bail, Result};
 use serde::Serialize;
 use std::fmt;

@@ -1,8 +1,8 @@
 //! Which [`Backend`] solves a run: the one place that knows every engine.
 
-use crate::fe::backend::{Backend, CcxBackend};
-use crate::fe::febio::FebioBackend;
-use crate::fe::spec::Engine;
+use crate::backend::{Backend, CcxBackend};
+use crate::febio::FebioBackend;
+use crate::spec::Engine;
 
 /// The backend of `engine`, its jobs each on `threads` solver threads (ccx always runs
 /// on one: its SPOOLES factorisation is serial in Debian's build).

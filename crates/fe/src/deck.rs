@@ -20,8 +20,8 @@ use anyhow::{bail, Result};
 use serde::Serialize;
 use std::fmt::Write;
 
-/// Version of the mesh and deck generator ([`versions::CCX_DECK`](crate::fe::versions::CCX_DECK)).
-pub use crate::fe::versions::CCX_DECK as GENERATOR_VERSION;
+/// Version of the mesh and deck generator ([`versions::CCX_DECK`](crate::versions::CCX_DECK)).
+pub use crate::versions::CCX_DECK as GENERATOR_VERSION;
 
 /// CalculiX ids of the needle's first node and first element: right after the tissue's
 /// (tissue ids start at 1). The ids are contiguous on purpose: ccx sizes its per-node and

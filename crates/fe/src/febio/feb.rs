@@ -20,9 +20,9 @@
 //!   load step with automatic time stepping between; the log file records the rigid
 //!   body's reaction force and moment at the must points only.
 
-use crate::fe::deck::{model_name, MeshSummary};
-use crate::fe::mesh::{self, NeedleMesh, TissueMesh, FACES};
-use crate::fe::spec::{Campaign, FebioSettings, MeshLevel, PoseSpec, Symmetry};
+use crate::deck::{model_name, MeshSummary};
+use crate::mesh::{self, NeedleMesh, TissueMesh, FACES};
+use crate::spec::{Campaign, FebioSettings, MeshLevel, PoseSpec, Symmetry};
 use anyhow::{bail, Result};
 use std::fmt::Write;
 

@@ -1,5 +1,5 @@
 //! The versions of the two input generators, part of every run's spec hash
-//! ([`Campaign::run_hash`](crate::fe::spec::Campaign::run_hash)): bump one when its
+//! ([`Campaign::run_hash`](crate::spec::Campaign::run_hash)): bump one when its
 //! generator's output changes, and the campaign reruns that engine's poses. Defined here,
 //! apart from the generators, so that the spec does not depend on them.
 

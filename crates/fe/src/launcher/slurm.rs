@@ -2,7 +2,7 @@
 //! array, one task per pose. Each task runs `needle fe run-one --pose <name>` with the
 //! same spec options, which solves the pose through the campaign's own code path and
 //! writes `<out>/<pose>.csv` and its manifest entry atomically, the manifest under the
-//! campaign's file lock ([`lock_manifest`](crate::fe::campaign::lock_manifest)), so
+//! campaign's file lock ([`lock_manifest`](crate::campaign::lock_manifest)), so
 //! the folder ends exactly as a local run would leave it (plus `launcher = "slurm"` and
 //! `batch_job` in the entries).
 //!
@@ -17,16 +17,16 @@
 //! earlier submission is still pending or running (`squeue`), so rerunning the command
 //! after a cancelled or partly failed array submits only what is missing or stale. A
 //! failed task has already had the engine's retries inside it (the same
-//! [`solve_with_retry`](crate::fe::campaign) as a local job).
+//! [`solve_with_retry`](crate::campaign) as a local job).
 //!
 //! Before anything is submitted nothing of the set changes: a missing `sbatch`, a
 //! controller that does not answer, or a submission that SLURM refuses is one error, and
 //! `<out>/.slurm/` is only kept once a job was accepted.
 
-use crate::fe::campaign::{self, Plan, RunOptions};
-use crate::fe::manifest::rfc3339_utc;
-use crate::fe::process::which;
-use crate::fe::results;
+use crate::campaign::{self, Plan, RunOptions};
+use crate::manifest::rfc3339_utc;
+use crate::process::which;
+use crate::results;
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -235,7 +235,7 @@ pub fn submit(opts: &RunOptions, slurm: &SlurmOptions) -> Result<SubmitReport> {
     if poses.is_empty() {
         return Ok(report);
     }
-    let attempts = crate::fe::engines::backend_for(plan.campaign.solver.engine, 1).attempts();
+    let attempts = crate::engines::backend_for(plan.campaign.solver.engine, 1).attempts();
     let res = Resources::defaults(&plan, attempts, slurm);
     let out_abs = absolute(&plan.out_dir)?;
     let slurm_dir = out_abs.join(SLURM_DIR);

@@ -1,6 +1,6 @@
 //! Where the campaign's solver jobs run, chosen apart from the solver (`--launcher`):
 //! - `local` (the default): worker threads of `needle fe run` on this machine
-//!   ([`campaign::run`](crate::fe::campaign::run)).
+//!   ([`campaign::run`](crate::campaign::run)).
 //! - `slurm`: one SLURM job array per `needle fe run --launcher slurm`, one array task
 //!   per pose still to solve ([`slurm`]); each task is `needle fe run-one`, which solves
 //!   its pose through the same code path as a local job (deck, solver, retries, CSV and

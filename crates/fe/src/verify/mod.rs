@@ -86,8 +86,8 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
     }
     if opts.punch {
         let p = match c.solver.engine {
-            crate::fe::spec::Engine::Febio => punch_febio::punch(&c, &work, opts)?,
-            crate::fe::spec::Engine::Ccx => punch::punch(&c, &work, opts)?,
+            crate::spec::Engine::Febio => punch_febio::punch(&c, &work, opts)?,
+            crate::spec::Engine::Ccx => punch::punch(&c, &work, opts)?,
         };
         println!(
             "flat punch a = {} mm, delta = {} mm, nu = {:.4}, {}: F(block) = {:.5e} N, F(2x block) = {:.5e} N, \

@@ -783,8 +783,8 @@ impl Campaign {
             mesh: self.mesh.get(mesh_name),
             pose,
             generator: match self.solver.engine {
-                Engine::Ccx => crate::fe::versions::CCX_DECK,
-                Engine::Febio => crate::fe::versions::FEBIO_INPUT,
+                Engine::Ccx => crate::versions::CCX_DECK,
+                Engine::Febio => crate::versions::FEBIO_INPUT,
             },
             solver: (self.solver.engine != Engine::Ccx).then_some(&self.solver),
         };
@@ -900,7 +900,7 @@ mod tests {
     /// another design.
     #[test]
     fn training_poses_are_nested_stratified_sobol_prefixes() {
-        let set = Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default");
+        let set = crate::workspace_root().join("coeffs/default");
         let Ok((mut c, _)) = super::load(&set) else { panic!("cannot load {}", set.display()) };
         c.campaign.train_seed = 7;
         c.campaign.train_count = 16;
@@ -953,7 +953,7 @@ mod tests {
     /// Issue 18: a pose outside the block and a sweep pose off its axis were accepted.
     #[test]
     fn poses_outside_the_block_or_off_their_sweep_axis_are_refused() {
-        let set = Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default");
+        let set = crate::workspace_root().join("coeffs/default");
         let text = std::fs::read_to_string(set.join("campaign.toml")).expect("campaign.toml");
         let cases = [
             // block 10 mm wide: x+06 (the first listed pose beyond 4.5 mm) is outside

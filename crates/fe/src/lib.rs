@@ -1,6 +1,7 @@
 //! The FE campaign: spec, material check, mesh and deck writer, the ccx runner and
 //! result parser, the reduction of nodal reactions to the needle wrench, and the campaign
 //! driver (backend, manifest, report, progress).
+#![forbid(unsafe_code)]
 
 pub mod backend;
 pub mod campaign;
@@ -21,3 +22,9 @@ pub mod spec;
 pub mod verify;
 pub mod versions;
 pub mod wrench;
+
+/// The workspace root (this crate is `crates/fe`), for the unit tests' `coeffs/default`.
+#[cfg(test)]
+pub(crate) fn workspace_root() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}

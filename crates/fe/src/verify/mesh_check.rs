@@ -5,9 +5,9 @@
 //! (goal 2 %), and, with three or more levels, Richardson's estimate of the converged
 //! value from the finest three.
 
-use crate::fe::backend::Job;
-use crate::fe::engines::backend_for;
-use crate::fe::spec::{Campaign, Role};
+use crate::backend::Job;
+use crate::engines::backend_for;
+use crate::spec::{Campaign, Role};
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use std::path::Path;
@@ -108,14 +108,14 @@ pub(super) fn mesh_convergence(c: &Campaign, work: &Path, threads: usize) -> Res
             steps: c.loading.steps,
             work_dir: &dir,
             timeout: None,
-            stall: Some(crate::fe::campaign::DEFAULT_STALL),
+            stall: Some(crate::campaign::DEFAULT_STALL),
             first_increment: 1.0,
             attempt: 0,
         };
         // the campaign's attempts (Backend::attempts): a level is solved as a pose is;
         // wall_s counts every attempt, the manifest-style `retry` says which failed
         let start = std::time::Instant::now();
-        let solved = crate::fe::campaign::solve_with_retry(backend.as_ref(), &job);
+        let solved = crate::campaign::solve_with_retry(backend.as_ref(), &job);
         let wall_s = start.elapsed().as_secs_f64();
         let run = match solved {
             Ok(s) => LevelRun {

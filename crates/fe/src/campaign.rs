@@ -31,20 +31,20 @@
 //! with a softer contact penalty). The manifest entry records it (`first_increment`,
 //! `retry`, `solver_settings`). Only when the last attempt fails too is the pose failed.
 //!
-//! The pieces: [`backend`](crate::fe::backend) solves one pose, [`manifest`](crate::fe::manifest)
-//! records how each CSV was made, [`report`](crate::fe::report) is the outcome and
+//! The pieces: [`backend`](crate::backend) solves one pose, [`manifest`](crate::manifest)
+//! records how each CSV was made, [`report`](crate::report) is the outcome and
 //! `progress` the display.
 
-use crate::fe::backend::{Backend, Job, SolveFailure, Solved};
-use crate::fe::deck;
-use crate::fe::engines::backend_for;
-use crate::fe::launcher::Launched;
-use crate::fe::manifest::{manifest_text, read_manifest, rfc3339_utc, Manifest, ManifestEntry, MANIFEST};
-use crate::fe::process;
-use crate::fe::progress::Progress;
-use crate::fe::report::{PoseReport, Report, Status};
-use crate::fe::results::{self, Row};
-use crate::fe::spec::{self, Campaign, Engine, MeshLevel, PoseSpec};
+use crate::backend::{Backend, Job, SolveFailure, Solved};
+use crate::deck;
+use crate::engines::backend_for;
+use crate::launcher::Launched;
+use crate::manifest::{manifest_text, read_manifest, rfc3339_utc, Manifest, ManifestEntry, MANIFEST};
+use crate::process;
+use crate::progress::Progress;
+use crate::report::{PoseReport, Report, Status};
+use crate::results::{self, Row};
+use crate::spec::{self, Campaign, Engine, MeshLevel, PoseSpec};
 use anyhow::{bail, Context, Result};
 use std::collections::BTreeMap;
 use std::collections::VecDeque;
@@ -144,7 +144,7 @@ struct Ctx<'a> {
 /// the spec (with the `--solver` and `--steps` overrides applied), the mesh level, the
 /// output folder and, per selected pose, whether its result is up to date. Shared by the
 /// local run ([`run_with`]), the SLURM submission
-/// ([`launcher::slurm`](crate::fe::launcher::slurm)) and `needle fe status`.
+/// ([`launcher::slurm`](crate::launcher::slurm)) and `needle fe status`.
 pub struct Plan {
     /// The spec with the overrides applied.
     pub campaign: Campaign,
@@ -182,7 +182,7 @@ impl Plan {
 /// As [`run`], except solver problems (nothing is solved here).
 pub fn plan(opts: &RunOptions) -> Result<Plan> {
     let (mut campaign, spec_path) = spec::load(&opts.set_dir)?;
-    let stability = crate::fe::material::check(&campaign.tissue)
+    let stability = crate::material::check(&campaign.tissue)
         .with_context(|| format!("{}: the tissue fails the material stability check; nothing was run", spec_path.display()))?;
     eprintln!("material check passed: {}", stability.to_string().replace('\n', "\n  "));
     if let Some(engine) = opts.solver {
@@ -551,8 +551,8 @@ fn update_manifest(ctx: &Ctx<'_>, f: impl FnOnce(&mut Manifest)) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fe::deck::MeshSummary;
-    use crate::fe::spec::Role;
+    use crate::deck::MeshSummary;
+    use crate::spec::Role;
     use std::sync::atomic::{AtomicUsize, Ordering};
 
     /// A solver that returns a made-up wrench (bookkeeping tests only, no physics), can
@@ -624,7 +624,7 @@ mod tests {
 
     fn set_dir() -> tempfile::TempDir {
         let d = tempfile::tempdir().expect("tempdir");
-        let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default/campaign.toml");
+        let src = crate::workspace_root().join("coeffs/default/campaign.toml");
         std::fs::copy(&src, d.path().join("campaign.toml")).expect("copy the default spec");
         d
     }

@@ -73,7 +73,7 @@ pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<Row>> {
 #[must_use]
 pub fn content_sha256(bytes: &[u8]) -> String {
     use sha2::{Digest, Sha256};
-    crate::fe::spec::hex(&Sha256::digest(bytes))
+    crate::spec::hex(&Sha256::digest(bytes))
 }
 
 /// Read an FE result file.

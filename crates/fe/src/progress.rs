@@ -7,7 +7,7 @@
 //! runs, and the runs are scheduled over the jobs. Without them it comes from the load
 //! steps done so far, which underestimates: the deeper steps take more increments.
 
-use crate::fe::report::{PoseReport, Status};
+use crate::report::{PoseReport, Status};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;
 use std::io::IsTerminal;
@@ -37,7 +37,7 @@ pub(crate) struct Progress {
 
 impl Progress {
     /// `runs`: (pose name, model) in queue order; `earlier_walls_s`: measured wall times
-    /// by model ([`Manifest::wall_times_s`](crate::fe::manifest::Manifest::wall_times_s)).
+    /// by model ([`Manifest::wall_times_s`](crate::manifest::Manifest::wall_times_s)).
     pub(crate) fn new(runs: Vec<(String, String)>, steps: u32, jobs: usize, earlier_walls_s: BTreeMap<String, Vec<f64>>) -> Self {
         let (names, models): (Vec<String>, Vec<String>) = runs.into_iter().unzip();
         let total_steps = names.len() as u64 * u64::from(steps);

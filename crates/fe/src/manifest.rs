@@ -2,7 +2,7 @@
 //! increments, wall time), read to skip up-to-date poses and rewritten atomically by the
 //! campaign after each pose.
 
-use crate::fe::spec::{Campaign, PoseSpec, Role};
+use crate::spec::{Campaign, PoseSpec, Role};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -25,7 +25,7 @@ pub struct Manifest {
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ManifestEntry {
-    /// [`Campaign::run_hash`](crate::fe::spec::Campaign::run_hash) of the spec (with the steps actually run), pose and mesh.
+    /// [`Campaign::run_hash`](crate::spec::Campaign::run_hash) of the spec (with the steps actually run), pose and mesh.
     pub spec_hash: String,
     /// The engine that solved it: "ccx" or "febio" (entries written before there were
     /// two engines have none: ccx).
@@ -43,7 +43,7 @@ pub struct ManifestEntry {
     pub solver_settings: String,
     /// Mesh level name.
     pub mesh: String,
-    /// SHA-256 of the CSV as the campaign wrote it ([`results::content_sha256`](crate::fe::results::content_sha256)):
+    /// SHA-256 of the CSV as the campaign wrote it ([`results::content_sha256`](crate::results::content_sha256)):
     /// the fitter, validator, plots and explorer refuse a CSV whose content differs
     /// (`fit::data::read_run`). Entries written before it was recorded get it from
     /// the next `needle fe run` on their folder ([`Manifest::backfill_csv_hashes`]).
@@ -107,7 +107,7 @@ pub struct ManifestEntry {
 impl Manifest {
     /// The entry of `pose` when it says the pose's result came from the spec `campaign`
     /// as it is now, on mesh level `mesh_name` (its spec hash is
-    /// [`Campaign::run_hash`](crate::fe::spec::Campaign::run_hash)); otherwise why not.
+    /// [`Campaign::run_hash`](crate::spec::Campaign::run_hash)); otherwise why not.
     /// The one test of "current" shared by the campaign's skipping and by the fitter's
     /// and validator's refusal of stale runs.
     ///
@@ -133,7 +133,7 @@ impl ManifestEntry {
     /// or the entry predates the hash.
     #[must_use]
     pub fn content_matches(&self, bytes: &[u8]) -> bool {
-        self.csv_sha256.as_ref().is_none_or(|h| *h == crate::fe::results::content_sha256(bytes))
+        self.csv_sha256.as_ref().is_none_or(|h| *h == crate::results::content_sha256(bytes))
     }
 }
 
@@ -146,7 +146,7 @@ impl Manifest {
         for (name, e) in &mut self.pose {
             if e.csv_sha256.is_none() {
                 if let Ok(bytes) = std::fs::read(out_dir.join(format!("{name}.csv"))) {
-                    e.csv_sha256 = Some(crate::fe::results::content_sha256(&bytes));
+                    e.csv_sha256 = Some(crate::results::content_sha256(&bytes));
                     added.push(name.clone());
                 }
             }

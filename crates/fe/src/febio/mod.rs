@@ -11,15 +11,15 @@ pub mod feb;
 pub mod logs;
 pub mod restart;
 
-use crate::fe::backend::{Backend, Job, SolveFailure, Solved};
-use crate::fe::process::{self, ExitKind, LOG_TAIL_LINES};
-use crate::fe::wrench::expand_mirrors;
+use crate::backend::{Backend, Job, SolveFailure, Solved};
+use crate::process::{self, ExitKind, LOG_TAIL_LINES};
+use crate::wrench::expand_mirrors;
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// Version of the FEBio input generator ([`versions::FEBIO_INPUT`](crate::fe::versions::FEBIO_INPUT)).
-pub use crate::fe::versions::FEBIO_INPUT as GENERATOR_VERSION;
+/// Version of the FEBio input generator ([`versions::FEBIO_INPUT`](crate::versions::FEBIO_INPUT)).
+pub use crate::versions::FEBIO_INPUT as GENERATOR_VERSION;
 
 /// Environment variable naming the `febio4` to use.
 pub const FEBIO_ENV: &str = "FEBIO";
@@ -152,7 +152,7 @@ impl Backend for FebioBackend {
         if attempt < 2 {
             1.0
         } else {
-            crate::fe::deck::RETRY_FIRST_INCREMENT
+            crate::deck::RETRY_FIRST_INCREMENT
         }
     }
 
@@ -320,7 +320,7 @@ impl Backend for FebioBackend {
 }
 
 /// The FEBio settings of a run in one line, for the manifest.
-pub fn settings_line(s: &crate::fe::spec::FebioSettings, friction: f64, threads: usize, retry: bool) -> String {
+pub fn settings_line(s: &crate::spec::FebioSettings, friction: f64, threads: usize, retry: bool) -> String {
     let (dtol, rtol) = if retry { (s.retry_dtol, s.retry_rtol) } else { (s.dtol, s.rtol) };
     format!(
         "{} contact, primary {}, {} penalty {}{}{}, friction {friction}, projections updated {}; {}, max_refs {}, dtol {} etol {} rtol {}; Pardiso, {threads} thread(s)",
@@ -426,9 +426,8 @@ mod tests {
         let d = tempfile::tempdir().expect("tempdir");
         let set = d.path().join("set");
         std::fs::create_dir_all(&set).expect("mkdir");
-        std::fs::copy(Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default/campaign.toml"), set.join("campaign.toml"))
-            .expect("copy");
-        let (mut c, _) = crate::fe::spec::load(&set).expect("spec");
+        std::fs::copy(crate::workspace_root().join("coeffs/default/campaign.toml"), set.join("campaign.toml")).expect("copy");
+        let (mut c, _) = crate::spec::load(&set).expect("spec");
         c.loading.steps = 4;
         let pose = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");
         let mesh = c.mesh_level("smoke").expect("smoke").clone();

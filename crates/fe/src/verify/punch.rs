@@ -58,10 +58,10 @@
 //! takes about a minute and is the CI test (tests/fe_verify_punch.rs).
 
 use super::VerifyOptions;
-use crate::fe::ccx;
-use crate::fe::dat;
-use crate::fe::mesh::{self, P3};
-use crate::fe::spec::{self, Campaign, PoseSpec, Role, Symmetry};
+use crate::ccx;
+use crate::dat;
+use crate::mesh::{self, P3};
+use crate::spec::{self, Campaign, PoseSpec, Role, Symmetry};
 use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -373,7 +373,7 @@ pub fn punch_deck(c: &Campaign, mesh: &spec::MeshLevel, el: PunchElement, a: f64
 /// The punch block: the spec's block scaled by `scale` in every direction, and its
 /// quarter model (mirror planes x = 0, z = 0) meshed with `mesh` and a round core (the
 /// punch's footprint).
-pub fn punch_block(c: &Campaign, mesh: &spec::MeshLevel, scale: f64) -> (crate::fe::spec::Block, mesh::TissueMesh) {
+pub fn punch_block(c: &Campaign, mesh: &spec::MeshLevel, scale: f64) -> (crate::spec::Block, mesh::TissueMesh) {
     let mut block = c.block.clone();
     block.size_x_mm *= scale;
     block.size_z_mm *= scale;
@@ -404,7 +404,7 @@ pub struct PunchSets {
 ///
 /// # Errors
 /// Fewer than 4 nodes under the punch (a mesh too coarse for the punch).
-pub fn punch_sets(nodes: &[P3], block: &crate::fe::spec::Block, a: f64) -> Result<PunchSets> {
+pub fn punch_sets(nodes: &[P3], block: &crate::spec::Block, a: f64) -> Result<PunchSets> {
     let hb = [block.size_x_mm / 2.0, block.depth_mm, block.size_z_mm / 2.0];
     let eps = 1e-6;
     let pick = |f: &dyn Fn(&P3) -> bool| -> Vec<usize> { (0..nodes.len()).filter(|&i| f(&nodes[i])).collect() };

@@ -1,13 +1,13 @@
 //! The solver side of a campaign: the [`Backend`] trait (one pose in, wrenches out),
 //! [`CcxBackend`], which writes the deck, runs CalculiX, reads the `.dat` back and reduces
-//! the needle's nodal reactions to the wrench, (the engine of a run: [`engines::backend_for`](crate::fe::engines::backend_for)).
+//! the needle's nodal reactions to the wrench, (the engine of a run: [`engines::backend_for`](crate::engines::backend_for)).
 //! FEBio's backend is `fe::febio::FebioBackend`. Tests inject other backends.
 
-use crate::fe::ccx;
-use crate::fe::dat;
-use crate::fe::deck::{self, MeshSummary};
-use crate::fe::spec::{Campaign, MeshLevel, PoseSpec};
-use crate::fe::wrench;
+use crate::ccx;
+use crate::dat;
+use crate::deck::{self, MeshSummary};
+use crate::spec::{Campaign, MeshLevel, PoseSpec};
+use crate::wrench;
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -221,8 +221,8 @@ fn check_step_times(blocks: &[dat::StepRf], steps: u32) -> Result<()> {
 }
 
 /// Keep a failed ccx attempt's log, status and SPOOLES files (see
-/// [`process::keep_failed_attempt`](crate::fe::process::keep_failed_attempt)).
+/// [`process::keep_failed_attempt`](crate::process::keep_failed_attempt)).
 fn keep_failed_attempt(job: &Job<'_>) -> String {
     let files = [(format!("{JOB}.log"), "log"), (format!("{JOB}.sta"), "sta"), ("spooles.out".to_string(), "spooles.out")];
-    crate::fe::process::keep_failed_attempt(job.work_dir, &format!("first-increment-{}", job.first_increment), &files)
+    crate::process::keep_failed_attempt(job.work_dir, &format!("first-increment-{}", job.first_increment), &files)
 }

@@ -2,8 +2,8 @@
 //! solved) beside the queue state of its latest SLURM array task (`squeue`) and, for a
 //! task that left the queue without a result, the cause its output states.
 
-use crate::fe::campaign::Plan;
-use crate::fe::launcher::slurm::{self, QueueState, SLURM_DIR};
+use crate::campaign::Plan;
+use crate::launcher::slurm::{self, QueueState, SLURM_DIR};
 use anyhow::Result;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -71,7 +71,7 @@ impl StatusReport {
     }
 }
 
-/// The status of the poses of `plan` ([`campaign::plan`](crate::fe::campaign::plan)).
+/// The status of the poses of `plan` ([`campaign::plan`](crate::campaign::plan)).
 ///
 /// # Errors
 /// The submissions record cannot be read. A queue that cannot be read is not an error:
