@@ -1,6 +1,6 @@
 //! The fixed-point evaluator's error against the f64 evaluation of the same model,
 //! measured: the library's [`needle_haptics::fixed::wrench`] against the fitter's
-//! [`crate::fit::eval_f64`] on the f64 coefficients of the set's `model.toml`, at the same
+//! [`needle_fit::eval_f64`] on the f64 coefficients of the set's `model.toml`, at the same
 //! Q16.16 poses (exact in f64), beside the bound the code generator derived
 //! ([`needle_haptics::fixed::tables::ERROR_BOUND_MICRO`]).
 //!
@@ -8,9 +8,9 @@
 //! and relative to the model's peak |Fy| over the grid (moments: to peak |Fy| times the
 //! needle's lever arm `needle.reference_from_tip_mm`, as in the validation reports).
 
-use crate::fit::contract::{unit, COMPONENTS};
-use crate::fit::{eval_f64, model::Model, model_file, MODEL_FILE};
 use anyhow::{Context, Result};
+use needle_fit::contract::{unit, COMPONENTS};
+use needle_fit::{eval_f64, model::Model, model_file, MODEL_FILE};
 use needle_haptics::fixed::{self, tables::ERROR_BOUND_MICRO};
 use std::fmt::Write as _;
 use std::path::Path;

@@ -5,6 +5,5 @@
 pub mod cli;
 pub mod explore;
 pub mod firmware;
-pub mod fit;
 pub mod fixed_error;
 pub mod plot;

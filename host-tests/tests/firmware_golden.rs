@@ -122,7 +122,7 @@ fn fixed_comparison_catches_one_bit() {
 /// section are all caught.
 #[test]
 fn stiffness_comparison_catches_one_bit_and_a_differing_wrench() {
-    let h = needle_host::fit::golden_stiffness::header();
+    let h = needle_fit::golden_stiffness::header();
     let inputs = "0x00000000,0x00000000,0x00000000,0x00000000,0x40400000";
     let rates: Vec<String> = (0..18).map(|i| format!("0x3c{i:06x}")).collect();
     let row = format!("{inputs},0x00,{}", rates.join(","));

@@ -2,7 +2,7 @@
 //! set reproduces the committed files byte for byte (unicode-ident style). Never skipped:
 //! a missing file is a failure that says how to make it.
 
-use needle_host::fit::{fit_set, GOLDEN_FILE, GOLDEN_FIXED_FILE, GOLDEN_STIFFNESS_FILE, MODEL_FILE};
+use needle_fit::{fit_set, GOLDEN_FILE, GOLDEN_FIXED_FILE, GOLDEN_STIFFNESS_FILE, MODEL_FILE};
 use std::path::PathBuf;
 
 fn set_dir() -> PathBuf {

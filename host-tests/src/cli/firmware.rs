@@ -113,7 +113,7 @@ struct Goals {
 impl Goals {
     /// The goals of the form of `set`'s model.toml.
     fn of(set: &std::path::Path) -> anyhow::Result<Goals> {
-        let model = crate::fit::model_file::read(&set.join(crate::fit::MODEL_FILE))?;
+        let model = needle_fit::model_file::read(&set.join(needle_fit::MODEL_FILE))?;
         Ok(if model.cross.is_some() {
             Goals { form: "coupled", m4f_f32_instructions: 1500.0, m0_fixed_instructions: 15_000.0, model_flash_bytes: 16 * 1024 }
         } else {

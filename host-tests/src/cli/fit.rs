@@ -1,8 +1,8 @@
 //! `needle fit`, `needle validate`: fit the model, compare it with FE.
-use crate::fit::{self, validate as val, GOLDEN_FILE, GOLDEN_FIXED_FILE, GOLDEN_STIFFNESS_FILE, MODEL_FILE};
 use anyhow::{Context, Result};
 use clap::Args;
 use needle_fe::results::write_all_atomic;
+use needle_fit::{self as fit, validate as val, GOLDEN_FILE, GOLDEN_FIXED_FILE, GOLDEN_STIFFNESS_FILE, MODEL_FILE};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 

@@ -1,8 +1,8 @@
 //! `/set.json` of the explorer: what the page needs besides the evaluator.
 
-use crate::fit::data::{read_run, run_path};
 use anyhow::{Context, Result};
 use needle_fe::spec;
+use needle_fit::data::{read_run, run_path};
 use serde_json::{json, Value};
 use std::path::Path;
 

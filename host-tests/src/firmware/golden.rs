@@ -118,7 +118,7 @@ pub struct CoreRun {
 pub fn run(core: &Core, set: &Path) -> anyhow::Result<CoreRun> {
     let golden = set.join("golden-f32.csv");
     let csv = std::fs::read_to_string(&golden).with_context(|| format!("cannot read {}", golden.display()))?;
-    let golden_stiffness = set.join(crate::fit::GOLDEN_STIFFNESS_FILE);
+    let golden_stiffness = set.join(needle_fit::GOLDEN_STIFFNESS_FILE);
     let csv_stiffness =
         std::fs::read_to_string(&golden_stiffness).with_context(|| format!("cannot read {}", golden_stiffness.display()))?;
     let golden_fixed = set.join("golden-fixed.csv");

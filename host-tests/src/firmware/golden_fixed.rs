@@ -3,7 +3,7 @@
 use super::comparison::{Comparison, Section};
 
 /// The fixed-point golden file's header line.
-pub const HEADER: &str = crate::fit::golden_fixed::HEADER;
+pub const HEADER: &str = needle_fit::golden_fixed::HEADER;
 
 /// Compares the fixed-point section of the `golden` firmware's stdout `output` (after its
 /// `needle-golden-fixed rows=N` line) with the text `csv` of golden-fixed.csv.

@@ -3,8 +3,8 @@
 //! class), and the firmware's own count of rows whose `wrench_and_stiffness` wrench is
 //! not `wrench`'s must be 0.
 use super::comparison::{same_f32, Comparison, Section};
-use crate::fit::golden_stiffness::{header, RATE_COLUMNS};
 use anyhow::bail;
+use needle_fit::golden_stiffness::{header, RATE_COLUMNS};
 
 /// Compares the stiffness section of the `golden` firmware's stdout `output` (after its
 /// `needle-golden-stiffness rows=N` line) with the text `csv` of golden-stiffness-f32.csv.

@@ -4,15 +4,15 @@
 //! the FE verification (flat punch, mesh study) when `fe/verify.toml` exists.
 //!
 //! Model curves are the f64 evaluation of the set's `model.toml`
-//! ([`crate::fit::eval_f64`]), FE points its current runs.
+//! ([`needle_fit::eval_f64`]), FE points its current runs.
 
 use super::panel::{Panel, Series, Style, COMPONENT_COLOURS};
-use crate::fit::contract::{unit, Sweep, COMPONENTS, DEPTH_MAX_MM};
-use crate::fit::data::{load_fit_data, load_validation_runs, Run};
-use crate::fit::eval_f64::eval;
-use crate::fit::model::Model;
 use anyhow::Result;
 use needle_fe::spec::Role;
+use needle_fit::contract::{unit, Sweep, COMPONENTS, DEPTH_MAX_MM};
+use needle_fit::data::{load_fit_data, load_validation_runs, Run};
+use needle_fit::eval_f64::eval;
+use needle_fit::model::Model;
 use plotters::style::RGBColor;
 use std::path::Path;
 

@@ -5,8 +5,8 @@
 pub mod figures;
 pub mod panel;
 
-use crate::fit::{model_file, MODEL_FILE};
 use anyhow::{Context, Result};
+use needle_fit::{model_file, MODEL_FILE};
 use std::path::Path;
 
 /// Width and height of one panel, pixels.

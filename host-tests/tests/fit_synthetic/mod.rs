@@ -7,7 +7,7 @@
 use needle_fe::manifest::{manifest_text, Manifest, ManifestEntry, MANIFEST};
 use needle_fe::results::{content_sha256, to_csv, Row};
 use needle_fe::spec::{self, PoseSpec};
-use needle_host::fit::{fit_set, FitOutput};
+use needle_fit::{fit_set, FitOutput};
 use std::path::{Path, PathBuf};
 
 /// Lever arm used to scale moments in the tolerances, mm (the default set's hub).

@@ -9,6 +9,7 @@
 //! own fixed-point implementation ([`fixed_formats`], [`eval_fixed`]). [`validate`] compares the
 //! model ([`eval_f64`], [`eval_f32`]) with the validation runs, and [`error_trend`] tells
 //! whether its errors follow the tilt or the offset.
+#![forbid(unsafe_code)]
 
 pub mod contract;
 pub mod coupled;
@@ -93,4 +94,10 @@ pub fn summary(m: &model::Model) -> String {
         }
     }
     s
+}
+
+/// The workspace root (this crate is `crates/fit`), for the unit tests' `coeffs/default`.
+#[cfg(test)]
+pub(crate) fn workspace_root() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }

@@ -205,7 +205,7 @@ pub fn to_table(r: &CoupledReport) -> String {
         let names: Vec<String> = sel
             .choices
             .iter()
-            .zip(crate::fit::contract::COMPONENTS)
+            .zip(crate::contract::COMPONENTS)
             .map(|(f, name)| match f {
                 Some(f) => format!("{name} {}/{}", f.max_degree, f.depth_degree),
                 None => format!("{name} none"),
@@ -253,8 +253,8 @@ pub fn to_table(r: &CoupledReport) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fit::cross_terms::{CrossForm, CrossTerms};
-    use crate::fit::model::Coupled;
+    use crate::cross_terms::{CrossForm, CrossTerms};
+    use crate::model::Coupled;
     use needle_fe::results::Row;
     use needle_fe::spec::{PoseSpec, Role};
 
@@ -264,8 +264,8 @@ mod tests {
     /// model, so both rows of `needle fit` showed the coupled form's errors.)
     #[test]
     fn the_paper_row_leaves_the_cross_terms_out() {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default/model.toml");
-        let mut model = crate::fit::model_file::read(&path).unwrap_or_else(|e| panic!("{e:#}"));
+        let path = crate::workspace_root().join("coeffs/default/model.toml");
+        let mut model = crate::model_file::read(&path).unwrap_or_else(|e| panic!("{e:#}"));
         assert!(model.cross.is_none(), "the default set is the paper form");
         let pose = PoseSpec { name: "lhs-test".into(), role: Role::Lhs, x_mm: 6.0, z_mm: 0.0, theta_x_deg: 0.0, theta_z_deg: 9.0 };
         let rows: Vec<Row> = (1..=20)
