@@ -4,6 +4,5 @@
 
 pub mod cli;
 pub mod explore;
-pub mod firmware;
 pub mod fixed_error;
 pub mod plot;

@@ -4,8 +4,8 @@
 //! the same glue the page uses (src/explore/page/needle-wasm.mjs). Node and the wasm32
 //! target are required (`.ci/test` installs both); missing, the test fails.
 
+use needle_firmware_host::workspace_root;
 use needle_host::explore;
-use needle_host::firmware::workspace_root;
 use std::process::Command;
 
 #[test]

@@ -8,7 +8,7 @@
 //!
 //! Nothing skips: a missing QEMU, rustup target, model.toml or golden file fails with a
 //! message that says what to install or run.
-use needle_host::firmware::{self, golden, golden_fixed, golden_stiffness};
+use needle_firmware_host::{self as firmware, golden, golden_fixed, golden_stiffness};
 
 fn golden_on(name: &str) {
     let core = firmware::core(name).unwrap_or_else(|e| panic!("{e:#}"));

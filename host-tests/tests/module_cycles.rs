@@ -10,8 +10,16 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// The crates' source folders, from the workspace root.
-const CRATES: [&str; 7] =
-    ["src", "host-tests/src", "crates/fe/src", "crates/fit/src", "crates/codegen/src", "crates/capi/src", "crates/wasm/src"];
+const CRATES: [&str; 8] = [
+    "src",
+    "host-tests/src",
+    "crates/fe/src",
+    "crates/fit/src",
+    "crates/codegen/src",
+    "crates/capi/src",
+    "crates/wasm/src",
+    "crates/firmware-host/src",
+];
 
 type Graph = BTreeMap<String, BTreeSet<String>>;
 

@@ -1,6 +1,6 @@
 //! `needle firmware ...`: the library on Cortex-M under QEMU (examples/ firmware).
-use crate::firmware::{self, bench, build, golden, size, Core};
 use clap::{Args, Subcommand};
+use needle_firmware_host::{self as firmware, bench, build, golden, size, Core};
 use std::path::PathBuf;
 use std::process::ExitCode;
 

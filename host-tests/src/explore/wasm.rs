@@ -1,7 +1,7 @@
 //! Build of the explorer's WebAssembly evaluator (`crates/wasm`) for one set.
 
-use crate::firmware::build::{check_target, nested_cargo, run_cargo, target_dir};
 use anyhow::{bail, Result};
+use needle_firmware_host::build::{check_target, nested_cargo, run_cargo, target_dir};
 use std::path::{Path, PathBuf};
 
 /// The Rust target of the explorer's module.

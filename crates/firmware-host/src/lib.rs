@@ -10,6 +10,7 @@
 //! The firmware is built by a nested `cargo build` in its own target folder
 //! (`<target dir>/firmware`, so it never waits for the lock of an outer `cargo test`),
 //! in the release profile, with `NEEDLE_COEFFS` set to the absolute path of the set.
+#![forbid(unsafe_code)]
 
 pub mod bench;
 pub mod board;
@@ -70,10 +71,11 @@ pub fn cores(names: &[String]) -> anyhow::Result<Vec<Core>> {
     names.iter().map(|n| core(n)).collect()
 }
 
-/// Root of the workspace (the `needle-haptics` package: Cargo.toml, examples/, memory.x).
+/// Root of the workspace (the `needle-haptics` package: Cargo.toml, examples/, memory.x),
+/// two folders above this crate (`crates/firmware-host`).
 #[must_use]
 pub fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().map_or_else(|| PathBuf::from(".."), Path::to_path_buf)
+    Path::new(env!("CARGO_MANIFEST_DIR")).ancestors().nth(2).map_or_else(|| PathBuf::from("../.."), Path::to_path_buf)
 }
 
 /// The set compiled into this build of the host tools (absolute path), the default set
