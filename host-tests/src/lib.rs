@@ -3,6 +3,4 @@
 #![forbid(unsafe_code)]
 
 pub mod cli;
-pub mod explore;
 pub mod fixed_error;
-pub mod plot;

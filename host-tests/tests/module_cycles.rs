@@ -10,7 +10,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// The crates' source folders, from the workspace root.
-const CRATES: [&str; 8] = [
+const CRATES: [&str; 10] = [
     "src",
     "host-tests/src",
     "crates/fe/src",
@@ -19,6 +19,8 @@ const CRATES: [&str; 8] = [
     "crates/capi/src",
     "crates/wasm/src",
     "crates/firmware-host/src",
+    "crates/plot/src",
+    "crates/explore/src",
 ];
 
 type Graph = BTreeMap<String, BTreeSet<String>>;

@@ -1,8 +1,8 @@
 //! `needle explore`: serve the model explorer page for a set.
 
-use crate::explore::{self, server::Content, server::Explorer};
 use anyhow::{Context, Result};
 use clap::Args;
+use needle_explore::{self as explore, server::Content, server::Explorer};
 use std::net::{IpAddr, Ipv4Addr, SocketAddr};
 use std::path::PathBuf;
 use std::process::ExitCode;

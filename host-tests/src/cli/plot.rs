@@ -26,7 +26,7 @@ pub struct PlotArgs {
 /// # Errors
 /// The set cannot be read or a figure cannot be written.
 pub fn plot(a: PlotArgs) -> Result<ExitCode> {
-    let figures = crate::plot::render_set(&a.set).with_context(|| format!("needle plot --set {}", a.set.display()))?;
+    let figures = needle_plot::render_set(&a.set).with_context(|| format!("needle plot --set {}", a.set.display()))?;
     let out = a.out.unwrap_or_else(|| a.set.join("figures"));
     if a.check {
         let mut ok = true;

@@ -1,6 +1,7 @@
 //! `needle plot`: the figures of a set as SVG ([`figures`] says which, [`panel`] draws
 //! them). Rendering is deterministic, so committed figures can be checked for staleness
 //! by rendering again and comparing bytes.
+#![forbid(unsafe_code)]
 
 pub mod figures;
 pub mod panel;

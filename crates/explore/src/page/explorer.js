@@ -1,7 +1,7 @@
 // The explorer page: pose inputs -> the wasm evaluator (needle-wasm.mjs) -> the six
 // components, their status, the force-depth curve of the pose with the set's FE points
 // when the pose is one of its runs, and side views of needle and block.
-// Served by `needle explore` (host-tests/src/explore); no network, no framework.
+// Served by `needle explore` (crates/explore); no network, no framework.
 import { load, COMPONENTS, statusNames } from "./needle-wasm.mjs";
 
 const UNITS = { fx_n: "N", fy_n: "N", fz_n: "N", mx_nmm: "N·mm", my_nmm: "N·mm", mz_nmm: "N·mm" };
