@@ -23,7 +23,7 @@ fn committed_model_and_golden_vectors_are_reproducible() {
             Ok(t) => committed.push(t),
             Err(e) => panic!(
                 "{}: cannot read ({e}). The shipped set has no fitted model yet: once the FE campaign \
-                 is complete, run `cargo run --release -p needle-host -- fit --set coeffs/default` and commit \
+                 is complete, run `cargo run --release -p needle-cli -- fit --set coeffs/default` and commit \
                  coeffs/default/{MODEL_FILE}, {GOLDEN_FILE}, {GOLDEN_FIXED_FILE} and {GOLDEN_STIFFNESS_FILE}.",
                 path.display()
             ),

@@ -2,9 +2,9 @@
 //! exceeds the bound derived at code generation (`fixed::tables::ERROR_BOUND_MICRO`): on a
 //! dense grid over the domain and on proptest-random poses. The bounds meet the goal of
 //! issue 5: <= 0.1 % of peak |Fy| (moments: of peak |Fy| x the lever arm).
+use needle_cli::fixed_error::{self, ErrorStats, GOAL_PCT};
 use needle_fit::eval_f64;
 use needle_haptics::{fixed, model_info};
-use needle_host::fixed_error::{self, ErrorStats, GOAL_PCT};
 use proptest::prelude::*;
 use std::path::Path;
 use std::sync::OnceLock;

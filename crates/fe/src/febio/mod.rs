@@ -116,8 +116,8 @@ impl FebioBackend {
 
 /// The sign that turns FEBio's rigid-body reaction (`m_Fr`, `m_Mr`: minus the sum of the
 /// contact forces the needle's nodes receive in the residual) into the wrench the tissue
-/// exerts on the needle. Checked by `tests/fe_febio.rs` (Fy > 0: the tissue pushes the
-/// needle back up).
+/// exerts on the needle. Checked by `crates/cli/tests/fe_febio.rs` (Fy > 0: the tissue
+/// pushes the needle back up).
 pub const REACTION_SIGN: f64 = -1.0;
 
 impl Backend for FebioBackend {

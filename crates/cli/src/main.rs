@@ -14,39 +14,39 @@ struct Cli {
 enum Command {
     /// FE campaign (FEBio or CalculiX): run, verify.
     #[command(subcommand)]
-    Fe(needle_host::cli::fe::FeCommand),
+    Fe(needle_cli::fe::FeCommand),
     /// Fit the paper model to a set's FE sweeps and write model.toml and golden vectors.
-    Fit(needle_host::cli::fit::FitArgs),
+    Fit(needle_cli::fit::FitArgs),
     /// Evaluate the wrench at one pose with the library (the firmware's code).
-    Eval(needle_host::cli::model::EvalArgs),
+    Eval(needle_cli::model::EvalArgs),
     /// Compare the model with the FE runs it was not fitted on.
-    Validate(needle_host::cli::fit::ValidateArgs),
+    Validate(needle_cli::fit::ValidateArgs),
     /// Serve the model explorer (the firmware's evaluator compiled to wasm) on a local port.
-    Explore(needle_host::cli::explore::ExploreArgs),
+    Explore(needle_cli::explore::ExploreArgs),
     /// The set's figures as SVG (the paper's Figs 4, 6, 7, 8, parity, FE verification).
-    Plot(needle_host::cli::plot::PlotArgs),
+    Plot(needle_cli::plot::PlotArgs),
     /// The fixed-point evaluator's error against f64 on a grid and random poses, beside
     /// its generated bound.
-    FixedError(needle_host::cli::fixed::FixedErrorArgs),
+    FixedError(needle_cli::fixed::FixedErrorArgs),
     /// Copy the generated C header out for C users.
-    Header(needle_host::cli::model::HeaderArgs),
+    Header(needle_cli::model::HeaderArgs),
     /// The library on Cortex-M under QEMU: size, bench, golden, check.
     #[command(subcommand)]
-    Firmware(needle_host::cli::firmware::FirmwareCommand),
+    Firmware(needle_cli::firmware::FirmwareCommand),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Fe(c) => needle_host::cli::fe::run(c),
-        Command::Fit(a) => needle_host::cli::fit::fit(a),
-        Command::Eval(a) => needle_host::cli::model::eval(a),
-        Command::Validate(a) => needle_host::cli::fit::validate(a),
-        Command::Explore(a) => needle_host::cli::explore::explore(a),
-        Command::Plot(a) => needle_host::cli::plot::plot(a),
-        Command::Header(a) => needle_host::cli::model::header(a),
-        Command::FixedError(a) => needle_host::cli::fixed::fixed_error(a),
-        Command::Firmware(c) => needle_host::cli::firmware::run(c),
+        Command::Fe(c) => needle_cli::fe::run(c),
+        Command::Fit(a) => needle_cli::fit::fit(a),
+        Command::Eval(a) => needle_cli::model::eval(a),
+        Command::Validate(a) => needle_cli::fit::validate(a),
+        Command::Explore(a) => needle_cli::explore::explore(a),
+        Command::Plot(a) => needle_cli::plot::plot(a),
+        Command::Header(a) => needle_cli::model::header(a),
+        Command::FixedError(a) => needle_cli::fixed::fixed_error(a),
+        Command::Firmware(c) => needle_cli::firmware::run(c),
     };
     match result {
         Ok(code) => code,

@@ -3,11 +3,11 @@
 //! file comes from the fitter's own f32 implementation, not from the library); bad rows
 //! are named by file and line and nothing is written.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::Command;
 
 fn default_set() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default")
+    needle_firmware_host::workspace_root().join("coeffs/default")
 }
 
 fn needle(args: &[&str]) -> std::process::Output {

@@ -1,7 +1,7 @@
 //! `needle fixed-error`: the fixed-point evaluator's measured error against f64, beside
 //! the bound derived at code generation.
-use crate::cli::model::check_compiled_set;
 use crate::fixed_error::{self, ErrorStats, GOAL_PCT};
+use crate::model::check_compiled_set;
 use clap::Args;
 use rand::{RngCore, SeedableRng};
 use std::path::PathBuf;

@@ -1,7 +1,6 @@
 //! Numbers on the command line: negative and non-finite values are accepted as values
 //! (not taken for options), and out-of-range counts are refused with the range.
 
-use std::path::Path;
 use std::process::Command;
 
 fn needle(args: &[&str]) -> std::process::Output {
@@ -9,7 +8,7 @@ fn needle(args: &[&str]) -> std::process::Output {
 }
 
 fn set() -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default").to_string_lossy().into_owned()
+    needle_firmware_host::workspace_root().join("coeffs/default").to_string_lossy().into_owned()
 }
 
 #[test]

@@ -61,7 +61,7 @@ pub struct HeaderArgs {
 pub fn check_compiled_set(dir: &Path) -> anyhow::Result<()> {
     let model_path = dir.join(needle_codegen::MODEL_FILE);
     let rebuild = format!(
-        "rebuild with NEEDLE_COEFFS={} (e.g. `NEEDLE_COEFFS={} cargo build --release -p needle-host`)",
+        "rebuild with NEEDLE_COEFFS={} (e.g. `NEEDLE_COEFFS={} cargo build --release -p needle-cli`)",
         dir.display(),
         dir.display()
     );

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn default_set() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default")
+    needle_firmware_host::workspace_root().join("coeffs/default")
 }
 
 fn plot(args: &[&str]) -> std::process::Output {

@@ -1,4 +1,5 @@
 //! The `needle` command line: one module per command group.
+#![forbid(unsafe_code)]
 
 pub mod eval_batch;
 pub mod explore;
@@ -6,5 +7,6 @@ pub mod fe;
 pub mod firmware;
 pub mod fit;
 pub mod fixed;
+pub mod fixed_error;
 pub mod model;
 pub mod plot;
