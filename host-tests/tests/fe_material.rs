@@ -1,4 +1,4 @@
-//! The material check run before any FE solve (host-tests/src/fe/material.rs).
+//! The material check run before any FE solve (crates/fe/src/material.rs).
 
 use needle_fe::material::{self, Mode};
 use needle_fe::spec::{self, Tissue};

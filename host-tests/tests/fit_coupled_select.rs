@@ -1,4 +1,4 @@
-//! The coupled form's size is chosen per component (host-tests/src/fit/coupled.rs,
+//! The coupled form's size is chosen per component (crates/fit/src/coupled.rs,
 //! coeffs/README.md "The coupled form"): on training runs made from the default set's
 //! paper model with a known cross term in fy and an unrepresentable wiggle in fx, fy
 //! gets its term back and every other component none.

@@ -358,7 +358,7 @@ pub fn punch_deck(c: &Campaign, mesh: &spec::MeshLevel, el: PunchElement, a: f64
     let _ = writeln!(s, "** neo-Hookean, mu = {mu:e} N/mm^2, K0 = {k0:e} N/mm^2: C10 = mu/2, D1 = 2/K0");
     let _ = writeln!(
         s,
-        "** (the same energy as Ogden N=1, alpha=2; ccx's Ogden law does not converge here, see host-tests/src/fe/verify/punch.rs)"
+        "** (the same energy as Ogden N=1, alpha=2; ccx's Ogden law does not converge here, see crates/fe/src/verify/punch.rs)"
     );
     let _ = writeln!(s, "*MATERIAL, NAME=BLOCK\n*HYPERELASTIC, NEO HOOKE\n{:e}, {d1:e}", mu / 2.0);
     let _ = writeln!(s, "*SOLID SECTION, ELSET=BLOCK, MATERIAL=BLOCK");
