@@ -8,8 +8,8 @@
 //!   non-zero exit, never a panic.
 //! - A set without `model.toml` (a new set before `needle fit` has run) builds an
 //!   *unfitted* library with a `cargo::warning`: every evaluation then returns the zero
-//!   wrench with status `NO_MODEL | ERROR`. (The fitter, `needle-host`, depends on this
-//!   library, so it must build before the first fit.)
+//!   wrench with status `NO_MODEL | ERROR`. (The `needle` tool, `needle-cli`, depends on
+//!   this library, so it must build before the first fit.)
 //! - Never emits `rustc-link-search` (it would override the user's memory map); link
 //!   arguments go to this package's examples only, for bare-metal targets.
 use std::path::{Path, PathBuf};

@@ -1,7 +1,7 @@
 //! The model's tilt angles from a needle direction or an orientation quaternion, as a
 //! device's kinematics gives them.
 //!
-//! Convention (the FE campaign's, `host-tests/src/fe/spec.rs`): the needle is rotated
+//! Convention (the FE campaign's, `crates/fe/src/spec.rs`): the needle is rotated
 //! first by `theta_x` about x, then by `theta_z` about z, so its axis from tip to hub is
 //! `a = (-sin θz cos θx, cos θz cos θx, sin θx)` (vertical: `+y`). Hence, for a unit `a`,
 //!

@@ -3,8 +3,8 @@
 //! second (issue 19's goal: 100,000 poses in under 1 s on one core). Parsing, evaluation
 //! and formatting are timed separately to show where the time goes.
 //!
-//! `cargo bench -p needle-host --bench eval_batch` (plain `std::time`, no harness).
-use needle_host::cli::eval_batch::{evaluate, parse_poses, to_csv};
+//! `cargo bench -p needle-host-tests --bench eval_batch` (plain `std::time`, no harness).
+use needle_cli::eval_batch::{evaluate, parse_poses, to_csv};
 use std::hint::black_box;
 use std::path::Path;
 use std::time::Instant;

@@ -1,7 +1,7 @@
 //! Host benchmark of the library's f32 paper model: wrench evaluations per second over a
 //! fixed pseudo-random pose set, next to the paper's 5.12 s per evaluation in MATLAB.
 //!
-//! `cargo bench -p needle-host --bench eval_f32` (plain `std::time`, no harness). Timings
+//! `cargo bench -p needle-host-tests --bench eval_f32` (plain `std::time`, no harness). Timings
 //! on shared machines are noisy: the best of several rounds is reported, and the ratio
 //! matters more than the absolute figure.
 use needle_haptics::{model_info, wrench, Pose};

@@ -7,11 +7,11 @@
 //! the paper part is unchanged. Not a fitted model: nothing here goes under coeffs/.
 mod made_up_model;
 
-use needle_host::fit::eval_f32::{eval as eval32, Tables32};
-use needle_host::fit::eval_f64::{eval as eval64, eval_paper};
-use needle_host::fit::eval_fixed::eval as eval_fixed;
-use needle_host::fit::fixed_formats::TablesFixed;
-use needle_host::fit::model_file::parse;
+use needle_fit::eval_f32::{eval as eval32, Tables32};
+use needle_fit::eval_f64::{eval as eval64, eval_paper};
+use needle_fit::eval_fixed::eval as eval_fixed;
+use needle_fit::fixed_formats::TablesFixed;
+use needle_fit::model_file::parse;
 use std::path::Path;
 
 use needle_contract::COMPONENTS;

@@ -1,11 +1,11 @@
 //! The explorer's wasm evaluator reproduces the set's golden vectors bit for bit: the
-//! module `needle explore` serves (host-tests/wasm, built for wasm32-unknown-unknown with
+//! module `needle explore` serves (crates/wasm, built for wasm32-unknown-unknown with
 //! the default set) replays every row of coeffs/default/golden-f32.csv under Node, through
-//! the same glue the page uses (src/explore/page/needle-wasm.mjs). Node and the wasm32
+//! the same glue the page uses (crates/explore/src/page/needle-wasm.mjs). Node and the wasm32
 //! target are required (`.ci/test` installs both); missing, the test fails.
 
-use needle_host::explore;
-use needle_host::firmware::workspace_root;
+use needle_explore as explore;
+use needle_firmware_host::workspace_root;
 use std::process::Command;
 
 #[test]

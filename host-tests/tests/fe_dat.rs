@@ -1,8 +1,8 @@
 //! The `.dat` reaction force reader and the `.sta` reader, on real ccx 2.20 output
 //! stored in tests/data/ccx/ (see its README for the decks that produced it).
 
-use needle_host::fe::ccx;
-use needle_host::fe::dat::{parse_rf, StepRf};
+use needle_fe::ccx;
+use needle_fe::dat::{parse_rf, StepRf};
 use std::path::PathBuf;
 
 fn data(name: &str) -> String {

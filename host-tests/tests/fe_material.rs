@@ -1,7 +1,7 @@
-//! The material check run before any FE solve (host-tests/src/fe/material.rs).
+//! The material check run before any FE solve (crates/fe/src/material.rs).
 
-use needle_host::fe::material::{self, Mode};
-use needle_host::fe::spec::{self, Tissue};
+use needle_fe::material::{self, Mode};
+use needle_fe::spec::{self, Tissue};
 use std::path::{Path, PathBuf};
 
 fn repo() -> PathBuf {

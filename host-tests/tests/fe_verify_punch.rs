@@ -3,8 +3,8 @@
 //! solve. The solve needs `ccx` (Debian `calculix-ccx`); without it the test fails, it is
 //! not skipped.
 
-use needle_host::fe::verify::{self, PunchElement, VerifyOptions};
-use needle_host::fe::{ccx, spec};
+use needle_fe::verify::{self, PunchElement, VerifyOptions};
+use needle_fe::{ccx, spec};
 use std::path::{Path, PathBuf};
 
 /// Tolerance of the coarse check, %. The coarse mesh (`punch_mesh_scale = 2`: 4 C3D20R

@@ -2,7 +2,7 @@
 //! defmt over RTT, probe-rs runner) builds for thumbv7em-none-eabihf with no warning
 //! and fits the STM32F401RE (512 KiB flash, 96 KiB RAM); its flash and RAM are printed.
 //! It needs the board to run, so CI builds it only.
-use needle_host::firmware::{self, board};
+use needle_firmware_host::{self as firmware, board};
 
 /// STM32F401RE memories (examples/nucleo-f401re/memory.x).
 const FLASH_BYTES: u64 = 512 * 1024;

@@ -6,7 +6,7 @@
 //!
 //! Nothing skips: a missing QEMU, rustup target or `defmt-print` (.ci/test installs it
 //! with `cargo install defmt-print`) fails with a message.
-use needle_host::firmware::{self, build, qemu};
+use needle_firmware_host::{self as firmware, build, qemu};
 use std::io::Write;
 use std::process::{Command, Stdio};
 

@@ -8,8 +8,8 @@
 //!
 //! Nothing skips: a missing QEMU, rustup target, model.toml or golden file fails with a
 //! message that says what to install or run.
-use needle_host::firmware::{self, golden, golden_fixed, golden_stiffness};
-use needle_host::fit::{eval_f32::Tables32, fixed_formats::TablesFixed, model_file};
+use needle_firmware_host::{self as firmware, golden, golden_fixed, golden_stiffness};
+use needle_fit::{eval_f32::Tables32, fixed_formats::TablesFixed, model_file};
 use std::path::Path;
 
 mod made_up_model;
@@ -69,7 +69,7 @@ fn golden_bits_on_cortex_m0_microbit() {
 /// model: it lives in a temporary folder, never under coeffs/.
 #[test]
 fn golden_bits_of_a_coupled_model_on_cortex_m4f_mps2_an386() {
-    use needle_host::fit::{golden as g32, golden_fixed as gfixed, golden_stiffness as gs32, golden_stiffness_fixed as gsfixed};
+    use needle_fit::{golden as g32, golden_fixed as gfixed, golden_stiffness as gs32, golden_stiffness_fixed as gsfixed};
     let dir = tempfile::tempdir().expect("temporary set folder");
     let set = dir.path().join("made-up-coupled");
     std::fs::create_dir(&set).expect("set folder");
@@ -145,7 +145,7 @@ fn fixed_comparison_catches_one_bit() {
 /// section are all caught.
 #[test]
 fn stiffness_comparison_catches_one_bit_and_a_differing_wrench() {
-    let h = needle_host::fit::golden_stiffness::header();
+    let h = needle_fit::golden_stiffness::header();
     let inputs = "0x00000000,0x00000000,0x00000000,0x00000000,0x40400000";
     let rates: Vec<String> = (0..18).map(|i| format!("0x3c{i:06x}")).collect();
     let row = format!("{inputs},0x00,{}", rates.join(","));
@@ -173,7 +173,7 @@ fn stiffness_comparison_catches_one_bit_and_a_differing_wrench() {
 /// wrench the firmware found differing, a missing or truncated section are all caught.
 #[test]
 fn fixed_stiffness_comparison_catches_one_unit_and_a_differing_wrench() {
-    let h = needle_host::fit::golden_stiffness_fixed::header();
+    let h = needle_fit::golden_stiffness_fixed::header();
     let inputs = "0,0,0,0,196608";
     let rates: Vec<String> = (0..18).map(|i| format!("{}", 1000 * i - 7000)).collect();
     let row = format!("{inputs},0x00,{}", rates.join(","));

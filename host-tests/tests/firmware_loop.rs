@@ -8,7 +8,7 @@
 //!   must ramp, the command must stay within the 0.06 N limit, and no sample is dropped.
 //!
 //! Nothing skips: a missing QEMU or rustup target fails with a message.
-use needle_host::firmware::{self, build, qemu};
+use needle_firmware_host::{self as firmware, build, qemu};
 use std::time::Duration;
 
 fn field<'a>(line: &'a str, key: &str) -> Option<&'a str> {

@@ -7,7 +7,7 @@
 //! same check does find them in the f32 evaluator).
 //!
 //! Nothing skips: a missing rustup target, QEMU or fitted model fails with a message.
-use needle_host::firmware::{self, build, float_check, qemu, size, CORES};
+use needle_firmware_host::{self as firmware, build, float_check, qemu, size, CORES};
 use std::time::Duration;
 
 #[test]

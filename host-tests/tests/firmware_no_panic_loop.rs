@@ -4,7 +4,7 @@
 //! `no_panic` image.
 //!
 //! Nothing skips: a missing rustup target, QEMU or fitted model fails with a message.
-use needle_host::firmware::{self, build, qemu, size, CORES};
+use needle_firmware_host::{self as firmware, build, qemu, size, CORES};
 use std::time::Duration;
 
 #[test]

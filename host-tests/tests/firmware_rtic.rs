@@ -9,7 +9,7 @@
 //! host: golden tests), the stale window ramps, the needle goes in to 6 mm and out.
 //!
 //! Nothing skips: a missing QEMU or rustup target fails with a message.
-use needle_host::firmware::{self, board, qemu};
+use needle_firmware_host::{self as firmware, board, qemu};
 use std::time::Duration;
 
 fn field<'a>(line: &'a str, key: &str) -> Option<&'a str> {

@@ -1,13 +1,13 @@
-//! The coupled form's size is chosen per component (host-tests/src/fit/coupled.rs,
+//! The coupled form's size is chosen per component (crates/fit/src/coupled.rs,
 //! coeffs/README.md "The coupled form"): on training runs made from the default set's
 //! paper model with a known cross term in fy and an unrepresentable wiggle in fx, fy
 //! gets its term back and every other component none.
-use needle_host::fe::results::Row;
-use needle_host::fe::spec::{PoseSpec, Role};
-use needle_host::fit::contract::COMPONENTS;
-use needle_host::fit::coupled::{scales, select_and_fit};
-use needle_host::fit::data::Run;
-use needle_host::fit::eval_f64::eval_paper;
+use needle_fe::results::Row;
+use needle_fe::spec::{PoseSpec, Role};
+use needle_fit::contract::COMPONENTS;
+use needle_fit::coupled::{scales, select_and_fit};
+use needle_fit::data::Run;
+use needle_fit::eval_f64::eval_paper;
 use std::path::Path;
 
 /// Training runs whose FE rows are the default set's paper model plus, for fy, a known
@@ -18,7 +18,7 @@ use std::path::Path;
 #[test]
 fn each_component_chooses_its_own_size_and_none_when_the_paper_form_is_better() {
     let path = Path::new(needle_haptics::model_info::SET_DIR).join("model.toml");
-    let paper = needle_host::fit::model_file::read(&path).unwrap_or_else(|e| panic!("{e:#}"));
+    let paper = needle_fit::model_file::read(&path).unwrap_or_else(|e| panic!("{e:#}"));
     // 16 combined poses from a fixed low-discrepancy rule (golden-ratio steps).
     let runs: Vec<Run> = (0..16)
         .map(|i| {

@@ -2,7 +2,7 @@
 //! degenerate input.
 
 use nalgebra::{DMatrix, DVector};
-use needle_host::fit::lsq::{lstsq, polyfit, vandermonde};
+use needle_fit::lsq::{lstsq, polyfit, vandermonde};
 
 fn eval(p: &[f64], w: f64) -> f64 {
     p.iter().rev().fold(0.0, |acc, c| acc * w + c)

@@ -2,7 +2,7 @@
 //! data of the shipped set reproduces the committed files byte for byte (unicode-ident style). Never skipped:
 //! a missing file is a failure that says how to make it.
 
-use needle_host::fit::fit_set;
+use needle_fit::fit_set;
 use std::path::PathBuf;
 
 fn set_dir() -> PathBuf {
@@ -25,7 +25,7 @@ fn committed_model_and_golden_vectors_are_reproducible() {
         let have = match std::fs::read_to_string(&path) {
             Ok(t) => t,
             Err(e) => panic!(
-                "{}: cannot read ({e}). Run `cargo run --release -p needle-host -- fit --set coeffs/default` \
+                "{}: cannot read ({e}). Run `cargo run --release -p needle-cli -- fit --set coeffs/default` \
                  and commit every file it writes ({:?}).",
                 path.display(),
                 out.files().map(|(n, _)| n)

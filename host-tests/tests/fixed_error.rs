@@ -2,15 +2,15 @@
 //! exceeds the bound derived at code generation (`fixed::tables::ERROR_BOUND_MICRO`): on a
 //! dense grid over the domain and on proptest-random poses. The bounds meet the goal of
 //! issue 5: <= 0.1 % of peak |Fy| (moments: of peak |Fy| x the lever arm).
+use needle_cli::fixed_error::{self, ErrorStats, GOAL_PCT};
+use needle_fit::eval_f64;
 use needle_haptics::{fixed, model_info};
-use needle_host::fit::eval_f64;
-use needle_host::fixed_error::{self, ErrorStats, GOAL_PCT};
 use proptest::prelude::*;
 use std::path::Path;
 use std::sync::OnceLock;
 
-fn set() -> &'static (needle_host::fit::model::Model, f64) {
-    static S: OnceLock<(needle_host::fit::model::Model, f64)> = OnceLock::new();
+fn set() -> &'static (needle_fit::model::Model, f64) {
+    static S: OnceLock<(needle_fit::model::Model, f64)> = OnceLock::new();
     S.get_or_init(|| {
         if !model_info::FITTED {
             panic!("no fitted model compiled in: run `needle fit`");

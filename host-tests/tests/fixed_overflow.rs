@@ -6,11 +6,11 @@
 //!
 //! Also: the fitter's choice of formats equals the tables compiled into the library, and
 //! the checker does catch an overflow when the formats are one bit too ambitious.
+use needle_fit::eval_fixed::eval;
+use needle_fit::fixed_formats::TablesFixed;
+use needle_fit::model_file;
 use needle_haptics::fixed::{self, tables};
 use needle_haptics::model_info;
-use needle_host::fit::eval_fixed::eval;
-use needle_host::fit::fixed_formats::TablesFixed;
-use needle_host::fit::model_file;
 use proptest::prelude::*;
 use std::path::Path;
 use std::sync::OnceLock;

@@ -4,9 +4,9 @@
 //! `wrench_and_stiffness` has the bits of `wrench` at every golden pose.
 //!
 //! A missing file is a failure, never a skip: `needle fit` writes it with model.toml.
+use needle_fit::golden_stiffness::{parse_csv, rate_columns};
+use needle_fit::GOLDEN_STIFFNESS_FILE;
 use needle_haptics::{model_info, wrench, wrench_and_stiffness, Pose};
-use needle_host::fit::golden_stiffness::{parse_csv, rate_columns};
-use needle_host::fit::GOLDEN_STIFFNESS_FILE;
 use std::path::Path;
 
 /// Equal as the contract demands: NaN matches NaN, anything else by bits (+0.0 and -0.0

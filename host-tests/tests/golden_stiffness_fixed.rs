@@ -4,10 +4,10 @@
 //! and the wrench of `fixed::wrench_and_stiffness` is `fixed::wrench`'s at every pose.
 //!
 //! A missing file is a failure, never a skip: `needle fit` writes it with model.toml.
+use needle_fit::golden_stiffness::rate_columns;
+use needle_fit::golden_stiffness_fixed::parse_csv;
+use needle_fit::GOLDEN_STIFFNESS_FIXED_FILE;
 use needle_haptics::{fixed, model_info};
-use needle_host::fit::golden_stiffness::rate_columns;
-use needle_host::fit::golden_stiffness_fixed::parse_csv;
-use needle_host::fit::GOLDEN_STIFFNESS_FIXED_FILE;
 use std::path::Path;
 
 #[test]
@@ -69,11 +69,11 @@ fn library_fixed_stiffness_matches_golden_vectors_exactly() {
 #[test]
 fn fixed_rates_follow_the_f64_derivatives() {
     let path = Path::new(model_info::SET_DIR).join("model.toml");
-    let model = needle_host::fit::model_file::read(&path).unwrap_or_else(|e| panic!("{e:#}"));
+    let model = needle_fit::model_file::read(&path).unwrap_or_else(|e| panic!("{e:#}"));
     let mut rows = Vec::new();
-    for p in needle_host::fit::golden_fixed::poses() {
+    for p in needle_fit::golden_fixed::poses() {
         let exact = p.map(|v| f64::from(v) / 65536.0);
-        let (want, status) = needle_host::fit::eval_rate_f64::eval_rates(&model, exact);
+        let (want, status) = needle_fit::eval_rate_f64::eval_rates(&model, exact);
         if status != 0 || exact[0] == 0.0 || exact[1] == 0.0 {
             continue;
         }

@@ -4,12 +4,12 @@
 //! terms (`made_up_model`), at 400 poses inside the domain.
 mod made_up_model;
 
-use needle_host::fit::eval_f32::Tables32;
-use needle_host::fit::eval_f64::eval;
-use needle_host::fit::eval_rate_f32::eval_rates as rates32;
-use needle_host::fit::eval_rate_f64::eval_rates as rates64;
-use needle_host::fit::model::Model;
-use needle_host::fit::model_file::{parse, read};
+use needle_fit::eval_f32::Tables32;
+use needle_fit::eval_f64::eval;
+use needle_fit::eval_rate_f32::eval_rates as rates32;
+use needle_fit::eval_rate_f64::eval_rates as rates64;
+use needle_fit::model::Model;
+use needle_fit::model_file::{parse, read};
 use rand::{Rng, SeedableRng};
 use std::path::Path;
 

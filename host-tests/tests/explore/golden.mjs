@@ -3,7 +3,7 @@
 // Usage: node golden.mjs NEEDLE_WASM GOLDEN_CSV   (exit 0: all rows equal; 1: a mismatch;
 // 2: bad input). Run by host-tests/tests/explore_wasm.rs.
 import { readFileSync } from "node:fs";
-import { load } from "../../src/explore/page/needle-wasm.mjs";
+import { load } from "../../../crates/explore/src/page/needle-wasm.mjs";
 
 const [wasmPath, csvPath] = process.argv.slice(2);
 if (!wasmPath || !csvPath) {

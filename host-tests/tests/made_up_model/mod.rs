@@ -81,7 +81,7 @@ pub fn coupled_default_text() -> String {
     let mut k = 0u32;
     for (c, name) in COMPONENTS.iter().enumerate() {
         let size = if c < 3 { 5e-4 } else { 3e-2 };
-        for e in needle_host::fit::cross_terms::monomials(c, 3) {
+        for e in needle_fit::cross_terms::monomials(c, 3) {
             let p: Vec<f64> = (0..3)
                 .map(|i| {
                     k += 1;
@@ -89,7 +89,7 @@ pub fn coupled_default_text() -> String {
                 })
                 .collect();
             let f64s: Vec<String> = p.iter().map(|v| format!("{v:?}")).collect();
-            let f32s: Vec<String> = p.iter().map(|v| format!("\"{}\"", needle_host::fit::model_file::hex32(*v as f32))).collect();
+            let f32s: Vec<String> = p.iter().map(|v| format!("\"{}\"", needle_fit::model_file::hex32(*v as f32))).collect();
             let _ = writeln!(
                 s,
                 "\n[[cross]]\ncomponent = \"{name}\"\nexponents = [{}, {}, {}, {}]\ncoeffs = [{}]\ncoeffs_f32 = [{}]",

@@ -1,0 +1,351 @@
+//! `needle fe ...`: the FE campaign commands.
+use clap::{Args, Subcommand};
+use needle_fe::campaign::{self, RunOptions};
+use needle_fe::launcher::slurm::{self, SlurmOptions};
+use needle_fe::launcher::Launched;
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Duration;
+
+/// `needle fe` subcommands.
+#[derive(Subcommand)]
+pub enum FeCommand {
+    /// Run the FE campaign of a set on its engine (FEBio or CalculiX, campaign.toml's
+    /// [solver] engine or --solver): one input and one solver job per pose,
+    /// results in <set>/fe/<pose>.csv (depth in mm, forces in N, moments in N*mm about the
+    /// needle hub) and <set>/fe/manifest.toml. Poses whose result matches the current
+    /// spec are skipped; a killed campaign resumes where it stopped. Exit status 1 when a
+    /// run failed (the others are still written), 2 on an error before any run.
+    Run(RunArgs),
+    /// Verify the FE setup: flat punch against Sneddon (four small solves), mesh
+    /// convergence of the centred needle (two needle solves, the fine one is slow) and
+    /// the mirror runs against their counterparts (no solve). Without --punch, --mesh or
+    /// --mirror all three run. Prints the table and writes <set>/fe/verify.toml. Exit
+    /// status 1 when a check misses its goal, 2 on an error.
+    Verify(VerifyArgs),
+    /// The state of a set's poses: up to date or why not, and with --launcher slurm
+    /// submissions the queue state of each pose's latest array task (squeue) or the cause
+    /// a task that ended without a result states. With --project-nodes, the campaign's
+    /// wall time on that many nodes, projected from the manifest's measured runs.
+    Status(StatusArgs),
+    /// Solve one pose as a local job would (one job; threads from SLURM_CPUS_PER_TASK):
+    /// what each array task of `needle fe run --launcher slurm` runs.
+    #[command(hide = true)]
+    RunOne(RunOneArgs),
+}
+
+/// Where the solver jobs run.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LauncherArg {
+    /// Worker threads of this process (--jobs at once).
+    Local,
+    /// One SLURM job array (sbatch), one task per pose still to solve.
+    Slurm,
+}
+
+/// What a campaign command works on: the set, its engine, mesh level, steps, poses and
+/// output folder (shared by `fe run` and `fe status`).
+#[derive(Args, Debug)]
+pub struct SpecArgs {
+    /// Set folder holding campaign.toml, e.g. coeffs/default.
+    #[arg(long, value_name = "DIR")]
+    pub set: PathBuf,
+    /// FE engine instead of campaign.toml's [solver] engine: febio or ccx.
+    #[arg(long, value_name = "ENGINE", value_parser = ["febio", "ccx"])]
+    pub solver: Option<String>,
+    /// Only the poses whose name matches this glob, e.g. 'x+*' or 'centre' (quote it), or
+    /// any of several comma-separated globs, e.g. 'lhs-09,lhs-1*'.
+    #[arg(long, value_name = "PATTERN")]
+    pub only: Option<String>,
+    /// Mesh level of campaign.toml ([mesh.<LEVEL>]); default: campaign.mesh.
+    #[arg(long, value_name = "LEVEL")]
+    pub mesh: Option<String>,
+    /// Number of load steps instead of loading.steps (smoke runs: rows at N+1 depths from 0
+    /// to loading.depth_mm). Part of the spec hash: results of other step counts are rerun.
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=10_000))]
+    pub steps: Option<u32>,
+    /// Output folder for <pose>.csv, manifest.toml and .work/; default: <set>/fe.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+}
+
+/// How each pose is solved (shared by `fe run` and the array tasks' `fe run-one`).
+#[derive(Args, Debug)]
+pub struct SolveArgs {
+    /// Rerun the selected poses even when their results are up to date.
+    #[arg(long)]
+    pub force: bool,
+    /// Keep the work folder (<out>/.work/<pose>: solver input and logs) of successful
+    /// runs too; failed runs always keep theirs.
+    #[arg(long)]
+    pub keep_work: bool,
+    /// Wall-clock limit of one ccx job, in seconds; a job running longer is killed and
+    /// reported failed.
+    #[arg(long, value_name = "S", allow_negative_numbers = true, value_parser = positive_seconds)]
+    pub timeout_s: Option<f64>,
+    /// A ccx job that writes no output (log, .sta, .cvg) for this many seconds is killed as stalled; a failed or stalled job is retried once with a smaller first increment per step
+    #[arg(long, value_name = "S", default_value_t = campaign::DEFAULT_STALL.as_secs_f64(), allow_negative_numbers = true, value_parser = positive_seconds)]
+    pub stall_s: f64,
+}
+
+/// The solve options of `a` applied to `opts`.
+fn with_solve(opts: RunOptions, a: &SolveArgs) -> RunOptions {
+    RunOptions {
+        force: a.force,
+        keep_work: a.keep_work,
+        timeout: a.timeout_s.map(Duration::from_secs_f64),
+        stall: Some(Duration::from_secs_f64(a.stall_s)),
+        ..opts
+    }
+}
+
+/// Arguments of `needle fe run`.
+#[derive(Args, Debug)]
+pub struct RunArgs {
+    #[command(flatten)]
+    pub spec: SpecArgs,
+    /// Number of solver jobs at the same time (memory: about 2.5 GB per ccx job on the
+    /// committed mesh).
+    #[arg(long, value_name = "N", default_value_t = 1, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub jobs: u32,
+    /// Solver threads per job (FEBio's Pardiso and assembly; ccx always runs on one).
+    /// Default: the machine's cores divided by --jobs.
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub threads: Option<u32>,
+    #[command(flatten)]
+    pub solve: SolveArgs,
+    /// Where the solver jobs run: local (this machine, --jobs at once) or slurm (one
+    /// sbatch job array, one task per pose still to solve, on the shared filesystem;
+    /// `needle fe status` follows it, rerunning the command resumes it).
+    #[arg(long, value_enum, default_value_t = LauncherArg::Local)]
+    pub launcher: LauncherArg,
+    /// slurm: sbatch --partition (default: the cluster's default partition).
+    #[arg(long, value_name = "NAME")]
+    pub partition: Option<String>,
+    /// slurm: sbatch --time per task, SLURM's format (minutes, HH:MM:SS, D-HH); default:
+    /// the engine's attempts x the longest measured run on this mesh x 1.5, at least 10 min.
+    #[arg(long, value_name = "TIME")]
+    pub time: Option<String>,
+    /// slurm: sbatch --mem per task (e.g. 4G); default: the largest measured solver peak
+    /// memory on this mesh x 1.5 + 256 MiB.
+    #[arg(long, value_name = "SIZE")]
+    pub mem: Option<String>,
+    /// slurm: sbatch --cpus-per-task, also the solver threads of each task (default 1).
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub cpus_per_task: Option<u32>,
+    /// slurm: one more sbatch argument, passed as given (repeatable), e.g.
+    /// --sbatch-arg=--account=abc.
+    #[arg(long, value_name = "ARG", allow_hyphen_values = true)]
+    pub sbatch_arg: Vec<String>,
+}
+
+/// Arguments of `needle fe status`.
+#[derive(Args, Debug)]
+pub struct StatusArgs {
+    #[command(flatten)]
+    pub spec: SpecArgs,
+    /// Project the selected poses' campaign wall time on these node counts, e.g. 1,4,16,
+    /// from the measured wall time of each pose (or the median of its model kind).
+    #[arg(long, value_name = "N,N,...", value_delimiter = ',', value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub project_nodes: Vec<u32>,
+    /// Tasks at once per node for the projection (cores per node / --cpus-per-task);
+    /// default: this machine's cores.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub tasks_per_node: Option<u32>,
+}
+
+/// Arguments of the hidden `needle fe run-one`: the spec options of `fe run` (the batch
+/// script passes them all) and the one pose.
+#[derive(Args, Debug)]
+pub struct RunOneArgs {
+    #[command(flatten)]
+    pub spec: SpecArgs,
+    #[command(flatten)]
+    pub solve: SolveArgs,
+    /// The pose, by its exact name.
+    #[arg(long, value_name = "NAME")]
+    pub pose: String,
+}
+
+/// A duration in seconds on the command line: finite and > 0 (at most 30 days).
+fn positive_seconds(text: &str) -> Result<f64, String> {
+    let v: f64 = text.trim().parse().map_err(|_| format!("{text:?} is not a number of seconds"))?;
+    if v.is_finite() && v > 0.0 && v <= 30.0 * 86_400.0 {
+        Ok(v)
+    } else {
+        Err(format!("{v} s: must be > 0 s and at most 30 days (2592000 s)"))
+    }
+}
+
+/// Arguments of `needle fe verify`.
+#[derive(Args, Debug)]
+pub struct VerifyArgs {
+    /// Set folder holding campaign.toml and fe/, e.g. coeffs/default.
+    #[arg(long, value_name = "DIR")]
+    pub set: PathBuf,
+    /// Run the flat-punch check (Sneddon, goal 5%).
+    #[arg(long)]
+    pub punch: bool,
+    /// Run the mesh-convergence check (Fy at full depth on the levels of campaign.mesh_study: committed level against its 2x refinement, goal 2%; Richardson estimate).
+    #[arg(long)]
+    pub mesh: bool,
+    /// Check the mirror runs against their counterparts (goal 1% of peak |Fy|).
+    #[arg(long)]
+    pub mirror: bool,
+    /// Coarsen the flat-punch mesh by this factor (1 = the verification mesh; the goal
+    /// applies to 1).
+    #[arg(long, value_name = "F", default_value_t = 1.0)]
+    pub punch_mesh_scale: f64,
+    /// Skip the flat punch with the campaign's element (C3D8), which is solved and
+    /// reported by default to measure its volumetric locking.
+    #[arg(long)]
+    pub no_campaign_element: bool,
+    /// Work folder for the solves; default: <set>/fe/.work/verify.
+    #[arg(long, value_name = "DIR")]
+    pub work: Option<PathBuf>,
+    /// Solver threads of each solve (FEBio); default: all cores.
+    #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub threads: Option<u32>,
+    /// FE engine of the checks instead of campaign.toml's [solver] engine: febio or ccx.
+    #[arg(long, value_name = "ENGINE", value_parser = ["febio", "ccx"])]
+    pub solver: Option<String>,
+}
+
+/// Run an `fe` subcommand.
+///
+/// # Errors
+/// Any failure before the runs start (spec, material check, ccx missing, output folder),
+/// with its context. Failed runs are reported and give exit status 1, not an error.
+pub fn run(c: FeCommand) -> anyhow::Result<ExitCode> {
+    match c {
+        FeCommand::Run(a) => run_campaign(a),
+        FeCommand::Verify(a) => run_verify(a),
+        FeCommand::Status(a) => run_status(a),
+        FeCommand::RunOne(a) => run_one(a),
+    }
+}
+
+fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
+    let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    let jobs = a.jobs as usize;
+    if a.launcher == LauncherArg::Local
+        && (a.partition.is_some() || a.time.is_some() || a.mem.is_some() || a.cpus_per_task.is_some() || !a.sbatch_arg.is_empty())
+    {
+        anyhow::bail!("--partition, --time, --mem, --cpus-per-task and --sbatch-arg are options of --launcher slurm");
+    }
+    let opts = with_solve(
+        RunOptions { jobs, threads: a.threads.map(|t| t as usize).unwrap_or((cores / jobs).max(1)), ..spec_options(a.spec)? },
+        &a.solve,
+    );
+    if a.launcher == LauncherArg::Slurm {
+        let slurm = SlurmOptions {
+            partition: a.partition,
+            time: a.time,
+            mem: a.mem,
+            cpus_per_task: a.cpus_per_task,
+            extra: a.sbatch_arg,
+            needle: None,
+        };
+        let r = slurm::submit(&opts, &slurm)?;
+        print!("{}", submit_summary(&r));
+        return Ok(ExitCode::SUCCESS);
+    }
+    needle_fe::process::stop_jobs_on_termination()?;
+    let report = campaign::run(&opts)?;
+    print!("{}", report.table());
+    if needle_fe::process::interrupted() {
+        return Ok(ExitCode::from(needle_fe::process::EXIT_INTERRUPTED));
+    }
+    Ok(if report.failed() > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+/// What `needle fe run --launcher slurm` prints.
+fn submit_summary(r: &slurm::SubmitReport) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let _ = writeln!(s, "{} pose(s) selected: {} up to date, {} still in the queue", r.selected, r.up_to_date.len(), r.in_queue.len());
+    for (pose, task, state) in &r.in_queue {
+        let _ = writeln!(s, "  {pose}: task {task} {}", state.to_lowercase());
+    }
+    match (&r.submission, &r.resources) {
+        (Some(sub), Some(res)) => {
+            let _ = writeln!(s, "submitted job array {} with {} task(s): {}", sub.job_id, sub.poses.len(), sub.poses.join(", "));
+            for w in &res.why {
+                let _ = writeln!(s, "  {w}");
+            }
+            let _ = writeln!(
+                s,
+                "follow it with: needle fe status (same --set/--out/--mesh/--steps); rerun this command to resubmit what fails"
+            );
+        }
+        _ => {
+            let _ = writeln!(s, "nothing to submit");
+        }
+    }
+    s
+}
+
+fn run_status(a: StatusArgs) -> anyhow::Result<ExitCode> {
+    let plan = campaign::plan(&spec_options(a.spec)?)?;
+    let r = needle_fe::launcher::status::status(&plan)?;
+    print!("{}", r.table());
+    if !a.project_nodes.is_empty() {
+        let per_node =
+            a.tasks_per_node.map(|n| n as usize).unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
+        let nodes: Vec<usize> = a.project_nodes.iter().map(|&n| n as usize).collect();
+        print!("{}", needle_fe::launcher::projection::table(&plan, &nodes, per_node));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The run options of `spec`, the others at their defaults.
+fn spec_options(spec: SpecArgs) -> anyhow::Result<RunOptions> {
+    Ok(RunOptions {
+        solver: spec.solver.as_deref().map(needle_fe::spec::Engine::parse).transpose()?,
+        only: spec.only,
+        mesh: spec.mesh,
+        steps: spec.steps,
+        out_dir: spec.out,
+        ..RunOptions::new(spec.set)
+    })
+}
+
+fn run_one(a: RunOneArgs) -> anyhow::Result<ExitCode> {
+    if a.pose.contains(',') || a.pose.chars().any(|c| matches!(c, '*' | '?' | '[' | ']')) || a.spec.only.is_some() {
+        anyhow::bail!("--pose {:?}: one pose name, not a pattern (and no --only)", a.pose);
+    }
+    let threads = std::env::var("SLURM_CPUS_PER_TASK").ok().and_then(|v| v.trim().parse::<usize>().ok()).unwrap_or(1).max(1);
+    let only = Some(a.pose.clone());
+    let opts = with_solve(RunOptions { jobs: 1, threads, only, launcher: Launched::from_env(), ..spec_options(a.spec)? }, &a.solve);
+    needle_fe::process::stop_jobs_on_termination()?;
+    let report = campaign::run(&opts)?;
+    print!("{}", report.table());
+    if needle_fe::process::interrupted() {
+        return Ok(ExitCode::from(needle_fe::process::EXIT_INTERRUPTED));
+    }
+    Ok(if report.failed() > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+fn run_verify(a: VerifyArgs) -> anyhow::Result<ExitCode> {
+    if !(a.punch_mesh_scale.is_finite() && a.punch_mesh_scale >= 1.0) {
+        anyhow::bail!("--punch-mesh-scale {}: must be a number >= 1", a.punch_mesh_scale);
+    }
+    let all = !(a.punch || a.mesh || a.mirror);
+    let opts = needle_fe::verify::VerifyOptions {
+        set_dir: a.set,
+        punch: a.punch || all,
+        mesh: a.mesh || all,
+        mirror: a.mirror || all,
+        work_dir: a.work,
+        punch_mesh_scale: a.punch_mesh_scale,
+        punch_campaign_element: !a.no_campaign_element,
+        threads: a.threads.map(|t| t as usize).unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)),
+        engine: a.solver.as_deref().map(needle_fe::spec::Engine::parse).transpose()?,
+    };
+    needle_fe::process::stop_jobs_on_termination()?;
+    let (_, ok) = needle_fe::verify::run(&opts)?;
+    if !ok {
+        eprintln!("needle fe verify: a check missed its goal");
+    }
+    Ok(if ok { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}

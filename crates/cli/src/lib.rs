@@ -1,0 +1,12 @@
+//! The `needle` command line: one module per command group.
+#![forbid(unsafe_code)]
+
+pub mod eval_batch;
+pub mod explore;
+pub mod fe;
+pub mod firmware;
+pub mod fit;
+pub mod fixed;
+pub mod fixed_error;
+pub mod model;
+pub mod plot;

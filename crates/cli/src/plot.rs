@@ -1,0 +1,56 @@
+//! `needle plot`: write (or check) the figures of a set.
+
+use anyhow::{Context, Result};
+use clap::Args;
+use needle_fe::results::write_atomic;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Arguments of `needle plot`.
+#[derive(Args, Debug)]
+pub struct PlotArgs {
+    /// Set folder holding campaign.toml, fe/ and model.toml, e.g. coeffs/default.
+    #[arg(long, value_name = "DIR")]
+    pub set: PathBuf,
+    /// Output folder; default: <set>/figures.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Compare with the figures in the output folder instead of writing; exit 1 when one
+    /// is missing or differs (stale).
+    #[arg(long)]
+    pub check: bool,
+}
+
+/// Run `needle plot`.
+///
+/// # Errors
+/// The set cannot be read or a figure cannot be written.
+pub fn plot(a: PlotArgs) -> Result<ExitCode> {
+    let figures = needle_plot::render_set(&a.set).with_context(|| format!("needle plot --set {}", a.set.display()))?;
+    let out = a.out.unwrap_or_else(|| a.set.join("figures"));
+    if a.check {
+        let mut ok = true;
+        for (file, svg) in &figures {
+            let path = out.join(file);
+            match std::fs::read_to_string(&path) {
+                Ok(old) if old == *svg => println!("{}: up to date", path.display()),
+                Ok(_) => {
+                    println!("{}: stale (differs from a fresh rendering; run `needle plot --set {}`)", path.display(), a.set.display());
+                    ok = false;
+                }
+                Err(e) => {
+                    println!("{}: missing ({e})", path.display());
+                    ok = false;
+                }
+            }
+        }
+        return Ok(if ok { ExitCode::SUCCESS } else { ExitCode::from(1) });
+    }
+    std::fs::create_dir_all(&out).with_context(|| format!("{}: cannot create", out.display()))?;
+    for (file, svg) in &figures {
+        let path = out.join(file);
+        write_atomic(&path, svg.as_bytes())?;
+        println!("wrote {} ({} bytes)", path.display(), svg.len());
+    }
+    Ok(ExitCode::SUCCESS)
+}

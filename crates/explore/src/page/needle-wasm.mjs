@@ -1,0 +1,45 @@
+// The needle-haptics f32 evaluator (crates/wasm, the firmware's own no_std source)
+// as a JavaScript object. Shared by the explorer page and the Node golden check
+// (host-tests/tests/explore/golden.mjs), so both run the same glue.
+//
+// load(bytes) -> { evaluate(x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm),
+//                  domain: { x_max_mm, z_max_mm, theta_max_deg, depth_max_mm },
+//                  form: "paper" | "coupled" | "unfitted" }
+// evaluate returns { status, bits: Uint32Array(6), wrench: Float32Array(6) }: fx, fy, fz
+// in N, mx, my, mz in N*mm about the hub, status the library's Status bits.
+
+export const COMPONENTS = ["fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"];
+
+export const STATUS_FLAGS = [
+  [0x01, "SAT_X"], [0x02, "SAT_Z"], [0x04, "SAT_THETA_X"], [0x08, "SAT_THETA_Z"],
+  [0x10, "SAT_DEPTH"], [0x40, "NO_MODEL"], [0x80, "ERROR"],
+];
+
+export function statusNames(status) {
+  const names = STATUS_FLAGS.filter(([bit]) => status & bit).map(([, name]) => name);
+  return names.length ? names.join(" | ") : "OK";
+}
+
+export async function load(bytes) {
+  const { instance } = await WebAssembly.instantiate(bytes, {});
+  const e = instance.exports;
+  for (const name of ["memory", "needle_eval", "needle_out", "needle_domain", "needle_coupled"]) {
+    if (!(name in e)) throw new Error(`needle.wasm does not export ${name}: rebuild it with needle explore`);
+  }
+  const form = ["paper", "coupled", "unfitted"][e.needle_coupled()] ?? "unknown";
+  return {
+    form,
+    domain: {
+      x_max_mm: e.needle_domain(0),
+      z_max_mm: e.needle_domain(1),
+      theta_max_deg: e.needle_domain(2),
+      depth_max_mm: e.needle_domain(3),
+    },
+    evaluate(x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm) {
+      const status = e.needle_eval(x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm) >>> 0;
+      // the memory may have grown since the last call: take a fresh view each time
+      const bits = Uint32Array.from(new Uint32Array(e.memory.buffer, e.needle_out(), 6));
+      return { status, bits, wrench: new Float32Array(bits.buffer) };
+    },
+  };
+}

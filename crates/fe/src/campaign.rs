@@ -1,0 +1,822 @@
+//! The FE campaign driver behind `needle fe run`: select the poses, skip the ones whose
+//! result is up to date, solve the others in parallel on the set's engine (a
+//! [`Backend`]: FEBio or CalculiX; `jobs` at once, `threads` solver threads each), write
+//! `fe/<pose>.csv` and the manifest atomically, and report.
+//!
+//! Files, in the output folder (default `<set>/fe/`):
+//! - `<pose>.csv`: the wrench at `steps + 1` depths (format: coeffs/README.md). Written
+//!   with [`results::write_atomic`]: a killed run never leaves a half-written CSV.
+//! - `manifest.toml`: one table per finished pose (see [`ManifestEntry`]), sorted by
+//!   pose name, rewritten atomically after each pose.
+//! - `manifest.toml.lock`: the lock ([`lock_manifest`]) under which every process
+//!   (this one's jobs, SLURM array tasks, another `needle fe run`) rewrites the manifest.
+//! - `.work/<pose>/`: the solver's input and files of a run; removed when the run
+//!   succeeds (unless `keep_work`), kept for debugging when it fails.
+//!
+//! A pose is up to date, and skipped, when its CSV exists with `steps + 1` rows and its
+//! manifest entry has the spec hash of the current run ([`Campaign::run_hash`] of the
+//! spec with the `--steps` override applied, the pose and the mesh level). A rerun
+//! (stale spec, `--force`) leaves the earlier CSV and its entry alone until it succeeds:
+//! then the new CSV is renamed over the old one and the new entry replaces the old. A
+//! failed or interrupted rerun therefore keeps the earlier result usable. Killed between
+//! the two renames, the new CSV sits beside the old entry: with a stale spec the entry's
+//! hash is not the current one and the pose is rerun; with `--force` both come from the
+//! same spec.
+//!
+//! A run that fails (solver error, no convergence, timeout) or stalls (no output for
+//! [`RunOptions::stall`]: ccx 2.20 was seen spinning without output at the start of a
+//! step, deterministically, e.g. theta_z = 15 degrees at 5.4 mm) is rerun with every load
+//! step starting at [`deck::RETRY_FIRST_INCREMENT`] of the step instead of the whole step,
+//! up to the engine's [`Backend::attempts`] in all (ccx: one retry; FEBio: two, the last
+//! with a softer contact penalty). The manifest entry records it (`first_increment`,
+//! `retry`, `solver_settings`). Only when the last attempt fails too is the pose failed.
+//!
+//! The pieces: [`backend`](crate::backend) solves one pose, [`manifest`](crate::manifest)
+//! records how each CSV was made, [`report`](crate::report) is the outcome and
+//! `progress` the display.
+
+use crate::backend::{Backend, Job, SolveFailure, Solved};
+use crate::deck;
+use crate::engines::backend_for;
+use crate::launcher::Launched;
+use crate::manifest::{manifest_text, read_manifest, rfc3339_utc, Manifest, ManifestEntry, MANIFEST};
+use crate::process;
+use crate::progress::Progress;
+use crate::report::{PoseReport, Report, Status};
+use crate::results::{self, Row};
+use crate::spec::{self, Campaign, Engine, MeshLevel, PoseSpec};
+use anyhow::{bail, Context, Result};
+use std::collections::BTreeMap;
+use std::collections::VecDeque;
+use std::path::{Path, PathBuf};
+use std::sync::{mpsc, Mutex};
+use std::time::{Duration, Instant, SystemTime};
+
+/// What `needle fe run` was asked to do.
+#[derive(Debug, Clone)]
+pub struct RunOptions {
+    /// The set folder, holding `campaign.toml`.
+    pub set_dir: PathBuf,
+    /// Number of solver jobs run at the same time; 0 counts as 1.
+    pub jobs: usize,
+    /// Solver threads per job (FEBio: OpenMP threads of Pardiso and the assembly; ccx
+    /// always runs on one); 0 counts as 1.
+    pub threads: usize,
+    /// The engine instead of the spec's `[solver] engine`; part of the spec hash.
+    pub solver: Option<Engine>,
+    /// Keep the work folder of a successful run too (inputs and solver logs, for study).
+    pub keep_work: bool,
+    /// Glob over pose names (`*`, `?`, `[..]`); `None`: every pose.
+    pub only: Option<String>,
+    /// Mesh level; `None`: `campaign.mesh` of the spec.
+    pub mesh: Option<String>,
+    /// Number of load steps instead of `loading.steps` (smoke runs); part of the hash.
+    pub steps: Option<u32>,
+    /// Output folder; `None`: `<set_dir>/fe`.
+    pub out_dir: Option<PathBuf>,
+    /// Solve every selected pose, even when its result is up to date.
+    pub force: bool,
+    /// Wall-clock limit of one ccx job; the job is killed and reported failed after it.
+    pub timeout: Option<Duration>,
+    /// A ccx job that writes no output for this long is killed as stalled (then retried).
+    pub stall: Option<Duration>,
+    /// How this process was started, recorded in the manifest entries it writes.
+    pub launcher: Launched,
+}
+
+impl RunOptions {
+    /// Options for the whole campaign of `set_dir` with the spec's settings, one job.
+    pub fn new(set_dir: impl Into<PathBuf>) -> Self {
+        RunOptions {
+            set_dir: set_dir.into(),
+            jobs: 1,
+            threads: 1,
+            solver: None,
+            keep_work: false,
+            only: None,
+            mesh: None,
+            steps: None,
+            out_dir: None,
+            force: false,
+            timeout: None,
+            stall: Some(DEFAULT_STALL),
+            launcher: Launched::Local,
+        }
+    }
+}
+
+/// Default [`RunOptions::stall`]: ccx writes its log in 4 KiB blocks, a few Newton
+/// iterations each (an iteration takes seconds on the committed mesh); ten minutes of
+/// silence is not progress.
+pub const DEFAULT_STALL: Duration = Duration::from_secs(600);
+
+/// Run the campaign on its engine (`opts.solver`, else the spec's `[solver] engine`).
+/// See the module docs.
+///
+/// # Errors
+/// The spec cannot be loaded or is invalid, the tissue fails the material check,
+/// `--mesh` names no level, `--only` matches no pose or is not a glob, `--steps 0`,
+/// ccx is missing, the manifest is corrupt or the output folder cannot be written.
+/// Failed solves are not errors: they are in the [`Report`].
+pub fn run(opts: &RunOptions) -> Result<Report> {
+    let (campaign, _) = spec::load(&opts.set_dir)?;
+    let engine = opts.solver.unwrap_or(campaign.solver.engine);
+    run_with(opts, backend_for(engine, opts.threads).as_mut())
+}
+
+/// Everything shared by the workers.
+struct Ctx<'a> {
+    campaign: &'a Campaign,
+    mesh_name: &'a str,
+    mesh: &'a MeshLevel,
+    steps: u32,
+    out_dir: &'a Path,
+    timeout: Option<Duration>,
+    stall: Option<Duration>,
+    backend: &'a dyn Backend,
+    solver_version: String,
+    manifest_lock: Mutex<()>,
+    keep_work: bool,
+    launcher: &'a Launched,
+}
+
+/// What a campaign run will do, worked out before anything is solved or submitted:
+/// the spec (with the `--solver` and `--steps` overrides applied), the mesh level, the
+/// output folder and, per selected pose, whether its result is up to date. Shared by the
+/// local run ([`run_with`]), the SLURM submission
+/// ([`launcher::slurm`](crate::launcher::slurm)) and `needle fe status`.
+pub struct Plan {
+    /// The spec with the overrides applied.
+    pub campaign: Campaign,
+    /// `campaign.toml`'s path.
+    pub spec_path: PathBuf,
+    /// Mesh level name.
+    pub mesh_name: String,
+    /// Load steps per run.
+    pub steps: u32,
+    /// The output folder (`<set>/fe` unless `--out`).
+    pub out_dir: PathBuf,
+    /// The manifest as read (without the csv_sha256 backfill).
+    pub manifest: Manifest,
+    /// One report per selected pose, in campaign order: [`Status::UpToDate`] (with the
+    /// manifest's figures) or a placeholder for the poses in `to_run`.
+    pub reports: Vec<PoseReport>,
+    /// Indices into `reports` (and the selected poses) of the poses to solve.
+    pub to_run: Vec<usize>,
+    /// The selected poses, in campaign order (same order as `reports`).
+    pub selected: Vec<PoseSpec>,
+}
+
+impl Plan {
+    /// Names of the poses to solve, in campaign order.
+    pub fn to_run_names(&self) -> Vec<String> {
+        self.to_run.iter().filter_map(|&i| self.selected.get(i)).map(|p| p.name.clone()).collect()
+    }
+}
+
+/// Work out what `opts` asks for without changing any file: load and check the spec, pick
+/// the mesh level and the poses, read the manifest, and sort the poses into up to date
+/// and to solve (module docs).
+///
+/// # Errors
+/// As [`run`], except solver problems (nothing is solved here).
+pub fn plan(opts: &RunOptions) -> Result<Plan> {
+    let (mut campaign, spec_path) = spec::load(&opts.set_dir)?;
+    let stability = crate::material::check(&campaign.tissue)
+        .with_context(|| format!("{}: the tissue fails the material stability check; nothing was run", spec_path.display()))?;
+    eprintln!("material check passed: {}", stability.to_string().replace('\n', "\n  "));
+    if let Some(engine) = opts.solver {
+        campaign.solver.engine = engine;
+    }
+    if let Some(s) = opts.steps {
+        if s == 0 {
+            bail!("--steps 0: must be >= 1");
+        }
+        campaign.loading.steps = s;
+    }
+    let steps = campaign.loading.steps;
+    let mesh_name = opts.mesh.clone().unwrap_or_else(|| campaign.campaign.mesh.clone());
+    campaign.mesh_level(&mesh_name)?;
+    let all = campaign.poses();
+    let selected: Vec<PoseSpec> = spec::select(&all, opts.only.as_deref())?.into_iter().cloned().collect();
+    if selected.is_empty() {
+        bail!(
+            "--only {:?} matches no pose (poses: {})",
+            opts.only.as_deref().unwrap_or(""),
+            all.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ")
+        );
+    }
+    let out_dir = opts.out_dir.clone().unwrap_or_else(|| opts.set_dir.join("fe"));
+    let manifest = read_manifest(&out_dir.join(MANIFEST))?;
+    let mut reports: Vec<PoseReport> = Vec::with_capacity(selected.len());
+    let mut to_run: Vec<usize> = Vec::new();
+    for pose in &selected {
+        let csv = out_dir.join(format!("{}.csv", pose.name));
+        let entry = manifest.current_entry(&campaign, pose, &mesh_name).ok();
+        // a CSV whose content is not what the campaign wrote is not up to date
+        let rows = entry
+            .and_then(|e| std::fs::read_to_string(&csv).ok().filter(|text| e.content_matches(text.as_bytes())))
+            .and_then(|text| results::parse_csv(&text, &csv).ok())
+            .filter(|r| r.len() == steps as usize + 1);
+        let mut report = PoseReport {
+            pose: pose.name.clone(),
+            status: Status::UpToDate,
+            wall_s: None,
+            increments: None,
+            fy_final_n: None,
+            work_dir: None,
+        };
+        match (entry, rows) {
+            (Some(e), Some(rows)) if !opts.force => {
+                report.wall_s = Some(e.wall_s);
+                report.increments = Some(e.increments);
+                report.fy_final_n = rows.last().map(|r| r.wrench[1]);
+            }
+            _ => to_run.push(reports.len()),
+        }
+        reports.push(report);
+    }
+    Ok(Plan { campaign, spec_path, mesh_name, steps, out_dir, manifest, reports, to_run, selected })
+}
+
+/// [`run`] with a given solver backend (tests use a fake one).
+///
+/// # Errors
+/// As [`run`].
+pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> {
+    let start = Instant::now();
+    let Plan { campaign, mesh_name, steps, out_dir, mut reports, to_run, selected, .. } = plan(opts)?;
+    let mesh = campaign.mesh_level(&mesh_name)?.clone();
+    std::fs::create_dir_all(&out_dir).with_context(|| format!("{}: cannot create", out_dir.display()))?;
+    let manifest_path = out_dir.join(MANIFEST);
+    let (hashed, manifest) = {
+        let _lock = lock_manifest(&out_dir)?;
+        // read again under the lock: another process may have written it since the plan
+        let mut manifest = read_manifest(&manifest_path)?;
+        let hashed = manifest.backfill_csv_hashes(&out_dir);
+        if !hashed.is_empty() {
+            results::write_atomic(&manifest_path, manifest_text(&manifest)?.as_bytes())?;
+        }
+        (hashed, manifest)
+    };
+    if !hashed.is_empty() {
+        eprintln!("{}: recorded csv_sha256 of {} earlier result(s) ({})", manifest_path.display(), hashed.len(), hashed.join(", "));
+    }
+    let to_run: Vec<(usize, &PoseSpec)> = to_run.iter().filter_map(|&i| selected.get(i).map(|p| (i, p))).collect();
+    let skipped = reports.len() - to_run.len();
+    let jobs = opts.jobs.clamp(1, to_run.len().max(1));
+    eprintln!(
+        "needle fe run: {} pose(s) selected; skipped {skipped} up to date; {} to run with {jobs} job(s) (mesh {mesh_name}, {steps} steps to {} mm) -> {}",
+        reports.len(),
+        to_run.len(),
+        campaign.loading.depth_mm,
+        out_dir.display()
+    );
+    if !to_run.is_empty() {
+        let solver_version = backend.prepare()?;
+        let backend: &dyn Backend = backend;
+        let ctx = Ctx {
+            campaign: &campaign,
+            mesh_name: &mesh_name,
+            mesh: &mesh,
+            steps,
+            out_dir: &out_dir,
+            timeout: opts.timeout,
+            stall: opts.stall,
+            backend,
+            solver_version,
+            manifest_lock: Mutex::new(()),
+            keep_work: opts.keep_work,
+            launcher: &opts.launcher,
+        };
+        let earlier_walls_s = manifest.wall_times_s(ctx.campaign.solver.engine.name(), &mesh_name, steps);
+        run_workers(&ctx, &to_run, jobs, earlier_walls_s, &mut reports);
+    }
+    Ok(Report { poses: reports, mesh: mesh_name, steps, depth_mm: campaign.loading.depth_mm, out_dir, wall: start.elapsed() })
+}
+
+/// Name of the lock file beside the manifest: campaigns in other processes (SLURM array
+/// tasks on other nodes, a second `needle fe run`) update the same manifest.
+pub const MANIFEST_LOCK: &str = "manifest.toml.lock";
+
+/// Hold an exclusive lock on `<out_dir>/manifest.toml.lock` (`flock`; on a shared
+/// filesystem it needs the filesystem's lock support, which NFSv4 and Lustre give) for
+/// the read-change-write of the manifest. Released when the returned file is dropped.
+///
+/// # Errors
+/// The lock file cannot be created or locked.
+pub fn lock_manifest(out_dir: &Path) -> Result<std::fs::File> {
+    let path = out_dir.join(MANIFEST_LOCK);
+    let f = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&path)
+        .with_context(|| format!("{}: cannot create the manifest's lock file", path.display()))?;
+    f.lock().with_context(|| format!("{}: cannot lock", path.display()))?;
+    Ok(f)
+}
+
+enum Event {
+    Started(usize),
+    Finished(usize, PoseReport),
+}
+
+/// Solve `to_run` (report index, pose) with `jobs` worker threads, filling `reports`.
+/// `earlier_walls_s`: the manifest's measured wall times by model, for the ETA.
+fn run_workers(
+    ctx: &Ctx<'_>,
+    to_run: &[(usize, &PoseSpec)],
+    jobs: usize,
+    earlier_walls_s: BTreeMap<String, Vec<f64>>,
+    reports: &mut [PoseReport],
+) {
+    let queue: Mutex<VecDeque<usize>> = Mutex::new((0..to_run.len()).collect());
+    let (tx, rx) = mpsc::channel::<Event>();
+    let runs = to_run.iter().map(|(_, p)| (p.name.clone(), deck::model_name(p.symmetry()).to_string())).collect();
+    let mut progress = Progress::new(runs, ctx.steps, jobs, earlier_walls_s);
+    std::thread::scope(|s| {
+        for _ in 0..jobs {
+            let tx = tx.clone();
+            let queue = &queue;
+            s.spawn(move || loop {
+                if process::interrupted() {
+                    break;
+                }
+                let next = queue.lock().map(|mut q| q.pop_front()).unwrap_or(None);
+                let Some(i) = next else { break };
+                let Some(&(_, pose)) = to_run.get(i) else { break };
+                if tx.send(Event::Started(i)).is_err() {
+                    break;
+                }
+                let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| solve_pose(ctx, pose))).unwrap_or_else(|panic| {
+                    let what = panic
+                        .downcast_ref::<String>()
+                        .cloned()
+                        .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                        .unwrap_or_default();
+                    failed_report(pose, ctx, format!("panic while solving: {what}"), String::new())
+                });
+                if tx.send(Event::Finished(i, r)).is_err() {
+                    break;
+                }
+            });
+        }
+        drop(tx);
+        loop {
+            match rx.recv_timeout(Duration::from_millis(500)) {
+                Ok(Event::Started(i)) => progress.started(i),
+                Ok(Event::Finished(i, r)) => {
+                    progress.finished(i, &r);
+                    if let Some(dst) = to_run.get(i).and_then(|&(slot, _)| reports.get_mut(slot)) {
+                        *dst = r;
+                    }
+                }
+                Err(mpsc::RecvTimeoutError::Timeout) => {}
+                Err(mpsc::RecvTimeoutError::Disconnected) => break,
+            }
+            progress.tick(|i| to_run.get(i).map(|(_, p)| ctx.backend.steps_done(&work_dir(ctx.out_dir, &p.name))).unwrap_or(0));
+        }
+    });
+    progress.finish();
+}
+
+/// `<out_dir>/.work/<pose>/`
+fn work_dir(out_dir: &Path, pose: &str) -> PathBuf {
+    out_dir.join(".work").join(pose)
+}
+
+fn failed_report(pose: &PoseSpec, ctx: &Ctx<'_>, message: String, log_tail: String) -> PoseReport {
+    PoseReport {
+        pose: pose.name.clone(),
+        status: Status::Failed { message, log_tail },
+        wall_s: None,
+        increments: None,
+        fy_final_n: None,
+        work_dir: Some(work_dir(ctx.out_dir, &pose.name)),
+    }
+}
+
+/// Solve one pose and write its results; never returns an error, a failure is a report.
+fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
+    let start = Instant::now();
+    let wd = work_dir(ctx.out_dir, &pose.name);
+    let fail = |message: String, log_tail: String| failed_report(pose, ctx, message, log_tail);
+    let prepared = (|| -> Result<()> {
+        if wd.exists() {
+            std::fs::remove_dir_all(&wd).with_context(|| format!("{}: cannot clear", wd.display()))?;
+        }
+        std::fs::create_dir_all(&wd).with_context(|| format!("{}: cannot create", wd.display()))?;
+        // The earlier result and its entry stay until the new ones replace them: a failed
+        // or interrupted rerun (`--force`) costs nothing (module docs).
+        Ok(())
+    })();
+    if let Err(e) = prepared {
+        return fail(format!("{e:#}"), String::new());
+    }
+    let job = Job {
+        campaign: ctx.campaign,
+        pose,
+        mesh_name: ctx.mesh_name,
+        mesh: ctx.mesh,
+        steps: ctx.steps,
+        work_dir: &wd,
+        timeout: ctx.timeout,
+        stall: ctx.stall,
+        first_increment: 1.0,
+        attempt: 0,
+    };
+    let solved = match solve_with_retry(ctx.backend, &job) {
+        Ok(s) => s,
+        Err(f) => return fail(f.message, f.log_tail),
+    };
+    let wall_s = (start.elapsed().as_secs_f64() * 1000.0).round() / 1000.0;
+    match write_results(ctx, pose, &solved, wall_s) {
+        Ok(fy) => {
+            // the work folder is only for debugging failed runs; a leftover is harmless
+            if !ctx.keep_work {
+                let _ = std::fs::remove_dir_all(&wd);
+            }
+            PoseReport {
+                pose: pose.name.clone(),
+                status: Status::Done,
+                wall_s: Some(wall_s),
+                increments: Some(solved.increments),
+                fy_final_n: Some(fy),
+                work_dir: None,
+            }
+        }
+        Err(e) => fail(format!("{e:#}"), String::new()),
+    }
+}
+
+/// Solve `job`; when that fails, again with [`deck::RETRY_FIRST_INCREMENT`], up to the
+/// backend's [`Backend::attempts`] (module docs). The failures so far go into the
+/// result's `retry` (or the final failure's message).
+pub(crate) fn solve_with_retry(backend: &dyn Backend, job: &Job<'_>) -> std::result::Result<Solved, SolveFailure> {
+    let mut failures: Vec<String> = Vec::new();
+    let attempts = backend.attempts().max(1);
+    for attempt in 0..attempts {
+        let r = backend.first_increment(attempt);
+        let this = Job { first_increment: r, attempt, ..*job };
+        match backend.solve(&this) {
+            Ok(s) => return Ok(Solved { retry: (!failures.is_empty()).then(|| failures.join("; ")), ..s }),
+            Err(f) => {
+                let message = if attempt == 0 { f.message } else { format!("retry {attempt} (first increment {r}): {}", f.message) };
+                failures.push(message);
+                if attempt + 1 == attempts || process::interrupted() {
+                    return Err(SolveFailure { message: failures.join("; "), log_tail: f.log_tail });
+                }
+                eprintln!(
+                    "{}: {}; retry {} of {} with each step's first increment at {} of the step",
+                    job.pose.name,
+                    failures.last().map(String::as_str).unwrap_or_default(),
+                    attempt + 1,
+                    attempts - 1,
+                    backend.first_increment(attempt + 1)
+                );
+            }
+        }
+    }
+    Err(SolveFailure { message: failures.join("; "), log_tail: String::new() })
+}
+
+/// Check the wrenches, write the CSV, then the manifest entry. Returns Fy at the final depth.
+fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Result<f64> {
+    if s.wrenches.len() != ctx.steps as usize {
+        bail!("the solver returned {} wrenches for {} steps", s.wrenches.len(), ctx.steps);
+    }
+    let mut rows = vec![Row { depth_mm: 0.0, wrench: [0.0; 6] }];
+    for (k, w) in (1u32..).zip(&s.wrenches) {
+        if w.iter().any(|v| !v.is_finite()) {
+            bail!("step {k}: the wrench is not finite: {w:?}");
+        }
+        rows.push(Row { depth_mm: ctx.campaign.loading.depth_at(k), wrench: *w });
+    }
+    let csv = ctx.out_dir.join(format!("{}.csv", pose.name));
+    let text = results::to_csv(&rows);
+    results::write_atomic(&csv, text.as_bytes())?;
+    let entry = ManifestEntry {
+        spec_hash: ctx.campaign.run_hash(pose, ctx.mesh_name),
+        engine: ctx.backend.engine().to_string(),
+        engine_version: ctx.solver_version.clone(),
+        element: s.element.clone(),
+        solver_settings: s.settings.clone(),
+        mesh: ctx.mesh_name.to_string(),
+        csv_sha256: Some(results::content_sha256(text.as_bytes())),
+        model: s.summary.model.clone(),
+        tissue_mesh: s.summary.tissue_mesh.clone(),
+        tissue_nodes: s.summary.tissue_nodes as u64,
+        tissue_elements: s.summary.tissue_elements as u64,
+        needle_nodes: s.summary.needle_nodes as u64,
+        needle_elements: s.summary.needle_elements as u64,
+        steps: ctx.steps,
+        depth_mm: ctx.campaign.loading.depth_mm,
+        increments: s.increments,
+        iterations: s.iterations,
+        wall_s,
+        peak_rss_mib: (s.peak_rss_mib > 0.0).then(|| (s.peak_rss_mib * 10.0).round() / 10.0),
+        date: rfc3339_utc(SystemTime::now()),
+        role: pose.role,
+        x_mm: pose.x_mm,
+        z_mm: pose.z_mm,
+        theta_x_deg: pose.theta_x_deg,
+        theta_z_deg: pose.theta_z_deg,
+        first_increment: (s.first_increment != 1.0).then_some(s.first_increment),
+        retry: s.retry.clone(),
+        launcher: Some(ctx.launcher.name().to_string()),
+        batch_job: ctx.launcher.batch_job(),
+    };
+    update_manifest(ctx, |m| {
+        m.pose.insert(pose.name.clone(), entry);
+    })?;
+    Ok(rows.last().map(|r| r.wrench[1]).unwrap_or(0.0))
+}
+
+/// Read the manifest from disk (another `needle fe run` may have written it), change it,
+/// write it back atomically; under the campaign's manifest lock.
+fn update_manifest(ctx: &Ctx<'_>, f: impl FnOnce(&mut Manifest)) -> Result<()> {
+    let _guard = ctx.manifest_lock.lock().unwrap_or_else(|p| p.into_inner());
+    let _lock = lock_manifest(ctx.out_dir)?;
+    let path = ctx.out_dir.join(MANIFEST);
+    let mut m = read_manifest(&path)?;
+    let before = m.clone();
+    f(&mut m);
+    if m == before && path.exists() {
+        return Ok(());
+    }
+    results::write_atomic(&path, manifest_text(&m)?.as_bytes())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::deck::MeshSummary;
+    use crate::spec::Role;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    /// A solver that returns a made-up wrench (bookkeeping tests only, no physics), can
+    /// fail or panic on one pose, and counts its solves.
+    #[derive(Default)]
+    struct Fake {
+        fail: Option<String>,
+        /// Fails this pose's first attempt only (whole-step first increment).
+        fail_first: Option<String>,
+        panic_on: Option<String>,
+        solves: AtomicUsize,
+        prepared: usize,
+    }
+
+    impl Backend for Fake {
+        fn prepare(&mut self) -> Result<String> {
+            self.prepared += 1;
+            Ok("fake-1".into())
+        }
+        fn engine(&self) -> &'static str {
+            "fake"
+        }
+        fn solve(&self, job: &Job<'_>) -> std::result::Result<Solved, SolveFailure> {
+            self.solves.fetch_add(1, Ordering::SeqCst);
+            assert!(job.work_dir.is_dir(), "work dir exists");
+            if job.first_increment == 1.0 {
+                assert_eq!(std::fs::read_dir(job.work_dir).map(|d| d.count()).unwrap_or(9), 0, "work dir is empty");
+            }
+            std::fs::write(job.work_dir.join("pose.log"), "fake log\n").map_err(anyhow::Error::from)?;
+            if self.panic_on.as_deref() == Some(job.pose.name.as_str()) {
+                panic!("fake panic");
+            }
+            if self.fail.as_deref() == Some(job.pose.name.as_str()) {
+                return Err(SolveFailure { message: "fake exit code 201".into(), log_tail: "*ERROR fake".into() });
+            }
+            if self.fail_first.as_deref() == Some(job.pose.name.as_str()) && job.first_increment == 1.0 {
+                return Err(SolveFailure { message: "fake stall".into(), log_tail: String::new() });
+            }
+            let wrenches = (1..=job.steps)
+                .map(|k| {
+                    let d = job.campaign.loading.depth_at(k);
+                    [job.pose.x_mm * d, d * d, job.pose.z_mm, 0.0, 0.0, 0.0]
+                })
+                .collect();
+            let summary = MeshSummary {
+                tissue_nodes: 1,
+                tissue_elements: 2,
+                needle_nodes: 3,
+                needle_elements: 4,
+                model: "fake".into(),
+                tissue_mesh: "fake".into(),
+            };
+            Ok(Solved {
+                wrenches,
+                summary,
+                increments: job.steps,
+                iterations: 2 * job.steps,
+                first_increment: job.first_increment,
+                retry: None,
+                element: "fake".into(),
+                settings: "fake".into(),
+                peak_rss_mib: 0.0,
+            })
+        }
+        fn steps_done(&self, _work_dir: &Path) -> u32 {
+            0
+        }
+    }
+
+    fn set_dir() -> tempfile::TempDir {
+        let d = tempfile::tempdir().expect("tempdir");
+        let src = crate::workspace_root().join("coeffs/default/campaign.toml");
+        std::fs::copy(&src, d.path().join("campaign.toml")).expect("copy the default spec");
+        d
+    }
+
+    fn opts(dir: &Path, only: &str, steps: u32) -> RunOptions {
+        RunOptions { only: Some(only.into()), steps: Some(steps), mesh: Some("smoke".into()), jobs: 2, ..RunOptions::new(dir) }
+    }
+
+    #[test]
+    fn writes_results_and_skips_up_to_date_poses() {
+        let d = set_dir();
+        let mut fake = Fake::default();
+        let o = opts(d.path(), "x+0[24]", 2);
+        let r = run_with(&o, &mut fake).expect("run");
+        assert_eq!((r.done(), r.up_to_date(), r.failed()), (2, 0, 0), "{}", r.table());
+        let fe = d.path().join("fe");
+        for name in ["x+02", "x+04"] {
+            let rows = results::read_csv(&fe.join(format!("{name}.csv"))).expect("csv");
+            assert_eq!(rows.len(), 3);
+            assert_eq!(rows[0], Row { depth_mm: 0.0, wrench: [0.0; 6] });
+            assert_eq!(rows.iter().map(|r| r.depth_mm).collect::<Vec<_>>(), [0.0, 3.0, 6.0]);
+            assert_eq!(rows[2].wrench[1], 36.0);
+            assert!(!fe.join(".work").join(name).exists(), "work dir removed on success");
+        }
+        let text = std::fs::read_to_string(fe.join(MANIFEST)).expect("manifest");
+        let m = read_manifest(&fe.join(MANIFEST)).expect("parse");
+        assert_eq!(m.pose.keys().cloned().collect::<Vec<_>>(), ["x+02", "x+04"]);
+        assert!(text.find("[pose.\"x+02\"]") < text.find("[pose.\"x+04\"]"), "sorted:\n{text}");
+        let (mut c, _) = spec::load(d.path()).expect("spec");
+        c.loading.steps = 2;
+        let p4 = c.poses().into_iter().find(|p| p.name == "x+04").expect("x+04");
+        let e = &m.pose["x+04"];
+        assert_eq!(e.spec_hash, c.run_hash(&p4, "smoke"));
+        assert_eq!((e.engine_version.as_str(), e.mesh.as_str(), e.steps, e.increments, e.iterations), ("fake-1", "smoke", 2, 2, 4));
+        assert_eq!((e.x_mm, e.role), (4.0, Role::SweepX));
+        assert_eq!(e.date.len(), "2025-01-01T00:00:00Z".len());
+        assert_eq!(fake.solves.load(Ordering::SeqCst), 2);
+
+        // rerun: nothing to do, the solver is not even prepared, files untouched
+        let mut again = Fake::default();
+        let r = run_with(&o, &mut again).expect("rerun");
+        assert_eq!((r.done(), r.up_to_date()), (0, 2));
+        assert_eq!((again.prepared, again.solves.load(Ordering::SeqCst)), (0, 0));
+        assert_eq!(std::fs::read_to_string(fe.join(MANIFEST)).expect("manifest"), text);
+        assert!(r.table().contains("up to date"));
+        assert_eq!(r.poses[0].fy_final_n, Some(36.0));
+
+        // another step count is another spec: rerun
+        let r = run_with(&opts(d.path(), "x+02", 3), &mut again).expect("steps 3");
+        assert_eq!(r.done(), 1);
+        assert_eq!(results::read_csv(&fe.join("x+02.csv")).expect("csv").len(), 4);
+        // --force reruns an up-to-date pose
+        let r = run_with(&RunOptions { force: true, ..opts(d.path(), "x+04", 2) }, &mut again).expect("force");
+        assert_eq!(r.done(), 1);
+        // a CSV deleted by hand is rerun even though the manifest has its entry
+        std::fs::remove_file(fe.join("x+04.csv")).expect("rm");
+        let r = run_with(&o, &mut again).expect("missing csv");
+        assert_eq!((r.done(), r.up_to_date()), (2, 0), "x+02 has 4 rows (3 steps), x+04 has no CSV");
+    }
+
+    /// The bytes of every CSV and the manifest in `fe`.
+    fn snapshot(fe: &Path) -> Vec<(String, Vec<u8>)> {
+        let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(fe)
+            .expect("fe folder")
+            .flatten()
+            .filter(|e| e.path().is_file())
+            .map(|e| (e.file_name().to_string_lossy().into_owned(), std::fs::read(e.path()).expect("read")))
+            .collect();
+        files.sort();
+        files
+    }
+
+    /// Issue 18: a solver killed mid-run, an unwritable result file and a corrupted
+    /// manifest each leave every earlier result intact, and the next run completes the set.
+    #[test]
+    fn faults_leave_earlier_results_intact_and_the_next_run_completes_the_set() {
+        let d = set_dir();
+        let fe = d.path().join("fe");
+        run_with(&opts(d.path(), "x+0[24]", 2), &mut Fake::default()).expect("first results");
+        let before = snapshot(&fe);
+        let all = "x+0[2468]";
+
+        // 1. the solver is killed while solving x+06 (and x+08 in the same run finishes)
+        let mut killed = Fake { fail: Some("x+06".into()), ..Fake::default() };
+        let r = run_with(&opts(d.path(), all, 2), &mut killed).expect("run");
+        assert_eq!((r.done(), r.up_to_date(), r.failed()), (1, 2, 1), "{}", r.table());
+        let after: Vec<_> = snapshot(&fe).into_iter().filter(|(n, _)| n != "x+08.csv" && n != MANIFEST).collect();
+        assert_eq!(after, before.iter().filter(|(n, _)| n != MANIFEST).cloned().collect::<Vec<_>>(), "earlier CSVs intact");
+        let m = read_manifest(&fe.join(MANIFEST)).expect("manifest");
+        assert_eq!(m.pose.keys().cloned().collect::<Vec<_>>(), ["x+02", "x+04", "x+08"], "no entry for the killed x+06");
+
+        // 2. x+06's result file cannot be written (a folder is in its place)
+        std::fs::create_dir(fe.join("x+06.csv")).expect("block the CSV path");
+        let r = run_with(&opts(d.path(), all, 2), &mut Fake::default()).expect("run");
+        assert_eq!((r.done(), r.up_to_date(), r.failed()), (0, 3, 1), "{}", r.table());
+        assert!(r.table().contains("x+06.csv"), "the failure names the file:\n{}", r.table());
+        let intact = snapshot(&fe);
+        std::fs::remove_dir(fe.join("x+06.csv")).expect("unblock");
+
+        // 3. the manifest is corrupted: refused before anything is solved or written
+        let manifest = fe.join(MANIFEST);
+        let good = std::fs::read(&manifest).expect("manifest");
+        std::fs::write(&manifest, b"[pose.x+02\nspec_hash = ").expect("corrupt");
+        let mut untouched = Fake::default();
+        let e = run_with(&opts(d.path(), all, 2), &mut untouched).expect_err("corrupt manifest");
+        assert!(format!("{e:#}").contains(MANIFEST), "{e:#}");
+        assert_eq!(untouched.solves.load(Ordering::SeqCst), 0);
+        std::fs::write(&manifest, &good).expect("restore the manifest (from git, say)");
+        assert_eq!(snapshot(&fe), intact, "every result as before the faults");
+
+        // temporaries a killed campaign left beside its targets (a pid that is gone)
+        let stale = [fe.join(".x+06.csv.4194303.tmp"), fe.join(format!(".{MANIFEST}.4194303.tmp"))];
+        for t in &stale {
+            std::fs::write(t, b"half").expect("stale temporary");
+        }
+        let mut intact = intact;
+        intact
+            .extend(stale.iter().map(|t| (t.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default(), b"half".to_vec())));
+        intact.sort();
+        assert_eq!(snapshot(&fe), intact);
+
+        // the next run completes the set, solving only x+06, and removes the temporaries
+        let mut last = Fake::default();
+        let r = run_with(&opts(d.path(), all, 2), &mut last).expect("run");
+        assert_eq!((r.done(), r.up_to_date(), r.failed()), (1, 3, 0), "{}", r.table());
+        assert_eq!(last.solves.load(Ordering::SeqCst), 1);
+        assert!(stale.iter().all(|t| !t.exists()), "stale temporaries removed");
+        for (name, bytes) in &before {
+            if name != MANIFEST {
+                assert_eq!(&std::fs::read(fe.join(name)).expect("read"), bytes, "{name} unchanged through the faults");
+            }
+        }
+    }
+
+    #[test]
+    fn a_failed_pose_keeps_its_work_dir_and_the_others_finish() {
+        let d = set_dir();
+        let fe = d.path().join("fe");
+        // a first, good result of x+04
+        run_with(&opts(d.path(), "x+04", 2), &mut Fake::default()).expect("first");
+        assert!(fe.join("x+04.csv").exists());
+
+        let mut fake = Fake { fail: Some("x+04".into()), panic_on: Some("x+06".into()), ..Fake::default() };
+        let r = run_with(&RunOptions { force: true, ..opts(d.path(), "x+0[246]", 2) }, &mut fake).expect("run");
+        assert_eq!((r.done(), r.failed()), (1, 2), "{}", r.table());
+        let t = r.table();
+        assert!(t.contains("FAILED x+04: fake exit code 201") && t.contains("| *ERROR fake"), "{t}");
+        assert!(t.contains("FAILED x+06: panic while solving: fake panic"), "{t}");
+        assert!(fe.join(".work/x+04/pose.log").exists(), "work dir kept on failure");
+        assert!(!fe.join("x+06.csv").exists());
+        // the failed --force rerun cost nothing: x+04's first CSV and its entry are intact
+        // (issue 18: the entry used to be deleted, and `needle fit` then refused the set)
+        let m = read_manifest(&fe.join(MANIFEST)).expect("manifest");
+        assert_eq!(m.pose.keys().cloned().collect::<Vec<_>>(), ["x+02", "x+04"]);
+        assert_eq!(results::read_csv(&fe.join("x+04.csv")).expect("csv").len(), 3, "the first result's CSV");
+        // so the next run only solves x+06
+        let mut ok = Fake::default();
+        let r = run_with(&opts(d.path(), "x+0[246]", 2), &mut ok).expect("resume");
+        assert_eq!((r.done(), r.up_to_date(), r.failed()), (1, 2, 0), "{}", r.table());
+        assert!(fe.join("x+06.csv").exists());
+    }
+
+    #[test]
+    fn a_failed_run_is_retried_once_with_a_smaller_first_increment_and_the_manifest_says_so() {
+        let d = set_dir();
+        let mut fake = Fake { fail_first: Some("x+04".into()), ..Fake::default() };
+        let r = run_with(&opts(d.path(), "x+0[24]", 2), &mut fake).expect("run");
+        assert_eq!((r.done(), r.failed()), (2, 0), "{}", r.table());
+        assert_eq!(fake.solves.load(Ordering::SeqCst), 3, "x+02 once, x+04 twice");
+        let m = read_manifest(&d.path().join("fe").join(MANIFEST)).expect("manifest");
+        let (x2, x4) = (&m.pose["x+02"], &m.pose["x+04"]);
+        assert_eq!((x2.first_increment, x2.retry.as_deref()), (None, None));
+        assert_eq!((x4.first_increment, x4.retry.as_deref()), (Some(deck::RETRY_FIRST_INCREMENT), Some("fake stall")));
+        let text = std::fs::read_to_string(d.path().join("fe").join(MANIFEST)).expect("manifest text");
+        assert_eq!(text.matches("first_increment = 0.25").count(), 1, "{text}");
+        assert_eq!(text.matches("retry = \"fake stall\"").count(), 1, "{text}");
+    }
+
+    #[test]
+    fn refuses_bad_options_and_a_corrupt_manifest_before_solving() {
+        let d = set_dir();
+        let mut fake = Fake::default();
+        let e = run_with(&opts(d.path(), "nothing*", 2), &mut fake).expect_err("no pose").to_string();
+        assert!(e.contains("matches no pose"), "{e}");
+        let e = run_with(&RunOptions { mesh: Some("huge".into()), ..opts(d.path(), "x+02", 2) }, &mut fake).expect_err("mesh").to_string();
+        assert!(e.contains("huge"), "{e}");
+        let e = run_with(&opts(d.path(), "x+02", 0), &mut fake).expect_err("steps").to_string();
+        assert!(e.contains("--steps 0"), "{e}");
+        std::fs::create_dir_all(d.path().join("fe")).expect("mkdir");
+        std::fs::write(d.path().join("fe").join(MANIFEST), "[pose.x]\nspec_hash = 1\n").expect("write");
+        let e = run_with(&opts(d.path(), "x+02", 2), &mut fake).expect_err("manifest").to_string();
+        assert!(e.contains("delete it"), "{e}");
+        assert_eq!((fake.prepared, fake.solves.load(Ordering::SeqCst)), (0, 0));
+    }
+}

@@ -1,0 +1,335 @@
+//! FEBio 4 input writer: one `.feb` (FEBio XML, spec version 4.0) per pose.
+//!
+//! The model, the same physics as the CalculiX deck (`fe::deck`) with FEBio's elements:
+//! - tissue: the campaign's hexahedral mesh (`fe::mesh::tissue`) as `hex8` with FEBio's
+//!   uncoupled `Ogden` material, which FEBio solves with its three-field (displacement,
+//!   pressure, dilatation) hexahedron: no volumetric locking at K0/mu0 = 100. FEBio's
+//!   Ogden energy is `sum c_i / m_i^2 (l1^m_i + l2^m_i + l3^m_i - 3) + U(J)`; the spec's is
+//!   Abaqus's `sum 2 mu_i / alpha_i^2 (...)`, so `c_i = 2 mu_i`, `m_i = alpha_i`, and the
+//!   bulk modulus `k = K0 = bulk_to_shear * mu0`;
+//! - needle: the needle mesh (`fe::mesh::needle`) as a `rigid body` (steel is about 1e5
+//!   times stiffer than the tissue), its rotations fixed, its translation prescribed
+//!   along its own axis; its centre of mass is placed at the wrench's reference point
+//!   (the hub), so that FEBio's rigid-body reaction moment is the moment about the hub;
+//! - contact: `[solver.febio]` (type, primary surface, enforcement), Coulomb friction
+//!   `contact.friction`; the tissue's top surface near the path against the needle's
+//!   outer faces;
+//! - boundary: bottom fixed, sides fixed (pinned: hex8 has no rotations), mirror planes
+//!   of quarter and half models fixed in their normal direction;
+//! - time: t runs from 0 to the insertion depth in mm (t = depth), one must point per
+//!   load step with automatic time stepping between; the log file records the rigid
+//!   body's reaction force and moment at the must points only.
+
+use crate::deck::{model_name, MeshSummary};
+use crate::mesh::{self, NeedleMesh, TissueMesh, FACES};
+use crate::spec::{Campaign, FebioSettings, MeshLevel, PoseSpec, Symmetry};
+use anyhow::{bail, Result};
+use std::fmt::Write;
+
+/// File name (in the work folder) of the rigid body's reaction log.
+pub const RIGID_LOG: &str = "needle-rb.txt";
+
+/// Material id of the needle's rigid body (the item of the `rigid_body_data` record).
+const NEEDLE_MAT_ID: u32 = 2;
+
+/// A written FEBio input and what is needed to read its results back.
+#[derive(Debug, Clone)]
+pub struct Feb {
+    /// The whole `.feb` text.
+    pub text: String,
+    /// Size of the model.
+    pub summary: MeshSummary,
+    /// Load steps: must points at t = depth * k / steps, k = 1..=steps.
+    pub steps: u32,
+    /// Mirror planes of the modelled part.
+    pub symmetry: Symmetry,
+}
+
+/// Write the FEBio input of `pose` on mesh level `mesh_level` with `steps` load steps
+/// over the spec's insertion depth. `dt_fraction`: the first automatic time step as a
+/// fraction of a load step (1 on a first attempt; the campaign's retry asks for less,
+/// and then also gets the retry's convergence tolerances, `retry_dtol`/`retry_rtol`).
+///
+/// # Errors
+/// The spec's values make an empty mesh, `steps` is 0, or `dt_fraction` is not in (0, 1].
+pub fn write(c: &Campaign, pose: &PoseSpec, mesh_level: &MeshLevel, steps: u32, dt_fraction: f64) -> Result<Feb> {
+    write_with_symmetry(c, pose, mesh_level, steps, dt_fraction, pose.symmetry())
+}
+
+/// As [`write`], with the mirror planes chosen by the caller (a full model of a
+/// symmetric pose, for checking the symmetry reduction).
+///
+/// # Errors
+/// As [`write`]; a mirror plane the pose does not have.
+pub fn write_with_symmetry(
+    c: &Campaign,
+    pose: &PoseSpec,
+    mesh_level: &MeshLevel,
+    steps: u32,
+    dt_fraction: f64,
+    sym: Symmetry,
+) -> Result<Feb> {
+    if !(dt_fraction > 0.0 && dt_fraction <= 1.0) {
+        bail!("pose {}: first time step {dt_fraction} of a load step: must be in (0, 1]", pose.name);
+    }
+    let depth = c.loading.depth_mm;
+    let (t, n) = mesh::pose_meshes(c, pose, mesh_level, steps, sym)?;
+    let hub = [0, 1, 2].map(|k| n.tip[k] + c.needle.reference_from_tip_mm * n.axis[k]);
+    let s = &c.solver.febio;
+    let mut w = String::with_capacity(160 * (t.nodes.len() + n.nodes.len()));
+    let _ = writeln!(w, r#"<?xml version="1.0" encoding="ISO-8859-1"?>"#);
+    let _ = writeln!(
+        w,
+        "<!-- needle-haptics FEBio input (generator v{}), set {:?}, pose {:?}: x = {} mm, z = {} mm, theta_x = {} deg, theta_z = {} deg; insertion {} mm in {} load steps; model: {}; tissue mesh: {}. Units: mm, N, N/mm^2, s (time t = depth in mm). -->",
+        super::GENERATOR_VERSION,
+        c.set.name,
+        pose.name,
+        pose.x_mm,
+        pose.z_mm,
+        pose.theta_x_deg,
+        pose.theta_z_deg,
+        depth,
+        steps,
+        model_name(sym),
+        t.info
+    );
+    let _ = writeln!(w, r#"<febio_spec version="4.0">"#);
+    let _ = writeln!(w, r#"  <Module type="solid"/>"#);
+    write_control(&mut w, s, depth, steps, dt_fraction);
+    write_material(&mut w, c, hub);
+    let needle0 = t.nodes.len();
+    let needle_el0 = t.elements.len();
+    write_mesh(&mut w, &t, &n, needle0, needle_el0, s);
+    let _ = writeln!(w, "  <MeshDomains>");
+    let _ = writeln!(w, r#"    <SolidDomain name="tissue" mat="tissue"/>"#);
+    let _ = writeln!(w, r#"    <SolidDomain name="needle" mat="needle"/>"#);
+    let _ = writeln!(w, "  </MeshDomains>");
+    write_boundary(&mut w, &t);
+    write_rigid(&mut w, n.axis);
+    write_contact(&mut w, c);
+    write_load_data(&mut w, depth, steps);
+    let _ = writeln!(w, "  <Output>");
+    let _ = writeln!(w, "    <logfile>");
+    let _ =
+        writeln!(w, r#"      <rigid_body_data data="Fx;Fy;Fz;Mx;My;Mz" file="{RIGID_LOG}" delim=",">{NEEDLE_MAT_ID}</rigid_body_data>"#);
+    let _ = writeln!(w, "    </logfile>");
+    let _ = writeln!(w, "  </Output>");
+    let _ = writeln!(w, "</febio_spec>");
+    Ok(Feb { text: w, summary: MeshSummary::of(&t, &n, sym), steps, symmetry: sym })
+}
+
+fn write_control(w: &mut String, s: &FebioSettings, depth: f64, steps: u32, dt_fraction: f64) {
+    let dt = depth / f64::from(steps);
+    // FEBio ends at time_steps * step_size: keep that the insertion depth when the first
+    // step is a fraction of a load step (the automatic stepper then grows it to dt)
+    let time_steps = (f64::from(steps) / dt_fraction).round().max(1.0) as u64;
+    let _ = writeln!(w, "  <Control>");
+    let _ = writeln!(w, "    <analysis>STATIC</analysis>");
+    let _ = writeln!(w, "    <time_steps>{time_steps}</time_steps>");
+    let _ = writeln!(w, "    <step_size>{}</step_size>", num(dt * dt_fraction));
+    let _ = writeln!(w, "    <plot_zero_state>0</plot_zero_state>");
+    let _ = writeln!(w, "    <plot_level>PLOT_NEVER</plot_level>");
+    let _ = writeln!(w, "    <output_level>OUTPUT_MUST_POINTS</output_level>");
+    let _ = writeln!(w, "    <time_stepper type=\"default\">");
+    let _ = writeln!(w, "      <max_retries>{}</max_retries>", s.max_retries);
+    let _ = writeln!(w, "      <opt_iter>{}</opt_iter>", s.opt_iter);
+    let _ = writeln!(w, "      <dtmin>{}</dtmin>", num(dt * s.dtmin_fraction));
+    let _ = writeln!(w, "      <dtmax lc=\"2\">0</dtmax>");
+    let _ = writeln!(w, "      <aggressiveness>1</aggressiveness>");
+    let _ = writeln!(w, "      <cutback>0.5</cutback>");
+    let _ = writeln!(w, "      <dtforce>0</dtforce>");
+    let _ = writeln!(w, "    </time_stepper>");
+    let _ = writeln!(w, "    <solver type=\"solid\">");
+    // friction makes the contact stiffness non-symmetric
+    let _ = writeln!(w, "      <symmetric_stiffness>non-symmetric</symmetric_stiffness>");
+    let _ = writeln!(w, "      <equation_scheme>staggered</equation_scheme>");
+    let _ = writeln!(w, "      <lstol>{}</lstol>", num(s.lstol));
+    let _ = writeln!(w, "      <lsmin>0.01</lsmin>");
+    let _ = writeln!(w, "      <lsiter>5</lsiter>");
+    let _ = writeln!(w, "      <max_refs>{}</max_refs>", s.max_refs);
+    let _ = writeln!(w, "      <reform_each_time_step>1</reform_each_time_step>");
+    let _ = writeln!(w, "      <diverge_reform>1</diverge_reform>");
+    let _ = writeln!(w, "      <min_residual>1e-20</min_residual>");
+    // the campaign's retry (a first step below a whole load step) converges on energy and
+    // residual with `retry_dtol` / `retry_rtol` (FebioSettings docs)
+    let (dtol, rtol) = if dt_fraction < 1.0 { (s.retry_dtol, s.retry_rtol) } else { (s.dtol, s.rtol) };
+    let _ = writeln!(w, "      <dtol>{}</dtol>", num(dtol));
+    let _ = writeln!(w, "      <etol>{}</etol>", num(s.etol));
+    let _ = writeln!(w, "      <rtol>{}</rtol>", num(rtol));
+    let _ = writeln!(w, "      <qn_method type=\"BFGS\">");
+    let _ = writeln!(w, "        <max_ups>{}</max_ups>", s.max_ups);
+    let _ = writeln!(w, "      </qn_method>");
+    let _ = writeln!(w, "      <linear_solver type=\"pardiso\"/>");
+    let _ = writeln!(w, "    </solver>");
+    let _ = writeln!(w, "  </Control>");
+}
+
+fn write_material(w: &mut String, c: &Campaign, hub: [f64; 3]) {
+    let t = &c.tissue;
+    let _ = writeln!(w, "  <Material>");
+    let _ = writeln!(
+        w,
+        "    <!-- Ogden N={}: c_i = 2 mu_i (N/mm^2), m_i = alpha_i; k = K0 = {} * mu0 = {} N/mm^2 -->",
+        t.mu_n_per_mm2.len(),
+        t.bulk_to_shear,
+        num(t.k0_n_per_mm2())
+    );
+    let _ = writeln!(w, r#"    <material id="1" name="tissue" type="Ogden">"#);
+    let _ = writeln!(w, "      <density>1e-9</density>");
+    let _ = writeln!(w, "      <k>{}</k>", num(t.k0_n_per_mm2()));
+    for (i, (mu, a)) in t.mu_n_per_mm2.iter().zip(&t.alpha).enumerate() {
+        let _ = writeln!(w, "      <c{}>{}</c{}>", i + 1, num(2.0 * mu), i + 1);
+        let _ = writeln!(w, "      <m{}>{}</m{}>", i + 1, num(*a), i + 1);
+    }
+    let _ = writeln!(w, "    </material>");
+    let _ = writeln!(w, "    <!-- rigid needle; centre of mass at the hub: the reaction moment is about the hub -->");
+    let _ = writeln!(w, r#"    <material id="{NEEDLE_MAT_ID}" name="needle" type="rigid body">"#);
+    let _ = writeln!(w, "      <density>7.85e-9</density>");
+    let _ = writeln!(w, "      <E>210000</E>");
+    let _ = writeln!(w, "      <v>0.3</v>");
+    let _ = writeln!(w, "      <center_of_mass>{},{},{}</center_of_mass>", num(hub[0]), num(hub[1]), num(hub[2]));
+    let _ = writeln!(w, "    </material>");
+    let _ = writeln!(w, "  </Material>");
+}
+
+fn ids(w: &mut String, ids: impl Iterator<Item = usize>) {
+    let v: Vec<String> = ids.map(|i| i.to_string()).collect();
+    for chunk in v.chunks(16) {
+        let _ = writeln!(w, "      {},", chunk.join(","));
+    }
+    // FEBio's list reader accepts a trailing comma at the end of a line
+}
+
+fn write_mesh(w: &mut String, t: &TissueMesh, n: &NeedleMesh, needle0: usize, needle_el0: usize, s: &FebioSettings) {
+    let _ = writeln!(w, "  <Mesh>");
+    let _ = writeln!(w, r#"    <Nodes name="all">"#);
+    for (i, p) in t.nodes.iter().chain(&n.nodes).enumerate() {
+        let _ = writeln!(w, r#"      <node id="{}">{:.7},{:.7},{:.7}</node>"#, i + 1, p[0], p[1], p[2]);
+    }
+    let _ = writeln!(w, "    </Nodes>");
+    let _ = writeln!(w, r#"    <Elements type="hex8" name="tissue">"#);
+    for (e, nn) in t.elements.iter().enumerate() {
+        let v: Vec<String> = nn.iter().map(|i| (i + 1).to_string()).collect();
+        let _ = writeln!(w, r#"      <elem id="{}">{}</elem>"#, e + 1, v.join(","));
+    }
+    let _ = writeln!(w, "    </Elements>");
+    let _ = writeln!(w, r#"    <Elements type="hex8" name="needle">"#);
+    for (e, nn) in n.elements.iter().enumerate() {
+        let v: Vec<String> = nn.iter().map(|i| (needle0 + i + 1).to_string()).collect();
+        let _ = writeln!(w, r#"      <elem id="{}">{}</elem>"#, needle_el0 + e + 1, v.join(","));
+    }
+    let _ = writeln!(w, "    </Elements>");
+    for (name, set) in [("bottom", &t.bottom), ("sides", &t.sides), ("sym_x", &t.plane_x), ("sym_z", &t.plane_z)] {
+        if set.is_empty() {
+            continue;
+        }
+        let _ = writeln!(w, r#"    <NodeSet name="{name}">"#);
+        ids(w, set.iter().map(|i| i + 1));
+        let _ = writeln!(w, "    </NodeSet>");
+    }
+    // FACES lists each face's nodes the Abaqus way, whose right-hand normal points into
+    // the element; FEBio takes a facet's right-hand normal as its outward normal, so the
+    // order is reversed.
+    let face = |e: usize, f: u8, nodes: &[[usize; 8]], off: usize| -> String {
+        let el = nodes[e];
+        let v: Vec<String> = FACES[usize::from(f - 1)].iter().rev().map(|&k| (off + el[k] + 1).to_string()).collect();
+        v.join(",")
+    };
+    let _ = writeln!(w, r#"    <Surface name="tissue_top">"#);
+    for (k, &(e, f)) in t.top_faces.iter().enumerate() {
+        let _ = writeln!(w, r#"      <quad4 id="{}">{}</quad4>"#, k + 1, face(e, f, &t.elements, 0));
+    }
+    let _ = writeln!(w, "    </Surface>");
+    let _ = writeln!(w, r#"    <Surface name="needle_surface">"#);
+    for (k, &(e, f)) in n.faces.iter().enumerate() {
+        let _ = writeln!(w, r#"      <quad4 id="{}">{}</quad4>"#, k + 1, face(e, f, &n.elements, needle0));
+    }
+    let _ = writeln!(w, "    </Surface>");
+    let (primary, secondary) = if s.primary == "needle" { ("needle_surface", "tissue_top") } else { ("tissue_top", "needle_surface") };
+    let _ = writeln!(w, r#"    <SurfacePair name="needle_tissue">"#);
+    let _ = writeln!(w, "      <primary>{primary}</primary>");
+    let _ = writeln!(w, "      <secondary>{secondary}</secondary>");
+    let _ = writeln!(w, "    </SurfacePair>");
+    let _ = writeln!(w, "  </Mesh>");
+}
+
+fn write_boundary(w: &mut String, t: &TissueMesh) {
+    let _ = writeln!(w, "  <Boundary>");
+    let bc = |w: &mut String, set: &str, xyz: [u8; 3]| {
+        let _ = writeln!(w, r#"    <bc name="fix_{set}" node_set="{set}" type="zero displacement">"#);
+        let _ = writeln!(w, "      <x_dof>{}</x_dof>\n      <y_dof>{}</y_dof>\n      <z_dof>{}</z_dof>", xyz[0], xyz[1], xyz[2]);
+        let _ = writeln!(w, "    </bc>");
+    };
+    bc(w, "bottom", [1, 1, 1]);
+    bc(w, "sides", [1, 1, 1]);
+    if !t.plane_x.is_empty() {
+        bc(w, "sym_x", [1, 0, 0]);
+    }
+    if !t.plane_z.is_empty() {
+        bc(w, "sym_z", [0, 0, 1]);
+    }
+    let _ = writeln!(w, "  </Boundary>");
+}
+
+fn write_rigid(w: &mut String, axis: [f64; 3]) {
+    let _ = writeln!(w, "  <Rigid>");
+    let _ = writeln!(w, r#"    <rigid_bc name="needle_no_rotation" type="rigid_fixed">"#);
+    let _ = writeln!(w, "      <rb>needle</rb>");
+    let _ = writeln!(w, "      <Rx_dof>0</Rx_dof>\n      <Ry_dof>0</Ry_dof>\n      <Rz_dof>0</Rz_dof>");
+    let _ = writeln!(w, "      <Ru_dof>1</Ru_dof>\n      <Rv_dof>1</Rv_dof>\n      <Rw_dof>1</Rw_dof>");
+    let _ = writeln!(w, "    </rigid_bc>");
+    // fed along its own axis, towards the tip: displacement = -t * axis (t = depth, mm)
+    for (k, dof) in ["x", "y", "z"].iter().enumerate() {
+        let _ = writeln!(w, r#"    <rigid_bc name="needle_feed_{dof}" type="rigid_displacement">"#);
+        let _ = writeln!(w, "      <rb>needle</rb>\n      <dof>{dof}</dof>");
+        let _ = writeln!(w, r#"      <value lc="1">{}</value>"#, num(-axis[k]));
+        let _ = writeln!(w, "      <relative>0</relative>");
+        let _ = writeln!(w, "    </rigid_bc>");
+    }
+    let _ = writeln!(w, "  </Rigid>");
+}
+
+fn write_contact(w: &mut String, c: &Campaign) {
+    let s = &c.solver.febio;
+    let _ = writeln!(w, "  <Contact>");
+    let _ = writeln!(w, r#"    <contact name="needle_tissue" surface_pair="needle_tissue" type="{}">"#, s.contact);
+    let _ = writeln!(w, "      <laugon>{}</laugon>", if s.augmented { "AUGLAG" } else { "PENALTY" });
+    let _ = writeln!(w, "      <tolerance>{}</tolerance>", num(s.aug_tolerance));
+    let _ = writeln!(w, "      <gaptol>{}</gaptol>", num(s.gap_tolerance_mm));
+    let _ = writeln!(w, "      <penalty>{}</penalty>", num(s.penalty));
+    let _ = writeln!(w, "      <auto_penalty>{}</auto_penalty>", u8::from(s.auto_penalty));
+    let _ = writeln!(w, "      <two_pass>{}</two_pass>", u8::from(s.two_pass));
+    let _ = writeln!(w, "      <search_tol>{}</search_tol>", num(s.search_tol));
+    let _ = writeln!(w, "      <minaug>0</minaug>\n      <maxaug>{}</maxaug>", s.max_aug);
+    let _ = writeln!(w, "      <fric_coeff>{}</fric_coeff>", num(c.contact.friction));
+    if s.contact == "sliding-elastic" {
+        let _ = writeln!(w, "      <search_radius>{}</search_radius>", num(s.search_radius_mm));
+        let _ = writeln!(w, "      <seg_up>{}</seg_up>", s.seg_up);
+        let _ = writeln!(w, "      <symmetric_stiffness>0</symmetric_stiffness>");
+    }
+    let _ = writeln!(w, "    </contact>");
+    let _ = writeln!(w, "  </Contact>");
+}
+
+fn write_load_data(w: &mut String, depth: f64, steps: u32) {
+    let dt = depth / f64::from(steps);
+    let _ = writeln!(w, "  <LoadData>");
+    let _ = writeln!(w, r#"    <load_controller id="1" name="feed_mm" type="loadcurve">"#);
+    let _ = writeln!(w, "      <interpolate>LINEAR</interpolate>\n      <extend>EXTRAPOLATE</extend>");
+    let _ = writeln!(w, "      <points>\n        <pt>0,0</pt>\n        <pt>{},{}</pt>\n      </points>", num(depth), num(depth));
+    let _ = writeln!(w, "    </load_controller>");
+    let _ = writeln!(w, "    <!-- must points: the end of every load step; value: the largest time step -->");
+    let _ = writeln!(w, r#"    <load_controller id="2" name="must_points" type="loadcurve">"#);
+    let _ = writeln!(w, "      <interpolate>STEP</interpolate>\n      <extend>CONSTANT</extend>\n      <points>");
+    for k in 1..=steps {
+        let _ = writeln!(w, "        <pt>{},{}</pt>", num(depth * f64::from(k) / f64::from(steps)), num(dt));
+    }
+    let _ = writeln!(w, "      </points>\n    </load_controller>");
+    let _ = writeln!(w, "  </LoadData>");
+}
+
+/// A number as FEBio reads it: Rust's shortest round-trip form.
+fn num(v: f64) -> String {
+    let v = if v == 0.0 { 0.0 } else { v };
+    format!("{v:?}")
+}

@@ -1,0 +1,482 @@
+//! The FEBio engine: finding `febio4`, writing the `.feb` input ([`feb`]), running it
+//! and reading the rigid needle's reaction back ([`logs`]), behind the campaign's
+//! [`Backend`] trait.
+//!
+//! `febio4` is found, in order: `$FEBIO` (must be an executable; a bad path is an
+//! error, not a silent fallback), the build of `.ci/install-febio` in the cache folder
+//! (`$NEEDLE_CACHE`, default `~/.cache/needle-haptics`, `febio-4.11/bin/febio4`), a
+//! `febio4` on `PATH`.
+
+pub mod feb;
+pub mod logs;
+pub mod restart;
+
+use crate::backend::{Backend, Job, SolveFailure, Solved};
+use crate::process::{self, ExitKind, LOG_TAIL_LINES};
+use crate::wrench::expand_mirrors;
+use anyhow::{bail, Context, Result};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Version of the FEBio input generator ([`versions::FEBIO_INPUT`](crate::versions::FEBIO_INPUT)).
+pub use crate::versions::FEBIO_INPUT as GENERATOR_VERSION;
+
+/// Environment variable naming the `febio4` to use.
+pub const FEBIO_ENV: &str = "FEBIO";
+
+/// The FEBio release `.ci/install-febio` builds (the cache folder is keyed by it).
+pub const FEBIO_RELEASE: &str = "4.11";
+
+/// The input file's stem in a pose's work folder (`pose.feb`, `pose.log`).
+pub const JOB: &str = "pose";
+
+/// The cache folder of `.ci/install-febio`: `$NEEDLE_CACHE`, else
+/// `$XDG_CACHE_HOME/needle-haptics`, else `$HOME/.cache/needle-haptics`.
+pub fn cache_dir() -> Option<PathBuf> {
+    let var = |k: &str| std::env::var_os(k).filter(|v| !v.is_empty()).map(PathBuf::from);
+    var("NEEDLE_CACHE")
+        .or_else(|| var("XDG_CACHE_HOME").map(|d| d.join("needle-haptics")))
+        .or_else(|| var("HOME").map(|d| d.join(".cache").join("needle-haptics")))
+}
+
+/// Find `febio4` (module docs for the order).
+///
+/// # Errors
+/// `$FEBIO` is set but is not an executable file; or no `febio4` anywhere, with how to
+/// get one.
+pub fn find_febio() -> Result<PathBuf> {
+    if let Some(p) = std::env::var_os(FEBIO_ENV).filter(|p| !p.is_empty()) {
+        let p = PathBuf::from(p);
+        if process::is_executable(&p) {
+            return Ok(p);
+        }
+        if p.components().count() == 1 {
+            if let Some(found) = process::which(&p) {
+                return Ok(found);
+            }
+        }
+        bail!("{FEBIO_ENV}={}: not an executable file (unset it to use the build of .ci/install-febio)", p.display());
+    }
+    if let Some(c) = cache_dir().map(|d| d.join(format!("febio-{FEBIO_RELEASE}")).join("bin").join("febio4")) {
+        if process::is_executable(&c) {
+            return Ok(c);
+        }
+    }
+    process::which(Path::new("febio4"))
+        .context("febio4 not found: run .ci/install-febio (builds FEBio 4.11 into ~/.cache/needle-haptics), or set FEBIO to your febio4")
+}
+
+/// The version `febio4 -info -norun` prints ("FEBio version  = 4.11.0"; with stdin
+/// closed it then exits).
+///
+/// # Errors
+/// It cannot be started, or prints no version (then it is not FEBio, or broken).
+pub fn febio_version(exe: &Path) -> Result<String> {
+    let out = Command::new(exe)
+        .args(["-nosplash", "-info", "-norun"])
+        .stdin(std::process::Stdio::null())
+        .output()
+        .with_context(|| format!("{}: cannot start", exe.display()))?;
+    let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    parse_version(&text)
+        .with_context(|| format!("{} -info: no FEBio version in its output ({}): is it febio4?", exe.display(), process::tail(&text, 5)))
+}
+
+/// The version in FEBio's banner or `-info` output: the word after "version".
+pub fn parse_version(text: &str) -> Option<String> {
+    let mut words = text.split_whitespace();
+    while let Some(w) = words.next() {
+        if w.trim_end_matches(':').eq_ignore_ascii_case("version") {
+            let mut v = words.next()?;
+            if v == "=" || v == ":" {
+                v = words.next()?;
+            }
+            let v = v.trim_end_matches([',', '.']);
+            if v.chars().next().is_some_and(|c| c.is_ascii_digit()) {
+                return Some(v.to_string());
+            }
+        }
+    }
+    None
+}
+
+/// The FEBio backend: `threads` OpenMP threads per job (Pardiso and assembly).
+#[derive(Debug)]
+pub struct FebioBackend {
+    exe: Option<PathBuf>,
+    threads: usize,
+}
+
+impl FebioBackend {
+    /// A backend whose jobs each run on `threads` threads (0 counts as 1).
+    pub fn new(threads: usize) -> Self {
+        FebioBackend { exe: None, threads: threads.max(1) }
+    }
+}
+
+/// The sign that turns FEBio's rigid-body reaction (`m_Fr`, `m_Mr`: minus the sum of the
+/// contact forces the needle's nodes receive in the residual) into the wrench the tissue
+/// exerts on the needle. Checked by `crates/cli/tests/fe_febio.rs` (Fy > 0: the tissue
+/// pushes the needle back up).
+pub const REACTION_SIGN: f64 = -1.0;
+
+impl Backend for FebioBackend {
+    fn prepare(&mut self) -> Result<String> {
+        let exe = find_febio()?;
+        let v = febio_version(&exe)?;
+        self.exe = Some(exe);
+        Ok(v)
+    }
+
+    fn engine(&self) -> &'static str {
+        "febio"
+    }
+
+    /// Five attempts, each changing one thing that was seen to decide convergence:
+    /// 1. the spec's settings;
+    /// 2. the contact projections updated by the other rule (`retry_seg_up` instead of
+    ///    `seg_up`: freezing them stops a node chattering between two facets, x+02 on
+    ///    needle8, but lets other poses, tx+04 and z+10, invert elements at 0.6 mm);
+    /// 3. each load step starting at a quarter step, convergence on energy and residual
+    ///    (`retry_dtol`, `retry_rtol`), `seg_up`;
+    /// 4. as 3 with `retry_seg_up`;
+    /// 5. as 3 with the penalty scaled by `last_attempt_penalty_scale`.
+    ///
+    /// A converged run's equilibrium does not depend on the path (the centred run is bit
+    /// for bit the same with `seg_up` 0 and 5); the manifest records the settings used.
+    fn attempts(&self) -> u32 {
+        5
+    }
+
+    fn first_increment(&self, attempt: u32) -> f64 {
+        if attempt < 2 {
+            1.0
+        } else {
+            crate::deck::RETRY_FIRST_INCREMENT
+        }
+    }
+
+    fn solve(&self, job: &Job<'_>) -> std::result::Result<Solved, SolveFailure> {
+        let exe = self.exe.as_deref().context("FebioBackend::solve before prepare")?;
+        let changed;
+        let campaign = if job.attempt == 0 || job.attempt == 2 {
+            job.campaign
+        } else {
+            let mut c = job.campaign.clone();
+            let s = &mut c.solver.febio;
+            if job.attempt % 2 == 1 {
+                s.seg_up = s.retry_seg_up;
+            } else {
+                s.penalty *= s.last_attempt_penalty_scale;
+            }
+            changed = c;
+            &changed
+        };
+        let feb = feb::write(campaign, job.pose, job.mesh, job.steps, job.first_increment).context("writing the FEBio input")?;
+        let input = job.work_dir.join(format!("{JOB}.feb"));
+        std::fs::write(&input, &feb.text).with_context(|| format!("{}: cannot write", input.display()))?;
+        let rb_path = job.work_dir.join(feb::RIGID_LOG);
+        let log_path = job.work_dir.join(format!("{JOB}.log"));
+        let out_path = job.work_dir.join("febio.out");
+        // files of an earlier attempt in this folder would be taken for this one's
+        for n in 0..=restart::MAX_CONTINUATIONS {
+            remove_if_exists(&restart::segment_log(job.work_dir, n))?;
+        }
+        for f in [rb_path.clone(), job.work_dir.join(restart::DUMP), job.work_dir.join(restart::DUMP_FROM)] {
+            remove_if_exists(&f)?;
+        }
+        let depth = job.campaign.loading.depth_mm;
+        let step_mm = depth / f64::from(job.steps.max(1));
+        let started = std::time::Instant::now();
+        let mut segments: Vec<logs::RigidRecord> = Vec::new();
+        let mut cont = restart::Continuations::default();
+        let mut totals = logs::RunLog::default();
+        let (done, run, log_tail, at_steps, done_steps) = loop {
+            let mut cmd = Command::new(exe);
+            cmd.arg("-nosplash");
+            if cont.from_mm.is_empty() {
+                cmd.arg("-i").arg(format!("{JOB}.feb")).arg("-p").arg(format!("{JOB}.xplt"));
+            } else {
+                cmd.arg("-r").arg(restart::RESTART_INPUT).arg("-noappend").arg("-p").arg(format!("{JOB}.xplt"));
+            }
+            cmd.arg("-o")
+                .arg(format!("{JOB}.log"))
+                .arg("-dump=3")
+                .arg(restart::DUMP)
+                .env("OMP_NUM_THREADS", self.threads.to_string())
+                .env("MKL_NUM_THREADS", self.threads.to_string());
+            let timeout = job.timeout.map(|t| t.saturating_sub(started.elapsed()));
+            let done = process::run(cmd, job.work_dir, &out_path, &[log_path.clone(), rb_path.clone()], timeout, job.stall)?;
+            let log_text = std::fs::read_to_string(&log_path).unwrap_or_default();
+            let run = logs::parse_run_log(if log_text.is_empty() { &done.log_text } else { &log_text });
+            totals.time_steps += run.time_steps;
+            totals.iterations += run.iterations;
+            totals.retries += run.retries;
+            let tail_src = if log_text.trim().is_empty() { &done.log_text } else { &log_text };
+            let log_tail = process::tail(tail_src, LOG_TAIL_LINES);
+            let records = std::fs::read_to_string(&rb_path)
+                .map_err(anyhow::Error::from)
+                .and_then(|t| logs::parse_rigid_log(&t))
+                .with_context(|| format!("{}", rb_path.display()));
+            let mut all = segments.clone();
+            if let Ok(r) = &records {
+                all.extend_from_slice(r);
+            }
+            let at_steps = pick_steps(&all, depth, job.steps);
+            let done_steps = at_steps.iter().take_while(|w| w.is_some()).count();
+            let solved = done.exit == ExitKind::Code(0) && run.normal_termination && done_steps >= job.steps as usize;
+            // continue from the last must point when the solver gave up (not on a
+            // timeout, stall or stop) and a dump of a converged must point exists
+            let last_mm = done_steps as f64 * step_mm;
+            let next = (!solved && matches!(done.exit, ExitKind::Code(_)) && done_steps > 0 && !process::interrupted())
+                .then(|| cont.next_fraction(last_mm))
+                .flatten()
+                .filter(|_| job.work_dir.join(restart::DUMP).is_file());
+            let Some(fraction) = next else {
+                break (done, run, log_tail, at_steps, done_steps);
+            };
+            let n = cont.from_mm.len() as u32;
+            eprintln!(
+                "{}: febio4 stopped at t = {} mm ({}); continuing from the must point at {last_mm} mm with a first time step of {} mm",
+                job.pose.name,
+                run.last_time,
+                run.cause.as_deref().unwrap_or("no stated cause"),
+                step_mm * fraction
+            );
+            if rb_path.exists() {
+                let seg = restart::segment_log(job.work_dir, n);
+                std::fs::rename(&rb_path, &seg).with_context(|| format!("{}: cannot keep as {}", rb_path.display(), seg.display()))?;
+            }
+            segments = all;
+            let from = job.work_dir.join(restart::DUMP_FROM);
+            std::fs::copy(job.work_dir.join(restart::DUMP), &from).with_context(|| format!("{}: cannot write", from.display()))?;
+            let dtmin = step_mm * campaign.solver.febio.dtmin_fraction * restart::CONTINUE_DTMIN_SCALE;
+            let input = job.work_dir.join(restart::RESTART_INPUT);
+            std::fs::write(&input, restart::restart_input(step_mm * fraction, dtmin))
+                .with_context(|| format!("{}: cannot write", input.display()))?;
+            cont.from_mm.push(last_mm);
+        };
+        // the dumps are large (tens of MB) and only needed while the run goes on
+        for f in [restart::DUMP, restart::DUMP_FROM] {
+            let _ = std::fs::remove_file(job.work_dir.join(f));
+        }
+        if done.exit != ExitKind::Code(0) || !run.normal_termination || done_steps < job.steps as usize {
+            let how = match done.exit {
+                ExitKind::Code(0) if run.error_termination => "ended with ERROR TERMINATION".to_string(),
+                ExitKind::Code(0) => "exited 0".to_string(),
+                e => e.to_string(),
+            };
+            let kept = keep_failed_attempt(job);
+            let continued = cont.describe();
+            return Err(SolveFailure {
+                message: format!(
+                    "febio4 {how} after {done_steps} of {} steps (t = {} mm), {} time steps, {} retries, {:.1} s{}{}{kept}",
+                    job.steps,
+                    run.last_time,
+                    totals.time_steps,
+                    totals.retries,
+                    started.elapsed().as_secs_f64(),
+                    if continued.is_empty() { String::new() } else { format!(", {continued}") },
+                    run.cause.as_deref().map(|c| format!(": {c}")).unwrap_or_default(),
+                ),
+                log_tail,
+            });
+        }
+        let run = logs::RunLog { time_steps: totals.time_steps, iterations: totals.iterations, ..run };
+        let wrenches = at_steps
+            .into_iter()
+            .map(|v| {
+                let v = v.unwrap_or([f64::NAN; 6]);
+                expand_mirrors(v.map(|x| REACTION_SIGN * x), feb.symmetry)
+            })
+            .collect();
+        Ok(Solved {
+            wrenches,
+            summary: feb.summary,
+            increments: run.time_steps,
+            iterations: run.iterations,
+            first_increment: job.first_increment,
+            retry: None,
+            element: "hex8, three-field (u-p-J) for the uncoupled Ogden tissue; rigid-body needle".into(),
+            peak_rss_mib: done.peak_rss_mib,
+            settings: {
+                let line = settings_line(&campaign.solver.febio, campaign.contact.friction, self.threads, job.first_increment < 1.0);
+                let continued = cont.describe();
+                if continued.is_empty() {
+                    line
+                } else {
+                    format!("{line}; {continued}")
+                }
+            },
+        })
+    }
+
+    /// Must points logged so far, over the continued segments' logs too.
+    fn steps_done(&self, work_dir: &Path) -> u32 {
+        let count = |p: PathBuf| std::fs::read_to_string(p).ok().and_then(|t| logs::parse_rigid_log(&t).ok()).map(|r| r.len() as u32);
+        let segments: u32 = (0..restart::MAX_CONTINUATIONS).map_while(|n| count(restart::segment_log(work_dir, n))).sum();
+        segments + count(work_dir.join(feb::RIGID_LOG)).unwrap_or(0)
+    }
+}
+
+/// The FEBio settings of a run in one line, for the manifest.
+pub fn settings_line(s: &crate::spec::FebioSettings, friction: f64, threads: usize, retry: bool) -> String {
+    let (dtol, rtol) = if retry { (s.retry_dtol, s.retry_rtol) } else { (s.dtol, s.rtol) };
+    format!(
+        "{} contact, primary {}, {} penalty {}{}{}, friction {friction}, projections updated {}; {}, max_refs {}, dtol {} etol {} rtol {}; Pardiso, {threads} thread(s)",
+        s.contact,
+        s.primary,
+        if s.augmented { "augmented Lagrangian" } else { "pure" },
+        s.penalty,
+        if s.auto_penalty { " x auto" } else { " N/mm^3" },
+        if s.augmented {
+            format!(" (tolerance {}, gap tolerance {} mm, at most {} augmentations)", s.aug_tolerance, s.gap_tolerance_mm, s.max_aug)
+        } else {
+            String::new()
+        },
+        if s.seg_up == 0 { "every iteration".to_string() } else { format!("in the first {} iterations of each augmentation", s.seg_up) },
+        if s.max_ups == 0 { "full Newton".to_string() } else { format!("BFGS {} updates", s.max_ups) },
+        s.max_refs,
+        dtol,
+        s.etol,
+        rtol,
+    )
+}
+
+/// The record at each must point t_k = depth * k / steps, k = 1..=steps (None where the
+/// log has none; FEBio logs must points only, but a retried step may log twice: the last
+/// record at a time wins).
+fn pick_steps(records: &[logs::RigidRecord], depth: f64, steps: u32) -> Vec<Option<[f64; 6]>> {
+    (1..=steps)
+        .map(|k| {
+            let t = depth * f64::from(k) / f64::from(steps);
+            records.iter().rev().find(|r| (r.time - t).abs() <= 1e-6 * depth).map(|r| r.values)
+        })
+        .collect()
+}
+
+fn remove_if_exists(p: &Path) -> Result<()> {
+    match std::fs::remove_file(p) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(e).with_context(|| format!("{}: cannot remove the earlier attempt's", p.display())),
+    }
+}
+
+/// Keep a failed FEBio attempt's logs (see [`process::keep_failed_attempt`]).
+fn keep_failed_attempt(job: &Job<'_>) -> String {
+    let files = [
+        (format!("{JOB}.feb"), "feb"),
+        (format!("{JOB}.log"), "log"),
+        ("febio.out".to_string(), "out"),
+        (feb::RIGID_LOG.to_string(), "rb.txt"),
+    ];
+    process::keep_failed_attempt(job.work_dir, &format!("attempt-{}", job.attempt + 1), &files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn versions() {
+        assert_eq!(parse_version("compiled on Nov 24 2026\nFEBio version  = 4.11.0\n").as_deref(), Some("4.11.0"));
+        assert_eq!(parse_version("  Version  4.11.0  \n").as_deref(), Some("4.11.0"));
+        assert_eq!(parse_version("version: unknown"), None);
+    }
+
+    /// A stand-in for febio4 (a shell script; bookkeeping only, no physics): the first
+    /// run logs the must points at 1.5 and 3 mm, dumps and gives up at 3.2 mm; a restart
+    /// (`-r`) checks its input and archive, then logs 4.5 and 6 mm, or (`stuck`) gives up
+    /// again without a new must point.
+    fn fake_febio(dir: &Path, stuck: bool) -> PathBuf {
+        use std::os::unix::fs::PermissionsExt;
+        let rb = |ts: &[(f64, f64)]| -> String {
+            ts.iter()
+                .map(|(t, v)| format!("*Step  = 1\\n*Time  = {t}\\n*Data  = Fx;Fy;Fz;Mx;My;Mz\\n2,{v},{v},{v},{v},{v},{v}\\n"))
+                .collect()
+        };
+        let restart = if stuck {
+            "printf ' ------- failed to converge at time : 3.1\\n E R R O R   T E R M I N A T I O N\\n' > pose.log; exit 1".to_string()
+        } else {
+            format!(
+                "printf '{}' > needle-rb.txt; printf ' ------- converged at time : 4.5\\n ------- converged at time : 6\\n N O R M A L   T E R M I N A T I O N\\n' > pose.log; exit 0",
+                rb(&[(4.5, 3.0), (6.0, 4.0)])
+            )
+        };
+        let script = format!(
+            "#!/bin/sh\n\
+             case \" $* \" in *\" -r \"*)\n\
+             grep -q '<Archive>pose-from.dmp</Archive>' pose-restart.feb && grep -q 'step_size' pose-restart.feb && [ -f pose-from.dmp ] || exit 3\n\
+             {restart};;\n\
+             esac\n\
+             printf '{}' > needle-rb.txt; echo state > pose.dmp\n\
+             printf ' ------- converged at time : 1.5\\n ------- converged at time : 3\\n ------- failed to converge at time : 3.2\\n E R R O R   T E R M I N A T I O N\\n' > pose.log\n\
+             exit 1\n",
+            rb(&[(1.5, 1.0), (3.0, 2.0)])
+        );
+        let p = dir.join("fake-febio4");
+        std::fs::write(&p, script).expect("write the fake febio4");
+        std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o755)).expect("chmod");
+        p
+    }
+
+    #[test]
+    fn a_run_that_gives_up_continues_from_its_last_must_point() {
+        let d = tempfile::tempdir().expect("tempdir");
+        let set = d.path().join("set");
+        std::fs::create_dir_all(&set).expect("mkdir");
+        std::fs::copy(crate::workspace_root().join("coeffs/default/campaign.toml"), set.join("campaign.toml")).expect("copy");
+        let (mut c, _) = crate::spec::load(&set).expect("spec");
+        c.loading.steps = 4;
+        let pose = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");
+        let mesh = c.mesh_level("smoke").expect("smoke").clone();
+        for stuck in [false, true] {
+            let work = d.path().join(format!("work-{stuck}"));
+            std::fs::create_dir_all(&work).expect("mkdir");
+            let backend = FebioBackend { exe: Some(fake_febio(d.path(), stuck)), threads: 1 };
+            let job = Job {
+                campaign: &c,
+                pose: &pose,
+                mesh_name: "smoke",
+                mesh: &mesh,
+                steps: 4,
+                work_dir: &work,
+                timeout: None,
+                stall: None,
+                first_increment: 1.0,
+                attempt: 0,
+            };
+            let r = backend.solve(&job);
+            assert!(!work.join(restart::DUMP).exists() && !work.join(restart::DUMP_FROM).exists(), "dumps removed");
+            if stuck {
+                let f = r.expect_err("a continuation without progress: failed");
+                assert!(
+                    f.message.contains("after 2 of 4 steps")
+                        && f.message.contains("continued 1 time(s) from the last converged must point (3 mm)"),
+                    "{}",
+                    f.message
+                );
+            } else {
+                let s = r.unwrap_or_else(|f| panic!("continued run: {}", f.message));
+                let fy: Vec<f64> = s.wrenches.iter().map(|w| w[1]).collect();
+                // the fake's values 1, 2 (first run) and 3, 4 (continuation), through the
+                // reaction sign and the quarter model's mirror expansion (x4 for Fy)
+                assert_eq!(fy, vec![-4.0, -8.0, -12.0, -16.0]);
+                assert!(s.settings.ends_with("continued 1 time(s) from the last converged must point (3 mm)"), "{}", s.settings);
+                assert_eq!(backend.steps_done(&work), 4, "the must points of both segments");
+                let restart = std::fs::read_to_string(work.join(restart::RESTART_INPUT)).expect("restart input");
+                assert!(restart.contains(&format!("<step_size>{:e}</step_size>", 1.5 * restart::CONTINUE_STEP_FRACTION)), "{restart}");
+            }
+        }
+    }
+
+    #[test]
+    fn must_points_are_picked_by_time() {
+        let r = |t: f64, v: f64| logs::RigidRecord { time: t, values: [v; 6] };
+        let recs = [r(3.0, 1.0), r(3.0, 2.0), r(6.0, 3.0)];
+        let got = pick_steps(&recs, 6.0, 2);
+        assert_eq!(got, vec![Some([2.0; 6]), Some([3.0; 6])]);
+        assert_eq!(pick_steps(&recs[..1], 6.0, 2), vec![Some([1.0; 6]), None]);
+    }
+}

@@ -1,0 +1,145 @@
+//! `needle fe status`: each selected pose's result (up to date, or why it is to be
+//! solved) beside the queue state of its latest SLURM array task (`squeue`) and, for a
+//! task that left the queue without a result, the cause its output states.
+
+use crate::campaign::Plan;
+use crate::launcher::slurm::{self, QueueState, SLURM_DIR};
+use anyhow::Result;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// The state of one pose.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PoseState {
+    /// Pose name.
+    pub pose: String,
+    /// The result is up to date.
+    pub done: bool,
+    /// Why it is not (`no entry in fe/manifest.toml`, `solved from another spec`...).
+    pub result: String,
+    /// The latest array task of the pose, `<job>_<task>`.
+    pub task: Option<String>,
+    /// `done`, `pending`, `running`, `failed`, `cancelled`, `ended` (no result, cause
+    /// unknown) or `not submitted`.
+    pub state: String,
+    /// The cause, for a task that failed or left the queue without a result.
+    pub cause: String,
+}
+
+/// What `needle fe status` shows.
+#[derive(Debug, Clone)]
+pub struct StatusReport {
+    /// One per selected pose, in campaign order.
+    pub poses: Vec<PoseState>,
+    /// Why the queue could not be read, if it could not (the manifest part stands).
+    pub queue_error: Option<String>,
+}
+
+impl StatusReport {
+    /// Number of poses in each state, e.g. `done 3, running 1, failed 1`.
+    pub fn counts(&self) -> BTreeMap<String, usize> {
+        let mut m = BTreeMap::new();
+        for p in &self.poses {
+            *m.entry(p.state.clone()).or_insert(0) += 1;
+        }
+        m
+    }
+
+    /// The table and the count line.
+    pub fn table(&self) -> String {
+        let mut s = String::new();
+        let w = self.poses.iter().map(|p| p.pose.len()).max().unwrap_or(4).max(4);
+        let _ = writeln!(s, "{:<w$}  {:<13}  {:<12}  {:<36}  cause", "pose", "state", "slurm task", "result");
+        for p in &self.poses {
+            let _ = writeln!(
+                s,
+                "{:<w$}  {:<13}  {:<12}  {:<36}  {}",
+                p.pose,
+                p.state,
+                p.task.as_deref().unwrap_or("-"),
+                if p.done { "up to date" } else { p.result.as_str() },
+                p.cause
+            );
+        }
+        let counts: Vec<String> = self.counts().into_iter().map(|(k, v)| format!("{k} {v}")).collect();
+        let _ = writeln!(s, "{} pose(s): {}", self.poses.len(), counts.join(", "));
+        if let Some(e) = &self.queue_error {
+            let _ = writeln!(s, "queue not read: {e}");
+        }
+        s
+    }
+}
+
+/// The status of the poses of `plan` ([`campaign::plan`](crate::campaign::plan)).
+///
+/// # Errors
+/// The submissions record cannot be read. A queue that cannot be read is not an error:
+/// the report says so in [`StatusReport::queue_error`].
+pub fn status(plan: &Plan) -> Result<StatusReport> {
+    let subs = slurm::read_submissions(&plan.out_dir)?;
+    let latest = subs.latest_tasks();
+    let (queue, queue_error) = if subs.submission.is_empty() {
+        (BTreeMap::new(), None)
+    } else {
+        match slurm::queue_states(&subs) {
+            Ok(q) => (q, None),
+            Err(e) => (BTreeMap::new(), Some(format!("{e:#}"))),
+        }
+    };
+    let mut poses = Vec::new();
+    for (i, pose) in plan.selected.iter().enumerate() {
+        let done = !plan.to_run.contains(&i);
+        let result = if done {
+            String::new()
+        } else {
+            match plan.manifest.current_entry(&plan.campaign, pose, &plan.mesh_name) {
+                Err(why) => why,
+                Ok(_) => "CSV missing, changed or of other steps".to_string(),
+            }
+        };
+        let task = latest.get(&pose.name).map(|(job, t)| format!("{job}_{t}"));
+        let (state, cause) = match (&task, done) {
+            (_, true) => ("done".to_string(), String::new()),
+            (None, false) => ("not submitted".to_string(), String::new()),
+            (Some(t), false) => match queue.get(t) {
+                Some(q) => (q.state.to_lowercase(), reason(q)),
+                None if queue_error.is_some() => ("unknown".to_string(), String::new()),
+                None => ended_task(&plan.out_dir, t, &pose.name),
+            },
+        };
+        poses.push(PoseState { pose: pose.name.clone(), done, result, task, state, cause });
+    }
+    Ok(StatusReport { poses, queue_error })
+}
+
+fn reason(q: &QueueState) -> String {
+    if q.reason.is_empty() || q.reason == "None" {
+        String::new()
+    } else {
+        format!("waiting: {}", q.reason)
+    }
+}
+
+/// A task that left the queue without an up-to-date result: the cause from its output
+/// file `<out>/.slurm/<job>_<task>.out`.
+fn ended_task(out_dir: &Path, task: &str, pose: &str) -> (String, String) {
+    let path = out_dir.join(SLURM_DIR).join(format!("{task}.out"));
+    let Ok(text) = std::fs::read_to_string(&path) else {
+        return ("ended".into(), format!("no output file {} (the task never started?)", path.display()));
+    };
+    if let Some(l) = text.lines().rev().find(|l| l.contains("CANCELLED")) {
+        // slurmstepd's line: `slurmstepd-<node>: error: *** JOB 9 ON vm CANCELLED AT ... ***`
+        let what = l.find("***").and_then(|i| l.get(i..)).unwrap_or(l);
+        return ("cancelled".into(), what.trim().to_string());
+    }
+    if let Some(l) = text.lines().find(|l| l.starts_with(&format!("FAILED {pose}:"))) {
+        return ("failed".into(), l.trim().to_string());
+    }
+    for key in ["DUE TO TIME LIMIT", "oom-kill", "Error:", "error:"] {
+        if let Some(l) = text.lines().rev().find(|l| l.contains(key)) {
+            return ("failed".into(), l.trim().to_string());
+        }
+    }
+    ("ended".into(), format!("no result and no stated cause: see {}", path.display()))
+}

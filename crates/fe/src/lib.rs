@@ -1,0 +1,30 @@
+//! The FE campaign: spec, material check, mesh and deck writer, the ccx runner and
+//! result parser, the reduction of nodal reactions to the needle wrench, and the campaign
+//! driver (backend, manifest, report, progress).
+#![forbid(unsafe_code)]
+
+pub mod backend;
+pub mod campaign;
+pub mod ccx;
+pub mod dat;
+pub mod deck;
+pub mod engines;
+pub mod febio;
+pub mod launcher;
+pub mod manifest;
+pub mod material;
+pub mod mesh;
+pub mod process;
+mod progress;
+pub mod report;
+pub mod results;
+pub mod spec;
+pub mod verify;
+pub mod versions;
+pub mod wrench;
+
+/// The workspace root (this crate is `crates/fe`), for the unit tests' `coeffs/default`.
+#[cfg(test)]
+pub(crate) fn workspace_root() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}

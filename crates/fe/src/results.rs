@@ -1,0 +1,180 @@
+//! FE result files `fe/<pose>.csv`: one row per depth, the reaction wrench on the needle.
+//! Format: coeffs/README.md, "FE result files".
+
+use anyhow::{bail, Context, Result};
+use std::io::Write;
+use std::path::Path;
+
+/// The header line of every FE result file.
+pub const HEADER: &str = "depth_mm,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm";
+
+/// One row: depth (mm) and the wrench (N, N·mm) about the needle's reference point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Row {
+    /// Depth along the needle axis, mm.
+    pub depth_mm: f64,
+    /// fx_n, fy_n, fz_n, mx_nmm, my_nmm, mz_nmm.
+    pub wrench: [f64; 6],
+}
+
+/// The CSV text of a result (header and rows, `\n` line ends, shortest round-trip numbers).
+pub fn to_csv(rows: &[Row]) -> String {
+    let mut s = String::with_capacity(64 * (rows.len() + 1));
+    s.push_str(HEADER);
+    s.push('\n');
+    for r in rows {
+        s.push_str(&format!("{}", r.depth_mm));
+        for v in r.wrench {
+            // normalise -0 to 0 so that the files do not depend on the sign of a zero sum
+            let v = if v == 0.0 { 0.0 } else { v };
+            s.push_str(&format!(",{v}"));
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// Parse the CSV text of a result; `path` is only used in messages.
+///
+/// # Errors
+/// Wrong header, a row without 7 fields, a field that is not a finite number: the
+/// message has `path:line` and the offending value.
+pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<Row>> {
+    let mut lines = text.lines().enumerate();
+    match lines.next() {
+        Some((_, h)) if h.trim() == HEADER => {}
+        Some((_, h)) => bail!("{}:1: header is {h:?}, expected {HEADER:?}", path.display()),
+        None => bail!("{}:1: empty file, expected the header {HEADER:?}", path.display()),
+    }
+    let mut rows = Vec::new();
+    for (i, line) in lines {
+        let n = i + 1;
+        if line.trim().is_empty() {
+            continue;
+        }
+        let fields: Vec<&str> = line.split(',').collect();
+        if fields.len() != 7 {
+            bail!("{}:{n}: {} fields, expected 7: {line:?}", path.display(), fields.len());
+        }
+        let mut v = [0.0f64; 7];
+        for (k, f) in fields.iter().enumerate() {
+            let x: f64 = f.trim().parse().with_context(|| format!("{}:{n}: field {} = {f:?} is not a number", path.display(), k + 1))?;
+            if !x.is_finite() {
+                bail!("{}:{n}: field {} = {f:?} is not finite", path.display(), k + 1);
+            }
+            v[k] = x;
+        }
+        rows.push(Row { depth_mm: v[0], wrench: [v[1], v[2], v[3], v[4], v[5], v[6]] });
+    }
+    Ok(rows)
+}
+
+/// SHA-256 of a result file's bytes, 64 hex digits: the manifest's `csv_sha256`.
+#[must_use]
+pub fn content_sha256(bytes: &[u8]) -> String {
+    use sha2::{Digest, Sha256};
+    crate::spec::hex(&Sha256::digest(bytes))
+}
+
+/// Read an FE result file.
+///
+/// # Errors
+/// As [`parse_csv`], or the file cannot be read.
+pub fn read_csv(path: &Path) -> Result<Vec<Row>> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    parse_csv(&text, path)
+}
+
+/// Write `bytes` to `path` atomically: a temporary file in the same folder, flushed and
+/// synced, then renamed over `path`. A crash leaves either the old file or the new one;
+/// a failed write removes its temporary; stale temporaries of `path` from processes that
+/// are gone are removed first.
+///
+/// # Errors
+/// The folder cannot be written.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    // temporaries of `path` left by a killed process go first
+    remove_stale_temporaries(path);
+    let tmp = write_temporary(path, bytes)?;
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        anyhow::anyhow!("{}: cannot rename to {}: {e}", tmp.display(), path.display())
+    })
+}
+
+/// The temporary of `path` for this process: `.<name>.<pid>.tmp` beside it.
+fn temporary_of(path: &Path) -> Result<std::path::PathBuf> {
+    let dir = path.parent().with_context(|| format!("{}: no parent folder", path.display()))?;
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("out");
+    Ok(dir.join(format!(".{name}.{}.tmp", std::process::id())))
+}
+
+/// Write `bytes` to the temporary of `path` (synced); removed again on failure.
+fn write_temporary(path: &Path, bytes: &[u8]) -> Result<std::path::PathBuf> {
+    let dir = path.parent().with_context(|| format!("{}: no parent folder", path.display()))?;
+    std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
+    let tmp = temporary_of(path)?;
+    let written = (|| -> Result<()> {
+        let mut f = std::fs::File::create(&tmp).with_context(|| format!("{}: cannot create", tmp.display()))?;
+        f.write_all(bytes).with_context(|| format!("{}: cannot write", tmp.display()))?;
+        f.sync_all().with_context(|| format!("{}: cannot sync", tmp.display()))?;
+        Ok(())
+    })();
+    if let Err(e) = written {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e);
+    }
+    Ok(tmp)
+}
+
+/// Remove temporaries `.<name>.<pid>.tmp` of `path` left by processes that are gone
+/// (a crash or kill between write and rename). Linux: a pid is alive while `/proc/<pid>`
+/// exists; elsewhere only this process's own temporary is kept.
+pub fn remove_stale_temporaries(path: &Path) {
+    let (Some(dir), Some(name)) = (path.parent(), path.file_name().and_then(|n| n.to_str())) else { return };
+    let prefix = format!(".{name}.");
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for e in entries.flatten() {
+        let file = e.file_name();
+        let Some(rest) = file.to_str().and_then(|f| f.strip_prefix(&prefix)).and_then(|r| r.strip_suffix(".tmp")) else { continue };
+        let Ok(pid) = rest.parse::<u32>() else { continue };
+        let alive = pid == std::process::id() || (cfg!(target_os = "linux") && Path::new(&format!("/proc/{pid}")).exists());
+        if !alive {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
+/// Write several files all or nothing: every target is checked (not a folder), every
+/// content written to its temporary and synced, and only then are the temporaries
+/// renamed over the targets, one by one. When a check or a write fails, the temporaries
+/// are removed and no target has changed. (The renames are in the same folders and do
+/// not fail on a checked target; a crash between two of them can leave the first ones
+/// new.) Stale temporaries of the targets are removed first.
+///
+/// # Errors
+/// A target is a folder, or a temporary cannot be written.
+pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<()> {
+    for (path, _) in files {
+        remove_stale_temporaries(path);
+        if path.is_dir() {
+            bail!("{}: is a folder, cannot write a file there (nothing written)", path.display());
+        }
+    }
+    let mut temps = Vec::new();
+    for (path, bytes) in files {
+        match write_temporary(path, bytes) {
+            Ok(t) => temps.push(t),
+            Err(e) => {
+                for t in &temps {
+                    let _ = std::fs::remove_file(t);
+                }
+                return Err(e.context("nothing written"));
+            }
+        }
+    }
+    for (tmp, (path, _)) in temps.iter().zip(files) {
+        std::fs::rename(tmp, path).with_context(|| format!("{}: cannot rename to {}", tmp.display(), path.display()))?;
+    }
+    Ok(())
+}

@@ -1,0 +1,161 @@
+//! `needle fe verify`: checks of the FE setup against theory and against itself.
+//!
+//! 1. **Flat punch (Sneddon)** ([`punch`]): a rigid flat-ended punch of the needle's
+//!    radius pressed into the block, against Sneddon's half-space force (goal: within 5%).
+//! 2. **Mesh convergence** ([`mesh_check`]): the centred vertical needle on the levels of
+//!    `campaign.mesh_study`, Fy at full depth: committed level against its 2x refinement
+//!    (goal 2%), Richardson's estimate of the converged value.
+//! 3. **Mirror runs**: each `mirror` pose against its mirrored counterpart from the
+//!    committed data, with the sign flips of coeffs/README.md (goal 1% of peak |Fy|).
+
+mod mesh_check;
+mod mirror;
+pub mod punch;
+pub mod punch_febio;
+
+pub use mesh_check::{richardson, LevelRun, MeshReport, MESH_GOAL_PERCENT};
+pub use mirror::MirrorReport;
+pub use punch::{
+    bonded_punch_force, poisson, punch_deck, punch_mesh, sneddon_force, PunchDeck, PunchElement, PunchReport, PunchRun,
+    PUNCH_CORE_ELEMENTS_C3D20R, PUNCH_CORE_ELEMENTS_C3D8, PUNCH_GOAL_PERCENT, PUNCH_GROWTH, PUNCH_MU_N_PER_MM2,
+};
+
+use super::results;
+use super::spec;
+use anyhow::{Context, Result};
+use serde::Serialize;
+use std::path::PathBuf;
+
+/// What to verify.
+#[derive(Debug, Clone)]
+pub struct VerifyOptions {
+    /// The set folder (with campaign.toml and fe/).
+    pub set_dir: PathBuf,
+    /// Run the flat-punch check.
+    pub punch: bool,
+    /// Run the mesh-convergence check (two needle solves, the fine one is slow).
+    pub mesh: bool,
+    /// Check the mirror runs (no solve).
+    pub mirror: bool,
+    /// Coarsening of the flat-punch mesh: 1 = the verification mesh; 2 = half the
+    /// elements across the punch and twice the fine size (quick tests).
+    pub punch_mesh_scale: f64,
+    /// Also solve the flat punch with the campaign's element (C3D8) and report its
+    /// error (no goal: it measures the element's volumetric locking).
+    pub punch_campaign_element: bool,
+    /// Where to keep work folders (default `<set>/fe/.work/verify`).
+    pub work_dir: Option<PathBuf>,
+    /// Solver threads of each solve (FEBio; ccx always runs on one).
+    pub threads: usize,
+    /// The engine instead of the spec's `[solver] engine`.
+    pub engine: Option<spec::Engine>,
+}
+
+/// Everything `needle fe verify` measured.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct VerifyReport {
+    /// Flat punch against Sneddon.
+    pub punch: Option<PunchReport>,
+    /// Committed mesh against the fine one.
+    pub mesh: Option<MeshReport>,
+    /// Mirror runs.
+    pub mirror: Vec<MirrorReport>,
+}
+
+/// Run the checks, print the table, write `<set>/fe/verify.toml`.
+///
+/// # Errors
+/// ccx missing or failing, missing FE files for the mirror check.
+pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
+    let (mut c, _) = spec::load(&opts.set_dir)?;
+    if let Some(e) = opts.engine {
+        c.solver.engine = e;
+    }
+    let work = opts.work_dir.clone().unwrap_or_else(|| opts.set_dir.join("fe").join(".work").join("verify"));
+    let mut report = VerifyReport::default();
+    let mut ok = true;
+    if opts.mirror {
+        report.mirror = mirror::mirror_checks(&c, &opts.set_dir.join("fe"))?;
+        for m in &report.mirror {
+            println!(
+                "mirror {:>6} vs {:>6}: max difference {:.3e} ({}) = {:.3}% of peak |Fy| (goal <= 1%)",
+                m.pose, m.counterpart, m.max_difference, m.component, m.percent_of_peak_fy
+            );
+            ok &= m.percent_of_peak_fy <= 1.0;
+        }
+    }
+    if opts.punch {
+        let p = match c.solver.engine {
+            crate::spec::Engine::Febio => punch_febio::punch(&c, &work, opts)?,
+            crate::spec::Engine::Ccx => punch::punch(&c, &work, opts)?,
+        };
+        println!(
+            "flat punch a = {} mm, delta = {} mm, nu = {:.4}, {}: F(block) = {:.5e} N, F(2x block) = {:.5e} N, \
+             F(half-space, extrapolated) = {:.5e} N, Sneddon {:.5e} N: error {:+.2}% (goal within {}%); {} {:.0} s + {:.0} s",
+            p.radius_mm,
+            p.delta_mm,
+            p.nu,
+            p.check.element,
+            p.check.force_block_n,
+            p.check.force_block_2x_n,
+            p.check.force_half_space_n,
+            p.force_sneddon_n,
+            p.check.error_percent,
+            p.goal_percent,
+            p.solver,
+            p.check.wall_s[0],
+            p.check.wall_s[1]
+        );
+        if let Some(r) = &p.campaign_element {
+            println!(
+                "  campaign element {}: F(block) = {:.5e} N, F(2x block) = {:.5e} N, F(half-space) = {:.5e} N: {:+.2}% \
+                 (no goal: volumetric locking of the fully integrated C3D8 at K0/mu0 = {}); ccx {:.0} s + {:.0} s",
+                r.element,
+                r.force_block_n,
+                r.force_block_2x_n,
+                r.force_half_space_n,
+                r.error_percent,
+                p.bulk_to_shear,
+                r.wall_s[0],
+                r.wall_s[1]
+            );
+        }
+        ok &= p.check.error_percent.abs() <= p.goal_percent;
+        report.punch = Some(p);
+    }
+    if opts.mesh {
+        let m = mesh_check::mesh_convergence(&c, &work, opts.threads)?;
+        println!(
+            "mesh convergence, centred vertical needle ({}): Fy({} mm) {:?} {:.5e} N, refined {:?} {:.5e} N: {:+.2}% (goal within {}%)",
+            m.engine,
+            m.depth_mm,
+            m.committed,
+            m.levels.iter().find(|l| l.level == m.committed).map(|l| l.fy_n).unwrap_or(f64::NAN),
+            m.refined,
+            m.levels.iter().find(|l| l.level == m.refined).map(|l| l.fy_n).unwrap_or(f64::NAN),
+            m.difference_percent,
+            m.goal_percent
+        );
+        if let (Some(f), Some(p), Some(d)) = (m.richardson_fy_n, m.richardson_order, m.committed_vs_richardson_percent) {
+            println!("  Richardson estimate of the converged Fy: {f:.5e} N (observed order {p:.2}); committed level {d:+.2}% from it");
+        } else if m.levels.len() >= 3 {
+            println!("  Richardson estimate: none (the finest three levels are not in the asymptotic range)");
+        }
+        ok &= m.levels.iter().all(|l| l.failure.is_none()) && m.difference_percent.abs() <= m.goal_percent;
+        report.mesh = Some(m);
+    }
+    let path = opts.set_dir.join("fe").join("verify.toml");
+    let mut old: toml::Table = std::fs::read_to_string(&path).ok().and_then(|t| t.parse().ok()).unwrap_or_default();
+    let mut new: toml::Table = toml::Table::try_from(&report).context("cannot serialise the verify report")?;
+    // only the checks that ran replace their part of an earlier verify.toml
+    if !opts.mirror {
+        new.remove("mirror");
+    }
+    for (k, v) in new {
+        old.insert(k, v);
+    }
+    let text = format!("# written by `needle fe verify`; do not edit\n{}", toml::to_string(&old)?);
+    results::write_atomic(&path, text.as_bytes())?;
+    println!("wrote {}", path.display());
+    Ok((report, ok))
+}

@@ -1,0 +1,288 @@
+//! What `needle fit` measures about the coupled form: the cross-validation of its size
+//! on the training runs, the learning curve (held-out error against the number of
+//! training runs) and the held-out errors of both forms side by side.
+//!
+//! Held-out runs are the validation runs (Table 2 and the Latin hypercube): never
+//! fitted, never used by the cross-validation. Errors are `needle validate`'s: per run
+//! and component, RMS over the run's depths in % of the run's peak |Fy| (moments: times
+//! the lever arm), and for Table 2 the largest |Fy| error at depths >= 1 mm in % of FE.
+
+use super::coupled::{self, Selection};
+use super::cross_terms::CrossTerms;
+use super::data::{load_training_runs, load_validation_runs, Run};
+use super::eval_f64::{eval_paper, eval_with_cross, Pose64};
+use super::model::Model;
+use super::validate::TABLE2_MIN_DEPTH_MM;
+use anyhow::Result;
+use needle_fe::spec::Role;
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Held-out errors of one form.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct HeldOut {
+    /// Worst per-run, per-component RMS over the lhs runs, % of the run's peak |Fy|.
+    pub lhs_worst_rms_pct: f64,
+    /// Worst per-run, per-component RMS over the Table 2 runs, %.
+    pub table2_worst_rms_pct: f64,
+    /// Largest |Fy error| / |FE Fy| over the Table 2 runs at depths >= 1 mm, %.
+    pub table2_fy_max_pct: f64,
+    /// Largest error of any component at any depth of any held-out run, % of peak |Fy|.
+    pub worst_max_pct: f64,
+}
+
+/// One point of the learning curve.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CurvePoint {
+    /// Training runs used: the first `runs` of the design.
+    pub runs: usize,
+    /// Form chosen by cross-validation on them (`max_degree`, `depth_degree`).
+    pub form: Option<(u8, u8)>,
+    /// Held-out errors of the coupled form fitted on them; `None` if nothing could be fitted.
+    pub held_out: Option<HeldOut>,
+}
+
+/// Everything measured.
+#[derive(Debug, Clone)]
+pub struct CoupledReport {
+    /// Training runs found (and usable).
+    pub training_runs: usize,
+    /// Training runs missing or stale.
+    pub unusable: Vec<String>,
+    /// Held-out runs compared.
+    pub held_out_runs: usize,
+    /// Cross-validation of every candidate on all training runs, the paper form's error
+    /// there and each component's choice; `None` when nothing could be fitted.
+    pub selection: Option<Selection>,
+    /// The chosen cross terms, fitted on all training runs.
+    pub terms: Option<CrossTerms>,
+    /// The paper form's held-out errors.
+    pub paper: HeldOut,
+    /// The coupled form's held-out errors.
+    pub coupled: Option<HeldOut>,
+    /// Learning curve.
+    pub curve: Vec<CurvePoint>,
+}
+
+fn pose_of(r: &Run, depth_mm: f64) -> Pose64 {
+    let p = &r.pose;
+    [p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg, depth_mm]
+}
+
+/// Held-out errors of `model` on `runs` (module docs).
+pub fn held_out(runs: &[&Run], lever_arm_mm: f64, model: impl Fn(Pose64) -> [f64; 6]) -> HeldOut {
+    let mut h = HeldOut::default();
+    for r in runs {
+        let peak = r.rows.iter().map(|x| x.wrench[1].abs()).fold(0.0, f64::max);
+        let scale: [f64; 6] = std::array::from_fn(|c| if c < 3 { peak } else { peak * lever_arm_mm });
+        let mut s = [0.0f64; 6];
+        for row in &r.rows {
+            let w = model(pose_of(r, row.depth_mm));
+            for c in 0..6 {
+                let e = w[c] - row.wrench[c];
+                s[c] += e * e;
+                if scale[c] > 0.0 {
+                    h.worst_max_pct = h.worst_max_pct.max(100.0 * e.abs() / scale[c]);
+                }
+            }
+            if r.pose.role == Role::Table2 && row.depth_mm >= TABLE2_MIN_DEPTH_MM - 1e-9 && row.wrench[1] != 0.0 {
+                h.table2_fy_max_pct = h.table2_fy_max_pct.max(100.0 * (w[1] - row.wrench[1]).abs() / row.wrench[1].abs());
+            }
+        }
+        let n = r.rows.len().max(1) as f64;
+        let worst = (0..6).filter(|&c| scale[c] > 0.0).map(|c| 100.0 * (s[c] / n).sqrt() / scale[c]).fold(0.0, f64::max);
+        match r.pose.role {
+            Role::Lhs => h.lhs_worst_rms_pct = h.lhs_worst_rms_pct.max(worst),
+            Role::Table2 => h.table2_worst_rms_pct = h.table2_worst_rms_pct.max(worst),
+            _ => {}
+        }
+    }
+    h
+}
+
+/// Sizes of the learning curve: 8, 16, 24, ... up to all `n` training runs.
+pub fn curve_sizes(n: usize) -> Vec<usize> {
+    let mut v: Vec<usize> = (1..).map(|k| 8 * k).take_while(|&k| k < n).collect();
+    v.push(n);
+    v
+}
+
+/// Held-out errors of the paper part of `model` alone (its cross terms, if any, left
+/// out): the paper form's row of the report, also when `model` is the fitted coupled
+/// model.
+pub fn paper_held_out(runs: &[&Run], lever_arm_mm: f64, model: &Model) -> HeldOut {
+    held_out(runs, lever_arm_mm, |p| eval_paper(model, p).0)
+}
+
+/// Measure the coupled form of the set in `set_dir` against its paper form: the paper
+/// part of `paper` (a fitted coupled model may be passed; its cross terms are ignored).
+///
+/// # Errors
+/// The spec, the manifest or a run cannot be read.
+pub fn measure(set_dir: &Path, paper: &Model) -> Result<CoupledReport> {
+    let (campaign, train, unusable) = load_training_runs(set_dir)?;
+    let (_, validation, _) = load_validation_runs(set_dir)?;
+    let lever = campaign.needle.reference_from_tip_mm;
+    let held: Vec<&Run> = validation.iter().filter(|r| r.pose.role.is_validation()).collect();
+    let train_refs: Vec<&Run> = train.iter().collect();
+    let paper_errors = paper_held_out(&held, lever, paper);
+    let mut report = CoupledReport {
+        training_runs: train.len(),
+        unusable: unusable.iter().map(|u| format!("{} ({})", u.pose.name, u.why)).collect(),
+        held_out_runs: held.len(),
+        selection: None,
+        terms: None,
+        paper: paper_errors,
+        coupled: None,
+        curve: Vec::new(),
+    };
+    if train.len() < 2 {
+        return Ok(report);
+    }
+    let scale = coupled::scales(&train_refs, lever);
+    for n in curve_sizes(train.len()) {
+        let got = coupled::select_and_fit(paper, &train_refs[..n], scale).ok();
+        let point = CurvePoint {
+            runs: n,
+            form: got.as_ref().map(|g| (g.1.form.max_degree, g.1.form.depth_degree)),
+            held_out: got.as_ref().map(|g| held_out(&held, lever, |p| eval_with_cross(paper, &g.1, p).0)),
+        };
+        if n == train.len() {
+            if let Some((selection, terms)) = got {
+                report.coupled = point.held_out;
+                report.selection = Some(selection);
+                report.terms = Some(terms);
+            }
+        }
+        report.curve.push(point);
+    }
+    Ok(report)
+}
+
+/// The report as plain text.
+pub fn to_table(r: &CoupledReport) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "coupled form: {} training runs{}; held out: {} validation runs (table2, lhs)",
+        r.training_runs,
+        match r.unusable.as_slice() {
+            [] => String::new(),
+            [a, b, c, _, ..] => format!(" ({} unusable: {a}, {b}, {c}, ...)", r.unusable.len()),
+            all => format!(" ({} unusable: {})", all.len(), all.join(", ")),
+        },
+        r.held_out_runs
+    );
+    if let Some(sel) = &r.selection {
+        let _ =
+            writeln!(s, "{}-fold cross-validation on the training runs (RMS, % of their peak |Fy|; moments x lever arm):", coupled::FOLDS);
+        let _ = writeln!(
+            s,
+            "  {:>10} {:>10}  {:>6} {:>6} {:>6} {:>6} {:>6} {:>6}",
+            "pose deg", "depth deg", "fx", "fy", "fz", "mx", "my", "mz"
+        );
+        let cells = |e: &[f64; 6], form: Option<super::cross_terms::CrossForm>| -> String {
+            (0..6).map(|c| format!(" {:>6.3}{}", e[c], if sel.choices[c] == form { "*" } else { " " })).collect()
+        };
+        let _ = writeln!(s, "  {:>10} {:>10} {}  (paper form alone, out of sample)", "none", "-", cells(&sel.paper_rms_pct, None));
+        for c in &sel.cv {
+            match c.rms_pct {
+                Some(e) => {
+                    let _ = writeln!(s, "  {:>10} {:>10} {}", c.form.max_degree, c.form.depth_degree, cells(&e, Some(c.form)));
+                }
+                None => {
+                    let _ = writeln!(
+                        s,
+                        "  {:>10} {:>10}  not fitted: {}",
+                        c.form.max_degree,
+                        c.form.depth_degree,
+                        c.failure.as_deref().unwrap_or("")
+                    );
+                }
+            }
+        }
+        let names: Vec<String> = sel
+            .choices
+            .iter()
+            .zip(crate::contract::COMPONENTS)
+            .map(|(f, name)| match f {
+                Some(f) => format!("{name} {}/{}", f.max_degree, f.depth_degree),
+                None => format!("{name} none"),
+            })
+            .collect();
+        let _ = writeln!(s, "  chosen per component (*): {}", names.join(", "));
+    }
+    let _ = writeln!(s, "learning curve (held-out errors of the coupled form fitted on the first n training runs):");
+    let _ = writeln!(s, "  {:>4} {:>8}  {:>12} {:>12} {:>12} {:>10}", "n", "form", "lhs rms %", "t2 rms %", "t2 Fy max %", "max %");
+    for p in &r.curve {
+        match (p.form, p.held_out) {
+            (Some(f), Some(h)) => {
+                let _ = writeln!(
+                    s,
+                    "  {:>4} {:>8}  {:>12.3} {:>12.3} {:>12.3} {:>10.3}",
+                    p.runs,
+                    format!("{}/{}", f.0, f.1),
+                    h.lhs_worst_rms_pct,
+                    h.table2_worst_rms_pct,
+                    h.table2_fy_max_pct,
+                    h.worst_max_pct
+                );
+            }
+            _ => {
+                let _ = writeln!(s, "  {:>4} {:>8}  (too few runs for any candidate)", p.runs, "-");
+            }
+        }
+    }
+    let _ = writeln!(s, "held-out errors, both forms ({} runs):", r.held_out_runs);
+    let _ = writeln!(s, "  {:<8} {:>12} {:>12} {:>12} {:>10}", "form", "lhs rms %", "t2 rms %", "t2 Fy max %", "max %");
+    let mut row = |name: &str, h: &HeldOut| {
+        let _ = writeln!(
+            s,
+            "  {:<8} {:>12.3} {:>12.3} {:>12.3} {:>10.3}",
+            name, h.lhs_worst_rms_pct, h.table2_worst_rms_pct, h.table2_fy_max_pct, h.worst_max_pct
+        );
+    };
+    row("paper", &r.paper);
+    if let Some(c) = &r.coupled {
+        row("coupled", c);
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cross_terms::{CrossForm, CrossTerms};
+    use crate::model::Coupled;
+    use needle_fe::results::Row;
+    use needle_fe::spec::{PoseSpec, Role};
+
+    /// The paper row of the report is the paper part alone: with cross terms in the
+    /// model (as `needle fit` passes the fitted coupled model), a run equal to the paper
+    /// part has zero paper error and a nonzero coupled one. (It once evaluated the whole
+    /// model, so both rows of `needle fit` showed the coupled form's errors.)
+    #[test]
+    fn the_paper_row_leaves_the_cross_terms_out() {
+        let path = crate::workspace_root().join("coeffs/default/model.toml");
+        let mut model = crate::model_file::read(&path).unwrap_or_else(|e| panic!("{e:#}"));
+        assert!(model.cross.is_none(), "the default set is the paper form");
+        let pose = PoseSpec { name: "lhs-test".into(), role: Role::Lhs, x_mm: 6.0, z_mm: 0.0, theta_x_deg: 0.0, theta_z_deg: 9.0 };
+        let rows: Vec<Row> = (1..=20)
+            .map(|i| {
+                let depth_mm = 0.3 * f64::from(i);
+                Row { depth_mm, wrench: eval_paper(&model, [pose.x_mm, pose.z_mm, pose.theta_x_deg, pose.theta_z_deg, depth_mm]).0 }
+            })
+            .collect();
+        let run = Run { pose, file_name: "lhs-test.csv".into(), rows };
+        // fy += 0.01 N * (x/12) * (theta_z/15): nonzero at this pose.
+        let mut terms: [Vec<([u8; 4], Vec<f64>)>; 6] = Default::default();
+        terms[1].push(([1, 0, 0, 1], vec![0.01, 0.0, 0.0]));
+        let terms = CrossTerms { form: CrossForm { max_degree: 2, depth_degree: 2 }, terms };
+        model.cross = Some(Coupled { terms: terms.clone(), training_runs: 1, cv_rms_pct: [0.0; 6], scale: [1.0; 6] });
+        let paper = paper_held_out(&[&run], 60.0, &model);
+        let coupled = held_out(&[&run], 60.0, |p| eval_with_cross(&model, &terms, p).0);
+        assert_eq!(paper.lhs_worst_rms_pct, 0.0, "the paper row must not include the cross terms");
+        assert!(coupled.lhs_worst_rms_pct > 1.0, "the cross term shows in the coupled row: {}", coupled.lhs_worst_rms_pct);
+    }
+}

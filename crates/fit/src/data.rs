@@ -1,0 +1,322 @@
+//! The FE runs of a set, by role: the fitted sweeps (with the centre run) and the
+//! validation runs, read from `<set>/fe/<pose>.csv` as the campaign spec names them.
+
+use super::contract::{Sweep, DEPTH_MAX_MM, NCOEF};
+use anyhow::{bail, Context, Result};
+use needle_fe::manifest::{read_manifest, Manifest, MANIFEST};
+use needle_fe::results::{parse_csv, Row};
+use needle_fe::spec::{self, hex, Campaign, ModelForm, PoseSpec, Role};
+use sha2::{Digest, Sha256};
+use std::path::{Path, PathBuf};
+
+/// One FE run: its pose and the wrench at every depth.
+#[derive(Debug, Clone)]
+pub struct Run {
+    /// The pose as the campaign spec gives it (mm, degrees).
+    pub pose: PoseSpec,
+    /// File name inside `fe/`, e.g. `x+02.csv`.
+    pub file_name: String,
+    /// One row per depth (depth in mm, wrench in N and N·mm).
+    pub rows: Vec<Row>,
+}
+
+/// One point of a sweep: the swept value (mm or degrees, >= 0) and its run.
+#[derive(Debug, Clone)]
+pub struct SweepPoint {
+    /// The swept variable's value: 0 for the centre run.
+    pub value: f64,
+    /// The run.
+    pub run: Run,
+}
+
+/// Everything the fitter reads.
+#[derive(Debug, Clone)]
+pub struct FitData {
+    /// The campaign spec.
+    pub campaign: Campaign,
+    /// The centred vertical run.
+    pub centre: Run,
+    /// Per sweep in contract order: the centre run at value 0, then the sweep's runs in
+    /// increasing value.
+    pub sweeps: [Vec<SweepPoint>; 4],
+    /// The training runs (role train, spec order) when the set fits the coupled form
+    /// (`[fit] form = "coupled"`); empty for the paper form.
+    pub train: Vec<Run>,
+    /// SHA-256 (hex) of the FE files read, as coeffs/README.md defines `fe_sha256`.
+    pub fe_sha256: String,
+}
+
+/// The sweep a fitting role belongs to (None for the centre and for unfitted roles).
+pub fn sweep_of(role: Role) -> Option<Sweep> {
+    match role {
+        Role::SweepX => Some(Sweep::X),
+        Role::SweepZ => Some(Sweep::Z),
+        Role::SweepThetaX => Some(Sweep::ThetaX),
+        Role::SweepThetaZ => Some(Sweep::ThetaZ),
+        _ => None,
+    }
+}
+
+/// The pose's value of the swept variable `k` (mm or degrees) and the largest |value| of
+/// the other three inputs.
+fn sweep_value(pose: &PoseSpec, k: Sweep) -> (f64, f64) {
+    let all = [pose.x_mm, pose.z_mm, pose.theta_x_deg, pose.theta_z_deg];
+    let v = all[k.index()];
+    let others = all.iter().enumerate().filter(|(i, _)| *i != k.index()).map(|(_, v)| v.abs()).fold(0.0, f64::max);
+    (v, others)
+}
+
+/// Path of a pose's result file.
+pub fn run_path(set_dir: &Path, pose: &PoseSpec) -> PathBuf {
+    set_dir.join("fe").join(format!("{}.csv", pose.name))
+}
+
+/// Read one run and check its depth grid against the spec's loading (steps + 1 rows at
+/// `depth_at(k)`, to 1e-9 mm).
+///
+/// # Errors
+/// The file cannot be read or parsed, or its depths are not the spec's.
+pub fn read_run(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Result<Run> {
+    let path = run_path(set_dir, pose);
+    let text = std::fs::read_to_string(&path).with_context(|| format!("{}: cannot read", path.display()))?;
+    check_content(set_dir, pose, &path, text.as_bytes())?;
+    let rows = parse_csv(&text, &path)?;
+    let steps = campaign.loading.steps;
+    if rows.len() != steps as usize + 1 {
+        bail!("{}: {} depth rows, expected loading.steps + 1 = {} (an unfinished or failed run?)", path.display(), rows.len(), steps + 1);
+    }
+    for (k, r) in (0u32..).zip(&rows) {
+        let want = campaign.loading.depth_at(k);
+        if (r.depth_mm - want).abs() > 1e-9 {
+            bail!("{}:{}: depth_mm = {}, expected {want}", path.display(), k + 2, r.depth_mm);
+        }
+    }
+    Ok(Run { pose: pose.clone(), file_name: format!("{}.csv", pose.name), rows })
+}
+
+/// A run's CSV must be the bytes the campaign wrote: when its manifest entry records a
+/// `csv_sha256`, the file's hash must match (issue 18: a hand-edited CSV was fitted and
+/// validated silently). The original is not kept, so the message gives both hashes.
+///
+/// # Errors
+/// The manifest cannot be read, or `bytes` (the file at `path`) differ from the recorded hash.
+fn check_content(set_dir: &Path, pose: &PoseSpec, path: &Path, bytes: &[u8]) -> Result<()> {
+    let manifest = read_set_manifest(set_dir)?;
+    let Some(entry) = manifest.pose.get(&pose.name) else { return Ok(()) };
+    if let (false, Some(want)) = (entry.content_matches(bytes), entry.csv_sha256.as_ref()) {
+        let have = needle_fe::results::content_sha256(bytes);
+        bail!(
+            "{}: content changed since the FE run wrote it (sha256 {} now, {} in fe/manifest.toml): restore it (git checkout) or rerun the pose with `needle fe run --force --only {}`",
+            path.display(),
+            have.get(..16).unwrap_or(&have),
+            want.get(..16).unwrap_or(want),
+            pose.name
+        );
+    }
+    Ok(())
+}
+
+/// The manifest of a set's FE runs (`<set>/fe/manifest.toml`; none is an empty one).
+///
+/// # Errors
+/// The file exists but is not a valid manifest.
+pub fn read_set_manifest(set_dir: &Path) -> Result<Manifest> {
+    read_manifest(&set_dir.join("fe").join(MANIFEST))
+}
+
+/// Why the present result of `pose` cannot be used with the current spec, or `None` when
+/// it is current on the spec's committed mesh level ([`Manifest::current_entry`]). A
+/// result solved before `campaign.toml` changed (tissue, contact, mesh, loading...) is
+/// stale: fitting or validating on a mix of old and new runs would be silently wrong.
+pub fn stale_reason(manifest: &Manifest, campaign: &Campaign, pose: &PoseSpec) -> Option<String> {
+    manifest.current_entry(campaign, pose, &campaign.campaign.mesh).err()
+}
+
+/// The poses the fitter uses: the centre and every sweep run not listed in
+/// `campaign.fit_without` (their files make up `fe_sha256`).
+pub fn fitted_poses(campaign: &Campaign) -> Vec<PoseSpec> {
+    let left_out = &campaign.campaign.fit_without;
+    let coupled = campaign.fit.form == ModelForm::Coupled;
+    campaign
+        .poses()
+        .into_iter()
+        .filter(|p| (p.role.is_fitted() && !left_out.contains(&p.name)) || (coupled && p.role == Role::Train))
+        .collect()
+}
+
+/// Load the campaign and every run the fitter uses: the centre and the four sweeps.
+///
+/// # Errors
+/// The spec cannot be loaded; its loading depth is not the contract's 6 mm; a fitted run
+/// is missing (the message lists every missing pose; runs named in `campaign.fit_without`
+/// are not fitted and may be missing); a fitted run cannot be read or has
+/// the wrong depths; a sweep pose has another input nonzero or a negative value; there is
+/// not exactly one centre pose; a sweep has fewer than 5 distinct values (centre
+/// included) or a value outside its half-range.
+pub fn load_fit_data(set_dir: &Path) -> Result<FitData> {
+    let (campaign, spec_path) = spec::load(set_dir)?;
+    if campaign.loading.depth_mm != DEPTH_MAX_MM {
+        bail!(
+            "{}: loading.depth_mm = {}: the model contract (coeffs/README.md) fixes the depth range to 0 ..= {DEPTH_MAX_MM} mm",
+            spec_path.display(),
+            campaign.loading.depth_mm
+        );
+    }
+    let fitted = fitted_poses(&campaign);
+    let missing: Vec<&str> = fitted.iter().filter(|p| !run_path(set_dir, p).is_file()).map(|p| p.name.as_str()).collect();
+    if !missing.is_empty() {
+        bail!(
+            "{} of the {} fitted FE runs are missing from {}: {}\n(run `needle fe run --set {}` to finish the campaign; the fit needs the centre run, every sweep run not listed in campaign.fit_without and, for [fit] form = \"coupled\", every training run)",
+            missing.len(),
+            fitted.len(),
+            set_dir.join("fe").display(),
+            missing.join(", "),
+            set_dir.display()
+        );
+    }
+
+    let manifest = read_set_manifest(set_dir)?;
+    let stale: Vec<String> =
+        fitted.iter().filter_map(|p| stale_reason(&manifest, &campaign, p).map(|why| format!("{}: {why}", p.name))).collect();
+    if !stale.is_empty() {
+        bail!(
+            "{} of the {} fitted FE runs in {} are stale:\n  {}\n(run `needle fe run --set {}`: it solves exactly the poses whose result is not current)",
+            stale.len(),
+            fitted.len(),
+            set_dir.join("fe").display(),
+            stale.join("\n  "),
+            set_dir.display()
+        );
+    }
+
+    let centres: Vec<&PoseSpec> = fitted.iter().filter(|p| p.role == Role::Centre).collect();
+    let centre_pose = match centres.as_slice() {
+        [one] => (*one).clone(),
+        _ => bail!("{}: {} poses with role centre, expected exactly one", spec_path.display(), centres.len()),
+    };
+    if centre_pose.x_mm != 0.0 || centre_pose.z_mm != 0.0 || centre_pose.theta_x_deg != 0.0 || centre_pose.theta_z_deg != 0.0 {
+        bail!("{}: pose {:?} (role centre) is not at x = z = theta_x = theta_z = 0", spec_path.display(), centre_pose.name);
+    }
+    let centre = read_run(set_dir, &campaign, &centre_pose)?;
+
+    let mut sweeps: [Vec<SweepPoint>; 4] = Default::default();
+    for k in Sweep::ALL {
+        sweeps[k.index()].push(SweepPoint { value: 0.0, run: centre.clone() });
+    }
+    for pose in &fitted {
+        let Some(k) = sweep_of(pose.role) else { continue };
+        let (v, others) = sweep_value(pose, k);
+        if others != 0.0 {
+            bail!(
+                "{}: pose {:?} (role sweep-{}) has another input nonzero: a sweep varies only its own input",
+                spec_path.display(),
+                pose.name,
+                k.name().replace('_', "-")
+            );
+        }
+        if !(v > 0.0 && v <= k.half_range()) {
+            bail!(
+                "{}: pose {:?}: swept value {v} {} must be > 0 and <= {}; negative values are mirror runs (role mirror), not fitted",
+                spec_path.display(),
+                pose.name,
+                k.unit(),
+                k.half_range()
+            );
+        }
+        let run = read_run(set_dir, &campaign, pose)?;
+        sweeps[k.index()].push(SweepPoint { value: v, run });
+    }
+    for k in Sweep::ALL {
+        let pts = &mut sweeps[k.index()];
+        pts.sort_by(|a, b| a.value.total_cmp(&b.value).then_with(|| a.run.file_name.cmp(&b.run.file_name)));
+        let mut distinct: Vec<f64> = pts.iter().map(|p| p.value).collect();
+        distinct.dedup();
+        if distinct.len() < NCOEF {
+            bail!(
+                "sweep {}: {} distinct values ({}) with the centre run, need at least {NCOEF} for a 4th-order fit",
+                k.name(),
+                distinct.len(),
+                distinct.iter().map(|v| format!("{v}")).collect::<Vec<_>>().join(", ")
+            );
+        }
+    }
+
+    let train = fitted.iter().filter(|p| p.role == Role::Train).map(|p| read_run(set_dir, &campaign, p)).collect::<Result<Vec<_>>>()?;
+    let fe_sha256 = fitted_fe_sha256(set_dir, &fitted)?;
+    Ok(FitData { campaign, centre, sweeps, train, fe_sha256 })
+}
+
+/// `fe_sha256` of the runs of `poses` in `set_dir` (their `<pose>.csv` files).
+///
+/// # Errors
+/// A file cannot be read.
+pub fn fitted_fe_sha256(set_dir: &Path, poses: &[PoseSpec]) -> Result<String> {
+    let mut files: Vec<(String, PathBuf)> = poses.iter().map(|p| (format!("{}.csv", p.name), run_path(set_dir, p))).collect();
+    fe_sha256(&mut files)
+}
+
+/// `fe_sha256` of coeffs/README.md: SHA-256 over, for each file in byte order of its
+/// name, the name (e.g. `x+02.csv`), a `\n`, and the file's bytes. Sorts `files`.
+///
+/// # Errors
+/// A file cannot be read.
+pub fn fe_sha256(files: &mut [(String, PathBuf)]) -> Result<String> {
+    files.sort_by(|a, b| a.0.as_bytes().cmp(b.0.as_bytes()));
+    let mut h = Sha256::new();
+    for (name, path) in files.iter() {
+        let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
+        h.update(name.as_bytes());
+        h.update(b"\n");
+        h.update(&bytes);
+    }
+    Ok(hex(&h.finalize()))
+}
+
+/// A validation run that cannot be compared: its pose and why (no result file, or a
+/// stale one, see [`stale_reason`]).
+#[derive(Debug, Clone)]
+pub struct Unusable {
+    /// The pose.
+    pub pose: PoseSpec,
+    /// Why, e.g. `no result file`.
+    pub why: String,
+}
+
+/// The validation runs of a set: roles table2, lhs and mirror, in spec order, and those
+/// that cannot be used (missing or stale).
+///
+/// # Errors
+/// The spec or the manifest cannot be loaded, or a present run cannot be read or has the
+/// wrong depths.
+pub fn load_validation_runs(set_dir: &Path) -> Result<(Campaign, Vec<Run>, Vec<Unusable>)> {
+    load_runs_where(set_dir, |r| r.is_validation() || r == Role::Mirror)
+}
+
+/// The training runs of a set (role train, in spec order: `train-01`, ...) and those that
+/// cannot be used (missing or stale).
+///
+/// # Errors
+/// As [`load_validation_runs`].
+pub fn load_training_runs(set_dir: &Path) -> Result<(Campaign, Vec<Run>, Vec<Unusable>)> {
+    load_runs_where(set_dir, |r| r == Role::Train)
+}
+
+fn load_runs_where(set_dir: &Path, keep: impl Fn(Role) -> bool) -> Result<(Campaign, Vec<Run>, Vec<Unusable>)> {
+    let (campaign, _) = spec::load(set_dir)?;
+    let manifest = read_set_manifest(set_dir)?;
+    let mut runs = Vec::new();
+    let mut unusable = Vec::new();
+    for pose in campaign.poses() {
+        if !keep(pose.role) {
+            continue;
+        }
+        if !run_path(set_dir, &pose).is_file() {
+            unusable.push(Unusable { pose, why: "no result file".into() });
+        } else if let Some(why) = stale_reason(&manifest, &campaign, &pose) {
+            unusable.push(Unusable { pose, why });
+        } else {
+            runs.push(read_run(set_dir, &campaign, &pose)?);
+        }
+    }
+    Ok((campaign, runs, unusable))
+}

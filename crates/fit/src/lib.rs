@@ -1,0 +1,125 @@
+//! The fitter: FE sweeps -> `model.toml` and the golden vectors (`golden-f32.csv`,
+//! `golden-fixed.csv`, `golden-stiffness-f32.csv`, `golden-stiffness-fixed.csv`;
+//! coeffs/README.md), and the
+//! validation of a fitted model against the FE runs it was not fitted on.
+//!
+//! Pipeline: [`data::load_fit_data`] reads the centre and sweep runs, [`model::fit`] fits
+//! the paper model by least squares ([`lsq`]) in normalised variables,
+//! [`model_file::to_toml`] writes it, [`golden::to_csv`] evaluates it with this crate's
+//! own f32 implementation of the contract ([`eval_f32`]), [`golden_fixed::to_csv`] with its
+//! own fixed-point implementation ([`fixed_formats`], [`eval_fixed`]). [`validate`] compares the
+//! model ([`eval_f64`], [`eval_f32`]) with the validation runs, and [`error_trend`] tells
+//! whether its errors follow the tilt or the offset.
+#![forbid(unsafe_code)]
+
+pub mod contract;
+pub mod coupled;
+pub mod coupled_report;
+pub mod cross_terms;
+pub mod data;
+pub mod error_trend;
+pub mod eval_f32;
+pub mod eval_f64;
+pub mod eval_fixed;
+pub mod eval_rate_f32;
+pub mod eval_rate_f64;
+pub mod fixed_formats;
+pub mod golden;
+pub mod golden_fixed;
+pub mod golden_stiffness;
+pub mod golden_stiffness_fixed;
+pub mod lsq;
+pub mod model;
+pub mod model_file;
+pub mod poly;
+pub mod validate;
+
+use anyhow::Result;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Name of the model file inside a set folder.
+pub const MODEL_FILE: &str = "model.toml";
+/// Name of the golden-vector file inside a set folder.
+pub const GOLDEN_FILE: &str = "golden-f32.csv";
+/// Name of the fixed-point golden-vector file inside a set folder.
+pub const GOLDEN_FIXED_FILE: &str = "golden-fixed.csv";
+/// Name of the stiffness golden-vector file inside a set folder.
+pub const GOLDEN_STIFFNESS_FILE: &str = "golden-stiffness-f32.csv";
+/// Name of the fixed-point stiffness golden-vector file inside a set folder.
+pub const GOLDEN_STIFFNESS_FIXED_FILE: &str = "golden-stiffness-fixed.csv";
+
+/// What `needle fit` produces for a set, in memory.
+#[derive(Debug, Clone)]
+pub struct FitOutput {
+    /// The fitted model.
+    pub model: model::Model,
+    /// The text of `model.toml`.
+    pub model_toml: String,
+    /// The text of `golden-f32.csv`.
+    pub golden_csv: String,
+    /// The text of `golden-fixed.csv`.
+    pub golden_fixed_csv: String,
+    /// The text of `golden-stiffness-f32.csv`.
+    pub golden_stiffness_csv: String,
+    /// The text of `golden-stiffness-fixed.csv`.
+    pub golden_stiffness_fixed_csv: String,
+}
+
+impl FitOutput {
+    /// Every file `needle fit` writes into the set folder (name, text), model first.
+    pub fn files(&self) -> [(&'static str, &str); 5] {
+        [
+            (MODEL_FILE, &self.model_toml),
+            (GOLDEN_FILE, &self.golden_csv),
+            (GOLDEN_FIXED_FILE, &self.golden_fixed_csv),
+            (GOLDEN_STIFFNESS_FILE, &self.golden_stiffness_csv),
+            (GOLDEN_STIFFNESS_FIXED_FILE, &self.golden_stiffness_fixed_csv),
+        ]
+    }
+}
+
+/// Fit the set in `set_dir` and render its output files ([`FitOutput::files`]), without
+/// writing anything.
+///
+/// # Errors
+/// As [`data::load_fit_data`] (missing or malformed runs, bad spec) and [`model::fit`]
+/// (rank-deficient fits); a model too large for the fixed-point evaluator.
+pub fn fit_set(set_dir: &Path) -> Result<FitOutput> {
+    let data = data::load_fit_data(set_dir)?;
+    let mut model = model::fit(&data)?;
+    if data.campaign.fit.form == needle_fe::spec::ModelForm::Coupled {
+        model.cross = Some(coupled::fit_coupled(&model, &data.train, data.campaign.needle.reference_from_tip_mm)?);
+    }
+    let model_toml = model_file::to_toml(&model, &data.campaign.campaign.fit_without);
+    let tables = eval_f32::Tables32::from_model(&model);
+    let golden_csv = golden::to_csv(&tables);
+    let golden_stiffness_csv = golden_stiffness::to_csv(&tables);
+    let fixed = fixed_formats::TablesFixed::from_model(&model)?;
+    let golden_fixed_csv = golden_fixed::to_csv(&fixed)?;
+    let golden_stiffness_fixed_csv = golden_stiffness_fixed::to_csv(&fixed)?;
+    Ok(FitOutput { model, model_toml, golden_csv, golden_fixed_csv, golden_stiffness_csv, golden_stiffness_fixed_csv })
+}
+
+/// A plain-text table of the fit residuals (RMS and max, in N or N·mm).
+pub fn summary(m: &model::Model) -> String {
+    use contract::{unit, Sweep, COMPONENTS};
+    let mut s = String::new();
+    let _ = writeln!(s, "fit residuals (model - FE over the fitted runs and all depths)");
+    let _ = writeln!(s, "{:<10} {:<8} {:>12} {:>12}  unit", "sweep", "comp", "rms", "max");
+    for (c, b) in m.baseline.iter().enumerate() {
+        let _ = writeln!(s, "{:<10} {:<8} {:>12.4e} {:>12.4e}  {}", "baseline", COMPONENTS[c], b.residual_rms, b.residual_max, unit(c));
+    }
+    for k in Sweep::ALL {
+        for (c, d) in m.matrices[k.index()].iter().enumerate() {
+            let _ = writeln!(s, "{:<10} {:<8} {:>12.4e} {:>12.4e}  {}", k.name(), COMPONENTS[c], d.residual_rms, d.residual_max, unit(c));
+        }
+    }
+    s
+}
+
+/// The workspace root (this crate is `crates/fit`), for the unit tests' `coeffs/default`.
+#[cfg(test)]
+pub(crate) fn workspace_root() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}

@@ -1,0 +1,438 @@
+//! `needle validate`: the fitted model against every FE run it was not fitted on
+//! (roles table2 and lhs; the mirror runs are reported on their own), at every depth.
+//!
+//! Per run and component: RMS and max error in N or N·mm, and the same in % of the run's
+//! peak |Fy| (over its depths). A moment error (N·mm) is given in % of peak |Fy| times the
+//! lever arm `needle.reference_from_tip_mm` (the hub, 60 mm for the default set), so that
+//! forces and moments are compared on the same scale.
+//!
+//! Goals, checked on both the f64 and the f32 model (the worse counts), by form
+//! ([`Goals::of`]):
+//! - paper form (issue 3): table2: at every depth >= 1 mm, |Fy_model - Fy_FE| <= 5 % of
+//!   |Fy_FE| at that depth; table2 and lhs: for every run and component, RMS error <= 2 %
+//!   of the run's peak |Fy| (on table2 since issue 18: a run with a wrong Fz or moment
+//!   fails, not only one with a wrong Fy);
+//! - coupled form (issue 16): table2: Fy within 2.5 % at every depth >= 1 mm; table2 and
+//!   lhs: every component's RMS error <= 2 % of peak |Fy| (the 1 % goal is reported, the
+//!   2 % limit decides) and its largest error <= 3 %.
+//!
+//! For the coupled form the paper part of the same model (its sweeps without the cross
+//! terms) is compared on the same runs and printed beside it (no goal).
+//!
+//! Validation poses are never tuned, dropped or refitted on: a missing or stale run is
+//! a missed goal.
+
+use super::contract::{unit, COMPONENTS};
+use super::data::{fitted_fe_sha256, fitted_poses, load_validation_runs, run_path, Run};
+use super::error_trend::{trend, ErrorTrend};
+use super::eval_f32::{eval as eval32, Tables32};
+use super::eval_f64::{eval as eval64, eval_paper};
+use super::model::{rms_max, Model};
+use super::model_file;
+use anyhow::Result;
+use needle_fe::spec::Role;
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Table 2 goal: largest |Fy error| over |FE Fy| at depths >= [`TABLE2_MIN_DEPTH_MM`], %.
+pub const TABLE2_GOAL_PCT: f64 = 5.0;
+/// Smallest depth at which the Table 2 goal applies, mm.
+pub const TABLE2_MIN_DEPTH_MM: f64 = 1.0;
+/// LHS goal: largest RMS error of any component in % of peak |Fy| (moments: of peak |Fy|
+/// times the lever arm).
+pub const LHS_GOAL_PCT: f64 = 2.0;
+
+/// The goals of one model form (module docs).
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct Goals {
+    /// `paper` or `coupled`.
+    pub form: &'static str,
+    /// Table 2: largest |Fy error| / |FE Fy| at depths >= 1 mm, %.
+    pub table2_fy_pct: f64,
+    /// Largest RMS error of any component, % of peak |Fy| (lhs and table2).
+    pub rms_pct: f64,
+    /// The stricter RMS goal reported beside the limit (coupled form: 1 %).
+    pub rms_stretch_pct: Option<f64>,
+    /// Largest error of any component at any depth, % of peak |Fy|.
+    pub max_pct: Option<f64>,
+}
+
+impl Goals {
+    /// The goals of the form of `model`.
+    pub fn of(model: &Model) -> Goals {
+        if model.cross.is_some() {
+            Goals { form: "coupled", table2_fy_pct: 2.5, rms_pct: 2.0, rms_stretch_pct: Some(1.0), max_pct: Some(3.0) }
+        } else {
+            Goals { form: "paper", table2_fy_pct: TABLE2_GOAL_PCT, rms_pct: LHS_GOAL_PCT, rms_stretch_pct: None, max_pct: None }
+        }
+    }
+
+    fn met(&self, role: Role, fy_rel_pct: f64, worst_rms_pct: f64, worst_max_pct: f64) -> Option<bool> {
+        let rms_ok = worst_rms_pct <= self.rms_pct && self.max_pct.is_none_or(|m| worst_max_pct <= m);
+        match role {
+            Role::Table2 => Some(fy_rel_pct <= self.table2_fy_pct && rms_ok),
+            Role::Lhs => Some(rms_ok),
+            _ => None,
+        }
+    }
+}
+
+/// The paper part's errors on one run, beside the coupled form's (f64).
+#[derive(Debug, Clone, Copy, Serialize, Default)]
+pub struct PaperPart {
+    /// Largest |Fy error| / |FE Fy| at depths >= 1 mm, %.
+    pub fy_rel_max_pct: f64,
+    /// Largest RMS error of any component, % of scale.
+    pub worst_rms_pct: f64,
+    /// Largest error of any component at any depth, % of scale.
+    pub worst_max_pct: f64,
+}
+
+/// Errors of one component over one run's depths.
+#[derive(Debug, Clone, Copy, Serialize, Default)]
+pub struct CompError {
+    /// RMS of model - FE, N or N·mm.
+    pub rms: f64,
+    /// Largest |model - FE|, N or N·mm.
+    pub max: f64,
+    /// `rms` in % of the run's peak |Fy| (moments: of peak |Fy| x lever arm).
+    pub rms_pct: f64,
+    /// `max` in % of the same scale.
+    pub max_pct: f64,
+}
+
+/// The comparison of one FE run with the model.
+#[derive(Debug, Clone, Serialize)]
+pub struct RunReport {
+    /// Pose name (`fe/<name>.csv`).
+    pub name: String,
+    /// `table2`, `lhs` or `mirror`.
+    pub role: String,
+    /// `[x_mm, z_mm, theta_x_deg, theta_z_deg]`.
+    pub pose: [f64; 4],
+    /// Largest |Fy| of the FE run over its depths, N.
+    pub peak_fy_n: f64,
+    /// Errors of the f64 model, component order.
+    pub f64_errors: [CompError; 6],
+    /// Errors of the f32 model, component order.
+    pub f32_errors: [CompError; 6],
+    /// Largest |Fy_model - Fy_FE| / |Fy_FE| at depths >= 1 mm, %, worse of f64 and f32.
+    pub fy_rel_max_pct: f64,
+    /// Largest RMS error of any component in % of scale, worse of f64 and f32.
+    pub worst_rms_pct: f64,
+    /// Largest error of any component at any depth in % of scale, worse of f64 and f32.
+    pub worst_max_pct: f64,
+    /// The paper part of a coupled model on the same run; `None` for the paper form.
+    pub paper_part: Option<PaperPart>,
+    /// Whether this run meets its role's goal (None for mirror runs: no goal).
+    pub goal_met: Option<bool>,
+}
+
+/// The whole validation.
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    /// The set folder.
+    pub set_dir: String,
+    /// Lever arm used to scale moment errors, mm.
+    pub lever_arm_mm: f64,
+    /// Whether model.toml's fe_sha256 matches the fitted FE files now in the set.
+    pub model_matches_fe: bool,
+    /// The goals of the model's form.
+    pub goals: Goals,
+    /// Validation runs (table2, lhs, mirror) in spec order.
+    pub runs: Vec<RunReport>,
+    /// Validation poses without a usable result, as `name (role, why)`: no result file, or
+    /// a stale one (solved from another spec, see `data::stale_reason`).
+    pub missing: Vec<String>,
+    /// Largest |f32 - f64| model difference at the validation points, in % of the run's
+    /// peak |Fy| scale.
+    pub f32_vs_f64_max_pct: f64,
+    /// Table 2 goal met (every table2 run present and within 5 %).
+    pub table2_goal_met: bool,
+    /// LHS goal met (every lhs run present and within 2 %).
+    pub lhs_goal_met: bool,
+    /// Both goals met.
+    pub passed: bool,
+    /// Whether the errors of the table2 and lhs runs follow the tilt or the offset
+    /// (diagnostic, no goal); `None` below 3 runs.
+    pub error_trend: Option<ErrorTrend>,
+}
+
+fn role_name(r: Role) -> &'static str {
+    match r {
+        Role::Table2 => "table2",
+        Role::Lhs => "lhs",
+        Role::Mirror => "mirror",
+        _ => "other",
+    }
+}
+
+fn errors(model_w: &[[f64; 6]], run: &Run, scale: [f64; 6]) -> [CompError; 6] {
+    let mut out = [CompError::default(); 6];
+    for (c, e) in out.iter_mut().enumerate() {
+        let (rms, max) = rms_max(model_w.iter().zip(&run.rows).map(|(w, r)| w[c] - r.wrench[c]));
+        *e = CompError { rms, max, rms_pct: 100.0 * rms / scale[c], max_pct: 100.0 * max / scale[c] };
+    }
+    out
+}
+
+/// Largest |Fy_model - Fy_FE| / |Fy_FE| at depths >= 1 mm over `models`' rows, %.
+fn fy_rel_max(models: &[&[[f64; 6]]], run: &Run) -> f64 {
+    let mut fy_rel = 0.0f64;
+    for w in models {
+        for (m, r) in w.iter().zip(&run.rows) {
+            if r.depth_mm >= TABLE2_MIN_DEPTH_MM - 1e-9 {
+                let fe = r.wrench[1];
+                let rel = if fe == 0.0 { f64::INFINITY } else { 100.0 * (m[1] - fe).abs() / fe.abs() };
+                fy_rel = fy_rel.max(rel);
+            }
+        }
+    }
+    fy_rel
+}
+
+/// Compare one run with the model (f64 and f32; for the coupled form also its paper part).
+pub fn compare_run(model: &Model, tables: &Tables32, run: &Run, lever_arm_mm: f64) -> (RunReport, f64) {
+    let p = &run.pose;
+    let pose4 = [p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg];
+    let w64: Vec<[f64; 6]> = run.rows.iter().map(|r| eval64(model, [pose4[0], pose4[1], pose4[2], pose4[3], r.depth_mm]).0).collect();
+    let w32: Vec<[f64; 6]> = run
+        .rows
+        .iter()
+        .map(|r| {
+            let q = [pose4[0] as f32, pose4[1] as f32, pose4[2] as f32, pose4[3] as f32, r.depth_mm as f32];
+            eval32(tables, q).0.map(f64::from)
+        })
+        .collect();
+    let peak = run.rows.iter().map(|r| r.wrench[1].abs()).fold(0.0, f64::max);
+    let scale: [f64; 6] = std::array::from_fn(|c| if c < 3 { peak } else { peak * lever_arm_mm });
+    let e64 = errors(&w64, run, scale);
+    let e32 = errors(&w32, run, scale);
+    let fy_rel = fy_rel_max(&[&w64, &w32], run);
+    let paper_part = model.cross.as_ref().map(|_| {
+        let wp: Vec<[f64; 6]> =
+            run.rows.iter().map(|r| eval_paper(model, [pose4[0], pose4[1], pose4[2], pose4[3], r.depth_mm]).0).collect();
+        let ep = errors(&wp, run, scale);
+        PaperPart {
+            fy_rel_max_pct: fy_rel_max(&[&wp], run),
+            worst_rms_pct: ep.iter().map(|e| e.rms_pct).fold(0.0, f64::max),
+            worst_max_pct: ep.iter().map(|e| e.max_pct).fold(0.0, f64::max),
+        }
+    });
+    let mut diff = 0.0f64;
+    for (a, b) in w64.iter().zip(&w32) {
+        for c in 0..6 {
+            diff = diff.max(100.0 * (a[c] - b[c]).abs() / scale[c]);
+        }
+    }
+    let worst_rms_pct = e64.iter().chain(&e32).map(|e| e.rms_pct).fold(0.0, f64::max);
+    let worst_max_pct = e64.iter().chain(&e32).map(|e| e.max_pct).fold(0.0, f64::max);
+    let goal_met = Goals::of(model).met(p.role, fy_rel, worst_rms_pct, worst_max_pct);
+    (
+        RunReport {
+            name: p.name.clone(),
+            role: role_name(p.role).to_string(),
+            pose: pose4,
+            peak_fy_n: peak,
+            f64_errors: e64,
+            f32_errors: e32,
+            fy_rel_max_pct: fy_rel,
+            worst_rms_pct,
+            worst_max_pct,
+            paper_part,
+            goal_met,
+        },
+        diff,
+    )
+}
+
+/// Validate the model of `set_dir` (its `model.toml`) against the set's validation runs.
+///
+/// # Errors
+/// The spec or model.toml cannot be read or is malformed; a present run is malformed.
+pub fn validate(set_dir: &Path) -> Result<Report> {
+    let model = model_file::read(&set_dir.join(super::MODEL_FILE))?;
+    let tables = Tables32::from_model(&model);
+    let (campaign, runs, missing) = load_validation_runs(set_dir)?;
+    let lever = campaign.needle.reference_from_tip_mm;
+
+    let fitted = fitted_poses(&campaign);
+    let all_present = fitted.iter().all(|p| run_path(set_dir, p).is_file());
+    let model_matches_fe = all_present && fitted_fe_sha256(set_dir, &fitted)? == model.fe_sha256;
+
+    let mut reports = Vec::new();
+    let mut diff = 0.0f64;
+    for run in &runs {
+        let (r, d) = compare_run(&model, &tables, run, lever);
+        diff = diff.max(d);
+        reports.push(r);
+    }
+    let goal = |role: Role| {
+        !missing.iter().any(|u| u.pose.role == role)
+            && reports.iter().filter(|r| r.role == role_name(role)).all(|r| r.goal_met == Some(true))
+    };
+    let table2_goal_met = goal(Role::Table2);
+    let lhs_goal_met = goal(Role::Lhs);
+    let judged: Vec<&RunReport> = reports.iter().filter(|r| r.goal_met.is_some()).collect();
+    let error_trend =
+        trend(&judged.iter().map(|r| r.pose).collect::<Vec<_>>(), &judged.iter().map(|r| r.worst_rms_pct).collect::<Vec<_>>());
+    Ok(Report {
+        set_dir: set_dir.display().to_string(),
+        lever_arm_mm: lever,
+        model_matches_fe,
+        goals: Goals::of(&model),
+        runs: reports,
+        missing: missing.iter().map(|u| format!("{} ({}, {})", u.pose.name, role_name(u.pose.role), u.why)).collect(),
+        f32_vs_f64_max_pct: diff,
+        table2_goal_met,
+        lhs_goal_met,
+        passed: table2_goal_met && lhs_goal_met,
+        error_trend,
+    })
+}
+
+fn pass(b: bool) -> &'static str {
+    if b {
+        "PASS"
+    } else {
+        "FAIL"
+    }
+}
+
+/// The report as a plain-text table.
+pub fn to_table(r: &Report) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "validation of {}/model.toml against the FE runs it was not fitted on", r.set_dir);
+    let _ = writeln!(
+        s,
+        "errors: model (f64) - FE over all depths; % of the run's peak |Fy| (moments: of peak |Fy| x {} mm lever arm)",
+        r.lever_arm_mm
+    );
+    if !r.model_matches_fe {
+        let _ = writeln!(s, "WARNING: model.toml's fe_sha256 does not match the fitted FE files in the set (refit with `needle fit`)");
+    }
+    let _ = writeln!(s);
+    let _ = writeln!(s, "{:<8} {:<7} {:<7} {:>11} {:>11} {:<5} {:>8} {:>8}", "run", "role", "comp", "rms", "max", "unit", "rms %", "max %");
+    for run in &r.runs {
+        for (c, e) in run.f64_errors.iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "{:<8} {:<7} {:<7} {:>11.3e} {:>11.3e} {:<5} {:>8.3} {:>8.3}",
+                run.name,
+                run.role,
+                COMPONENTS[c],
+                e.rms,
+                e.max,
+                unit(c),
+                e.rms_pct,
+                e.max_pct
+            );
+        }
+    }
+    let _ = writeln!(s);
+    let coupled = r.goals.form == "coupled";
+    let _ = writeln!(
+        s,
+        "{:<8} {:<7} {:>7} {:>7} {:>7} {:>7} {:>10} {:>14} {:>12} {:>12}{}  goal",
+        "run",
+        "role",
+        "x mm",
+        "z mm",
+        "tx deg",
+        "tz deg",
+        "peak|Fy| N",
+        "Fy rel d>=1 %",
+        "worst rms %",
+        "worst max %",
+        if coupled { format!("  {:>14} {:>12} {:>12}", "paper: Fy rel %", "rms %", "max %") } else { String::new() }
+    );
+    for run in &r.runs {
+        let goal = match run.goal_met {
+            Some(b) => pass(b),
+            None => "-",
+        };
+        let paper = match run.paper_part {
+            Some(pp) => format!("  {:>14.3} {:>12.3} {:>12.3}", pp.fy_rel_max_pct, pp.worst_rms_pct, pp.worst_max_pct),
+            None => String::new(),
+        };
+        let _ = writeln!(
+            s,
+            "{:<8} {:<7} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>10.4e} {:>14.3} {:>12.3} {:>12.3}{paper}  {goal}",
+            run.name,
+            run.role,
+            run.pose[0],
+            run.pose[1],
+            run.pose[2],
+            run.pose[3],
+            run.peak_fy_n,
+            run.fy_rel_max_pct,
+            run.worst_rms_pct,
+            run.worst_max_pct
+        );
+    }
+    let _ = writeln!(s);
+    if !r.missing.is_empty() {
+        let _ = writeln!(s, "missing or stale FE runs (goal cannot be met): {}", r.missing.join(", "));
+    }
+    let worst = |role: &str, f: fn(&RunReport) -> f64| -> String {
+        let v: Vec<f64> = r.runs.iter().filter(|x| x.role == role).map(f).collect();
+        if v.is_empty() {
+            "no runs".to_string()
+        } else {
+            format!("worst {:.3} % over {} runs", v.iter().copied().fold(0.0, f64::max), v.len())
+        }
+    };
+    let g = &r.goals;
+    let _ = writeln!(s, "goals of the {} form:", g.form);
+    let _ = writeln!(
+        s,
+        "goal table2: Fy within {} % of FE at every depth >= {TABLE2_MIN_DEPTH_MM} mm, and the rms and max goals below: {} ({})",
+        g.table2_fy_pct,
+        pass(r.table2_goal_met),
+        worst("table2", |x| x.fy_rel_max_pct)
+    );
+    let _ = writeln!(
+        s,
+        "goal lhs: every component's RMS error <= {} % of peak |Fy|{}: {} ({}{})",
+        g.rms_pct,
+        g.max_pct.map(|m| format!(", largest error <= {m} %")).unwrap_or_default(),
+        pass(r.lhs_goal_met),
+        worst("lhs", |x| x.worst_rms_pct),
+        if g.max_pct.is_some() { format!("; max {}", worst("lhs", |x| x.worst_max_pct)) } else { String::new() }
+    );
+    if let Some(stretch) = g.rms_stretch_pct {
+        let all: Vec<f64> = r.runs.iter().filter(|x| x.goal_met.is_some()).map(|x| x.worst_rms_pct).collect();
+        let w = all.iter().copied().fold(0.0, f64::max);
+        let _ = writeln!(
+            s,
+            "goal (reported, not the exit code): every component's RMS <= {stretch} % on table2 and lhs: {} (worst {w:.3} % over {} runs)",
+            pass(w <= stretch),
+            all.len()
+        );
+    }
+    if coupled {
+        let pw = |role: &str, f: fn(&PaperPart) -> f64| -> f64 {
+            r.runs.iter().filter(|x| x.role == role).filter_map(|x| x.paper_part.as_ref().map(f)).fold(0.0, f64::max)
+        };
+        let _ = writeln!(
+            s,
+            "paper part of the same model (no cross terms), same runs: table2 Fy worst {:.3} %, rms worst {:.3} %; lhs rms worst {:.3} %, max worst {:.3} %",
+            pw("table2", |p| p.fy_rel_max_pct),
+            pw("table2", |p| p.worst_rms_pct),
+            pw("lhs", |p| p.worst_rms_pct),
+            pw("lhs", |p| p.worst_max_pct)
+        );
+    }
+    let _ = writeln!(s, "mirror runs (symmetry check, no goal): rms {}", worst("mirror", |x| x.worst_rms_pct));
+    if let Some(t) = r.error_trend {
+        let _ = writeln!(
+            s,
+            "error trend (no goal): Spearman rank correlation of a run's worst rms % over {} table2 and lhs runs: {:+.2} with its tilt |theta_x|+|theta_z|, {:+.2} with its offset |x|+|z|",
+            t.runs, t.tilt_rho, t.offset_rho
+        );
+    }
+    let _ = writeln!(s, "f32 model vs f64 model: largest difference {:.3e} % of scale", r.f32_vs_f64_max_pct);
+    let _ = writeln!(s, "result: {}", pass(r.passed));
+    s
+}
