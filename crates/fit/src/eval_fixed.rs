@@ -158,6 +158,11 @@ fn accumulate(t: &TablesFixed, pose: [i32; 5]) -> Result<Accumulated, Overflow> 
 /// An intermediate leaves `|v| <= 2^30` (the tables do not meet the contract).
 pub fn eval(t: &TablesFixed, pose: [i32; 5]) -> Result<([i32; 6], u8), Overflow> {
     let acc = accumulate(t, pose)?;
+    Ok((output(t, &acc)?, acc.status))
+}
+
+/// Step 7: `W = h(A, U)` per component, rounded half up to whole µN or µN·mm.
+fn output(t: &TablesFixed, acc: &Accumulated) -> Result<[i32; 6], Overflow> {
     let mut w = [0i32; 6];
     for (c, wc) in w.iter_mut().enumerate() {
         let h = horner(&acc.a[c], acc.u, &|| format!("Horner in u of component {c}"))?;
@@ -166,7 +171,7 @@ pub fn eval(t: &TablesFixed, pose: [i32; 5]) -> Result<([i32; 6], u8), Overflow>
         let out = (h + half).div_euclid(1i64 << g);
         *wc = i32::try_from(out).map_err(|_| Overflow { what: format!("output {c}"), value: Some(out) })?;
     }
-    Ok((w, acc.status))
+    Ok(w)
 }
 
 /// The rates are computed on coefficients divided by `2^R` (floor), `R = min(3, G)`.
@@ -205,8 +210,8 @@ pub type RatesFixed = ([i32; 6], [[i32; 6]; 3], u8);
 /// # Errors
 /// An intermediate leaves `|v| <= 2^30` (the tables do not meet the contract).
 pub fn eval_rates(t: &TablesFixed, pose: [i32; 5]) -> Result<RatesFixed, Overflow> {
-    let (w, status) = eval(t, pose)?;
     let acc = accumulate(t, pose)?;
+    let (w, status) = (output(t, &acc)?, acc.status);
     let mut rates = [[0i32; 6]; 3];
     for c in 0..6 {
         let g = t.acc_frac[c];
