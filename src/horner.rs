@@ -1,9 +1,10 @@
 //! Horner evaluation of a quartic, in the contract's exact operation order.
+use needle_contract::TERMS;
 
 /// `h(p, w) = (((p4*w + p3)*w + p2)*w + p1)*w + p0`: every multiply and add rounded on
 /// its own (Rust never fuses them into an FMA), highest power first.
 #[inline(always)]
-pub(crate) fn horner(p: &[f32; 5], w: f32) -> f32 {
+pub(crate) fn horner(p: &[f32; TERMS], w: f32) -> f32 {
     let [p0, p1, p2, p3, p4] = *p;
     (((p4 * w + p3) * w + p2) * w + p1) * w + p0
 }
@@ -13,7 +14,7 @@ pub(crate) fn horner(p: &[f32; 5], w: f32) -> f32 {
 /// `d = p4`, then `d = d*w + b` after each of the value's steps for `p3`, `p2`, `p1`
 /// (`b` the value so far), 3 multiplies and 3 adds more, no further coefficient loads.
 #[inline(always)]
-pub(crate) fn horner_with_rate(p: &[f32; 5], w: f32) -> (f32, f32) {
+pub(crate) fn horner_with_rate(p: &[f32; TERMS], w: f32) -> (f32, f32) {
     let [p0, p1, p2, p3, p4] = *p;
     let b3 = p4 * w + p3;
     let d3 = p4 * w + b3;

@@ -3,6 +3,7 @@ use crate::cross_f32::{add_cross, COUPLED, CROSS_SCALES};
 use crate::horner::horner;
 use crate::tables::{BASELINE, DEPTH_MAX_MM, DEVIATION, FITTED, THETA_MAX_DEG, X_MAX_MM, Z_MAX_MM};
 use crate::{Evaluation, Pose, Status, Wrench};
+use needle_contract::TERMS;
 
 /// The nearest f32 to 1/3 (`u = depth * (1/3) - 1`).
 pub(crate) const ONE_THIRD: f32 = needle_contract::ONE_THIRD_F32;
@@ -21,13 +22,13 @@ fn abs(v: f32) -> f32 {
 }
 
 /// Whether every coefficient of `p` is `+0.0` (bit pattern 0; `-0.0` does not count).
-const fn is_plus_zero(p: &[f32; 5]) -> bool {
+const fn is_plus_zero(p: &[f32; TERMS]) -> bool {
     let [p0, p1, p2, p3, p4] = *p;
     p0.to_bits() | p1.to_bits() | p2.to_bits() | p3.to_bits() | p4.to_bits() == 0
 }
 
 /// Whether every coefficient of the 5x5 matrix `m` is `+0.0`.
-pub(crate) const fn is_plus_zero_matrix(m: &[[f32; 5]; 5]) -> bool {
+pub(crate) const fn is_plus_zero_matrix(m: &[[f32; TERMS]; TERMS]) -> bool {
     let [r0, r1, r2, r3, r4] = m;
     is_plus_zero(r0) && is_plus_zero(r1) && is_plus_zero(r2) && is_plus_zero(r3) && is_plus_zero(r4)
 }
@@ -58,7 +59,7 @@ const SKIP_DEVIATION: [[bool; 6]; 4] = {
 ///   sum is `-0.0` only when both addends are `-0.0`, so `w_c` could only become
 ///   `-0.0` by starting as `-0.0`, from a baseline whose constant coefficient is
 ///   `-0.0`. For such a component nothing is skipped.
-const fn skip_sweep(mats: &[[[f32; 5]; 5]; 6]) -> [bool; 6] {
+const fn skip_sweep(mats: &[[[f32; TERMS]; TERMS]; 6]) -> [bool; 6] {
     let [m0, m1, m2, m3, m4, m5] = mats;
     let [b0, b1, b2, b3, b4, b5] = &BASELINE;
     [
@@ -73,7 +74,7 @@ const fn skip_sweep(mats: &[[[f32; 5]; 5]; 6]) -> [bool; 6] {
 
 /// Whether `h(b, u)` is never `-0.0`: its last operation adds `b[0]`, and the sum is
 /// `-0.0` only when `b[0]` is.
-pub(crate) const fn starts_not_neg_zero(b: &[f32; 5]) -> bool {
+pub(crate) const fn starts_not_neg_zero(b: &[f32; TERMS]) -> bool {
     let [b0, ..] = *b;
     b0.to_bits() != 0x8000_0000
 }
@@ -81,7 +82,7 @@ pub(crate) const fn starts_not_neg_zero(b: &[f32; 5]) -> bool {
 /// `B_c(u)`: `+0.0` without evaluating it when every coefficient is `+0.0` (exact,
 /// see [`skip_sweep`]).
 #[inline(always)]
-pub(crate) fn baseline(b: &[f32; 5], zero: bool, u: f32) -> f32 {
+pub(crate) fn baseline(b: &[f32; TERMS], zero: bool, u: f32) -> f32 {
     if zero {
         0.0
     } else {
@@ -92,7 +93,7 @@ pub(crate) fn baseline(b: &[f32; 5], zero: bool, u: f32) -> f32 {
 /// `D_kc(t, u)` of one 5x5 deviation matrix `m`: Horner in `t` along each row (`r_i`),
 /// then Horner in `u` over the five `r_i` (step 4 of the contract).
 #[inline(always)]
-fn deviation(m: &[[f32; 5]; 5], t: f32, u: f32) -> f32 {
+fn deviation(m: &[[f32; TERMS]; TERMS], t: f32, u: f32) -> f32 {
     let [m0, m1, m2, m3, m4] = m;
     horner(&[horner(m0, t), horner(m1, t), horner(m2, t), horner(m3, t), horner(m4, t)], u)
 }
@@ -162,7 +163,7 @@ fn superpose(sweeps: [f32; 4], u: f32) -> [f32; 6] {
 /// Adds one sweep's six deviations to `w` (unrolled form of the inner loop).
 #[cfg(target_abi = "eabihf")]
 #[inline(always)]
-fn add_sweep(w: &mut [f32; 6], mats: &[[[f32; 5]; 5]; 6], odd: &[bool; 6], skip: &[bool; 6], v: f32, s: f32, u: f32) {
+fn add_sweep(w: &mut [f32; 6], mats: &[[[f32; TERMS]; TERMS]; 6], odd: &[bool; 6], skip: &[bool; 6], v: f32, s: f32, u: f32) {
     let t = sweep_t(v, s);
     let sign = if v < 0.0 { -1.0_f32 } else { 1.0 };
     let [w0, w1, w2, w3, w4, w5] = w;
@@ -180,7 +181,7 @@ fn add_sweep(w: &mut [f32; 6], mats: &[[[f32; 5]; 5]; 6], odd: &[bool; 6], skip:
 /// `w_c = w_c ± D_kc(t, u)` for one component (`odd` is a constant after unrolling).
 #[cfg(target_abi = "eabihf")]
 #[inline(always)]
-fn add_deviation(wc: &mut f32, m: &[[f32; 5]; 5], odd: bool, skip: bool, sign: f32, t: f32, u: f32) {
+fn add_deviation(wc: &mut f32, m: &[[f32; TERMS]; TERMS], odd: bool, skip: bool, sign: f32, t: f32, u: f32) {
     if skip {
         return;
     }

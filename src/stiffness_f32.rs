@@ -6,17 +6,18 @@ use crate::model_f32::{clamp_to_domain, is_plus_zero_matrix, starts_not_neg_zero
 use crate::stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
 use crate::tables::{BASELINE, DEVIATION, FITTED};
 use crate::{Pose, Status, Wrench};
+use needle_contract::TERMS;
 
 /// Whether neither `B(u)` nor `B'(u)` of the baseline `b` can be `-0.0`: `B` as for the
 /// wrench ([`starts_not_neg_zero`]), and `B'`'s last addition adds `b1` (a rounded sum is
 /// `-0.0` only when both addends are).
-const fn rates_not_neg_zero(b: &[f32; 5]) -> bool {
+const fn rates_not_neg_zero(b: &[f32; TERMS]) -> bool {
     let [_, b1, ..] = *b;
     starts_not_neg_zero(b) && b1.to_bits() != 0x8000_0000
 }
 
 /// One sweep's row of [`SKIP`].
-const fn skip_sweep(mats: &[[[f32; 5]; 5]; 6]) -> [bool; 6] {
+const fn skip_sweep(mats: &[[[f32; TERMS]; TERMS]; 6]) -> [bool; 6] {
     let [m0, m1, m2, m3, m4, m5] = mats;
     let [b0, b1, b2, b3, b4, b5] = &BASELINE;
     [
@@ -142,9 +143,9 @@ struct Component {
 /// One component's tables: its baseline (and whether it is all `+0.0`), and per sweep
 /// its deviation matrix, parity and skip flag.
 struct ComponentTables {
-    baseline: [f32; 5],
+    baseline: [f32; TERMS],
     zero: bool,
-    mats: [[[f32; 5]; 5]; 4],
+    mats: [[[f32; TERMS]; TERMS]; 4],
     odd: [bool; 4],
     skip: [bool; 4],
 }
@@ -186,7 +187,7 @@ fn component_of<const C: usize>(at: &At) -> Component {
 /// and `w + (-D)` is `w - D` by definition; `+0 + -0 = +0 = +0 - +0`): one multiply-add
 /// on the FPU and no branch.
 #[inline(always)]
-fn component(b: &[f32; 5], zero: bool, mats: [&[[f32; 5]; 5]; 4], odd: [bool; 4], skip: [bool; 4], at: &At) -> Component {
+fn component(b: &[f32; TERMS], zero: bool, mats: [&[[f32; TERMS]; TERMS]; 4], odd: [bool; 4], skip: [bool; 4], at: &At) -> Component {
     let u = at.u;
     let (w, a) = if zero { (0.0, 0.0) } else { horner_with_rate(b, u) };
     let mut c = Component { w, a, gx: 0.0, gz: 0.0 };
@@ -212,7 +213,7 @@ fn component(b: &[f32; 5], zero: bool, mats: [&[[f32; 5]; 5]; 4], odd: [bool; 4]
 
 /// A theta sweep: `w ± D`, `a ± dD/du`.
 #[inline(always)]
-fn add_across(w: &mut f32, a: &mut f32, m: &[[f32; 5]; 5], odd: bool, sign: f32, t: f32, u: f32) {
+fn add_across(w: &mut f32, a: &mut f32, m: &[[f32; TERMS]; TERMS], odd: bool, sign: f32, t: f32, u: f32) {
     let [m0, m1, m2, m3, m4] = m;
     let (dev, du) = horner_with_rate(&[horner(m0, t), horner(m1, t), horner(m2, t), horner(m3, t), horner(m4, t)], u);
     if odd {
@@ -228,7 +229,7 @@ fn add_across(w: &mut f32, a: &mut f32, m: &[[f32; 5]; 5], odd: bool, sign: f32,
 /// with its t-rate ([`horner_with_rate`]).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn add_along(w: &mut f32, a: &mut f32, g: f32, m: &[[f32; 5]; 5], odd: bool, sign: f32, t: f32, u: f32) -> f32 {
+fn add_along(w: &mut f32, a: &mut f32, g: f32, m: &[[f32; TERMS]; TERMS], odd: bool, sign: f32, t: f32, u: f32) -> f32 {
     let [m0, m1, m2, m3, m4] = m;
     let (r0, q0) = horner_with_rate(m0, t);
     let (r1, q1) = horner_with_rate(m1, t);

@@ -95,7 +95,7 @@ fn golden_bits_of_a_coupled_model_on_cortex_m4f_mps2_an386() {
 /// status, and NaN payloads.
 #[test]
 fn comparison_catches_one_bit_and_allows_nan_payloads() {
-    let h = golden::HEADER;
+    let h = golden::header();
     let csv = format!(
         "{h}\n\
          0x00000000,0x00000000,0x00000000,0x00000000,0x40000000,0x00,0x3f800000,0x80000000,0x7fc00000,0x00000000,0x00000000,0x00000000\n"

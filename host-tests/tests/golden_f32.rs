@@ -7,7 +7,6 @@
 use needle_haptics::{model_info, wrench, Pose};
 use std::path::Path;
 
-const HEADER: &str = "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,status,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm";
 use needle_contract::COMPONENTS;
 
 /// `0x` and 8 lower-case hex digits.
@@ -52,7 +51,7 @@ fn library_matches_golden_vectors_bit_for_bit() {
         )
     });
     let mut lines = text.lines();
-    assert_eq!(lines.next(), Some(HEADER), "{}:1: unexpected header", path.display());
+    assert_eq!(lines.next(), Some(needle_fit::golden::header().as_str()), "{}:1: unexpected header", path.display());
 
     let mut rows = 0usize;
     let mut mismatches = Vec::new();

@@ -1,6 +1,7 @@
 //! The integer primitives of the fixed-point contract: the Q15 product and the
 //! normalisation. Both are exact (the same integer on every core); only how they are
 //! computed differs, for speed.
+use needle_contract::TERMS;
 
 /// `floor(a * w / 2^15)`, for `|a| <= 2^30` and `|w| <= 2^15` (the generator proves both
 /// for every call): the Q15 product of a Horner step.
@@ -57,7 +58,7 @@ pub(crate) fn clamp(v: i32, lo: i32, hi: i32) -> (i32, bool) {
 /// `h(p, w) = (((p4 w + p3) w + p2) w + p1) w + p0` with every product [`mul_q15`]:
 /// the contract's Horner step in Q15.
 #[inline(always)]
-pub(crate) fn horner(p: &[i32; 5], w: i32) -> i32 {
+pub(crate) fn horner(p: &[i32; TERMS], w: i32) -> i32 {
     let [p0, p1, p2, p3, p4] = *p;
     let a = mul_q15(p4, w).wrapping_add(p3);
     let a = mul_q15(a, w).wrapping_add(p2);

@@ -7,6 +7,7 @@ use super::tables::{
 use super::{Evaluation, Pose, Wrench};
 use crate::tables::FITTED;
 use crate::Status;
+use needle_contract::TERMS;
 
 /// The reaction wrench of the compiled-in set's model at `pose`, in integer arithmetic
 /// only (no floating point: fast on cores without an FPU).
@@ -104,7 +105,7 @@ impl Inputs {
 /// Steps 4-6: every component's accumulators `A_i` (baseline, the four sweeps' rows, the
 /// cross terms), each in its Q(G).
 #[inline(always)]
-pub(super) fn accumulators(at: &Inputs) -> [[i32; 5]; 6] {
+pub(super) fn accumulators(at: &Inputs) -> [[i32; TERMS]; 6] {
     let mut a = BASELINE;
     let tables = ROWS.iter().zip(SHIFTS.iter()).zip(ODD.iter());
     for (ac, ((rows, shifts), odd)) in a.iter_mut().zip(tables) {
@@ -124,7 +125,7 @@ pub(super) fn accumulators(at: &Inputs) -> [[i32; 5]; 6] {
 
 /// Step 7: `W = h(A, U)` per component, rounded half up to whole µN or µN·mm.
 #[inline(always)]
-pub(super) fn output(a: &[[i32; 5]; 6], u: i32) -> [i32; 6] {
+pub(super) fn output(a: &[[i32; TERMS]; 6], u: i32) -> [i32; 6] {
     let mut w = [0_i32; 6];
     for ((wc, ac), &g) in w.iter_mut().zip(a.iter()).zip(FRAC_BITS.iter()) {
         let acc = horner(ac, u);

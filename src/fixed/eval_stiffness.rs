@@ -8,6 +8,7 @@ use super::tables::{FRAC_BITS, ODD, RATE_ROWS, RATE_SHIFTS, SHIFTS};
 use super::{Pose, Wrench};
 use crate::tables::FITTED;
 use crate::Status;
+use needle_contract::{DEGREE, TERMS};
 
 /// The wrench of [`wrench`](super::wrench) (the same integers) and its partial
 /// derivatives by depth, x and z in µN/mm and µN·mm/mm, in integer arithmetic only: the
@@ -86,7 +87,7 @@ fn along<const K: usize>(pose: &Pose, out: &mut WrenchRate) {
     let [tx, tz, _, _] = at.t;
     let [neg_x, neg_z, _, _] = at.negative;
     let (t, negative) = if K == 0 { (tx, neg_x) } else { (tz, neg_z) };
-    let mut g = [[0_i32; 5]; 6];
+    let mut g = [[0_i32; TERMS]; 6];
     let tables = RATE_ROWS.iter().zip(SHIFTS.iter()).zip(ODD.iter());
     for (gc, ((rate_rows, shifts), odd)) in g.iter_mut().zip(tables) {
         let [rows_x, rows_z] = rate_rows;
@@ -115,7 +116,7 @@ fn along<const K: usize>(pose: &Pose, out: &mut WrenchRate) {
 /// One sweep's row rates into `g`: `g_i = g_i ± (h3(rows[i], t) >> shifts[i])`, minus
 /// when `minus` (negative input, component even under the mirror).
 #[inline(always)]
-fn add_row_rates(g: &mut [i32; 5], rows: &[[i32; 4]; 5], shifts: &[u32; 5], t: i32, minus: bool) {
+fn add_row_rates(g: &mut [i32; TERMS], rows: &[[i32; DEGREE]; TERMS], shifts: &[u32; TERMS], t: i32, minus: bool) {
     for ((gi, row), &s) in g.iter_mut().zip(rows.iter()).zip(shifts.iter()) {
         let r = horner3(row, t).wrapping_shr(s);
         *gi = if minus { gi.wrapping_sub(r) } else { gi.wrapping_add(r) };

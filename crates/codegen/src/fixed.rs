@@ -12,6 +12,7 @@
 use crate::contract::{COMPONENTS, SWEEPS};
 use crate::error::CodegenError;
 use crate::model::Model;
+use needle_contract::{DEGREE, TERMS};
 use std::path::Path;
 
 /// Fractional bits of the fixed-point pose inputs (Q16.16: mm or degrees times 65536).
@@ -53,7 +54,7 @@ pub fn quantize(c: f64, frac_bits: u32) -> i64 {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct FixedRow {
     /// Integer coefficients; `coeffs[j]` multiplies `t^j`.
-    pub coeffs: [i32; 5],
+    pub coeffs: [i32; TERMS],
     /// Fractional bits `f` of the row (its value is `r * 2^-f` micro-units).
     pub frac_bits: u32,
     /// `sum_j |coeffs[j]|`: bound of every Horner intermediate of the row over `|t| <= 1`.
@@ -81,15 +82,15 @@ pub struct FixedCross {
 #[derive(Debug, Clone, PartialEq)]
 pub struct FixedComponent {
     /// `rows[k][i]`: row `i` (power of u) of sweep `k`'s deviation matrix.
-    pub rows: [[FixedRow; 5]; 4],
+    pub rows: [[FixedRow; TERMS]; 4],
     /// `shifts[k][i] = rows[k][i].frac_bits - frac_bits` (>= 0).
-    pub shifts: [[u32; 5]; 4],
+    pub shifts: [[u32; TERMS]; 4],
     /// Baseline coefficients in Q(`frac_bits`); `baseline[i]` multiplies `u^i`.
-    pub baseline: [i32; 5],
+    pub baseline: [i32; TERMS],
     /// Fractional bits `G` of the accumulator `A_i` and of the Horner in `u`.
     pub frac_bits: u32,
     /// Bound of `|A_i|` (every partial sum) per `i`.
-    pub a_bounds: [i64; 5],
+    pub a_bounds: [i64; TERMS],
     /// `sum_i a_bounds[i]`: bound of every intermediate of the Horner in `u`.
     pub horner_bound: i64,
     /// Error bound of the integer result against the f64 evaluation, in micro-units.
@@ -101,7 +102,7 @@ pub struct FixedComponent {
     pub rate_shift: u32,
     /// `rate_rows[k][i]` (sweeps x and z): the t-derivative of row `rows[k][i]`,
     /// `[(j + 1) * (P[j + 1] >> R)]` for `j = 0..4`, in Q(f - R).
-    pub rate_rows: [[[i32; 4]; 5]; 2],
+    pub rate_rows: [[[i32; DEGREE]; TERMS]; 2],
     /// Bounds of the stiffness's Horner intermediates: by depth, by x, by z (each
     /// `<= LIMIT`, checked by [`fixed_formats`]).
     pub rate_bounds: [i64; 3],
@@ -115,7 +116,7 @@ pub struct FixedTables {
 }
 
 /// The largest `f` in `0..=MAX_FRAC_BITS` whose quantised row fits: `sum_j |q(c_j, f)| <= LIMIT`.
-fn choose_row(c: &[f64; 5]) -> Option<FixedRow> {
+fn choose_row(c: &[f64; TERMS]) -> Option<FixedRow> {
     (0..=MAX_FRAC_BITS).rev().find_map(|f| {
         let q = c.map(|v| quantize(v, f));
         let bound = q.iter().map(|v| i128::from(*v).abs()).sum::<i128>();
@@ -138,9 +139,9 @@ fn shifted_bound(s: i64, shift: u32) -> i64 {
 }
 
 /// `(a_bounds, horner_bound, baseline)` of a component at accumulator format `g`.
-fn component_bounds(rows: &[[FixedRow; 5]; 4], cross: &[FixedCross], base: &[f64; 5], g: u32) -> ([i64; 5], i64, [i64; 5]) {
+fn component_bounds(rows: &[[FixedRow; TERMS]; 4], cross: &[FixedCross], base: &[f64; TERMS], g: u32) -> ([i64; TERMS], i64, [i64; TERMS]) {
     let baseline = base.map(|b| quantize(b, g));
-    let mut a = [0i64; 5];
+    let mut a = [0i64; TERMS];
     for (i, ai) in a.iter_mut().enumerate() {
         let mut s = i128::from(baseline[i]).abs();
         for row in rows {
@@ -158,7 +159,7 @@ fn component_bounds(rows: &[[FixedRow; 5]; 4], cross: &[FixedCross], base: &[f64
 
 /// The t-derivative of a row for the fixed-point stiffness: `(j + 1) * (p[j + 1] >> r)`
 /// (`r <= 3`), `None` when a coefficient would leave [`LIMIT`] (`r < 3` only).
-fn rate_row(p: &[i32; 5], r: u32) -> Option<[i32; 4]> {
+fn rate_row(p: &[i32; TERMS], r: u32) -> Option<[i32; 4]> {
     let [_, p1, p2, p3, p4] = p.map(|v| i64::from(v >> r));
     let d = [p1, 2 * p2, 3 * p3, 4 * p4];
     d.iter().all(|v| v.abs() <= LIMIT).then(|| d.map(|v| v as i32))
@@ -173,7 +174,13 @@ fn rate_row(p: &[i32; 5], r: u32) -> Option<[i32; 4]> {
 ///   `e * ceil(ceil(|P[i]| / 2^r) / 2^(shift + 1))`; the Horner in `u` of those sums is
 ///   bounded by their total (each row's own Horner by its coefficient sum, below
 ///   `LIMIT` for `r = 3` by construction: `4 * 2^27`).
-fn rate_bounds(a_bounds: &[i64; 5], r: u32, rate_rows: &[[[i32; 4]; 5]; 2], shifts: &[[u32; 5]; 4], cross: &[FixedCross]) -> [i64; 3] {
+fn rate_bounds(
+    a_bounds: &[i64; TERMS],
+    r: u32,
+    rate_rows: &[[[i32; DEGREE]; TERMS]; 2],
+    shifts: &[[u32; TERMS]; 4],
+    cross: &[FixedCross],
+) -> [i64; 3] {
     let depth = a_bounds.iter().enumerate().skip(1).map(|(i, a)| i as i64 * shifted_bound(*a, r)).sum();
     let along = |k: usize| -> i64 {
         let mut total = 0i64;
@@ -202,10 +209,10 @@ fn rate_bounds(a_bounds: &[i64; 5], r: u32, rate_rows: &[[[i32; 4]; 5]; 2], shif
 /// the matrix (or baseline), its line in `model_path` and the bound that is exceeded.
 pub fn fixed_formats(model: &Model, model_path: &Path) -> Result<FixedTables, CodegenError> {
     let at = |line: usize, message: String| CodegenError { path: model_path.to_path_buf(), line: (line > 0).then_some(line), message };
-    let zero_row = FixedRow { coeffs: [0; 5], frac_bits: 0, bound: 0 };
+    let zero_row = FixedRow { coeffs: [0; TERMS], frac_bits: 0, bound: 0 };
     let mut components = Vec::with_capacity(6);
     for (c, base) in model.baseline.iter().enumerate() {
-        let mut rows = [[zero_row; 5]; 4];
+        let mut rows = [[zero_row; TERMS]; 4];
         for m in model.matrices.iter().filter(|m| m.component == c) {
             for (i, row) in m.rows.iter().enumerate() {
                 rows[m.sweep][i] = choose_row(row).ok_or_else(|| {
@@ -261,7 +268,7 @@ pub fn fixed_formats(model: &Model, model_path: &Path) -> Result<FixedTables, Co
         }
         let rate_shift = g.min(MAX_RATE_SHIFT);
         let [rows_x, rows_z, _, _] = &rows;
-        let rate_of = |rows: &[FixedRow; 5]| -> Option<[[i32; 4]; 5]> {
+        let rate_of = |rows: &[FixedRow; TERMS]| -> Option<[[i32; DEGREE]; TERMS]> {
             let r: Vec<[i32; 4]> = rows.iter().map(|row| rate_row(&row.coeffs, rate_shift)).collect::<Option<_>>()?;
             r.try_into().ok()
         };

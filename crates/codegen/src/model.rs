@@ -1,6 +1,7 @@
 //! Reading and validating `model.toml` (format in `coeffs/README.md`).
 use crate::contract::{COMPONENTS, DEPTH_MAX_MM, FORMAT, HALF_RANGES, ODD, SWEEPS};
 use crate::error::CodegenError;
+use needle_contract::TERMS;
 use serde::Deserialize;
 use std::ops::Range;
 use std::path::Path;
@@ -12,9 +13,9 @@ pub struct Baseline {
     /// Component index (0..5, order of [`COMPONENTS`]).
     pub component: usize,
     /// f64 coefficients; `coeffs[i]` multiplies `u^i`.
-    pub coeffs: [f64; 5],
+    pub coeffs: [f64; TERMS],
     /// The f32 the firmware uses: the nearest f32 of each `coeffs[i]`.
-    pub coeffs_f32: [f32; 5],
+    pub coeffs_f32: [f32; TERMS],
     /// RMS fit residual, in the component's unit (N or N*mm).
     pub residual_rms: f64,
     /// Maximum absolute fit residual, in the component's unit.
@@ -33,9 +34,9 @@ pub struct Matrix {
     /// The component changes sign under the sweep's mirror.
     pub odd: bool,
     /// f64 coefficients; `rows[i][j]` multiplies `u^i * t^j`.
-    pub rows: [[f64; 5]; 5],
+    pub rows: [[f64; TERMS]; TERMS],
     /// The nearest f32 of each `rows[i][j]`.
-    pub rows_f32: [[f32; 5]; 5],
+    pub rows_f32: [[f32; TERMS]; TERMS],
     /// RMS residual of (centre run + deviation) against FE over the sweep, in the
     /// component's unit.
     pub residual_rms: f64,
@@ -100,15 +101,22 @@ impl Model {
     /// The placeholder of a set without a fitted model: zero tables, `fitted == false`.
     pub fn unfitted(set: &str) -> Self {
         let baseline = (0..6)
-            .map(|c| Baseline { component: c, coeffs: [0.0; 5], coeffs_f32: [0.0; 5], residual_rms: 0.0, residual_max: 0.0, line: 0 })
+            .map(|c| Baseline {
+                component: c,
+                coeffs: [0.0; TERMS],
+                coeffs_f32: [0.0; TERMS],
+                residual_rms: 0.0,
+                residual_max: 0.0,
+                line: 0,
+            })
             .collect();
         let matrices = (0..24)
             .map(|n| Matrix {
                 sweep: n / 6,
                 component: n % 6,
                 odd: ODD[n / 6][n % 6],
-                rows: [[0.0; 5]; 5],
-                rows_f32: [[0.0; 5]; 5],
+                rows: [[0.0; TERMS]; TERMS],
+                rows_f32: [[0.0; TERMS]; TERMS],
                 residual_rms: 0.0,
                 residual_max: 0.0,
                 line: 0,
@@ -118,8 +126,8 @@ impl Model {
     }
 
     /// The f32 baseline table, `[component][i]`.
-    pub fn baseline_f32(&self) -> [[f32; 5]; 6] {
-        let mut out = [[0.0; 5]; 6];
+    pub fn baseline_f32(&self) -> [[f32; TERMS]; 6] {
+        let mut out = [[0.0; TERMS]; 6];
         for (o, b) in out.iter_mut().zip(&self.baseline) {
             *o = b.coeffs_f32;
         }
@@ -127,8 +135,8 @@ impl Model {
     }
 
     /// The f32 deviation table, `[sweep][component][i][j]`.
-    pub fn deviation_f32(&self) -> [[[[f32; 5]; 5]; 6]; 4] {
-        let mut out = [[[[0.0; 5]; 5]; 6]; 4];
+    pub fn deviation_f32(&self) -> [[[[f32; TERMS]; TERMS]; 6]; 4] {
+        let mut out = [[[[0.0; TERMS]; TERMS]; 6]; 4];
         for m in &self.matrices {
             out[m.sweep][m.component] = m.rows_f32;
         }
@@ -459,10 +467,10 @@ impl Checker<'_> {
         bits: &Spanned<Vec<Spanned<String>>>,
         what: &str,
         what_f32: &str,
-    ) -> Result<([f64; 5], [f32; 5]), CodegenError> {
+    ) -> Result<([f64; TERMS], [f32; TERMS]), CodegenError> {
         let (v, b) = self.list(values, bits, 5, what, what_f32)?;
-        let mut out = [0.0; 5];
-        let mut out32 = [0.0; 5];
+        let mut out = [0.0; TERMS];
+        let mut out32 = [0.0; TERMS];
         out.copy_from_slice(&v);
         out32.copy_from_slice(&b);
         Ok((out, out32))
@@ -548,8 +556,8 @@ impl Checker<'_> {
                 return Err(self.err(span, format!("{label}: {name} has {n} rows, expected 5 (powers of u 0..=4)")));
             }
         }
-        let mut rows = [[0.0; 5]; 5];
-        let mut rows_f32 = [[0.0; 5]; 5];
+        let mut rows = [[0.0; TERMS]; TERMS];
+        let mut rows_f32 = [[0.0; TERMS]; TERMS];
         for (i, ((r, b), (o, o32))) in
             raw.rows.get_ref().iter().zip(raw.rows_f32.get_ref()).zip(rows.iter_mut().zip(rows_f32.iter_mut())).enumerate()
         {

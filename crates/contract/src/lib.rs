@@ -27,6 +27,38 @@ pub const SWEEPS: [&str; 4] = ["x", "z", "theta_x", "theta_z"];
 pub const SWEEP_INPUTS: [&str; 4] = ["x_mm", "z_mm", "theta_x_deg", "theta_z_deg"];
 /// Unit of each sweep's variable.
 pub const SWEEP_UNITS: [&str; 4] = ["mm", "mm", "deg", "deg"];
+/// The depth input's name (the `Pose` field and the files' column).
+pub const DEPTH_INPUT: &str = "depth_mm";
+
+/// Columns of the f32 golden file (`golden-f32.csv`): the four pose inputs, the depth,
+/// the status bits, the wrench components.
+pub const GOLDEN_COLUMNS: [&str; 12] = {
+    let mut out = [""; 12];
+    let mut i = 0;
+    while i < 4 {
+        out[i] = SWEEP_INPUTS[i];
+        i += 1;
+    }
+    out[4] = DEPTH_INPUT;
+    out[5] = "status";
+    let mut c = 0;
+    while c < 6 {
+        out[6 + c] = COMPONENTS[c];
+        c += 1;
+    }
+    out
+};
+
+/// Columns of an FE run's file (`fe/<pose>.csv`): the depth, the wrench components.
+pub const FE_COLUMNS: [&str; 7] = {
+    let mut out = [DEPTH_INPUT; 7];
+    let mut c = 0;
+    while c < 6 {
+        out[1 + c] = COMPONENTS[c];
+        c += 1;
+    }
+    out
+};
 
 /// Largest `|x|` and `|z|` of the domain, mm.
 pub const XZ_MAX_MM: f64 = 12.0;

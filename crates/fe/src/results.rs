@@ -5,8 +5,10 @@ use anyhow::{bail, Context, Result};
 use std::io::Write;
 use std::path::Path;
 
-/// The header line of every FE result file.
-pub const HEADER: &str = "depth_mm,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm";
+/// The header line of every FE result file (the contract's [`FE_COLUMNS`](needle_contract::FE_COLUMNS)).
+pub fn header() -> String {
+    needle_contract::FE_COLUMNS.join(",")
+}
 
 /// One row: depth (mm) and the wrench (N, N·mm) about the needle's reference point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -20,7 +22,7 @@ pub struct Row {
 /// The CSV text of a result (header and rows, `\n` line ends, shortest round-trip numbers).
 pub fn to_csv(rows: &[Row]) -> String {
     let mut s = String::with_capacity(64 * (rows.len() + 1));
-    s.push_str(HEADER);
+    s.push_str(&header());
     s.push('\n');
     for r in rows {
         s.push_str(&format!("{}", r.depth_mm));
@@ -41,10 +43,11 @@ pub fn to_csv(rows: &[Row]) -> String {
 /// message has `path:line` and the offending value.
 pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<Row>> {
     let mut lines = text.lines().enumerate();
+    let header = header();
     match lines.next() {
-        Some((_, h)) if h.trim() == HEADER => {}
-        Some((_, h)) => bail!("{}:1: header is {h:?}, expected {HEADER:?}", path.display()),
-        None => bail!("{}:1: empty file, expected the header {HEADER:?}", path.display()),
+        Some((_, h)) if h.trim() == header => {}
+        Some((_, h)) => bail!("{}:1: header is {h:?}, expected {header:?}", path.display()),
+        None => bail!("{}:1: empty file, expected the header {header:?}", path.display()),
     }
     let mut rows = Vec::new();
     for (i, line) in lines {

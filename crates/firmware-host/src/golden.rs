@@ -10,11 +10,10 @@ use anyhow::{bail, Context};
 use std::path::Path;
 use std::time::Duration;
 
-/// The golden file's header line.
-pub const HEADER: &str = "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,status,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm";
+/// The golden file's header line (the fitter's, from the contract's columns).
+pub use needle_fit::golden::header;
 
-const COLUMNS: [&str; 12] =
-    ["x_mm", "z_mm", "theta_x_deg", "theta_z_deg", "depth_mm", "status", "fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"];
+use needle_contract::GOLDEN_COLUMNS as COLUMNS;
 
 pub use super::comparison::{same_f32, Comparison};
 
@@ -31,8 +30,9 @@ fn bits(field: &str) -> Option<u32> {
 /// [`Comparison::mismatches`].
 pub fn compare(output: &str, csv: &str, fe_sha256: &str) -> anyhow::Result<Comparison> {
     let mut want = csv.lines();
-    if want.next() != Some(HEADER) {
-        bail!("golden-f32.csv: the first line is not the header {HEADER:?}");
+    let header = header();
+    if want.next() != Some(header.as_str()) {
+        bail!("golden-f32.csv: the first line is not the header {header:?}");
     }
     let want: Vec<&str> = want.collect();
     let mut got = output.lines();
@@ -49,7 +49,7 @@ pub fn compare(output: &str, csv: &str, fe_sha256: &str) -> anyhow::Result<Compa
     if !banner.split(' ').any(|w| w == format!("rows={}", want.len())) {
         bail!("the firmware holds another number of poses than the golden file's {} (banner {banner:?})", want.len());
     }
-    if got.next() != Some(HEADER) {
+    if got.next() != Some(header.as_str()) {
         bail!("the firmware's second line is not the golden header");
     }
     let mut mismatches = Vec::new();

@@ -16,7 +16,9 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 /// Header line of golden-f32.csv.
-pub const HEADER: &str = "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,status,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm";
+pub fn header() -> String {
+    needle_contract::GOLDEN_COLUMNS.join(",")
+}
 
 /// Seed of the random golden poses (ChaCha8).
 pub const GOLDEN_SEED: u64 = 0x6e65_6564_6c65_0001;
@@ -160,7 +162,7 @@ pub fn poses() -> Vec<[f32; 5]> {
 pub fn to_csv(t: &Tables32) -> String {
     let poses = poses();
     let mut s = String::with_capacity(128 * (poses.len() + 1));
-    s.push_str(HEADER);
+    s.push_str(&header());
     s.push('\n');
     for p in poses {
         let (w, status) = eval(t, p);
@@ -193,7 +195,7 @@ pub struct GoldenRow {
 /// Wrong header, a row without 12 fields, a malformed hex field (`path:line` in the
 /// message).
 pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<GoldenRow>> {
-    parse_rows(text, path, HEADER, |field, at| {
+    parse_rows(text, path, &header(), |field, at| {
         let value = |s: &str| parse_hex32(s).ok_or_else(|| anyhow::anyhow!("{at}: field {s:?} is not 0x + 8 hex digits"));
         let mut v = [0.0f32; 11];
         for (j, dst) in v.iter_mut().enumerate() {
@@ -261,12 +263,12 @@ mod tests {
             f.push(last);
             f.join(",")
         };
-        let good = format!("{HEADER}\n{}\n", row("0x01", one));
+        let good = format!("{}\n{}\n", header(), row("0x01", one));
         let rows = parse_csv(&good, Path::new("g.csv")).expect("good file");
         assert_eq!(rows, [GoldenRow { pose: [1.0; 5], status: 1, wrench: [1.0; 6] }]);
-        assert_eq!(err("x\n"), format!("g.csv:1: expected the header {HEADER:?}"));
-        assert_eq!(err(&format!("{HEADER}\n{}\n0x1\n", row("0x00", one))), "g.csv:3: 1 fields, expected 12");
-        assert_eq!(err(&format!("{HEADER}\n{}\n", row("0x1", one))), "g.csv:2: status \"0x1\" is not 0x + 2 hex digits");
-        assert_eq!(err(&format!("{HEADER}\n{}\n", row("0x00", "1.0"))), "g.csv:2: field \"1.0\" is not 0x + 8 hex digits");
+        assert_eq!(err("x\n"), format!("g.csv:1: expected the header {:?}", header()));
+        assert_eq!(err(&format!("{}\n{}\n0x1\n", header(), row("0x00", one))), "g.csv:3: 1 fields, expected 12");
+        assert_eq!(err(&format!("{}\n{}\n", header(), row("0x1", one))), "g.csv:2: status \"0x1\" is not 0x + 2 hex digits");
+        assert_eq!(err(&format!("{}\n{}\n", header(), row("0x00", "1.0"))), "g.csv:2: field \"1.0\" is not 0x + 8 hex digits");
     }
 }
