@@ -38,8 +38,8 @@ use anyhow::Result;
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// Name of the model file inside a set folder.
-pub const MODEL_FILE: &str = "model.toml";
+/// Name of the model file inside a set folder (the generator's, which reads it).
+pub use needle_codegen::MODEL_FILE;
 /// Name of the golden-vector file inside a set folder.
 pub const GOLDEN_FILE: &str = "golden-f32.csv";
 /// Name of the fixed-point golden-vector file inside a set folder.
