@@ -159,9 +159,8 @@ fn component_bounds(rows: &[[FixedRow; TERMS]; 4], cross: &[FixedCross], base: &
 
 /// The t-derivative of a row for the fixed-point stiffness: `(j + 1) * (p[j + 1] >> r)`
 /// (`r <= 3`), `None` when a coefficient would leave [`LIMIT`] (`r < 3` only).
-fn rate_row(p: &[i32; TERMS], r: u32) -> Option<[i32; 4]> {
-    let [_, p1, p2, p3, p4] = p.map(|v| i64::from(v >> r));
-    let d = [p1, 2 * p2, 3 * p3, 4 * p4];
+fn rate_row(p: &[i32; TERMS], r: u32) -> Option<[i32; DEGREE]> {
+    let d: [i64; DEGREE] = std::array::from_fn(|j| (j as i64 + 1) * i64::from(p[j + 1] >> r));
     d.iter().all(|v| v.abs() <= LIMIT).then(|| d.map(|v| v as i32))
 }
 
@@ -269,7 +268,7 @@ pub fn fixed_formats(model: &Model, model_path: &Path) -> Result<FixedTables, Co
         let rate_shift = g.min(MAX_RATE_SHIFT);
         let [rows_x, rows_z, _, _] = &rows;
         let rate_of = |rows: &[FixedRow; TERMS]| -> Option<[[i32; DEGREE]; TERMS]> {
-            let r: Vec<[i32; 4]> = rows.iter().map(|row| rate_row(&row.coeffs, rate_shift)).collect::<Option<_>>()?;
+            let r: Vec<[i32; DEGREE]> = rows.iter().map(|row| rate_row(&row.coeffs, rate_shift)).collect::<Option<_>>()?;
             r.try_into().ok()
         };
         let rate_rows = rate_of(rows_x).zip(rate_of(rows_z)).map(|(x, z)| [x, z]);

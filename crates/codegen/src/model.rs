@@ -1,7 +1,7 @@
 //! Reading and validating `model.toml` (format in `coeffs/README.md`).
 use crate::contract::{COMPONENTS, DEPTH_MAX_MM, FORMAT, HALF_RANGES, ODD, SWEEPS};
 use crate::error::CodegenError;
-use needle_contract::TERMS;
+use needle_contract::{DEGREE, TERMS};
 use serde::Deserialize;
 use std::ops::Range;
 use std::path::Path;
@@ -460,15 +460,15 @@ impl Checker<'_> {
         Ok(x)
     }
 
-    /// Five finite f64 and their five f32 bit strings, each the nearest f32.
-    fn five(
+    /// One polynomial: `TERMS` finite f64 and their f32 bit strings, each the nearest f32.
+    fn poly(
         &self,
         values: &Spanned<Vec<Spanned<f64>>>,
         bits: &Spanned<Vec<Spanned<String>>>,
         what: &str,
         what_f32: &str,
     ) -> Result<([f64; TERMS], [f32; TERMS]), CodegenError> {
-        let (v, b) = self.list(values, bits, 5, what, what_f32)?;
+        let (v, b) = self.list(values, bits, TERMS, what, what_f32)?;
         let mut out = [0.0; TERMS];
         let mut out32 = [0.0; TERMS];
         out.copy_from_slice(&v);
@@ -523,7 +523,7 @@ impl Checker<'_> {
         self.name_at(&raw.component, "component", &COMPONENTS, c, &COMPONENTS.join(", "))?;
         let name = COMPONENTS[c];
         let (coeffs, coeffs_f32) =
-            self.five(&raw.coeffs, &raw.coeffs_f32, &format!("baseline {name}: coeffs"), &format!("baseline {name}: coeffs_f32"))?;
+            self.poly(&raw.coeffs, &raw.coeffs_f32, &format!("baseline {name}: coeffs"), &format!("baseline {name}: coeffs_f32"))?;
         Ok(Baseline {
             component: c,
             coeffs,
@@ -552,8 +552,8 @@ impl Checker<'_> {
         for (n, name, span) in
             [(raw.rows.get_ref().len(), "rows", raw.rows.span()), (raw.rows_f32.get_ref().len(), "rows_f32", raw.rows_f32.span())]
         {
-            if n != 5 {
-                return Err(self.err(span, format!("{label}: {name} has {n} rows, expected 5 (powers of u 0..=4)")));
+            if n != TERMS {
+                return Err(self.err(span, format!("{label}: {name} has {n} rows, expected {TERMS} (powers of u 0..={DEGREE})")));
             }
         }
         let mut rows = [[0.0; TERMS]; TERMS];
@@ -561,7 +561,7 @@ impl Checker<'_> {
         for (i, ((r, b), (o, o32))) in
             raw.rows.get_ref().iter().zip(raw.rows_f32.get_ref()).zip(rows.iter_mut().zip(rows_f32.iter_mut())).enumerate()
         {
-            let (row, row32) = self.five(r, b, &format!("{label}: rows[{i}]"), &format!("{label}: rows_f32[{i}]"))?;
+            let (row, row32) = self.poly(r, b, &format!("{label}: rows[{i}]"), &format!("{label}: rows_f32[{i}]"))?;
             // A deviation is zero at t = -1 (sweep value 0), in f64 up to rounding.
             let at_zero: f64 = row.iter().zip([1.0, -1.0, 1.0, -1.0, 1.0]).map(|(a, s)| a * s).sum();
             let scale: f64 = row.iter().map(|a| a.abs()).sum();
