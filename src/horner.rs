@@ -1,12 +1,14 @@
 //! Horner evaluation of a quartic, in the contract's exact operation order.
 use needle_contract::TERMS;
 
-/// `h(p, w) = (((p4*w + p3)*w + p2)*w + p1)*w + p0`: every multiply and add rounded on
-/// its own (Rust never fuses them into an FMA), highest power first.
+/// `h(p, w) = (((p4*w + p3)*w + p2)*w + p1)*w + p0` (for the contract's degree 4):
+/// every multiply and add rounded on its own (Rust never fuses them into an FMA),
+/// highest power first, starting from the highest coefficient itself (not `0*w + p4`,
+/// which would turn a `-0.0` into `+0.0`).
 #[inline(always)]
 pub(crate) fn horner(p: &[f32; TERMS], w: f32) -> f32 {
-    let [p0, p1, p2, p3, p4] = *p;
-    (((p4 * w + p3) * w + p2) * w + p1) * w + p0
+    let [lower @ .., top] = p;
+    lower.iter().rev().fold(*top, |acc, &c| acc * w + c)
 }
 
 /// `h(p, w)` and `h'(p, w)` together (coeffs/README.md, "Stiffness"): the value by the
@@ -15,12 +17,11 @@ pub(crate) fn horner(p: &[f32; TERMS], w: f32) -> f32 {
 /// (`b` the value so far), 3 multiplies and 3 adds more, no further coefficient loads.
 #[inline(always)]
 pub(crate) fn horner_with_rate(p: &[f32; TERMS], w: f32) -> (f32, f32) {
-    let [p0, p1, p2, p3, p4] = *p;
-    let b3 = p4 * w + p3;
-    let d3 = p4 * w + b3;
-    let b2 = b3 * w + p2;
-    let d2 = d3 * w + b2;
-    let b1 = b2 * w + p1;
-    let d1 = d2 * w + b1;
-    (b1 * w + p0, d1)
+    let [p0, middle @ .., top] = p;
+    // (b, d): the value and the derivative so far, both starting at the top coefficient
+    let (b, d) = middle.iter().rev().fold((*top, *top), |(b, d), &c| {
+        let b = b * w + c;
+        (b, d * w + b)
+    });
+    (b * w + p0, d)
 }

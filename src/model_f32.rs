@@ -23,14 +23,25 @@ fn abs(v: f32) -> f32 {
 
 /// Whether every coefficient of `p` is `+0.0` (bit pattern 0; `-0.0` does not count).
 const fn is_plus_zero(p: &[f32; TERMS]) -> bool {
-    let [p0, p1, p2, p3, p4] = *p;
-    p0.to_bits() | p1.to_bits() | p2.to_bits() | p3.to_bits() | p4.to_bits() == 0
+    let mut bits = 0;
+    let mut rest: &[f32] = p;
+    while let [first, tail @ ..] = rest {
+        bits |= first.to_bits();
+        rest = tail;
+    }
+    bits == 0
 }
 
-/// Whether every coefficient of the 5x5 matrix `m` is `+0.0`.
+/// Whether every coefficient of the matrix `m` is `+0.0`.
 pub(crate) const fn is_plus_zero_matrix(m: &[[f32; TERMS]; TERMS]) -> bool {
-    let [r0, r1, r2, r3, r4] = m;
-    is_plus_zero(r0) && is_plus_zero(r1) && is_plus_zero(r2) && is_plus_zero(r3) && is_plus_zero(r4)
+    let mut rest: &[[f32; TERMS]] = m;
+    while let [first, tail @ ..] = rest {
+        if !is_plus_zero(first) {
+            return false;
+        }
+        rest = tail;
+    }
+    true
 }
 
 /// `ZERO_BASELINE[c]`: every coefficient of `B_c` is `+0.0`.
@@ -90,8 +101,8 @@ pub(crate) fn baseline(b: &[f32; TERMS], zero: bool, u: f32) -> f32 {
     }
 }
 
-/// `D_kc(t, u)` of one 5x5 deviation matrix `m`: Horner in `t` along each row (`r_i`),
-/// then Horner in `u` over the five `r_i` (step 4 of the contract).
+/// `D_kc(t, u)` of one deviation matrix `m`: Horner in `t` along each row (`r_i`),
+/// then Horner in `u` over the `r_i` (step 4 of the contract).
 #[inline(always)]
 fn deviation(m: &[[f32; TERMS]; TERMS], t: f32, u: f32) -> f32 {
     let [m0, m1, m2, m3, m4] = m;

@@ -5,6 +5,7 @@ use crate::contract::{
     UNITS,
 };
 use crate::model::Model;
+use needle_contract::TERMS;
 use std::fmt::Write as _;
 
 use crate::literal::f32_literal;
@@ -79,7 +80,7 @@ pub fn render_rust(model: &Model) -> String {
     let _ = writeln!(w, "/// Baseline polynomials `B_c(u)` of the centred, vertical needle, `[component][i]`:");
     let _ = writeln!(w, "/// `B_c = sum_i BASELINE[c][i] * u^i` (evaluated by Horner, highest power first),");
     let _ = writeln!(w, "/// `{DEPTH_DOMAIN}`. Components in the order fx_n, fy_n, fz_n (N), mx_nmm, my_nmm, mz_nmm (N*mm).");
-    let _ = writeln!(w, "pub const BASELINE: [[f32; 5]; 6] = [");
+    let _ = writeln!(w, "pub const BASELINE: [[f32; {TERMS}]; 6] = [");
     for b in &model.baseline {
         let unit = UNITS[b.component];
         let _ = writeln!(w, "    // {} ({unit}); domain {DEPTH_DOMAIN};", COMPONENTS[b.component]);
@@ -96,7 +97,7 @@ pub fn render_rust(model: &Model) -> String {
     let _ = writeln!(w, "/// Deviation polynomials `D_kc(t, u)`, `[sweep][component][i][j]`: `DEVIATION[k][c][i][j]`");
     let _ = writeln!(w, "/// multiplies `u^i * t^j`; rows are evaluated by Horner in `t`, then the row values by Horner");
     let _ = writeln!(w, "/// in `u`. Sweeps in the order x, z, theta_x, theta_z; components as in [`BASELINE`].");
-    let _ = writeln!(w, "pub const DEVIATION: [[[[f32; 5]; 5]; 6]; 4] = [");
+    let _ = writeln!(w, "pub const DEVIATION: [[[[f32; {TERMS}]; {TERMS}]; 6]; 4] = [");
     for (k, sweep) in SWEEPS.iter().enumerate() {
         let _ = writeln!(w, "    // sweep {sweep}: {}", sweep_domain(k));
         let _ = writeln!(w, "    [");
@@ -198,7 +199,7 @@ pub fn render_c_header(model: &Model) -> String {
     let _ = writeln!(w, "}};");
     let _ = writeln!(w);
     let _ = writeln!(w, "/* Baselines B_c(u), [component][i]: coefficient of u^i; {DEPTH_DOMAIN}. */");
-    let _ = writeln!(w, "static const float NEEDLE_BASELINE[6][5] = {{");
+    let _ = writeln!(w, "static const float NEEDLE_BASELINE[6][{TERMS}] = {{");
     for b in &model.baseline {
         let unit = UNITS[b.component];
         let _ = writeln!(
@@ -216,7 +217,7 @@ pub fn render_c_header(model: &Model) -> String {
     let _ = writeln!(w, "}};");
     let _ = writeln!(w);
     let _ = writeln!(w, "/* Deviations D_kc(t, u), [sweep][component][i][j]: coefficient of u^i * t^j. */");
-    let _ = writeln!(w, "static const float NEEDLE_DEVIATION[4][6][5][5] = {{");
+    let _ = writeln!(w, "static const float NEEDLE_DEVIATION[4][6][{TERMS}][{TERMS}] = {{");
     for (k, sweep) in SWEEPS.iter().enumerate() {
         let _ = writeln!(w, "    /* sweep {sweep}: {} */", sweep_domain(k));
         let _ = writeln!(w, "    {{");

@@ -13,6 +13,7 @@ use crate::contract::{COMPONENTS, CROSS_SCALES_F32, HALF_RANGES, SWEEPS, UNITS};
 use crate::fixed::{FixedTables, CROSS_DIVISORS};
 use crate::literal::f32_literal;
 use crate::model::Model;
+use needle_contract::TERMS;
 use std::fmt::Write as _;
 
 /// Names of the normalised inputs in the generated code.
@@ -223,7 +224,7 @@ pub fn render_rust_cross_fixed(model: &Model, t: &FixedTables) -> String {
     let _ = writeln!(w, "/// Adds every cross term to the accumulators `a[c][i]` (each component in its Q(G)).");
     let _ = writeln!(w, "#[inline(always)]");
     let _ = writeln!(w, "#[allow(unused_variables)]");
-    let _ = writeln!(w, "pub(crate) fn add_cross(n: [i32; 4], a: &mut [[i32; 5]; 6]) {{");
+    let _ = writeln!(w, "pub(crate) fn add_cross(n: [i32; 4], a: &mut [[i32; {TERMS}]; 6]) {{");
     let any = t.components.iter().any(|c| !c.cross.is_empty());
     if !any {
         let _ = writeln!(w, "    let _ = (n, a);");
@@ -270,7 +271,7 @@ fn render_rust_cross_rates_fixed(w: &mut String, t: &FixedTables) {
         let _ = writeln!(w, "/// Adds every cross term's {name} rates to `g[c][i]` (Q(G - R) per unit of t_{name}, `R = RATE_SHIFTS[c]`).");
         let _ = writeln!(w, "#[inline(always)]");
         let _ = writeln!(w, "#[allow(unused_variables)]");
-        let _ = writeln!(w, "pub(crate) fn add_cross_rates_{name}(n: [i32; 4], g: &mut [[i32; 5]; 6]) {{");
+        let _ = writeln!(w, "pub(crate) fn add_cross_rates_{name}(n: [i32; 4], g: &mut [[i32; {TERMS}]; 6]) {{");
         let any = t.components.iter().any(|c| c.cross.iter().any(|x| x.exponents[k] > 0));
         if !any {
             let _ = writeln!(w, "    let _ = (n, g);");

@@ -3,6 +3,7 @@
 use crate::contract::{COMPONENTS, DEPTH_MAX_MM, HALF_RANGES, ODD, SWEEPS, UNITS};
 use crate::fixed::{FixedTables, DEPTH_DIVISOR, LIMIT, MAX_RATE_SHIFT, NORM_FRAC_BITS, POSE_FRAC_BITS, SWEEP_DIVISORS};
 use crate::model::Model;
+use needle_contract::{DEGREE, TERMS};
 use std::fmt::Write as _;
 
 /// `µN` or `µN*mm` (ASCII: `uN`, `uN*mm`) for component `c`.
@@ -86,7 +87,7 @@ pub fn render_rust_fixed(model: &Model, t: &FixedTables) -> String {
 
     let _ = writeln!(w);
     let _ = writeln!(w, "/// Baseline coefficients `[component][i]` (multiplies `u^i`), in each component's Q(G).");
-    let _ = writeln!(w, "pub const BASELINE: [[i32; 5]; 6] = [");
+    let _ = writeln!(w, "pub const BASELINE: [[i32; {TERMS}]; 6] = [");
     for (c, comp) in t.components.iter().enumerate() {
         let _ = writeln!(
             w,
@@ -105,7 +106,7 @@ pub fn render_rust_fixed(model: &Model, t: &FixedTables) -> String {
     let _ = writeln!(w, "/// Row polynomials `[component][sweep][i][j]`: `ROWS[c][k][i][j]` multiplies `t_k^j`; row `i` is");
     let _ = writeln!(w, "/// the coefficient of `u^i` of the deviation of sweep `k` (x, z, theta_x, theta_z). Each row in");
     let _ = writeln!(w, "/// its own Q(f); `SHIFTS[c][k][i] = f - G`.");
-    let _ = writeln!(w, "pub const ROWS: [[[[i32; 5]; 5]; 4]; 6] = [");
+    let _ = writeln!(w, "pub const ROWS: [[[[i32; {TERMS}]; {TERMS}]; 4]; 6] = [");
     for (c, comp) in t.components.iter().enumerate() {
         let _ = writeln!(w, "    // {} ({})", COMPONENTS[c], micro_unit(c));
         let _ = writeln!(w, "    [");
@@ -123,7 +124,7 @@ pub fn render_rust_fixed(model: &Model, t: &FixedTables) -> String {
 
     let _ = writeln!(w);
     let _ = writeln!(w, "/// Alignment shifts `[component][sweep][i]`: row value `>> SHIFTS[c][k][i]` is in Q(G).");
-    let _ = writeln!(w, "pub const SHIFTS: [[[u32; 5]; 4]; 6] = [");
+    let _ = writeln!(w, "pub const SHIFTS: [[[u32; {TERMS}]; 4]; 6] = [");
     for (c, comp) in t.components.iter().enumerate() {
         let rows: Vec<String> = comp.shifts.iter().map(|r| format!("{r:?}")).collect();
         let _ = writeln!(w, "    [{}], // {}", rows.join(", "), COMPONENTS[c]);
@@ -145,7 +146,7 @@ fn render_rate_tables(w: &mut String, t: &FixedTables) {
     let _ = writeln!(w, "/// Row t-derivatives of the x and z sweeps `[component][sweep][i][j]`:");
     let _ = writeln!(w, "/// `RATE_ROWS[c][k][i][j] = (j + 1) * (ROWS[c][k][i][j + 1] >> RATE_SHIFTS[c])` multiplies `t_k^j`,");
     let _ = writeln!(w, "/// in the row's Q(f - R) (aligned to Q(G - R) by the same `SHIFTS[c][k][i]`).");
-    let _ = writeln!(w, "pub const RATE_ROWS: [[[[i32; 4]; 5]; 2]; 6] = [");
+    let _ = writeln!(w, "pub const RATE_ROWS: [[[[i32; {DEGREE}]; {TERMS}]; 2]; 6] = [");
     for (c, comp) in t.components.iter().enumerate() {
         let [d, x, z] = comp.rate_bounds;
         let _ = writeln!(
