@@ -6,6 +6,7 @@
 //!
 //! Also: the fitter's choice of formats equals the tables compiled into the library, and
 //! the checker does catch an overflow when the formats are one bit too ambitious.
+use needle_contract::TERMS;
 use needle_fit::eval_fixed::eval;
 use needle_fit::fixed_formats::TablesFixed;
 use needle_fit::model_file;
@@ -99,13 +100,16 @@ fn an_intermediate_beyond_two_to_the_thirty_is_caught() {
     let mut t = fitter_tables().clone();
     for k in 0..4 {
         for c in 0..6 {
-            t.rows[k][c] = [[0; 5]; 5];
-            t.row_frac[k][c] = [0; 5];
+            t.rows[k][c] = [[0; TERMS]; TERMS];
+            t.row_frac[k][c] = [0; TERMS];
         }
     }
     t.acc_frac = [0; 6];
-    t.baseline = [[0; 5]; 6];
-    t.baseline[1] = [1 << 29, (1 << 29) + 1, 0, 0, 0];
+    t.baseline = [[0; TERMS]; 6];
+    // B(u) = 2^29 + (2^29 + 1) u: 2^30 + 1 at u = +1
+    t.baseline[1] = [0; TERMS];
+    t.baseline[1][0] = 1 << 29;
+    t.baseline[1][1] = (1 << 29) + 1;
     let full = eval(&t, [0, 0, 0, 0, 6 << 16]);
     assert!(full.is_err(), "2^30 + 1 at u = +1 not caught: {full:?}");
     assert!(format!("{}", full.unwrap_err()).contains("component 1"));

@@ -59,14 +59,15 @@ impl Tables32 {
     }
 }
 
-/// `h(p, w) = (((p4*w + p3)*w + p2)*w + p1)*w + p0` in f32, written out.
+/// `h(p, w) = (((p4*w + p3)*w + p2)*w + p1)*w + p0` in f32 (degree 4): from the top
+/// coefficient down, one rounded multiply and one rounded add per step.
 #[inline(never)]
 pub fn h32(p: &[f32; NCOEF], w: f32) -> f32 {
-    let [p0, p1, p2, p3, p4] = *p;
-    let a = p4 * w + p3;
-    let b = a * w + p2;
-    let c = b * w + p1;
-    c * w + p0
+    let mut acc = p[NCOEF - 1];
+    for i in (0..NCOEF - 1).rev() {
+        acc = acc * w + p[i];
+    }
+    acc
 }
 
 /// Clamp to `[lo, hi]` by comparison: a value inside (either zero sign included) is
@@ -130,7 +131,7 @@ pub fn eval(t: &Tables32, pose: [f32; 5]) -> ([f32; 6], u8) {
         let mut acc = h32(&t.baseline[c], u);
         for k in 0..4 {
             let m = &t.rows[k][c];
-            let r = [h32(&m[0], tt[k]), h32(&m[1], tt[k]), h32(&m[2], tt[k]), h32(&m[3], tt[k]), h32(&m[4], tt[k])];
+            let r: [f32; NCOEF] = std::array::from_fn(|i| h32(&m[i], tt[k]));
             let dev = h32(&r, u);
             if negative[k] && ODD[k][c] {
                 acc -= dev;

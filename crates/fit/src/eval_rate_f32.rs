@@ -11,14 +11,13 @@ use super::eval_f32::{clamp32, eval, h32, horner_n32, monomial32, Tables32, ODD,
 /// accumulated alongside (`d = p4`, then `d = d*w + b` after the steps for p3, p2, p1,
 /// `b` the value so far), written out.
 pub fn hd32(p: &[f32; NCOEF], w: f32) -> (f32, f32) {
-    let [p0, p1, p2, p3, p4] = *p;
-    let mut b = p4;
-    let mut d = p4;
-    for c in [p3, p2, p1] {
-        b = b * w + c;
+    let mut b = p[NCOEF - 1];
+    let mut d = b;
+    for i in (1..NCOEF - 1).rev() {
+        b = b * w + p[i];
         d = d * w + b;
     }
-    (b * w + p0, d)
+    (b * w + p[0], d)
 }
 
 /// The wrench's rates at `pose = [x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm]`:

@@ -162,9 +162,10 @@ mod tests {
     #[test]
     fn row_format_keeps_the_largest_fitting_format() {
         // 1 N = 10^6 uN: 2^30 / 10^6 = 1073.7, so f = 10 (1024 * 10^6 <= 2^30 < 2048 * 10^6)
-        let (f, q, s) = row_format(&[1.0, 0.0, 0.0, 0.0, 0.0]).unwrap();
+        let only = |c0: f64| std::array::from_fn(|i| if i == 0 { c0 } else { 0.0 });
+        let (f, q, s) = row_format(&only(1.0)).unwrap();
         assert_eq!((f, q[0], s), (10, 1_024_000_000, 1_024_000_000));
-        assert_eq!(row_format(&[0.0; 5]).unwrap().0, MAX_FRAC);
-        assert!(row_format(&[2000.0, 0.0, 0.0, 0.0, 0.0]).is_none());
+        assert_eq!(row_format(&[0.0; NCOEF]).unwrap().0, MAX_FRAC);
+        assert!(row_format(&only(2000.0)).is_none());
     }
 }
