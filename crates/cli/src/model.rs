@@ -105,7 +105,10 @@ pub fn status_names(status: Status) -> Vec<&'static str> {
     Status::FLAGS.iter().filter(|(f, _)| status.contains(*f)).map(|(_, n)| *n).collect()
 }
 
-const NAMES: [(&str, &str); 6] = [("fx_n", "N"), ("fy_n", "N"), ("fz_n", "N"), ("mx_nmm", "N*mm"), ("my_nmm", "N*mm"), ("mz_nmm", "N*mm")];
+/// Each component's name and unit, in the contract's order.
+fn names() -> impl Iterator<Item = (&'static str, &'static str)> {
+    needle_contract::COMPONENTS.into_iter().zip(needle_contract::UNITS)
+}
 
 /// The compiled-in model's form: `paper` or `coupled`.
 pub fn form_name() -> &'static str {
@@ -125,7 +128,7 @@ pub fn accuracy_json() -> serde_json::Value {
     }
     let mut pct = serde_json::Map::new();
     let mut abs = serde_json::Map::new();
-    for (((name, _), p), scale) in NAMES.iter().zip(model_info::CV_RMS_PCT).zip(model_info::CV_SCALE) {
+    for (((name, _), p), scale) in names().zip(model_info::CV_RMS_PCT).zip(model_info::CV_SCALE) {
         pct.insert((*name).to_string(), serde_json::json!(p));
         abs.insert((*name).to_string(), serde_json::json!(p * scale / 100.0));
     }
@@ -146,7 +149,7 @@ pub fn to_json(poses: &[Pose], evals: &[Evaluation]) -> serde_json::Value {
 pub fn eval_json(pose: &Pose, e: &Evaluation) -> serde_json::Value {
     let mut wrench = serde_json::Map::new();
     let mut bits = serde_json::Map::new();
-    for ((name, _), v) in NAMES.iter().zip(e.wrench.to_array()) {
+    for ((name, _), v) in names().zip(e.wrench.to_array()) {
         wrench.insert((*name).to_string(), serde_json::json!(v));
         bits.insert((*name).to_string(), serde_json::json!(format!("{:#010x}", v.to_bits())));
     }
@@ -200,7 +203,7 @@ pub fn eval(a: EvalArgs) -> anyhow::Result<ExitCode> {
             pose.x_mm, pose.z_mm, pose.theta_x_deg, pose.theta_z_deg, pose.depth_mm
         );
         println!("wrench on the needle, moments about the hub:");
-        for ((name, unit), v) in NAMES.iter().zip(e.wrench.to_array()) {
+        for ((name, unit), v) in names().zip(e.wrench.to_array()) {
             println!("  {name:<7} = {:>15} {unit:<5} ({:#010x})", format!("{v:?}"), v.to_bits());
         }
         let meaning = if e.status.is_error() {
