@@ -294,13 +294,37 @@ fn fit_without_leaves_a_sweep_run_out_and_model_toml_says_so() {
 }
 
 #[test]
-fn fit_without_accepts_only_listed_sweep_runs() {
+fn a_training_run_left_out_of_the_coupled_fit_is_refused_unless_listed() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    fit_synthetic::make_set(dir.path(), &["train-05"]);
+    let path = dir.path().join("campaign.toml");
+    let text = std::fs::read_to_string(&path).expect("read campaign.toml");
+    let text = if text.contains("\n[fit]\n") {
+        text.replace("\n[fit]\n", "\n[fit]\nform = \"coupled\"\n")
+    } else {
+        text.replacen("\n[[pose]]\n", "\n[fit]\nform = \"coupled\"\n\n[[pose]]\n", 1)
+    };
+    std::fs::write(&path, text).expect("write campaign.toml");
+    set_fit_without(dir.path(), "[]");
+    let e = needle_fit::fit_set(dir.path()).expect_err("train-05 is missing and not listed");
+    let msg = format!("{e:#}");
+    assert!(msg.contains("1 of the") && msg.contains("train-05"), "{msg}");
+    set_fit_without(dir.path(), r#"["train-05"]"#);
+    let out = needle_fit::fit_set(dir.path()).unwrap_or_else(|e| panic!("{e:#}"));
+    assert!(out.model.cross.is_some(), "the coupled form was fitted");
+    let note = out.model_toml.lines().nth(1).unwrap_or_default();
+    assert!(note.starts_with("# Not fitted") && note.ends_with("train-05"), "{note}");
+}
+
+#[test]
+fn fit_without_accepts_only_sweep_and_training_runs() {
     let dir = tempfile::tempdir().expect("tempdir");
     fit_synthetic::make_set(dir.path(), &[]);
     for (list, want) in [
-        (r#"["nope"]"#, "\"nope\" is not a listed pose"),
-        (r#"["centre"]"#, "only sweep runs can be left out"),
-        (r#"["t2-a"]"#, "only sweep runs can be left out"),
+        (r#"["nope"]"#, "\"nope\" is not a pose of this campaign"),
+        (r#"["centre"]"#, "only sweep and training runs can be left out"),
+        (r#"["t2-a"]"#, "only sweep and training runs can be left out"),
+        (r#"["lhs-01"]"#, "only sweep and training runs can be left out"),
     ] {
         set_fit_without(dir.path(), list);
         let e = needle_fe::spec::load(dir.path()).expect_err(list);

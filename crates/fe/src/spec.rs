@@ -425,10 +425,10 @@ pub struct CampaignSettings {
     /// prefixes. 0: none.
     #[serde(default)]
     pub train_count: u32,
-    /// Sweep runs the fitter leaves out, by pose name, each because its FE run cannot be
-    /// solved (the reason is written next to the list in campaign.toml). The run stays in
-    /// the campaign; the fit needs at least 5 distinct values per sweep without it, and
-    /// model.toml names what was left out.
+    /// Sweep and training runs the fitter leaves out, by pose name, each because its FE
+    /// run cannot be solved (the reason is written next to the list in campaign.toml). The
+    /// run stays in the campaign; the fit needs at least 5 distinct values per sweep
+    /// without it, and model.toml names what was left out.
     #[serde(default)]
     pub fit_without: Vec<String>,
     /// Mesh levels of `needle fe verify --mesh`, coarse to fine, each a 2x refinement of
@@ -468,6 +468,12 @@ impl Role {
     /// Whether the fitter may use runs of this role.
     pub fn is_fitted(self) -> bool {
         matches!(self, Role::Centre | Role::SweepX | Role::SweepZ | Role::SweepThetaX | Role::SweepThetaZ)
+    }
+    /// Whether `campaign.fit_without` may name a run of this role: a sweep or a training
+    /// run whose FE run cannot be solved. The centre run is always fitted; validation runs
+    /// are never fitted.
+    pub fn may_be_left_out(self) -> bool {
+        matches!(self, Role::SweepX | Role::SweepZ | Role::SweepThetaX | Role::SweepThetaZ | Role::Train)
     }
     /// Whether the run is a validation run (never fitted).
     pub fn is_validation(self) -> bool {
@@ -655,11 +661,15 @@ impl Campaign {
                 bail!("{p}: pose {:?}: role train is generated from campaign.train_seed, not listed", pose.name);
             }
         }
+        let every_pose = self.poses();
         for name in &self.campaign.fit_without {
-            match self.pose.iter().find(|q| &q.name == name) {
-                None => bail!("{p}: campaign.fit_without: {name:?} is not a listed pose"),
-                Some(q) if !q.role.is_fitted() || q.role == Role::Centre => {
-                    bail!("{p}: campaign.fit_without: pose {name:?} has role {:?}; only sweep runs can be left out of the fit", q.role)
+            match every_pose.iter().find(|q| &q.name == name) {
+                None => bail!("{p}: campaign.fit_without: {name:?} is not a pose of this campaign"),
+                Some(q) if !q.role.may_be_left_out() => {
+                    bail!(
+                        "{p}: campaign.fit_without: pose {name:?} has role {:?}; only sweep and training runs can be left out of the fit",
+                        q.role
+                    )
                 }
                 Some(_) => {}
             }

@@ -132,15 +132,16 @@ pub fn stale_reason(manifest: &Manifest, campaign: &Campaign, pose: &PoseSpec) -
     manifest.current_entry(campaign, pose, &campaign.campaign.mesh).err()
 }
 
-/// The poses the fitter uses: the centre and every sweep run not listed in
-/// `campaign.fit_without` (their files make up `fe_sha256`).
+/// The poses the fitter uses: the centre, every sweep run and, for the coupled form, every
+/// training run, less those listed in `campaign.fit_without` (their files make up
+/// `fe_sha256`).
 pub fn fitted_poses(campaign: &Campaign) -> Vec<PoseSpec> {
     let left_out = &campaign.campaign.fit_without;
     let coupled = campaign.fit.form == ModelForm::Coupled;
     campaign
         .poses()
         .into_iter()
-        .filter(|p| (p.role.is_fitted() && !left_out.contains(&p.name)) || (coupled && p.role == Role::Train))
+        .filter(|p| (p.role.is_fitted() || (coupled && p.role == Role::Train)) && !left_out.contains(&p.name))
         .collect()
 }
 
@@ -166,7 +167,7 @@ pub fn load_fit_data(set_dir: &Path) -> Result<FitData> {
     let missing: Vec<&str> = fitted.iter().filter(|p| !run_path(set_dir, p).is_file()).map(|p| p.name.as_str()).collect();
     if !missing.is_empty() {
         bail!(
-            "{} of the {} fitted FE runs are missing from {}: {}\n(run `needle fe run --set {}` to finish the campaign; the fit needs the centre run, every sweep run not listed in campaign.fit_without and, for [fit] form = \"coupled\", every training run)",
+            "{} of the {} fitted FE runs are missing from {}: {}\n(run `needle fe run --set {}` to finish the campaign; the fit needs the centre run, every sweep run and, for [fit] form = \"coupled\", every training run, less those listed in campaign.fit_without)",
             missing.len(),
             fitted.len(),
             set_dir.join("fe").display(),
