@@ -169,10 +169,27 @@ fn ramp(f: [f32; 3], step: f32) -> [f32; 3] {
     })
 }
 
-/// A good tick on golden row `r`, then `fault` until the ramp reaches zero (enable low,
-/// DISABLED), two more fault ticks, then a good tick that resumes.
-fn ramp_case(fault: Result<Pose, PoseFault>, flag: LoopFlags, cfg: LoopConfig<3>, model: Option<Status>) {
-    let r = golden_in_domain(10)[7];
+/// Magnitude of the force command of golden row `r`, N.
+fn force_norm_n(r: &GoldenRow) -> f32 {
+    let f = forces(r);
+    (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt()
+}
+
+/// The row the ramp cases start from: of `golden_in_domain(10)`, the one with the largest
+/// force below `below_n`, so that ramping it to zero takes several ticks whatever the
+/// fitted model's magnitudes are.
+fn row_to_ramp(below_n: f32) -> GoldenRow {
+    golden_in_domain(10)
+        .into_iter()
+        .filter(|r| force_norm_n(r) < below_n)
+        .max_by(|a, b| force_norm_n(a).total_cmp(&force_norm_n(b)))
+        .expect("an in-domain golden row below the bound")
+}
+
+/// A good tick on golden row `row_to_ramp(below_n)`, then `fault` until the ramp reaches
+/// zero (enable low, DISABLED), two more fault ticks, then a good tick that resumes.
+fn ramp_case(fault: Result<Pose, PoseFault>, flag: LoopFlags, cfg: LoopConfig<3>, model: Option<Status>, below_n: f32) {
+    let r = row_to_ramp(below_n);
     let step = cfg.ramp_step_n;
     let mut cmds = vec![forces(&r)];
     loop {
@@ -220,33 +237,33 @@ fn ramp_case(fault: Result<Pose, PoseFault>, flag: LoopFlags, cfg: LoopConfig<3>
 
 #[test]
 fn stale_pose_ramps_to_zero_then_disables() {
-    ramp_case(Err(PoseFault::Stale), LoopFlags::POSE_STALE, config(10.0, OverLimit::Saturate, 0.01), Some(Status::OK));
+    ramp_case(Err(PoseFault::Stale), LoopFlags::POSE_STALE, config(10.0, OverLimit::Saturate, 0.01), Some(Status::OK), f32::INFINITY);
 }
 
 #[test]
 fn missing_pose_ramps_to_zero_then_disables() {
-    ramp_case(Err(PoseFault::Missing), LoopFlags::POSE_MISSING, config(10.0, OverLimit::Saturate, 0.01), Some(Status::OK));
+    ramp_case(Err(PoseFault::Missing), LoopFlags::POSE_MISSING, config(10.0, OverLimit::Saturate, 0.01), Some(Status::OK), f32::INFINITY);
 }
 
 #[test]
 fn evaluation_error_ramps_to_zero_then_disables() {
     let nan = Pose::new(f32::NAN, 0.0, 0.0, 0.0, 3.0);
-    ramp_case(Ok(nan), LoopFlags::EVAL_ERROR, config(10.0, OverLimit::Saturate, 0.01), Some(Status::ERROR));
+    ramp_case(Ok(nan), LoopFlags::EVAL_ERROR, config(10.0, OverLimit::Saturate, 0.01), Some(Status::ERROR), f32::INFINITY);
 }
 
 #[test]
 fn over_limit_in_ramp_mode_ramps_to_zero() {
     // A pose whose force is far above a tiny limit: the deepest centred pose.
     let deep = Pose::new(0.0, 0.0, 0.0, 0.0, 6.0);
-    let r = golden_in_domain(10)[7];
-    let f = forces(&r);
-    let n = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
     let deep_f = needle_haptics::wrench(&deep).wrench;
     let deep_n = (deep_f.fx_n.powi(2) + deep_f.fy_n.powi(2) + deep_f.fz_n.powi(2)).sqrt();
+    let below_n = deep_n / 1.01;
+    let r = row_to_ramp(below_n);
+    let n = force_norm_n(&r);
     assert!(deep_n > n * 1.01, "the deep pose must push harder than golden line {}", r.line);
     // The limit lets the good ticks through and stops the deep one.
     let limit = n * 1.005;
-    ramp_case(Ok(deep), LoopFlags::OVER_LIMIT, config(limit, OverLimit::RampToZero, 0.005), None);
+    ramp_case(Ok(deep), LoopFlags::OVER_LIMIT, config(limit, OverLimit::RampToZero, 0.005), None, below_n);
 }
 
 #[test]

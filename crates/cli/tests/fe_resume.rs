@@ -79,6 +79,8 @@ fn smoke_campaign_skips_and_resumes_after_a_kill() {
     let e = m.pose.get("centre").expect("manifest entry of centre");
     let (mut c, _) = spec::load(&set).expect("spec");
     c.loading.steps = 2;
+    // the run was solved with --solver ccx, whatever the spec's own engine is
+    c.solver.engine = spec::Engine::Ccx;
     let centre = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");
     assert_eq!(e.spec_hash, c.run_hash(&centre, "smoke"), "hash of the spec with --steps 2");
     let version = ccx::ccx_version(&ccx::find_ccx().expect("ccx")).expect("version");
