@@ -14,11 +14,13 @@ pub const DEGREE: usize = 4;
 /// Coefficients per polynomial (`DEGREE + 1`).
 pub const TERMS: usize = DEGREE + 1;
 
-/// Wrench components in the contract's order (index `c = 0..5`): forces in N, moments
-/// in N·mm about the hub.
-pub const COMPONENTS: [&str; 6] = ["fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"];
+/// Number of model outputs (wrench components).
+pub const COMPONENT_COUNT: usize = 6;
+/// Wrench components in the contract's order (index `c = 0..COMPONENT_COUNT`): forces in
+/// N, moments in N·mm about the hub.
+pub const COMPONENTS: [&str; COMPONENT_COUNT] = ["fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"];
 /// Unit of each component (ASCII: `N*mm` is newton millimetre).
-pub const UNITS: [&str; 6] = ["N", "N", "N", "N*mm", "N*mm", "N*mm"];
+pub const UNITS: [&str; COMPONENT_COUNT] = ["N", "N", "N", "N*mm", "N*mm", "N*mm"];
 
 /// The four single-axis sweeps in the contract's order (index `k = 0..3`), as named in
 /// `model.toml`.
@@ -32,8 +34,8 @@ pub const DEPTH_INPUT: &str = "depth_mm";
 
 /// Columns of the f32 golden file (`golden-f32.csv`): the four pose inputs, the depth,
 /// the status bits, the wrench components.
-pub const GOLDEN_COLUMNS: [&str; 12] = {
-    let mut out = [""; 12];
+pub const GOLDEN_COLUMNS: [&str; 6 + COMPONENT_COUNT] = {
+    let mut out = [""; 6 + COMPONENT_COUNT];
     let mut i = 0;
     while i < 4 {
         out[i] = SWEEP_INPUTS[i];
@@ -42,7 +44,7 @@ pub const GOLDEN_COLUMNS: [&str; 12] = {
     out[4] = DEPTH_INPUT;
     out[5] = "status";
     let mut c = 0;
-    while c < 6 {
+    while c < COMPONENT_COUNT {
         out[6 + c] = COMPONENTS[c];
         c += 1;
     }
@@ -50,10 +52,10 @@ pub const GOLDEN_COLUMNS: [&str; 12] = {
 };
 
 /// Columns of an FE run's file (`fe/<pose>.csv`): the depth, the wrench components.
-pub const FE_COLUMNS: [&str; 7] = {
-    let mut out = [DEPTH_INPUT; 7];
+pub const FE_COLUMNS: [&str; 1 + COMPONENT_COUNT] = {
+    let mut out = [DEPTH_INPUT; 1 + COMPONENT_COUNT];
     let mut c = 0;
-    while c < 6 {
+    while c < COMPONENT_COUNT {
         out[1 + c] = COMPONENTS[c];
         c += 1;
     }
@@ -72,7 +74,7 @@ pub const HALF_RANGES: [f64; 4] = [XZ_MAX_MM, XZ_MAX_MM, THETA_MAX_DEG, THETA_MA
 /// `ODD[k][c]`: component `c` changes sign under sweep `k`'s mirror. The mirror x -> -x
 /// maps (x, theta_z) to (-x, -theta_z) and flips fx, my, mz; z -> -z maps (z, theta_x)
 /// to (-z, -theta_x) and flips fz, mx, my.
-pub const ODD: [[bool; 6]; 4] = [
+pub const ODD: [[bool; COMPONENT_COUNT]; 4] = [
     [true, false, false, false, true, true],
     [false, false, true, true, true, false],
     [false, false, true, true, true, false],
