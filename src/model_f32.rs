@@ -3,6 +3,7 @@ use crate::cross_f32::{add_cross, COUPLED, CROSS_SCALES};
 use crate::horner::horner;
 use crate::tables::{BASELINE, DEPTH_MAX_MM, DEVIATION, FITTED, THETA_MAX_DEG, X_MAX_MM, Z_MAX_MM};
 use crate::{Evaluation, Pose, Status, Wrench};
+use needle_contract::COMPONENT_COUNT;
 use needle_contract::TERMS;
 
 /// The nearest f32 to 1/3 (`u = depth * (1/3) - 1`).
@@ -13,7 +14,7 @@ pub(crate) const SWEEP_SCALES: [f32; 4] = needle_contract::SWEEP_SCALES_F32;
 
 /// `ODD[k][c]`: component c (fx, fy, fz, mx, my, mz) changes sign under sweep k's mirror
 /// (the contract's table, `needle_contract::ODD`).
-pub(crate) const ODD: [[bool; 6]; 4] = needle_contract::ODD;
+pub(crate) const ODD: [[bool; COMPONENT_COUNT]; 4] = needle_contract::ODD;
 
 /// `|v|`, exactly (clears the sign bit).
 #[inline(always)]
@@ -45,13 +46,13 @@ pub(crate) const fn is_plus_zero_matrix(m: &[[f32; TERMS]; TERMS]) -> bool {
 }
 
 /// `ZERO_BASELINE[c]`: every coefficient of `B_c` is `+0.0`.
-pub(crate) const ZERO_BASELINE: [bool; 6] = {
+pub(crate) const ZERO_BASELINE: [bool; COMPONENT_COUNT] = {
     let [b0, b1, b2, b3, b4, b5] = &BASELINE;
     [is_plus_zero(b0), is_plus_zero(b1), is_plus_zero(b2), is_plus_zero(b3), is_plus_zero(b4), is_plus_zero(b5)]
 };
 
 /// `SKIP_DEVIATION[k][c]`: `D_kc` is skipped (see [`skip_sweep`]).
-const SKIP_DEVIATION: [[bool; 6]; 4] = {
+const SKIP_DEVIATION: [[bool; COMPONENT_COUNT]; 4] = {
     let [d0, d1, d2, d3] = &DEVIATION;
     [skip_sweep(d0), skip_sweep(d1), skip_sweep(d2), skip_sweep(d3)]
 };
@@ -70,7 +71,7 @@ const SKIP_DEVIATION: [[bool; 6]; 4] = {
 ///   sum is `-0.0` only when both addends are `-0.0`, so `w_c` could only become
 ///   `-0.0` by starting as `-0.0`, from a baseline whose constant coefficient is
 ///   `-0.0`. For such a component nothing is skipped.
-const fn skip_sweep(mats: &[[[f32; TERMS]; TERMS]; 6]) -> [bool; 6] {
+const fn skip_sweep(mats: &[[[f32; TERMS]; TERMS]; COMPONENT_COUNT]) -> [bool; COMPONENT_COUNT] {
     let [m0, m1, m2, m3, m4, m5] = mats;
     let [b0, b1, b2, b3, b4, b5] = &BASELINE;
     [
@@ -123,8 +124,8 @@ pub(crate) fn sweep_t(v: f32, s: f32) -> f32 {
 /// 7.5 KiB instead of 4.7 KiB).
 #[cfg(not(target_abi = "eabihf"))]
 #[inline(always)]
-fn superpose(sweeps: [f32; 4], u: f32) -> [f32; 6] {
-    let mut w = [0.0_f32; 6];
+fn superpose(sweeps: [f32; 4], u: f32) -> [f32; COMPONENT_COUNT] {
+    let mut w = [0.0_f32; COMPONENT_COUNT];
     for ((wc, b), &zero) in w.iter_mut().zip(BASELINE.iter()).zip(ZERO_BASELINE.iter()) {
         *wc = baseline(b, zero, u);
     }
@@ -154,7 +155,7 @@ fn superpose(sweeps: [f32; 4], u: f32) -> [f32; 6] {
 /// it is one `vmla.f32` (multiply rounded, then add rounded: not fused).
 #[cfg(target_abi = "eabihf")]
 #[inline(always)]
-fn superpose(sweeps: [f32; 4], u: f32) -> [f32; 6] {
+fn superpose(sweeps: [f32; 4], u: f32) -> [f32; COMPONENT_COUNT] {
     let [b0, b1, b2, b3, b4, b5] = &BASELINE;
     let [z0, z1, z2, z3, z4, z5] = ZERO_BASELINE;
     let mut w =
@@ -174,7 +175,15 @@ fn superpose(sweeps: [f32; 4], u: f32) -> [f32; 6] {
 /// Adds one sweep's six deviations to `w` (unrolled form of the inner loop).
 #[cfg(target_abi = "eabihf")]
 #[inline(always)]
-fn add_sweep(w: &mut [f32; 6], mats: &[[[f32; TERMS]; TERMS]; 6], odd: &[bool; 6], skip: &[bool; 6], v: f32, s: f32, u: f32) {
+fn add_sweep(
+    w: &mut [f32; COMPONENT_COUNT],
+    mats: &[[[f32; TERMS]; TERMS]; COMPONENT_COUNT],
+    odd: &[bool; COMPONENT_COUNT],
+    skip: &[bool; COMPONENT_COUNT],
+    v: f32,
+    s: f32,
+    u: f32,
+) {
     let t = sweep_t(v, s);
     let sign = if v < 0.0 { -1.0_f32 } else { 1.0 };
     let [w0, w1, w2, w3, w4, w5] = w;

@@ -1,6 +1,7 @@
 //! [`Stiffness`]: how the reaction wrench changes with depth and with the insertion point,
 //! and [`StiffnessEvaluation`], a wrench with its stiffness.
 use crate::{Status, Wrench};
+use needle_contract::COMPONENT_COUNT;
 
 /// The rate of change of every wrench component with respect to one input measured in
 /// mm: forces in N/mm, moments in N·mm/mm.
@@ -23,19 +24,19 @@ pub struct WrenchRate {
 
 impl WrenchRate {
     /// Every rate `+0.0`.
-    pub const ZERO: Self = Self::from_array([0.0; 6]);
+    pub const ZERO: Self = Self::from_array([0.0; COMPONENT_COUNT]);
 
     /// The six rates in the model's component order (fx, fy, fz, mx, my, mz).
     #[inline]
     #[must_use]
-    pub const fn to_array(self) -> [f32; 6] {
+    pub const fn to_array(self) -> [f32; COMPONENT_COUNT] {
         [self.dfx_n_per_mm, self.dfy_n_per_mm, self.dfz_n_per_mm, self.dmx_nmm_per_mm, self.dmy_nmm_per_mm, self.dmz_nmm_per_mm]
     }
 
     /// Rates from `[fx, fy, fz, mx, my, mz]` (N/mm and N·mm/mm).
     #[inline]
     #[must_use]
-    pub const fn from_array(a: [f32; 6]) -> Self {
+    pub const fn from_array(a: [f32; COMPONENT_COUNT]) -> Self {
         let [dfx_n_per_mm, dfy_n_per_mm, dfz_n_per_mm, dmx_nmm_per_mm, dmy_nmm_per_mm, dmz_nmm_per_mm] = a;
         Self { dfx_n_per_mm, dfy_n_per_mm, dfz_n_per_mm, dmx_nmm_per_mm, dmy_nmm_per_mm, dmz_nmm_per_mm }
     }

@@ -6,6 +6,7 @@ use crate::model_f32::{clamp_to_domain, is_plus_zero_matrix, starts_not_neg_zero
 use crate::stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
 use crate::tables::{BASELINE, DEVIATION, FITTED};
 use crate::{Pose, Status, Wrench};
+use needle_contract::COMPONENT_COUNT;
 use needle_contract::TERMS;
 
 /// Whether neither `B(u)` nor `B'(u)` of the baseline `b` can be `-0.0`: `B` as for the
@@ -17,7 +18,7 @@ const fn rates_not_neg_zero(b: &[f32; TERMS]) -> bool {
 }
 
 /// One sweep's row of [`SKIP`].
-const fn skip_sweep(mats: &[[[f32; TERMS]; TERMS]; 6]) -> [bool; 6] {
+const fn skip_sweep(mats: &[[[f32; TERMS]; TERMS]; COMPONENT_COUNT]) -> [bool; COMPONENT_COUNT] {
     let [m0, m1, m2, m3, m4, m5] = mats;
     let [b0, b1, b2, b3, b4, b5] = &BASELINE;
     [
@@ -35,7 +36,7 @@ const fn skip_sweep(mats: &[[[f32; TERMS]; TERMS]; 6]) -> [bool; 6] {
 /// `model_f32::skip_sweep`), and neither `B_c(u)` nor `B_c'(u)` can be `-0.0`
 /// ([`rates_not_neg_zero`]). The x and z rates of a skipped matrix start from `+0.0` and
 /// stay `+0.0` (`+0 - +0 = +0`).
-const SKIP: [[bool; 6]; 4] = {
+const SKIP: [[bool; COMPONENT_COUNT]; 4] = {
     let [d0, d1, d2, d3] = &DEVIATION;
     [skip_sweep(d0), skip_sweep(d1), skip_sweep(d2), skip_sweep(d3)]
 };
@@ -86,10 +87,10 @@ pub fn wrench_and_stiffness(pose: &Pose) -> StiffnessEvaluation {
     // then the sweeps x, z, theta_x, theta_z), written out with constant indices so the
     // tables, parities and skip flags are constants in straight-line code and only one
     // component's four accumulators are live at a time.
-    let mut w = [0.0_f32; 6];
-    let mut by_depth = [0.0_f32; 6];
-    let mut by_x = [0.0_f32; 6];
-    let mut by_z = [0.0_f32; 6];
+    let mut w = [0.0_f32; COMPONENT_COUNT];
+    let mut by_depth = [0.0_f32; COMPONENT_COUNT];
+    let mut by_x = [0.0_f32; COMPONENT_COUNT];
+    let mut by_z = [0.0_f32; COMPONENT_COUNT];
     let columns = [
         component_of::<0>(&at),
         component_of::<1>(&at),
@@ -110,7 +111,7 @@ pub fn wrench_and_stiffness(pose: &Pose) -> StiffnessEvaluation {
         add_cross(n, u, &mut w);
         add_cross_rates(n, u, &mut by_depth, &mut by_x, &mut by_z);
     }
-    let along = |flag: Status, r: [f32; 6]| if status.contains(flag) { WrenchRate::ZERO } else { WrenchRate::from_array(r) };
+    let along = |flag: Status, r: [f32; COMPONENT_COUNT]| if status.contains(flag) { WrenchRate::ZERO } else { WrenchRate::from_array(r) };
     StiffnessEvaluation {
         wrench: Wrench::from_array(w),
         stiffness: Stiffness {

@@ -1,4 +1,5 @@
 //! [`Wrench`]: the reaction force and moment of the tissue on the needle.
+use needle_contract::COMPONENT_COUNT;
 
 /// Reaction wrench of the tissue on the needle, in the block frame (`docs/architecture.md` §3).
 ///
@@ -25,19 +26,19 @@ pub struct Wrench {
 
 impl Wrench {
     /// The zero wrench (every component `+0.0`).
-    pub const ZERO: Self = Self::from_array([0.0; 6]);
+    pub const ZERO: Self = Self::from_array([0.0; COMPONENT_COUNT]);
 
     /// The six components in the model's order: `[fx_n, fy_n, fz_n, mx_nmm, my_nmm, mz_nmm]`.
     #[inline]
     #[must_use]
-    pub const fn to_array(self) -> [f32; 6] {
+    pub const fn to_array(self) -> [f32; COMPONENT_COUNT] {
         [self.fx_n, self.fy_n, self.fz_n, self.mx_nmm, self.my_nmm, self.mz_nmm]
     }
 
     /// A wrench from `[fx_n, fy_n, fz_n, mx_nmm, my_nmm, mz_nmm]` (N and N·mm).
     #[inline]
     #[must_use]
-    pub const fn from_array(a: [f32; 6]) -> Self {
+    pub const fn from_array(a: [f32; COMPONENT_COUNT]) -> Self {
         let [fx_n, fy_n, fz_n, mx_nmm, my_nmm, mz_nmm] = a;
         Self { fx_n, fy_n, fz_n, mx_nmm, my_nmm, mz_nmm }
     }

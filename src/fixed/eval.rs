@@ -7,6 +7,7 @@ use super::tables::{
 use super::{Evaluation, Pose, Wrench};
 use crate::tables::FITTED;
 use crate::Status;
+use needle_contract::COMPONENT_COUNT;
 use needle_contract::TERMS;
 
 /// The reaction wrench of the compiled-in set's model at `pose`, in integer arithmetic
@@ -105,7 +106,7 @@ impl Inputs {
 /// Steps 4-6: every component's accumulators `A_i` (baseline, the four sweeps' rows, the
 /// cross terms), each in its Q(G).
 #[inline(always)]
-pub(super) fn accumulators(at: &Inputs) -> [[i32; TERMS]; 6] {
+pub(super) fn accumulators(at: &Inputs) -> [[i32; TERMS]; COMPONENT_COUNT] {
     let mut a = BASELINE;
     let tables = ROWS.iter().zip(SHIFTS.iter()).zip(ODD.iter());
     for (ac, ((rows, shifts), odd)) in a.iter_mut().zip(tables) {
@@ -125,8 +126,8 @@ pub(super) fn accumulators(at: &Inputs) -> [[i32; TERMS]; 6] {
 
 /// Step 7: `W = h(A, U)` per component, rounded half up to whole µN or µN·mm.
 #[inline(always)]
-pub(super) fn output(a: &[[i32; TERMS]; 6], u: i32) -> [i32; 6] {
-    let mut w = [0_i32; 6];
+pub(super) fn output(a: &[[i32; TERMS]; COMPONENT_COUNT], u: i32) -> [i32; COMPONENT_COUNT] {
+    let mut w = [0_i32; COMPONENT_COUNT];
     for ((wc, ac), &g) in w.iter_mut().zip(a.iter()).zip(FRAC_BITS.iter()) {
         let acc = horner(ac, u);
         *wc = acc.wrapping_add(1_i32.wrapping_shl(g) >> 1).wrapping_shr(g);

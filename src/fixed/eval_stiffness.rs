@@ -8,6 +8,7 @@ use super::tables::{FRAC_BITS, ODD, RATE_ROWS, RATE_SHIFTS, SHIFTS};
 use super::{Pose, Wrench};
 use crate::tables::FITTED;
 use crate::Status;
+use needle_contract::COMPONENT_COUNT;
 use needle_contract::{DEGREE, TERMS};
 
 /// The wrench of [`wrench`](super::wrench) (the same integers) and its partial
@@ -64,7 +65,7 @@ fn wrench_and_depth_rates(pose: &Pose, e: &mut StiffnessEvaluation) {
     let at = &Inputs::of(pose);
     let a = accumulators(at);
     let w = output(&a, at.u);
-    let mut by_depth = [0_i32; 6];
+    let mut by_depth = [0_i32; COMPONENT_COUNT];
     for (((r, ac), &g), &rs) in by_depth.iter_mut().zip(a.iter()).zip(FRAC_BITS.iter()).zip(RATE_SHIFTS.iter()) {
         // E_i = (i + 1) * (A_(i+1) >> R), written out: the loop form costs the M0 14
         // instructions per call (11,486.1 -> 11,500.0, needle firmware bench)
@@ -89,7 +90,7 @@ fn along<const K: usize>(pose: &Pose, out: &mut WrenchRate) {
     let [tx, tz, _, _] = at.t;
     let [neg_x, neg_z, _, _] = at.negative;
     let (t, negative) = if K == 0 { (tx, neg_x) } else { (tz, neg_z) };
-    let mut g = [[0_i32; TERMS]; 6];
+    let mut g = [[0_i32; TERMS]; COMPONENT_COUNT];
     let tables = RATE_ROWS.iter().zip(SHIFTS.iter()).zip(ODD.iter());
     for (gc, ((rate_rows, shifts), odd)) in g.iter_mut().zip(tables) {
         let [rows_x, rows_z] = rate_rows;
@@ -106,7 +107,7 @@ fn along<const K: usize>(pose: &Pose, out: &mut WrenchRate) {
     } else {
         add_cross_rates_z(at.cross_inputs(), &mut g);
     }
-    let mut rates = [0_i32; 6];
+    let mut rates = [0_i32; COMPONENT_COUNT];
     for (((r, gc), &bits), &rs) in rates.iter_mut().zip(g.iter()).zip(FRAC_BITS.iter()).zip(RATE_SHIFTS.iter()) {
         *r = div_round(horner(gc, at.u), 6_i32.wrapping_shl(bits.wrapping_sub(rs)));
     }

@@ -2,6 +2,7 @@
 //! [`StiffnessEvaluation`], a fixed-point wrench with its stiffness.
 use super::Wrench;
 use crate::Status;
+use needle_contract::COMPONENT_COUNT;
 
 /// The rate of change of every wrench component with respect to one input measured in
 /// mm, in integers: forces in µN/mm, moments in µN·mm/mm (the f32 [`crate::WrenchRate`]
@@ -24,19 +25,19 @@ pub struct WrenchRate {
 
 impl WrenchRate {
     /// Every rate zero.
-    pub const ZERO: Self = Self::from_array([0; 6]);
+    pub const ZERO: Self = Self::from_array([0; COMPONENT_COUNT]);
 
     /// The six rates in the model's component order (fx, fy, fz, mx, my, mz).
     #[inline]
     #[must_use]
-    pub const fn to_array(self) -> [i32; 6] {
+    pub const fn to_array(self) -> [i32; COMPONENT_COUNT] {
         [self.dfx_un_per_mm, self.dfy_un_per_mm, self.dfz_un_per_mm, self.dmx_unmm_per_mm, self.dmy_unmm_per_mm, self.dmz_unmm_per_mm]
     }
 
     /// Rates from `[fx, fy, fz, mx, my, mz]` (µN/mm and µN·mm/mm).
     #[inline]
     #[must_use]
-    pub const fn from_array(a: [i32; 6]) -> Self {
+    pub const fn from_array(a: [i32; COMPONENT_COUNT]) -> Self {
         let [dfx_un_per_mm, dfy_un_per_mm, dfz_un_per_mm, dmx_unmm_per_mm, dmy_unmm_per_mm, dmz_unmm_per_mm] = a;
         Self { dfx_un_per_mm, dfy_un_per_mm, dfz_un_per_mm, dmx_unmm_per_mm, dmy_unmm_per_mm, dmz_unmm_per_mm }
     }

@@ -1,5 +1,6 @@
 //! [`Wrench`] in fixed point (micro-newtons) and the fixed-point [`Evaluation`].
 use crate::Status;
+use needle_contract::COMPONENT_COUNT;
 
 /// Reaction wrench of the tissue on the needle in integers: forces in micro-newtons
 /// (µN, 10^-6 N), moments in micro-newton millimetres (µN·mm), about the needle's
@@ -26,19 +27,19 @@ pub struct Wrench {
 
 impl Wrench {
     /// The zero wrench.
-    pub const ZERO: Self = Self::from_array([0; 6]);
+    pub const ZERO: Self = Self::from_array([0; COMPONENT_COUNT]);
 
     /// The six components in the model's order: `[fx_un, fy_un, fz_un, mx_unmm, my_unmm, mz_unmm]`.
     #[inline]
     #[must_use]
-    pub const fn to_array(self) -> [i32; 6] {
+    pub const fn to_array(self) -> [i32; COMPONENT_COUNT] {
         [self.fx_un, self.fy_un, self.fz_un, self.mx_unmm, self.my_unmm, self.mz_unmm]
     }
 
     /// A wrench from `[fx_un, fy_un, fz_un, mx_unmm, my_unmm, mz_unmm]` (µN and µN·mm).
     #[inline]
     #[must_use]
-    pub const fn from_array(a: [i32; 6]) -> Self {
+    pub const fn from_array(a: [i32; COMPONENT_COUNT]) -> Self {
         let [fx_un, fy_un, fz_un, mx_unmm, my_unmm, mz_unmm] = a;
         Self { fx_un, fy_un, fz_un, mx_unmm, my_unmm, mz_unmm }
     }

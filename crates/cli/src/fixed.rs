@@ -3,6 +3,7 @@
 use crate::fixed_error::{self, ErrorStats, GOAL_PCT};
 use crate::model::check_compiled_set;
 use clap::Args;
+use needle_contract::COMPONENT_COUNT;
 use rand::{RngCore, SeedableRng};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -47,8 +48,8 @@ pub fn fixed_error(a: FixedErrorArgs) -> anyhow::Result<ExitCode> {
     }
     println!("needle fixed-error: set {} ({}^5 grid + {} random poses)", a.set.display(), a.grid, a.random);
     print!("{}", fixed_error::table(&stats, lever));
-    let within = (0..6).all(|c| stats.max_error[c] <= fixed_error::bound(c));
-    let goal = (0..6).all(|c| 100.0 * fixed_error::bound(c) / fixed_error::scale(&stats, c, lever) <= GOAL_PCT);
+    let within = (0..COMPONENT_COUNT).all(|c| stats.max_error[c] <= fixed_error::bound(c));
+    let goal = (0..COMPONENT_COUNT).all(|c| 100.0 * fixed_error::bound(c) / fixed_error::scale(&stats, c, lever) <= GOAL_PCT);
     println!("every measured error within its bound: {}", if within { "yes" } else { "NO" });
     Ok(if within && goal { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }

@@ -9,6 +9,7 @@
 //! needle's lever arm `needle.reference_from_tip_mm`, as in the validation reports).
 
 use anyhow::{Context, Result};
+use needle_contract::COMPONENT_COUNT;
 use needle_fit::contract::{unit, COMPONENTS};
 use needle_fit::{eval_f64, model::Model, model_file, MODEL_FILE};
 use needle_haptics::fixed::{self, tables::ERROR_BOUND_MICRO};
@@ -28,9 +29,9 @@ pub struct ErrorStats {
     /// Poses evaluated.
     pub poses: usize,
     /// Largest |fixed - f64| per component, N or N·mm.
-    pub max_error: [f64; 6],
+    pub max_error: [f64; COMPONENT_COUNT],
     /// A pose where it was reached (Q16.16).
-    pub worst_pose: [[i32; 5]; 6],
+    pub worst_pose: [[i32; 5]; COMPONENT_COUNT],
     /// Largest |Fy| of the f64 model over the poses, N.
     pub peak_fy_n: f64,
 }
@@ -40,7 +41,7 @@ impl ErrorStats {
     pub fn add(&mut self, model: &Model, pose: [i32; 5]) {
         let (want, _) = eval_f64::eval(model, pose.map(|v| f64::from(v) / 65536.0));
         let got = fixed::wrench(&fixed::Pose::new(pose[0], pose[1], pose[2], pose[3], pose[4])).wrench.to_array();
-        for c in 0..6 {
+        for c in 0..COMPONENT_COUNT {
             let e = (f64::from(got[c]) * 1e-6 - want[c]).abs();
             if e > self.max_error[c] {
                 self.max_error[c] = e;
@@ -113,7 +114,7 @@ pub fn table(stats: &ErrorStats, lever_arm_mm: f64) -> String {
         stats.poses, stats.peak_fy_n
     );
     let _ = writeln!(s, "{:<8} {:>14} {:>10} {:>14} {:>10}  unit", "comp", "max error", "% peak", "bound", "% peak");
-    for c in 0..6 {
+    for c in 0..COMPONENT_COUNT {
         let sc = scale(stats, c, lever_arm_mm);
         let _ = writeln!(
             s,
@@ -126,7 +127,7 @@ pub fn table(stats: &ErrorStats, lever_arm_mm: f64) -> String {
             unit(c)
         );
     }
-    let worst = (0..6).map(|c| 100.0 * bound(c) / scale(stats, c, lever_arm_mm)).fold(0.0, f64::max);
+    let worst = (0..COMPONENT_COUNT).map(|c| 100.0 * bound(c) / scale(stats, c, lever_arm_mm)).fold(0.0, f64::max);
     let _ = writeln!(
         s,
         "goal: every bound <= {GOAL_PCT} % of peak |Fy| (x lever arm): {} (worst {worst:.5} %)",

@@ -12,6 +12,7 @@
 use crate::contract::{COMPONENTS, SWEEPS};
 use crate::error::CodegenError;
 use crate::model::Model;
+use needle_contract::COMPONENT_COUNT;
 use needle_contract::{DEGREE, TERMS};
 use std::path::Path;
 
@@ -112,7 +113,7 @@ pub struct FixedComponent {
 #[derive(Debug, Clone, PartialEq)]
 pub struct FixedTables {
     /// One entry per component, contract order.
-    pub components: [FixedComponent; 6],
+    pub components: [FixedComponent; COMPONENT_COUNT],
 }
 
 /// The largest `f` in `0..=MAX_FRAC_BITS` whose quantised row fits: `sum_j |q(c_j, f)| <= LIMIT`.
@@ -298,7 +299,8 @@ pub fn fixed_formats(model: &Model, model_path: &Path) -> Result<FixedTables, Co
         };
         components.push(comp);
     }
-    let components: [FixedComponent; 6] = components.try_into().map_err(|_| at(0, "the model does not have 6 components".into()))?;
+    let components: [FixedComponent; COMPONENT_COUNT] =
+        components.try_into().map_err(|_| at(0, "the model does not have 6 components".into()))?;
     Ok(FixedTables { components })
 }
 

@@ -1,6 +1,7 @@
 //! Reading and validating `model.toml` (format in `coeffs/README.md`).
 use crate::contract::{COMPONENTS, DEPTH_MAX_MM, FORMAT, HALF_RANGES, ODD, SWEEPS};
 use crate::error::CodegenError;
+use needle_contract::COMPONENT_COUNT;
 use needle_contract::{DEGREE, TERMS};
 use serde::Deserialize;
 use std::ops::Range;
@@ -71,10 +72,10 @@ pub struct Coupled {
     /// Training runs the cross terms were fitted on.
     pub training_runs: usize,
     /// Cross-validated RMS error per component, % of `scale`.
-    pub cv_rms_pct: [f64; 6],
+    pub cv_rms_pct: [f64; COMPONENT_COUNT],
     /// The scale of `cv_rms_pct` per component: peak |Fy| of the training runs (N), times
     /// the lever arm for the moments (N*mm).
-    pub scale: [f64; 6],
+    pub scale: [f64; COMPONENT_COUNT],
 }
 
 /// A validated model: everything the generators need.
@@ -100,7 +101,7 @@ pub struct Model {
 impl Model {
     /// The placeholder of a set without a fitted model: zero tables, `fitted == false`.
     pub fn unfitted(set: &str) -> Self {
-        let baseline = (0..6)
+        let baseline = (0..COMPONENT_COUNT)
             .map(|c| Baseline {
                 component: c,
                 coeffs: [0.0; TERMS],
@@ -126,8 +127,8 @@ impl Model {
     }
 
     /// The f32 baseline table, `[component][i]`.
-    pub fn baseline_f32(&self) -> [[f32; TERMS]; 6] {
-        let mut out = [[0.0; TERMS]; 6];
+    pub fn baseline_f32(&self) -> [[f32; TERMS]; COMPONENT_COUNT] {
+        let mut out = [[0.0; TERMS]; COMPONENT_COUNT];
         for (o, b) in out.iter_mut().zip(&self.baseline) {
             *o = b.coeffs_f32;
         }
@@ -135,8 +136,8 @@ impl Model {
     }
 
     /// The f32 deviation table, `[sweep][component][i][j]`.
-    pub fn deviation_f32(&self) -> [[[[f32; TERMS]; TERMS]; 6]; 4] {
-        let mut out = [[[[0.0; TERMS]; TERMS]; 6]; 4];
+    pub fn deviation_f32(&self) -> [[[[f32; TERMS]; TERMS]; COMPONENT_COUNT]; 4] {
+        let mut out = [[[[0.0; TERMS]; TERMS]; COMPONENT_COUNT]; 4];
         for m in &self.matrices {
             out[m.sweep][m.component] = m.rows_f32;
         }
@@ -334,12 +335,12 @@ impl Checker<'_> {
         let depth_degree = degree(&raw.depth_degree, "depth_degree")?;
         let training_runs = usize::try_from(*raw.training_runs.get_ref())
             .map_err(|_| self.err(raw.training_runs.span(), "[coupled] training_runs: expected a count >= 0"))?;
-        let six = |v: &Spanned<Vec<Spanned<f64>>>, key: &str| -> Result<[f64; 6], CodegenError> {
+        let six = |v: &Spanned<Vec<Spanned<f64>>>, key: &str| -> Result<[f64; COMPONENT_COUNT], CodegenError> {
             let list = v.get_ref();
             if list.len() != 6 {
                 return Err(self.err(v.span(), format!("[coupled] {key}: {} values, expected 6 (one per component)", list.len())));
             }
-            let mut out = [0.0; 6];
+            let mut out = [0.0; COMPONENT_COUNT];
             for (o, x) in out.iter_mut().zip(list) {
                 let val = self.finite(x, &format!("[coupled] {key}"))?;
                 if val < 0.0 {

@@ -5,6 +5,7 @@ use crate::contract::{
     UNITS,
 };
 use crate::model::Model;
+use needle_contract::COMPONENT_COUNT;
 use needle_contract::TERMS;
 use std::fmt::Write as _;
 
@@ -80,7 +81,7 @@ pub fn render_rust(model: &Model) -> String {
     let _ = writeln!(w, "/// Baseline polynomials `B_c(u)` of the centred, vertical needle, `[component][i]`:");
     let _ = writeln!(w, "/// `B_c = sum_i BASELINE[c][i] * u^i` (evaluated by Horner, highest power first),");
     let _ = writeln!(w, "/// `{DEPTH_DOMAIN}`. Components in the order fx_n, fy_n, fz_n (N), mx_nmm, my_nmm, mz_nmm (N*mm).");
-    let _ = writeln!(w, "pub const BASELINE: [[f32; {TERMS}]; 6] = [");
+    let _ = writeln!(w, "pub const BASELINE: [[f32; {TERMS}]; {COMPONENT_COUNT}] = [");
     for b in &model.baseline {
         let unit = UNITS[b.component];
         let _ = writeln!(w, "    // {} ({unit}); domain {DEPTH_DOMAIN};", COMPONENTS[b.component]);
@@ -97,7 +98,7 @@ pub fn render_rust(model: &Model) -> String {
     let _ = writeln!(w, "/// Deviation polynomials `D_kc(t, u)`, `[sweep][component][i][j]`: `DEVIATION[k][c][i][j]`");
     let _ = writeln!(w, "/// multiplies `u^i * t^j`; rows are evaluated by Horner in `t`, then the row values by Horner");
     let _ = writeln!(w, "/// in `u`. Sweeps in the order x, z, theta_x, theta_z; components as in [`BASELINE`].");
-    let _ = writeln!(w, "pub const DEVIATION: [[[[f32; {TERMS}]; {TERMS}]; 6]; 4] = [");
+    let _ = writeln!(w, "pub const DEVIATION: [[[[f32; {TERMS}]; {TERMS}]; {COMPONENT_COUNT}]; 4] = [");
     for (k, sweep) in SWEEPS.iter().enumerate() {
         let _ = writeln!(w, "    // sweep {sweep}: {}", sweep_domain(k));
         let _ = writeln!(w, "    [");

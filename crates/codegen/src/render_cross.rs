@@ -13,6 +13,7 @@ use crate::contract::{COMPONENTS, CROSS_SCALES_F32, HALF_RANGES, SWEEPS, UNITS};
 use crate::fixed::{FixedTables, CROSS_DIVISORS};
 use crate::literal::f32_literal;
 use crate::model::Model;
+use needle_contract::COMPONENT_COUNT;
 use needle_contract::TERMS;
 use std::fmt::Write as _;
 
@@ -97,19 +98,27 @@ pub fn render_rust_cross(model: &Model) -> String {
     let _ = writeln!(w, "pub const CROSS_SCALES: [f32; 4] = [{}];", scales.join(", "));
     let _ = writeln!(w, "/// Cross-validated RMS error of the coupled form per component (fx_n .. mz_nmm), in %");
     let _ = writeln!(w, "/// of [`CV_SCALE`] (`cv_rms_pct` in model.toml); all zero for the paper form (not measured).");
-    let cv = coupled.map_or([0.0; 6], |c| c.cv_rms_pct);
-    let _ = writeln!(w, "pub const CV_RMS_PCT: [f32; 6] = [{}];", cv.iter().map(|v| lit(*v as f32)).collect::<Vec<_>>().join(", "));
+    let cv = coupled.map_or([0.0; COMPONENT_COUNT], |c| c.cv_rms_pct);
+    let _ = writeln!(
+        w,
+        "pub const CV_RMS_PCT: [f32; {COMPONENT_COUNT}] = [{}];",
+        cv.iter().map(|v| lit(*v as f32)).collect::<Vec<_>>().join(", ")
+    );
     let _ = writeln!(w, "/// What [`CV_RMS_PCT`] is a percentage of, per component: the training runs' peak |Fy| (N),");
     let _ = writeln!(w, "/// times the lever arm for the moments (N*mm); zero for the paper form.");
-    let scale = coupled.map_or([0.0; 6], |c| c.scale);
-    let _ = writeln!(w, "pub const CV_SCALE: [f32; 6] = [{}];", scale.iter().map(|v| lit(*v as f32)).collect::<Vec<_>>().join(", "));
+    let scale = coupled.map_or([0.0; COMPONENT_COUNT], |c| c.scale);
+    let _ = writeln!(
+        w,
+        "pub const CV_SCALE: [f32; {COMPONENT_COUNT}] = [{}];",
+        scale.iter().map(|v| lit(*v as f32)).collect::<Vec<_>>().join(", ")
+    );
     let _ = writeln!(w, "/// Training runs the cross terms were fitted on (0 for the paper form).");
     let _ = writeln!(w, "pub const TRAINING_RUNS: u32 = {};", coupled.map_or(0, |c| c.training_runs));
     let _ = writeln!(w);
     let _ = writeln!(w, "/// Step 6: `w[c] = w[c] + m * q` for every cross term, in file order (module docs of");
     let _ = writeln!(w, "/// `needle-codegen`'s `render_cross`). `n` = `(xi, zeta, alpha, beta)`, `u` the depth variable.");
     let _ = writeln!(w, "#[inline(always)]");
-    let _ = writeln!(w, "pub(crate) fn add_cross(n: [f32; 4], u: f32, w: &mut [f32; 6]) {{");
+    let _ = writeln!(w, "pub(crate) fn add_cross(n: [f32; 4], u: f32, w: &mut [f32; {COMPONENT_COUNT}]) {{");
     if model.cross.is_empty() {
         let _ = writeln!(w, "    let _ = (n, u, w);");
     } else {
@@ -141,7 +150,7 @@ fn render_rust_cross_rates(w: &mut String, model: &Model) {
     let _ = writeln!(w, "/// The cross terms' rates: `d[c] += (m * P'(u)) * (1/3)`, `x[c] += ((e_x * m/xi) * P(u)) * (1/12)`,");
     let _ = writeln!(w, "/// `z[c]` likewise, per term in file order (coeffs/README.md, \"Stiffness\").");
     let _ = writeln!(w, "#[inline(always)]");
-    let _ = writeln!(w, "pub(crate) fn add_cross_rates(n: [f32; 4], u: f32, d: &mut [f32; 6], x: &mut [f32; 6], z: &mut [f32; 6]) {{");
+    let _ = writeln!(w, "pub(crate) fn add_cross_rates(n: [f32; 4], u: f32, d: &mut [f32; {COMPONENT_COUNT}], x: &mut [f32; {COMPONENT_COUNT}], z: &mut [f32; {COMPONENT_COUNT}]) {{");
     if model.cross.is_empty() {
         let _ = writeln!(w, "    let _ = (n, u, d, x, z);");
     } else {
@@ -224,7 +233,7 @@ pub fn render_rust_cross_fixed(model: &Model, t: &FixedTables) -> String {
     let _ = writeln!(w, "/// Adds every cross term to the accumulators `a[c][i]` (each component in its Q(G)).");
     let _ = writeln!(w, "#[inline(always)]");
     let _ = writeln!(w, "#[allow(unused_variables)]");
-    let _ = writeln!(w, "pub(crate) fn add_cross(n: [i32; 4], a: &mut [[i32; {TERMS}]; 6]) {{");
+    let _ = writeln!(w, "pub(crate) fn add_cross(n: [i32; 4], a: &mut [[i32; {TERMS}]; {COMPONENT_COUNT}]) {{");
     let any = t.components.iter().any(|c| !c.cross.is_empty());
     if !any {
         let _ = writeln!(w, "    let _ = (n, a);");
@@ -271,7 +280,7 @@ fn render_rust_cross_rates_fixed(w: &mut String, t: &FixedTables) {
         let _ = writeln!(w, "/// Adds every cross term's {name} rates to `g[c][i]` (Q(G - R) per unit of t_{name}, `R = RATE_SHIFTS[c]`).");
         let _ = writeln!(w, "#[inline(always)]");
         let _ = writeln!(w, "#[allow(unused_variables)]");
-        let _ = writeln!(w, "pub(crate) fn add_cross_rates_{name}(n: [i32; 4], g: &mut [[i32; {TERMS}]; 6]) {{");
+        let _ = writeln!(w, "pub(crate) fn add_cross_rates_{name}(n: [i32; 4], g: &mut [[i32; {TERMS}]; {COMPONENT_COUNT}]) {{");
         let any = t.components.iter().any(|c| c.cross.iter().any(|x| x.exponents[k] > 0));
         if !any {
             let _ = writeln!(w, "    let _ = (n, g);");

@@ -3,6 +3,7 @@
 use crate::contract::{COMPONENTS, DEPTH_MAX_MM, HALF_RANGES, ODD, SWEEPS, UNITS};
 use crate::fixed::{FixedTables, DEPTH_DIVISOR, LIMIT, MAX_RATE_SHIFT, NORM_FRAC_BITS, POSE_FRAC_BITS, SWEEP_DIVISORS};
 use crate::model::Model;
+use needle_contract::COMPONENT_COUNT;
 use needle_contract::{DEGREE, TERMS};
 use std::fmt::Write as _;
 
@@ -51,7 +52,7 @@ pub fn render_rust_fixed(model: &Model, t: &FixedTables) -> String {
     let _ = writeln!(w, "/// rounded to nearest.");
     let _ = writeln!(w, "pub const SWEEP_DIVISORS: [u32; 4] = {SWEEP_DIVISORS:?};");
     let _ = writeln!(w, "/// `ODD[c][k]`: component c changes sign under sweep k's mirror (the contract's table, transposed).");
-    let _ = writeln!(w, "pub const ODD: [[bool; 4]; 6] = [");
+    let _ = writeln!(w, "pub const ODD: [[bool; 4]; {COMPONENT_COUNT}] = [");
     for (c, name) in COMPONENTS.iter().enumerate() {
         let col: Vec<String> = ODD.iter().map(|row| row[c].to_string()).collect();
         let _ = writeln!(w, "    [{}], // {name}", col.join(", "));
@@ -61,13 +62,13 @@ pub fn render_rust_fixed(model: &Model, t: &FixedTables) -> String {
     let _ = writeln!(w, "/// Fractional bits `G` of each component's accumulator (`A_i`, the Horner in `u`), contract");
     let _ = writeln!(w, "/// component order; the result is `(W + ((1 << G) >> 1)) >> G` micro-units.");
     let g: Vec<String> = t.components.iter().map(|c| c.frac_bits.to_string()).collect();
-    let _ = writeln!(w, "pub const FRAC_BITS: [u32; 6] = [{}];", g.join(", "));
+    let _ = writeln!(w, "pub const FRAC_BITS: [u32; {COMPONENT_COUNT}] = [{}];", g.join(", "));
 
     let _ = writeln!(w);
     let _ = writeln!(w, "/// Error bound of each component against the f64 evaluation of the same model (f64");
     let _ = writeln!(w, "/// coefficients, exact pose), over the whole domain: whole micro-units (uN for forces, uN*mm");
     let _ = writeln!(w, "/// for moments), rounded up. Derived term by term at code generation (coeffs/README.md).");
-    let _ = writeln!(w, "pub const ERROR_BOUND_MICRO: [u32; 6] = [");
+    let _ = writeln!(w, "pub const ERROR_BOUND_MICRO: [u32; {COMPONENT_COUNT}] = [");
     for (c, comp) in t.components.iter().enumerate() {
         let e = &comp.error_bound;
         let _ = writeln!(
@@ -87,7 +88,7 @@ pub fn render_rust_fixed(model: &Model, t: &FixedTables) -> String {
 
     let _ = writeln!(w);
     let _ = writeln!(w, "/// Baseline coefficients `[component][i]` (multiplies `u^i`), in each component's Q(G).");
-    let _ = writeln!(w, "pub const BASELINE: [[i32; {TERMS}]; 6] = [");
+    let _ = writeln!(w, "pub const BASELINE: [[i32; {TERMS}]; {COMPONENT_COUNT}] = [");
     for (c, comp) in t.components.iter().enumerate() {
         let _ = writeln!(
             w,
@@ -106,7 +107,7 @@ pub fn render_rust_fixed(model: &Model, t: &FixedTables) -> String {
     let _ = writeln!(w, "/// Row polynomials `[component][sweep][i][j]`: `ROWS[c][k][i][j]` multiplies `t_k^j`; row `i` is");
     let _ = writeln!(w, "/// the coefficient of `u^i` of the deviation of sweep `k` (x, z, theta_x, theta_z). Each row in");
     let _ = writeln!(w, "/// its own Q(f); `SHIFTS[c][k][i] = f - G`.");
-    let _ = writeln!(w, "pub const ROWS: [[[[i32; {TERMS}]; {TERMS}]; 4]; 6] = [");
+    let _ = writeln!(w, "pub const ROWS: [[[[i32; {TERMS}]; {TERMS}]; 4]; {COMPONENT_COUNT}] = [");
     for (c, comp) in t.components.iter().enumerate() {
         let _ = writeln!(w, "    // {} ({})", COMPONENTS[c], micro_unit(c));
         let _ = writeln!(w, "    [");
@@ -124,7 +125,7 @@ pub fn render_rust_fixed(model: &Model, t: &FixedTables) -> String {
 
     let _ = writeln!(w);
     let _ = writeln!(w, "/// Alignment shifts `[component][sweep][i]`: row value `>> SHIFTS[c][k][i]` is in Q(G).");
-    let _ = writeln!(w, "pub const SHIFTS: [[[u32; {TERMS}]; 4]; 6] = [");
+    let _ = writeln!(w, "pub const SHIFTS: [[[u32; {TERMS}]; 4]; {COMPONENT_COUNT}] = [");
     for (c, comp) in t.components.iter().enumerate() {
         let rows: Vec<String> = comp.shifts.iter().map(|r| format!("{r:?}")).collect();
         let _ = writeln!(w, "    [{}], // {}", rows.join(", "), COMPONENTS[c]);
@@ -142,11 +143,11 @@ fn render_rate_tables(w: &mut String, t: &FixedTables) {
     let _ = writeln!(w, "/// (`min({MAX_RATE_SHIFT}, G)`: `A_i >> R`, `P_j >> R`), so every rate is computed in Q(G - R) and its Horner");
     let _ = writeln!(w, "/// intermediates stay within 2^30.");
     let r: Vec<String> = t.components.iter().map(|c| c.rate_shift.to_string()).collect();
-    let _ = writeln!(w, "pub const RATE_SHIFTS: [u32; 6] = [{}];", r.join(", "));
+    let _ = writeln!(w, "pub const RATE_SHIFTS: [u32; {COMPONENT_COUNT}] = [{}];", r.join(", "));
     let _ = writeln!(w, "/// Row t-derivatives of the x and z sweeps `[component][sweep][i][j]`:");
     let _ = writeln!(w, "/// `RATE_ROWS[c][k][i][j] = (j + 1) * (ROWS[c][k][i][j + 1] >> RATE_SHIFTS[c])` multiplies `t_k^j`,");
     let _ = writeln!(w, "/// in the row's Q(f - R) (aligned to Q(G - R) by the same `SHIFTS[c][k][i]`).");
-    let _ = writeln!(w, "pub const RATE_ROWS: [[[[i32; {DEGREE}]; {TERMS}]; 2]; 6] = [");
+    let _ = writeln!(w, "pub const RATE_ROWS: [[[[i32; {DEGREE}]; {TERMS}]; 2]; {COMPONENT_COUNT}] = [");
     for (c, comp) in t.components.iter().enumerate() {
         let [d, x, z] = comp.rate_bounds;
         let _ = writeln!(

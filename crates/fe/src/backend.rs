@@ -9,6 +9,7 @@ use crate::deck::{self, MeshSummary};
 use crate::spec::{Campaign, MeshLevel, PoseSpec};
 use crate::wrench;
 use anyhow::{bail, Context, Result};
+use needle_contract::COMPONENT_COUNT;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -48,7 +49,7 @@ pub struct Job<'a> {
 pub struct Solved {
     /// The wrench on the needle about its reference point after each step, `steps`
     /// entries: fx, fy, fz (N), mx, my, mz (N·mm).
-    pub wrenches: Vec<[f64; 6]>,
+    pub wrenches: Vec<[f64; COMPONENT_COUNT]>,
     /// Size of the model.
     pub summary: MeshSummary,
     /// Converged increments.

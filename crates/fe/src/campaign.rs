@@ -46,6 +46,7 @@ use crate::report::{PoseReport, Report, Status};
 use crate::results::{self, Row};
 use crate::spec::{self, Campaign, Engine, MeshLevel, PoseSpec};
 use anyhow::{bail, Context, Result};
+use needle_contract::COMPONENT_COUNT;
 use std::collections::BTreeMap;
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
@@ -486,7 +487,7 @@ fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Res
     if s.wrenches.len() != ctx.steps as usize {
         bail!("the solver returned {} wrenches for {} steps", s.wrenches.len(), ctx.steps);
     }
-    let mut rows = vec![Row { depth_mm: 0.0, wrench: [0.0; 6] }];
+    let mut rows = vec![Row { depth_mm: 0.0, wrench: [0.0; COMPONENT_COUNT] }];
     for (k, w) in (1u32..).zip(&s.wrenches) {
         if w.iter().any(|v| !v.is_finite()) {
             bail!("step {k}: the wrench is not finite: {w:?}");
@@ -644,7 +645,7 @@ mod tests {
         for name in ["x+02", "x+04"] {
             let rows = results::read_csv(&fe.join(format!("{name}.csv"))).expect("csv");
             assert_eq!(rows.len(), 3);
-            assert_eq!(rows[0], Row { depth_mm: 0.0, wrench: [0.0; 6] });
+            assert_eq!(rows[0], Row { depth_mm: 0.0, wrench: [0.0; COMPONENT_COUNT] });
             assert_eq!(rows.iter().map(|r| r.depth_mm).collect::<Vec<_>>(), [0.0, 3.0, 6.0]);
             assert_eq!(rows[2].wrench[1], 36.0);
             assert!(!fe.join(".work").join(name).exists(), "work dir removed on success");

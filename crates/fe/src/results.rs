@@ -2,6 +2,7 @@
 //! Format: coeffs/README.md, "FE result files".
 
 use anyhow::{bail, Context, Result};
+use needle_contract::COMPONENT_COUNT;
 use std::io::Write;
 use std::path::Path;
 
@@ -16,7 +17,7 @@ pub struct Row {
     /// Depth along the needle axis, mm.
     pub depth_mm: f64,
     /// fx_n, fy_n, fz_n, mx_nmm, my_nmm, mz_nmm.
-    pub wrench: [f64; 6],
+    pub wrench: [f64; COMPONENT_COUNT],
 }
 
 /// The CSV text of a result (header and rows, `\n` line ends, shortest round-trip numbers).

@@ -14,6 +14,7 @@
 use super::deck::Deck;
 use super::spec::{Campaign, PoseSpec, Symmetry};
 use anyhow::{bail, Result};
+use needle_contract::COMPONENT_COUNT;
 use std::collections::HashMap;
 
 /// The wrench `[fx_n, fy_n, fz_n, mx_nmm, my_nmm, mz_nmm]` on the whole needle from the
@@ -21,10 +22,10 @@ use std::collections::HashMap;
 ///
 /// # Errors
 /// A node in `rf` that is not one of the deck's printed needle nodes, or a non-finite force.
-pub fn reduce(deck: &Deck, _pose: &PoseSpec, _c: &Campaign, rf: &[(u32, [f64; 3])]) -> Result<[f64; 6]> {
+pub fn reduce(deck: &Deck, _pose: &PoseSpec, _c: &Campaign, rf: &[(u32, [f64; 3])]) -> Result<[f64; COMPONENT_COUNT]> {
     let pos: HashMap<u32, [f64; 3]> = deck.print_nodes.iter().copied().collect();
     let h = deck.reference_mm;
-    let mut w = [0.0f64; 6];
+    let mut w = [0.0f64; COMPONENT_COUNT];
     for (id, f) in rf {
         let Some(x) = pos.get(id) else {
             bail!("reaction force for node {id}, which is not a printed needle node");
@@ -47,8 +48,8 @@ pub fn reduce(deck: &Deck, _pose: &PoseSpec, _c: &Campaign, rf: &[(u32, [f64; 3]
 /// The wrench on the whole needle from the wrench `w` on the modelled part of a mirror
 /// model: plane z = 0 doubles Fx, Fy, Mz and zeroes Fz, Mx, My; plane x = 0 doubles Fy,
 /// Fz, Mx and zeroes Fx, My, Mz (the components odd under a mirror vanish exactly).
-pub fn expand_mirrors(mut w: [f64; 6], sym: Symmetry) -> [f64; 6] {
-    let mut k = [1.0f64; 6];
+pub fn expand_mirrors(mut w: [f64; COMPONENT_COUNT], sym: Symmetry) -> [f64; COMPONENT_COUNT] {
+    let mut k = [1.0f64; COMPONENT_COUNT];
     if sym.plane_z {
         for (i, f) in [2.0, 2.0, 0.0, 0.0, 0.0, 2.0].iter().enumerate() {
             k[i] *= f;

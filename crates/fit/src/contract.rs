@@ -2,7 +2,7 @@
 //! order, half-ranges, which components are odd under which sweep's mirror, status bits.
 //!
 //! The constants are the `needle-contract` crate's, where each is defined once.
-pub use needle_contract::{COMPONENTS, DEGREE, DEPTH_MAX_MM, TERMS as NCOEF, THETA_MAX_DEG, XZ_MAX_MM};
+pub use needle_contract::{COMPONENTS, COMPONENT_COUNT, DEGREE, DEPTH_MAX_MM, TERMS as NCOEF, THETA_MAX_DEG, XZ_MAX_MM};
 
 /// Unit of component `c`: `"N"` for forces (c < 3), `"N*mm"` for moments.
 pub fn unit(c: usize) -> &'static str {

@@ -27,6 +27,7 @@ use super::data::Run;
 use super::eval_f64::{eval_paper, eval_with_cross};
 use super::lsq::lstsq;
 use super::model::{Coupled, Model};
+use crate::contract::COMPONENT_COUNT;
 use anyhow::{bail, Context, Result};
 use nalgebra::{DMatrix, DVector};
 
@@ -36,7 +37,7 @@ use nalgebra::{DMatrix, DVector};
 /// Fewer equations than unknowns or a rank-deficient design (too few training runs for
 /// the form); the message names the component.
 pub fn fit(paper: &Model, runs: &[&Run], form: CrossForm) -> Result<CrossTerms> {
-    let mut terms: [Vec<(Exponents, Vec<f64>)>; 6] = Default::default();
+    let mut terms: [Vec<(Exponents, Vec<f64>)>; COMPONENT_COUNT] = Default::default();
     let nd = usize::from(form.depth_degree) + 1;
     for (c, out) in terms.iter_mut().enumerate() {
         let ms = monomials(c, form.max_degree);
@@ -77,20 +78,20 @@ pub fn fit(paper: &Model, runs: &[&Run], form: CrossForm) -> Result<CrossTerms> 
 
 /// Per-component error scales of a set of runs: the largest |Fy| over them (N) for the
 /// forces, times `lever_arm_mm` for the moments (as `needle validate` scales errors).
-pub fn scales(runs: &[&Run], lever_arm_mm: f64) -> [f64; 6] {
+pub fn scales(runs: &[&Run], lever_arm_mm: f64) -> [f64; COMPONENT_COUNT] {
     let peak = runs.iter().flat_map(|r| r.rows.iter()).map(|r| r.wrench[1].abs()).fold(0.0, f64::max);
     std::array::from_fn(|c| if c < 3 { peak } else { peak * lever_arm_mm })
 }
 
 /// RMS error per component of `model` over every depth of `runs`, in % of `scale`.
-pub fn rms_pct(runs: &[&Run], scale: [f64; 6], model: impl Fn(Pose64) -> [f64; 6]) -> [f64; 6] {
-    let mut s = [0.0f64; 6];
+pub fn rms_pct(runs: &[&Run], scale: [f64; COMPONENT_COUNT], model: impl Fn(Pose64) -> [f64; COMPONENT_COUNT]) -> [f64; COMPONENT_COUNT] {
+    let mut s = [0.0f64; COMPONENT_COUNT];
     let mut n = 0usize;
     for r in runs {
         let p = &r.pose;
         for row in &r.rows {
             let w = model([p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg, row.depth_mm]);
-            for c in 0..6 {
+            for c in 0..COMPONENT_COUNT {
                 s[c] += (w[c] - row.wrench[c]).powi(2);
             }
             n += 1;
@@ -106,7 +107,7 @@ pub struct CvScore {
     pub form: CrossForm,
     /// Cross-validated RMS error per component, % of the scale ([`scales`]); `None`
     /// when a fold could not be fitted (the reason in `failure`).
-    pub rms_pct: Option<[f64; 6]>,
+    pub rms_pct: Option<[f64; COMPONENT_COUNT]>,
     /// Why a fold could not be fitted.
     pub failure: Option<String>,
 }
@@ -124,9 +125,9 @@ pub const FOLDS: usize = 8;
 /// k-fold cross-validation of `form`: training run `i` is in fold `i % k`; each fold is
 /// predicted by the cross terms fitted on the others; errors pooled over every held-out
 /// depth.
-pub fn cross_validate(paper: &Model, runs: &[&Run], form: CrossForm, scale: [f64; 6]) -> CvScore {
+pub fn cross_validate(paper: &Model, runs: &[&Run], form: CrossForm, scale: [f64; COMPONENT_COUNT]) -> CvScore {
     let k = FOLDS.min(runs.len());
-    let mut s = [0.0f64; 6];
+    let mut s = [0.0f64; COMPONENT_COUNT];
     let mut n = 0usize;
     for fold in 0..k {
         let train: Vec<&Run> = runs.iter().enumerate().filter(|(i, _)| i % k != fold).map(|(_, r)| *r).collect();
@@ -139,7 +140,7 @@ pub fn cross_validate(paper: &Model, runs: &[&Run], form: CrossForm, scale: [f64
             let p = &r.pose;
             for row in &r.rows {
                 let w = eval_with_cross(paper, &t, [p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg, row.depth_mm]).0;
-                for c in 0..6 {
+                for c in 0..COMPONENT_COUNT {
                     s[c] += (w[c] - row.wrench[c]).powi(2);
                 }
                 n += 1;
@@ -152,7 +153,7 @@ pub fn cross_validate(paper: &Model, runs: &[&Run], form: CrossForm, scale: [f64
 
 /// What cross-validation chose for each component: a candidate, or `None` for no cross
 /// terms (the paper form alone).
-pub type Choices = [Option<CrossForm>; 6];
+pub type Choices = [Option<CrossForm>; COMPONENT_COUNT];
 
 /// The outcome of [`select`]: the choice and score of each component, every
 /// candidate's cross-validation and the paper form's error on the training runs.
@@ -162,11 +163,11 @@ pub struct Selection {
     pub choices: Choices,
     /// Per component: the chosen candidate's cross-validated RMS (or the paper form's
     /// error), % of the scale.
-    pub rms_pct: [f64; 6],
+    pub rms_pct: [f64; COMPONENT_COUNT],
     /// Every candidate's cross-validation.
     pub cv: Vec<CvScore>,
     /// The paper form's RMS on the training runs per component, % of the scale.
-    pub paper_rms_pct: [f64; 6],
+    pub paper_rms_pct: [f64; COMPONENT_COUNT],
 }
 
 /// Cross-validate every candidate and choose per component (module docs): the candidate
@@ -176,7 +177,7 @@ pub struct Selection {
 ///
 /// # Errors
 /// Fewer than 2 training runs, or no candidate could be fitted (too few training runs).
-pub fn select(paper: &Model, runs: &[&Run], scale: [f64; 6]) -> Result<Selection> {
+pub fn select(paper: &Model, runs: &[&Run], scale: [f64; COMPONENT_COUNT]) -> Result<Selection> {
     if runs.len() < 2 {
         bail!("the coupled form needs training runs (role train): {} found", runs.len());
     }
@@ -189,9 +190,9 @@ pub fn select(paper: &Model, runs: &[&Run], scale: [f64; 6]) -> Result<Selection
         );
     }
     let paper_rms_pct = rms_pct(runs, scale, |p| eval_paper(paper, p).0);
-    let mut choices: Choices = [None; 6];
+    let mut choices: Choices = [None; COMPONENT_COUNT];
     let mut chosen_rms = paper_rms_pct;
-    for c in 0..6 {
+    for c in 0..COMPONENT_COUNT {
         for score in &cv {
             // A form without monomials for this component adds nothing to it.
             if monomials(c, score.form.max_degree).is_empty() {
@@ -234,7 +235,7 @@ pub fn fit_chosen(paper: &Model, runs: &[&Run], choices: &Choices) -> Result<Cro
             fitted.push(fit(paper, runs, f)?);
         }
     }
-    let mut terms: [Vec<(Exponents, Vec<f64>)>; 6] = Default::default();
+    let mut terms: [Vec<(Exponents, Vec<f64>)>; COMPONENT_COUNT] = Default::default();
     for (c, out) in terms.iter_mut().enumerate() {
         let own: &[(Exponents, Vec<f64>)] =
             choices[c].and_then(|f| fitted.iter().find(|t| t.form == f)).map_or(&[], |t| t.terms[c].as_slice());
@@ -258,7 +259,7 @@ pub fn fit_chosen(paper: &Model, runs: &[&Run], choices: &Choices) -> Result<Cro
 ///
 /// # Errors
 /// As [`select`] and [`fit`].
-pub fn select_and_fit(paper: &Model, runs: &[&Run], scale: [f64; 6]) -> Result<(Selection, CrossTerms)> {
+pub fn select_and_fit(paper: &Model, runs: &[&Run], scale: [f64; COMPONENT_COUNT]) -> Result<(Selection, CrossTerms)> {
     let selection = select(paper, runs, scale)?;
     let terms = fit_chosen(paper, runs, &selection.choices)?;
     Ok((selection, terms))

@@ -13,6 +13,7 @@ use super::data::{load_training_runs, load_validation_runs, Run};
 use super::eval_f64::{eval_paper, eval_with_cross, Pose64};
 use super::model::Model;
 use super::validate::TABLE2_MIN_DEPTH_MM;
+use crate::contract::COMPONENT_COUNT;
 use anyhow::Result;
 use needle_fe::spec::Role;
 use serde::Serialize;
@@ -71,15 +72,15 @@ fn pose_of(r: &Run, depth_mm: f64) -> Pose64 {
 }
 
 /// Held-out errors of `model` on `runs` (module docs).
-pub fn held_out(runs: &[&Run], lever_arm_mm: f64, model: impl Fn(Pose64) -> [f64; 6]) -> HeldOut {
+pub fn held_out(runs: &[&Run], lever_arm_mm: f64, model: impl Fn(Pose64) -> [f64; COMPONENT_COUNT]) -> HeldOut {
     let mut h = HeldOut::default();
     for r in runs {
         let peak = r.rows.iter().map(|x| x.wrench[1].abs()).fold(0.0, f64::max);
-        let scale: [f64; 6] = std::array::from_fn(|c| if c < 3 { peak } else { peak * lever_arm_mm });
-        let mut s = [0.0f64; 6];
+        let scale: [f64; COMPONENT_COUNT] = std::array::from_fn(|c| if c < 3 { peak } else { peak * lever_arm_mm });
+        let mut s = [0.0f64; COMPONENT_COUNT];
         for row in &r.rows {
             let w = model(pose_of(r, row.depth_mm));
-            for c in 0..6 {
+            for c in 0..COMPONENT_COUNT {
                 let e = w[c] - row.wrench[c];
                 s[c] += e * e;
                 if scale[c] > 0.0 {
@@ -91,7 +92,7 @@ pub fn held_out(runs: &[&Run], lever_arm_mm: f64, model: impl Fn(Pose64) -> [f64
             }
         }
         let n = r.rows.len().max(1) as f64;
-        let worst = (0..6).filter(|&c| scale[c] > 0.0).map(|c| 100.0 * (s[c] / n).sqrt() / scale[c]).fold(0.0, f64::max);
+        let worst = (0..COMPONENT_COUNT).filter(|&c| scale[c] > 0.0).map(|c| 100.0 * (s[c] / n).sqrt() / scale[c]).fold(0.0, f64::max);
         match r.pose.role {
             Role::Lhs => h.lhs_worst_rms_pct = h.lhs_worst_rms_pct.max(worst),
             Role::Table2 => h.table2_worst_rms_pct = h.table2_worst_rms_pct.max(worst),
@@ -182,8 +183,8 @@ pub fn to_table(r: &CoupledReport) -> String {
             "  {:>10} {:>10}  {:>6} {:>6} {:>6} {:>6} {:>6} {:>6}",
             "pose deg", "depth deg", "fx", "fy", "fz", "mx", "my", "mz"
         );
-        let cells = |e: &[f64; 6], form: Option<super::cross_terms::CrossForm>| -> String {
-            (0..6).map(|c| format!(" {:>6.3}{}", e[c], if sel.choices[c] == form { "*" } else { " " })).collect()
+        let cells = |e: &[f64; COMPONENT_COUNT], form: Option<super::cross_terms::CrossForm>| -> String {
+            (0..COMPONENT_COUNT).map(|c| format!(" {:>6.3}{}", e[c], if sel.choices[c] == form { "*" } else { " " })).collect()
         };
         let _ = writeln!(s, "  {:>10} {:>10} {}  (paper form alone, out of sample)", "none", "-", cells(&sel.paper_rms_pct, None));
         for c in &sel.cv {
@@ -276,10 +277,11 @@ mod tests {
             .collect();
         let run = Run { pose, file_name: "lhs-test.csv".into(), rows };
         // fy += 0.01 N * (x/12) * (theta_z/15): nonzero at this pose.
-        let mut terms: [Vec<([u8; 4], Vec<f64>)>; 6] = Default::default();
+        let mut terms: [Vec<([u8; 4], Vec<f64>)>; COMPONENT_COUNT] = Default::default();
         terms[1].push(([1, 0, 0, 1], vec![0.01, 0.0, 0.0]));
         let terms = CrossTerms { form: CrossForm { max_degree: 2, depth_degree: 2 }, terms };
-        model.cross = Some(Coupled { terms: terms.clone(), training_runs: 1, cv_rms_pct: [0.0; 6], scale: [1.0; 6] });
+        model.cross =
+            Some(Coupled { terms: terms.clone(), training_runs: 1, cv_rms_pct: [0.0; COMPONENT_COUNT], scale: [1.0; COMPONENT_COUNT] });
         let paper = paper_held_out(&[&run], 60.0, &model);
         let coupled = held_out(&[&run], 60.0, |p| eval_with_cross(&model, &terms, p).0);
         assert_eq!(paper.lhs_worst_rms_pct, 0.0, "the paper row must not include the cross terms");

@@ -16,6 +16,7 @@
 
 use super::contract::Pose64;
 use super::contract::{u_of, Sweep, DEPTH_MAX_MM};
+use crate::contract::COMPONENT_COUNT;
 
 /// Exponents of `(xi, zeta, alpha, beta)` in one cross monomial.
 pub type Exponents = [u8; 4];
@@ -47,7 +48,7 @@ pub struct CrossTerms {
     pub form: CrossForm,
     /// Per component in contract order: each monomial and its depth polynomial's
     /// coefficients (`coeffs[i]` multiplies `u^i`; unit of the component).
-    pub terms: [Vec<(Exponents, Vec<f64>)>; 6],
+    pub terms: [Vec<(Exponents, Vec<f64>)>; COMPONENT_COUNT],
 }
 
 /// Whether monomial `e` has component `c`'s mirror parities (module docs).
@@ -99,7 +100,7 @@ pub fn poly(coeffs: &[f64], u: f64) -> f64 {
 }
 
 /// The cross terms' contribution to each component at `pose` (f64).
-pub fn cross_value(t: &CrossTerms, pose: Pose64) -> [f64; 6] {
+pub fn cross_value(t: &CrossTerms, pose: Pose64) -> [f64; COMPONENT_COUNT] {
     let (n, u) = normalised(pose);
     std::array::from_fn(|c| t.terms[c].iter().map(|(e, p)| mono(*e, &n) * poly(p, u)).sum())
 }
@@ -115,7 +116,7 @@ mod tests {
         let n = [0.3, -0.7, 0.45, 0.9];
         let mx = [-n[0], n[1], n[2], -n[3]];
         let mz = [n[0], -n[1], -n[2], n[3]];
-        for c in 0..6 {
+        for c in 0..COMPONENT_COUNT {
             let ms = monomials(c, 4);
             assert!(!ms.is_empty(), "{}: no cross terms", COMPONENTS[c]);
             for e in ms {

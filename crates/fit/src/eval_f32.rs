@@ -5,6 +5,7 @@
 
 use super::contract::{NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z};
 use super::model::Model;
+use crate::contract::COMPONENT_COUNT;
 
 /// The f32 nearest 1/3 (IEEE division is correctly rounded): 0x3eaaaaab.
 pub const ONE_THIRD: f32 = needle_contract::ONE_THIRD_F32;
@@ -24,13 +25,13 @@ pub use needle_contract::ODD;
 #[derive(Debug, Clone, PartialEq)]
 pub struct Tables32 {
     /// `baseline[c][i]` multiplies `u^i`.
-    pub baseline: [[f32; NCOEF]; 6],
+    pub baseline: [[f32; NCOEF]; COMPONENT_COUNT],
     /// `rows[k][c][i][j]` multiplies `u^i t^j` for sweep k, component c.
-    pub rows: [[[[f32; NCOEF]; NCOEF]; 6]; 4],
+    pub rows: [[[[f32; NCOEF]; NCOEF]; COMPONENT_COUNT]; 4],
     /// The coupled form's cross terms per component, in file order: exponents of
     /// `(xi, zeta, alpha, beta)` and the depth polynomial (`p[i]` multiplies `u^i`).
     /// Empty for the paper form.
-    pub cross: [Vec<([u8; 4], Vec<f32>)>; 6],
+    pub cross: [Vec<([u8; 4], Vec<f32>)>; COMPONENT_COUNT],
 }
 
 impl Tables32 {
@@ -40,7 +41,7 @@ impl Tables32 {
             Some(k) => k.terms.terms[c].iter().map(|(e, p)| (*e, p.iter().map(|v| *v as f32).collect())).collect(),
             None => Vec::new(),
         });
-        let mut t = Tables32 { baseline: [[0.0; NCOEF]; 6], rows: [[[[0.0; NCOEF]; NCOEF]; 6]; 4], cross };
+        let mut t = Tables32 { baseline: [[0.0; NCOEF]; COMPONENT_COUNT], rows: [[[[0.0; NCOEF]; NCOEF]; COMPONENT_COUNT]; 4], cross };
         for (dst, src) in t.baseline.iter_mut().zip(&model.baseline) {
             for (d, s) in dst.iter_mut().zip(&src.coeffs) {
                 *d = *s as f32;
@@ -85,11 +86,11 @@ pub fn clamp32(v: f32, lo: f32, hi: f32) -> f32 {
 /// Evaluate at `pose = [x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm]` (f32): the wrench
 /// `[fx_n, fy_n, fz_n, mx_nmm, my_nmm, mz_nmm]` (N, N·mm) and the status byte, bit for
 /// bit as coeffs/README.md specifies.
-pub fn eval(t: &Tables32, pose: [f32; 5]) -> ([f32; 6], u8) {
+pub fn eval(t: &Tables32, pose: [f32; 5]) -> ([f32; COMPONENT_COUNT], u8) {
     // 1. error
     for v in pose {
         if !v.is_finite() {
-            return ([0.0; 6], STATUS_ERROR);
+            return ([0.0; COMPONENT_COUNT], STATUS_ERROR);
         }
     }
     let [x, z, tx, tz, d] = pose;
@@ -126,8 +127,8 @@ pub fn eval(t: &Tables32, pose: [f32; 5]) -> ([f32; 6], u8) {
         negative[k] = vals[k] < 0.0;
     }
     // 4. polynomials, 5. superposition
-    let mut w = [0.0f32; 6];
-    for c in 0..6 {
+    let mut w = [0.0f32; COMPONENT_COUNT];
+    for c in 0..COMPONENT_COUNT {
         let mut acc = h32(&t.baseline[c], u);
         for k in 0..4 {
             let m = &t.rows[k][c];

@@ -6,6 +6,7 @@ use super::contract::{
 };
 use super::cross_terms::{cross_value, CrossTerms};
 use super::model::Model;
+use crate::contract::COMPONENT_COUNT;
 
 pub use super::poly::{deviation, horner};
 
@@ -13,7 +14,7 @@ pub use super::contract::Pose64;
 
 /// Evaluate the model at `pose`, in its form: the paper part ([`eval_paper`]) plus, for
 /// the coupled form, its cross terms ([`eval_with_cross`]).
-pub fn eval(model: &Model, pose: Pose64) -> ([f64; 6], u8) {
+pub fn eval(model: &Model, pose: Pose64) -> ([f64; COMPONENT_COUNT], u8) {
     match &model.cross {
         Some(c) => eval_with_cross(model, &c.terms, pose),
         None => eval_paper(model, pose),
@@ -22,7 +23,7 @@ pub fn eval(model: &Model, pose: Pose64) -> ([f64; 6], u8) {
 
 /// The paper part of `paper` at `pose` plus the cross terms `t` ([`cross_value`]), unless
 /// the status is an error.
-pub fn eval_with_cross(paper: &Model, t: &CrossTerms, pose: Pose64) -> ([f64; 6], u8) {
+pub fn eval_with_cross(paper: &Model, t: &CrossTerms, pose: Pose64) -> ([f64; COMPONENT_COUNT], u8) {
     let (mut w, status) = eval_paper(paper, pose);
     if status & STATUS_ERROR == 0 {
         for (a, b) in w.iter_mut().zip(cross_value(t, pose)) {
@@ -35,9 +36,9 @@ pub fn eval_with_cross(paper: &Model, t: &CrossTerms, pose: Pose64) -> ([f64; 6]
 /// Evaluate the paper part of the model at `pose` (all of it for the paper form): the wrench `[fx_n, fy_n, fz_n, mx_nmm, my_nmm, mz_nmm]`
 /// (N, N·mm) and the contract's status byte. NaN or infinite input gives the zero wrench
 /// and status 0x80; inputs outside the domain are clamped and flagged.
-pub fn eval_paper(model: &Model, pose: Pose64) -> ([f64; 6], u8) {
+pub fn eval_paper(model: &Model, pose: Pose64) -> ([f64; COMPONENT_COUNT], u8) {
     if pose.iter().any(|v| !v.is_finite()) {
-        return ([0.0; 6], STATUS_ERROR);
+        return ([0.0; COMPONENT_COUNT], STATUS_ERROR);
     }
     let mut status = 0u8;
     let mut clamped = [0.0f64; 4];
@@ -56,7 +57,7 @@ pub fn eval_paper(model: &Model, pose: Pose64) -> ([f64; 6], u8) {
         status |= STATUS_SAT_DEPTH;
     }
     let u = u_of(d);
-    let mut w = [0.0f64; 6];
+    let mut w = [0.0f64; COMPONENT_COUNT];
     for (c, wc) in w.iter_mut().enumerate() {
         let mut acc = horner(&model.baseline[c].coeffs, u);
         for k in Sweep::ALL {

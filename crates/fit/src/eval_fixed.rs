@@ -9,6 +9,7 @@
 
 use super::contract::{Sweep, NCOEF, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z};
 use super::fixed_formats::{TablesFixed, LIMIT};
+use crate::contract::COMPONENT_COUNT;
 use std::fmt;
 
 /// 1 mm or 1 degree in the Q16.16 pose.
@@ -75,7 +76,7 @@ struct Accumulated {
     tk: [i64; 4],
     n: [i64; 4],
     status: u8,
-    a: [[i64; NCOEF]; 6],
+    a: [[i64; NCOEF]; COMPONENT_COUNT],
 }
 
 /// The factors of the monomial of exponents `e` over the inputs `n`, in input order, each
@@ -156,14 +157,14 @@ fn accumulate(t: &TablesFixed, pose: [i32; 5]) -> Result<Accumulated, Overflow> 
 ///
 /// # Errors
 /// An intermediate leaves `|v| <= 2^30` (the tables do not meet the contract).
-pub fn eval(t: &TablesFixed, pose: [i32; 5]) -> Result<([i32; 6], u8), Overflow> {
+pub fn eval(t: &TablesFixed, pose: [i32; 5]) -> Result<([i32; COMPONENT_COUNT], u8), Overflow> {
     let acc = accumulate(t, pose)?;
     Ok((output(t, &acc)?, acc.status))
 }
 
 /// Step 7: `W = h(A, U)` per component, rounded half up to whole µN or µN·mm.
-fn output(t: &TablesFixed, acc: &Accumulated) -> Result<[i32; 6], Overflow> {
-    let mut w = [0i32; 6];
+fn output(t: &TablesFixed, acc: &Accumulated) -> Result<[i32; COMPONENT_COUNT], Overflow> {
+    let mut w = [0i32; COMPONENT_COUNT];
     for (c, wc) in w.iter_mut().enumerate() {
         let h = horner(&acc.a[c], acc.u, &|| format!("Horner in u of component {c}"))?;
         let g = t.acc_frac[c];
@@ -201,7 +202,7 @@ fn rate_coefficients(p: &[i64; NCOEF], r: u32, what: &dyn Fn() -> String) -> Res
 
 /// The wrench (µN, µN·mm), the rates `[by depth, by x, by z]` (each `[fx .. mz]`) and
 /// the status byte of [`eval_rates`].
-pub type RatesFixed = ([i32; 6], [[i32; 6]; 3], u8);
+pub type RatesFixed = ([i32; COMPONENT_COUNT], [[i32; COMPONENT_COUNT]; 3], u8);
 
 /// The wrench, its rates `[by depth, by x, by z]` (each `[fx .. mz]`, µN/mm and
 /// µN·mm/mm) and the status at the Q16.16 pose, by coeffs/README.md, "Fixed-point
@@ -212,8 +213,8 @@ pub type RatesFixed = ([i32; 6], [[i32; 6]; 3], u8);
 pub fn eval_rates(t: &TablesFixed, pose: [i32; 5]) -> Result<RatesFixed, Overflow> {
     let acc = accumulate(t, pose)?;
     let (w, status) = (output(t, &acc)?, acc.status);
-    let mut rates = [[0i32; 6]; 3];
-    for c in 0..6 {
+    let mut rates = [[0i32; COMPONENT_COUNT]; 3];
+    for c in 0..COMPONENT_COUNT {
         let g = t.acc_frac[c];
         let rs = g.min(MAX_RATE_SHIFT);
         let unit = 1i64 << (g - rs);
@@ -253,7 +254,7 @@ pub fn eval_rates(t: &TablesFixed, pose: [i32; 5]) -> Result<RatesFixed, Overflo
     }
     for (slot, bit) in [(0, STATUS_SAT_DEPTH), (1, STATUS_SAT_X), (2, STATUS_SAT_Z)] {
         if status & bit != 0 {
-            rates[slot] = [0; 6];
+            rates[slot] = [0; COMPONENT_COUNT];
         }
     }
     Ok((w, rates, status))

@@ -6,6 +6,7 @@
 
 use super::contract::{NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_X, STATUS_SAT_Z};
 use super::eval_f32::{clamp32, eval, h32, horner_n32, monomial32, Tables32, ODD, ONE_THIRD, R_THETA, R_XZ, S_THETA, S_XZ};
+use crate::contract::COMPONENT_COUNT;
 
 /// `(h(p, w), h'(p, w))` in f32: the value by [`h32`]'s operations, the derivative
 /// accumulated alongside (`d = p4`, then `d = d*w + b` after the steps for p3, p2, p1,
@@ -23,10 +24,10 @@ pub fn hd32(p: &[f32; NCOEF], w: f32) -> (f32, f32) {
 /// The wrench's rates at `pose = [x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm]`:
 /// `[by_depth, by_x, by_z]`, each `[fx, fy, fz, mx, my, mz]` in N/mm and N·mm/mm, and
 /// the status byte, bit for bit as coeffs/README.md specifies.
-pub fn eval_rates(t: &Tables32, pose: [f32; 5]) -> ([[f32; 6]; 3], u8) {
+pub fn eval_rates(t: &Tables32, pose: [f32; 5]) -> ([[f32; COMPONENT_COUNT]; 3], u8) {
     let (_, status) = eval(t, pose);
     if status & STATUS_ERROR != 0 {
-        return ([[0.0; 6]; 3], status);
+        return ([[0.0; COMPONENT_COUNT]; 3], status);
     }
     let [x, z, tx, tz, d] = pose;
     let clamp = |v: f32, m: f32| clamp32(v, -m, m);
@@ -35,9 +36,9 @@ pub fn eval_rates(t: &Tables32, pose: [f32; 5]) -> ([[f32; 6]; 3], u8) {
     let u = dc * ONE_THIRD - 1.0;
     let vals = [xc, zc, txc, tzc];
     let scales = [S_XZ, S_XZ, S_THETA, S_THETA];
-    let mut a = [0.0f32; 6];
-    let mut g = [[0.0f32; 6]; 2];
-    for c in 0..6 {
+    let mut a = [0.0f32; COMPONENT_COUNT];
+    let mut g = [[0.0f32; COMPONENT_COUNT]; 2];
+    for c in 0..COMPONENT_COUNT {
         a[c] = hd32(&t.baseline[c], u).1;
         for k in 0..4 {
             let tt = vals[k].abs() * scales[k] - 1.0;
@@ -80,7 +81,7 @@ pub fn eval_rates(t: &Tables32, pose: [f32; 5]) -> ([[f32; 6]; 3], u8) {
     }
     for (i, flag) in [STATUS_SAT_DEPTH, STATUS_SAT_X, STATUS_SAT_Z].into_iter().enumerate() {
         if status & flag != 0 {
-            rates[i] = [0.0; 6];
+            rates[i] = [0.0; COMPONENT_COUNT];
         }
     }
     (rates, status)

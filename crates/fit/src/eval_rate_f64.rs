@@ -7,6 +7,7 @@ use super::contract::{u_of, Sweep, DEPTH_MAX_MM, NCOEF, STATUS_ERROR, STATUS_SAT
 use super::cross_terms::{mono, normalised, poly};
 use super::eval_f64::{eval, horner, Pose64};
 use super::model::Model;
+use crate::contract::COMPONENT_COUNT;
 
 /// `p'(w)` of the polynomial `p` (`p[i]` multiplies `w^i`).
 pub fn horner_rate(p: &[f64], w: f64) -> f64 {
@@ -16,15 +17,15 @@ pub fn horner_rate(p: &[f64], w: f64) -> f64 {
 /// The rates `[by_depth, by_x, by_z]` of the model at `pose`, each `[fx, fy, fz, mx, my,
 /// mz]` in N/mm and N·mm/mm, and the status byte (as [`eval`]). Zero along a clamped
 /// input and for an error; at `x = 0` (`z = 0`) the rate for `x -> 0+`.
-pub fn eval_rates(model: &Model, pose: Pose64) -> ([[f64; 6]; 3], u8) {
+pub fn eval_rates(model: &Model, pose: Pose64) -> ([[f64; COMPONENT_COUNT]; 3], u8) {
     let (_, status) = eval(model, pose);
     if status & STATUS_ERROR != 0 {
-        return ([[0.0; 6]; 3], status);
+        return ([[0.0; COMPONENT_COUNT]; 3], status);
     }
     let v: [f64; 4] = std::array::from_fn(|i| pose[i].clamp(-Sweep::ALL[i].half_range(), Sweep::ALL[i].half_range()));
     let u = u_of(pose[4].clamp(0.0, DEPTH_MAX_MM));
-    let mut rates = [[0.0f64; 6]; 3];
-    for c in 0..6 {
+    let mut rates = [[0.0f64; COMPONENT_COUNT]; 3];
+    for c in 0..COMPONENT_COUNT {
         let mut a = horner_rate(&model.baseline[c].coeffs, u);
         for k in Sweep::ALL {
             let vk = v[k.index()];
@@ -59,7 +60,7 @@ pub fn eval_rates(model: &Model, pose: Pose64) -> ([[f64; 6]; 3], u8) {
     }
     for (i, flag) in [STATUS_SAT_DEPTH, STATUS_SAT_X, STATUS_SAT_Z].into_iter().enumerate() {
         if status & flag != 0 {
-            rates[i] = [0.0; 6];
+            rates[i] = [0.0; COMPONENT_COUNT];
         }
     }
     (rates, status)

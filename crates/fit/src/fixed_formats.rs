@@ -5,6 +5,7 @@
 
 use super::contract::{Sweep, COMPONENTS, NCOEF};
 use super::model::Model;
+use crate::contract::COMPONENT_COUNT;
 use anyhow::{bail, Result};
 
 /// Magnitude limit of every integer intermediate: 2^30.
@@ -16,17 +17,17 @@ pub const MAX_FRAC: u32 = 30;
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct TablesFixed {
     /// `rows[k][c][i][j]`: integer coefficient of `t^j` in row `i` of matrix (k, c).
-    pub rows: [[[[i64; NCOEF]; NCOEF]; 6]; 4],
+    pub rows: [[[[i64; NCOEF]; NCOEF]; COMPONENT_COUNT]; 4],
     /// Fractional bits `f` of each row, `[k][c][i]`.
-    pub row_frac: [[[u32; NCOEF]; 6]; 4],
+    pub row_frac: [[[u32; NCOEF]; COMPONENT_COUNT]; 4],
     /// Baseline coefficients in each component's accumulator format, `[c][i]`.
-    pub baseline: [[i64; NCOEF]; 6],
+    pub baseline: [[i64; NCOEF]; COMPONENT_COUNT],
     /// Fractional bits `G` of each component's accumulator.
-    pub acc_frac: [u32; 6],
+    pub acc_frac: [u32; COMPONENT_COUNT],
     /// The coupled form's cross terms per component, file order: exponents, integer
     /// coefficients (`[i]` goes to `A_i`) and their fractional bits `F` (empty for the
     /// paper form).
-    pub cross: [Vec<CrossTermFixed>; 6],
+    pub cross: [Vec<CrossTermFixed>; COMPONENT_COUNT],
 }
 
 /// One cross term in fixed point: exponents of (x, z, theta_x, theta_z), integer
@@ -77,10 +78,10 @@ impl TablesFixed {
     /// bits (the library's build refuses such a model too).
     pub fn from_model(model: &Model) -> Result<Self> {
         let mut t = TablesFixed {
-            rows: [[[[0; NCOEF]; NCOEF]; 6]; 4],
-            row_frac: [[[0; NCOEF]; 6]; 4],
-            baseline: [[0; NCOEF]; 6],
-            acc_frac: [0; 6],
+            rows: [[[[0; NCOEF]; NCOEF]; COMPONENT_COUNT]; 4],
+            row_frac: [[[0; NCOEF]; COMPONENT_COUNT]; 4],
+            baseline: [[0; NCOEF]; COMPONENT_COUNT],
+            acc_frac: [0; COMPONENT_COUNT],
             cross: Default::default(),
         };
         if let Some(k) = &model.cross {
@@ -93,9 +94,9 @@ impl TablesFixed {
                 }
             }
         }
-        let mut row_sum = [[[0i64; NCOEF]; 6]; 4];
+        let mut row_sum = [[[0i64; NCOEF]; COMPONENT_COUNT]; 4];
         for k in Sweep::ALL {
-            for c in 0..6 {
+            for c in 0..COMPONENT_COUNT {
                 for (i, row) in model.matrices[k.index()][c].rows.iter().enumerate() {
                     let Some((f, q, s)) = row_format(row) else {
                         bail!("matrix {}/{}: row u^{i} does not fit in 2^30 micro-units", k.name(), COMPONENTS[c]);
@@ -106,7 +107,7 @@ impl TablesFixed {
                 }
             }
         }
-        for c in 0..6 {
+        for c in 0..COMPONENT_COUNT {
             let g_max =
                 Sweep::ALL.iter().flat_map(|k| t.row_frac[k.index()][c]).chain(t.cross[c].iter().map(|x| x.2)).min().unwrap_or(MAX_FRAC);
             let bound_at = |g: u32| -> (i64, [i64; NCOEF]) {

@@ -9,6 +9,7 @@
 
 use super::eval_f32::{eval, Tables32};
 use super::model_file::{hex32, parse_hex32};
+use crate::contract::COMPONENT_COUNT;
 use anyhow::{bail, Result};
 use rand::RngCore;
 use rand::SeedableRng;
@@ -186,7 +187,7 @@ pub struct GoldenRow {
     /// Status byte.
     pub status: u8,
     /// `[fx_n, fy_n, fz_n, mx_nmm, my_nmm, mz_nmm]` (N, N·mm).
-    pub wrench: [f32; 6],
+    pub wrench: [f32; COMPONENT_COUNT],
 }
 
 /// Parse golden-f32.csv text; `path` is only used in messages.
@@ -265,7 +266,7 @@ mod tests {
         };
         let good = format!("{}\n{}\n", header(), row("0x01", one));
         let rows = parse_csv(&good, Path::new("g.csv")).expect("good file");
-        assert_eq!(rows, [GoldenRow { pose: [1.0; 5], status: 1, wrench: [1.0; 6] }]);
+        assert_eq!(rows, [GoldenRow { pose: [1.0; 5], status: 1, wrench: [1.0; COMPONENT_COUNT] }]);
         assert_eq!(err("x\n"), format!("g.csv:1: expected the header {:?}", header()));
         assert_eq!(err(&format!("{}\n{}\n0x1\n", header(), row("0x00", one))), "g.csv:3: 1 fields, expected 12");
         assert_eq!(err(&format!("{}\n{}\n", header(), row("0x1", one))), "g.csv:2: status \"0x1\" is not 0x + 2 hex digits");

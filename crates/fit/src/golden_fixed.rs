@@ -9,6 +9,7 @@
 
 use super::eval_fixed::{eval, DEPTH_DIVISOR, DEPTH_MAX_Q16, DIVISORS, HALF_RANGE_Q16, ONE};
 use super::fixed_formats::TablesFixed;
+use crate::contract::COMPONENT_COUNT;
 use anyhow::{anyhow, Result};
 use rand::{RngCore, SeedableRng};
 use std::fmt::Write as _;
@@ -144,7 +145,7 @@ pub struct FixedRow {
     /// Status byte.
     pub status: u8,
     /// `[fx, fy, fz, mx, my, mz]`, µN and µN·mm.
-    pub wrench: [i32; 6],
+    pub wrench: [i32; COMPONENT_COUNT],
 }
 
 /// Parse golden-fixed.csv text; `path` is only used in messages.
@@ -158,7 +159,7 @@ pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<FixedRow>> {
         for (d, s) in pose.iter_mut().zip(&field[..5]) {
             *d = int(s)?;
         }
-        let mut wrench = [0; 6];
+        let mut wrench = [0; COMPONENT_COUNT];
         for (d, s) in wrench.iter_mut().zip(&field[6..]) {
             *d = int(s)?;
         }

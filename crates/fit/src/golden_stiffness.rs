@@ -7,6 +7,7 @@ use super::eval_f32::Tables32;
 use super::eval_rate_f32::eval_rates;
 use super::golden::poses;
 use super::model_file::{hex32, parse_hex32};
+use crate::contract::COMPONENT_COUNT;
 use anyhow::Result;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -63,7 +64,7 @@ pub struct StiffnessRow {
     /// Status byte.
     pub status: u8,
     /// `[by_depth, by_x, by_z]`, each `[fx, fy, fz, mx, my, mz]` (N/mm, N·mm/mm).
-    pub rates: [[f32; 6]; 3],
+    pub rates: [[f32; COMPONENT_COUNT]; 3],
 }
 
 /// Parse golden-stiffness-f32.csv text; `path` is only used in messages.
@@ -77,7 +78,7 @@ pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<StiffnessRow>> {
         for (dst, s) in pose.iter_mut().zip(field) {
             *dst = value(s)?;
         }
-        let mut rates = [[0.0f32; 6]; 3];
+        let mut rates = [[0.0f32; COMPONENT_COUNT]; 3];
         for (dst, s) in rates.iter_mut().flatten().zip(field.iter().skip(6)) {
             *dst = value(s)?;
         }

@@ -6,6 +6,7 @@ use super::eval_fixed::eval_rates;
 use super::fixed_formats::TablesFixed;
 use super::golden_fixed::poses;
 use super::golden_stiffness::rate_columns;
+use crate::contract::COMPONENT_COUNT;
 use anyhow::{anyhow, Result};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -47,7 +48,7 @@ pub struct FixedStiffnessRow {
     /// Status byte.
     pub status: u8,
     /// `[by_depth, by_x, by_z]`, each `[fx, fy, fz, mx, my, mz]` (µN/mm, µN·mm/mm).
-    pub rates: [[i32; 6]; 3],
+    pub rates: [[i32; COMPONENT_COUNT]; 3],
 }
 
 /// Parse golden-stiffness-fixed.csv text; `path` is only used in messages.
@@ -61,7 +62,7 @@ pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<FixedStiffnessRow>> {
         for (d, s) in pose.iter_mut().zip(field) {
             *d = int(s)?;
         }
-        let mut rates = [[0; 6]; 3];
+        let mut rates = [[0; COMPONENT_COUNT]; 3];
         for (d, s) in rates.iter_mut().flatten().zip(field.iter().skip(6)) {
             *d = int(s)?;
         }

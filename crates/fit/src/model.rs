@@ -7,6 +7,7 @@ use super::cross_terms::CrossTerms;
 use super::data::{FitData, Run, SweepPoint};
 use super::lsq::polyfit;
 use super::poly::{deviation, horner};
+use crate::contract::COMPONENT_COUNT;
 use anyhow::{Context, Result};
 
 /// The centre run's polynomial in depth for one component.
@@ -41,9 +42,9 @@ pub struct Model {
     /// SHA-256 of the FE files fitted (coeffs/README.md).
     pub fe_sha256: String,
     /// Baselines in component order.
-    pub baseline: [Baseline; 6],
+    pub baseline: [Baseline; COMPONENT_COUNT],
     /// Deviation matrices, `matrices[k][c]` for sweep k and component c.
-    pub matrices: [[Deviation; 6]; 4],
+    pub matrices: [[Deviation; COMPONENT_COUNT]; 4],
     /// The cross terms of the coupled form (`form = "coupled"`); `None`: the paper form.
     pub cross: Option<Coupled>,
 }
@@ -57,10 +58,10 @@ pub struct Coupled {
     pub training_runs: usize,
     /// Cross-validated RMS error of the coupled form per component over the training
     /// runs, % of `scale` ([`super::coupled::cross_validate`]).
-    pub cv_rms_pct: [f64; 6],
+    pub cv_rms_pct: [f64; COMPONENT_COUNT],
     /// What the percentages refer to, per component: the training runs' peak |Fy| (N),
     /// times the lever arm for the moments (N*mm).
-    pub scale: [f64; 6],
+    pub scale: [f64; COMPONENT_COUNT],
 }
 
 /// `+0.0` for a zero of either sign, else `v`: the files never carry `-0.0`.
@@ -164,13 +165,13 @@ pub fn fit_baseline(centre: &Run, c: usize) -> Result<Baseline> {
 /// A least-squares problem is rank deficient (the message names sweep, component and
 /// stage).
 pub fn fit(data: &FitData) -> Result<Model> {
-    let mut baseline = [Baseline::default(); 6];
+    let mut baseline = [Baseline::default(); COMPONENT_COUNT];
     for (c, b) in baseline.iter_mut().enumerate() {
         *b = fit_baseline(&data.centre, c)?;
     }
-    let mut matrices = [[Deviation::default(); 6]; 4];
+    let mut matrices = [[Deviation::default(); COMPONENT_COUNT]; 4];
     for k in Sweep::ALL {
-        for c in 0..6 {
+        for c in 0..COMPONENT_COUNT {
             matrices[k.index()][c] = fit_deviation(k, c, &data.sweeps[k.index()], &baseline[c].coeffs)?;
         }
     }

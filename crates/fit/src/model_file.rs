@@ -6,6 +6,7 @@ use super::contract::{Sweep, COMPONENTS, DEPTH_MAX_MM, THETA_MAX_DEG, XZ_MAX_MM}
 use super::coupled::FOLDS;
 use super::cross_terms::{monomials, CrossForm, CrossTerms, Exponents, CANDIDATES};
 use super::model::{Baseline, Coupled, Deviation, Model};
+use crate::contract::COMPONENT_COUNT;
 use anyhow::{bail, Result};
 use needle_fe::spec::ModelForm;
 use std::fmt::Write as _;
@@ -141,11 +142,11 @@ fn write_coupled(s: &mut String, c: &Coupled) {
 /// fitter's [`CANDIDATES`] or whose `[[cross]]` entries are not its monomials in order.
 pub fn parse(text: &str, path: &Path) -> Result<Model> {
     let m = needle_codegen::parse_model_str(text, path).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let mut baseline = [Baseline::default(); 6];
+    let mut baseline = [Baseline::default(); COMPONENT_COUNT];
     for (dst, b) in baseline.iter_mut().zip(&m.baseline) {
         *dst = Baseline { coeffs: b.coeffs, residual_rms: b.residual_rms, residual_max: b.residual_max };
     }
-    let mut matrices = [[Deviation::default(); 6]; 4];
+    let mut matrices = [[Deviation::default(); COMPONENT_COUNT]; 4];
     for d in &m.matrices {
         matrices[d.sweep][d.component] = Deviation { rows: d.rows, residual_rms: d.residual_rms, residual_max: d.residual_max };
     }
@@ -167,7 +168,7 @@ fn coupled(c: &needle_codegen::Coupled, cross: &[needle_codegen::Cross], p: &str
             c.depth_degree
         );
     }
-    let mut terms: [Vec<(Exponents, Vec<f64>)>; 6] = Default::default();
+    let mut terms: [Vec<(Exponents, Vec<f64>)>; COMPONENT_COUNT] = Default::default();
     let mut entries = cross.iter();
     for (comp, out) in terms.iter_mut().enumerate() {
         for e in monomials(comp, form.max_degree) {

@@ -29,6 +29,7 @@ use super::eval_f32::{eval as eval32, Tables32};
 use super::eval_f64::{eval as eval64, eval_paper};
 use super::model::{rms_max, Model};
 use super::model_file;
+use crate::contract::COMPONENT_COUNT;
 use anyhow::Result;
 use needle_fe::spec::Role;
 use serde::Serialize;
@@ -114,9 +115,9 @@ pub struct RunReport {
     /// Largest |Fy| of the FE run over its depths, N.
     pub peak_fy_n: f64,
     /// Errors of the f64 model, component order.
-    pub f64_errors: [CompError; 6],
+    pub f64_errors: [CompError; COMPONENT_COUNT],
     /// Errors of the f32 model, component order.
-    pub f32_errors: [CompError; 6],
+    pub f32_errors: [CompError; COMPONENT_COUNT],
     /// Largest |Fy_model - Fy_FE| / |Fy_FE| at depths >= 1 mm, %, worse of f64 and f32.
     pub fy_rel_max_pct: f64,
     /// Largest RMS error of any component in % of scale, worse of f64 and f32.
@@ -168,8 +169,8 @@ fn role_name(r: Role) -> &'static str {
     }
 }
 
-fn errors(model_w: &[[f64; 6]], run: &Run, scale: [f64; 6]) -> [CompError; 6] {
-    let mut out = [CompError::default(); 6];
+fn errors(model_w: &[[f64; COMPONENT_COUNT]], run: &Run, scale: [f64; COMPONENT_COUNT]) -> [CompError; COMPONENT_COUNT] {
+    let mut out = [CompError::default(); COMPONENT_COUNT];
     for (c, e) in out.iter_mut().enumerate() {
         let (rms, max) = rms_max(model_w.iter().zip(&run.rows).map(|(w, r)| w[c] - r.wrench[c]));
         *e = CompError { rms, max, rms_pct: 100.0 * rms / scale[c], max_pct: 100.0 * max / scale[c] };
@@ -178,7 +179,7 @@ fn errors(model_w: &[[f64; 6]], run: &Run, scale: [f64; 6]) -> [CompError; 6] {
 }
 
 /// Largest |Fy_model - Fy_FE| / |Fy_FE| at depths >= 1 mm over `models`' rows, %.
-fn fy_rel_max(models: &[&[[f64; 6]]], run: &Run) -> f64 {
+fn fy_rel_max(models: &[&[[f64; COMPONENT_COUNT]]], run: &Run) -> f64 {
     let mut fy_rel = 0.0f64;
     for w in models {
         for (m, r) in w.iter().zip(&run.rows) {
@@ -196,8 +197,9 @@ fn fy_rel_max(models: &[&[[f64; 6]]], run: &Run) -> f64 {
 pub fn compare_run(model: &Model, tables: &Tables32, run: &Run, lever_arm_mm: f64) -> (RunReport, f64) {
     let p = &run.pose;
     let pose4 = [p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg];
-    let w64: Vec<[f64; 6]> = run.rows.iter().map(|r| eval64(model, [pose4[0], pose4[1], pose4[2], pose4[3], r.depth_mm]).0).collect();
-    let w32: Vec<[f64; 6]> = run
+    let w64: Vec<[f64; COMPONENT_COUNT]> =
+        run.rows.iter().map(|r| eval64(model, [pose4[0], pose4[1], pose4[2], pose4[3], r.depth_mm]).0).collect();
+    let w32: Vec<[f64; COMPONENT_COUNT]> = run
         .rows
         .iter()
         .map(|r| {
@@ -206,12 +208,12 @@ pub fn compare_run(model: &Model, tables: &Tables32, run: &Run, lever_arm_mm: f6
         })
         .collect();
     let peak = run.rows.iter().map(|r| r.wrench[1].abs()).fold(0.0, f64::max);
-    let scale: [f64; 6] = std::array::from_fn(|c| if c < 3 { peak } else { peak * lever_arm_mm });
+    let scale: [f64; COMPONENT_COUNT] = std::array::from_fn(|c| if c < 3 { peak } else { peak * lever_arm_mm });
     let e64 = errors(&w64, run, scale);
     let e32 = errors(&w32, run, scale);
     let fy_rel = fy_rel_max(&[&w64, &w32], run);
     let paper_part = model.cross.as_ref().map(|_| {
-        let wp: Vec<[f64; 6]> =
+        let wp: Vec<[f64; COMPONENT_COUNT]> =
             run.rows.iter().map(|r| eval_paper(model, [pose4[0], pose4[1], pose4[2], pose4[3], r.depth_mm]).0).collect();
         let ep = errors(&wp, run, scale);
         PaperPart {
@@ -222,7 +224,7 @@ pub fn compare_run(model: &Model, tables: &Tables32, run: &Run, lever_arm_mm: f6
     });
     let mut diff = 0.0f64;
     for (a, b) in w64.iter().zip(&w32) {
-        for c in 0..6 {
+        for c in 0..COMPONENT_COUNT {
             diff = diff.max(100.0 * (a[c] - b[c]).abs() / scale[c]);
         }
     }

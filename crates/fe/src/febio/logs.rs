@@ -2,6 +2,7 @@
 //! the run log (time steps, iterations, how it terminated).
 
 use anyhow::{bail, Context, Result};
+use needle_contract::COMPONENT_COUNT;
 
 /// One record of the rigid-body log: the time and the six values of one body.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -9,7 +10,7 @@ pub struct RigidRecord {
     /// Time t of the record (t = depth in mm in the campaign's inputs).
     pub time: f64,
     /// Fx, Fy, Fz (N), Mx, My, Mz (N·mm) as FEBio logs them.
-    pub values: [f64; 6],
+    pub values: [f64; COMPONENT_COUNT],
 }
 
 /// Parse a `rigid_body_data` log with `data="Fx;Fy;Fz;Mx;My;Mz"`: blocks of `*Step`,
@@ -45,7 +46,7 @@ pub fn parse_rigid_log(text: &str) -> Result<Vec<RigidRecord>> {
             bail!("line {}: {} fields, expected the body id and 6 values: {line:?}", i + 1, fields.len());
         }
         let Some(t) = time else { bail!("line {}: data before any *Time line", i + 1) };
-        let mut values = [0.0f64; 6];
+        let mut values = [0.0f64; COMPONENT_COUNT];
         for (k, f) in fields.iter().skip(1).enumerate() {
             values[k] = match f.parse::<f64>() {
                 Ok(v) => v,

@@ -15,6 +15,7 @@ use crate::backend::{Backend, Job, SolveFailure, Solved};
 use crate::process::{self, ExitKind, LOG_TAIL_LINES};
 use crate::wrench::expand_mirrors;
 use anyhow::{bail, Context, Result};
+use needle_contract::COMPONENT_COUNT;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -286,7 +287,7 @@ impl Backend for FebioBackend {
         let wrenches = at_steps
             .into_iter()
             .map(|v| {
-                let v = v.unwrap_or([f64::NAN; 6]);
+                let v = v.unwrap_or([f64::NAN; COMPONENT_COUNT]);
                 expand_mirrors(v.map(|x| REACTION_SIGN * x), feb.symmetry)
             })
             .collect();
@@ -347,7 +348,7 @@ pub fn settings_line(s: &crate::spec::FebioSettings, friction: f64, threads: usi
 /// The record at each must point t_k = depth * k / steps, k = 1..=steps (None where the
 /// log has none; FEBio logs must points only, but a retried step may log twice: the last
 /// record at a time wins).
-fn pick_steps(records: &[logs::RigidRecord], depth: f64, steps: u32) -> Vec<Option<[f64; 6]>> {
+fn pick_steps(records: &[logs::RigidRecord], depth: f64, steps: u32) -> Vec<Option<[f64; COMPONENT_COUNT]>> {
     (1..=steps)
         .map(|k| {
             let t = depth * f64::from(k) / f64::from(steps);
@@ -474,10 +475,10 @@ mod tests {
 
     #[test]
     fn must_points_are_picked_by_time() {
-        let r = |t: f64, v: f64| logs::RigidRecord { time: t, values: [v; 6] };
+        let r = |t: f64, v: f64| logs::RigidRecord { time: t, values: [v; COMPONENT_COUNT] };
         let recs = [r(3.0, 1.0), r(3.0, 2.0), r(6.0, 3.0)];
         let got = pick_steps(&recs, 6.0, 2);
-        assert_eq!(got, vec![Some([2.0; 6]), Some([3.0; 6])]);
-        assert_eq!(pick_steps(&recs[..1], 6.0, 2), vec![Some([1.0; 6]), None]);
+        assert_eq!(got, vec![Some([2.0; COMPONENT_COUNT]), Some([3.0; COMPONENT_COUNT])]);
+        assert_eq!(pick_steps(&recs[..1], 6.0, 2), vec![Some([1.0; COMPONENT_COUNT]), None]);
     }
 }

@@ -5,6 +5,7 @@
 use crate::results;
 use crate::spec::{Campaign, PoseSpec, Role};
 use anyhow::{bail, Result};
+use needle_contract::COMPONENT_COUNT;
 use serde::Serialize;
 use std::path::Path;
 
@@ -54,7 +55,7 @@ pub(super) fn mirror_checks(c: &Campaign, fe: &Path) -> Result<Vec<MirrorReport>
         if a.len() != b.len() {
             bail!("mirror pose {}: {} rows, counterpart {} has {}", m.name, a.len(), cp.name, b.len());
         }
-        let mut sign = [1.0f64; 6];
+        let mut sign = [1.0f64; COMPONENT_COUNT];
         if flip_x {
             for i in [0, 4, 5] {
                 sign[i] = -sign[i];
@@ -70,7 +71,7 @@ pub(super) fn mirror_checks(c: &Campaign, fe: &Path) -> Result<Vec<MirrorReport>
         let lever = c.needle.reference_from_tip_mm;
         let (mut worst, mut worst_rel, mut comp) = (0.0f64, 0.0f64, 0usize);
         for (ra, rb) in a.iter().zip(&b) {
-            for i in 0..6 {
+            for i in 0..COMPONENT_COUNT {
                 let d = (ra.wrench[i] - sign[i] * rb.wrench[i]).abs();
                 let rel = if i < 3 { d } else { d / lever };
                 if rel > worst_rel {
