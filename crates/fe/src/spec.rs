@@ -305,14 +305,6 @@ pub struct FebioSettings {
     pub etol: f64,
     /// Residual convergence tolerance (`rtol`; 0: off).
     pub rtol: f64,
-    /// Absolute floor of the squared residual norm, N^2 (FEBio's `min_residual`): an
-    /// iteration whose residual is below it counts as converged whatever the relative
-    /// norms say. With `rtol` > 0 it keeps a short time step, whose initial residual is
-    /// already near the contact's noise, from failing on a relative reduction that
-    /// noise does not allow. 0: FEBio's own 1e-20 (no floor). Left out of the run hash
-    /// when 0, so adding it kept the results solved before it existed.
-    #[serde(default, skip_serializing_if = "is_zero_f64")]
-    pub min_residual_n2: f64,
     /// Line search tolerance (`lstol`; 0: off).
     pub lstol: f64,
     /// `dtol` of the campaign's retry of a failed run (0: off). Seen on the committed
@@ -354,7 +346,6 @@ impl Default for FebioSettings {
             dtol: 1e-3,
             etol: 1e-2,
             rtol: 0.0,
-            min_residual_n2: 0.0,
             lstol: 0.9,
             retry_dtol: 0.0,
             retry_rtol: 1e-3,
@@ -389,7 +380,6 @@ impl FebioSettings {
             ("gap_tolerance_mm", self.gap_tolerance_mm),
             ("dtol", self.dtol),
             ("rtol", self.rtol),
-            ("min_residual_n2", self.min_residual_n2),
             ("lstol", self.lstol),
             ("retry_dtol", self.retry_dtol),
             ("retry_rtol", self.retry_rtol),
@@ -817,11 +807,6 @@ impl Campaign {
 
 fn is_zero_u32(v: &u32) -> bool {
     *v == 0
-}
-
-#[allow(clippy::trivially_copy_pass_by_ref)] // serde's skip_serializing_if passes a reference
-fn is_zero_f64(v: &f64) -> bool {
-    *v == 0.0
 }
 
 /// A sweep pose varies its own axis only (the centre none): the fitter reads a sweep

@@ -324,7 +324,7 @@ impl Backend for FebioBackend {
 pub fn settings_line(s: &crate::spec::FebioSettings, friction: f64, threads: usize, retry: bool) -> String {
     let (dtol, rtol) = if retry { (s.retry_dtol, s.retry_rtol) } else { (s.dtol, s.rtol) };
     format!(
-        "{} contact, primary {}, {} penalty {}{}{}, friction {friction}, projections updated {}; {}, max_refs {}, dtol {} etol {} rtol {}{}; Pardiso, {threads} thread(s)",
+        "{} contact, primary {}, {} penalty {}{}{}, friction {friction}, projections updated {}; {}, max_refs {}, dtol {} etol {} rtol {}; Pardiso, {threads} thread(s)",
         s.contact,
         s.primary,
         if s.augmented { "augmented Lagrangian" } else { "pure" },
@@ -341,7 +341,6 @@ pub fn settings_line(s: &crate::spec::FebioSettings, friction: f64, threads: usi
         dtol,
         s.etol,
         rtol,
-        if s.min_residual_n2 > 0.0 { format!(" min_residual {} N^2", s.min_residual_n2) } else { String::new() },
     )
 }
 
