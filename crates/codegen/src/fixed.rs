@@ -300,7 +300,7 @@ pub fn fixed_formats(model: &Model, model_path: &Path) -> Result<FixedTables, Co
         components.push(comp);
     }
     let components: [FixedComponent; COMPONENT_COUNT] =
-        components.try_into().map_err(|_| at(0, "the model does not have 6 components".into()))?;
+        components.try_into().map_err(|_| at(0, format!("the model does not have {COMPONENT_COUNT} components")))?;
     Ok(FixedTables { components })
 }
 

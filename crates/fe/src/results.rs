@@ -40,9 +40,10 @@ pub fn to_csv(rows: &[Row]) -> String {
 /// Parse the CSV text of a result; `path` is only used in messages.
 ///
 /// # Errors
-/// Wrong header, a row without 7 fields, a field that is not a finite number: the
+/// Wrong header, a row without one field per column of `FE_COLUMNS` (7), a field that is not a finite number: the
 /// message has `path:line` and the offending value.
 pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<Row>> {
+    const FIELDS: usize = needle_contract::FE_COLUMNS.len();
     let mut lines = text.lines().enumerate();
     let header = header();
     match lines.next() {
@@ -57,10 +58,10 @@ pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<Row>> {
             continue;
         }
         let fields: Vec<&str> = line.split(',').collect();
-        if fields.len() != 7 {
-            bail!("{}:{n}: {} fields, expected 7: {line:?}", path.display(), fields.len());
+        if fields.len() != FIELDS {
+            bail!("{}:{n}: {} fields, expected {FIELDS}: {line:?}", path.display(), fields.len());
         }
-        let mut v = [0.0f64; 7];
+        let mut v = [0.0f64; FIELDS];
         for (k, f) in fields.iter().enumerate() {
             let x: f64 = f.trim().parse().with_context(|| format!("{}:{n}: field {} = {f:?} is not a number", path.display(), k + 1))?;
             if !x.is_finite() {
@@ -68,7 +69,7 @@ pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<Row>> {
             }
             v[k] = x;
         }
-        rows.push(Row { depth_mm: v[0], wrench: [v[1], v[2], v[3], v[4], v[5], v[6]] });
+        rows.push(Row { depth_mm: v[0], wrench: std::array::from_fn(|c| v[1 + c]) });
     }
     Ok(rows)
 }
