@@ -122,7 +122,7 @@ fn comparison_catches_one_bit_and_allows_nan_payloads() {
 /// status, a missing section and a truncated one are all caught.
 #[test]
 fn fixed_comparison_catches_one_bit() {
-    let h = golden_fixed::HEADER;
+    let h = golden_fixed::header();
     let row = "0,0,0,0,196608,0x00,0,80000,-3,17,0,-5";
     let csv = format!("{h}\n{row}\n");
     let out = |r: &str| format!("needle-golden end rows=9\nneedle-golden-fixed rows=1\n{r}\nneedle-golden-fixed end rows=1\n");

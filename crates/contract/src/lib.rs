@@ -51,6 +51,31 @@ pub const GOLDEN_COLUMNS: [&str; 6 + COMPONENT_COUNT] = {
     out
 };
 
+/// Wrench components of the fixed-point evaluator, in the contract's order: forces in µN
+/// (`un`), moments in µN·mm (`unmm`).
+pub const FIXED_COMPONENTS: [&str; COMPONENT_COUNT] = ["fx_un", "fy_un", "fz_un", "mx_unmm", "my_unmm", "mz_unmm"];
+/// The fixed-point evaluator's inputs in Q16.16: the four sweep inputs and the depth, as
+/// named in the fixed-point golden files.
+pub const FIXED_INPUTS: [&str; 5] = ["x_mm_q16", "z_mm_q16", "theta_x_deg_q16", "theta_z_deg_q16", "depth_mm_q16"];
+
+/// Columns of the fixed-point golden file (`golden-fixed.csv`): the Q16.16 inputs, the
+/// status bits, the wrench components in µN and µN·mm.
+pub const GOLDEN_FIXED_COLUMNS: [&str; 6 + COMPONENT_COUNT] = {
+    let mut out = [""; 6 + COMPONENT_COUNT];
+    let mut i = 0;
+    while i < 5 {
+        out[i] = FIXED_INPUTS[i];
+        i += 1;
+    }
+    out[5] = "status";
+    let mut c = 0;
+    while c < COMPONENT_COUNT {
+        out[6 + c] = FIXED_COMPONENTS[c];
+        c += 1;
+    }
+    out
+};
+
 /// Columns of an FE run's file (`fe/<pose>.csv`): the depth, the wrench components.
 pub const FE_COLUMNS: [&str; 1 + COMPONENT_COUNT] = {
     let mut out = [DEPTH_INPUT; 1 + COMPONENT_COUNT];

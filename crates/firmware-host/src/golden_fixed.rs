@@ -4,8 +4,7 @@
 //! `fixed::wrench_and_stiffness` wrench is not `fixed::wrench`'s must be 0).
 use super::comparison::{Comparison, Section};
 
-/// The fixed-point golden file's header line.
-pub const HEADER: &str = needle_fit::golden_fixed::HEADER;
+pub use needle_fit::golden_fixed::header;
 
 /// The differing integer fields of one row (after the five inputs), named by `header`.
 fn integer_diffs(header: &str, want: &[&str], got: &[&str]) -> Vec<String> {
@@ -25,8 +24,9 @@ fn integer_diffs(header: &str, want: &[&str], got: &[&str]) -> Vec<String> {
 /// The section is missing, truncated or malformed, or holds another number of rows;
 /// differing values are [`Comparison::mismatches`].
 pub fn compare(output: &str, csv: &str) -> anyhow::Result<Comparison> {
-    let section = Section { file: "golden-fixed.csv", tag: "needle-golden-fixed", header: HEADER, fields: 12, end_suffix: "" };
-    section.compare(output, csv, |_, want, got| Ok(integer_diffs(HEADER, want, got)))
+    let header = header();
+    let section = Section { file: "golden-fixed.csv", tag: "needle-golden-fixed", header: &header, fields: 12, end_suffix: "" };
+    section.compare(output, csv, |_, want, got| Ok(integer_diffs(&header, want, got)))
 }
 
 /// Compares the fixed-point stiffness section of the `golden` firmware's stdout `output`

@@ -16,7 +16,9 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 /// Header line of golden-fixed.csv.
-pub const HEADER: &str = "x_mm_q16,z_mm_q16,theta_x_deg_q16,theta_z_deg_q16,depth_mm_q16,status,fx_un,fy_un,fz_un,mx_unmm,my_unmm,mz_unmm";
+pub fn header() -> String {
+    needle_contract::GOLDEN_FIXED_COLUMNS.join(",")
+}
 
 /// Seed of the random poses (ChaCha8).
 pub const GOLDEN_FIXED_SEED: u64 = 0x6e65_6564_6c65_0002;
@@ -121,7 +123,7 @@ pub fn poses() -> Vec<[i32; 5]> {
 pub fn to_csv(t: &TablesFixed) -> Result<String> {
     let poses = poses();
     let mut s = String::with_capacity(96 * (poses.len() + 1));
-    s.push_str(HEADER);
+    s.push_str(&header());
     s.push('\n');
     for p in poses {
         let (w, status) = eval(t, p).map_err(|e| anyhow!("fixed-point evaluation at {p:?}: {e}"))?;
@@ -153,7 +155,7 @@ pub struct FixedRow {
 /// # Errors
 /// Wrong header, a row without 12 fields, a malformed field (`path:line` in the message).
 pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<FixedRow>> {
-    super::golden::parse_rows(text, path, HEADER, |field, at| {
+    super::golden::parse_rows(text, path, &header(), |field, at| {
         let int = |s: &str| s.parse::<i32>().map_err(|_| anyhow!("{at}: {s:?} is not an i32"));
         let mut pose = [0; 5];
         for (d, s) in pose.iter_mut().zip(&field[..5]) {
@@ -174,10 +176,10 @@ mod tests {
 
     #[test]
     fn fixed_rows_parse_and_a_bad_integer_names_the_line() {
-        let good = format!("{HEADER}\n1,2,3,4,5,0x10,-1,-2,-3,-4,-5,-6\n");
+        let good = format!("{}\n1,2,3,4,5,0x10,-1,-2,-3,-4,-5,-6\n", header());
         let rows = parse_csv(&good, Path::new("f.csv")).expect("good file");
         assert_eq!(rows, [FixedRow { pose: [1, 2, 3, 4, 5], status: 0x10, wrench: [-1, -2, -3, -4, -5, -6] }]);
-        let bad = format!("{HEADER}\n1,2,3,4,5,0x10,-1,-2,-3,-4,-5,x\n");
+        let bad = format!("{}\n1,2,3,4,5,0x10,-1,-2,-3,-4,-5,x\n", header());
         let e = format!("{:#}", parse_csv(&bad, Path::new("f.csv")).expect_err("refused"));
         assert_eq!(e, "f.csv:2: \"x\" is not an i32");
     }

@@ -14,7 +14,7 @@ use std::path::Path;
 /// The header line: the five Q16.16 inputs, `status`, then the 18 rates in µN/mm and
 /// µN·mm/mm ([`rate_columns`] with `micro`).
 pub fn header() -> String {
-    format!("x_mm_q16,z_mm_q16,theta_x_deg_q16,theta_z_deg_q16,depth_mm_q16,status,{}", rate_columns(true).join(","))
+    format!("{},status,{}", needle_contract::FIXED_INPUTS.join(","), rate_columns(true).join(","))
 }
 
 /// The text of golden-stiffness-fixed.csv for the tables `t`.
