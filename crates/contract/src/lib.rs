@@ -34,22 +34,25 @@ pub const DEPTH_INPUT: &str = "depth_mm";
 
 /// Columns of the f32 golden file (`golden-f32.csv`): the four pose inputs, the depth,
 /// the status bits, the wrench components.
-pub const GOLDEN_COLUMNS: [&str; 6 + COMPONENT_COUNT] = {
+pub const GOLDEN_COLUMNS: [&str; 6 + COMPONENT_COUNT] =
+    golden_columns([SWEEP_INPUTS[0], SWEEP_INPUTS[1], SWEEP_INPUTS[2], SWEEP_INPUTS[3], DEPTH_INPUT], COMPONENTS);
+
+/// A golden file's columns: the five pose inputs, `status`, the wrench components.
+const fn golden_columns(inputs: [&'static str; 5], components: [&'static str; COMPONENT_COUNT]) -> [&'static str; 6 + COMPONENT_COUNT] {
     let mut out = [""; 6 + COMPONENT_COUNT];
     let mut i = 0;
-    while i < 4 {
-        out[i] = SWEEP_INPUTS[i];
+    while i < 5 {
+        out[i] = inputs[i];
         i += 1;
     }
-    out[4] = DEPTH_INPUT;
     out[5] = "status";
     let mut c = 0;
     while c < COMPONENT_COUNT {
-        out[6 + c] = COMPONENTS[c];
+        out[6 + c] = components[c];
         c += 1;
     }
     out
-};
+}
 
 /// Wrench components of the fixed-point evaluator, in the contract's order: forces in µN
 /// (`un`), moments in µN·mm (`unmm`).
@@ -60,21 +63,7 @@ pub const FIXED_INPUTS: [&str; 5] = ["x_mm_q16", "z_mm_q16", "theta_x_deg_q16", 
 
 /// Columns of the fixed-point golden file (`golden-fixed.csv`): the Q16.16 inputs, the
 /// status bits, the wrench components in µN and µN·mm.
-pub const GOLDEN_FIXED_COLUMNS: [&str; 6 + COMPONENT_COUNT] = {
-    let mut out = [""; 6 + COMPONENT_COUNT];
-    let mut i = 0;
-    while i < 5 {
-        out[i] = FIXED_INPUTS[i];
-        i += 1;
-    }
-    out[5] = "status";
-    let mut c = 0;
-    while c < COMPONENT_COUNT {
-        out[6 + c] = FIXED_COMPONENTS[c];
-        c += 1;
-    }
-    out
-};
+pub const GOLDEN_FIXED_COLUMNS: [&str; 6 + COMPONENT_COUNT] = golden_columns(FIXED_INPUTS, FIXED_COMPONENTS);
 
 /// Columns of an FE run's file (`fe/<pose>.csv`): the depth, the wrench components.
 pub const FE_COLUMNS: [&str; 1 + COMPONENT_COUNT] = {
