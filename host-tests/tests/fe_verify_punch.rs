@@ -36,6 +36,7 @@ fn coarse_flat_punch_matches_sneddon() {
         punch: true,
         mesh: false,
         mirror: false,
+        smooth: false,
         work_dir: None,
         punch_mesh_scale: 2.0,
         punch_campaign_element: false,

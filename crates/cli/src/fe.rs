@@ -18,9 +18,9 @@ pub enum FeCommand {
     /// run failed (the others are still written), 2 on an error before any run.
     Run(RunArgs),
     /// Verify the FE setup: flat punch against Sneddon (four small solves), mesh
-    /// convergence of the centred needle (two needle solves, the fine one is slow) and
-    /// the mirror runs against their counterparts (no solve). Without --punch, --mesh or
-    /// --mirror all three run. Prints the table and writes <set>/fe/verify.toml. Exit
+    /// convergence of the centred needle (two needle solves, the fine one is slow), the
+    /// mirror runs against their counterparts and every result's smoothness in depth (no
+    /// solve). Without --punch, --mesh, --mirror or --smooth all four run. Prints the table and writes <set>/fe/verify.toml. Exit
     /// status 1 when a check misses its goal, 2 on an error.
     Verify(VerifyArgs),
     /// The state of a set's poses: up to date or why not, and with --launcher slurm
@@ -192,6 +192,10 @@ pub struct VerifyArgs {
     /// Check the mirror runs against their counterparts (goal 1% of peak |Fy|).
     #[arg(long)]
     pub mirror: bool,
+    /// Check every FE result present for a must point off the mean of its neighbours (a
+    /// state accepted off the equilibrium path; goal 3% of peak |Fy|).
+    #[arg(long)]
+    pub smooth: bool,
     /// Coarsen the flat-punch mesh by this factor (1 = the verification mesh; the goal
     /// applies to 1).
     #[arg(long, value_name = "F", default_value_t = 1.0)]
@@ -330,12 +334,13 @@ fn run_verify(a: VerifyArgs) -> anyhow::Result<ExitCode> {
     if !(a.punch_mesh_scale.is_finite() && a.punch_mesh_scale >= 1.0) {
         anyhow::bail!("--punch-mesh-scale {}: must be a number >= 1", a.punch_mesh_scale);
     }
-    let all = !(a.punch || a.mesh || a.mirror);
+    let all = !(a.punch || a.mesh || a.mirror || a.smooth);
     let opts = needle_fe::verify::VerifyOptions {
         set_dir: a.set,
         punch: a.punch || all,
         mesh: a.mesh || all,
         mirror: a.mirror || all,
+        smooth: a.smooth || all,
         work_dir: a.work,
         punch_mesh_scale: a.punch_mesh_scale,
         punch_campaign_element: !a.no_campaign_element,

@@ -7,11 +7,15 @@
 //!    (goal 2%), Richardson's estimate of the converged value.
 //! 3. **Mirror runs**: each `mirror` pose against its mirrored counterpart from the
 //!    committed data, with the sign flips of coeffs/README.md (goal 1% of peak |Fy|).
+//! 4. **Smoothness** ([`smooth`]): in every result present, the must point furthest from
+//!    its neighbours' mean (goal [`SMOOTH_GOAL_PERCENT`] of peak |Fy|): a state the
+//!    solver accepted off the equilibrium path shows as such a point.
 
 mod mesh_check;
 mod mirror;
 pub mod punch;
 pub mod punch_febio;
+pub mod smooth;
 
 pub use mesh_check::{richardson, LevelRun, MeshReport, MESH_GOAL_PERCENT};
 pub use mirror::MirrorReport;
@@ -19,6 +23,7 @@ pub use punch::{
     bonded_punch_force, poisson, punch_deck, punch_mesh, sneddon_force, PunchDeck, PunchElement, PunchReport, PunchRun,
     PUNCH_CORE_ELEMENTS_C3D20R, PUNCH_CORE_ELEMENTS_C3D8, PUNCH_GOAL_PERCENT, PUNCH_GROWTH, PUNCH_MU_N_PER_MM2,
 };
+pub use smooth::{SmoothReport, SMOOTH_GOAL_PERCENT};
 
 use super::results;
 use super::spec;
@@ -37,6 +42,8 @@ pub struct VerifyOptions {
     pub mesh: bool,
     /// Check the mirror runs (no solve).
     pub mirror: bool,
+    /// Check every result present for a must point off its neighbours (no solve).
+    pub smooth: bool,
     /// Coarsening of the flat-punch mesh: 1 = the verification mesh; 2 = half the
     /// elements across the punch and twice the fine size (quick tests).
     pub punch_mesh_scale: f64,
@@ -60,6 +67,8 @@ pub struct VerifyReport {
     pub mesh: Option<MeshReport>,
     /// Mirror runs.
     pub mirror: Vec<MirrorReport>,
+    /// Each result's must point furthest from its neighbours' mean.
+    pub smooth: Vec<SmoothReport>,
 }
 
 /// Run the checks, print the table, write `<set>/fe/verify.toml`.
@@ -82,6 +91,16 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
                 m.pose, m.counterpart, m.max_difference, m.component, m.percent_of_peak_fy
             );
             ok &= m.percent_of_peak_fy <= 1.0;
+        }
+    }
+    if opts.smooth {
+        report.smooth = smooth::smooth_checks(&c, &opts.set_dir.join("fe"))?;
+        for s in &report.smooth {
+            println!(
+                "smooth {:>8}: largest must-point jump {:+.3e} ({}) at {} mm = {:.3}% of peak |Fy| (goal <= {SMOOTH_GOAL_PERCENT}%)",
+                s.pose, s.deviation, s.component, s.depth_mm, s.percent_of_peak_fy
+            );
+            ok &= s.percent_of_peak_fy <= SMOOTH_GOAL_PERCENT;
         }
     }
     if opts.punch {
@@ -150,6 +169,9 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
     // only the checks that ran replace their part of an earlier verify.toml
     if !opts.mirror {
         new.remove("mirror");
+    }
+    if !opts.smooth {
+        new.remove("smooth");
     }
     for (k, v) in new {
         old.insert(k, v);
