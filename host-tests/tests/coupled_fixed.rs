@@ -70,7 +70,7 @@ fn generator_and_fitter_agree_and_the_bound_holds() {
             max_cross[c] = max_cross[c].max((w64[c] - wp[c]).abs());
             let bound = fixed.components[c].error_bound.total();
             assert!(err <= bound, "{} at {p:?}: fixed {} uN vs f64 {} uN: error {err} > bound {bound}", COMPONENTS[c], wq[c], w64[c] * 1e6);
-            let scale: f64 = if c < 3 { 1e-3 } else { 6e-2 };
+            let scale: f64 = if needle_contract::is_force(c) { 1e-3 } else { 6e-2 };
             assert!((f64::from(w32[c]) - w64[c]).abs() <= 1e-4 * scale.max(w64[c].abs()), "{} f32 at {p:?}", COMPONENTS[c]);
         }
     }

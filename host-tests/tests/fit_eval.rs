@@ -39,7 +39,7 @@ fn f32_vs_f64(model: &Model, n: usize) -> (f64, f64) {
         assert_eq!(s32, s64, "status differs at {p:?}");
         peak = peak.max(w64[1].abs());
         for c in 0..6 {
-            let scale = if c < 3 { 1.0 } else { fit_synthetic::LEVER_MM };
+            let scale = if needle_contract::is_force(c) { 1.0 } else { fit_synthetic::LEVER_MM };
             worst = worst.max((f64::from(w32[c]) - w64[c]).abs() / scale);
         }
     }
@@ -144,7 +144,7 @@ fn single_axis_mirror_is_antisymmetric_to_rounding() {
                 let (wp, _) = eval32(&t, p);
                 let (wq, _) = eval32(&t, q);
                 for c in 0..6 {
-                    let scale = if c < 3 { 1.0 } else { fit_synthetic::LEVER_MM };
+                    let scale = if needle_contract::is_force(c) { 1.0 } else { fit_synthetic::LEVER_MM };
                     let want = if k.is_odd(c) { -wp[c] } else { wp[c] };
                     if !k.is_odd(c) {
                         assert_eq!(wq[c].to_bits(), wp[c].to_bits(), "even component {c}, sweep {k:?}, v = {v}");
@@ -375,7 +375,7 @@ fn a_table2_run_with_a_wrong_fz_fails_its_goal() {
     // Fz + 10 % of the run's peak |Fy| at every depth (Fy untouched)
     let csv = dir.path().join("fe").join(format!("{name}.csv"));
     let rows = needle_fe::results::read_csv(&csv).expect("read run");
-    let peak_fy = rows.iter().map(|r| r.wrench[1].abs()).fold(0.0, f64::max);
+    let peak_fy = needle_fe::results::peak_fy_n(&rows);
     let edited: Vec<_> = rows
         .iter()
         .map(|r| {

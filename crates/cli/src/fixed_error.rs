@@ -96,11 +96,7 @@ pub fn load(set_dir: &Path) -> Result<(Model, f64)> {
 /// lever arm (moments).
 #[must_use]
 pub fn scale(stats: &ErrorStats, c: usize, lever_arm_mm: f64) -> f64 {
-    if c < 3 {
-        stats.peak_fy_n
-    } else {
-        stats.peak_fy_n * lever_arm_mm
-    }
+    needle_contract::error_scales(stats.peak_fy_n, lever_arm_mm).get(c).copied().unwrap_or(f64::NAN)
 }
 
 /// The report as a table: measured max error and derived bound per component, absolute

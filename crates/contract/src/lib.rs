@@ -19,8 +19,41 @@ pub const COMPONENT_COUNT: usize = 6;
 /// Wrench components in the contract's order (index `c = 0..COMPONENT_COUNT`): forces in
 /// N, moments in N·mm about the hub.
 pub const COMPONENTS: [&str; COMPONENT_COUNT] = ["fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"];
-/// Unit of each component (ASCII: `N*mm` is newton millimetre).
-pub const UNITS: [&str; COMPONENT_COUNT] = ["N", "N", "N", "N*mm", "N*mm", "N*mm"];
+/// The first `FORCE_COUNT` components are forces (N), the others moments (N·mm about
+/// the hub).
+pub const FORCE_COUNT: usize = 3;
+/// Index of the axial force `fy_n`: relative errors are quoted against its peak |Fy|
+/// over a run ([`error_scales`]).
+pub const FY: usize = 1;
+/// Unit of each component (ASCII: `N*mm` is newton millimetre), from [`FORCE_COUNT`].
+pub const UNITS: [&str; COMPONENT_COUNT] = {
+    let mut units = ["N*mm"; COMPONENT_COUNT];
+    let mut c = 0;
+    while c < FORCE_COUNT {
+        units[c] = "N";
+        c += 1;
+    }
+    units
+};
+
+/// Whether component `c` is a force (N) rather than a moment (N·mm).
+#[must_use]
+pub const fn is_force(c: usize) -> bool {
+    c < FORCE_COUNT
+}
+
+/// The scale each component's error is quoted against in every report (`needle
+/// validate`, the FE checks, the figures): `peak_fy_n` (the largest |Fy| of the runs
+/// judged, N) for the forces, `peak_fy_n * lever_arm_mm` (N·mm; the lever arm is the
+/// hub's distance from the tip) for the moments.
+#[must_use]
+pub fn error_scales(peak_fy_n: f64, lever_arm_mm: f64) -> [f64; COMPONENT_COUNT] {
+    let mut scales = [peak_fy_n * lever_arm_mm; COMPONENT_COUNT];
+    for s in scales.iter_mut().take(FORCE_COUNT) {
+        *s = peak_fy_n;
+    }
+    scales
+}
 
 /// The four single-axis sweeps in the contract's order (index `k = 0..3`), as named in
 /// `model.toml`.

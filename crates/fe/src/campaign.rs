@@ -231,7 +231,7 @@ pub fn plan(opts: &RunOptions) -> Result<Plan> {
             (Some(e), Some(rows)) if !opts.force => {
                 report.wall_s = Some(e.wall_s);
                 report.increments = Some(e.increments);
-                report.fy_final_n = rows.last().map(|r| r.wrench[1]);
+                report.fy_final_n = rows.last().map(Row::fy_n);
             }
             _ => to_run.push(reports.len()),
         }
@@ -531,7 +531,7 @@ fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Res
     update_manifest(ctx, |m| {
         m.pose.insert(pose.name.clone(), entry);
     })?;
-    Ok(rows.last().map(|r| r.wrench[1]).unwrap_or(0.0))
+    Ok(rows.last().map(Row::fy_n).unwrap_or(0.0))
 }
 
 /// Read the manifest from disk (another `needle fe run` may have written it), change it,

@@ -20,6 +20,20 @@ pub struct Row {
     pub wrench: [f64; COMPONENT_COUNT],
 }
 
+impl Row {
+    /// The axial force `fy_n`, N.
+    #[must_use]
+    pub fn fy_n(&self) -> f64 {
+        self.wrench[needle_contract::FY]
+    }
+}
+
+/// The largest |Fy| of `rows` (N; 0 for none): the scale of relative errors
+/// ([`needle_contract::error_scales`]).
+pub fn peak_fy_n<'a>(rows: impl IntoIterator<Item = &'a Row>) -> f64 {
+    rows.into_iter().map(|r| r.fy_n().abs()).fold(0.0, f64::max)
+}
+
 /// The CSV text of a result (header and rows, `\n` line ends, shortest round-trip numbers).
 pub fn to_csv(rows: &[Row]) -> String {
     let mut s = String::with_capacity(64 * (rows.len() + 1));

@@ -4,7 +4,7 @@
 //! The constants are the `needle-contract` crate's, where each is defined once.
 pub use needle_contract::{COMPONENTS, COMPONENT_COUNT, DEGREE, DEPTH_MAX_MM, TERMS as NCOEF, THETA_MAX_DEG, XZ_MAX_MM};
 
-/// Unit of component `c`: `"N"` for forces (c < 3), `"N*mm"` for moments.
+/// Unit of component `c`: `"N"` for forces (the contract's first `FORCE_COUNT`), `"N*mm"` for moments.
 pub fn unit(c: usize) -> &'static str {
     needle_contract::UNITS.get(c).copied().unwrap_or("?")
 }

@@ -79,8 +79,7 @@ pub fn fit(paper: &Model, runs: &[&Run], form: CrossForm) -> Result<CrossTerms> 
 /// Per-component error scales of a set of runs: the largest |Fy| over them (N) for the
 /// forces, times `lever_arm_mm` for the moments (as `needle validate` scales errors).
 pub fn scales(runs: &[&Run], lever_arm_mm: f64) -> [f64; COMPONENT_COUNT] {
-    let peak = runs.iter().flat_map(|r| r.rows.iter()).map(|r| r.wrench[1].abs()).fold(0.0, f64::max);
-    std::array::from_fn(|c| if c < 3 { peak } else { peak * lever_arm_mm })
+    needle_contract::error_scales(needle_fe::results::peak_fy_n(runs.iter().flat_map(|r| r.rows.iter())), lever_arm_mm)
 }
 
 /// RMS error per component of `model` over every depth of `runs`, in % of `scale`.

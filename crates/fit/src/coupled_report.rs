@@ -75,8 +75,7 @@ fn pose_of(r: &Run, depth_mm: f64) -> Pose64 {
 pub fn held_out(runs: &[&Run], lever_arm_mm: f64, model: impl Fn(Pose64) -> [f64; COMPONENT_COUNT]) -> HeldOut {
     let mut h = HeldOut::default();
     for r in runs {
-        let peak = r.rows.iter().map(|x| x.wrench[1].abs()).fold(0.0, f64::max);
-        let scale: [f64; COMPONENT_COUNT] = std::array::from_fn(|c| if c < 3 { peak } else { peak * lever_arm_mm });
+        let scale = needle_contract::error_scales(needle_fe::results::peak_fy_n(&r.rows), lever_arm_mm);
         let mut s = [0.0f64; COMPONENT_COUNT];
         for row in &r.rows {
             let w = model(pose_of(r, row.depth_mm));
@@ -87,8 +86,8 @@ pub fn held_out(runs: &[&Run], lever_arm_mm: f64, model: impl Fn(Pose64) -> [f64
                     h.worst_max_pct = h.worst_max_pct.max(100.0 * e.abs() / scale[c]);
                 }
             }
-            if r.pose.role == Role::Table2 && row.depth_mm >= TABLE2_MIN_DEPTH_MM - 1e-9 && row.wrench[1] != 0.0 {
-                h.table2_fy_max_pct = h.table2_fy_max_pct.max(100.0 * (w[1] - row.wrench[1]).abs() / row.wrench[1].abs());
+            if r.pose.role == Role::Table2 && row.depth_mm >= TABLE2_MIN_DEPTH_MM - 1e-9 && row.fy_n() != 0.0 {
+                h.table2_fy_max_pct = h.table2_fy_max_pct.max(100.0 * (w[needle_contract::FY] - row.fy_n()).abs() / row.fy_n().abs());
             }
         }
         let n = r.rows.len().max(1) as f64;

@@ -184,7 +184,7 @@ fn fy_rel_max(models: &[&[[f64; COMPONENT_COUNT]]], run: &Run) -> f64 {
     for w in models {
         for (m, r) in w.iter().zip(&run.rows) {
             if r.depth_mm >= TABLE2_MIN_DEPTH_MM - 1e-9 {
-                let fe = r.wrench[1];
+                let fe = r.fy_n();
                 let rel = if fe == 0.0 { f64::INFINITY } else { 100.0 * (m[1] - fe).abs() / fe.abs() };
                 fy_rel = fy_rel.max(rel);
             }
@@ -207,8 +207,8 @@ pub fn compare_run(model: &Model, tables: &Tables32, run: &Run, lever_arm_mm: f6
             eval32(tables, q).0.map(f64::from)
         })
         .collect();
-    let peak = run.rows.iter().map(|r| r.wrench[1].abs()).fold(0.0, f64::max);
-    let scale: [f64; COMPONENT_COUNT] = std::array::from_fn(|c| if c < 3 { peak } else { peak * lever_arm_mm });
+    let peak = needle_fe::results::peak_fy_n(&run.rows);
+    let scale = needle_contract::error_scales(peak, lever_arm_mm);
     let e64 = errors(&w64, run, scale);
     let e32 = errors(&w32, run, scale);
     let fy_rel = fy_rel_max(&[&w64, &w32], run);

@@ -90,11 +90,11 @@ fn sweeps(model: &Model, sweep_runs: &[Vec<&Run>; 4], comps: [usize; 3]) -> Vec<
                     data: points,
                 });
             }
-            let unit = if comps[0] < 3 { "N" } else { "N*mm" };
+            let unit = needle_contract::UNITS[comps[0]];
             Panel {
                 title: format!("sweep in {} (others 0), depth {DEPTH_MAX_MM} mm", k.name()),
                 x_label: format!("{} ({})", k.name(), k.unit()),
-                y_label: format!("{} ({unit})", if comps[0] < 3 { "force" } else { "moment about the hub" }),
+                y_label: format!("{} ({unit})", if needle_contract::is_force(comps[0]) { "force" } else { "moment about the hub" }),
                 series,
             }
         })
@@ -122,7 +122,7 @@ fn fig8(model: &Model, table2: &[&Run]) -> Vec<Panel> {
                         label: "FE".into(),
                         colour: GREY,
                         style: Style::Points,
-                        data: r.rows.iter().map(|x| (x.depth_mm, x.wrench[1])).collect(),
+                        data: r.rows.iter().map(|x| (x.depth_mm, x.fy_n())).collect(),
                     },
                 ],
             }
@@ -132,7 +132,7 @@ fn fig8(model: &Model, table2: &[&Run]) -> Vec<Panel> {
 
 /// Parity: model against FE at every depth of every validation run, forces and moments.
 fn parity(model: &Model, held: &[&Run], lever_arm_mm: f64) -> Vec<Panel> {
-    let peak = held.iter().flat_map(|r| r.rows.iter()).map(|x| x.wrench[1].abs()).fold(0.0, f64::max);
+    let scales = needle_contract::error_scales(needle_fe::results::peak_fy_n(held.iter().flat_map(|r| r.rows.iter())), lever_arm_mm);
     [(0..3, "forces", "N"), (3..6, "moments about the hub", "N*mm")]
         .into_iter()
         .map(|(cs, what, u)| {
@@ -146,7 +146,7 @@ fn parity(model: &Model, held: &[&Run], lever_arm_mm: f64) -> Vec<Panel> {
                         r.rows.iter().map(move |x| (x.wrench[c], eval(model, [p[0], p[1], p[2], p[3], x.depth_mm]).0[c]))
                     })
                     .collect();
-                let scale = if c < 3 { peak } else { peak * lever_arm_mm };
+                let scale = scales[c];
                 let rms = (pts.iter().map(|(f, m)| (m - f).powi(2)).sum::<f64>() / pts.len().max(1) as f64).sqrt();
                 for &(f, m) in &pts {
                     lo = lo.min(f.min(m));

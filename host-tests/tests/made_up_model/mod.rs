@@ -80,7 +80,7 @@ pub fn coupled_default_text() -> String {
     let _ = writeln!(s, "cv_rms_pct = [0.1, 0.1, 0.1, 0.1, 0.1, 0.1]\nscale = [0.07, 0.07, 0.07, 4.2, 4.2, 4.2]");
     let mut k = 0u32;
     for (c, name) in COMPONENTS.iter().enumerate() {
-        let size = if c < 3 { 5e-4 } else { 3e-2 };
+        let size = if needle_contract::is_force(c) { 5e-4 } else { 3e-2 };
         for e in needle_fit::cross_terms::monomials(c, 3) {
             let p: Vec<f64> = (0..3)
                 .map(|i| {

@@ -5,7 +5,7 @@
 use crate::results;
 use crate::spec::{Campaign, PoseSpec, Role};
 use anyhow::{bail, Result};
-use needle_contract::COMPONENT_COUNT;
+use needle_contract::{error_scales, COMPONENT_COUNT, ODD};
 use serde::Serialize;
 use std::path::Path;
 
@@ -26,8 +26,8 @@ pub struct MirrorReport {
     pub percent_of_peak_fy: f64,
 }
 
-/// Each mirror pose against its counterpart: x -> -x flips (Fx, My, Mz), z -> -z flips
-/// (Fz, Mx, My).
+/// Each mirror pose against its counterpart: x -> -x flips the components odd in x (Fx,
+/// My, Mz), z -> -z those odd in z (Fz, Mx, My), per the contract's `ODD`.
 pub(super) fn mirror_checks(c: &Campaign, fe: &Path) -> Result<Vec<MirrorReport>> {
     let poses = c.poses();
     let mut out = Vec::new();
@@ -55,27 +55,27 @@ pub(super) fn mirror_checks(c: &Campaign, fe: &Path) -> Result<Vec<MirrorReport>
         if a.len() != b.len() {
             bail!("mirror pose {}: {} rows, counterpart {} has {}", m.name, a.len(), cp.name, b.len());
         }
-        let mut sign = [1.0f64; COMPONENT_COUNT];
-        if flip_x {
-            for i in [0, 4, 5] {
-                sign[i] = -sign[i];
+        // The x = 0 plane flips the components odd in x (ODD[0], the same as theta_z's),
+        // the z = 0 plane those odd in z (ODD[1], the same as theta_x's).
+        let [odd_x, odd_z, ..] = ODD;
+        let sign: [f64; COMPONENT_COUNT] = std::array::from_fn(|i| {
+            let flips = usize::from(flip_x && odd_x[i]) + usize::from(flip_z && odd_z[i]);
+            if flips % 2 == 1 {
+                -1.0
+            } else {
+                1.0
             }
-        }
-        if flip_z {
-            for i in [2, 3, 4] {
-                sign[i] = -sign[i];
-            }
-        }
-        let peak = b.iter().map(|r| r.wrench[1].abs()).fold(0.0, f64::max);
+        });
+        let peak = results::peak_fy_n(&b);
         // forces against peak |Fy|; moments against peak |Fy| times the hub's lever arm
-        let lever = c.needle.reference_from_tip_mm;
-        let (mut worst, mut worst_rel, mut comp) = (0.0f64, 0.0f64, 0usize);
+        let scales = error_scales(peak, c.needle.reference_from_tip_mm);
+        let (mut worst, mut worst_pct, mut comp) = (0.0f64, 0.0f64, 0usize);
         for (ra, rb) in a.iter().zip(&b) {
             for i in 0..COMPONENT_COUNT {
                 let d = (ra.wrench[i] - sign[i] * rb.wrench[i]).abs();
-                let rel = if i < 3 { d } else { d / lever };
-                if rel > worst_rel {
-                    worst_rel = rel;
+                let pct = if scales[i] > 0.0 { 100.0 * d / scales[i] } else { f64::INFINITY };
+                if pct > worst_pct {
+                    worst_pct = pct;
                     worst = d;
                     comp = i;
                 }
@@ -86,7 +86,7 @@ pub(super) fn mirror_checks(c: &Campaign, fe: &Path) -> Result<Vec<MirrorReport>
             counterpart: cp.name.clone(),
             max_difference: worst,
             component: needle_contract::COMPONENTS[comp].to_string(),
-            percent_of_peak_fy: if peak > 0.0 { 100.0 * worst_rel / peak } else { f64::INFINITY },
+            percent_of_peak_fy: worst_pct,
         });
     }
     Ok(out)

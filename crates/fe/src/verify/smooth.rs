@@ -41,17 +41,17 @@ pub struct SmoothReport {
 /// first loaded point's lower neighbour is the unloaded state, where contact starts, so
 /// it is not judged itself). `None` for fewer than four rows or a run without force.
 pub fn largest_jump(pose: &str, rows: &[Row], lever_arm_mm: f64) -> Option<SmoothReport> {
-    let peak = rows.iter().map(|r| r.wrench[1].abs()).fold(0.0, f64::max);
+    let peak = crate::results::peak_fy_n(rows);
     if peak <= 0.0 || lever_arm_mm.is_nan() || lever_arm_mm <= 0.0 {
         return None;
     }
+    let scales = needle_contract::error_scales(peak, lever_arm_mm);
     let mut best: Option<SmoothReport> = None;
     for w in rows.windows(3).skip(1) {
         let [before, at, after] = w else { continue };
         for c in 0..COMPONENT_COUNT {
             let deviation = at.wrench[c] - 0.5 * (before.wrench[c] + after.wrench[c]);
-            let scale = if c < 3 { peak } else { peak * lever_arm_mm };
-            let percent = 100.0 * deviation.abs() / scale;
+            let percent = 100.0 * deviation.abs() / scales[c];
             if best.as_ref().is_none_or(|b| percent > b.percent_of_peak_fy) {
                 best = Some(SmoothReport {
                     pose: pose.to_string(),
