@@ -46,9 +46,15 @@ pub(crate) const fn is_plus_zero_matrix(m: &[[f32; TERMS]; TERMS]) -> bool {
 }
 
 /// `ZERO_BASELINE[c]`: every coefficient of `B_c` is `+0.0`.
+#[allow(clippy::indexing_slicing)] // const evaluation only: an index out of range is a compile error
 pub(crate) const ZERO_BASELINE: [bool; COMPONENT_COUNT] = {
-    let [b0, b1, b2, b3, b4, b5] = &BASELINE;
-    [is_plus_zero(b0), is_plus_zero(b1), is_plus_zero(b2), is_plus_zero(b3), is_plus_zero(b4), is_plus_zero(b5)]
+    let mut zero = [false; COMPONENT_COUNT];
+    let mut c = 0;
+    while c < COMPONENT_COUNT {
+        zero[c] = is_plus_zero(&BASELINE[c]);
+        c += 1;
+    }
+    zero
 };
 
 /// `SKIP_DEVIATION[k][c]`: `D_kc` is skipped (see [`skip_sweep`]).
@@ -71,17 +77,15 @@ const SKIP_DEVIATION: [[bool; COMPONENT_COUNT]; 4] = {
 ///   sum is `-0.0` only when both addends are `-0.0`, so `w_c` could only become
 ///   `-0.0` by starting as `-0.0`, from a baseline whose constant coefficient is
 ///   `-0.0`. For such a component nothing is skipped.
+#[allow(clippy::indexing_slicing)] // const evaluation only: an index out of range is a compile error
 const fn skip_sweep(mats: &[[[f32; TERMS]; TERMS]; COMPONENT_COUNT]) -> [bool; COMPONENT_COUNT] {
-    let [m0, m1, m2, m3, m4, m5] = mats;
-    let [b0, b1, b2, b3, b4, b5] = &BASELINE;
-    [
-        is_plus_zero_matrix(m0) && starts_not_neg_zero(b0),
-        is_plus_zero_matrix(m1) && starts_not_neg_zero(b1),
-        is_plus_zero_matrix(m2) && starts_not_neg_zero(b2),
-        is_plus_zero_matrix(m3) && starts_not_neg_zero(b3),
-        is_plus_zero_matrix(m4) && starts_not_neg_zero(b4),
-        is_plus_zero_matrix(m5) && starts_not_neg_zero(b5),
-    ]
+    let mut skip = [false; COMPONENT_COUNT];
+    let mut c = 0;
+    while c < COMPONENT_COUNT {
+        skip[c] = is_plus_zero_matrix(&mats[c]) && starts_not_neg_zero(&BASELINE[c]);
+        c += 1;
+    }
+    skip
 }
 
 /// Whether `h(b, u)` is never `-0.0`: its last operation adds `b[0]`, and the sum is

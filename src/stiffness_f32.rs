@@ -18,17 +18,15 @@ const fn rates_not_neg_zero(b: &[f32; TERMS]) -> bool {
 }
 
 /// One sweep's row of [`SKIP`].
+#[allow(clippy::indexing_slicing)] // const evaluation only: an index out of range is a compile error
 const fn skip_sweep(mats: &[[[f32; TERMS]; TERMS]; COMPONENT_COUNT]) -> [bool; COMPONENT_COUNT] {
-    let [m0, m1, m2, m3, m4, m5] = mats;
-    let [b0, b1, b2, b3, b4, b5] = &BASELINE;
-    [
-        is_plus_zero_matrix(m0) && rates_not_neg_zero(b0),
-        is_plus_zero_matrix(m1) && rates_not_neg_zero(b1),
-        is_plus_zero_matrix(m2) && rates_not_neg_zero(b2),
-        is_plus_zero_matrix(m3) && rates_not_neg_zero(b3),
-        is_plus_zero_matrix(m4) && rates_not_neg_zero(b4),
-        is_plus_zero_matrix(m5) && rates_not_neg_zero(b5),
-    ]
+    let mut skip = [false; COMPONENT_COUNT];
+    let mut c = 0;
+    while c < COMPONENT_COUNT {
+        skip[c] = is_plus_zero_matrix(&mats[c]) && rates_not_neg_zero(&BASELINE[c]);
+        c += 1;
+    }
+    skip
 }
 
 /// `SKIP[k][c]`: `D_kc` and all its derivatives are `+0.0` and adding them changes no
@@ -91,7 +89,7 @@ pub fn wrench_and_stiffness(pose: &Pose) -> StiffnessEvaluation {
     let mut by_depth = [0.0_f32; COMPONENT_COUNT];
     let mut by_x = [0.0_f32; COMPONENT_COUNT];
     let mut by_z = [0.0_f32; COMPONENT_COUNT];
-    let columns = [
+    let columns: [Component; COMPONENT_COUNT] = [
         component_of::<0>(&at),
         component_of::<1>(&at),
         component_of::<2>(&at),

@@ -20,16 +20,11 @@ use std::path::Path;
 pub const POSE_FRAC_BITS: u32 = 16;
 /// Fractional bits of the normalised inputs `U`, `T_k` (Q15, in `[-32768, 32768]`).
 pub const NORM_FRAC_BITS: u32 = 15;
-/// `U = (D + DEPTH_DIVISOR / 2) / DEPTH_DIVISOR - 32768` (integer division of the
-/// clamped Q16 depth: u = d / 3 - 1 in Q15, rounded to nearest).
-pub const DEPTH_DIVISOR: u32 = 6;
-/// `T_k = (|V_k| + d / 2) / d - 32768` with `d = SWEEP_DIVISORS[k]` (x, z: 12; theta_x,
-/// theta_z: 15): t = |v| * 2 / V - 1 in Q15, rounded to nearest.
-pub const SWEEP_DIVISORS: [u32; 4] = [12, 12, 15, 15];
-/// `N_k = sign(v_k) * ((|v_k| + d / 2) / d)` with `d = CROSS_DIVISORS[k]` (x, z: 24;
-/// theta_x, theta_z: 30): the coupled form's signed input `n = v / V` in Q15, its
-/// magnitude rounded to nearest (coeffs/README.md, "The coupled form").
-pub const CROSS_DIVISORS: [u32; 4] = [24, 24, 30, 30];
+/// The normalisation divisors of depth, sweeps and cross inputs: the contract's (see
+/// `needle_contract::FIXED_DEPTH_DIVISOR` and the others).
+pub use needle_contract::{
+    FIXED_CROSS_DIVISORS as CROSS_DIVISORS, FIXED_DEPTH_DIVISOR as DEPTH_DIVISOR, FIXED_SWEEP_DIVISORS as SWEEP_DIVISORS,
+};
 /// Every intermediate of the integer evaluation has a magnitude of at most `2^30`.
 pub const LIMIT: i64 = 1 << 30;
 /// The fixed-point stiffness differentiates coefficients shifted right by
@@ -210,7 +205,7 @@ fn rate_bounds(
 pub fn fixed_formats(model: &Model, model_path: &Path) -> Result<FixedTables, CodegenError> {
     let at = |line: usize, message: String| CodegenError { path: model_path.to_path_buf(), line: (line > 0).then_some(line), message };
     let zero_row = FixedRow { coeffs: [0; TERMS], frac_bits: 0, bound: 0 };
-    let mut components = Vec::with_capacity(6);
+    let mut components = Vec::with_capacity(COMPONENT_COUNT);
     for (c, base) in model.baseline.iter().enumerate() {
         let mut rows = [[zero_row; TERMS]; 4];
         for m in model.matrices.iter().filter(|m| m.component == c) {

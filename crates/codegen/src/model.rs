@@ -87,9 +87,9 @@ pub struct Model {
     pub set: String,
     /// Hash of the FE files the model was fitted on (empty when unfitted).
     pub fe_sha256: String,
-    /// 6 baselines, component order.
+    /// `COMPONENT_COUNT` baselines, component order.
     pub baseline: Vec<Baseline>,
-    /// 24 deviation matrices, sweep-major then component order.
+    /// `SWEEPS.len() * COMPONENT_COUNT` deviation matrices, sweep-major then component order.
     pub matrices: Vec<Matrix>,
     /// The coupled form's table (`form = "coupled"`); `None`: the paper form.
     pub coupled: Option<Coupled>,
@@ -111,11 +111,11 @@ impl Model {
                 line: 0,
             })
             .collect();
-        let matrices = (0..24)
+        let matrices = (0..SWEEPS.len() * COMPONENT_COUNT)
             .map(|n| Matrix {
-                sweep: n / 6,
-                component: n % 6,
-                odd: ODD[n / 6][n % 6],
+                sweep: n / COMPONENT_COUNT,
+                component: n % COMPONENT_COUNT,
+                odd: ODD[n / COMPONENT_COUNT][n % COMPONENT_COUNT],
                 rows: [[0.0; TERMS]; TERMS],
                 rows_f32: [[0.0; TERMS]; TERMS],
                 residual_rms: 0.0,
@@ -277,8 +277,8 @@ impl Checker<'_> {
 
         let baseline_span = raw.baseline.span();
         let baselines = raw.baseline.into_inner();
-        self.count(&baselines, 6, "[[baseline]]", baseline_span)?;
-        let mut baseline = Vec::with_capacity(6);
+        self.count(&baselines, COMPONENT_COUNT, "[[baseline]]", baseline_span)?;
+        let mut baseline = Vec::with_capacity(COMPONENT_COUNT);
         for (c, entry) in baselines.into_iter().enumerate() {
             let line = crate::error::line_of(self.text, entry.span().start);
             baseline.push(Baseline { line, ..self.baseline(c, entry.into_inner())? });
@@ -286,11 +286,11 @@ impl Checker<'_> {
 
         let matrix_span = raw.matrix.span();
         let matrices_raw = raw.matrix.into_inner();
-        self.count(&matrices_raw, 24, "[[matrix]]", matrix_span)?;
-        let mut matrices = Vec::with_capacity(24);
+        self.count(&matrices_raw, SWEEPS.len() * COMPONENT_COUNT, "[[matrix]]", matrix_span)?;
+        let mut matrices = Vec::with_capacity(SWEEPS.len() * COMPONENT_COUNT);
         for (n, entry) in matrices_raw.into_iter().enumerate() {
             let line = crate::error::line_of(self.text, entry.span().start);
-            matrices.push(Matrix { line, ..self.matrix(n / 6, n % 6, entry.into_inner())? });
+            matrices.push(Matrix { line, ..self.matrix(n / COMPONENT_COUNT, n % COMPONENT_COUNT, entry.into_inner())? });
         }
 
         let (coupled, cross) = self.form(raw.form, raw.coupled, raw.cross)?;
@@ -337,8 +337,10 @@ impl Checker<'_> {
             .map_err(|_| self.err(raw.training_runs.span(), "[coupled] training_runs: expected a count >= 0"))?;
         let six = |v: &Spanned<Vec<Spanned<f64>>>, key: &str| -> Result<[f64; COMPONENT_COUNT], CodegenError> {
             let list = v.get_ref();
-            if list.len() != 6 {
-                return Err(self.err(v.span(), format!("[coupled] {key}: {} values, expected 6 (one per component)", list.len())));
+            if list.len() != COMPONENT_COUNT {
+                return Err(
+                    self.err(v.span(), format!("[coupled] {key}: {} values, expected {COMPONENT_COUNT} (one per component)", list.len()))
+                );
             }
             let mut out = [0.0; COMPONENT_COUNT];
             for (o, x) in out.iter_mut().zip(list) {
@@ -536,7 +538,8 @@ impl Checker<'_> {
     }
 
     fn matrix(&self, k: usize, c: usize, raw: RawMatrix) -> Result<Matrix, CodegenError> {
-        let order = "sweep-major (x, z, theta_x, theta_z), then component (fx_n .. mz_nmm)";
+        let order = format!("sweep-major ({}), then component ({})", SWEEPS.join(", "), crate::contract::component_range());
+        let order = order.as_str();
         self.name_at(&raw.sweep, "sweep", &SWEEPS, k, order)?;
         self.name_at(&raw.component, "component", &COMPONENTS, c, order)?;
         let label = format!("matrix {}/{}", SWEEPS[k], COMPONENTS[c]);

@@ -96,7 +96,7 @@ pub fn render_rust_cross(model: &Model) -> String {
     let _ = writeln!(w, "/// the cross terms' inputs are `n_k = v_k * CROSS_SCALES[k]` of the clamped pose.");
     let scales: Vec<String> = CROSS_SCALES_F32.iter().map(|v| lit(*v)).collect();
     let _ = writeln!(w, "pub const CROSS_SCALES: [f32; 4] = [{}];", scales.join(", "));
-    let _ = writeln!(w, "/// Cross-validated RMS error of the coupled form per component (fx_n .. mz_nmm), in %");
+    let _ = writeln!(w, "/// Cross-validated RMS error of the coupled form per component ({}), in %", crate::contract::component_range());
     let _ = writeln!(w, "/// of [`CV_SCALE`] (`cv_rms_pct` in model.toml); all zero for the paper form (not measured).");
     let cv = coupled.map_or([0.0; COMPONENT_COUNT], |c| c.cv_rms_pct);
     let _ = writeln!(

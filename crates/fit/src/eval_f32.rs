@@ -6,6 +6,7 @@
 use super::contract::{NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z};
 use super::model::Model;
 use crate::contract::COMPONENT_COUNT;
+use needle_contract::{DEPTH_MAX_MM, HALF_RANGES};
 
 /// The f32 nearest 1/3 (IEEE division is correctly rounded): 0x3eaaaaab.
 pub const ONE_THIRD: f32 = needle_contract::ONE_THIRD_F32;
@@ -95,11 +96,12 @@ pub fn eval(t: &Tables32, pose: [f32; 5]) -> ([f32; COMPONENT_COUNT], u8) {
     }
     let [x, z, tx, tz, d] = pose;
     // 2. saturation
-    let xc = clamp32(x, -12.0, 12.0);
-    let zc = clamp32(z, -12.0, 12.0);
-    let txc = clamp32(tx, -15.0, 15.0);
-    let tzc = clamp32(tz, -15.0, 15.0);
-    let dc = clamp32(d, 0.0, 6.0);
+    let [vx, vz, vtx, vtz] = HALF_RANGES.map(|v| v as f32);
+    let xc = clamp32(x, -vx, vx);
+    let zc = clamp32(z, -vz, vz);
+    let txc = clamp32(tx, -vtx, vtx);
+    let tzc = clamp32(tz, -vtz, vtz);
+    let dc = clamp32(d, 0.0, DEPTH_MAX_MM as f32);
     let mut status = 0u8;
     if xc != x {
         status |= STATUS_SAT_X;

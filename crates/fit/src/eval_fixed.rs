@@ -15,14 +15,20 @@ use std::fmt;
 /// 1 mm or 1 degree in the Q16.16 pose.
 pub const ONE: i64 = 65536;
 /// Half-ranges of x, z, theta_x, theta_z in Q16.16.
-pub const HALF_RANGE_Q16: [i64; 4] = [12 * ONE, 12 * ONE, 15 * ONE, 15 * ONE];
+pub const HALF_RANGE_Q16: [i64; 4] = {
+    let [x, z, tx, tz] = needle_contract::HALF_RANGES;
+    [x as i64 * ONE, z as i64 * ONE, tx as i64 * ONE, tz as i64 * ONE]
+};
 /// Depth range end in Q16.16.
-pub const DEPTH_MAX_Q16: i64 = 6 * ONE;
-/// Divisors of the normalisation: `V_k / 2 * 2^16 / 2^15` (x, z: 12; tilts: 15) and
-/// depth `3 * 2^16 / 2^15 = 6`.
-pub const DIVISORS: [i64; 4] = [12, 12, 15, 15];
-/// Depth divisor.
-pub const DEPTH_DIVISOR: i64 = 6;
+pub const DEPTH_MAX_Q16: i64 = needle_contract::DEPTH_MAX_MM as i64 * ONE;
+/// Divisors of the sweeps' normalisation, the contract's `FIXED_SWEEP_DIVISORS` (`V_k / 2 *
+/// 2^16 / 2^15`: x, z 12; tilts 15).
+pub const DIVISORS: [i64; 4] = {
+    let [x, z, tx, tz] = needle_contract::FIXED_SWEEP_DIVISORS;
+    [x as i64, z as i64, tx as i64, tz as i64]
+};
+/// Depth divisor, the contract's `FIXED_DEPTH_DIVISOR` (`3 * 2^16 / 2^15 = 6`).
+pub const DEPTH_DIVISOR: i64 = needle_contract::FIXED_DEPTH_DIVISOR as i64;
 /// `2^15`: the scale of U and T.
 const Q15: i64 = 1 << 15;
 

@@ -28,9 +28,15 @@ pub const GOLDEN_SEED: u64 = 0x6e65_6564_6c65_0001;
 pub const RANDOM_POSES: usize = 1000;
 
 /// Upper bound of each input's range: x, z (mm), theta_x, theta_z (deg), depth (mm).
-const MAX: [f32; 5] = [12.0, 12.0, 15.0, 15.0, 6.0];
-/// Lower bound of each input's range.
-const MIN: [f32; 5] = [-12.0, -12.0, -15.0, -15.0, 0.0];
+const MAX: [f32; 5] = {
+    let [x, z, tx, tz] = needle_contract::HALF_RANGES;
+    [x as f32, z as f32, tx as f32, tz as f32, needle_contract::DEPTH_MAX_MM as f32]
+};
+/// Lower bound of each input's range (depth from 0).
+const MIN: [f32; 5] = {
+    let [x, z, tx, tz, _] = MAX;
+    [-x, -z, -tx, -tz, 0.0]
+};
 /// An interior pose, all inputs nonzero and not on a grid line.
 const INTERIOR: [f32; 5] = [3.5, -2.25, 4.75, -9.5, 2.7];
 
@@ -193,16 +199,17 @@ pub struct GoldenRow {
 /// Parse golden-f32.csv text; `path` is only used in messages.
 ///
 /// # Errors
-/// Wrong header, a row without 12 fields, a malformed hex field (`path:line` in the
+/// Wrong header, a row without `6 + COMPONENT_COUNT` fields, a malformed hex field (`path:line` in the
 /// message).
 pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<GoldenRow>> {
     parse_rows(text, path, &header(), |field, at| {
         let value = |s: &str| parse_hex32(s).ok_or_else(|| anyhow::anyhow!("{at}: field {s:?} is not 0x + 8 hex digits"));
-        let mut v = [0.0f32; 11];
-        for (j, dst) in v.iter_mut().enumerate() {
+        let (mut pose, mut wrench) = ([0.0f32; 5], [0.0f32; COMPONENT_COUNT]);
+        for (j, dst) in pose.iter_mut().chain(wrench.iter_mut()).enumerate() {
+            // field 5 is the status, read by parse_rows
             *dst = value(if j < 5 { field[j] } else { field[j + 1] })?;
         }
-        Ok(([v[0], v[1], v[2], v[3], v[4]], [v[5], v[6], v[7], v[8], v[9], v[10]]))
+        Ok((pose, wrench))
     })
     .map(|rows| rows.into_iter().map(|(pose, status, wrench)| GoldenRow { pose, status, wrench }).collect())
 }
