@@ -232,8 +232,7 @@ mod firmware {
             let pose = Pose::new(f32::from_bits(x), f32::from_bits(z), f32::from_bits(tx), f32::from_bits(tz), f32::from_bits(d));
             let e = wrench_and_stiffness(black_box(&pose));
             let plain = wrench(black_box(&pose));
-            let bits = |w: [f32; 6]| w.map(f32::to_bits);
-            if plain.status != e.status || bits(plain.wrench.to_array()) != bits(e.wrench.to_array()) {
+            if plain.status != e.status || plain.wrench.to_array().map(f32::to_bits) != e.wrench.to_array().map(f32::to_bits) {
                 wrench_differs += 1;
             }
             for v in p {

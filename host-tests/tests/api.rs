@@ -9,7 +9,7 @@ fn wrench_array_round_trip_and_zero() {
     assert_eq!(w.fy_n, -2.0);
     assert_eq!(w.mz_nmm, 6.25);
     assert_eq!(w.to_array().map(f32::to_bits), a.map(f32::to_bits));
-    assert_eq!(Wrench::ZERO.to_array().map(f32::to_bits), [0; 6]);
+    assert_eq!(Wrench::ZERO.to_array().map(f32::to_bits), [0; needle_contract::COMPONENT_COUNT]);
     assert_eq!(Wrench::default(), Wrench::ZERO);
 }
 
@@ -80,7 +80,7 @@ fn non_finite_input_gives_zero_wrench_and_error() {
             let e = wrench(&pose);
             let want = if model_info::FITTED { Status::ERROR } else { Status::NO_MODEL | Status::ERROR };
             assert_eq!(e.status, want, "input {i} = {bad}");
-            assert_eq!(e.wrench.to_array().map(f32::to_bits), [0; 6], "all +0.0");
+            assert_eq!(e.wrench.to_array().map(f32::to_bits), [0; needle_contract::COMPONENT_COUNT], "all +0.0");
         }
     }
 }

@@ -45,7 +45,7 @@ fn generator_and_fitter_agree_and_the_bound_holds() {
     let generated = needle_codegen::parse_model_str(&text, path).unwrap_or_else(|e| panic!("{e}"));
     let fixed = needle_codegen::fixed_tables(&generated, path).unwrap_or_else(|e| panic!("{e}"));
     let host = TablesFixed::from_model(&model).unwrap_or_else(|e| panic!("{e:#}"));
-    for c in 0..6 {
+    for c in 0..needle_contract::COMPONENT_COUNT {
         let comp = &fixed.components[c];
         assert_eq!(comp.frac_bits, host.acc_frac[c], "{}: accumulator format", COMPONENTS[c]);
         assert_eq!(comp.baseline.map(i64::from), host.baseline[c], "{}: baseline", COMPONENTS[c]);
@@ -56,15 +56,15 @@ fn generator_and_fitter_agree_and_the_bound_holds() {
         }
     }
     let t32 = Tables32::from_model(&model);
-    let mut max_err = [0.0f64; 6];
-    let mut max_cross = [0.0f64; 6];
+    let mut max_err = [0.0f64; needle_contract::COMPONENT_COUNT];
+    let mut max_cross = [0.0f64; needle_contract::COMPONENT_COUNT];
     for p in poses() {
         let exact = p.map(|v| f64::from(v) / 65536.0);
         let (w64, _) = eval64(&model, exact);
         let (wp, _) = eval_paper(&model, exact);
         let (wq, _) = eval_fixed(&host, p).unwrap_or_else(|o| panic!("pose {p:?}: {o}"));
         let (w32, _) = eval32(&t32, exact.map(|v| v as f32));
-        for c in 0..6 {
+        for c in 0..needle_contract::COMPONENT_COUNT {
             let err = (f64::from(wq[c]) - w64[c] * 1e6).abs();
             max_err[c] = max_err[c].max(err);
             max_cross[c] = max_cross[c].max((w64[c] - wp[c]).abs());
@@ -74,7 +74,7 @@ fn generator_and_fitter_agree_and_the_bound_holds() {
             assert!((f64::from(w32[c]) - w64[c]).abs() <= 1e-4 * scale.max(w64[c].abs()), "{} f32 at {p:?}", COMPONENTS[c]);
         }
     }
-    for c in 0..6 {
+    for c in 0..needle_contract::COMPONENT_COUNT {
         // not vacuous: the cross terms change every component and the integer path rounds
         assert!(max_cross[c] > 1e-4, "{}: the cross terms change nothing ({:e})", COMPONENTS[c], max_cross[c]);
         assert!(max_err[c] > 0.0, "{}: no rounding at all", COMPONENTS[c]);

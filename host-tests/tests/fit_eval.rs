@@ -38,7 +38,7 @@ fn f32_vs_f64(model: &Model, n: usize) -> (f64, f64) {
         let (w64, s64) = eval64(model, p.map(f64::from));
         assert_eq!(s32, s64, "status differs at {p:?}");
         peak = peak.max(w64[1].abs());
-        for c in 0..6 {
+        for c in 0..needle_contract::COMPONENT_COUNT {
             let scale = if needle_contract::is_force(c) { 1.0 } else { fit_synthetic::LEVER_MM };
             worst = worst.max((f64::from(w32[c]) - w64[c]).abs() / scale);
         }
@@ -103,7 +103,7 @@ fn check_mirrors_bitwise(m: &Model, what: &str) {
         for k in [Sweep::X, Sweep::Z] {
             let (wm, sm) = eval32(&t, mirror(p, k));
             assert_eq!(s, sm);
-            for c in 0..6 {
+            for c in 0..needle_contract::COMPONENT_COUNT {
                 let want = if k.is_odd(c) { -w[c] } else { w[c] };
                 let same = wm[c].to_bits() == want.to_bits() || (wm[c] == 0.0 && want == 0.0);
                 assert!(same, "{what}: component {c}, mirror {k:?}, pose {p:?}: {} vs {}", wm[c], want);
@@ -143,7 +143,7 @@ fn single_axis_mirror_is_antisymmetric_to_rounding() {
                 q[k.index()] = -v;
                 let (wp, _) = eval32(&t, p);
                 let (wq, _) = eval32(&t, q);
-                for c in 0..6 {
+                for c in 0..needle_contract::COMPONENT_COUNT {
                     let scale = if needle_contract::is_force(c) { 1.0 } else { fit_synthetic::LEVER_MM };
                     let want = if k.is_odd(c) { -wp[c] } else { wp[c] };
                     if !k.is_odd(c) {
@@ -180,7 +180,7 @@ fn negative_zero_is_positive_zero_and_specials_give_error() {
             assert_eq!(s, STATUS_ERROR);
             assert!(w.iter().all(|x| x.to_bits() == 0), "zero wrench, all +0.0");
             let (w64, s64) = eval64(&out.model, p.map(f64::from));
-            assert_eq!((w64, s64), ([0.0; 6], STATUS_ERROR));
+            assert_eq!((w64, s64), ([0.0; needle_contract::COMPONENT_COUNT], STATUS_ERROR));
         }
     }
 }

@@ -26,7 +26,7 @@ fn error_within_the_generated_bound_on_a_dense_grid() {
     let mut stats = ErrorStats::default();
     stats.add_grid(model, 11);
     print!("{}", fixed_error::table(&stats, *lever));
-    for c in 0..6 {
+    for c in 0..needle_contract::COMPONENT_COUNT {
         assert!(
             stats.max_error[c] <= fixed_error::bound(c),
             "component {c}: error {:e} at pose {:?} exceeds the generated bound {:e}",
@@ -45,7 +45,7 @@ fn generated_bounds_meet_the_goal() {
     let mut stats = ErrorStats::default();
     stats.add_grid(model, 9);
     assert!(stats.peak_fy_n > 0.0);
-    for c in 0..6 {
+    for c in 0..needle_contract::COMPONENT_COUNT {
         let pct = 100.0 * fixed_error::bound(c) / fixed_error::scale(&stats, c, *lever);
         assert!(pct <= GOAL_PCT, "component {c}: bound {:e} is {pct:.4} % of the scale (goal {GOAL_PCT} %)", fixed_error::bound(c));
     }

@@ -6,7 +6,7 @@
 //!
 //! Also: the fitter's choice of formats equals the tables compiled into the library, and
 //! the checker does catch an overflow when the formats are one bit too ambitious.
-use needle_contract::TERMS;
+use needle_contract::{COMPONENT_COUNT, TERMS};
 use needle_fit::eval_fixed::eval;
 use needle_fit::fixed_formats::TablesFixed;
 use needle_fit::model_file;
@@ -36,7 +36,7 @@ fn check_pose(t: &TablesFixed, p: [i32; 5]) {
 #[test]
 fn fitter_formats_equal_the_generated_tables() {
     let t = fitter_tables();
-    for c in 0..6 {
+    for c in 0..needle_contract::COMPONENT_COUNT {
         assert_eq!(t.acc_frac[c], tables::FRAC_BITS[c], "G of component {c}");
         assert_eq!(t.baseline[c].map(|v| v as i32), tables::BASELINE[c], "baseline {c}");
         for k in 0..4 {
@@ -99,13 +99,13 @@ proptest! {
 fn an_intermediate_beyond_two_to_the_thirty_is_caught() {
     let mut t = fitter_tables().clone();
     for k in 0..4 {
-        for c in 0..6 {
+        for c in 0..COMPONENT_COUNT {
             t.rows[k][c] = [[0; TERMS]; TERMS];
             t.row_frac[k][c] = [0; TERMS];
         }
     }
-    t.acc_frac = [0; 6];
-    t.baseline = [[0; TERMS]; 6];
+    t.acc_frac = [0; COMPONENT_COUNT];
+    t.baseline = [[0; TERMS]; COMPONENT_COUNT];
     // B(u) = 2^29 + (2^29 + 1) u: 2^30 + 1 at u = +1
     t.baseline[1] = [0; TERMS];
     t.baseline[1][0] = 1 << 29;

@@ -82,7 +82,7 @@ fn fixed_rates_follow_the_f64_derivatives() {
     }
     assert!(rows.len() > 3000, "only {} golden poses inside the domain", rows.len());
     let columns = rate_columns(true);
-    let mut max_rate = [[0.0f64; 6]; 3];
+    let mut max_rate = [[0.0f64; needle_contract::COMPONENT_COUNT]; 3];
     for (_, want, _) in &rows {
         for (m, w) in max_rate.iter_mut().flatten().zip(want.iter().flatten()) {
             *m = m.max((w * 1e6).abs());

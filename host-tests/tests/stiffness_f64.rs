@@ -4,6 +4,7 @@
 //! terms (`made_up_model`), at 400 poses inside the domain.
 mod made_up_model;
 
+use needle_contract::COMPONENT_COUNT;
 use needle_fit::eval_f32::Tables32;
 use needle_fit::eval_f64::eval;
 use needle_fit::eval_rate_f32::eval_rates as rates32;
@@ -34,10 +35,10 @@ fn poses() -> Vec<[f64; 5]> {
 fn check(model: &Model, what: &str) -> (f64, f64) {
     const H_MM: f64 = 1e-4;
     let poses = poses();
-    let analytic: Vec<[[f64; 6]; 3]> = poses.iter().map(|p| rates64(model, *p).0).collect();
+    let analytic: Vec<[[f64; COMPONENT_COUNT]; 3]> = poses.iter().map(|p| rates64(model, *p).0).collect();
     // Per input and component: the largest |rate| over the poses, the scale of the
     // "relative" error where a rate passes through zero.
-    let mut scale = [[0.0f64; 6]; 3];
+    let mut scale = [[0.0f64; COMPONENT_COUNT]; 3];
     for r in &analytic {
         for (s, v) in scale.iter_mut().flatten().zip(r.iter().flatten()) {
             *s = s.max(v.abs());
@@ -54,7 +55,7 @@ fn check(model: &Model, what: &str) -> (f64, f64) {
             hi[input] += H_MM;
             lo[input] -= H_MM;
             let (fh, fl) = (eval(model, hi).0, eval(model, lo).0);
-            for c in 0..6 {
+            for c in 0..needle_contract::COMPONENT_COUNT {
                 let fd = (fh[c] - fl[c]) / (2.0 * H_MM);
                 if scale[j][c] == 0.0 {
                     assert!(a[j][c] == 0.0 && fd == 0.0, "{what}: component {c} by {} is zero at every other pose", INPUTS[j]);

@@ -41,7 +41,7 @@ fn files_in(dir: &Path) -> Vec<String> {
 fn check_csv(fe: &Path, pose: &str, steps: usize) {
     let rows = results::read_csv(&fe.join(format!("{pose}.csv"))).expect("csv");
     assert_eq!(rows.len(), steps + 1, "{pose}: rows");
-    assert_eq!(rows[0].wrench, [0.0; 6], "{pose}: zero wrench at depth 0");
+    assert_eq!(rows[0].wrench, [0.0; needle_contract::COMPONENT_COUNT], "{pose}: zero wrench at depth 0");
     let depths: Vec<f64> = rows.iter().map(|r| r.depth_mm).collect();
     let want: Vec<f64> = (0..=steps).map(|k| 6.0 * k as f64 / steps as f64).collect();
     assert_eq!(depths, want, "{pose}: depths");
