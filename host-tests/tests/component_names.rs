@@ -65,3 +65,28 @@ fn the_header_parser_sees_a_reordered_struct() {
     assert_ne!(header_fields(c, "needle_wrench_t"), COMPONENTS);
     assert!(header_fields(c, "needle_pose_t").is_empty());
 }
+
+/// The string items of the first `[...]` after `marker` in `text` (JavaScript source):
+/// every `"..."` literal up to the closing bracket of that array.
+fn js_strings_after(text: &str, marker: &str) -> Vec<String> {
+    let Some(start) = text.find(marker) else { return Vec::new() };
+    let rest = text.get(start + marker.len()..).unwrap_or_default();
+    let body = rest.split_once("];").map_or("", |(b, _)| b);
+    body.split('"').skip(1).step_by(2).map(str::to_string).collect()
+}
+
+const WASM_GLUE: &str = include_str!("../../crates/explore/src/page/needle-wasm.mjs");
+
+#[test]
+fn the_explorer_page_lists_the_contract_components_and_status_flags() {
+    assert_eq!(js_strings_after(WASM_GLUE, "export const COMPONENTS = ["), COMPONENTS);
+    // STATUS_FLAGS: [bit, "NAME"] pairs, every named bit but OK (0)
+    let flags = js_strings_after(WASM_GLUE, "export const STATUS_FLAGS = [");
+    let want: Vec<&str> = needle_contract::status::NAMES.iter().filter(|(_, bit)| *bit != 0).map(|(n, _)| *n).collect();
+    assert_eq!(flags, want);
+    for (name, bit) in needle_contract::status::NAMES.iter().filter(|(_, bit)| *bit != 0) {
+        assert!(WASM_GLUE.contains(&format!("[0x{bit:02x}, \"{name}\"]")), "STATUS_FLAGS: {name} = 0x{bit:02x}");
+    }
+    // the reader sees a list that differs
+    assert_ne!(js_strings_after("export const COMPONENTS = [\"fy_n\", \"fx_n\"];", "export const COMPONENTS = ["), COMPONENTS);
+}

@@ -6,18 +6,19 @@
 //! (`tests/explore_wasm.rs` replays `golden-f32.csv` through the module under Node).
 //!
 //! The exports use only numbers (no allocator, no bindings generator):
-//! - [`needle_eval`] evaluates one pose and returns the status bits; the six wrench
+//! - [`needle_eval`] evaluates one pose and returns the status bits; the wrench
 //!   components (fx, fy, fz in N; mx, my, mz in N*mm) are left, as f32 bit patterns, in
-//!   the six-word buffer at [`needle_out`];
+//!   the buffer of [`needle_component_count`] words at [`needle_out`];
 //! - [`needle_domain`] the model's domain, [`needle_coupled`] its form.
 #![cfg_attr(target_arch = "wasm32", no_std)]
 #![deny(missing_docs)]
 
 use core::sync::atomic::{AtomicU32, Ordering};
+use needle_contract::COMPONENT_COUNT;
 use needle_haptics::{model_info, wrench, Pose};
 
 /// The last evaluation: fx, fy, fz (N), mx, my, mz (N*mm) as f32 bits.
-static OUT: [AtomicU32; 6] = [const { AtomicU32::new(0) }; 6];
+static OUT: [AtomicU32; COMPONENT_COUNT] = [const { AtomicU32::new(0) }; COMPONENT_COUNT];
 
 /// Evaluates the wrench at `x_mm`, `z_mm` (entry point), `theta_x_deg`, `theta_z_deg`
 /// (tilt) and `depth_mm`, exactly as the firmware's `needle_haptics::wrench`; stores it
@@ -32,7 +33,14 @@ pub extern "C" fn needle_eval(x_mm: f32, z_mm: f32, theta_x_deg: f32, theta_z_de
     u32::from(e.status.bits())
 }
 
-/// Address of the six-word result buffer of [`needle_eval`] in the module's memory.
+/// Number of wrench components, the words at [`needle_out`] (the contract's
+/// `COMPONENT_COUNT`; the page checks its component list against it).
+#[no_mangle]
+pub extern "C" fn needle_component_count() -> u32 {
+    COMPONENT_COUNT as u32
+}
+
+/// Address of the result buffer of [`needle_eval`] in the module's memory.
 #[no_mangle]
 pub extern "C" fn needle_out() -> *const AtomicU32 {
     OUT.as_ptr()

@@ -4,7 +4,8 @@
 // Served by `needle explore` (crates/explore); no network, no framework.
 import { load, COMPONENTS, statusNames } from "./needle-wasm.mjs";
 
-const UNITS = { fx_n: "N", fy_n: "N", fz_n: "N", mx_nmm: "N·mm", my_nmm: "N·mm", mz_nmm: "N·mm" };
+// a component's unit from its name: "_n" newtons, "_nmm" newton millimetres
+const UNITS = Object.fromEntries(COMPONENTS.map((c) => [c, c.endsWith("_nmm") ? "N·mm" : "N"]));
 const CURVE_POINTS = 61; // depths 0 .. depth_max for the plot and the CSV
 const $ = (id) => document.getElementById(id);
 

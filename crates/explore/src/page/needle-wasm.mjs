@@ -5,8 +5,11 @@
 // load(bytes) -> { evaluate(x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm),
 //                  domain: { x_max_mm, z_max_mm, theta_max_deg, depth_max_mm },
 //                  form: "paper" | "coupled" | "unfitted" }
-// evaluate returns { status, bits: Uint32Array(6), wrench: Float32Array(6) }: fx, fy, fz
-// in N, mx, my, mz in N*mm about the hub, status the library's Status bits.
+// evaluate returns { status, bits: Uint32Array(n), wrench: Float32Array(n) }, n =
+// COMPONENTS.length: fx, fy, fz in N, mx, my, mz in N*mm about the hub, status the
+// library's Status bits. COMPONENTS and STATUS_FLAGS are the contract's (needle-contract:
+// COMPONENTS, status::NAMES), checked by host-tests/tests/component_names.rs; load()
+// refuses a module whose component count differs.
 
 export const COMPONENTS = ["fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"];
 
@@ -23,8 +26,11 @@ export function statusNames(status) {
 export async function load(bytes) {
   const { instance } = await WebAssembly.instantiate(bytes, {});
   const e = instance.exports;
-  for (const name of ["memory", "needle_eval", "needle_out", "needle_domain", "needle_coupled"]) {
+  for (const name of ["memory", "needle_eval", "needle_out", "needle_component_count", "needle_domain", "needle_coupled"]) {
     if (!(name in e)) throw new Error(`needle.wasm does not export ${name}: rebuild it with needle explore`);
+  }
+  if (e.needle_component_count() !== COMPONENTS.length) {
+    throw new Error(`needle.wasm has ${e.needle_component_count()} components, this page ${COMPONENTS.length}: rebuild it with needle explore`);
   }
   const form = ["paper", "coupled", "unfitted"][e.needle_coupled()] ?? "unknown";
   return {
@@ -38,7 +44,7 @@ export async function load(bytes) {
     evaluate(x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm) {
       const status = e.needle_eval(x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm) >>> 0;
       // the memory may have grown since the last call: take a fresh view each time
-      const bits = Uint32Array.from(new Uint32Array(e.memory.buffer, e.needle_out(), 6));
+      const bits = Uint32Array.from(new Uint32Array(e.memory.buffer, e.needle_out(), COMPONENTS.length));
       return { status, bits, wrench: new Float32Array(bits.buffer) };
     },
   };
