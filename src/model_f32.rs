@@ -60,7 +60,7 @@ pub(crate) const ZERO_BASELINE: [bool; COMPONENT_COUNT] = {
 /// `SKIP_DEVIATION[k][c]`: `D_kc` is skipped (see [`skip_sweep`]).
 const SKIP_DEVIATION: [[bool; COMPONENT_COUNT]; 4] = {
     let [d0, d1, d2, d3] = &DEVIATION;
-    [skip_sweep(d0), skip_sweep(d1), skip_sweep(d2), skip_sweep(d3)]
+    [skip_sweep(d0, false), skip_sweep(d1, false), skip_sweep(d2, false), skip_sweep(d3, false)]
 };
 
 /// Which of one sweep's six deviations `w_c = w_c ± D_kc` may be left out, exactly.
@@ -77,15 +77,27 @@ const SKIP_DEVIATION: [[bool; COMPONENT_COUNT]; 4] = {
 ///   sum is `-0.0` only when both addends are `-0.0`, so `w_c` could only become
 ///   `-0.0` by starting as `-0.0`, from a baseline whose constant coefficient is
 ///   `-0.0`. For such a component nothing is skipped.
+///
+/// `with_rates`: the same for an evaluation that also accumulates `B_c'(u)` (the
+/// stiffness, `stiffness_f32::SKIP`), which must not start at `-0.0` either: its last
+/// addition adds `b1` ([`rate_starts_not_neg_zero`]).
 #[allow(clippy::indexing_slicing)] // const evaluation only: an index out of range is a compile error
-const fn skip_sweep(mats: &[[[f32; TERMS]; TERMS]; COMPONENT_COUNT]) -> [bool; COMPONENT_COUNT] {
+pub(crate) const fn skip_sweep(mats: &[[[f32; TERMS]; TERMS]; COMPONENT_COUNT], with_rates: bool) -> [bool; COMPONENT_COUNT] {
     let mut skip = [false; COMPONENT_COUNT];
     let mut c = 0;
     while c < COMPONENT_COUNT {
-        skip[c] = is_plus_zero_matrix(&mats[c]) && starts_not_neg_zero(&BASELINE[c]);
+        let b = &BASELINE[c];
+        skip[c] = is_plus_zero_matrix(&mats[c]) && starts_not_neg_zero(b) && (!with_rates || rate_starts_not_neg_zero(b));
         c += 1;
     }
     skip
+}
+
+/// Whether `h'(b, u)` is never `-0.0`: its last addition adds `b[1]` (a rounded sum is
+/// `-0.0` only when both addends are).
+const fn rate_starts_not_neg_zero(b: &[f32; TERMS]) -> bool {
+    let [_, b1, ..] = *b;
+    b1.to_bits() != 0x8000_0000
 }
 
 /// Whether `h(b, u)` is never `-0.0`: its last operation adds `b[0]`, and the sum is

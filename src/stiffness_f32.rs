@@ -2,41 +2,21 @@
 //! ("Stiffness") bit for bit, sharing the wrench's operations.
 use crate::cross_f32::{add_cross, add_cross_rates, COUPLED, CROSS_SCALES};
 use crate::horner::{horner, horner_with_rate};
-use crate::model_f32::{clamp_to_domain, is_plus_zero_matrix, starts_not_neg_zero, sweep_t, ODD, ONE_THIRD, SWEEP_SCALES, ZERO_BASELINE};
+use crate::model_f32::{clamp_to_domain, skip_sweep, sweep_t, ODD, ONE_THIRD, SWEEP_SCALES, ZERO_BASELINE};
 use crate::stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
 use crate::tables::{BASELINE, DEVIATION, FITTED};
 use crate::{Pose, Status, Wrench};
 use needle_contract::COMPONENT_COUNT;
 use needle_contract::TERMS;
 
-/// Whether neither `B(u)` nor `B'(u)` of the baseline `b` can be `-0.0`: `B` as for the
-/// wrench ([`starts_not_neg_zero`]), and `B'`'s last addition adds `b1` (a rounded sum is
-/// `-0.0` only when both addends are).
-const fn rates_not_neg_zero(b: &[f32; TERMS]) -> bool {
-    let [_, b1, ..] = *b;
-    starts_not_neg_zero(b) && b1.to_bits() != 0x8000_0000
-}
-
-/// One sweep's row of [`SKIP`].
-#[allow(clippy::indexing_slicing)] // const evaluation only: an index out of range is a compile error
-const fn skip_sweep(mats: &[[[f32; TERMS]; TERMS]; COMPONENT_COUNT]) -> [bool; COMPONENT_COUNT] {
-    let mut skip = [false; COMPONENT_COUNT];
-    let mut c = 0;
-    while c < COMPONENT_COUNT {
-        skip[c] = is_plus_zero_matrix(&mats[c]) && rates_not_neg_zero(&BASELINE[c]);
-        c += 1;
-    }
-    skip
-}
-
 /// `SKIP[k][c]`: `D_kc` and all its derivatives are `+0.0` and adding them changes no
 /// accumulator, so they are left out exactly: the matrix is all `+0.0` (see
 /// `model_f32::skip_sweep`), and neither `B_c(u)` nor `B_c'(u)` can be `-0.0`
-/// ([`rates_not_neg_zero`]). The x and z rates of a skipped matrix start from `+0.0` and
+/// (`skip_sweep`'s `with_rates`). The x and z rates of a skipped matrix start from `+0.0` and
 /// stay `+0.0` (`+0 - +0 = +0`).
 const SKIP: [[bool; COMPONENT_COUNT]; 4] = {
     let [d0, d1, d2, d3] = &DEVIATION;
-    [skip_sweep(d0), skip_sweep(d1), skip_sweep(d2), skip_sweep(d3)]
+    [skip_sweep(d0, true), skip_sweep(d1, true), skip_sweep(d2, true), skip_sweep(d3, true)]
 };
 
 /// The wrench of [`wrench`](crate::wrench) (the same bits) and its exact partial
