@@ -79,11 +79,12 @@ pub struct SolveArgs {
     /// runs too; failed runs always keep theirs.
     #[arg(long)]
     pub keep_work: bool,
-    /// Wall-clock limit of one ccx job, in seconds; a job running longer is killed and
-    /// reported failed.
+    /// Wall-clock limit of one solver attempt (FEBio, with its continuations from the last
+    /// must point, or ccx), in seconds; an attempt running longer is killed and counted
+    /// failed (the next attempt of the retry ladder follows).
     #[arg(long, value_name = "S", allow_negative_numbers = true, value_parser = positive_seconds)]
     pub timeout_s: Option<f64>,
-    /// A ccx job that writes no output (log, .sta, .cvg) for this many seconds is killed as stalled; a failed or stalled job is retried once with a smaller first increment per step
+    /// A solver job that writes no output (FEBio: log and rigid-body file; ccx: log, .sta, .cvg) for this many seconds is killed as stalled and counted failed (the next attempt of the retry ladder follows)
     #[arg(long, value_name = "S", default_value_t = campaign::DEFAULT_STALL.as_secs_f64(), allow_negative_numbers = true, value_parser = positive_seconds)]
     pub stall_s: f64,
 }

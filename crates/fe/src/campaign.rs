@@ -77,9 +77,9 @@ pub struct RunOptions {
     pub out_dir: Option<PathBuf>,
     /// Solve every selected pose, even when its result is up to date.
     pub force: bool,
-    /// Wall-clock limit of one ccx job; the job is killed and reported failed after it.
+    /// Wall-clock limit of one solver attempt (FEBio or ccx); the attempt is killed and counted failed after it.
     pub timeout: Option<Duration>,
-    /// A ccx job that writes no output for this long is killed as stalled (then retried).
+    /// A solver job that writes no output for this long is killed as stalled (then retried).
     pub stall: Option<Duration>,
     /// How this process was started, recorded in the manifest entries it writes.
     pub launcher: Launched,
