@@ -99,16 +99,23 @@ pub const FIXED_INPUTS: [&str; 5] = ["x_mm_q16", "z_mm_q16", "theta_x_deg_q16", 
 pub const GOLDEN_FIXED_COLUMNS: [&str; 6 + COMPONENT_COUNT] = golden_columns(FIXED_INPUTS, FIXED_COMPONENTS);
 
 /// Fixed-point normalisation (coeffs/README.md, "Fixed-point evaluation"): `U = (D +
-/// d / 2) / d - 32768` with `d = FIXED_DEPTH_DIVISOR` for the Q16.16 depth `D` (u = depth
-/// / 3 - 1 in Q15: `3 * 2^16 / 2^15 = 6`).
-pub const FIXED_DEPTH_DIVISOR: u32 = 6;
-/// `T_k = (|V_k| + d / 2) / d - 32768` with `d = FIXED_SWEEP_DIVISORS[k]` (`V_k / 2 *
-/// 2^16 / 2^15`: x, z 12; theta_x, theta_z 15): t = |v| * 2 / V - 1 in Q15.
-pub const FIXED_SWEEP_DIVISORS: [u32; 4] = [12, 12, 15, 15];
+/// d / 2) / d - 32768` with `d = FIXED_DEPTH_DIVISOR` for the Q16.16 depth `D`: u =
+/// depth / (DEPTH_MAX_MM / 2) - 1 in Q15, so `d = DEPTH_MAX_MM / 2 * 2^16 / 2^15`, 6.
+pub const FIXED_DEPTH_DIVISOR: u32 = DEPTH_MAX_MM as u32;
+/// `T_k = (|V_k| + d / 2) / d - 32768` with `d = FIXED_SWEEP_DIVISORS[k]`: t = |v| * 2 /
+/// V - 1 in Q15 for the half-range V, so `d = V / 2 * 2^16 / 2^15 = V` (x, z 12; theta_x,
+/// theta_z 15).
+pub const FIXED_SWEEP_DIVISORS: [u32; 4] = {
+    let [x, z, tx, tz] = HALF_RANGES;
+    [x as u32, z as u32, tx as u32, tz as u32]
+};
 /// The coupled form's `N_k = sign(v_k) * ((|v_k| + d / 2) / d)` with `d =
-/// FIXED_CROSS_DIVISORS[k]` (`V_k * 2^16 / 2^15`: x, z 24; theta_x, theta_z 30): n = v /
-/// V in Q15.
-pub const FIXED_CROSS_DIVISORS: [u32; 4] = [24, 24, 30, 30];
+/// FIXED_CROSS_DIVISORS[k]`: n = v / V in Q15, so `d = V * 2^16 / 2^15 = 2 V` (x, z 24;
+/// theta_x, theta_z 30).
+pub const FIXED_CROSS_DIVISORS: [u32; 4] = {
+    let [x, z, tx, tz] = FIXED_SWEEP_DIVISORS;
+    [2 * x, 2 * z, 2 * tx, 2 * tz]
+};
 
 /// Columns of an FE run's file (`fe/<pose>.csv`): the depth, the wrench components.
 pub const FE_COLUMNS: [&str; 1 + COMPONENT_COUNT] = {
