@@ -539,9 +539,8 @@ impl Checker<'_> {
 
     fn matrix(&self, k: usize, c: usize, raw: RawMatrix) -> Result<Matrix, CodegenError> {
         let order = format!("sweep-major ({}), then component ({})", SWEEPS.join(", "), crate::contract::component_range());
-        let order = order.as_str();
-        self.name_at(&raw.sweep, "sweep", &SWEEPS, k, order)?;
-        self.name_at(&raw.component, "component", &COMPONENTS, c, order)?;
+        self.name_at(&raw.sweep, "sweep", &SWEEPS, k, &order)?;
+        self.name_at(&raw.component, "component", &COMPONENTS, c, &order)?;
         let label = format!("matrix {}/{}", SWEEPS[k], COMPONENTS[c]);
         let odd = ODD[k][c];
         if *raw.odd.get_ref() != odd {

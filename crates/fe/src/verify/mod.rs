@@ -18,7 +18,7 @@ pub mod punch_febio;
 pub mod smooth;
 
 pub use mesh_check::{richardson, LevelRun, MeshReport, MESH_GOAL_PERCENT};
-pub use mirror::MirrorReport;
+pub use mirror::{MirrorReport, MIRROR_GOAL_PERCENT};
 pub use punch::{
     bonded_punch_force, poisson, punch_deck, punch_mesh, sneddon_force, PunchDeck, PunchElement, PunchReport, PunchRun,
     PUNCH_CORE_ELEMENTS_C3D20R, PUNCH_CORE_ELEMENTS_C3D8, PUNCH_GOAL_PERCENT, PUNCH_GROWTH, PUNCH_MU_N_PER_MM2,
@@ -71,6 +71,16 @@ pub struct VerifyReport {
     pub smooth: Vec<SmoothReport>,
 }
 
+/// Prints each report's line and says whether every one is within `goal_percent`.
+fn print_judged<R: std::fmt::Display>(reports: &[R], percent: impl Fn(&R) -> f64, goal_percent: f64) -> bool {
+    let mut ok = true;
+    for r in reports {
+        println!("{r}");
+        ok &= percent(r) <= goal_percent;
+    }
+    ok
+}
+
 /// Run the checks, print the table, write `<set>/fe/verify.toml`.
 ///
 /// # Errors
@@ -85,23 +95,11 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
     let mut ok = true;
     if opts.mirror {
         report.mirror = mirror::mirror_checks(&c, &opts.set_dir.join("fe"))?;
-        for m in &report.mirror {
-            println!(
-                "mirror {:>6} vs {:>6}: max difference {:.3e} ({}) = {:.3}% of peak |Fy| (goal <= 1%)",
-                m.pose, m.counterpart, m.max_difference, m.component, m.percent_of_peak_fy
-            );
-            ok &= m.percent_of_peak_fy <= 1.0;
-        }
+        ok &= print_judged(&report.mirror, |m| m.percent_of_peak_fy, MIRROR_GOAL_PERCENT);
     }
     if opts.smooth {
         report.smooth = smooth::smooth_checks(&c, &opts.set_dir.join("fe"))?;
-        for s in &report.smooth {
-            println!(
-                "smooth {:>8}: largest must-point jump {:+.3e} ({}) at {} mm = {:.3}% of peak |Fy| (goal <= {SMOOTH_GOAL_PERCENT}%)",
-                s.pose, s.deviation, s.component, s.depth_mm, s.percent_of_peak_fy
-            );
-            ok &= s.percent_of_peak_fy <= SMOOTH_GOAL_PERCENT;
-        }
+        ok &= print_judged(&report.smooth, |s| s.percent_of_peak_fy, SMOOTH_GOAL_PERCENT);
     }
     if opts.punch {
         let p = match c.solver.engine {

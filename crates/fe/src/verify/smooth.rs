@@ -41,7 +41,7 @@ pub struct SmoothReport {
 /// first loaded point's lower neighbour is the unloaded state, where contact starts, so
 /// it is not judged itself). `None` for fewer than four rows or a run without force.
 pub fn largest_jump(pose: &str, rows: &[Row], lever_arm_mm: f64) -> Option<SmoothReport> {
-    let peak = crate::results::peak_fy_n(rows);
+    let peak = results::peak_fy_n(rows);
     if peak <= 0.0 || lever_arm_mm.is_nan() || lever_arm_mm <= 0.0 {
         return None;
     }
@@ -64,6 +64,17 @@ pub fn largest_jump(pose: &str, rows: &[Row], lever_arm_mm: f64) -> Option<Smoot
         }
     }
     best
+}
+
+impl std::fmt::Display for SmoothReport {
+    /// The report's line in `needle fe verify`'s table.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "smooth {:>8}: largest must-point jump {:+.3e} ({}) at {} mm = {:.3}% of peak |Fy| (goal <= {SMOOTH_GOAL_PERCENT}%)",
+            self.pose, self.deviation, self.component, self.depth_mm, self.percent_of_peak_fy
+        )
+    }
 }
 
 /// [`largest_jump`] of every pose of `c` whose result is in `fe`, in the spec's pose
