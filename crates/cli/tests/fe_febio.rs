@@ -97,8 +97,8 @@ fn a_bad_febio_path_is_a_clear_error() {
 /// termination for one pose, as a crash or a diverged run does) is reported with
 /// FEBio's words and each attempt's log and input kept, is retried four times (the
 /// ladder of `FebioBackend::attempts`: the other projection rule, quarter first
-/// increments, both, a softer contact penalty), and the campaign finishes the other
-/// poses.
+/// increments, both, a softer contact penalty; on the full block the projection rules
+/// swap), and the campaign finishes the other poses.
 #[test]
 fn a_failing_run_keeps_its_log_and_the_campaign_goes_on() {
     let (real, _) = require_febio();
@@ -107,7 +107,7 @@ fn a_failing_run_keeps_its_log_and_the_campaign_goes_on() {
     std::fs::write(
         &wrapper,
         format!(
-            "#!/bin/sh\nif grep -q 'pose \"z+02\"' pose.feb 2>/dev/null; then\n  echo ' *                                ERROR                                  *' > pose.log\n  echo ' * Fake divergence for the test.                                         *' >> pose.log\n  echo ' *************************************************************************' >> pose.log\n  echo ' E R R O R   T E R M I N A T I O N' >> pose.log\n  exit 1\nfi\nexec {} \"$@\"\n",
+            "#!/bin/sh\nif grep -q -e 'pose \"z+02\"' -e 'pose \"t2-a\"' pose.feb 2>/dev/null; then\n  echo ' *                                ERROR                                  *' > pose.log\n  echo ' * Fake divergence for the test.                                         *' >> pose.log\n  echo ' *************************************************************************' >> pose.log\n  echo ' E R R O R   T E R M I N A T I O N' >> pose.log\n  exit 1\nfi\nexec {} \"$@\"\n",
             real.display()
         ),
     )
@@ -116,7 +116,7 @@ fn a_failing_run_keeps_its_log_and_the_campaign_goes_on() {
     std::fs::set_permissions(&wrapper, std::fs::Permissions::from_mode(0o755)).expect("chmod");
     let w = wrapper.to_string_lossy().into_owned();
     let o = needle(
-        &["--solver", "febio", "--mesh", "smoke", "--steps", "10", "--only", "centre,z+02", "--threads", "1"],
+        &["--solver", "febio", "--mesh", "smoke", "--steps", "10", "--only", "centre,z+02,t2-a", "--threads", "1"],
         &set,
         &[("FEBIO", &w)],
     );
@@ -128,6 +128,8 @@ fn a_failing_run_keeps_its_log_and_the_campaign_goes_on() {
     }
     assert!(set.join("fe").join("centre.csv").exists(), "the other pose is solved");
     assert!(!set.join("fe").join("z+02.csv").exists());
+    assert!(out.contains("FAILED t2-a"), "{}", show(&o));
+    assert!(!set.join("fe").join("t2-a.csv").exists());
     let kept = set.join("fe").join(".work").join("z+02");
     for attempt in 1..=5 {
         for ext in ["log", "feb"] {
@@ -150,6 +152,16 @@ fn a_failing_run_keeps_its_log_and_the_campaign_goes_on() {
         seg_up,
         [Some(5.0), Some(0.0), Some(5.0), Some(0.0), Some(5.0)],
         "seg_up of campaign.toml, then retry_seg_up on attempts 2 and 4"
+    );
+    // the full block (t2-a: no mirror plane) takes the projection rules the other way round
+    let full = set.join("fe").join(".work").join("t2-a");
+    let seg_up_full: Vec<Option<f64>> = (1..=5)
+        .map(|n| value(&std::fs::read_to_string(full.join(format!("failed-attempt-{n}.feb"))).unwrap_or_default(), "seg_up"))
+        .collect();
+    assert_eq!(
+        seg_up_full,
+        [Some(0.0), Some(5.0), Some(0.0), Some(5.0), Some(5.0)],
+        "full block: retry_seg_up on attempts 1 and 3, seg_up of campaign.toml on 2, 4 and 5"
     );
     let steps: Vec<Option<f64>> = (1..=5).map(|n| value(&feb(n), "time_steps")).collect();
     let s1 = steps[0].unwrap_or(0.0);

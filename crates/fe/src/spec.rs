@@ -284,8 +284,8 @@ pub struct FebioSettings {
     /// iteration (FEBio's default). A node sliding over a facet edge can otherwise flip
     /// between two facets from one iteration to the next and stall Newton's method.
     pub seg_up: u32,
-    /// `seg_up` of the retries that try the other projection rule (FEBio attempts 2 and
-    /// 4, see `FebioBackend::attempts`); 0: every iteration. Left out of the run hash
+    /// `seg_up` of the attempts that try the other projection rule (FEBio attempts 2 and
+    /// 4; on the full block 1 and 3, see `FebioBackend::attempts`); 0: every iteration. Left out of the run hash
     /// when 0, so adding it kept the results solved before it existed.
     #[serde(default, skip_serializing_if = "is_zero_u32")]
     pub retry_seg_up: u32,
