@@ -190,6 +190,7 @@ impl Backend for FebioBackend {
         // files of an earlier attempt in this folder would be taken for this one's
         for n in 0..=restart::MAX_CONTINUATIONS {
             remove_if_exists(&restart::segment_log(job.work_dir, n))?;
+            remove_if_exists(&job.work_dir.join(restart::segment_solver_log_name(n)))?;
         }
         for f in [rb_path.clone(), job.work_dir.join(restart::DUMP), job.work_dir.join(restart::DUMP_FROM)] {
             remove_if_exists(&f)?;
@@ -252,9 +253,12 @@ impl Backend for FebioBackend {
                 run.cause.as_deref().unwrap_or("no stated cause"),
                 step_mm * fraction
             );
-            if rb_path.exists() {
-                let seg = restart::segment_log(job.work_dir, n);
-                std::fs::rename(&rb_path, &seg).with_context(|| format!("{}: cannot keep as {}", rb_path.display(), seg.display()))?;
+            for (from, to) in
+                [(&rb_path, restart::segment_log(job.work_dir, n)), (&log_path, job.work_dir.join(restart::segment_solver_log_name(n)))]
+            {
+                if from.exists() {
+                    std::fs::rename(from, &to).with_context(|| format!("{}: cannot keep as {}", from.display(), to.display()))?;
+                }
             }
             segments = all;
             let from = job.work_dir.join(restart::DUMP_FROM);
@@ -394,13 +398,21 @@ fn remove_if_exists(p: &Path) -> Result<()> {
 }
 
 /// Keep a failed FEBio attempt's logs (see [`process::keep_failed_attempt`]).
+/// Keeps the attempt's input, FEBio's output and, of a continued attempt, every
+/// segment's logs (`failed-attempt-N.log-0`, `.rb-0.txt`, ...: the must points before
+/// the last continuation), since the next attempt starts in the same folder.
 fn keep_failed_attempt(job: &Job<'_>) -> String {
-    let files = [
-        (format!("{JOB}.feb"), "feb"),
-        (format!("{JOB}.log"), "log"),
-        ("febio.out".to_string(), "out"),
-        (feb::RIGID_LOG.to_string(), "rb.txt"),
+    let mut files = vec![
+        (format!("{JOB}.feb"), "feb".to_string()),
+        (format!("{JOB}.log"), "log".to_string()),
+        ("febio.out".to_string(), "out".to_string()),
+        (feb::RIGID_LOG.to_string(), "rb.txt".to_string()),
     ];
+    for n in 0..restart::MAX_CONTINUATIONS {
+        files.push((restart::segment_solver_log_name(n), format!("log-{n}")));
+        files.push((restart::segment_log_name(n), format!("rb-{n}.txt")));
+    }
+    let files: Vec<(String, &str)> = files.iter().map(|(f, e)| (f.clone(), e.as_str())).collect();
     process::keep_failed_attempt(job.work_dir, &format!("attempt-{}", job.attempt + 1), &files)
 }
 
@@ -487,6 +499,12 @@ mod tests {
                     "{}",
                     f.message
                 );
+                // the first segment's logs, with its must points, are kept beside the last's
+                let first_rb = std::fs::read_to_string(work.join("failed-attempt-1.rb-0.txt")).unwrap_or_default();
+                assert_eq!(logs::parse_rigid_log(&first_rb).map(|r| r.len()).ok(), Some(2), "{first_rb}");
+                let first_log = std::fs::read_to_string(work.join("failed-attempt-1.log-0")).unwrap_or_default();
+                assert!(first_log.contains("converged at time : 3\n"), "{first_log}");
+                assert!(work.join("failed-attempt-1.log").is_file() && work.join("failed-attempt-1.feb").is_file());
             } else {
                 let s = r.unwrap_or_else(|f| panic!("continued run: {}", f.message));
                 let fy: Vec<f64> = s.wrenches.iter().map(|w| w[1]).collect();

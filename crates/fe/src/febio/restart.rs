@@ -44,7 +44,18 @@ pub const RESTART_INPUT: &str = "pose-restart.feb";
 
 /// The rigid-body log of segment `n` (0: the first run) once the next segment started.
 pub fn segment_log(work_dir: &Path, n: u32) -> PathBuf {
-    work_dir.join(format!("needle-rb-{n}.txt"))
+    work_dir.join(segment_log_name(n))
+}
+
+/// File name of [`segment_log`].
+pub fn segment_log_name(n: u32) -> String {
+    format!("needle-rb-{n}.txt")
+}
+
+/// FEBio's own log of segment `n` once the next segment started (the restart writes
+/// `pose.log` afresh).
+pub fn segment_solver_log_name(n: u32) -> String {
+    format!("pose-{n}.log")
 }
 
 /// The restart input: the archive to read, the first time step (mm of insertion: time is
