@@ -397,10 +397,11 @@ fn remove_if_exists(p: &Path) -> Result<()> {
     }
 }
 
-/// Keep a failed FEBio attempt's logs (see [`process::keep_failed_attempt`]).
-/// Keeps the attempt's input, FEBio's output and, of a continued attempt, every
-/// segment's logs (`failed-attempt-N.log-0`, `.rb-0.txt`, ...: the must points before
-/// the last continuation), since the next attempt starts in the same folder.
+/// Keeps a failed FEBio attempt's input, FEBio's output and, of a continued attempt,
+/// every segment's logs (`failed-attempt-N.log-0`, `.rb-0.txt`, ...: the must points
+/// before the last continuation), since the next attempt starts in the same folder
+/// ([`process::keep_failed_attempt`]). Segment copies of an earlier campaign's attempt N
+/// that this attempt did not reach are removed, so the kept files are all this one's.
 fn keep_failed_attempt(job: &Job<'_>) -> String {
     let mut files = vec![
         (format!("{JOB}.feb"), "feb".to_string()),
@@ -412,8 +413,15 @@ fn keep_failed_attempt(job: &Job<'_>) -> String {
         files.push((restart::segment_solver_log_name(n), format!("log-{n}")));
         files.push((restart::segment_log_name(n), format!("rb-{n}.txt")));
     }
+    let attempt = format!("attempt-{}", job.attempt + 1);
+    for (from, ext) in &files {
+        let stale = job.work_dir.join(format!("failed-{attempt}.{ext}"));
+        if !job.work_dir.join(from).is_file() && stale.is_file() {
+            let _ = std::fs::remove_file(stale);
+        }
+    }
     let files: Vec<(String, &str)> = files.iter().map(|(f, e)| (f.clone(), e.as_str())).collect();
-    process::keep_failed_attempt(job.work_dir, &format!("attempt-{}", job.attempt + 1), &files)
+    process::keep_failed_attempt(job.work_dir, &attempt, &files)
 }
 
 #[cfg(test)]
@@ -476,6 +484,8 @@ mod tests {
         for stuck in [false, true] {
             let work = d.path().join(format!("work-{stuck}"));
             std::fs::create_dir_all(&work).expect("mkdir");
+            // an earlier campaign's attempt 1 that was continued twice
+            std::fs::write(work.join("failed-attempt-1.log-1"), "an earlier campaign's").expect("write");
             let backend = FebioBackend { exe: Some(fake_febio(d.path(), stuck)), threads: 1 };
             let job = Job {
                 campaign: &c,
@@ -505,6 +515,7 @@ mod tests {
                 let first_log = std::fs::read_to_string(work.join("failed-attempt-1.log-0")).unwrap_or_default();
                 assert!(first_log.contains("converged at time : 3\n"), "{first_log}");
                 assert!(work.join("failed-attempt-1.log").is_file() && work.join("failed-attempt-1.feb").is_file());
+                assert!(!work.join("failed-attempt-1.log-1").exists(), "an earlier campaign's segment log is not kept as this one's");
             } else {
                 let s = r.unwrap_or_else(|f| panic!("continued run: {}", f.message));
                 let fy: Vec<f64> = s.wrenches.iter().map(|w| w[1]).collect();
