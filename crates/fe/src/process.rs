@@ -173,13 +173,17 @@ pub fn run(
 
 /// Copy a failed attempt's files (`(name in work_dir, extension)`) to
 /// `failed-<attempt>.<extension>` in `work_dir`, where the retry (which rewrites the
-/// solver's files) leaves them; returns ` (kept as failed-<attempt>.*)`, or nothing when
-/// no file could be copied.
+/// solver's files) leaves them; a copy an earlier campaign left there for a file this
+/// attempt did not write is removed, so every kept file is this attempt's. Returns
+/// ` (kept as failed-<attempt>.*)`, or nothing when no file could be copied.
 pub fn keep_failed_attempt(work_dir: &Path, attempt: &str, files: &[(String, &str)]) -> String {
     let mut kept = 0;
     for (from, ext) in files {
         let src = work_dir.join(from);
-        if src.is_file() && std::fs::copy(&src, work_dir.join(format!("failed-{attempt}.{ext}"))).is_ok() {
+        let dest = work_dir.join(format!("failed-{attempt}.{ext}"));
+        if !src.is_file() {
+            let _ = std::fs::remove_file(&dest);
+        } else if std::fs::copy(&src, &dest).is_ok() {
             kept += 1;
         }
     }

@@ -400,8 +400,8 @@ fn remove_if_exists(p: &Path) -> Result<()> {
 /// Keeps a failed FEBio attempt's input, FEBio's output and, of a continued attempt,
 /// every segment's logs (`failed-attempt-N.log-0`, `.rb-0.txt`, ...: the must points
 /// before the last continuation), since the next attempt starts in the same folder
-/// ([`process::keep_failed_attempt`]). Segment copies of an earlier campaign's attempt N
-/// that this attempt did not reach are removed, so the kept files are all this one's.
+/// ([`process::keep_failed_attempt`], which also drops an earlier campaign's copies of
+/// segments this attempt did not reach).
 fn keep_failed_attempt(job: &Job<'_>) -> String {
     let mut files = vec![
         (format!("{JOB}.feb"), "feb".to_string()),
@@ -413,15 +413,8 @@ fn keep_failed_attempt(job: &Job<'_>) -> String {
         files.push((restart::segment_solver_log_name(n), format!("log-{n}")));
         files.push((restart::segment_log_name(n), format!("rb-{n}.txt")));
     }
-    let attempt = format!("attempt-{}", job.attempt + 1);
-    for (from, ext) in &files {
-        let stale = job.work_dir.join(format!("failed-{attempt}.{ext}"));
-        if !job.work_dir.join(from).is_file() && stale.is_file() {
-            let _ = std::fs::remove_file(stale);
-        }
-    }
     let files: Vec<(String, &str)> = files.iter().map(|(f, e)| (f.clone(), e.as_str())).collect();
-    process::keep_failed_attempt(job.work_dir, &attempt, &files)
+    process::keep_failed_attempt(job.work_dir, &format!("attempt-{}", job.attempt + 1), &files)
 }
 
 #[cfg(test)]
