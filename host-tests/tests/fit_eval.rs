@@ -268,6 +268,16 @@ fn validate_runs_on_the_synthetic_set() {
     assert_eq!(t.runs, 20);
     assert!(t.tilt_rho.abs() <= 1.0 && t.offset_rho.abs() <= 1.0, "{t:?}");
     assert!(table.contains("error trend (no goal)"), "{table}");
+    // the floor is a lower bound: the fitted model is one of the models it bounds, so on
+    // every run its errors are at or above the floor
+    for run in &r.runs {
+        let f = run.floor.unwrap_or_else(|| panic!("{}: no floor", run.name));
+        assert!(f.fy_rel_pct <= run.fy_rel_max_pct * (1.0 + 1e-9) + 1e-12, "{}: {f:?} vs {}", run.name, run.fy_rel_max_pct);
+        for (c, e) in run.f64_errors.iter().enumerate() {
+            assert!(f.rms_pct[c] <= e.rms_pct * (1.0 + 1e-9) + 1e-12, "{} component {c}: {f:?} vs {}", run.name, e.rms_pct);
+        }
+    }
+    assert!(table.contains("floor (no goal;"), "{table}");
 }
 
 /// Rewrite the `fit_without = [...]` line of a set's campaign.toml.

@@ -17,6 +17,7 @@ pub mod coupled;
 pub mod coupled_report;
 pub mod cross_terms;
 pub mod data;
+pub mod depth_floor;
 pub mod error_trend;
 pub mod eval_f32;
 pub mod eval_f64;

@@ -21,9 +21,14 @@
 //!
 //! Validation poses are never tuned, dropped or refitted on: a missing or stale run is
 //! a missed goal.
+//!
+//! Beside each run's errors: its floor ([`crate::depth_floor`]), the smallest Table 2 Fy
+//! error and RMS errors any model of the contract's form could have on it (no goal: it
+//! says whether a missed goal is the model's or the FE curve's).
 
 use super::contract::{unit, COMPONENTS};
 use super::data::{fitted_fe_sha256, fitted_poses, load_validation_runs, run_path, Run};
+use super::depth_floor::{depth_floor, DepthFloor};
 use super::error_trend::{trend, ErrorTrend};
 use super::eval_f32::{eval as eval32, Tables32};
 use super::eval_f64::{eval as eval64, eval_paper};
@@ -126,6 +131,10 @@ pub struct RunReport {
     pub worst_max_pct: f64,
     /// The paper part of a coupled model on the same run; `None` for the paper form.
     pub paper_part: Option<PaperPart>,
+    /// The errors no model of the contract's form can beat on this run
+    /// ([`crate::depth_floor`]); `None` when they cannot be computed (fewer than five
+    /// depths >= 1 mm, Fy = 0 at one of them).
+    pub floor: Option<DepthFloor>,
     /// Whether this run meets its role's goal (None for mirror runs: no goal).
     pub goal_met: Option<bool>,
 }
@@ -243,6 +252,7 @@ pub fn compare_run(model: &Model, tables: &Tables32, run: &Run, lever_arm_mm: f6
             worst_rms_pct,
             worst_max_pct,
             paper_part,
+            floor: depth_floor(&run.rows, scale).ok(),
             goal_met,
         },
         diff,
@@ -336,7 +346,7 @@ pub fn to_table(r: &Report) -> String {
     let coupled = r.goals.form == "coupled";
     let _ = writeln!(
         s,
-        "{:<8} {:<7} {:>7} {:>7} {:>7} {:>7} {:>10} {:>14} {:>12} {:>12}{}  goal",
+        "{:<8} {:<7} {:>7} {:>7} {:>7} {:>7} {:>10} {:>14} {:>12} {:>12}{}  {:>12} {:>12}  goal",
         "run",
         "role",
         "x mm",
@@ -347,7 +357,9 @@ pub fn to_table(r: &Report) -> String {
         "Fy rel d>=1 %",
         "worst rms %",
         "worst max %",
-        if coupled { format!("  {:>14} {:>12} {:>12}", "paper: Fy rel %", "rms %", "max %") } else { String::new() }
+        if coupled { format!("  {:>14} {:>12} {:>12}", "paper: Fy rel %", "rms %", "max %") } else { String::new() },
+        "floor: Fy %",
+        "rms %"
     );
     for run in &r.runs {
         let goal = match run.goal_met {
@@ -358,9 +370,13 @@ pub fn to_table(r: &Report) -> String {
             Some(pp) => format!("  {:>14.3} {:>12.3} {:>12.3}", pp.fy_rel_max_pct, pp.worst_rms_pct, pp.worst_max_pct),
             None => String::new(),
         };
+        let floor = match run.floor {
+            Some(f) => format!("  {:>12.3} {:>12.3}", f.fy_rel_pct, f.worst_rms_pct()),
+            None => format!("  {:>12} {:>12}", "-", "-"),
+        };
         let _ = writeln!(
             s,
-            "{:<8} {:<7} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>10.4e} {:>14.3} {:>12.3} {:>12.3}{paper}  {goal}",
+            "{:<8} {:<7} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>10.4e} {:>14.3} {:>12.3} {:>12.3}{paper}{floor}  {goal}",
             run.name,
             run.role,
             run.pose[0],
@@ -426,6 +442,19 @@ pub fn to_table(r: &Report) -> String {
             pw("lhs", |p| p.worst_max_pct)
         );
     }
+    let floor = |role: &str, f: fn(&DepthFloor) -> f64| -> f64 {
+        r.runs.iter().filter(|x| x.role == role).filter_map(|x| x.floor.as_ref().map(f)).fold(0.0, f64::max)
+    };
+    let _ = writeln!(
+        s,
+        "floor (no goal; no model whose Fy at a pose is a degree-{} polynomial in depth does better on these FE runs): table2 Fy rel {:.3} % (goal {} %), rms {:.3} %; lhs rms {:.3} % (goal {} %)",
+        crate::contract::DEGREE,
+        floor("table2", |f| f.fy_rel_pct),
+        g.table2_fy_pct,
+        floor("table2", DepthFloor::worst_rms_pct),
+        floor("lhs", DepthFloor::worst_rms_pct),
+        g.rms_stretch_pct.unwrap_or(g.rms_pct)
+    );
     let _ = writeln!(s, "mirror runs (symmetry check, no goal): rms {}", worst("mirror", |x| x.worst_rms_pct));
     if let Some(t) = r.error_trend {
         let _ = writeln!(
