@@ -447,7 +447,7 @@ pub fn to_table(r: &Report) -> String {
     };
     let _ = writeln!(
         s,
-        "floor (no goal; no model whose Fy at a pose is a degree-{} polynomial in depth does better on these FE runs): table2 Fy rel {:.3} % (goal {} %), rms {:.3} %; lhs rms {:.3} % (goal {} %)",
+        "floor (no goal; no model whose wrench at a pose is a degree-{} polynomial in depth does better on these FE runs): table2 Fy rel {:.3} % (goal {} %), rms {:.3} %; lhs rms {:.3} % (goal {} %)",
         crate::contract::DEGREE,
         floor("table2", |f| f.fy_rel_pct),
         g.table2_fy_pct,
