@@ -10,7 +10,8 @@
 //!   all the run's depths. No model has a smaller RMS error on that run (least squares
 //!   minimises exactly that), in the same units as `needle validate`'s RMS.
 //! - **Table 2 floor**: a lower bound of the smallest possible largest relative Fy error
-//!   at depths >= [`TABLE2_MIN_DEPTH_MM`] (`needle validate`'s "Fy rel d>=1 %"). For any
+//!   at depths >= `min_depth_mm` (`needle validate` passes its Table 2 goal's 1 mm: its
+//!   "Fy rel d>=1 %"). For any
 //!   weights `l_k >= 0` summing to 1, the polynomial minimising `sum l_k e_k^2` (`e_k` the
 //!   relative error at depth k) has `sqrt(sum l_k e_k^2)` at most the weighted sum of the
 //!   minimax polynomial, which is at most the minimax error squared: so every such value
@@ -23,7 +24,6 @@
 
 use super::contract::{COMPONENT_COUNT, DEGREE, DEPTH_MAX_MM};
 use super::lsq::{lstsq, vandermonde};
-use super::validate::TABLE2_MIN_DEPTH_MM;
 use anyhow::{bail, Result};
 use nalgebra::DVector;
 use needle_fe::results::Row;
@@ -32,8 +32,8 @@ use serde::Serialize;
 /// The floors of one run (module docs).
 #[derive(Debug, Clone, Copy, Serialize, Default, PartialEq)]
 pub struct DepthFloor {
-    /// Lower bound of the largest |Fy_model - Fy_FE| / |Fy_FE| at depths >= 1 mm of any
-    /// model of the contract's form, % (module docs).
+    /// Lower bound of the largest |Fy_model - Fy_FE| / |Fy_FE| at depths >= `min_depth_mm`
+    /// of any model of the contract's form, % (module docs).
     pub fy_rel_pct: f64,
     /// Per component, the smallest possible RMS error over all depths, in % of the
     /// run's scale (`scale[c]`, as `needle validate`'s RMS %).
@@ -74,12 +74,13 @@ fn u_of(depth_mm: f64) -> f64 {
 }
 
 /// The floors of the run with `rows` (depth in mm, wrench in N and N·mm), RMS floors in %
-/// of `scale` (N, N·mm per component, as `needle validate`).
+/// of `scale` (N, N·mm per component, as `needle validate`), the relative Fy floor over
+/// the depths >= `min_depth_mm`.
 ///
 /// # Errors
-/// Fewer than `DEGREE + 1` distinct depths overall or at >= 1 mm; Fy zero at a depth
-/// >= 1 mm (no relative error); a non-finite value.
-pub fn depth_floor(rows: &[Row], scale: [f64; COMPONENT_COUNT]) -> Result<DepthFloor> {
+/// Fewer than `DEGREE + 1` distinct depths overall or at >= `min_depth_mm`; Fy zero at
+/// one of the latter (no relative error); a non-finite value.
+pub fn depth_floor(rows: &[Row], scale: [f64; COMPONENT_COUNT], min_depth_mm: f64) -> Result<DepthFloor> {
     let u: Vec<f64> = rows.iter().map(|r| u_of(r.depth_mm)).collect();
     let mut rms_pct = [0.0; COMPONENT_COUNT];
     for (c, out) in rms_pct.iter_mut().enumerate() {
@@ -87,7 +88,7 @@ pub fn depth_floor(rows: &[Row], scale: [f64; COMPONENT_COUNT]) -> Result<DepthF
         let res = residuals(&u, &y, &vec![1.0; y.len()])?;
         *out = if scale[c] > 0.0 { 100.0 * rms(&res) / scale[c] } else { 0.0 };
     }
-    let deep: Vec<&Row> = rows.iter().filter(|r| r.depth_mm >= TABLE2_MIN_DEPTH_MM - 1e-9).collect();
+    let deep: Vec<&Row> = rows.iter().filter(|r| r.depth_mm >= min_depth_mm - 1e-9).collect();
     if let Some(r) = deep.iter().find(|r| r.fy_n() == 0.0) {
         bail!("depth floor: Fy = 0 at {} mm: no relative error", r.depth_mm);
     }
@@ -145,7 +146,7 @@ mod tests {
     #[test]
     fn a_polynomial_of_the_model_degree_has_no_floor() {
         let f = |d: f64| 1e-3 * d + 2e-3 * d * d - 1e-4 * d.powi(4);
-        let fl = depth_floor(&rows(f), SCALE).unwrap();
+        let fl = depth_floor(&rows(f), SCALE, 1.0).unwrap();
         assert!(fl.fy_rel_pct < 1e-9 && fl.worst_rms_pct() < 1e-9, "{fl:?}");
     }
 
@@ -154,7 +155,7 @@ mod tests {
         let smooth = |d: f64| 2e-3 * d * d;
         let bumped = |d: f64| smooth(d) + if (d - 1.2).abs() < 1e-9 { 6e-4 } else { 0.0 };
         let rs = rows(bumped);
-        let fl = depth_floor(&rs, SCALE).unwrap();
+        let fl = depth_floor(&rs, SCALE, 1.0).unwrap();
         // The smooth curve itself is a candidate model: its errors are the bump alone.
         let bump_rel = 100.0 * 6e-4 / bumped(1.2);
         assert!(fl.fy_rel_pct > 0.1 && fl.fy_rel_pct <= bump_rel, "{} vs {bump_rel}", fl.fy_rel_pct);
@@ -188,7 +189,7 @@ mod tests {
             let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
             rs.push(Row { depth_mm: *d, wrench: [q(*d) / (1.0 - delta * sign); COMPONENT_COUNT] });
         }
-        let fl = depth_floor(&rs, SCALE).unwrap();
+        let fl = depth_floor(&rs, SCALE, 1.0).unwrap();
         let bound = fl.fy_rel_pct / 100.0;
         assert!(bound <= delta * (1.0 + 1e-9), "a lower bound above the minimax error: {bound}");
         assert!(bound >= delta * (1.0 - 1e-6), "Lawson did not reach the minimax error: {bound} vs {delta}");
@@ -196,7 +197,7 @@ mod tests {
 
     #[test]
     fn zero_fy_at_depth_is_an_error() {
-        let e = depth_floor(&rows(|_| 0.0), SCALE).unwrap_err();
+        let e = depth_floor(&rows(|_| 0.0), SCALE, 1.0).unwrap_err();
         assert!(e.to_string().contains("Fy = 0 at 1.2 mm"), "{e}");
     }
 }

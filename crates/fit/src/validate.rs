@@ -252,7 +252,7 @@ pub fn compare_run(model: &Model, tables: &Tables32, run: &Run, lever_arm_mm: f6
             worst_rms_pct,
             worst_max_pct,
             paper_part,
-            floor: depth_floor(&run.rows, scale).ok(),
+            floor: depth_floor(&run.rows, scale, TABLE2_MIN_DEPTH_MM).ok(),
             goal_met,
         },
         diff,
