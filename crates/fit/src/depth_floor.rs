@@ -22,8 +22,9 @@
 //! data as it is (the FE curve's must points are not on a polynomial of this degree:
 //! its contact events and mesh steps, `needle fe verify --smooth`).
 
-use super::contract::{COMPONENT_COUNT, DEGREE, DEPTH_MAX_MM};
+use super::contract::{u_of, COMPONENT_COUNT, DEGREE};
 use super::lsq::{lstsq, vandermonde};
+use super::model::rms_max;
 use anyhow::{bail, Result};
 use nalgebra::DVector;
 use needle_fe::results::Row;
@@ -64,15 +65,6 @@ fn residuals(w: &[f64], y: &[f64], weight: &[f64]) -> Result<Vec<f64>> {
     Ok(y.iter().zip(fitted.iter()).map(|(v, f)| v - f).collect())
 }
 
-fn rms(v: &[f64]) -> f64 {
-    (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
-}
-
-/// Depth normalised to [-1, 1] over the domain, as the model's `u`.
-fn u_of(depth_mm: f64) -> f64 {
-    depth_mm / (DEPTH_MAX_MM / 2.0) - 1.0
-}
-
 /// The floors of the run with `rows` (depth in mm, wrench in N and N·mm), RMS floors in %
 /// of `scale` (N, N·mm per component, as `needle validate`), the relative Fy floor over
 /// the depths >= `min_depth_mm`.
@@ -86,7 +78,7 @@ pub fn depth_floor(rows: &[Row], scale: [f64; COMPONENT_COUNT], min_depth_mm: f6
     for (c, out) in rms_pct.iter_mut().enumerate() {
         let y: Vec<f64> = rows.iter().map(|r| r.wrench[c]).collect();
         let res = residuals(&u, &y, &vec![1.0; y.len()])?;
-        *out = if scale[c] > 0.0 { 100.0 * rms(&res) / scale[c] } else { 0.0 };
+        *out = if scale[c] > 0.0 { 100.0 * rms_max(res).0 / scale[c] } else { 0.0 };
     }
     let deep: Vec<&Row> = rows.iter().filter(|r| r.depth_mm >= min_depth_mm - 1e-9).collect();
     if let Some(r) = deep.iter().find(|r| r.fy_n() == 0.0) {
