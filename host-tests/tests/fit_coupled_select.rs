@@ -1,24 +1,38 @@
 //! The coupled form's size is chosen per component (crates/fit/src/coupled.rs,
-//! coeffs/README.md "The coupled form"): on training runs made from the default set's
-//! paper model with a known cross term in fy and an unrepresentable wiggle in fx, fy
-//! gets its term back and every other component none.
+//! coeffs/README.md "The coupled form"): on runs made from the default set's paper model
+//! (its centre and sweep runs replaced by the model's values, so the paper part is exactly
+//! representable with sweep degree 4) plus, on the training runs, a known cross term in fy
+//! and in fx a wiggle whose sign alternates from run to run (no function of the pose), fy gets its term back, fx none, and the joint fit
+//! reproduces the paper model.
 use needle_fe::results::Row;
 use needle_fe::spec::{PoseSpec, Role};
 use needle_fit::contract::COMPONENTS;
 use needle_fit::coupled::{scales, select_and_fit};
-use needle_fit::data::Run;
-use needle_fit::eval_f64::eval_paper;
+use needle_fit::data::{load_fit_data, Run};
+use needle_fit::eval_f64::{eval, eval_paper};
 use std::path::Path;
 
-/// Training runs whose FE rows are the default set's paper model plus, for fy, a known
-/// cross term `0.004 N * xi * beta * (1 + u)` and, for fx, a deterministic wiggle no
-/// cross term represents: cross-validation must give fy cross terms that recover the
-/// term, and fx (where cross terms would only fit the wiggle) and the exact
-/// components none.
+fn pose_of(p: &PoseSpec, depth_mm: f64) -> [f64; 5] {
+    [p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg, depth_mm]
+}
+
 #[test]
-fn each_component_chooses_its_own_size_and_none_when_the_paper_form_is_better() {
-    let path = Path::new(needle_haptics::model_info::SET_DIR).join("model.toml");
-    let paper = needle_fit::model_file::read(&path).unwrap_or_else(|e| panic!("{e:#}"));
+fn each_component_chooses_its_own_size_and_the_cross_term_is_recovered() {
+    let set = Path::new(needle_haptics::model_info::SET_DIR);
+    let paper = needle_fit::model_file::read(&set.join("model.toml")).unwrap_or_else(|e| panic!("{e:#}"));
+    let mut data = load_fit_data(set).unwrap_or_else(|e| panic!("{e:#}"));
+    // The centre and sweep runs become the paper model's own values.
+    let exact = |run: &mut Run| {
+        for row in &mut run.rows {
+            row.wrench = eval_paper(&paper, pose_of(&run.pose, row.depth_mm)).0;
+        }
+    };
+    exact(&mut data.centre);
+    for pts in &mut data.sweeps {
+        for p in pts.iter_mut() {
+            exact(&mut p.run);
+        }
+    }
     // 16 combined poses from a fixed low-discrepancy rule (golden-ratio steps).
     let runs: Vec<Run> = (0..16)
         .map(|i| {
@@ -31,13 +45,12 @@ fn each_component_chooses_its_own_size_and_none_when_the_paper_form_is_better() 
                 theta_x_deg: 14.0 * f(0.569_840),
                 theta_z_deg: 14.0 * f(0.437_016),
             };
-            let rows = (1..=20)
+            let rows = (0..=20)
                 .map(|d| {
                     let depth_mm = 0.3 * f64::from(d);
-                    let p = [pose.x_mm, pose.z_mm, pose.theta_x_deg, pose.theta_z_deg, depth_mm];
-                    let mut wrench = eval_paper(&paper, p).0;
+                    let mut wrench = eval_paper(&paper, pose_of(&pose, depth_mm)).0;
                     wrench[1] += 0.004 * (pose.x_mm / 12.0) * (pose.theta_z_deg / 15.0) * (depth_mm / 3.0);
-                    wrench[0] += 2e-5 * (7.0 * depth_mm + f64::from(i)).sin();
+                    wrench[0] += if i % 2 == 0 { 2e-5 } else { -2e-5 } * (7.0 * depth_mm).sin();
                     Row { depth_mm, wrench }
                 })
                 .collect();
@@ -46,15 +59,27 @@ fn each_component_chooses_its_own_size_and_none_when_the_paper_form_is_better() 
         .collect();
     let refs: Vec<&Run> = runs.iter().collect();
     let scale = scales(&refs, 60.0);
-    let (sel, terms) = select_and_fit(&paper, &refs, scale).unwrap_or_else(|e| panic!("{e:#}"));
-    assert_eq!(sel.choices[0], None, "fx: cross terms only fit the wiggle: {sel:?}");
-    for c in [0, 2, 3, 4, 5] {
-        assert_eq!(sel.choices[c], None, "{}: no cross term there", COMPONENTS[c]);
-        assert!(terms.terms[c].iter().all(|(_, p)| p.iter().all(|v| *v == 0.0)), "{}: written as zeros", COMPONENTS[c]);
+    let (sel, model) = select_and_fit(&paper, &data, &refs, scale).unwrap_or_else(|e| panic!("{e:#}"));
+    let cross = model.cross.as_ref().unwrap_or_else(|| panic!("the coupled model has cross terms"));
+    // fx: cross terms would only fit the wiggle; the paper part needs sweep degree 4.
+    assert_eq!((sel.choices[0].sweep_degree, sel.choices[0].cross), (4, None), "fx: {}", sel.choices[0].label());
+    // Components without a cross term: exact (cv ~ 0) and any cross coefficient ~ 0.
+    for c in [2, 3, 4, 5] {
+        assert!(sel.rms_pct[c] < 1e-6, "{}: cv {} % on exact data", COMPONENTS[c], sel.rms_pct[c]);
+        let worst = cross.terms.terms[c].iter().flat_map(|(_, p)| p.iter()).fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(worst < 1e-9, "{}: cross coefficient {worst} where there is no cross term", COMPONENTS[c]);
     }
-    let fy = sel.choices[1].unwrap_or_else(|| panic!("fy needs its cross term: {sel:?}"));
+    let fy = sel.choices[1].cross.unwrap_or_else(|| panic!("fy needs its cross term: {}", sel.choices[1].label()));
     assert!(sel.rms_pct[1] < 1e-6 && sel.paper_rms_pct[1] > 0.1, "fy: cv {} %, paper {} %", sel.rms_pct[1], sel.paper_rms_pct[1]);
     // The fitted term: xi * beta with P(u) = 0.004 (u + 1).
-    let (_, p) = terms.terms[1].iter().find(|(e, _)| *e == [1, 0, 0, 1]).unwrap_or_else(|| panic!("no xi*beta term in {fy:?}"));
+    let (_, p) = cross.terms.terms[1].iter().find(|(e, _)| *e == [1, 0, 0, 1]).unwrap_or_else(|| panic!("no xi*beta term in {fy:?}"));
     assert!((p[0] - 0.004).abs() < 1e-9 && (p[1] - 0.004).abs() < 1e-9, "xi*beta: {p:?}");
+    // The joint fit's paper part is the paper model again (fy, away from the wiggle).
+    for r in &runs {
+        for row in &r.rows {
+            let want = row.wrench[1];
+            let got = eval(&model, pose_of(&r.pose, row.depth_mm)).0[1];
+            assert!((got - want).abs() < 1e-9, "{} at {} mm: fy {got} N, data {want} N", r.pose.name, row.depth_mm);
+        }
+    }
 }

@@ -86,7 +86,7 @@ pub fn fit(a: FitArgs) -> Result<ExitCode> {
     let writes: Vec<(&Path, &[u8])> = files.iter().map(|(path, text)| (path.as_path(), text.as_bytes())).collect();
     write_all_atomic(&writes)?;
     print!("{}", fit::summary(&out.model));
-    let coupled = fit::coupled_report::measure(&a.set, &out.model)
+    let coupled = fit::coupled_report::measure(&a.set)
         .with_context(|| format!("needle fit --set {}: measuring the coupled form", a.set.display()))?;
     print!("{}", fit::coupled_report::to_table(&coupled));
     for (path, text) in &files {

@@ -8,10 +8,9 @@
 //! the lever arm), and for Table 2 the largest |Fy| error at depths >= 1 mm in % of FE.
 
 use super::coupled::{self, Selection};
-use super::cross_terms::CrossTerms;
-use super::data::{load_training_runs, load_validation_runs, Run};
-use super::eval_f64::{eval_paper, eval_with_cross, Pose64};
-use super::model::Model;
+use super::data::{load_paper_data, load_training_runs, load_validation_runs, Run};
+use super::eval_f64::{eval, eval_paper, Pose64};
+use super::model::{fit as fit_paper, Model};
 use super::validate::TABLE2_MIN_DEPTH_MM;
 use crate::contract::COMPONENT_COUNT;
 use anyhow::Result;
@@ -38,8 +37,8 @@ pub struct HeldOut {
 pub struct CurvePoint {
     /// Training runs used: the first `runs` of the design.
     pub runs: usize,
-    /// Form chosen by cross-validation on them (`max_degree`, `depth_degree`).
-    pub form: Option<(u8, u8)>,
+    /// Per component, the size chosen by cross-validation on them ([`coupled::Candidate::label`]).
+    pub choices: Option<Vec<String>>,
     /// Held-out errors of the coupled form fitted on them; `None` if nothing could be fitted.
     pub held_out: Option<HeldOut>,
 }
@@ -56,8 +55,8 @@ pub struct CoupledReport {
     /// Cross-validation of every candidate on all training runs, the paper form's error
     /// there and each component's choice; `None` when nothing could be fitted.
     pub selection: Option<Selection>,
-    /// The chosen cross terms, fitted on all training runs.
-    pub terms: Option<CrossTerms>,
+    /// The coupled model fitted on all training runs.
+    pub model: Option<Model>,
     /// The paper form's held-out errors.
     pub paper: HeldOut,
     /// The coupled form's held-out errors.
@@ -109,30 +108,32 @@ pub fn curve_sizes(n: usize) -> Vec<usize> {
 }
 
 /// Held-out errors of the paper part of `model` alone (its cross terms, if any, left
-/// out): the paper form's row of the report, also when `model` is the fitted coupled
-/// model.
+/// out).
 pub fn paper_held_out(runs: &[&Run], lever_arm_mm: f64, model: &Model) -> HeldOut {
     held_out(runs, lever_arm_mm, |p| eval_paper(model, p).0)
 }
 
-/// Measure the coupled form of the set in `set_dir` against its paper form: the paper
-/// part of `paper` (a fitted coupled model may be passed; its cross terms are ignored).
+/// Measure the coupled form of the set in `set_dir` against its paper form (fitted here
+/// on the centre and sweep runs, as `form = "paper"` does), whichever form the set
+/// ships: the coupled form is fitted on the training runs present.
 ///
 /// # Errors
-/// The spec, the manifest or a run cannot be read.
-pub fn measure(set_dir: &Path, paper: &Model) -> Result<CoupledReport> {
+/// The spec, the manifest or a run cannot be read; the paper form cannot be fitted.
+pub fn measure(set_dir: &Path) -> Result<CoupledReport> {
+    let data = load_paper_data(set_dir)?;
+    let paper = fit_paper(&data)?;
     let (campaign, train, unusable) = load_training_runs(set_dir)?;
     let (_, validation, _) = load_validation_runs(set_dir)?;
     let lever = campaign.needle.reference_from_tip_mm;
     let held: Vec<&Run> = validation.iter().filter(|r| r.pose.role.is_validation()).collect();
     let train_refs: Vec<&Run> = train.iter().collect();
-    let paper_errors = paper_held_out(&held, lever, paper);
+    let paper_errors = paper_held_out(&held, lever, &paper);
     let mut report = CoupledReport {
         training_runs: train.len(),
         unusable: unusable.iter().map(|u| format!("{} ({})", u.pose.name, u.why)).collect(),
         held_out_runs: held.len(),
         selection: None,
-        terms: None,
+        model: None,
         paper: paper_errors,
         coupled: None,
         curve: Vec::new(),
@@ -142,17 +143,17 @@ pub fn measure(set_dir: &Path, paper: &Model) -> Result<CoupledReport> {
     }
     let scale = coupled::scales(&train_refs, lever);
     for n in curve_sizes(train.len()) {
-        let got = coupled::select_and_fit(paper, &train_refs[..n], scale).ok();
+        let got = coupled::select_and_fit(&paper, &data, &train_refs[..n], scale).ok();
         let point = CurvePoint {
             runs: n,
-            form: got.as_ref().map(|g| (g.1.form.max_degree, g.1.form.depth_degree)),
-            held_out: got.as_ref().map(|g| held_out(&held, lever, |p| eval_with_cross(paper, &g.1, p).0)),
+            choices: got.as_ref().map(|g| g.0.choices.iter().map(coupled::Candidate::label).collect()),
+            held_out: got.as_ref().map(|g| held_out(&held, lever, |p| eval(&g.1, p).0)),
         };
         if n == train.len() {
-            if let Some((selection, terms)) = got {
+            if let Some((selection, model)) = got {
                 report.coupled = point.held_out;
                 report.selection = Some(selection);
-                report.terms = Some(terms);
+                report.model = Some(model);
             }
         }
         report.curve.push(point);
@@ -175,62 +176,58 @@ pub fn to_table(r: &CoupledReport) -> String {
         r.held_out_runs
     );
     if let Some(sel) = &r.selection {
-        let _ =
-            writeln!(s, "{}-fold cross-validation on the training runs (RMS, % of their peak |Fy|; moments x lever arm):", coupled::FOLDS);
         let _ = writeln!(
             s,
-            "  {:>10} {:>10}  {:>6} {:>6} {:>6} {:>6} {:>6} {:>6}",
-            "pose deg", "depth deg", "fx", "fy", "fz", "mx", "my", "mz"
+            "{}-fold cross-validation on the sweep and training runs (RMS, % of the training runs' peak |Fy|; moments x lever arm);",
+            coupled::FOLDS
         );
-        let cells = |e: &[f64; COMPONENT_COUNT], form: Option<super::cross_terms::CrossForm>| -> String {
-            (0..COMPONENT_COUNT).map(|c| format!(" {:>6.3}{}", e[c], if sel.choices[c] == form { "*" } else { " " })).collect()
-        };
-        let _ = writeln!(s, "  {:>10} {:>10} {}  (paper form alone, out of sample)", "none", "-", cells(&sel.paper_rms_pct, None));
-        for c in &sel.cv {
-            match c.rms_pct {
-                Some(e) => {
-                    let _ = writeln!(s, "  {:>10} {:>10} {}", c.form.max_degree, c.form.depth_degree, cells(&e, Some(c.form)));
-                }
-                None => {
-                    let _ = writeln!(
-                        s,
-                        "  {:>10} {:>10}  not fitted: {}",
-                        c.form.max_degree,
-                        c.form.depth_degree,
-                        c.failure.as_deref().unwrap_or("")
-                    );
-                }
-            }
+        let _ = writeln!(s, "  form: sweep degree / cross degree / depth degree of the cross terms (- none):");
+        let _ = writeln!(s, "  {:>10}  {:>6} {:>6} {:>6} {:>6} {:>6} {:>6}", "form", "fx", "fy", "fz", "mx", "my", "mz");
+        let _ = writeln!(
+            s,
+            "  {:>10} {}  (paper form on the training runs, out of sample; reference)",
+            "paper",
+            (0..COMPONENT_COUNT).map(|c| format!(" {:>6.3} ", sel.paper_rms_pct[c])).collect::<String>()
+        );
+        for score in &sel.cv {
+            let cells: String = (0..COMPONENT_COUNT)
+                .map(|c| match score.rms_pct[c] {
+                    Some(e) => format!(" {:>6.3}{}", e, if sel.choices[c] == score.candidate { "*" } else { " " }),
+                    None => format!(" {:>6} ", "-"),
+                })
+                .collect();
+            let why = match (&score.failure, score.rms_pct.iter().any(Option::is_none)) {
+                (Some(f), true) => format!("  not fitted: {}", f.chars().take(160).collect::<String>()),
+                _ => String::new(),
+            };
+            let _ = writeln!(s, "  {:>10} {cells}{why}", score.candidate.label());
         }
-        let names: Vec<String> = sel
-            .choices
-            .iter()
-            .zip(crate::contract::COMPONENTS)
-            .map(|(f, name)| match f {
-                Some(f) => format!("{name} {}/{}", f.max_degree, f.depth_degree),
-                None => format!("{name} none"),
-            })
-            .collect();
+        let names: Vec<String> =
+            sel.choices.iter().zip(crate::contract::COMPONENTS).map(|(f, name)| format!("{name} {}", f.label())).collect();
         let _ = writeln!(s, "  chosen per component (*): {}", names.join(", "));
     }
     let _ = writeln!(s, "learning curve (held-out errors of the coupled form fitted on the first n training runs):");
-    let _ = writeln!(s, "  {:>4} {:>8}  {:>12} {:>12} {:>12} {:>10}", "n", "form", "lhs rms %", "t2 rms %", "t2 Fy max %", "max %");
+    let _ = writeln!(
+        s,
+        "  {:>4}  {:>12} {:>12} {:>12} {:>10}  chosen (fx fy fz mx my mz)",
+        "n", "lhs rms %", "t2 rms %", "t2 Fy max %", "max %"
+    );
     for p in &r.curve {
-        match (p.form, p.held_out) {
+        match (&p.choices, p.held_out) {
             (Some(f), Some(h)) => {
                 let _ = writeln!(
                     s,
-                    "  {:>4} {:>8}  {:>12.3} {:>12.3} {:>12.3} {:>10.3}",
+                    "  {:>4}  {:>12.3} {:>12.3} {:>12.3} {:>10.3}  {}",
                     p.runs,
-                    format!("{}/{}", f.0, f.1),
                     h.lhs_worst_rms_pct,
                     h.table2_worst_rms_pct,
                     h.table2_fy_max_pct,
-                    h.worst_max_pct
+                    h.worst_max_pct,
+                    f.join(" ")
                 );
             }
             _ => {
-                let _ = writeln!(s, "  {:>4} {:>8}  (too few runs for any candidate)", p.runs, "-");
+                let _ = writeln!(s, "  {:>4}  (too few runs for any candidate)", p.runs);
             }
         }
     }
@@ -282,7 +279,7 @@ mod tests {
         model.cross =
             Some(Coupled { terms: terms.clone(), training_runs: 1, cv_rms_pct: [0.0; COMPONENT_COUNT], scale: [1.0; COMPONENT_COUNT] });
         let paper = paper_held_out(&[&run], 60.0, &model);
-        let coupled = held_out(&[&run], 60.0, |p| eval_with_cross(&model, &terms, p).0);
+        let coupled = held_out(&[&run], 60.0, |p| crate::eval_f64::eval_with_cross(&model, &terms, p).0);
         assert_eq!(paper.lhs_worst_rms_pct, 0.0, "the paper row must not include the cross terms");
         assert!(coupled.lhs_worst_rms_pct > 1.0, "the cross term shows in the coupled row: {}", coupled.lhs_worst_rms_pct);
     }

@@ -155,7 +155,24 @@ pub fn fitted_poses(campaign: &Campaign) -> Vec<PoseSpec> {
 /// not exactly one centre pose; a sweep has fewer than 5 distinct values (centre
 /// included) or a value outside its half-range.
 pub fn load_fit_data(set_dir: &Path) -> Result<FitData> {
-    let (campaign, spec_path) = spec::load(set_dir)?;
+    load_fit_data_in(set_dir, None)
+}
+
+/// [`load_fit_data`] as if the set's `[fit] form` were `"paper"`: the centre and sweep
+/// runs only (no training runs, which may then be missing), `fe_sha256` over those; the
+/// data of the paper form that a coupled set is compared with.
+///
+/// # Errors
+/// As [`load_fit_data`], for the centre and sweep runs.
+pub fn load_paper_data(set_dir: &Path) -> Result<FitData> {
+    load_fit_data_in(set_dir, Some(ModelForm::Paper))
+}
+
+fn load_fit_data_in(set_dir: &Path, form: Option<ModelForm>) -> Result<FitData> {
+    let (mut campaign, spec_path) = spec::load(set_dir)?;
+    if let Some(f) = form {
+        campaign.fit.form = f;
+    }
     if campaign.loading.depth_mm != DEPTH_MAX_MM {
         bail!(
             "{}: loading.depth_mm = {}: the model contract (coeffs/README.md) fixes the depth range to 0 ..= {DEPTH_MAX_MM} mm",

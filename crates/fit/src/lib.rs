@@ -90,7 +90,7 @@ pub fn fit_set(set_dir: &Path) -> Result<FitOutput> {
     let data = data::load_fit_data(set_dir)?;
     let mut model = model::fit(&data)?;
     if data.campaign.fit.form == needle_fe::spec::ModelForm::Coupled {
-        model.cross = Some(coupled::fit_coupled(&model, &data.train, data.campaign.needle.reference_from_tip_mm)?);
+        model = coupled::fit_coupled(&data, &model, data.campaign.needle.reference_from_tip_mm)?;
     }
     let model_toml = model_file::to_toml(&model, &data.campaign.campaign.fit_without);
     let tables = eval_f32::Tables32::from_model(&model);

@@ -122,7 +122,13 @@ pub fn fit_deviation(k: Sweep, c: usize, points: &[SweepPoint], base: &[f64; NCO
             .with_context(|| format!("sweep {}, {}: fit of depth coefficient {i} over the sweep values", k.name(), COMPONENTS[c]))?;
         *row = to_array(&q);
     }
-    // Deviation shift: rows[i][0] -= sum_j rows[i][j] * (-1)^j, so that D(-1, u) = 0.
+    shift(&mut rows);
+    Ok(deviation_of(c, points, base, rows, k))
+}
+
+/// The deviation shift: `rows[i][0] -= sum_j rows[i][j] * (-1)^j` (j = 0..=4 in that
+/// order), so that `D(-1, u) = 0`; a zero of either sign is then written `+0.0`.
+pub fn shift(rows: &mut [[f64; NCOEF]; NCOEF]) {
     for row in rows.iter_mut() {
         let mut s = 0.0f64;
         let mut sign = 1.0f64;
@@ -135,6 +141,11 @@ pub fn fit_deviation(k: Sweep, c: usize, points: &[SweepPoint], base: &[f64; NCO
             *v = no_neg_zero(*v);
         }
     }
+}
+
+/// The deviation matrix `rows` of sweep `k`, component `c`, with its residuals: (`base`
+/// + the deviation) against every depth of the sweep's `points` (centre run included).
+pub fn deviation_of(c: usize, points: &[SweepPoint], base: &[f64; NCOEF], rows: [[f64; NCOEF]; NCOEF], k: Sweep) -> Deviation {
     let errors = points.iter().flat_map(|p| {
         let tp = k.t_of(p.value);
         p.run.rows.iter().map(move |r| {
@@ -143,7 +154,7 @@ pub fn fit_deviation(k: Sweep, c: usize, points: &[SweepPoint], base: &[f64; NCO
         })
     });
     let (residual_rms, residual_max) = rms_max(errors);
-    Ok(Deviation { rows, residual_rms, residual_max })
+    Deviation { rows, residual_rms, residual_max }
 }
 
 /// Fit the baseline of component `c` to the centre run.
@@ -151,12 +162,17 @@ pub fn fit_deviation(k: Sweep, c: usize, points: &[SweepPoint], base: &[f64; NCO
 /// # Errors
 /// The depth fit is rank deficient.
 pub fn fit_baseline(centre: &Run, c: usize) -> Result<Baseline> {
-    let mut coeffs = depth_fit(centre, c)?;
+    Ok(baseline_of(centre, c, depth_fit(centre, c)?))
+}
+
+/// The baseline `coeffs` of component `c` (a zero of either sign written `+0.0`) with its
+/// residuals against the centre run.
+pub fn baseline_of(centre: &Run, c: usize, mut coeffs: [f64; NCOEF]) -> Baseline {
     for v in coeffs.iter_mut() {
         *v = no_neg_zero(*v);
     }
     let (residual_rms, residual_max) = rms_max(centre.rows.iter().map(|r| horner(&coeffs, u_of(r.depth_mm)) - r.wrench[c]));
-    Ok(Baseline { coeffs, residual_rms, residual_max })
+    Baseline { coeffs, residual_rms, residual_max }
 }
 
 /// Fit the whole model: 6 baselines and 24 deviation matrices.
