@@ -133,7 +133,7 @@ pub fn accuracy_json() -> serde_json::Value {
         abs.insert((*name).to_string(), serde_json::json!(p * scale / 100.0));
     }
     serde_json::json!({
-        "method": format!("{}-fold cross-validation over {} training runs (role train)", needle_fit::coupled::FOLDS, model_info::TRAINING_RUNS),
+        "method": format!("{}-fold cross-validation over the sweep runs and {} training runs (role train)", needle_fit::coupled::FOLDS, model_info::TRAINING_RUNS),
         "rms_pct_of_scale": pct,
         "rms": abs,
         "scale": "peak |Fy| of the training runs (N) for the forces, times the hub lever arm (N*mm) for the moments",

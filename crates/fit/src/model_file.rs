@@ -109,8 +109,9 @@ fn write_coupled(s: &mut String, c: &Coupled) {
     let _ = writeln!(s, "# Cross terms: W_c += m(x/12, z/12, theta_x/15, theta_z/15) * P(u) per [[cross]] entry, in");
     let _ = writeln!(s, "# file order; every monomial of total degree 2..=max_degree in at least two inputs with");
     let _ = writeln!(s, "# the component's mirror parities, P of degree depth_degree (coeffs[i] multiplies u^i).");
-    let _ = writeln!(s, "# Size chosen per component by {FOLDS}-fold cross-validation over the training runs (terms");
-    let _ = writeln!(s, "# outside a component's choice are zeros); cv_rms_pct: each component's cross-validated");
+    let _ = writeln!(s, "# Baseline, deviations and cross terms fitted together on the centre, sweep and training");
+    let _ = writeln!(s, "# runs; size chosen per component by {FOLDS}-fold cross-validation over the sweep and training");
+    let _ = writeln!(s, "# runs (terms outside a component's choice are zeros); cv_rms_pct: each component's cross-validated");
     let _ = writeln!(s, "# RMS error, % of scale (the training runs' peak |Fy| in N, times the lever arm in N*mm");
     let _ = writeln!(s, "# for the moments).");
     let _ = writeln!(s, "max_degree = {}", c.terms.form.max_degree);
