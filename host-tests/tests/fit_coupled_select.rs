@@ -74,6 +74,19 @@ fn each_component_chooses_its_own_size_and_the_cross_term_is_recovered() {
     // The fitted term: xi * beta with P(u) = 0.004 (u + 1).
     let (_, p) = cross.terms.terms[1].iter().find(|(e, _)| *e == [1, 0, 0, 1]).unwrap_or_else(|| panic!("no xi*beta term in {fy:?}"));
     assert!((p[0] - 0.004).abs() < 1e-9 && (p[1] - 0.004).abs() < 1e-9, "xi*beta: {p:?}");
+    // The block's mirror symmetries hold exactly for the fitted model, although every
+    // training run has every component nonzero: x -> -x flips (x, theta_z) and fx, my,
+    // mz; z -> -z flips (z, theta_x) and fz, mx, my.
+    for r in &runs {
+        for row in r.rows.iter().step_by(4) {
+            let p = pose_of(&r.pose, row.depth_mm);
+            let w = eval(&model, p).0;
+            let wx = eval(&model, [-p[0], p[1], p[2], -p[3], p[4]]).0;
+            let wz = eval(&model, [p[0], -p[1], -p[2], p[3], p[4]]).0;
+            assert_eq!(wx, [-w[0], w[1], w[2], w[3], -w[4], -w[5]], "x mirror of {} at {} mm", r.pose.name, row.depth_mm);
+            assert_eq!(wz, [w[0], w[1], -w[2], -w[3], -w[4], w[5]], "z mirror of {} at {} mm", r.pose.name, row.depth_mm);
+        }
+    }
     // The joint fit's paper part is the paper model again (fy, away from the wiggle).
     for r in &runs {
         for row in &r.rows {

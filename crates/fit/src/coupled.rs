@@ -18,7 +18,9 @@
 //! Here every coefficient is one linear least-squares problem per component (Householder
 //! QR, [`lstsq`]) over every depth of every fitted run; a deviation is written in the
 //! basis `t^j - (-1)^j` (j >= 1), so it is zero at `t = -1` (sweep value 0) and the
-//! paper's shift gives `rows[i][0]` ([`super::model::shift`]).
+//! paper's shift gives `rows[i][0]` ([`super::model::shift`]). The block's mirror
+//! symmetries stay exact: a component has a baseline or a deviation only where its
+//! parities allow one ([`allowed`]), and cross monomials only of its parities.
 //!
 //! **The size per component** ([`select`]): k-fold cross-validation over the sweep and
 //! training runs (the centre run, the baseline's anchor, is fitted in every fold): the
@@ -89,13 +91,33 @@ pub struct ComponentFit {
     pub cross: Vec<(Exponents, Vec<f64>)>,
 }
 
-/// The design row of component `c` at `pose` (module docs): baseline, deviations, cross.
+/// Whether component `c` may have a baseline (`None`) or a deviation along sweep `k`
+/// under the block's mirror symmetries. The mirror `x -> -x` flips x and theta_z, the
+/// mirror `z -> -z` flips z and theta_x; a deviation along `k` is unchanged by the other
+/// mirror, so it is allowed only when `c` is even under that one, and the baseline only
+/// when `c` is even under both. The paper form gets these zeros from the FE data (a
+/// symmetric run gives exactly 0 there); the joint fit, whose training runs have every
+/// component nonzero, must leave the columns out to keep the symmetries exact.
+pub fn allowed(c: usize, k: Option<Sweep>) -> bool {
+    let odd_x = Sweep::X.is_odd(c);
+    let odd_z = Sweep::Z.is_odd(c);
+    match k {
+        None => !odd_x && !odd_z,
+        Some(Sweep::X | Sweep::ThetaZ) => !odd_z,
+        Some(Sweep::Z | Sweep::ThetaX) => !odd_x,
+    }
+}
+
+/// The design row of component `c` at `pose` (module docs): baseline, deviations, cross,
+/// each only where [`allowed`].
 fn design_row(pose: Pose64, c: usize, cand: Candidate, ms: &[Exponents], out: &mut Vec<f64>) {
     out.clear();
     let u = u_of(pose[4].clamp(0.0, DEPTH_MAX_MM));
     let up: Vec<f64> = (0..NCOEF).map(|i| u.powi(i as i32)).collect();
-    out.extend_from_slice(&up);
-    for k in Sweep::ALL {
+    if allowed(c, None) {
+        out.extend_from_slice(&up);
+    }
+    for k in Sweep::ALL.into_iter().filter(|&k| allowed(c, Some(k))) {
         let v = pose[k.index()].clamp(-k.half_range(), k.half_range());
         let t = k.t_of(v);
         let s = if v < 0.0 && k.is_odd(c) { -1.0 } else { 1.0 };
@@ -139,16 +161,26 @@ pub fn fit_component(runs: &[&Run], c: usize, cand: Candidate) -> Result<Compone
             b.push(fe.wrench[c]);
         }
     }
-    let cols = NCOEF * (1 + 4 * usize::from(cand.sweep_degree)) + ms.len() * cand.cross.map_or(0, |f| usize::from(f.depth_degree) + 1);
+    let cols = row.len();
+    if cols == 0 {
+        // my (odd under both mirrors) without cross terms: zero everywhere.
+        return Ok(ComponentFit { baseline: [0.0; NCOEF], rows: [[[0.0; NCOEF]; NCOEF]; 4], cross: Vec::new() });
+    }
     let a = DMatrix::from_row_slice(b.len(), cols, &rows);
     let x = lstsq(&a, &DVector::from_vec(b))
         .with_context(|| format!("coupled form {} of {}: {} runs", cand.label(), COMPONENTS[c], runs.len()))?;
     let x = x.as_slice();
     let mut baseline = [0.0; NCOEF];
-    baseline.copy_from_slice(&x[..NCOEF]);
+    let mut at = 0;
+    if allowed(c, None) {
+        baseline.copy_from_slice(&x[..NCOEF]);
+        at = NCOEF;
+    }
     let mut dev = [[[0.0; NCOEF]; NCOEF]; 4];
-    let mut at = NCOEF;
-    for rows_k in dev.iter_mut() {
+    for (k, rows_k) in Sweep::ALL.into_iter().zip(dev.iter_mut()) {
+        if !allowed(c, Some(k)) {
+            continue;
+        }
         for j in 1..=usize::from(cand.sweep_degree) {
             for (i, r) in rows_k.iter_mut().enumerate() {
                 r[j] = x[at + i];
