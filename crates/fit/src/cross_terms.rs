@@ -30,7 +30,8 @@ pub struct CrossForm {
     pub depth_degree: u8,
 }
 
-/// The candidates of the cross-validation: total degree 2..=4 in the pose, 2..=4 in depth.
+/// The cross forms a model file may hold (the generator accepts these): total degree 2..=4
+/// in the pose, 2..=4 in depth. The fitter tries the subset [`super::coupled::CROSS_FORMS`].
 pub const CANDIDATES: [CrossForm; 9] = {
     let mut out = [CrossForm { max_degree: 2, depth_degree: 2 }; 9];
     let mut i = 0;
