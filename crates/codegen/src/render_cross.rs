@@ -133,7 +133,7 @@ pub fn render_rust_cross(model: &Model) -> String {
                 "    // {} ({}), exponents {:?}, model.toml line {}",
                 COMPONENTS[t.component], UNITS[t.component], t.exponents, t.line
             );
-            let _ = writeln!(w, "    *w{c} = *w{c} + ({}) * {};", monomial(t.exponents), horner(&t.coeffs_f32), c = t.component);
+            let _ = writeln!(w, "    *w{c} += ({}) * {};", monomial(t.exponents), horner(&t.coeffs_f32), c = t.component);
         }
     }
     let _ = writeln!(w, "}}");
@@ -164,11 +164,11 @@ fn render_rust_cross_rates(w: &mut String, model: &Model) {
             let c = t.component;
             let _ = writeln!(w, "    // {} ({}), exponents {:?}, model.toml line {}", COMPONENTS[c], UNITS[c], t.exponents, t.line);
             if let Some(q) = horner_rate(&t.coeffs_f32) {
-                let _ = writeln!(w, "    *d{c} = *d{c} + (({}) * {q}) * {third};", monomial(t.exponents));
+                let _ = writeln!(w, "    *d{c} += (({}) * {q}) * {third};", monomial(t.exponents));
             }
             for (acc, k, scale) in [("x", 0, &rx), ("z", 1, &rz)] {
                 if let Some(m) = monomial_rate(t.exponents, k) {
-                    let _ = writeln!(w, "    *{acc}{c} = *{acc}{c} + (({m}) * {}) * {scale};", horner(&t.coeffs_f32));
+                    let _ = writeln!(w, "    *{acc}{c} += (({m}) * {}) * {scale};", horner(&t.coeffs_f32));
                 }
             }
         }
@@ -302,8 +302,8 @@ fn render_rust_cross_rates_fixed(w: &mut String, t: &FixedTables) {
                         if p3 == 0 {
                             continue;
                         }
-                        let term = format!("(mul_q15({p3}, r) >> {})", x.shift + 1);
-                        let term = if e == 1 { term } else { format!("{e}_i32.wrapping_mul{term}") };
+                        let term = format!("mul_q15({p3}, r) >> {}", x.shift + 1);
+                        let term = if e == 1 { term } else { format!("{e}_i32.wrapping_mul({term})") };
                         let _ = writeln!(w, "    g{c}[{i}] = g{c}[{i}].wrapping_add({term});");
                     }
                 }

@@ -62,13 +62,24 @@ pub fn model_text(
     s
 }
 
-/// The default model.toml with `form = "coupled"` and made-up cross terms (degree <= 3
+/// The default model.toml's baseline and deviation matrices alone, as a paper-form file
+/// (its `form` line and its `[coupled]` and `[[cross]]` entries left out, if any).
+pub fn paper_default_text() -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default/model.toml");
+    let text = std::fs::read_to_string(&path).expect("coeffs/default/model.toml");
+    let paper = text.find("\n[coupled]").map_or(text.as_str(), |i| &text[..i]);
+    let mut s = String::new();
+    for line in paper.lines().filter(|l| !l.starts_with("form = ")) {
+        let _ = writeln!(s, "{line}");
+    }
+    s
+}
+
+/// [`paper_default_text`] with `form = "coupled"` and made-up cross terms (degree <= 3
 /// in the pose, 2 in depth): a deterministic pattern of +-0.5 mN (forces) and +-30 mN*mm
 /// (moments), about 5 % of the default set's peak Fy.
 pub fn coupled_default_text() -> String {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default/model.toml");
-    let paper = std::fs::read_to_string(&path).expect("coeffs/default/model.toml");
-    assert!(!paper.contains("form = "), "the default set is already coupled: use it instead");
+    let paper = paper_default_text();
     let mut s = String::new();
     for line in paper.lines() {
         let _ = writeln!(s, "{line}");
