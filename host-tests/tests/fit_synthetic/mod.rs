@@ -29,13 +29,16 @@ pub fn wrench(p: &PoseSpec, d: f64) -> [f64; 6] {
     [fx, fy, fz, mx, my, mz]
 }
 
-/// Create a synthetic set in `dir` (campaign.toml copied from coeffs/default, one CSV per
-/// pose, and a manifest entry per CSV with the spec hash of the current spec, so that the
-/// runs count as current). `skip` names poses whose CSV is not written.
+/// Create a synthetic set in `dir` (campaign.toml copied from coeffs/default in the paper
+/// form, whatever form the default set ships: the tests that need the coupled form switch
+/// it on; one CSV per pose, and a manifest entry per CSV with the spec hash of the current
+/// spec, so that the runs count as current). `skip` names poses whose CSV is not written.
 pub fn make_set(dir: &Path, skip: &[&str]) {
     let src = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default/campaign.toml");
     std::fs::create_dir_all(dir.join("fe")).expect("create set folder");
-    std::fs::copy(&src, dir.join("campaign.toml")).expect("copy campaign.toml");
+    let text = std::fs::read_to_string(&src).expect("read campaign.toml");
+    let paper: Vec<&str> = text.lines().filter(|l| l.trim() != "form = \"coupled\"").collect();
+    std::fs::write(dir.join("campaign.toml"), paper.join("\n") + "\n").expect("write campaign.toml");
     let (campaign, _) = spec::load(dir).expect("load spec");
     let mut manifest = Manifest::default();
     for pose in campaign.poses() {
