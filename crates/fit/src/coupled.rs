@@ -30,12 +30,11 @@
 //! deviation columns above its sweep degree are zeros.
 
 use super::contract::{u_of, Pose64, Sweep, COMPONENTS, DEGREE, DEPTH_MAX_MM, NCOEF};
-use super::cross_terms::{mono, monomials, normalised, CrossForm, CrossTerms, Exponents};
+use super::cross_terms::{mono, monomials, normalised, poly, CrossForm, CrossTerms, Exponents};
 use super::data::{FitData, Run};
-use super::eval_f64::{eval_paper, horner};
+use super::eval_f64::{eval_paper, paper_component};
 use super::lsq::lstsq;
 use super::model::{baseline_of, deviation_of, shift, Coupled, Model};
-use super::poly::deviation;
 use crate::contract::COMPONENT_COUNT;
 use anyhow::{bail, Context, Result};
 use nalgebra::{DMatrix, DVector};
@@ -139,11 +138,6 @@ fn monomials_of(c: usize, cand: Candidate) -> Vec<Exponents> {
     cand.cross.map_or_else(Vec::new, |f| monomials(c, f.max_degree))
 }
 
-fn pose_of(r: &Run, depth_mm: f64) -> Pose64 {
-    let p = &r.pose;
-    [p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg, depth_mm]
-}
-
 /// Fit component `c` in the form `cand` by least squares over every depth of `runs`.
 ///
 /// # Errors
@@ -156,7 +150,7 @@ pub fn fit_component(runs: &[&Run], c: usize, cand: Candidate) -> Result<Compone
     let mut row = Vec::new();
     for r in runs {
         for fe in &r.rows {
-            design_row(pose_of(r, fe.depth_mm), c, cand, &ms, &mut row);
+            design_row(r.pose_at(fe.depth_mm), c, cand, &ms, &mut row);
             rows.extend_from_slice(&row);
             b.push(fe.wrench[c]);
         }
@@ -196,15 +190,10 @@ pub fn fit_component(runs: &[&Run], c: usize, cand: Candidate) -> Result<Compone
 
 /// Component `c` of `f` at `pose` (f64, the contract's algorithm).
 pub fn eval_component(f: &ComponentFit, c: usize, pose: Pose64) -> f64 {
-    let u = u_of(pose[4].clamp(0.0, DEPTH_MAX_MM));
-    let mut acc = horner(&f.baseline, u);
-    for k in Sweep::ALL {
-        let v = pose[k.index()].clamp(-k.half_range(), k.half_range());
-        let d = deviation(&f.rows[k.index()], k.t_of(v), u);
-        acc += if v < 0.0 && k.is_odd(c) { -d } else { d };
-    }
     let (n, u) = normalised(pose);
-    acc + f.cross.iter().map(|(e, p)| mono(*e, &n) * p.iter().rev().fold(0.0, |a, q| a * u + q)).sum::<f64>()
+    let clamped = std::array::from_fn(|k| pose[k].clamp(-Sweep::ALL[k].half_range(), Sweep::ALL[k].half_range()));
+    let rows = std::array::from_fn(|k| &f.rows[k]);
+    paper_component(&f.baseline, rows, c, clamped, u) + f.cross.iter().map(|(e, p)| mono(*e, &n) * poly(p, u)).sum::<f64>()
 }
 
 /// Per-component error scales of a set of runs: the largest |Fy| over them (N) for the
@@ -219,7 +208,7 @@ pub fn rms_pct(runs: &[&Run], scale: [f64; COMPONENT_COUNT], model: impl Fn(Pose
     let mut n = 0usize;
     for r in runs {
         for row in &r.rows {
-            let w = model(pose_of(r, row.depth_mm));
+            let w = model(r.pose_at(row.depth_mm));
             for c in 0..COMPONENT_COUNT {
                 s[c] += (w[c] - row.wrench[c]).powi(2);
             }
@@ -288,7 +277,7 @@ pub fn cross_validate(runs: &FitRuns, cand: Candidate, scale: [f64; COMPONENT_CO
             };
             for r in runs.pool.iter().enumerate().filter(|(i, _)| i % k == fold).map(|(_, r)| *r) {
                 for row in &r.rows {
-                    s += (eval_component(&f, c, pose_of(r, row.depth_mm)) - row.wrench[c]).powi(2);
+                    s += (eval_component(&f, c, r.pose_at(row.depth_mm)) - row.wrench[c]).powi(2);
                     n += 1;
                 }
             }

@@ -65,11 +65,6 @@ pub struct CoupledReport {
     pub curve: Vec<CurvePoint>,
 }
 
-fn pose_of(r: &Run, depth_mm: f64) -> Pose64 {
-    let p = &r.pose;
-    [p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg, depth_mm]
-}
-
 /// Held-out errors of `model` on `runs` (module docs).
 pub fn held_out(runs: &[&Run], lever_arm_mm: f64, model: impl Fn(Pose64) -> [f64; COMPONENT_COUNT]) -> HeldOut {
     let mut h = HeldOut::default();
@@ -77,7 +72,7 @@ pub fn held_out(runs: &[&Run], lever_arm_mm: f64, model: impl Fn(Pose64) -> [f64
         let scale = needle_contract::error_scales(needle_fe::results::peak_fy_n(&r.rows), lever_arm_mm);
         let mut s = [0.0f64; COMPONENT_COUNT];
         for row in &r.rows {
-            let w = model(pose_of(r, row.depth_mm));
+            let w = model(r.pose_at(row.depth_mm));
             for c in 0..COMPONENT_COUNT {
                 let e = w[c] - row.wrench[c];
                 s[c] += e * e;

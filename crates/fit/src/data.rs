@@ -20,6 +20,14 @@ pub struct Run {
     pub rows: Vec<Row>,
 }
 
+impl Run {
+    /// The pose `[x, z, theta_x, theta_z, depth]` of this run at `depth_mm` (mm, degrees).
+    pub fn pose_at(&self, depth_mm: f64) -> super::contract::Pose64 {
+        let p = &self.pose;
+        [p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg, depth_mm]
+    }
+}
+
 /// One point of a sweep: the swept value (mm or degrees, >= 0) and its run.
 #[derive(Debug, Clone)]
 pub struct SweepPoint {

@@ -2,7 +2,7 @@
 //! the reference for validation and for the f32 evaluator's error.
 
 use super::contract::{
-    u_of, Sweep, DEPTH_MAX_MM, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z,
+    u_of, Sweep, DEPTH_MAX_MM, NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z,
 };
 use super::cross_terms::{cross_value, CrossTerms};
 use super::model::Model;
@@ -57,19 +57,26 @@ pub fn eval_paper(model: &Model, pose: Pose64) -> ([f64; COMPONENT_COUNT], u8) {
         status |= STATUS_SAT_DEPTH;
     }
     let u = u_of(d);
-    let mut w = [0.0f64; COMPONENT_COUNT];
-    for (c, wc) in w.iter_mut().enumerate() {
-        let mut acc = horner(&model.baseline[c].coeffs, u);
-        for k in Sweep::ALL {
-            let v = clamped[k.index()];
-            let dev = deviation(&model.matrices[k.index()][c].rows, k.t_of(v), u);
-            if v < 0.0 && k.is_odd(c) {
-                acc -= dev;
-            } else {
-                acc += dev;
-            }
-        }
-        *wc = acc;
-    }
+    let w = std::array::from_fn(|c| {
+        let rows = std::array::from_fn(|k| &model.matrices[k][c].rows);
+        paper_component(&model.baseline[c].coeffs, rows, c, clamped, u)
+    });
     (w, status)
+}
+
+/// Component `c` of the paper form from its baseline and its four deviation matrices (sweep
+/// order), at the clamped inputs `clamped` and `u`: `B(u)`, then each sweep's `± D(t, u)` in
+/// sweep order (minus for a negative input of a sweep `c` is odd under).
+pub fn paper_component(baseline: &[f64; NCOEF], rows: [&[[f64; NCOEF]; NCOEF]; 4], c: usize, clamped: [f64; 4], u: f64) -> f64 {
+    let mut acc = horner(baseline, u);
+    for k in Sweep::ALL {
+        let v = clamped[k.index()];
+        let dev = deviation(rows[k.index()], k.t_of(v), u);
+        if v < 0.0 && k.is_odd(c) {
+            acc -= dev;
+        } else {
+            acc += dev;
+        }
+    }
+    acc
 }
