@@ -1,6 +1,6 @@
 //! The paper model in f32: the evaluation algorithm of `coeffs/README.md`, bit-exact.
 use crate::cross_f32::{add_cross, COUPLED, CROSS_SCALES};
-use crate::horner::horner;
+use crate::horner::{horner, horner_from, matrix_starts, MatrixStarts};
 use crate::tables::{BASELINE, DEPTH_MAX_MM, DEVIATION, FITTED, THETA_MAX_DEG, X_MAX_MM, Z_MAX_MM};
 use crate::{Evaluation, Pose, Status, Wrench};
 use needle_contract::COMPONENT_COUNT;
@@ -118,12 +118,33 @@ pub(crate) fn baseline(b: &[f32; TERMS], zero: bool, u: f32) -> f32 {
     }
 }
 
+/// `STARTS[k][c]`: where each Horner evaluation of `D_kc` starts (`crate::horner`,
+/// exact), decided at compile time.
+#[allow(clippy::indexing_slicing)] // const evaluation only: an index out of range is a compile error
+pub(crate) const STARTS: [[MatrixStarts; COMPONENT_COUNT]; 4] = {
+    let none = MatrixStarts { rows: [None; TERMS], outer: None, outer_rate: None };
+    let mut starts = [[none; COMPONENT_COUNT]; 4];
+    let mut k = 0;
+    while k < 4 {
+        let mut c = 0;
+        while c < COMPONENT_COUNT {
+            starts[k][c] = matrix_starts(&DEVIATION[k][c]);
+            c += 1;
+        }
+        k += 1;
+    }
+    starts
+};
+
 /// `D_kc(t, u)` of one deviation matrix `m`: Horner in `t` along each row (`r_i`),
-/// then Horner in `u` over the `r_i` (step 4 of the contract).
+/// then Horner in `u` over the `r_i` (step 4 of the contract), each from its start `s`
+/// (the steps left out change no bit, `crate::horner`).
 #[inline(always)]
-fn deviation(m: &[[f32; TERMS]; TERMS], t: f32, u: f32) -> f32 {
+fn deviation(m: &[[f32; TERMS]; TERMS], s: &MatrixStarts, t: f32, u: f32) -> f32 {
     let [m0, m1, m2, m3, m4] = m;
-    horner(&[horner(m0, t), horner(m1, t), horner(m2, t), horner(m3, t), horner(m4, t)], u)
+    let [s0, s1, s2, s3, s4] = s.rows;
+    let rows = [horner_from(m0, t, s0), horner_from(m1, t, s1), horner_from(m2, t, s2), horner_from(m3, t, s3), horner_from(m4, t, s4)];
+    horner_from(&rows, u, s.outer)
 }
 
 /// `t = |v| * s - 1` of one sweep (step 3 of the contract).
@@ -145,13 +166,13 @@ fn superpose(sweeps: [f32; 4], u: f32) -> [f32; COMPONENT_COUNT] {
     for ((wc, b), &zero) in w.iter_mut().zip(BASELINE.iter()).zip(ZERO_BASELINE.iter()) {
         *wc = baseline(b, zero, u);
     }
-    let sweeps = sweeps.iter().zip(SWEEP_SCALES.iter()).zip(DEVIATION.iter()).zip(ODD.iter()).zip(SKIP_DEVIATION.iter());
-    for ((((v, s), mats), odd), skip) in sweeps {
+    let sweeps = sweeps.iter().zip(SWEEP_SCALES.iter()).zip(DEVIATION.iter()).zip(ODD.iter()).zip(SKIP_DEVIATION.iter()).zip(STARTS.iter());
+    for (((((v, s), mats), odd), skip), starts) in sweeps {
         let t = sweep_t(*v, *s);
         let negative = *v < 0.0;
-        for (((wc, m), &o), &skip) in w.iter_mut().zip(mats.iter()).zip(odd.iter()).zip(skip.iter()) {
+        for ((((wc, m), &o), &skip), st) in w.iter_mut().zip(mats.iter()).zip(odd.iter()).zip(skip.iter()).zip(starts.iter()) {
             if !skip {
-                let dev = deviation(m, t, u);
+                let dev = deviation(m, st, t, u);
                 *wc = if negative && o { *wc - dev } else { *wc + dev };
             }
         }
@@ -181,21 +202,24 @@ fn superpose(sweeps: [f32; 4], u: f32) -> [f32; COMPONENT_COUNT] {
     let [d0, d1, d2, d3] = &DEVIATION;
     let [o0, o1, o2, o3] = &ODD;
     let [k0, k1, k2, k3] = &SKIP_DEVIATION;
-    add_sweep(&mut w, d0, o0, k0, v0, s0, u);
-    add_sweep(&mut w, d1, o1, k1, v1, s1, u);
-    add_sweep(&mut w, d2, o2, k2, v2, s2, u);
-    add_sweep(&mut w, d3, o3, k3, v3, s3, u);
+    let [st0, st1, st2, st3] = &STARTS;
+    add_sweep(&mut w, d0, o0, k0, st0, v0, s0, u);
+    add_sweep(&mut w, d1, o1, k1, st1, v1, s1, u);
+    add_sweep(&mut w, d2, o2, k2, st2, v2, s2, u);
+    add_sweep(&mut w, d3, o3, k3, st3, v3, s3, u);
     w
 }
 
 /// Adds one sweep's six deviations to `w` (unrolled form of the inner loop).
 #[cfg(target_abi = "eabihf")]
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn add_sweep(
     w: &mut [f32; COMPONENT_COUNT],
     mats: &[[[f32; TERMS]; TERMS]; COMPONENT_COUNT],
     odd: &[bool; COMPONENT_COUNT],
     skip: &[bool; COMPONENT_COUNT],
+    starts: &[MatrixStarts; COMPONENT_COUNT],
     v: f32,
     s: f32,
     u: f32,
@@ -206,22 +230,24 @@ fn add_sweep(
     let [m0, m1, m2, m3, m4, m5] = mats;
     let [o0, o1, o2, o3, o4, o5] = *odd;
     let [k0, k1, k2, k3, k4, k5] = *skip;
-    add_deviation(w0, m0, o0, k0, sign, t, u);
-    add_deviation(w1, m1, o1, k1, sign, t, u);
-    add_deviation(w2, m2, o2, k2, sign, t, u);
-    add_deviation(w3, m3, o3, k3, sign, t, u);
-    add_deviation(w4, m4, o4, k4, sign, t, u);
-    add_deviation(w5, m5, o5, k5, sign, t, u);
+    let [s0, s1, s2, s3, s4, s5] = starts;
+    add_deviation(w0, m0, o0, k0, s0, sign, t, u);
+    add_deviation(w1, m1, o1, k1, s1, sign, t, u);
+    add_deviation(w2, m2, o2, k2, s2, sign, t, u);
+    add_deviation(w3, m3, o3, k3, s3, sign, t, u);
+    add_deviation(w4, m4, o4, k4, s4, sign, t, u);
+    add_deviation(w5, m5, o5, k5, s5, sign, t, u);
 }
 
 /// `w_c = w_c ± D_kc(t, u)` for one component (`odd` is a constant after unrolling).
 #[cfg(target_abi = "eabihf")]
 #[inline(always)]
-fn add_deviation(wc: &mut f32, m: &[[f32; TERMS]; TERMS], odd: bool, skip: bool, sign: f32, t: f32, u: f32) {
+#[allow(clippy::too_many_arguments)]
+fn add_deviation(wc: &mut f32, m: &[[f32; TERMS]; TERMS], odd: bool, skip: bool, starts: &MatrixStarts, sign: f32, t: f32, u: f32) {
     if skip {
         return;
     }
-    let dev = deviation(m, t, u);
+    let dev = deviation(m, starts, t, u);
     *wc = if odd { *wc + sign * dev } else { *wc + dev };
 }
 
@@ -339,8 +365,10 @@ pub(crate) fn clamp_to_domain(pose: &Pose) -> Option<(Pose, Status)> {
 /// Constant work: no allocation, no loop that depends on the input, at most about 1,250
 /// f32 operations (24 deviation polynomials of 5x5 and 6 quartics); polynomials whose
 /// coefficients are all `+0.0` are left out at compile time, exactly (12 of the 24
-/// and 5 of the 6 in the default set). Inputs outside the domain, NaN or infinite
-/// take a slower path for steps 1 and 2.
+/// and 5 of the 6 in the default set), and every Horner starts at its highest
+/// coefficient that is not `+0.0` (`crate::horner`: the same bits; the coupled form's
+/// sweeps are of degree 1-4 in t). Inputs outside the domain, NaN or infinite take a
+/// slower path for steps 1 and 2.
 ///
 /// # Panics
 /// Never (no indexing, no division, no unwrap).

@@ -1,8 +1,8 @@
 //! The wrench and its stiffness in f32: the evaluation algorithm of `coeffs/README.md`
 //! ("Stiffness") bit for bit, sharing the wrench's operations.
 use crate::cross_f32::{add_cross, add_cross_rates, COUPLED, CROSS_SCALES};
-use crate::horner::{horner, horner_with_rate};
-use crate::model_f32::{clamp_to_domain, skip_sweep, sweep_t, ODD, ONE_THIRD, SWEEP_SCALES, ZERO_BASELINE};
+use crate::horner::{horner_from, horner_with_rate_from, start, MatrixStarts};
+use crate::model_f32::{clamp_to_domain, skip_sweep, sweep_t, ODD, ONE_THIRD, STARTS, SWEEP_SCALES, ZERO_BASELINE};
 use crate::stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
 use crate::tables::{BASELINE, DEVIATION, FITTED};
 use crate::{Pose, Status, Wrench};
@@ -132,8 +132,10 @@ struct Component {
 /// its deviation matrix, parity and skip flag.
 struct ComponentTables {
     baseline: [f32; TERMS],
+    baseline_start: Option<usize>,
     zero: bool,
     mats: [[[f32; TERMS]; TERMS]; 4],
+    starts: [MatrixStarts; 4],
     odd: [bool; 4],
     skip: [bool; 4],
 }
@@ -143,8 +145,10 @@ struct ComponentTables {
 const fn component_tables(c: usize) -> ComponentTables {
     ComponentTables {
         baseline: BASELINE[c],
+        baseline_start: start(&BASELINE[c]),
         zero: ZERO_BASELINE[c],
         mats: [DEVIATION[0][c], DEVIATION[1][c], DEVIATION[2][c], DEVIATION[3][c]],
+        starts: [STARTS[0][c], STARTS[1][c], STARTS[2][c], STARTS[3][c]],
         odd: [ODD[0][c], ODD[1][c], ODD[2][c], ODD[3][c]],
         skip: [SKIP[0][c], SKIP[1][c], SKIP[2][c], SKIP[3][c]],
     }
@@ -167,74 +171,77 @@ impl<const C: usize> Column<C> {
 /// way).
 #[inline(never)]
 fn component_of<const C: usize>(at: &At) -> Component {
-    let ComponentTables { baseline, zero, mats, odd, skip } = &Column::<C>::TABLES;
-    let [m0, m1, m2, m3] = mats;
-    component(baseline, *zero, [m0, m1, m2, m3], *odd, *skip, at)
+    component(&Column::<C>::TABLES, at)
 }
 
 /// One component: the baseline and its rate, then per sweep `w ± D`, `a ± dD/du`, and for
 /// x and z `g ± dD/dt`. `w + sign * D` is `w - D` for `sign = -1` (the product is exact,
 /// and `w + (-D)` is `w - D` by definition; `+0 + -0 = +0 = +0 - +0`): one multiply-add
-/// on the FPU and no branch.
+/// on the FPU and no branch. Every Horner starts where the tables say (`crate::horner`).
 #[inline(always)]
-fn component(b: &[f32; TERMS], zero: bool, mats: [&[[f32; TERMS]; TERMS]; 4], odd: [bool; 4], skip: [bool; 4], at: &At) -> Component {
+fn component(tables: &ComponentTables, at: &At) -> Component {
+    let ComponentTables { baseline, baseline_start, zero, mats, starts, odd, skip } = tables;
     let u = at.u;
-    let (w, a) = if zero { (0.0, 0.0) } else { horner_with_rate(b, u) };
+    let (w, a) = if *zero { (0.0, 0.0) } else { horner_with_rate_from(baseline, u, *baseline_start) };
     let mut c = Component { w, a, gx: 0.0, gz: 0.0 };
     let [mx, mz, mtx, mtz] = mats;
-    let [ox, oz, otx, otz] = odd;
-    let [kx, kz, ktx, ktz] = skip;
+    let [sx, sz, stx, stz] = starts;
+    let [ox, oz, otx, otz] = *odd;
+    let [kx, kz, ktx, ktz] = *skip;
     let [tx, tz, ttx, ttz] = at.t;
-    let [sx, sz, stx, stz] = at.sign;
+    let [nx, nz, ntx, ntz] = at.sign;
     if !kx {
-        c.gx = add_along(&mut c.w, &mut c.a, c.gx, mx, ox, sx, tx, u);
+        c.gx += add_along(&mut c, mx, sx, ox, nx, tx, u);
     }
     if !kz {
-        c.gz = add_along(&mut c.w, &mut c.a, c.gz, mz, oz, sz, tz, u);
+        c.gz += add_along(&mut c, mz, sz, oz, nz, tz, u);
     }
     if !ktx {
-        add_across(&mut c.w, &mut c.a, mtx, otx, stx, ttx, u);
+        add_across(&mut c, mtx, stx, otx, ntx, ttx, u);
     }
     if !ktz {
-        add_across(&mut c.w, &mut c.a, mtz, otz, stz, ttz, u);
+        add_across(&mut c, mtz, stz, otz, ntz, ttz, u);
     }
     c
 }
 
 /// A theta sweep: `w ± D`, `a ± dD/du`.
 #[inline(always)]
-fn add_across(w: &mut f32, a: &mut f32, m: &[[f32; TERMS]; TERMS], odd: bool, sign: f32, t: f32, u: f32) {
+fn add_across(c: &mut Component, m: &[[f32; TERMS]; TERMS], s: &MatrixStarts, odd: bool, sign: f32, t: f32, u: f32) {
     let [m0, m1, m2, m3, m4] = m;
-    let (dev, du) = horner_with_rate(&[horner(m0, t), horner(m1, t), horner(m2, t), horner(m3, t), horner(m4, t)], u);
+    let [s0, s1, s2, s3, s4] = s.rows;
+    let rows = [horner_from(m0, t, s0), horner_from(m1, t, s1), horner_from(m2, t, s2), horner_from(m3, t, s3), horner_from(m4, t, s4)];
+    let (dev, du) = horner_with_rate_from(&rows, u, s.outer);
     if odd {
-        *w += sign * dev;
-        *a += sign * du;
+        c.w += sign * dev;
+        c.a += sign * du;
     } else {
-        *w += dev;
-        *a += du;
+        c.w += dev;
+        c.a += du;
     }
 }
 
-/// The x or z sweep: as [`add_across`], and `g ± dD/dt` returned, each row evaluated once
-/// with its t-rate ([`horner_with_rate`]).
+/// The x or z sweep: as [`add_across`], and `±dD/dt` returned (the caller adds it to the
+/// rate by t, `g = g ± dD/dt`), each row evaluated once
+/// with its t-rate ([`horner_with_rate_from`]).
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn add_along(w: &mut f32, a: &mut f32, g: f32, m: &[[f32; TERMS]; TERMS], odd: bool, sign: f32, t: f32, u: f32) -> f32 {
+fn add_along(c: &mut Component, m: &[[f32; TERMS]; TERMS], s: &MatrixStarts, odd: bool, sign: f32, t: f32, u: f32) -> f32 {
     let [m0, m1, m2, m3, m4] = m;
-    let (r0, q0) = horner_with_rate(m0, t);
-    let (r1, q1) = horner_with_rate(m1, t);
-    let (r2, q2) = horner_with_rate(m2, t);
-    let (r3, q3) = horner_with_rate(m3, t);
-    let (r4, q4) = horner_with_rate(m4, t);
-    let (dev, du) = horner_with_rate(&[r0, r1, r2, r3, r4], u);
-    let dt = horner(&[q0, q1, q2, q3, q4], u);
+    let [s0, s1, s2, s3, s4] = s.rows;
+    let (r0, q0) = horner_with_rate_from(m0, t, s0);
+    let (r1, q1) = horner_with_rate_from(m1, t, s1);
+    let (r2, q2) = horner_with_rate_from(m2, t, s2);
+    let (r3, q3) = horner_with_rate_from(m3, t, s3);
+    let (r4, q4) = horner_with_rate_from(m4, t, s4);
+    let (dev, du) = horner_with_rate_from(&[r0, r1, r2, r3, r4], u, s.outer);
+    let dt = horner_from(&[q0, q1, q2, q3, q4], u, s.outer_rate);
     if odd {
-        *w += sign * dev;
-        *a += sign * du;
-        g + dt
+        c.w += sign * dev;
+        c.a += sign * du;
+        dt
     } else {
-        *w += dev;
-        *a += du;
-        g + sign * dt
+        c.w += dev;
+        c.a += du;
+        sign * dt
     }
 }

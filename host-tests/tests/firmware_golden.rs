@@ -69,26 +69,48 @@ fn golden_bits_on_cortex_m0_microbit() {
 /// model: it lives in a temporary folder, never under coeffs/.
 #[test]
 fn golden_bits_of_a_coupled_model_on_cortex_m4f_mps2_an386() {
-    use needle_fit::{golden as g32, golden_fixed as gfixed, golden_stiffness as gs32, golden_stiffness_fixed as gsfixed};
     let dir = tempfile::tempdir().expect("temporary set folder");
     let set = dir.path().join("made-up-coupled");
-    std::fs::create_dir(&set).expect("set folder");
     let text = made_up_model::coupled_default_text();
     let model = model_file::parse(&text, &set.join("model.toml")).unwrap_or_else(|e| panic!("{e:#}"));
     assert!(model.cross.as_ref().is_some_and(|c| c.terms.terms.iter().all(|t| !t.is_empty())), "cross terms in every component");
+    write_made_up_set(&set, text);
+    golden_of_set_on("m4f", &set);
+}
+
+/// The evaluators' exact Horner trimming (`src/horner.rs`, the cross terms' code from
+/// `needle-codegen`) on a made-up coupled model with `+0.0` and `-0.0` coefficients
+/// wherever a start at the wrong coefficient would change a bit
+/// (`made_up_model::signed_zeros_text`), against golden files from the fitter's untrimmed
+/// implementations: on the M4F (the unrolled evaluator, starts decided at compile time)
+/// and the M0 (the soft-float loop).
+#[test]
+fn golden_bits_of_signed_zero_coefficients_on_cortex_m4f_and_m0() {
+    let dir = tempfile::tempdir().expect("temporary set folder");
+    let set = dir.path().join("made-up-signed-zeros");
+    write_made_up_set(&set, made_up_model::signed_zeros_text());
+    golden_of_set_on("m4f", &set);
+    golden_of_set_on("m0", &set);
+}
+
+/// A set folder at `set` with the model file `text` and the four golden files written
+/// by the fitter's own implementations.
+fn write_made_up_set(set: &Path, text: String) {
+    use needle_fit::{golden as g32, golden_fixed as gfixed, golden_stiffness as gs32, golden_stiffness_fixed as gsfixed};
+    std::fs::create_dir(set).expect("set folder");
+    let model = model_file::parse(&text, &set.join("model.toml")).unwrap_or_else(|e| panic!("{e:#}"));
     let t32 = Tables32::from_model(&model);
     let tfixed = TablesFixed::from_model(&model).unwrap_or_else(|e| panic!("{e:#}"));
     let files = [
-        ("model.toml", text),
         ("golden-f32.csv", g32::to_csv(&t32)),
         ("golden-stiffness-f32.csv", gs32::to_csv(&t32)),
         ("golden-fixed.csv", gfixed::to_csv(&tfixed).unwrap_or_else(|e| panic!("{e:#}"))),
         ("golden-stiffness-fixed.csv", gsfixed::to_csv(&tfixed).unwrap_or_else(|e| panic!("{e:#}"))),
+        ("model.toml", text),
     ];
     for (name, body) in files {
         std::fs::write(set.join(name), body).unwrap_or_else(|e| panic!("{name}: {e}"));
     }
-    golden_of_set_on("m4f", &set);
 }
 
 /// The comparison itself, on hand-made output: one flipped bit, a sign of zero, a

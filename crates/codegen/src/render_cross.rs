@@ -44,8 +44,15 @@ fn monomial_q15(e: [u8; 4]) -> String {
     it.fold(first, |m, f| format!("mul_q15({m}, {f})"))
 }
 
-/// `q`, Horner over `p` (`p[i]` multiplies `u^i`), highest power first.
+/// `q`, Horner over `p` (`p[i]` multiplies `u^i`), highest power first, from the highest
+/// coefficient that is not `+0.0`: the steps above it change no bit (`u` is finite, so a
+/// `+0.0` accumulator stays `+0.0`, and `±0.0 + c = c`), unless that coefficient is
+/// `-0.0` (then every step is written; the library's `horner` module has the argument).
 fn horner(p: &[f32]) -> String {
+    const MINUS_ZERO: u32 = 0x8000_0000;
+    let top = p.iter().rposition(|v| v.to_bits() != 0).unwrap_or(0);
+    let starts_at_minus_zero = p.get(top).is_some_and(|v| v.to_bits() == MINUS_ZERO);
+    let p = if starts_at_minus_zero { p } else { p.get(..=top).unwrap_or(p) };
     let mut it = p.iter().rev();
     let mut s = it.next().map_or_else(|| lit(0.0), |v| lit(*v));
     for v in it {
