@@ -1,6 +1,6 @@
 //! The paper model in f32: the evaluation algorithm of `coeffs/README.md`, bit-exact.
 use crate::cross_f32::{add_cross, COUPLED, CROSS_SCALES};
-use crate::horner::{horner, horner_from, matrix_starts, MatrixStarts};
+use crate::horner::{horner_from, matrix_starts, start, MatrixStarts};
 use crate::tables::{BASELINE, DEPTH_MAX_MM, DEVIATION, FITTED, THETA_MAX_DEG, X_MAX_MM, Z_MAX_MM};
 use crate::{Evaluation, Pose, Status, Wrench};
 use needle_contract::COMPONENT_COUNT;
@@ -45,16 +45,18 @@ pub(crate) const fn is_plus_zero_matrix(m: &[[f32; TERMS]; TERMS]) -> bool {
     true
 }
 
-/// `ZERO_BASELINE[c]`: every coefficient of `B_c` is `+0.0`.
+/// `BASELINE_STARTS[c]`: where the Horner of `B_c` starts (`crate::horner`, exact;
+/// `Some(0)` with `p0 = +0.0` for an all-zero baseline, which is then the constant
+/// `+0.0`), decided at compile time.
 #[allow(clippy::indexing_slicing)] // const evaluation only: an index out of range is a compile error
-pub(crate) const ZERO_BASELINE: [bool; COMPONENT_COUNT] = {
-    let mut zero = [false; COMPONENT_COUNT];
+pub(crate) const BASELINE_STARTS: [Option<usize>; COMPONENT_COUNT] = {
+    let mut starts = [None; COMPONENT_COUNT];
     let mut c = 0;
     while c < COMPONENT_COUNT {
-        zero[c] = is_plus_zero(&BASELINE[c]);
+        starts[c] = start(&BASELINE[c]);
         c += 1;
     }
-    zero
+    starts
 };
 
 /// `SKIP_DEVIATION[k][c]`: `D_kc` is skipped (see [`skip_sweep`]).
@@ -107,15 +109,11 @@ pub(crate) const fn starts_not_neg_zero(b: &[f32; TERMS]) -> bool {
     b0.to_bits() != 0x8000_0000
 }
 
-/// `B_c(u)`: `+0.0` without evaluating it when every coefficient is `+0.0` (exact,
-/// see [`skip_sweep`]).
+/// `B_c(u)` from its start (`+0.0` without evaluating it when every coefficient is
+/// `+0.0`: see [`skip_sweep`] and `crate::horner`).
 #[inline(always)]
-pub(crate) fn baseline(b: &[f32; TERMS], zero: bool, u: f32) -> f32 {
-    if zero {
-        0.0
-    } else {
-        horner(b, u)
-    }
+pub(crate) fn baseline(b: &[f32; TERMS], start: Option<usize>, u: f32) -> f32 {
+    horner_from(b, u, start)
 }
 
 /// `STARTS[k][c]`: where each Horner evaluation of `D_kc` starts (`crate::horner`,
@@ -163,8 +161,8 @@ pub(crate) fn sweep_t(v: f32, s: f32) -> f32 {
 #[inline(always)]
 fn superpose(sweeps: [f32; 4], u: f32) -> [f32; COMPONENT_COUNT] {
     let mut w = [0.0_f32; COMPONENT_COUNT];
-    for ((wc, b), &zero) in w.iter_mut().zip(BASELINE.iter()).zip(ZERO_BASELINE.iter()) {
-        *wc = baseline(b, zero, u);
+    for ((wc, b), &start) in w.iter_mut().zip(BASELINE.iter()).zip(BASELINE_STARTS.iter()) {
+        *wc = baseline(b, start, u);
     }
     let sweeps = sweeps.iter().zip(SWEEP_SCALES.iter()).zip(DEVIATION.iter()).zip(ODD.iter()).zip(SKIP_DEVIATION.iter()).zip(STARTS.iter());
     for (((((v, s), mats), odd), skip), starts) in sweeps {
@@ -194,7 +192,7 @@ fn superpose(sweeps: [f32; 4], u: f32) -> [f32; COMPONENT_COUNT] {
 #[inline(always)]
 fn superpose(sweeps: [f32; 4], u: f32) -> [f32; COMPONENT_COUNT] {
     let [b0, b1, b2, b3, b4, b5] = &BASELINE;
-    let [z0, z1, z2, z3, z4, z5] = ZERO_BASELINE;
+    let [z0, z1, z2, z3, z4, z5] = BASELINE_STARTS;
     let mut w =
         [baseline(b0, z0, u), baseline(b1, z1, u), baseline(b2, z2, u), baseline(b3, z3, u), baseline(b4, z4, u), baseline(b5, z5, u)];
     let [v0, v1, v2, v3] = sweeps;

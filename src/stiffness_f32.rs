@@ -1,8 +1,8 @@
 //! The wrench and its stiffness in f32: the evaluation algorithm of `coeffs/README.md`
 //! ("Stiffness") bit for bit, sharing the wrench's operations.
 use crate::cross_f32::{add_cross, add_cross_rates, COUPLED, CROSS_SCALES};
-use crate::horner::{horner_from, horner_with_rate_from, start, MatrixStarts};
-use crate::model_f32::{clamp_to_domain, skip_sweep, sweep_t, ODD, ONE_THIRD, STARTS, SWEEP_SCALES, ZERO_BASELINE};
+use crate::horner::{horner_from, horner_with_rate_from, MatrixStarts};
+use crate::model_f32::{clamp_to_domain, skip_sweep, sweep_t, BASELINE_STARTS, ODD, ONE_THIRD, STARTS, SWEEP_SCALES};
 use crate::stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
 use crate::tables::{BASELINE, DEVIATION, FITTED};
 use crate::{Pose, Status, Wrench};
@@ -132,8 +132,8 @@ struct Component {
 /// its deviation matrix, parity and skip flag.
 struct ComponentTables {
     baseline: [f32; TERMS],
+    /// Where its Horner starts (`model_f32::BASELINE_STARTS`).
     baseline_start: Option<usize>,
-    zero: bool,
     mats: [[[f32; TERMS]; TERMS]; 4],
     starts: [MatrixStarts; 4],
     odd: [bool; 4],
@@ -145,8 +145,7 @@ struct ComponentTables {
 const fn component_tables(c: usize) -> ComponentTables {
     ComponentTables {
         baseline: BASELINE[c],
-        baseline_start: start(&BASELINE[c]),
-        zero: ZERO_BASELINE[c],
+        baseline_start: BASELINE_STARTS[c],
         mats: [DEVIATION[0][c], DEVIATION[1][c], DEVIATION[2][c], DEVIATION[3][c]],
         starts: [STARTS[0][c], STARTS[1][c], STARTS[2][c], STARTS[3][c]],
         odd: [ODD[0][c], ODD[1][c], ODD[2][c], ODD[3][c]],
@@ -180,9 +179,9 @@ fn component_of<const C: usize>(at: &At) -> Component {
 /// on the FPU and no branch. Every Horner starts where the tables say (`crate::horner`).
 #[inline(always)]
 fn component(tables: &ComponentTables, at: &At) -> Component {
-    let ComponentTables { baseline, baseline_start, zero, mats, starts, odd, skip } = tables;
+    let ComponentTables { baseline, baseline_start, mats, starts, odd, skip } = tables;
     let u = at.u;
-    let (w, a) = if *zero { (0.0, 0.0) } else { horner_with_rate_from(baseline, u, *baseline_start) };
+    let (w, a) = horner_with_rate_from(baseline, u, *baseline_start);
     let mut c = Component { w, a, gx: 0.0, gz: 0.0 };
     let [mx, mz, mtx, mtz] = mats;
     let [sx, sz, stx, stz] = starts;
