@@ -12,9 +12,10 @@
 //!
 //! The starts are computed at compile time from the generated tables
 //! ([`matrix_starts`], [`start`] in const items), so no coefficient is tested at run
-//! time. Measured with `needle firmware bench` on the coupled default model of
-//! 2026-11-26 (19 training runs): the M4F's wrench 519.1 -> 436.9 instructions, with the
-//! stiffness 959.1 -> 813.9; soft-float M3 33,494 -> 26,613, M0 55,314 -> 45,982.
+//! time. Measured side by side with `needle firmware bench` on the coupled default model
+//! of 2026-11-26 (21 training runs; README.md, "Horner trimming"): the M4F's wrench
+//! 541.1 -> 481.1 instructions, with the stiffness 973.0 -> 874.1; soft-float M3
+//! 37,014 -> 29,332, M0 61,588 -> 50,733.
 use needle_contract::TERMS;
 
 /// The bit pattern of `-0.0`.
