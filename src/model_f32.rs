@@ -192,9 +192,15 @@ fn superpose(sweeps: [f32; 4], u: f32) -> [f32; COMPONENT_COUNT] {
 #[inline(always)]
 fn superpose(sweeps: [f32; 4], u: f32) -> [f32; COMPONENT_COUNT] {
     let [b0, b1, b2, b3, b4, b5] = &BASELINE;
-    let [z0, z1, z2, z3, z4, z5] = BASELINE_STARTS;
-    let mut w =
-        [baseline(b0, z0, u), baseline(b1, z1, u), baseline(b2, z2, u), baseline(b3, z3, u), baseline(b4, z4, u), baseline(b5, z5, u)];
+    let [bs0, bs1, bs2, bs3, bs4, bs5] = BASELINE_STARTS;
+    let mut w = [
+        baseline(b0, bs0, u),
+        baseline(b1, bs1, u),
+        baseline(b2, bs2, u),
+        baseline(b3, bs3, u),
+        baseline(b4, bs4, u),
+        baseline(b5, bs5, u),
+    ];
     let [v0, v1, v2, v3] = sweeps;
     let [s0, s1, s2, s3] = SWEEP_SCALES;
     let [d0, d1, d2, d3] = &DEVIATION;

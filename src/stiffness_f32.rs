@@ -128,8 +128,8 @@ struct Component {
     gz: f32,
 }
 
-/// One component's tables: its baseline (and whether it is all `+0.0`), and per sweep
-/// its deviation matrix, parity and skip flag.
+/// One component's tables: its baseline and where its Horner starts, and per sweep its
+/// deviation matrix, the starts of its Horner evaluations, parity and skip flag.
 struct ComponentTables {
     baseline: [f32; TERMS],
     /// Where its Horner starts (`model_f32::BASELINE_STARTS`).
@@ -221,8 +221,8 @@ fn add_across(c: &mut Component, m: &[[f32; TERMS]; TERMS], s: &MatrixStarts, od
 }
 
 /// The x or z sweep: as [`add_across`], and `±dD/dt` returned (the caller adds it to the
-/// rate by t, `g = g ± dD/dt`), each row evaluated once
-/// with its t-rate ([`horner_with_rate_from`]).
+/// rate by t, `g = g ± dD/dt`), each row evaluated once with its t-rate
+/// ([`horner_with_rate_from`]).
 #[inline(always)]
 fn add_along(c: &mut Component, m: &[[f32; TERMS]; TERMS], s: &MatrixStarts, odd: bool, sign: f32, t: f32, u: f32) -> f32 {
     let [m0, m1, m2, m3, m4] = m;
