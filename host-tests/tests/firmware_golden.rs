@@ -63,8 +63,9 @@ fn golden_bits_on_cortex_m0_microbit() {
 }
 
 /// The coupled form's generated code (cross terms and their rates, f32 and fixed point)
-/// on the M4F, while the shipped set is still the paper form: a set folder with the
-/// default model plus made-up cross terms (`made_up_model`) and golden files written by
+/// on the M4F with cross terms in every component (the shipped set has them in fy and my
+/// only): a set folder with the default model's baseline and deviations plus made-up
+/// cross terms of degree <= 3 (`made_up_model`) and golden files written by
 /// the fitter's own implementations, compiled into the `golden` firmware. Not a fitted
 /// model: it lives in a temporary folder, never under coeffs/.
 #[test]

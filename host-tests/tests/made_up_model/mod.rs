@@ -88,8 +88,8 @@ pub fn coupled_default_text() -> String {
 }
 
 /// `paper` (a paper-form model file) with `form = "coupled"` and a cross term for every
-/// monomial of degree <= 3 with each component's parities, depth degree 2, coefficient
-/// `i` of the component's n-th term `coeff(c, i)` (called in file order).
+/// monomial of degree <= 3 with each component's parities, depth degree 2: coefficient
+/// `i` (of `u^i`) of each term of component `c` is `coeff(c, i)`, called in file order.
 pub fn coupled_text(paper: &str, mut coeff: impl FnMut(usize, u32) -> f64) -> String {
     let mut s = String::new();
     for line in paper.lines() {
