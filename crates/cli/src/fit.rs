@@ -29,6 +29,11 @@ pub struct ValidateArgs {
     /// Print the report as JSON instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Depth degree of each run's floor (the smallest error any model that is a
+    /// polynomial of this degree in depth at a pose could have on the run), 1 to 10;
+    /// default: the contract's degree. Goals and errors do not depend on it.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u8).range(1..=10))]
+    pub floor_degree: Option<u8>,
 }
 
 /// First differing line of two texts (1-based), if any.
@@ -105,7 +110,8 @@ pub fn fit(a: FitArgs) -> Result<ExitCode> {
 /// # Errors
 /// model.toml or the spec is missing or malformed, or a validation run is malformed.
 pub fn validate(a: ValidateArgs) -> Result<ExitCode> {
-    let report = val::validate(&a.set).with_context(|| format!("needle validate --set {}", a.set.display()))?;
+    let floor_degree = a.floor_degree.map_or(needle_contract::DEGREE, usize::from);
+    let report = val::validate_with(&a.set, floor_degree).with_context(|| format!("needle validate --set {}", a.set.display()))?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {

@@ -2,7 +2,7 @@
 //! validation errors that the FE curve's own shape sets.
 //!
 //! At a fixed pose every form of the model (the paper's and the coupled one) is a
-//! polynomial of degree [`DEGREE`] in depth: the baseline and every deviation are
+//! polynomial of degree [`DEGREE`](crate::contract::DEGREE) in depth: the baseline and every deviation are
 //! polynomials of that degree in `u`, and a cross term multiplies one of degree
 //! `depth_degree <= DEGREE` by a constant of the pose. So the best such polynomial
 //! fitted to the run alone bounds every model from below:
@@ -21,8 +21,12 @@
 //! Both are lower bounds, not estimates: a goal below its floor is out of reach for the
 //! data as it is (the FE curve's must points are not on a polynomial of this degree:
 //! its contact events and mesh steps, `needle fe verify --smooth`).
+//!
+//! The degree is a parameter ([`depth_floor`]): `needle validate` uses the contract's
+//! [`DEGREE`](crate::contract::DEGREE); `needle validate --floor-degree N` asks what a contract of depth degree
+//! `N` could reach on the same runs.
 
-use super::contract::{u_of, COMPONENT_COUNT, DEGREE};
+use super::contract::{u_of, COMPONENT_COUNT};
 use super::lsq::{lstsq, vandermonde};
 use super::model::rms_max;
 use anyhow::{bail, Result};
@@ -48,36 +52,37 @@ impl DepthFloor {
     }
 }
 
-/// Lawson iterations of the Table 2 floor (each a 5-unknown least squares; the bound
+/// Lawson iterations of the Table 2 floor (each a `degree + 1`-unknown least squares; the bound
 /// reached is within 1e-6 of the minimax error on the test's equioscillating data).
 pub const LAWSON_ITERATIONS: usize = 2000;
 
-/// Weighted least-squares residuals `y - p(w)` of the degree-[`DEGREE`] polynomial
+/// Weighted least-squares residuals `y - p(w)` of the degree-`degree` polynomial
 /// minimising `sum (weight_k (y_k - p(w_k)))^2`.
-fn residuals(w: &[f64], y: &[f64], weight: &[f64]) -> Result<Vec<f64>> {
-    let mut a = vandermonde(w, DEGREE);
+fn residuals(w: &[f64], y: &[f64], weight: &[f64], degree: usize) -> Result<Vec<f64>> {
+    let mut a = vandermonde(w, degree);
     for (k, s) in weight.iter().enumerate() {
         a.row_mut(k).scale_mut(*s);
     }
     let b = DVector::from_iterator(y.len(), y.iter().zip(weight).map(|(v, s)| v * s));
     let p = lstsq(&a, &b)?;
-    let fitted = vandermonde(w, DEGREE) * p;
+    let fitted = vandermonde(w, degree) * p;
     Ok(y.iter().zip(fitted.iter()).map(|(v, f)| v - f).collect())
 }
 
-/// The floors of the run with `rows` (depth in mm, wrench in N and N·mm), RMS floors in %
-/// of `scale` (N, N·mm per component, as `needle validate`), the relative Fy floor over
-/// the depths >= `min_depth_mm`.
+/// The floors of the run with `rows` (depth in mm, wrench in N and N·mm) for models that
+/// are polynomials of degree `degree` in depth at a pose (the contract's: [`DEGREE`](crate::contract::DEGREE)),
+/// RMS floors in % of `scale` (N, N·mm per component, as `needle validate`), the relative
+/// Fy floor over the depths >= `min_depth_mm`.
 ///
 /// # Errors
-/// Fewer than `DEGREE + 1` distinct depths overall or at >= `min_depth_mm`; Fy zero at
+/// Fewer than `degree + 1` distinct depths overall or at >= `min_depth_mm`; Fy zero at
 /// one of the latter (no relative error); a non-finite value.
-pub fn depth_floor(rows: &[Row], scale: [f64; COMPONENT_COUNT], min_depth_mm: f64) -> Result<DepthFloor> {
+pub fn depth_floor(rows: &[Row], scale: [f64; COMPONENT_COUNT], min_depth_mm: f64, degree: usize) -> Result<DepthFloor> {
     let u: Vec<f64> = rows.iter().map(|r| u_of(r.depth_mm)).collect();
     let mut rms_pct = [0.0; COMPONENT_COUNT];
     for (c, out) in rms_pct.iter_mut().enumerate() {
         let y: Vec<f64> = rows.iter().map(|r| r.wrench[c]).collect();
-        let res = residuals(&u, &y, &vec![1.0; y.len()])?;
+        let res = residuals(&u, &y, &vec![1.0; y.len()], degree)?;
         *out = if scale[c] > 0.0 { 100.0 * rms_max(res).0 / scale[c] } else { 0.0 };
     }
     let deep: Vec<&Row> = rows.iter().filter(|r| r.depth_mm >= min_depth_mm - 1e-9).collect();
@@ -86,19 +91,19 @@ pub fn depth_floor(rows: &[Row], scale: [f64; COMPONENT_COUNT], min_depth_mm: f6
     }
     let ud: Vec<f64> = deep.iter().map(|r| u_of(r.depth_mm)).collect();
     let fy: Vec<f64> = deep.iter().map(|r| r.fy_n()).collect();
-    Ok(DepthFloor { fy_rel_pct: 100.0 * minimax_lower_bound(&ud, &fy)?, rms_pct })
+    Ok(DepthFloor { fy_rel_pct: 100.0 * minimax_lower_bound(&ud, &fy, degree)?, rms_pct })
 }
 
 /// Lower bound of `min over p of max_k |y_k - p(w_k)| / |y_k|` (module docs: Lawson).
 /// The first iteration (equal weights) must solve; a later one that cannot (weights
 /// collapsed onto fewer points than unknowns) ends the iteration with the best bound so far.
-fn minimax_lower_bound(w: &[f64], y: &[f64]) -> Result<f64> {
+fn minimax_lower_bound(w: &[f64], y: &[f64], degree: usize) -> Result<f64> {
     let n = y.len() as f64;
     let mut l = vec![1.0 / n; y.len()];
     let mut best = 0.0f64;
     for it in 0..LAWSON_ITERATIONS {
         let weight: Vec<f64> = l.iter().zip(y).map(|(lk, v)| lk.sqrt() / v.abs()).collect();
-        let res = match residuals(w, y, &weight) {
+        let res = match residuals(w, y, &weight, degree) {
             Ok(r) => r,
             Err(e) if it == 0 => return Err(e),
             Err(_) => break,
@@ -119,6 +124,7 @@ fn minimax_lower_bound(w: &[f64], y: &[f64]) -> Result<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::contract::DEGREE;
     use needle_contract::FY;
 
     fn rows(f: impl Fn(f64) -> f64) -> Vec<Row> {
@@ -138,7 +144,7 @@ mod tests {
     #[test]
     fn a_polynomial_of_the_model_degree_has_no_floor() {
         let f = |d: f64| 1e-3 * d + 2e-3 * d * d - 1e-4 * d.powi(4);
-        let fl = depth_floor(&rows(f), SCALE, 1.0).unwrap();
+        let fl = depth_floor(&rows(f), SCALE, 1.0, DEGREE).unwrap();
         assert!(fl.fy_rel_pct < 1e-9 && fl.worst_rms_pct() < 1e-9, "{fl:?}");
     }
 
@@ -147,7 +153,7 @@ mod tests {
         let smooth = |d: f64| 2e-3 * d * d;
         let bumped = |d: f64| smooth(d) + if (d - 1.2).abs() < 1e-9 { 6e-4 } else { 0.0 };
         let rs = rows(bumped);
-        let fl = depth_floor(&rs, SCALE, 1.0).unwrap();
+        let fl = depth_floor(&rs, SCALE, 1.0, DEGREE).unwrap();
         // The smooth curve itself is a candidate model: its errors are the bump alone.
         let bump_rel = 100.0 * 6e-4 / bumped(1.2);
         assert!(fl.fy_rel_pct > 0.1 && fl.fy_rel_pct <= bump_rel, "{} vs {bump_rel}", fl.fy_rel_pct);
@@ -158,7 +164,7 @@ mod tests {
         let u: Vec<f64> = rs.iter().filter(|r| r.depth_mm >= 1.0 - 1e-9).map(|r| u_of(r.depth_mm)).collect();
         let fy: Vec<f64> = rs.iter().filter(|r| r.depth_mm >= 1.0 - 1e-9).map(Row::fy_n).collect();
         let wt: Vec<f64> = fy.iter().map(|v| 1.0 / v.abs()).collect();
-        let res = residuals(&u, &fy, &wt).unwrap();
+        let res = residuals(&u, &fy, &wt, DEGREE).unwrap();
         let base: f64 = res.iter().zip(&wt).map(|(e, s)| (e * s).powi(2)).sum();
         for j in 0..=DEGREE {
             for step in [-1e-6, 1e-6] {
@@ -181,15 +187,24 @@ mod tests {
             let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
             rs.push(Row { depth_mm: *d, wrench: [q(*d) / (1.0 - delta * sign); COMPONENT_COUNT] });
         }
-        let fl = depth_floor(&rs, SCALE, 1.0).unwrap();
+        let fl = depth_floor(&rs, SCALE, 1.0, DEGREE).unwrap();
         let bound = fl.fy_rel_pct / 100.0;
         assert!(bound <= delta * (1.0 + 1e-9), "a lower bound above the minimax error: {bound}");
         assert!(bound >= delta * (1.0 - 1e-6), "Lawson did not reach the minimax error: {bound} vs {delta}");
     }
 
     #[test]
+    fn a_higher_degree_lowers_the_floor_of_a_curve_of_that_degree_to_zero() {
+        let f = |d: f64| 1e-3 * d + 2e-3 * d * d + 4e-5 * d.powi(5) + 1e-4 * d.powi(6) / 6.0;
+        let contract = depth_floor(&rows(f), SCALE, 1.0, DEGREE).unwrap();
+        let sixth = depth_floor(&rows(f), SCALE, 1.0, 6).unwrap();
+        assert!(contract.fy_rel_pct > 1e-3 && contract.worst_rms_pct() > 1e-4, "{contract:?}");
+        assert!(sixth.fy_rel_pct < 1e-9 && sixth.worst_rms_pct() < 1e-9, "{sixth:?}");
+    }
+
+    #[test]
     fn zero_fy_at_depth_is_an_error() {
-        let e = depth_floor(&rows(|_| 0.0), SCALE, 1.0).unwrap_err();
+        let e = depth_floor(&rows(|_| 0.0), SCALE, 1.0, DEGREE).unwrap_err();
         assert!(e.to_string().contains("Fy = 0 at 1.2 mm"), "{e}");
     }
 }

@@ -25,7 +25,8 @@
 //!
 //! Beside each run's errors: its floor ([`crate::depth_floor`]), the smallest Table 2 Fy
 //! error and RMS errors any model of the contract's form could have on it (no goal: it
-//! says whether a missed goal is the model's or the FE curve's).
+//! says whether a missed goal is the model's or the FE curve's); [`validate_with`] takes
+//! another depth degree for the floor, to ask what a contract of that degree could reach.
 
 use super::contract::{unit, COMPONENTS};
 use super::data::{fitted_fe_sha256, fitted_poses, load_paper_data, load_validation_runs, run_path, Run};
@@ -35,7 +36,7 @@ use super::eval_f32::{eval as eval32, Tables32};
 use super::eval_f64::{eval as eval64, eval_paper};
 use super::model::{rms_max, Model};
 use super::model_file;
-use crate::contract::COMPONENT_COUNT;
+use crate::contract::{COMPONENT_COUNT, DEGREE};
 use anyhow::Result;
 use needle_fe::spec::Role;
 use serde::Serialize;
@@ -168,6 +169,8 @@ pub struct Report {
     /// Whether the errors of the table2 and lhs runs follow the tilt or the offset
     /// (diagnostic, no goal); `None` below 3 runs.
     pub error_trend: Option<ErrorTrend>,
+    /// The depth degree of the runs' floors (the contract's, 4, unless asked otherwise).
+    pub floor_degree: usize,
 }
 
 fn role_name(r: Role) -> &'static str {
@@ -205,8 +208,15 @@ fn fy_rel_max(models: &[&[[f64; COMPONENT_COUNT]]], run: &Run) -> f64 {
 
 /// Compare one run with the model (f64 and f32; for the coupled form also its paper part).
 /// `paper`: the paper form fitted on the same set, printed beside a coupled model (`None`
-/// for a paper-form model).
-pub fn compare_run(model: &Model, paper: Option<&Model>, tables: &Tables32, run: &Run, lever_arm_mm: f64) -> (RunReport, f64) {
+/// for a paper-form model); `floor_degree`: the depth degree of the run's floor.
+pub fn compare_run(
+    model: &Model,
+    paper: Option<&Model>,
+    tables: &Tables32,
+    run: &Run,
+    lever_arm_mm: f64,
+    floor_degree: usize,
+) -> (RunReport, f64) {
     let p = &run.pose;
     let pose4 = [p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg];
     let w64: Vec<[f64; COMPONENT_COUNT]> =
@@ -255,7 +265,7 @@ pub fn compare_run(model: &Model, paper: Option<&Model>, tables: &Tables32, run:
             worst_rms_pct,
             worst_max_pct,
             paper_part,
-            floor: depth_floor(&run.rows, scale, TABLE2_MIN_DEPTH_MM).ok(),
+            floor: depth_floor(&run.rows, scale, TABLE2_MIN_DEPTH_MM, floor_degree).ok(),
             goal_met,
         },
         diff,
@@ -267,6 +277,15 @@ pub fn compare_run(model: &Model, paper: Option<&Model>, tables: &Tables32, run:
 /// # Errors
 /// The spec or model.toml cannot be read or is malformed; a present run is malformed.
 pub fn validate(set_dir: &Path) -> Result<Report> {
+    validate_with(set_dir, DEGREE)
+}
+
+/// [`validate`] with each run's floor computed for models of depth degree `floor_degree`
+/// (the contract's is [`DEGREE`]; the goals and errors do not depend on it).
+///
+/// # Errors
+/// As [`validate`].
+pub fn validate_with(set_dir: &Path, floor_degree: usize) -> Result<Report> {
     let model = model_file::read(&set_dir.join(super::MODEL_FILE))?;
     let tables = Tables32::from_model(&model);
     let (campaign, runs, missing) = load_validation_runs(set_dir)?;
@@ -287,7 +306,7 @@ pub fn validate(set_dir: &Path) -> Result<Report> {
     let mut reports = Vec::new();
     let mut diff = 0.0f64;
     for run in &runs {
-        let (r, d) = compare_run(&model, paper.as_ref(), &tables, run, lever);
+        let (r, d) = compare_run(&model, paper.as_ref(), &tables, run, lever, floor_degree);
         diff = diff.max(d);
         reports.push(r);
     }
@@ -312,6 +331,7 @@ pub fn validate(set_dir: &Path) -> Result<Report> {
         lhs_goal_met,
         passed: table2_goal_met && lhs_goal_met,
         error_trend,
+        floor_degree,
     })
 }
 
@@ -461,7 +481,7 @@ pub fn to_table(r: &Report) -> String {
     let _ = writeln!(
         s,
         "floor (no goal; no model whose wrench at a pose is a degree-{} polynomial in depth does better on these FE runs): table2 Fy rel {:.3} % (goal {} %), rms {:.3} %; lhs rms {:.3} % (goal {} %)",
-        crate::contract::DEGREE,
+        r.floor_degree,
         floor("table2", |f| f.fy_rel_pct),
         g.table2_fy_pct,
         floor("table2", DepthFloor::worst_rms_pct),
