@@ -15,16 +15,25 @@
 //! time. Measured side by side with `needle firmware bench` on the coupled default model
 //! of 2026-11-26 (21 training runs; README.md, "Horner trimming"): the M4F's wrench
 //! 541.1 -> 481.1 instructions, with the stiffness 973.0 -> 874.1; soft-float M3
-//! 37,014 -> 29,332, M0 61,588 -> 50,733.
+//! 37,014 -> 29,312, M0 61,588 -> 50,786.
 use needle_contract::TERMS;
 
 /// The bit pattern of `-0.0`.
 const MINUS_ZERO: u32 = 0x8000_0000;
 
-/// Where Horner may start: `Some(k)` for the highest index whose entry of `nonzero` is
-/// `true` (`Some(0)` when none is), `None` when that entry's coefficient may be `-0.0`
-/// (`minus_zero[k]`; then every step is done).
-const fn start_at(nonzero: [bool; TERMS], minus_zero: [bool; TERMS]) -> Option<usize> {
+/// Where a Horner evaluation starts: the index of its first coefficient, so `4` (the
+/// contract's degree) is every step. One byte, so that the tables of starts cost little
+/// flash (`model_f32::STARTS`: 7 B per matrix).
+pub(crate) type Start = u8;
+
+/// Every step: the start at the top coefficient (index `DEGREE`, 4).
+#[allow(clippy::cast_possible_truncation)] // DEGREE is 4
+const EVERY_STEP: Start = needle_contract::DEGREE as Start;
+
+/// Where Horner may start: the highest index whose entry of `nonzero` is `true` (0 when
+/// none is), or [`EVERY_STEP`] when that entry's coefficient may be `-0.0`
+/// (`minus_zero[k]`).
+const fn start_at(nonzero: [bool; TERMS], minus_zero: [bool; TERMS]) -> Start {
     let [n0, n1, n2, n3, n4] = nonzero;
     let [z0, z1, z2, z3, z4] = minus_zero;
     let (top, minus) = if n4 {
@@ -39,14 +48,14 @@ const fn start_at(nonzero: [bool; TERMS], minus_zero: [bool; TERMS]) -> Option<u
         (0, z0 && n0)
     };
     if minus {
-        None
+        EVERY_STEP
     } else {
-        Some(top)
+        top
     }
 }
 
 /// The start of a polynomial with known coefficients `p` (see the module docs).
-pub(crate) const fn start(p: &[f32; TERMS]) -> Option<usize> {
+pub(crate) const fn start(p: &[f32; TERMS]) -> Start {
     let [c0, c1, c2, c3, c4] = *p;
     let [b0, b1, b2, b3, b4] = [c0.to_bits(), c1.to_bits(), c2.to_bits(), c3.to_bits(), c4.to_bits()];
     start_at(
@@ -74,7 +83,7 @@ const fn row_at(row: &[f32; TERMS], lowest: usize) -> (bool, bool) {
 /// whose last addition adds the value after the `m_i[1]` step: `-0.0` only when
 /// `m_i[1]` is `-0.0` (a row whose only nonzero coefficient is `m_i[0]` has the rate
 /// `+0.0`).
-const fn start_rows(m: &[[f32; TERMS]; TERMS], lowest: usize) -> Option<usize> {
+const fn start_rows(m: &[[f32; TERMS]; TERMS], lowest: usize) -> Start {
     let [r0, r1, r2, r3, r4] = m;
     let rows = [row_at(r0, lowest), row_at(r1, lowest), row_at(r2, lowest), row_at(r3, lowest), row_at(r4, lowest)];
     let [(n0, z0), (n1, z1), (n2, z2), (n3, z3), (n4, z4)] = rows;
@@ -86,11 +95,11 @@ const fn start_rows(m: &[[f32; TERMS]; TERMS], lowest: usize) -> Option<usize> {
 #[derive(Clone, Copy)]
 pub(crate) struct MatrixStarts {
     /// Each row's Horner in `t`.
-    pub(crate) rows: [Option<usize>; TERMS],
+    pub(crate) rows: [Start; TERMS],
     /// The Horner in `u` over the rows' values.
-    pub(crate) outer: Option<usize>,
+    pub(crate) outer: Start,
     /// The Horner in `u` over the rows' t-rates (the stiffness by x and z).
-    pub(crate) outer_rate: Option<usize>,
+    pub(crate) outer_rate: Start,
 }
 
 /// The starts of matrix `m` (const evaluation).
@@ -100,30 +109,30 @@ pub(crate) const fn matrix_starts(m: &[[f32; TERMS]; TERMS]) -> MatrixStarts {
 }
 
 /// `h(p, w) = (((p4*w + p3)*w + p2)*w + p1)*w + p0` (for the contract's degree 4) from
-/// a start decided by the caller (`None`: every step): every multiply and add rounded
+/// a start decided by the caller ([`Start`]; 4 or more: every step): every multiply and add rounded
 /// on its own (Rust never fuses them into an FMA), highest power first, starting from
 /// the highest coefficient itself (not `0*w + p4`, which would turn a `-0.0` into
 /// `+0.0`); trimmed (module docs).
 #[inline(always)]
-pub(crate) fn horner_from(p: &[f32; TERMS], w: f32, start: Option<usize>) -> f32 {
+pub(crate) fn horner_from(p: &[f32; TERMS], w: f32, start: Start) -> f32 {
     let [p0, p1, p2, p3, p4] = *p;
     match start {
-        Some(0) => p0,
-        Some(1) => p1 * w + p0,
-        Some(2) => (p2 * w + p1) * w + p0,
-        Some(3) => ((p3 * w + p2) * w + p1) * w + p0,
+        0 => p0,
+        1 => p1 * w + p0,
+        2 => (p2 * w + p1) * w + p0,
+        3 => ((p3 * w + p2) * w + p1) * w + p0,
         _ => (((p4 * w + p3) * w + p2) * w + p1) * w + p0,
     }
 }
 
 /// `h(p, w)` and `h'(p, w)` together (coeffs/README.md, "Stiffness"), from a start
-/// decided by the caller (`None`: every step): the value by the operations of
+/// decided by the caller ([`Start`]; 4 or more: every step): the value by the operations of
 /// [`horner_from`] (the same bits), the derivative accumulated alongside, `d = p4`, then
 /// `d = d*w + b` after each of the value's steps for `p3`, `p2`, `p1` (`b` the value so
 /// far), 3 multiplies and 3 adds more, no further coefficient loads. Trimmed (module
 /// docs): from `p_k`, `b = d = p_k` (for `k = 0`: `b = p0`, `d = +0.0`).
 #[inline(always)]
-pub(crate) fn horner_with_rate_from(p: &[f32; TERMS], w: f32, start: Option<usize>) -> (f32, f32) {
+pub(crate) fn horner_with_rate_from(p: &[f32; TERMS], w: f32, start: Start) -> (f32, f32) {
     let [p0, p1, p2, p3, p4] = *p;
     // one step of both: (b, d) -> (b*w + c, d*w + (b*w + c))
     let step = |(b, d): (f32, f32), c: f32| {
@@ -131,10 +140,10 @@ pub(crate) fn horner_with_rate_from(p: &[f32; TERMS], w: f32, start: Option<usiz
         (b, d * w + b)
     };
     let (b, d) = match start {
-        Some(0) => return (p0, 0.0),
-        Some(1) => (p1, p1),
-        Some(2) => step((p2, p2), p1),
-        Some(3) => step(step((p3, p3), p2), p1),
+        0 => return (p0, 0.0),
+        1 => (p1, p1),
+        2 => step((p2, p2), p1),
+        3 => step(step((p3, p3), p2), p1),
         _ => step(step(step((p4, p4), p3), p2), p1),
     };
     (b * w + p0, d)

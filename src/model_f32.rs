@@ -1,6 +1,6 @@
 //! The paper model in f32: the evaluation algorithm of `coeffs/README.md`, bit-exact.
 use crate::cross_f32::{add_cross, COUPLED, CROSS_SCALES};
-use crate::horner::{horner_from, matrix_starts, start, MatrixStarts};
+use crate::horner::{horner_from, matrix_starts, start, MatrixStarts, Start};
 use crate::tables::{BASELINE, DEPTH_MAX_MM, DEVIATION, FITTED, THETA_MAX_DEG, X_MAX_MM, Z_MAX_MM};
 use crate::{Evaluation, Pose, Status, Wrench};
 use needle_contract::COMPONENT_COUNT;
@@ -46,11 +46,11 @@ pub(crate) const fn is_plus_zero_matrix(m: &[[f32; TERMS]; TERMS]) -> bool {
 }
 
 /// `BASELINE_STARTS[c]`: where the Horner of `B_c` starts (`crate::horner`, exact;
-/// `Some(0)` with `p0 = +0.0` for an all-zero baseline, which is then the constant
+/// 0 with `p0 = +0.0` for an all-zero baseline, which is then the constant
 /// `+0.0`), decided at compile time.
 #[allow(clippy::indexing_slicing)] // const evaluation only: an index out of range is a compile error
-pub(crate) const BASELINE_STARTS: [Option<usize>; COMPONENT_COUNT] = {
-    let mut starts = [None; COMPONENT_COUNT];
+pub(crate) const BASELINE_STARTS: [Start; COMPONENT_COUNT] = {
+    let mut starts = [0; COMPONENT_COUNT];
     let mut c = 0;
     while c < COMPONENT_COUNT {
         starts[c] = start(&BASELINE[c]);
@@ -112,7 +112,7 @@ pub(crate) const fn starts_not_neg_zero(b: &[f32; TERMS]) -> bool {
 /// `B_c(u)` from its start (`+0.0` without evaluating it when every coefficient is
 /// `+0.0`: see [`skip_sweep`] and `crate::horner`).
 #[inline(always)]
-pub(crate) fn baseline(b: &[f32; TERMS], start: Option<usize>, u: f32) -> f32 {
+pub(crate) fn baseline(b: &[f32; TERMS], start: Start, u: f32) -> f32 {
     horner_from(b, u, start)
 }
 
@@ -120,8 +120,8 @@ pub(crate) fn baseline(b: &[f32; TERMS], start: Option<usize>, u: f32) -> f32 {
 /// exact), decided at compile time.
 #[allow(clippy::indexing_slicing)] // const evaluation only: an index out of range is a compile error
 pub(crate) const STARTS: [[MatrixStarts; COMPONENT_COUNT]; 4] = {
-    let none = MatrixStarts { rows: [None; TERMS], outer: None, outer_rate: None };
-    let mut starts = [[none; COMPONENT_COUNT]; 4];
+    let every = MatrixStarts { rows: [0; TERMS], outer: 0, outer_rate: 0 };
+    let mut starts = [[every; COMPONENT_COUNT]; 4];
     let mut k = 0;
     while k < 4 {
         let mut c = 0;

@@ -1,7 +1,7 @@
 //! The wrench and its stiffness in f32: the evaluation algorithm of `coeffs/README.md`
 //! ("Stiffness") bit for bit, sharing the wrench's operations.
 use crate::cross_f32::{add_cross, add_cross_rates, COUPLED, CROSS_SCALES};
-use crate::horner::{horner_from, horner_with_rate_from, MatrixStarts};
+use crate::horner::{horner_from, horner_with_rate_from, MatrixStarts, Start};
 use crate::model_f32::{clamp_to_domain, skip_sweep, sweep_t, BASELINE_STARTS, ODD, ONE_THIRD, STARTS, SWEEP_SCALES};
 use crate::stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
 use crate::tables::{BASELINE, DEVIATION, FITTED};
@@ -133,7 +133,7 @@ struct Component {
 struct ComponentTables {
     baseline: [f32; TERMS],
     /// Where its Horner starts (`model_f32::BASELINE_STARTS`).
-    baseline_start: Option<usize>,
+    baseline_start: Start,
     mats: [[[f32; TERMS]; TERMS]; 4],
     starts: [MatrixStarts; 4],
     odd: [bool; 4],
