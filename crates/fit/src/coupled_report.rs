@@ -95,6 +95,41 @@ pub fn held_out(runs: &[&Run], lever_arm_mm: f64, model: impl Fn(Pose64) -> [f64
     h
 }
 
+/// The learning curve's verdict on the design's size: if the held-out LHS worst RMS
+/// still falls by more than this fraction of itself per 8 added training runs between
+/// the curve's last two points, more runs still pay and the design stays as large as it
+/// is (`train_count`); below it the curve is flat (2 % of a 1 % error is 0.02 % of peak
+/// |Fy|, a tenth of the FE data's pose-to-pose scatter, coeffs/README.md).
+pub const CURVE_STILL_FALLING: f64 = 0.02;
+
+/// The verdict line of the learning curve (see [`CURVE_STILL_FALLING`]): `None` with
+/// fewer than two measured points.
+pub fn curve_verdict(curve: &[CurvePoint]) -> Option<String> {
+    let measured: Vec<(usize, HeldOut)> = curve.iter().filter_map(|p| p.held_out.map(|h| (p.runs, h))).collect();
+    let [.., (n0, h0), (n1, h1)] = measured.as_slice() else {
+        return None;
+    };
+    let added = n1.checked_sub(*n0).filter(|&a| a > 0)?;
+    let per8 = |a: f64, b: f64| if a > 0.0 { (a - b) / a * 8.0 / added as f64 } else { 0.0 };
+    let fall = per8(h0.lhs_worst_rms_pct, h1.lhs_worst_rms_pct);
+    let fall_max = per8(h0.worst_max_pct, h1.worst_max_pct);
+    let verdict = if fall > CURVE_STILL_FALLING {
+        "still falling: more training runs pay, the design keeps its size"
+    } else {
+        "flat: more training runs no longer pay"
+    };
+    Some(format!(
+        "learning curve, {n0} -> {n1} runs: lhs worst rms {:.3} -> {:.3} % ({:+.1} % of itself per 8 runs), worst max {:.3} -> {:.3} % ({:+.1} %): {verdict} (threshold {:.0} % per 8 runs)",
+        h0.lhs_worst_rms_pct,
+        h1.lhs_worst_rms_pct,
+        -100.0 * fall,
+        h0.worst_max_pct,
+        h1.worst_max_pct,
+        -100.0 * fall_max,
+        100.0 * CURVE_STILL_FALLING
+    ))
+}
+
 /// Sizes of the learning curve: 8, 16, 24, ... up to all `n` training runs.
 pub fn curve_sizes(n: usize) -> Vec<usize> {
     let mut v: Vec<usize> = (1..).map(|k| 8 * k).take_while(|&k| k < n).collect();
@@ -226,6 +261,9 @@ pub fn to_table(r: &CoupledReport) -> String {
             }
         }
     }
+    if let Some(v) = curve_verdict(&r.curve) {
+        let _ = writeln!(s, "  {v}");
+    }
     let _ = writeln!(s, "held-out errors, both forms ({} runs):", r.held_out_runs);
     let _ = writeln!(s, "  {:<8} {:>12} {:>12} {:>12} {:>10}", "form", "lhs rms %", "t2 rms %", "t2 Fy max %", "max %");
     let mut row = |name: &str, h: &HeldOut| {
@@ -249,6 +287,26 @@ mod tests {
     use crate::model::Coupled;
     use needle_fe::results::Row;
     use needle_fe::spec::{PoseSpec, Role};
+
+    fn point(runs: usize, lhs: f64, max: f64) -> CurvePoint {
+        let h = HeldOut { lhs_worst_rms_pct: lhs, table2_worst_rms_pct: 0.5, table2_fy_max_pct: 20.0, worst_max_pct: max };
+        CurvePoint { runs, choices: Some(vec![]), held_out: Some(h) }
+    }
+
+    /// The verdict compares the last two measured points, per 8 added runs.
+    #[test]
+    fn the_curve_verdict_reads_the_last_step_per_8_runs() {
+        // 16 -> 21 runs, 1.225 -> 1.114 %: -9.1 % over 5 runs, -14.5 % per 8
+        let falling = [point(8, 1.252, 4.3), point(16, 1.225, 4.25), point(21, 1.114, 3.978)];
+        let v = curve_verdict(&falling).expect("two points");
+        assert!(v.contains("16 -> 21 runs") && v.contains("-14.5 % of itself per 8 runs") && v.contains("still falling"), "{v}");
+        // 1 % per 8 runs: flat
+        let flat = [point(16, 1.0, 3.0), point(24, 0.99, 3.0)];
+        assert!(curve_verdict(&flat).expect("two points").contains("flat"));
+        // a point that could not be fitted is skipped; one measured point says nothing
+        let gap = [point(8, 1.0, 3.0), CurvePoint { runs: 16, choices: None, held_out: None }];
+        assert_eq!(curve_verdict(&gap), None);
+    }
 
     /// The paper row of the report is the paper part alone: with cross terms in the
     /// model (as `needle fit` passes the fitted coupled model), a run equal to the paper
