@@ -55,6 +55,50 @@ pub(crate) fn clamp(v: i32, lo: i32, hi: i32) -> (i32, bool) {
     }
 }
 
+/// Where the integer Horner of `p` may start: the index of its highest nonzero
+/// coefficient (0 when none is). The steps above it change nothing: the accumulator is 0
+/// there, `floor(0 * w / 2^15) = 0` and `0 + 0 = 0` (an integer has one zero, so unlike
+/// the f32 Horner there is no sign to keep). For the generated tables, in const items.
+pub(crate) const fn start<const N: usize>(p: &[i32; N]) -> u8 {
+    let mut rest: &[i32] = p;
+    let (mut index, mut top) = (0_u8, 0_u8);
+    while let [first, tail @ ..] = rest {
+        if *first != 0 {
+            top = index;
+        }
+        index += 1;
+        rest = tail;
+    }
+    top
+}
+
+/// [`horner`] from the coefficient at `start` ([`start`]; 4 or more: every step): the
+/// same integer. Cores with a 64-bit multiply (measured on the coupled default model,
+/// `needle firmware bench` and `size`: fixed-point wrench M4F 4,702.0 -> 4,070.9
+/// instructions for +184 B of flash, M3 4,603.0 -> 4,068.1 for +268 B).
+#[cfg(not(all(target_arch = "arm", not(target_has_atomic = "32"))))]
+#[inline(always)]
+pub(crate) fn horner_from(p: &[i32; TERMS], w: i32, start: u8) -> i32 {
+    let [p0, p1, p2, p3, _] = *p;
+    match start {
+        0 => p0,
+        1 => mul_q15(p1, w).wrapping_add(p0),
+        2 => mul_q15(mul_q15(p2, w).wrapping_add(p1), w).wrapping_add(p0),
+        3 => horner3(&[p0, p1, p2, p3], w),
+        _ => horner(p, w),
+    }
+}
+
+/// [`horner`], every step, on Armv6-M: there a copy of the step per start cost
+/// 1,386 B of flash (13,898 -> 15,284 B, 1.1 KiB below the 16 KiB goal) for 9 % of the
+/// fixed-point wrench's instructions (8,105.0 -> 7,368.9), and one loop over the steps
+/// left cost more of both (10,239.0 instructions, 17,282 B).
+#[cfg(all(target_arch = "arm", not(target_has_atomic = "32")))]
+#[inline(always)]
+pub(crate) fn horner_from(p: &[i32; TERMS], w: i32, _start: u8) -> i32 {
+    horner(p, w)
+}
+
 /// `h(p, w) = (((p4 w + p3) w + p2) w + p1) w + p0` with every product [`mul_q15`]:
 /// the contract's Horner step in Q15.
 #[inline(always)]

@@ -1,5 +1,5 @@
 //! The fixed-point evaluator: the integer algorithm of `coeffs/README.md`, bit-exact.
-use super::arith::{clamp, horner, normalise};
+use super::arith::{clamp, horner, horner_from, normalise, start};
 use super::cross::{add_cross, cross_input, CROSS_DIVISORS};
 use super::tables::{
     BASELINE, DEPTH_DIVISOR, DEPTH_MAX_MM_Q16, FRAC_BITS, ODD, ROWS, SHIFTS, SWEEP_DIVISORS, THETA_MAX_DEG_Q16, X_MAX_MM_Q16, Z_MAX_MM_Q16,
@@ -103,6 +103,29 @@ impl Inputs {
     }
 }
 
+/// `ROW_STARTS[c][k][i]`: where the Horner of `ROWS[c][k][i]` starts (`arith::start`:
+/// the steps above its highest nonzero coefficient change nothing), decided at compile
+/// time. The coupled form's sweeps are of degree 1-4 in t, and the matrices its mirror
+/// symmetries zero have rows of zeros (start 0: `h = 0`).
+#[allow(clippy::indexing_slicing)] // const evaluation only: an index out of range is a compile error
+pub(super) const ROW_STARTS: [[[u8; TERMS]; 4]; COMPONENT_COUNT] = {
+    let mut starts = [[[0_u8; TERMS]; 4]; COMPONENT_COUNT];
+    let mut c = 0;
+    while c < COMPONENT_COUNT {
+        let mut k = 0;
+        while k < 4 {
+            let mut i = 0;
+            while i < TERMS {
+                starts[c][k][i] = start(&ROWS[c][k][i]);
+                i += 1;
+            }
+            k += 1;
+        }
+        c += 1;
+    }
+    starts
+};
+
 /// Steps 4-6: every component's accumulators `A_i` (baseline, the four sweeps' rows, the
 /// cross terms), each in its Q(G).
 ///
@@ -114,14 +137,14 @@ impl Inputs {
 pub(super) fn accumulators(at: &Inputs) -> [[i32; TERMS]; COMPONENT_COUNT] {
     let mut a = BASELINE;
     add_cross(at.cross_inputs(), &mut a);
-    let tables = ROWS.iter().zip(SHIFTS.iter()).zip(ODD.iter());
-    for (ac, ((rows, shifts), odd)) in a.iter_mut().zip(tables) {
-        for ((((rows_k, shifts_k), &tk), &neg), &o) in
-            rows.iter().zip(shifts.iter()).zip(at.t.iter()).zip(at.negative.iter()).zip(odd.iter())
+    let tables = ROWS.iter().zip(SHIFTS.iter()).zip(ODD.iter()).zip(ROW_STARTS.iter());
+    for (ac, (((rows, shifts), odd), starts)) in a.iter_mut().zip(tables) {
+        for (((((rows_k, shifts_k), &tk), &neg), &o), starts_k) in
+            rows.iter().zip(shifts.iter()).zip(at.t.iter()).zip(at.negative.iter()).zip(odd.iter()).zip(starts.iter())
         {
             let flip = neg && o;
-            for ((ai, row), &s) in ac.iter_mut().zip(rows_k.iter()).zip(shifts_k.iter()) {
-                let r = horner(row, tk).wrapping_shr(s);
+            for (((ai, row), &s), &st) in ac.iter_mut().zip(rows_k.iter()).zip(shifts_k.iter()).zip(starts_k.iter()) {
+                let r = horner_from(row, tk, st).wrapping_shr(s);
                 *ai = if flip { ai.wrapping_sub(r) } else { ai.wrapping_add(r) };
             }
         }
