@@ -19,7 +19,7 @@
 use needle_contract::TERMS;
 
 /// The bit pattern of `-0.0`.
-const MINUS_ZERO: u32 = 0x8000_0000;
+pub(crate) const MINUS_ZERO: u32 = 0x8000_0000;
 
 /// Where a Horner evaluation starts: the index of its first coefficient, so `4` (the
 /// contract's degree) is every step. One byte, so that the tables of starts cost little

@@ -1,6 +1,6 @@
 //! The paper model in f32: the evaluation algorithm of `coeffs/README.md`, bit-exact.
 use crate::cross_f32::{add_cross, COUPLED, CROSS_SCALES};
-use crate::horner::{horner_from, matrix_starts, start, MatrixStarts, Start};
+use crate::horner::{horner_from, matrix_starts, start, MatrixStarts, Start, MINUS_ZERO};
 use crate::tables::{BASELINE, DEPTH_MAX_MM, DEVIATION, FITTED, THETA_MAX_DEG, X_MAX_MM, Z_MAX_MM};
 use crate::{Evaluation, Pose, Status, Wrench};
 use needle_contract::COMPONENT_COUNT;
@@ -99,14 +99,14 @@ pub(crate) const fn skip_sweep(mats: &[[[f32; TERMS]; TERMS]; COMPONENT_COUNT], 
 /// `-0.0` only when both addends are).
 const fn rate_starts_not_neg_zero(b: &[f32; TERMS]) -> bool {
     let [_, b1, ..] = *b;
-    b1.to_bits() != 0x8000_0000
+    b1.to_bits() != MINUS_ZERO
 }
 
 /// Whether `h(b, u)` is never `-0.0`: its last operation adds `b[0]`, and the sum is
 /// `-0.0` only when `b[0]` is.
 pub(crate) const fn starts_not_neg_zero(b: &[f32; TERMS]) -> bool {
     let [b0, ..] = *b;
-    b0.to_bits() != 0x8000_0000
+    b0.to_bits() != MINUS_ZERO
 }
 
 /// `B_c(u)` from its start (`+0.0` without evaluating it when every coefficient is

@@ -59,7 +59,7 @@ pub(crate) fn clamp(v: i32, lo: i32, hi: i32) -> (i32, bool) {
 /// coefficient (0 when none is). The steps above it change nothing: the accumulator is 0
 /// there, `floor(0 * w / 2^15) = 0` and `0 + 0 = 0` (an integer has one zero, so unlike
 /// the f32 Horner there is no sign to keep). For the generated tables, in const items.
-pub(crate) const fn start<const N: usize>(p: &[i32; N]) -> u8 {
+pub(crate) const fn start(p: &[i32; TERMS]) -> u8 {
     let mut rest: &[i32] = p;
     let (mut index, mut top) = (0_u8, 0_u8);
     while let [first, tail @ ..] = rest {

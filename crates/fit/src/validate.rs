@@ -219,24 +219,16 @@ pub fn compare_run(
 ) -> (RunReport, f64) {
     let p = &run.pose;
     let pose4 = [p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg];
-    let w64: Vec<[f64; COMPONENT_COUNT]> =
-        run.rows.iter().map(|r| eval64(model, [pose4[0], pose4[1], pose4[2], pose4[3], r.depth_mm]).0).collect();
-    let w32: Vec<[f64; COMPONENT_COUNT]> = run
-        .rows
-        .iter()
-        .map(|r| {
-            let q = [pose4[0] as f32, pose4[1] as f32, pose4[2] as f32, pose4[3] as f32, r.depth_mm as f32];
-            eval32(tables, q).0.map(f64::from)
-        })
-        .collect();
+    let w64: Vec<[f64; COMPONENT_COUNT]> = run.rows.iter().map(|r| eval64(model, run.pose_at(r.depth_mm)).0).collect();
+    let w32: Vec<[f64; COMPONENT_COUNT]> =
+        run.rows.iter().map(|r| eval32(tables, run.pose_at(r.depth_mm).map(|v| v as f32)).0.map(f64::from)).collect();
     let peak = needle_fe::results::peak_fy_n(&run.rows);
     let scale = needle_contract::error_scales(peak, lever_arm_mm);
     let e64 = errors(&w64, run, scale);
     let e32 = errors(&w32, run, scale);
     let fy_rel = fy_rel_max(&[&w64, &w32], run);
     let paper_part = paper.map(|paper| {
-        let wp: Vec<[f64; COMPONENT_COUNT]> =
-            run.rows.iter().map(|r| eval_paper(paper, [pose4[0], pose4[1], pose4[2], pose4[3], r.depth_mm]).0).collect();
+        let wp: Vec<[f64; COMPONENT_COUNT]> = run.rows.iter().map(|r| eval_paper(paper, run.pose_at(r.depth_mm)).0).collect();
         let ep = errors(&wp, run, scale);
         PaperPart {
             fy_rel_max_pct: fy_rel_max(&[&wp], run),
