@@ -1,6 +1,7 @@
 //! The `needle` command line: one module per command group.
 #![forbid(unsafe_code)]
 
+pub mod calibrate;
 pub mod eval_batch;
 pub mod explore;
 pub mod fe;
