@@ -60,15 +60,21 @@ impl Move {
     }
 }
 
+/// Where the hand is at the end of `moves` (it starts 1 mm above the surface).
+fn at(moves: &[Move]) -> f64 {
+    moves.last().map_or(-1.0, |m| m.to_mm)
+}
+
+/// Appends a move from where the hand is to `to_mm` at about `speed_mm_per_s`.
+fn go(moves: &mut Vec<Move>, to_mm: f64, speed_mm_per_s: f64) {
+    let from_mm = at(moves);
+    let duration_s = ((to_mm - from_mm).abs() / speed_mm_per_s).max(0.002);
+    moves.push(Move { from_mm, to_mm, duration_s });
+}
+
 /// A random trajectory: start above the surface, a few random actions, leave.
 fn trajectory(rng: &mut ChaCha8Rng, deepest_mm: f64) -> Vec<Move> {
     let mut moves = Vec::new();
-    let mut at = -1.0;
-    let mut go = |moves: &mut Vec<Move>, to: f64, speed_mm_per_s: f64| {
-        let duration_s = ((to - at).abs() / speed_mm_per_s).max(0.002);
-        moves.push(Move { from_mm: at, to_mm: to, duration_s });
-        at = to;
-    };
     for _ in 0..rng.gen_range(2..8) {
         match rng.gen_range(0..5) {
             0 | 1 => {
@@ -76,16 +82,16 @@ fn trajectory(rng: &mut ChaCha8Rng, deepest_mm: f64) -> Vec<Move> {
                 go(&mut moves, to, rng.gen_range(0.5..30.0));
             }
             2 => {
-                let hold = rng.gen_range(0.01..0.5);
-                moves.push(Move { from_mm: at, to_mm: at, duration_s: hold });
+                let here = at(&moves);
+                moves.push(Move { from_mm: here, to_mm: here, duration_s: rng.gen_range(0.01..0.5) });
             }
             3 => {
-                let to = (at - rng.gen_range(0.0..10.0)).max(-0.5);
+                let to = (at(&moves) - rng.gen_range(0.0..10.0)).max(-0.5);
                 go(&mut moves, to, rng.gen_range(0.5..30.0));
             }
             _ => {
                 let amplitude = rng.gen_range(0.005..0.5);
-                let centre = at;
+                let centre = at(&moves);
                 for _ in 0..rng.gen_range(2..12) {
                     go(&mut moves, centre + amplitude, rng.gen_range(1.0..60.0));
                     go(&mut moves, centre - amplitude, rng.gen_range(1.0..60.0));

@@ -108,6 +108,21 @@ pub enum Phase {
     InTrack(u8),
 }
 
+impl Phase {
+    /// The phase as one number: `0` approach, `0x100 | layer` deflecting,
+    /// `0x200 | layer` cutting, `0x300 | layer` in the track (the C API's and the golden
+    /// sequences' form).
+    #[must_use]
+    pub const fn code(self) -> u16 {
+        match self {
+            Self::Approach => 0,
+            Self::Deflecting(l) => 0x100 | l as u16,
+            Self::Cutting(l) => 0x200 | l as u16,
+            Self::InTrack(l) => 0x300 | l as u16,
+        }
+    }
+}
+
 /// One tick's result.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
