@@ -10,7 +10,16 @@ fn curve() -> PathBuf {
 }
 
 fn options(curve: &Path) -> Options<'_> {
-    Options { curve, name: "liver".into(), needle_diameter_mm: 1.27, speed_mm_per_s: 3.0, rule: EventRule::default() }
+    let set = Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default");
+    let mu0 = needle_codegen::tissue::read_fe_shear_modulus(&set).expect("campaign.toml").expect("a campaign");
+    Options {
+        curve,
+        name: "liver".into(),
+        needle_diameter_mm: 1.27,
+        speed_mm_per_s: 3.0,
+        rule: EventRule::default(),
+        fe_shear_modulus_n_per_mm2: mu0,
+    }
 }
 
 #[test]

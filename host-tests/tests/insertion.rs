@@ -177,3 +177,18 @@ fn scales_are_overridden_at_run_time() {
     let twice = ins.step(&pose(2.0)).wrench.fy_n;
     assert!((twice / base - 2.0).abs() < 1e-6, "{base} -> {twice}");
 }
+
+#[test]
+fn the_needle_axis_follows_the_orientation_convention() {
+    // the insertion's own sine and cosine (no libm: f32 polynomials) against f64
+    for k in -900..=900 {
+        let deg = k as f32 * 0.1;
+        let p = Pose { theta_x_deg: deg, theta_z_deg: -0.5 * deg, ..pose(5.0) };
+        let a = needle_haptics::insertion::needle_axis(&p);
+        let (tx, tz) = (f64::from(deg).to_radians(), f64::from(-0.5 * deg).to_radians());
+        let want = [-tz.sin() * tx.cos(), tz.cos() * tx.cos(), tx.sin()];
+        for c in 0..3 {
+            assert!((f64::from(a[c]) - want[c]).abs() < 3e-7, "{deg} deg: component {c}: {} vs {}", a[c], want[c]);
+        }
+    }
+}

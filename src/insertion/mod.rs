@@ -160,6 +160,15 @@ pub fn deflection(pose: &Pose, indentation_mm: f32, scale: f32, similarity: f32)
     crate::Evaluation { wrench: Wrench::from_array(scaled), status: e.status }
 }
 
+/// The needle's unit axis from tip to hub for the pose's tilts (each clamped to ±89
+/// degrees), as the insertion model computes it: `(-sin θz cos θx, cos θz cos θx, sin θx)`
+/// (the [`orientation`](crate::orientation) convention) with f32 polynomials for sine and
+/// cosine (error below 1e-7 against f64: the `track` module).
+#[must_use]
+pub fn needle_axis(pose: &Pose) -> [f32; 3] {
+    axis(pose.theta_x_deg, pose.theta_z_deg)
+}
+
 /// The state of one needle path through a stack: fixed size, no allocation.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Insertion {

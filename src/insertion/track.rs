@@ -28,10 +28,41 @@ pub(crate) type Vec3 = [f32; 3];
 
 const RAD_PER_DEG: f32 = core::f32::consts::PI / 180.0;
 
-/// The needle's unit axis from tip to hub for the tilts (degrees).
+/// Largest tilt the geometry takes, degrees: a needle at 90 degrees no longer enters the
+/// top surface; tilts beyond are clamped here (the surrogate clamps at its own domain).
+pub(crate) const TILT_MAX_DEG: f32 = 89.0;
+
+/// `(sin, cos)` of `deg` degrees, clamped to `±TILT_MAX_DEG`: Taylor polynomials in
+/// `x = deg * π/180` (`|x| <= 1.554`) to `x^13` and `x^12`, in plain f32 (Horner, no FMA:
+/// the same bits on every target). Truncation error below `x^15/15! < 6e-10` and
+/// `x^14/14! < 6.5e-9` at the clamp, under f32 round-off (a few 1e-8). `libm::sinf`
+/// works in f64, which costs about a thousand instructions a call on an FPU without
+/// double precision (the Cortex-M4F).
+pub(crate) fn sin_cos_deg(deg: f32) -> (f32, f32) {
+    let d = if deg > TILT_MAX_DEG {
+        TILT_MAX_DEG
+    } else if deg < -TILT_MAX_DEG {
+        -TILT_MAX_DEG
+    } else {
+        deg
+    };
+    let x = d * RAD_PER_DEG;
+    let x2 = x * x;
+    let s = x
+        * (1.0
+            + x2 * (-1.0 / 6.0
+                + x2 * (1.0 / 120.0
+                    + x2 * (-1.0 / 5040.0 + x2 * (1.0 / 362_880.0 + x2 * (-1.0 / 39_916_800.0 + x2 * (1.0 / 6_227_020_800.0)))))));
+    let c = 1.0
+        + x2 * (-0.5
+            + x2 * (1.0 / 24.0 + x2 * (-1.0 / 720.0 + x2 * (1.0 / 40_320.0 + x2 * (-1.0 / 3_628_800.0 + x2 * (1.0 / 479_001_600.0))))));
+    (s, c)
+}
+
+/// The needle's unit axis from tip to hub for the tilts (degrees; NaN stays NaN).
 pub(crate) fn axis(theta_x_deg: f32, theta_z_deg: f32) -> Vec3 {
-    let (sx, cx) = (libm::sinf(theta_x_deg * RAD_PER_DEG), libm::cosf(theta_x_deg * RAD_PER_DEG));
-    let (sz, cz) = (libm::sinf(theta_z_deg * RAD_PER_DEG), libm::cosf(theta_z_deg * RAD_PER_DEG));
+    let (sx, cx) = sin_cos_deg(theta_x_deg);
+    let (sz, cz) = sin_cos_deg(theta_z_deg);
     [-sz * cx, cz * cx, sx]
 }
 

@@ -10,10 +10,14 @@
 //!    [`Insertion`](needle_haptics::insertion::Insertion) along the measured insertion,
 //!    and [`replay::checks`] holds it against the curve.
 //!
-//! What a constant-speed curve cannot tell apart, and is therefore assumed (stated in
-//! the tissue file's `source` and by the command): the friction is all Coulomb at the
+//! What a constant-speed axial curve cannot tell apart, and is therefore assumed (stated
+//! in the tissue file's `source` and by the command): the friction is all Coulomb at the
 //! measured speed (static level = Coulomb level, no viscous term), the stick band is
-//! [`STICK_BAND_MM_PER_S`], the track's lateral stiffness is not identified (0).
+//! [`STICK_BAND_MM_PER_S`]; the track's lateral stiffness per mm of shaft is Winkler's
+//! subgrade modulus of a beam on an elastic solid, `k ≈ E` (Vesic 1961, "Bending of
+//! beams resting on isotropic elastic solid", J. Eng. Mech. Div. ASCE 87(2)), with the
+//! layer's Young's modulus `E = 3 s mu0` (incompressible; `mu0` of the set's FE tissue,
+//! scaled by the layer's `s`): [`WINKLER_E_PER_MU`].
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
@@ -34,6 +38,10 @@ use std::path::Path;
 /// cannot show the band).
 pub const STICK_BAND_MM_PER_S: f64 = 1.0;
 
+/// Young's modulus over shear modulus of an incompressible solid (`E = 2 (1 + ν) μ`,
+/// `ν = 1/2`), the factor of the track stiffness `k = E = 3 s mu0`.
+pub const WINKLER_E_PER_MU: f64 = 3.0;
+
 /// What to calibrate.
 #[derive(Debug, Clone)]
 pub struct Options<'a> {
@@ -47,6 +55,9 @@ pub struct Options<'a> {
     pub speed_mm_per_s: f64,
     /// How punctures are found.
     pub rule: events::EventRule,
+    /// The FE tissue's initial shear modulus `mu0`, N/mm² (`campaign.toml`), for the
+    /// track stiffness.
+    pub fe_shear_modulus_n_per_mm2: f64,
 }
 
 /// The result: the stack, its replay and the checks.
@@ -76,6 +87,9 @@ pub struct Calibration {
 pub fn calibrate(opts: &Options<'_>) -> Result<Calibration> {
     if !(opts.needle_diameter_mm.is_finite() && opts.needle_diameter_mm > 0.0) {
         bail!("--needle-diameter-mm {}: must be finite and > 0", opts.needle_diameter_mm);
+    }
+    if !(opts.fe_shear_modulus_n_per_mm2.is_finite() && opts.fe_shear_modulus_n_per_mm2 > 0.0) {
+        bail!("FE shear modulus {} N/mm^2: must be finite and > 0", opts.fe_shear_modulus_n_per_mm2);
     }
     if !(opts.speed_mm_per_s.is_finite() && opts.speed_mm_per_s > 0.0) {
         bail!("--speed-mm-per-s {}: must be finite and > 0", opts.speed_mm_per_s);
@@ -125,7 +139,7 @@ pub fn calibrate(opts: &Options<'_>) -> Result<Calibration> {
 
 fn to_file(opts: &Options<'_>, fit: &fit::Fit) -> file::Stack {
     let source = format!(
-        "needle calibrate on {} ({} mm needle at {} mm/s); friction all Coulomb at that speed, stick band {} mm/s assumed, track stiffness not identified",
+        "needle calibrate on {} ({} mm needle at {} mm/s); friction all Coulomb at that speed, stick band {} mm/s assumed; track stiffness = E = 3 s mu0 (Winkler subgrade k ~ E, Vesic 1961)",
         opts.curve.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default(),
         opts.needle_diameter_mm,
         opts.speed_mm_per_s,
@@ -154,7 +168,7 @@ fn to_file(opts: &Options<'_>, fit: &fit::Fit) -> file::Stack {
                 friction_coulomb_n_per_mm: l.friction_n_per_mm,
                 friction_viscous_n_s_per_mm2: 0.0,
                 stick_band_mm_per_s: STICK_BAND_MM_PER_S,
-                track_stiffness_n_per_mm2: 0.0,
+                track_stiffness_n_per_mm2: WINKLER_E_PER_MU * l.scale * opts.fe_shear_modulus_n_per_mm2,
                 source: source.clone(),
             }
         })

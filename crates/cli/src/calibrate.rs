@@ -43,8 +43,16 @@ pub struct CalibrateArgs {
 pub fn calibrate(a: CalibrateArgs) -> Result<ExitCode> {
     check_compiled_set(&a.set)?;
     let rule = EventRule { drop_fraction: a.drop_fraction, ..EventRule::default() };
-    let opts =
-        Options { curve: &a.curve, name: a.name.clone(), needle_diameter_mm: a.needle_diameter_mm, speed_mm_per_s: a.speed_mm_per_s, rule };
+    let mu0 = needle_codegen::tissue::read_fe_shear_modulus(&a.set)?
+        .with_context(|| format!("{}: no campaign.toml: the FE tissue's shear modulus sets the track stiffness", a.set.display()))?;
+    let opts = Options {
+        curve: &a.curve,
+        name: a.name.clone(),
+        needle_diameter_mm: a.needle_diameter_mm,
+        speed_mm_per_s: a.speed_mm_per_s,
+        rule,
+        fe_shear_modulus_n_per_mm2: mu0,
+    };
     let c = run_calibration(&opts)?;
     println!(
         "{} points, {} punctures; geometric similarity: measured needle {} mm / FE needle {} mm = {:.4} (lengths x {:.4}, forces x {:.4}; exact when the block scales too)",
@@ -59,8 +67,13 @@ pub fn calibrate(a: CalibrateArgs) -> Result<ExitCode> {
     println!("contact onset (depth 0) at {:.3} mm of needle position", c.fit.onset_mm);
     for (k, l) in c.fit.layers.iter().enumerate() {
         println!(
-            "layer {k}: boundary at {:.3} mm depth, scale s = {:.4}, puncture {:.4} N, cutting {:.4} N, friction {:.5} N/mm",
-            l.boundary_mm, l.scale, l.puncture_force_n, l.cutting_force_n, l.friction_n_per_mm
+            "layer {k}: boundary at {:.3} mm depth, scale s = {:.4}, puncture {:.4} N, cutting {:.4} N, friction {:.5} N/mm, track {:.5} N/mm^2 (= 3 s mu0, assumed)",
+            l.boundary_mm,
+            l.scale,
+            l.puncture_force_n,
+            l.cutting_force_n,
+            l.friction_n_per_mm,
+            needle_calibrate::WINKLER_E_PER_MU * l.scale * mu0
         );
     }
     let mut all_met = true;

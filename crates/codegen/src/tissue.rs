@@ -254,6 +254,33 @@ pub fn read_fe_needle(set_dir: &Path) -> Result<Option<FeNeedle>, CodegenError> 
     Ok(Some(FeNeedle { diameter_mm: get("diameter_mm")?, reference_from_tip_mm: get("reference_from_tip_mm")? }))
 }
 
+/// The initial shear modulus `mu0 = sum of [tissue] mu_n_per_mm2` of `<set>/campaign.toml`
+/// (N/mm²), or `None` without a campaign file.
+///
+/// # Errors
+/// The file is unreadable, or `mu_n_per_mm2` is missing, not a list of numbers, or sums
+/// to a value that is not finite and > 0.
+pub fn read_fe_shear_modulus(set_dir: &Path) -> Result<Option<f64>, CodegenError> {
+    let path = set_dir.join("campaign.toml");
+    if !path.is_file() {
+        return Ok(None);
+    }
+    let text = std::fs::read_to_string(&path).map_err(|e| CodegenError::file(&path, format!("cannot read: {e}")))?;
+    let value: toml::Table = toml::from_str(&text).map_err(|e| {
+        let offset = e.span().map_or(text.trim_end().len(), |s| s.start);
+        CodegenError::at(&path, &text, offset, e.message().trim_end())
+    })?;
+    let mu: Option<f64> = value
+        .get("tissue")
+        .and_then(|t| t.get("mu_n_per_mm2"))
+        .and_then(|m| m.as_array())
+        .map(|a| a.iter().map(|v| v.as_float().unwrap_or(f64::NAN)).sum());
+    match mu {
+        Some(m) if m.is_finite() && m > 0.0 => Ok(Some(m)),
+        _ => Err(CodegenError::file(&path, "[tissue] mu_n_per_mm2: missing, not numbers, or a sum that is not > 0")),
+    }
+}
+
 /// The Rust source of the stacks: one `pub const <NAME>: Stack` each and `ALL`, using the
 /// library's `Stack` and `Layer` types (every value an exact f32 literal).
 #[must_use]
