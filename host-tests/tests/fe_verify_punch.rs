@@ -34,9 +34,10 @@ fn coarse_flat_punch_matches_sneddon() {
     let opts = VerifyOptions {
         set_dir: set.clone(),
         punch: true,
-        mesh: false,
+        mesh: None,
         mirror: false,
         smooth: false,
+        scaling: None,
         work_dir: None,
         punch_mesh_scale: 2.0,
         punch_campaign_element: false,

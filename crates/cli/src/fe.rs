@@ -19,8 +19,9 @@ pub enum FeCommand {
     Run(RunArgs),
     /// Verify the FE setup: flat punch against Sneddon (four small solves), mesh
     /// convergence of the centred needle (two needle solves, the fine one is slow), the
-    /// mirror runs against their counterparts and every result's smoothness in depth (no
-    /// solve). Without --punch, --mesh, --mirror or --smooth all four run. Prints the table and writes <set>/fe/verify.toml. Exit
+    /// mirror runs against their counterparts, every result's smoothness in depth (no
+    /// solve) and the stiffness scaling law (four solves). Without --punch, --mesh, --mirror,
+    /// --smooth or --scaling all five run. Prints the table and writes <set>/fe/verify.toml. Exit
     /// status 1 when a check misses its goal, 2 on an error.
     Verify(VerifyArgs),
     /// The state of a set's poses: up to date or why not, and with --launcher slurm
@@ -64,9 +65,14 @@ pub struct SpecArgs {
     /// to loading.depth_mm). Part of the spec hash: results of other step counts are rerun.
     #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=10_000))]
     pub steps: Option<u32>,
-    /// Output folder for <pose>.csv, manifest.toml and .work/; default: <set>/fe.
+    /// Output folder for <pose>.csv, manifest.toml and .work/; default: <set>/fe (with
+    /// --deep: <set>/fe/deep).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// The deep runs of campaign.toml's [deep] section: its poses (--only selects among
+    /// them) to deep.depth_mm in deep.steps load steps on deep.mesh, into <set>/fe/deep/.
+    #[arg(long)]
+    pub deep: bool,
 }
 
 /// How each pose is solved (shared by `fe run` and the array tasks' `fe run-one`).
@@ -187,7 +193,11 @@ pub struct VerifyArgs {
     /// Run the flat-punch check (Sneddon, goal 5%).
     #[arg(long)]
     pub punch: bool,
-    /// Run the mesh-convergence check (Fy at full depth on the levels of campaign.mesh_study: committed level against its 2x refinement, goal 2%; Richardson estimate).
+    /// Run the mesh study: the centre on every level of campaign.mesh_study, the poses of
+    /// campaign.mesh_study_poses on the committed level and its refinement (runs in
+    /// <set>/fe/mesh/<level>/, resumed when interrupted); the shape after the best single
+    /// scale between levels (goal 2% RMS, 4% largest of peak |Fy|), the absolute change and
+    /// Richardson's estimate of Fy when in the asymptotic range.
     #[arg(long)]
     pub mesh: bool,
     /// Check the mirror runs against their counterparts (goal 1% of peak |Fy|).
@@ -197,6 +207,26 @@ pub struct VerifyArgs {
     /// state accepted off the equilibrium path; goal 3% of peak |Fy|).
     #[arg(long)]
     pub smooth: bool,
+    /// Check the stiffness scaling law: the --scaling-poses solved with every Ogden mu_i
+    /// x 0.5 and x 2 (work files under <work>/scaling-s<s>/, resumed when interrupted)
+    /// against s x their committed fe/<pose>.csv at every must point (goal 0.5% of peak
+    /// |Fy|).
+    #[arg(long)]
+    pub scaling: bool,
+    /// Poses of the scaling check, comma-separated exact names.
+    #[arg(long, value_name = "NAME,...", value_delimiter = ',', default_values_t = needle_fe::verify::scaling::SCALING_POSES.map(String::from))]
+    pub scaling_poses: Vec<String>,
+    /// Mesh level of the scaling check's runs and of the s = 1 runs it reads from fe/
+    /// (default: campaign.mesh).
+    #[arg(long, value_name = "LEVEL")]
+    pub scaling_mesh: Option<String>,
+    /// Load steps of the scaling check's runs and of the s = 1 runs (default: loading.steps).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=10_000))]
+    pub scaling_steps: Option<u32>,
+    /// Solve none of the scaling and mesh-study runs: compare the results already there
+    /// and name the missing ones.
+    #[arg(long)]
+    pub no_solve: bool,
     /// Coarsen the flat-punch mesh by this factor (1 = the verification mesh; the goal
     /// applies to 1).
     #[arg(long, value_name = "F", default_value_t = 1.0)]
@@ -311,6 +341,7 @@ fn spec_options(spec: SpecArgs) -> anyhow::Result<RunOptions> {
         mesh: spec.mesh,
         steps: spec.steps,
         out_dir: spec.out,
+        deep: spec.deep,
         ..RunOptions::new(spec.set)
     })
 }
@@ -335,17 +366,30 @@ fn run_verify(a: VerifyArgs) -> anyhow::Result<ExitCode> {
     if !(a.punch_mesh_scale.is_finite() && a.punch_mesh_scale >= 1.0) {
         anyhow::bail!("--punch-mesh-scale {}: must be a number >= 1", a.punch_mesh_scale);
     }
-    let all = !(a.punch || a.mesh || a.mirror || a.smooth);
+    let all = !(a.punch || a.mesh || a.mirror || a.smooth || a.scaling);
+    let threads = a.threads.map(|t| t as usize).unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
+    let work = a.work.clone().unwrap_or_else(|| a.set.join("fe").join(".work").join("verify"));
+    let scaling = (a.scaling || all).then(|| needle_fe::verify::scaling::ScalingOptions {
+        set_dir: a.set.clone(),
+        work_dir: work,
+        poses: a.scaling_poses.clone(),
+        mesh: a.scaling_mesh.clone(),
+        steps: a.scaling_steps,
+        threads,
+        solve: !a.no_solve,
+    });
+    let mesh = (a.mesh || all).then(|| needle_fe::verify::mesh_check::MeshOptions { set_dir: a.set.clone(), threads, solve: !a.no_solve });
     let opts = needle_fe::verify::VerifyOptions {
+        scaling,
+        mesh,
         set_dir: a.set,
         punch: a.punch || all,
-        mesh: a.mesh || all,
         mirror: a.mirror || all,
         smooth: a.smooth || all,
         work_dir: a.work,
         punch_mesh_scale: a.punch_mesh_scale,
         punch_campaign_element: !a.no_campaign_element,
-        threads: a.threads.map(|t| t as usize).unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)),
+        threads,
         engine: a.solver.as_deref().map(needle_fe::spec::Engine::parse).transpose()?,
     };
     needle_fe::process::stop_jobs_on_termination()?;

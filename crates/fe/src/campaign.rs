@@ -83,6 +83,13 @@ pub struct RunOptions {
     pub stall: Option<Duration>,
     /// How this process was started, recorded in the manifest entries it writes.
     pub launcher: Launched,
+    /// The deep runs of `[deep]` (`crate::deep`): its depth, steps, mesh level and poses
+    /// (`only` then selects among them), output in `<set>/fe/deep/` unless `out_dir`.
+    pub deep: bool,
+    /// Every Ogden mu_i times this factor (the bulk modulus follows): the scaling check of
+    /// `needle fe verify --scaling`. Part of the run hash through the tissue; needs `out_dir`
+    /// (scaled runs never go into `<set>/fe/`).
+    pub tissue_scale: Option<f64>,
 }
 
 impl RunOptions {
@@ -102,6 +109,8 @@ impl RunOptions {
             timeout: None,
             stall: Some(DEFAULT_STALL),
             launcher: Launched::Local,
+            deep: false,
+            tissue_scale: None,
         }
     }
 }
@@ -189,16 +198,11 @@ pub fn plan(opts: &RunOptions) -> Result<Plan> {
     if let Some(engine) = opts.solver {
         campaign.solver.engine = engine;
     }
-    if let Some(s) = opts.steps {
-        if s == 0 {
-            bail!("--steps 0: must be >= 1");
-        }
-        campaign.loading.steps = s;
-    }
+    let variant = apply_variant(opts, &mut campaign, &spec_path)?;
     let steps = campaign.loading.steps;
-    let mesh_name = opts.mesh.clone().unwrap_or_else(|| campaign.campaign.mesh.clone());
+    let mesh_name = opts.mesh.clone().unwrap_or(variant.mesh);
     campaign.mesh_level(&mesh_name)?;
-    let all = campaign.poses();
+    let all = variant.poses.unwrap_or_else(|| campaign.poses());
     let selected: Vec<PoseSpec> = spec::select(&all, opts.only.as_deref())?.into_iter().cloned().collect();
     if selected.is_empty() {
         bail!(
@@ -207,7 +211,7 @@ pub fn plan(opts: &RunOptions) -> Result<Plan> {
             all.iter().map(|p| p.name.as_str()).collect::<Vec<_>>().join(", ")
         );
     }
-    let out_dir = opts.out_dir.clone().unwrap_or_else(|| opts.set_dir.join("fe"));
+    let out_dir = opts.out_dir.clone().unwrap_or(variant.out_dir);
     let manifest = read_manifest(&out_dir.join(MANIFEST))?;
     let mut reports: Vec<PoseReport> = Vec::with_capacity(selected.len());
     let mut to_run: Vec<usize> = Vec::new();
@@ -238,6 +242,43 @@ pub fn plan(opts: &RunOptions) -> Result<Plan> {
         reports.push(report);
     }
     Ok(Plan { campaign, spec_path, mesh_name, steps, out_dir, manifest, reports, to_run, selected })
+}
+
+/// What a run variant (`--deep`, a tissue scale) changes besides the spec it rewrites.
+struct Variant {
+    /// Default mesh level.
+    mesh: String,
+    /// The poses to select from (`None`: every pose of the campaign).
+    poses: Option<Vec<PoseSpec>>,
+    /// Default output folder.
+    out_dir: PathBuf,
+}
+
+/// Apply `--steps`, `--deep` and the tissue scale of `opts` to `campaign` (in that order:
+/// `--steps` overrides the deep steps too).
+fn apply_variant(opts: &RunOptions, campaign: &mut Campaign, spec_path: &Path) -> Result<Variant> {
+    let mut v = Variant { mesh: campaign.campaign.mesh.clone(), poses: None, out_dir: opts.set_dir.join("fe") };
+    if opts.deep {
+        let d = campaign.deep.clone().with_context(|| format!("{}: --deep: the spec has no [deep] section", spec_path.display()))?;
+        let every = campaign.poses();
+        *campaign = d.apply(campaign);
+        v.poses = Some(d.poses.iter().filter_map(|n| every.iter().find(|p| &p.name == n).cloned()).collect());
+        v.mesh = d.mesh;
+        v.out_dir = opts.set_dir.join("fe").join(crate::deep::DEEP_DIR);
+    }
+    if let Some(s) = opts.steps {
+        if s == 0 {
+            bail!("--steps 0: must be >= 1");
+        }
+        campaign.loading.steps = s;
+    }
+    if let Some(s) = opts.tissue_scale {
+        if !(s.is_finite() && s > 0.0) || opts.out_dir.is_none() {
+            bail!("tissue scale {s}: must be finite and > 0, with its own output folder (never <set>/fe)");
+        }
+        campaign.tissue.mu_n_per_mm2.iter_mut().for_each(|mu| *mu *= s);
+    }
+    Ok(v)
 }
 
 /// [`run`] with a given solver backend (tests use a fake one).
@@ -802,6 +843,32 @@ mod tests {
         let text = std::fs::read_to_string(d.path().join("fe").join(MANIFEST)).expect("manifest text");
         assert_eq!(text.matches("first_increment = 0.25").count(), 1, "{text}");
         assert_eq!(text.matches("retry = \"fake stall\"").count(), 1, "{text}");
+    }
+
+    /// `--deep`: the [deep] poses only, to the deep depth, into fe/deep/ with its own
+    /// manifest; the shallow results are not touched.
+    #[test]
+    fn deep_runs_go_to_their_own_folder_at_the_deep_depth() {
+        let d = set_dir();
+        let deep = |only: &str| RunOptions {
+            deep: true,
+            only: Some(only.into()),
+            mesh: Some("smoke".into()),
+            steps: Some(5),
+            ..RunOptions::new(d.path())
+        };
+        let r = run_with(&deep("centre"), &mut Fake::default()).expect("deep run");
+        assert_eq!((r.done(), r.depth_mm), (1, 15.0), "{}", r.table());
+        let rows = results::read_csv(&d.path().join("fe/deep/centre.csv")).expect("deep csv");
+        assert_eq!(rows.iter().map(|r| r.depth_mm).collect::<Vec<_>>(), [0.0, 3.0, 6.0, 9.0, 12.0, 15.0]);
+        assert_eq!(rows[5].wrench[1], 225.0, "the fake's depth squared at 15 mm");
+        assert!(!d.path().join("fe/centre.csv").exists(), "nothing written beside the shallow runs");
+        let m = read_manifest(&d.path().join("fe/deep").join(MANIFEST)).expect("deep manifest");
+        assert_eq!((m.pose["centre"].depth_mm, m.pose["centre"].steps), (15.0, 5));
+        let again = run_with(&deep("centre"), &mut Fake::default()).expect("rerun");
+        assert_eq!(again.up_to_date(), 1, "resumes like the campaign");
+        let e = run_with(&deep("x+02"), &mut Fake::default()).err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(e.contains("matches no pose (poses: centre, x+04, tz+08, z+04)"), "{e}");
     }
 
     #[test]

@@ -8,6 +8,7 @@ pub mod campaign;
 pub mod ccx;
 pub mod dat;
 pub mod deck;
+pub mod deep;
 pub mod engines;
 pub mod febio;
 pub mod launcher;

@@ -41,6 +41,9 @@ pub struct Campaign {
     /// What `needle fit` fits; absent: the paper's model.
     #[serde(default)]
     pub fit: FitSettings,
+    /// The deep runs of `needle fe run --deep` (`crate::deep`); absent: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub deep: Option<crate::deep::DeepSettings>,
     /// The named poses as written (the Latin hypercube poses are added by [`Campaign::poses`]).
     #[serde(rename = "pose", default)]
     pub pose: Vec<PoseSpec>,
@@ -436,6 +439,10 @@ pub struct CampaignSettings {
     /// Empty: `[mesh, "fine"]`.
     #[serde(default)]
     pub mesh_study: Vec<String>,
+    /// Poses besides the centre that the mesh study solves on the committed level and its
+    /// refinement (`needle fe verify --mesh`; issue 42: an x, a z and a theta pose).
+    #[serde(default)]
+    pub mesh_study_poses: Vec<String>,
 }
 
 /// What a pose is for.
@@ -560,6 +567,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Campaign> {
         anyhow::anyhow!("{}:{}: {}", path.display(), line, e.message())
     })?;
     campaign.validate(path)?;
+    crate::deep::validate(&campaign, text, path)?;
     Ok(campaign)
 }
 
@@ -662,6 +670,11 @@ impl Campaign {
             }
         }
         let every_pose = self.poses();
+        for name in &self.campaign.mesh_study_poses {
+            if !every_pose.iter().any(|q| &q.name == name) {
+                bail!("{p}: campaign.mesh_study_poses: {name:?} is not a pose of this campaign");
+            }
+        }
         for name in &self.campaign.fit_without {
             match every_pose.iter().find(|q| &q.name == name) {
                 None => bail!("{p}: campaign.fit_without: {name:?} is not a pose of this campaign"),
@@ -831,7 +844,7 @@ fn check_pose_role(pose: &PoseSpec, p: &str) -> Result<()> {
 
 /// The needle stays inside the block: at entry and at full depth (after the lateral
 /// travel of the tilt), the needle's axis is at least its radius from each side face.
-fn check_pose_in_block(pose: &PoseSpec, block: &Block, radius_mm: f64, depth_mm: f64, p: &str) -> Result<()> {
+pub(crate) fn check_pose_in_block(pose: &PoseSpec, block: &Block, radius_mm: f64, depth_mm: f64, p: &str) -> Result<()> {
     let (tx, tz) = pose.lateral_travel(depth_mm);
     for (f, entry, travel, half) in [("x_mm", pose.x_mm, tx, block.size_x_mm / 2.0), ("z_mm", pose.z_mm, tz, block.size_z_mm / 2.0)] {
         let reach = entry.abs().max((entry + travel).abs()) + radius_mm;

@@ -7,6 +7,7 @@
 //! (`$NEEDLE_CACHE`, default `~/.cache/needle-haptics`, `febio-4.11/bin/febio4`), a
 //! `febio4` on `PATH`.
 
+pub mod failures;
 pub mod feb;
 pub mod logs;
 pub mod restart;

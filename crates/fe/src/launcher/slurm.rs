@@ -336,6 +336,9 @@ fn batch_script(opts: &RunOptions, plan: &Plan, needle: &Path, poses: &[String])
         "--steps".into(),
         plan.steps.to_string(),
     ];
+    if opts.deep {
+        cmd.push("--deep".into());
+    }
     if opts.force {
         cmd.push("--force".into());
     }

@@ -1,6 +1,7 @@
 //! `needle fe status`: each selected pose's result (up to date, or why it is to be
 //! solved) beside the queue state of its latest SLURM array task (`squeue`) and, for a
-//! task that left the queue without a result, the cause its output states.
+//! task that left the queue without a result, the cause its output states; for a pose
+//! run locally without a result, its failed attempts by class and depth.
 
 use crate::campaign::Plan;
 use crate::launcher::slurm::{self, QueueState, SLURM_DIR};
@@ -101,7 +102,7 @@ pub fn status(plan: &Plan) -> Result<StatusReport> {
         let task = latest.get(&pose.name).map(|(job, t)| format!("{job}_{t}"));
         let (state, cause) = match (&task, done) {
             (_, true) => ("done".to_string(), String::new()),
-            (None, false) => ("not submitted".to_string(), String::new()),
+            (None, false) => ("not submitted".to_string(), local_failures(&plan.out_dir, &pose.name)),
             (Some(t), false) => match queue.get(t) {
                 Some(q) => (q.state.to_lowercase(), reason(q)),
                 None if queue_error.is_some() => ("unknown".to_string(), String::new()),
@@ -111,6 +112,13 @@ pub fn status(plan: &Plan) -> Result<StatusReport> {
         poses.push(PoseState { pose: pose.name.clone(), done, result, task, state, cause });
     }
     Ok(StatusReport { poses, queue_error })
+}
+
+/// The failed attempts a local run left in `<out>/.work/<pose>/`, by class
+/// ([`febio::failures`](crate::febio::failures)); empty when there are none.
+fn local_failures(out_dir: &Path, pose: &str) -> String {
+    let f = crate::febio::failures::read_failures(&out_dir.join(".work").join(pose));
+    crate::febio::failures::summary(&f)
 }
 
 fn reason(q: &QueueState) -> String {

@@ -1,44 +1,67 @@
-//! The mesh-convergence check of `needle fe verify`: the centred vertical needle solved
-//! on the levels of `campaign.mesh_study` (coarse to fine, each a 2x refinement of the
-//! one before, the committed level and its 2x refinement among them), on the set's
-//! engine. Fy at full depth: the change from the committed level to its refinement
-//! (goal 2 %), and, with three or more levels, Richardson's estimate of the converged
-//! value from the finest three.
+//! The mesh study of `needle fe verify --mesh`: the centre pose on every level of
+//! `campaign.mesh_study` (coarse to fine, each a 2x refinement of the one before) and the
+//! half-model poses of `campaign.mesh_study_poses` on the committed level and its
+//! refinement. Runs of the committed level are the committed `fe/<pose>.csv`; the others
+//! are solved through the campaign's machinery into `fe/mesh/<level>/` (with a manifest:
+//! an interrupted study resumes, a solved run is read, not solved again).
+//!
+//! Reported: the absolute change of Fy at full depth between levels (the centre's, with
+//! Richardson's estimate when the finest three are in the asymptotic range, else the
+//! ratio of successive changes), and per pose and pair of levels the shape comparison of
+//! [`shape`](super::shape) (judged: the goal of issue 42).
 
-use crate::backend::Job;
-use crate::engines::backend_for;
+use super::runs::{read_current, same_depths, solve_and_read, PoseRows};
+use super::shape::{self, ShapeComparison};
+use crate::campaign::RunOptions;
 use crate::spec::{Campaign, Role};
 use anyhow::{bail, Context, Result};
+use needle_contract::FY;
 use serde::Serialize;
-use std::path::Path;
+use std::path::PathBuf;
 
-/// One level of the study.
+/// Sub-folder of `<set>/fe/` with the study's runs, one folder per level.
+pub const MESH_DIR: &str = "mesh";
+
+/// What the study runs on.
+#[derive(Debug, Clone)]
+pub struct MeshOptions {
+    /// The set folder.
+    pub set_dir: PathBuf,
+    /// Solver threads of each run.
+    pub threads: usize,
+    /// Solve the runs that are not up to date (false: compare what is there).
+    pub solve: bool,
+}
+
+/// One run of the study.
 #[derive(Debug, Clone, Serialize)]
 pub struct LevelRun {
+    /// Pose name.
+    pub pose: String,
     /// Mesh level name.
     pub level: String,
     /// Element size of the fine region (`fine_size_mm`), mm.
     pub element_mm: f64,
-    /// Tissue elements of the (quarter) model.
-    pub tissue_elements: usize,
-    /// Fy at full depth, N (NaN when the run failed).
-    pub fy_n: f64,
-    /// Wall time of the solve, s.
-    pub wall_s: f64,
-    /// Solver threads of the solve.
-    pub threads: usize,
-    /// Why the run failed, when it did.
+    /// Tissue elements of the model (0: no run).
+    pub tissue_elements: u64,
+    /// Fy at full depth, N.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fy_n: Option<f64>,
+    /// Wall time of the solve (the manifest's), s.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub wall_s: Option<f64>,
+    /// Why there is no result.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub failure: Option<String>,
-    /// The attempts that failed before the one that solved it (the campaign's retries).
+    /// The attempts that failed before the one that solved it (the manifest's `retry`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub retry: Option<String>,
 }
 
-/// Mesh-convergence result.
+/// The study.
 #[derive(Debug, Clone, Serialize)]
 pub struct MeshReport {
-    /// The engine that solved the study.
+    /// The engine of the set.
     pub engine: String,
     /// Mesh level of the committed data.
     pub committed: String,
@@ -46,14 +69,18 @@ pub struct MeshReport {
     pub refined: String,
     /// Depth of the comparison, mm (full depth).
     pub depth_mm: f64,
-    /// Every level, coarse to fine.
+    /// Every run, levels coarse to fine, the centre first.
     pub levels: Vec<LevelRun>,
-    /// (Fy committed - Fy refined) / Fy refined, %; NaN when a run failed.
-    pub difference_percent: f64,
-    /// Goal on |difference_percent|.
-    pub goal_percent: f64,
-    /// Richardson extrapolation of the finest three levels (refinement ratio 2):
-    /// the converged Fy, N, when the differences shrink monotonically.
+    /// The centre's (Fy committed - Fy refined) / Fy refined at full depth, %.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub difference_percent: Option<f64>,
+    /// The centre's changes of Fy at full depth between the finest three levels, the
+    /// finer over the coarser: below 1 and positive in the asymptotic range.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ratio_of_changes: Option<f64>,
+    /// "in the asymptotic range" or "not in the asymptotic range" (or why unknown).
+    pub asymptotic: String,
+    /// Richardson extrapolation of the centre's Fy from the finest three levels, N.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub richardson_fy_n: Option<f64>,
     /// The observed order of convergence of that extrapolation.
@@ -62,10 +89,20 @@ pub struct MeshReport {
     /// (Fy committed - Richardson) / Richardson, %.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub committed_vs_richardson_percent: Option<f64>,
+    /// Goals of the shape comparisons, % of peak |Fy|: RMS and largest.
+    pub shape_goal_percent: [f64; 2],
+    /// Every pose's shape comparison between successive levels it was run on.
+    pub shape: Vec<ShapeComparison>,
 }
 
-/// Goal of the check: |change| of Fy at full depth under a 2x refinement, %.
-pub const MESH_GOAL_PERCENT: f64 = 2.0;
+impl MeshReport {
+    /// Every study run present and the committed level within the shape goals against its
+    /// refinement for every pose.
+    pub fn ok(&self) -> bool {
+        self.levels.iter().all(|l| l.failure.is_none())
+            && self.shape.iter().filter(|s| s.coarse == self.committed && s.fine == self.refined).all(ShapeComparison::ok)
+    }
+}
 
 /// Richardson extrapolation of f(h) from values at h, h/2, h/4 (coarse to fine): the
 /// limit and the observed order, or `None` when the differences do not shrink with the
@@ -79,7 +116,11 @@ pub fn richardson(f1: f64, f2: f64, f3: f64) -> Option<(f64, f64)> {
     Some((f3 - d2 / (2f64.powf(p) - 1.0), p))
 }
 
-pub(super) fn mesh_convergence(c: &Campaign, work: &Path, threads: usize) -> Result<MeshReport> {
+/// The study's levels, coarse to fine, each with the poses it runs.
+type StudyPlan = Vec<(String, Vec<String>)>;
+
+/// The study's plan, the committed level and its refinement.
+fn plan_study(c: &Campaign) -> Result<(StudyPlan, String, String)> {
     let centre = c.pose.iter().find(|p| p.role == Role::Centre).context("no pose with role centre in the spec")?;
     let study = c.mesh_study();
     let committed = c.campaign.mesh.clone();
@@ -89,84 +130,140 @@ pub(super) fn mesh_convergence(c: &Campaign, work: &Path, threads: usize) -> Res
     let Some(refined) = study.get(k + 1).cloned() else {
         bail!("campaign.mesh_study {study:?}: the committed level {committed:?} needs its 2x refinement after it");
     };
-    let mut backend = backend_for(c.solver.engine, threads);
-    backend.prepare()?;
-    let mut levels = Vec::new();
-    for level in &study {
-        let mesh = c.mesh_level(level)?;
-        let dir = work.join(format!("mesh-{}-{level}", c.solver.engine.name()));
-        if dir.exists() {
-            std::fs::remove_dir_all(&dir).with_context(|| format!("{}: cannot clear", dir.display()))?;
-        }
-        std::fs::create_dir_all(&dir).with_context(|| format!("{}: cannot create", dir.display()))?;
-        println!("solving the centred needle on mesh {level:?} with {} ...", c.solver.engine.name());
-        let job = Job {
-            campaign: c,
-            pose: centre,
-            mesh_name: level,
-            mesh,
-            steps: c.loading.steps,
-            work_dir: &dir,
-            timeout: None,
-            stall: Some(crate::campaign::DEFAULT_STALL),
-            first_increment: 1.0,
-            attempt: 0,
+    let plan = study
+        .iter()
+        .map(|level| {
+            let mut poses = vec![centre.name.clone()];
+            if *level == committed || *level == refined {
+                poses.extend(c.campaign.mesh_study_poses.iter().cloned());
+            }
+            (level.clone(), poses)
+        })
+        .collect();
+    Ok((plan, committed, refined))
+}
+
+/// Run (or resume) the study and compare.
+///
+/// # Errors
+/// The spec, `campaign.mesh_study`, an option or a manifest (a failed solve is a run's
+/// `failure`).
+pub fn mesh_convergence(c: &Campaign, o: &MeshOptions) -> Result<MeshReport> {
+    let (plan, committed, refined) = plan_study(c)?;
+    let mut results: Vec<(String, PoseRows)> = Vec::new();
+    for (level, poses) in &plan {
+        let committed_level = *level == committed;
+        let out_dir = if committed_level { o.set_dir.join("fe") } else { o.set_dir.join("fe").join(MESH_DIR).join(level) };
+        let opts = RunOptions {
+            only: Some(poses.join(",")),
+            mesh: Some(level.clone()),
+            out_dir: Some(out_dir.clone()),
+            threads: o.threads,
+            ..RunOptions::new(&o.set_dir)
         };
-        // the campaign's attempts (Backend::attempts): a level is solved as a pose is;
-        // wall_s counts every attempt, the manifest-style `retry` says which failed
-        let start = std::time::Instant::now();
-        let solved = crate::campaign::solve_with_retry(backend.as_ref(), &job);
-        let wall_s = start.elapsed().as_secs_f64();
-        let run = match solved {
-            Ok(s) => LevelRun {
-                level: level.clone(),
-                element_mm: mesh.fine_size_mm,
-                tissue_elements: s.summary.tissue_elements,
-                fy_n: s.wrenches.last().map(|w| w[1]).unwrap_or(f64::NAN),
-                wall_s,
-                threads,
-                failure: None,
-                retry: s.retry,
-            },
-            Err(f) => LevelRun {
-                level: level.clone(),
-                element_mm: mesh.fine_size_mm,
-                tissue_elements: 0,
-                fy_n: f64::NAN,
-                wall_s,
-                threads,
-                failure: Some(f.message),
-                retry: None,
-            },
-        };
-        println!(
-            "  {level}: Fy({} mm) = {:.5e} N, {} tissue elements, {:.0} s{}",
-            c.loading.depth_mm,
-            run.fy_n,
-            run.tissue_elements,
-            run.wall_s,
-            run.failure.as_deref().map(|f| format!(" (FAILED: {f})")).unwrap_or_default()
-        );
-        levels.push(run);
+        println!("mesh study, level {level}: {} in {}", poses.join(", "), out_dir.display());
+        // the committed level's runs are the campaign's: read, never solved here
+        let rows = if o.solve && !committed_level { solve_and_read(&opts)? } else { read_current(&opts)? };
+        results.push((level.clone(), rows));
     }
-    let fy = |name: &str| levels.iter().find(|l| l.level == name).map(|l| l.fy_n).unwrap_or(f64::NAN);
-    let (fc, fr) = (fy(&committed), fy(&refined));
-    let rich = match levels.as_slice() {
-        [.., a, b, d] => richardson(a.fy_n, b.fy_n, d.fy_n),
+    let levels = level_runs(c, &results)?;
+    let shape = shape_comparisons(c, &results);
+    for s in &shape {
+        println!("{s}");
+    }
+    Ok(report(c, committed, refined, levels, shape, &plan))
+}
+
+fn level_runs(c: &Campaign, results: &[(String, PoseRows)]) -> Result<Vec<LevelRun>> {
+    let mut out = Vec::new();
+    for (level, rows) in results {
+        let element_mm = c.mesh_level(level)?.fine_size_mm;
+        for (pose, r) in rows {
+            let run = LevelRun {
+                pose: pose.clone(),
+                level: level.clone(),
+                element_mm,
+                tissue_elements: r.as_ref().map(|r| r.entry.tissue_elements).unwrap_or(0),
+                fy_n: r.as_ref().ok().and_then(|r| r.rows.last()).map(|w| w.wrench[FY]),
+                wall_s: r.as_ref().ok().map(|r| r.entry.wall_s),
+                failure: r.as_ref().err().cloned(),
+                retry: r.as_ref().ok().and_then(|r| r.entry.retry.clone()),
+            };
+            println!(
+                "  {pose} on {level}: {}",
+                match (run.fy_n, &run.failure) {
+                    (Some(f), _) => format!(
+                        "Fy({} mm) = {f:.6e} N, {} tissue elements, {:.0} s",
+                        c.loading.depth_mm,
+                        run.tissue_elements,
+                        run.wall_s.unwrap_or(0.0)
+                    ),
+                    (None, f) => format!("no result: {}", f.as_deref().unwrap_or("?")),
+                }
+            );
+            out.push(run);
+        }
+    }
+    Ok(out)
+}
+
+/// Each pose between each pair of successive levels it has results on.
+fn shape_comparisons(c: &Campaign, results: &[(String, PoseRows)]) -> Vec<ShapeComparison> {
+    let mut poses: Vec<&String> = results.iter().flat_map(|(_, r)| r.keys()).collect();
+    poses.sort();
+    poses.dedup();
+    let mut out = Vec::new();
+    for pose in poses {
+        let have: Vec<(&String, &[crate::results::Row])> =
+            results.iter().filter_map(|(l, r)| r.get(pose).and_then(|r| r.as_ref().ok()).map(|r| (l, r.rows.as_slice()))).collect();
+        for w in have.windows(2) {
+            let ((la, a), (lb, b)) = (w[0], w[1]);
+            if same_depths(a, b) {
+                out.push(shape::compare(pose, (la, lb), a, b, c.needle.reference_from_tip_mm));
+            }
+        }
+    }
+    out
+}
+
+fn report(
+    c: &Campaign,
+    committed: String,
+    refined: String,
+    levels: Vec<LevelRun>,
+    shape: Vec<ShapeComparison>,
+    plan: &[(String, Vec<String>)],
+) -> MeshReport {
+    let centre = plan.first().and_then(|(_, p)| p.first()).cloned().unwrap_or_default();
+    let fy = |level: &str| levels.iter().find(|l| l.level == level && l.pose == centre).and_then(|l| l.fy_n);
+    let study: Vec<Option<f64>> = plan.iter().map(|(l, _)| fy(l)).collect();
+    let difference_percent = fy(&committed).zip(fy(&refined)).map(|(a, b)| 100.0 * (a - b) / b);
+    let last3 = match study.as_slice() {
+        [.., Some(a), Some(b), Some(d)] => Some((*a, *b, *d)),
         _ => None,
     };
-    Ok(MeshReport {
+    let rich = last3.and_then(|(a, b, d)| richardson(a, b, d));
+    let ratio_of_changes = last3.map(|(a, b, d)| (b - d) / (a - b));
+    let asymptotic = match (last3, rich) {
+        (None, _) => "unknown: the centre has no result on three levels".to_string(),
+        (Some(_), Some(_)) => "in the asymptotic range".to_string(),
+        (Some(_), None) => "not in the asymptotic range".to_string(),
+    };
+    MeshReport {
         engine: c.solver.engine.name().to_string(),
-        committed,
-        refined,
         depth_mm: c.loading.depth_mm,
-        difference_percent: 100.0 * (fc - fr) / fr,
-        goal_percent: MESH_GOAL_PERCENT,
+        difference_percent,
+        ratio_of_changes,
+        asymptotic,
         richardson_fy_n: rich.map(|r| r.0),
         richardson_order: rich.map(|r| r.1),
-        committed_vs_richardson_percent: rich.map(|r| 100.0 * (fc - r.0) / r.0),
+        committed_vs_richardson_percent: rich.zip(fy(&committed)).map(|(r, f)| 100.0 * (f - r.0) / r.0),
+        shape_goal_percent: [shape::SHAPE_RMS_GOAL_PERCENT, shape::SHAPE_MAX_GOAL_PERCENT],
+        committed,
+        refined,
         levels,
-    })
+        shape,
+    }
 }
 
 #[cfg(test)]

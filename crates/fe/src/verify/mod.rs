@@ -2,22 +2,28 @@
 //!
 //! 1. **Flat punch (Sneddon)** ([`punch`]): a rigid flat-ended punch of the needle's
 //!    radius pressed into the block, against Sneddon's half-space force (goal: within 5%).
-//! 2. **Mesh convergence** ([`mesh_check`]): the centred vertical needle on the levels of
-//!    `campaign.mesh_study`, Fy at full depth: committed level against its 2x refinement
-//!    (goal 2%), Richardson's estimate of the converged value.
+//! 2. **Mesh study** ([`mesh_check`]): the centre on the levels of `campaign.mesh_study`
+//!    and the poses of `campaign.mesh_study_poses` on the committed level and its
+//!    refinement; the shape after the best scale ([`shape`]: goal 2 % RMS, 4 % largest),
+//!    the absolute change of Fy and Richardson's estimate when in the asymptotic range.
 //! 3. **Mirror runs**: each `mirror` pose against its mirrored counterpart from the
 //!    committed data, with the sign flips of coeffs/README.md (goal 1% of peak |Fy|).
 //! 4. **Smoothness** ([`smooth`]): in every result present, the must point furthest from
 //!    its neighbours' mean (goal [`SMOOTH_GOAL_PERCENT`] of peak |Fy|): a state the
 //!    solver accepted off the equilibrium path shows as such a point.
+//! 5. **Scaling law** ([`scaling`]): the centre and a half-model pose with every Ogden
+//!    mu_i scaled by 0.5 and 2 against s times the committed run (goal 0.5 % of peak |Fy|).
 
-mod mesh_check;
+pub mod mesh_check;
 mod mirror;
 pub mod punch;
 pub mod punch_febio;
+pub mod runs;
+pub mod scaling;
+pub mod shape;
 pub mod smooth;
 
-pub use mesh_check::{richardson, LevelRun, MeshReport, MESH_GOAL_PERCENT};
+pub use mesh_check::{richardson, LevelRun, MeshReport};
 pub use mirror::{MirrorReport, MIRROR_GOAL_PERCENT};
 pub use punch::{
     bonded_punch_force, poisson, punch_deck, punch_mesh, sneddon_force, PunchDeck, PunchElement, PunchReport, PunchRun,
@@ -38,12 +44,14 @@ pub struct VerifyOptions {
     pub set_dir: PathBuf,
     /// Run the flat-punch check.
     pub punch: bool,
-    /// Run the mesh-convergence check (two needle solves, the fine one is slow).
-    pub mesh: bool,
+    /// Run the mesh study with these options (`None`: not run; the fine runs are slow).
+    pub mesh: Option<mesh_check::MeshOptions>,
     /// Check the mirror runs (no solve).
     pub mirror: bool,
     /// Check every result present for a must point off its neighbours (no solve).
     pub smooth: bool,
+    /// Run the scaling-law check with these options (`None`: not run).
+    pub scaling: Option<scaling::ScalingOptions>,
     /// Coarsening of the flat-punch mesh: 1 = the verification mesh; 2 = half the
     /// elements across the punch and twice the fine size (quick tests).
     pub punch_mesh_scale: f64,
@@ -69,6 +77,8 @@ pub struct VerifyReport {
     pub mirror: Vec<MirrorReport>,
     /// Each result's must point furthest from its neighbours' mean.
     pub smooth: Vec<SmoothReport>,
+    /// The scaling law.
+    pub scaling: Option<scaling::ScalingReport>,
 }
 
 /// Prints each report's line and says whether every one is within `goal_percent`.
@@ -100,6 +110,11 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
     if opts.smooth {
         report.smooth = smooth::smooth_checks(&c, &opts.set_dir.join("fe"))?;
         ok &= print_judged(&report.smooth, |s| s.percent_of_peak_fy, SMOOTH_GOAL_PERCENT);
+    }
+    if let Some(o) = &opts.scaling {
+        let s = scaling::scaling_check(&c, o)?;
+        ok &= s.ok();
+        report.scaling = Some(s);
     }
     if opts.punch {
         let p = match c.solver.engine {
@@ -140,25 +155,23 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
         ok &= p.check.error_percent.abs() <= p.goal_percent;
         report.punch = Some(p);
     }
-    if opts.mesh {
-        let m = mesh_check::mesh_convergence(&c, &work, opts.threads)?;
+    if let Some(o) = &opts.mesh {
+        let m = mesh_check::mesh_convergence(&c, o)?;
         println!(
-            "mesh convergence, centred vertical needle ({}): Fy({} mm) {:?} {:.5e} N, refined {:?} {:.5e} N: {:+.2}% (goal within {}%)",
-            m.engine,
+            "mesh study, centre Fy({} mm): {} vs {} {}; {}{}",
             m.depth_mm,
             m.committed,
-            m.levels.iter().find(|l| l.level == m.committed).map(|l| l.fy_n).unwrap_or(f64::NAN),
             m.refined,
-            m.levels.iter().find(|l| l.level == m.refined).map(|l| l.fy_n).unwrap_or(f64::NAN),
-            m.difference_percent,
-            m.goal_percent
+            m.difference_percent
+                .map(|d| format!("{d:+.2}% (absolute level: reported, not judged)"))
+                .unwrap_or_else(|| "no comparison".into()),
+            m.asymptotic,
+            m.ratio_of_changes.map(|r| format!(" (ratio of successive changes {r:.3})")).unwrap_or_default()
         );
         if let (Some(f), Some(p), Some(d)) = (m.richardson_fy_n, m.richardson_order, m.committed_vs_richardson_percent) {
             println!("  Richardson estimate of the converged Fy: {f:.5e} N (observed order {p:.2}); committed level {d:+.2}% from it");
-        } else if m.levels.len() >= 3 {
-            println!("  Richardson estimate: none (the finest three levels are not in the asymptotic range)");
         }
-        ok &= m.levels.iter().all(|l| l.failure.is_none()) && m.difference_percent.abs() <= m.goal_percent;
+        ok &= m.ok();
         report.mesh = Some(m);
     }
     let path = opts.set_dir.join("fe").join("verify.toml");

@@ -1,0 +1,78 @@
+//! `needle fe run --deep` and `needle fe verify --scaling` end to end on FEBio, on the
+//! smoke mesh (seconds): the deep run lands in fe/deep/ at the deep depth with its own
+//! manifest; the scaled runs reproduce s x the s = 1 wrench. They need `febio4`
+//! (`.ci/install-febio`); without it they fail, they are not skipped.
+
+use needle_fe::manifest::{read_manifest, MANIFEST};
+use needle_fe::results;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+const NEEDLE: &str = env!("CARGO_BIN_EXE_needle");
+
+/// A copy of coeffs/default/campaign.toml in a fresh temporary folder: (tempdir, set dir).
+fn default_set() -> (tempfile::TempDir, PathBuf) {
+    let d = tempfile::tempdir().expect("tempdir");
+    let set = d.path().join("set");
+    std::fs::create_dir_all(&set).expect("mkdir");
+    let src = needle_firmware_host::workspace_root().join("coeffs/default/campaign.toml");
+    std::fs::copy(&src, set.join("campaign.toml")).expect("copy the default spec");
+    (d, set)
+}
+
+fn needle(args: &[&str], set: &Path) -> Output {
+    let mut c = Command::new(NEEDLE);
+    c.args(args).arg("--set").arg(set).stdin(Stdio::null());
+    c.output().expect("run needle")
+}
+
+fn show(o: &Output) -> String {
+    format!("status {:?}\n--- stdout\n{}\n--- stderr\n{}", o.status, String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+}
+
+/// The centre to the deep depth (15 mm) on the smoke mesh in 5 steps: fe/deep/centre.csv
+/// from 0 to 15 mm with Fy growing, its manifest entry at 15 mm, nothing in fe/.
+#[test]
+fn deep_centre_run_on_the_smoke_mesh() {
+    let (_d, set) = default_set();
+    let o = needle(&["fe", "run", "--deep", "--only", "centre", "--mesh", "smoke", "--steps", "5", "--threads", "1"], &set);
+    assert!(o.status.success(), "{}", show(&o));
+    let rows = results::read_csv(&set.join("fe/deep/centre.csv")).expect("deep csv");
+    assert_eq!(rows.iter().map(|r| r.depth_mm).collect::<Vec<_>>(), [0.0, 3.0, 6.0, 9.0, 12.0, 15.0]);
+    let fy: Vec<f64> = rows.iter().map(results::Row::fy_n).collect();
+    assert!(fy.windows(2).all(|w| w[1] > w[0]), "Fy grows with depth: {fy:?}");
+    let m = read_manifest(&set.join("fe/deep").join(MANIFEST)).expect("deep manifest");
+    assert_eq!((m.pose["centre"].depth_mm, m.pose["centre"].steps, m.pose["centre"].mesh.as_str()), (15.0, 5, "smoke"));
+    assert!(!set.join("fe/centre.csv").exists(), "the shallow folder is not written");
+    // resumed, not solved again
+    let again = needle(&["fe", "run", "--deep", "--only", "centre", "--mesh", "smoke", "--steps", "5", "--threads", "1"], &set);
+    assert!(again.status.success() && String::from_utf8_lossy(&again.stdout).contains("up to date"), "{}", show(&again));
+}
+
+/// The centre on the smoke mesh at s = 1 (the set's fe/), then `verify --scaling`: the
+/// runs at s = 0.5 and 2 equal s x the s = 1 wrench within the goal, in verify.toml.
+#[test]
+fn scaling_check_on_the_smoke_mesh() {
+    let (_d, set) = default_set();
+    let base = needle(&["fe", "run", "--only", "centre", "--mesh", "smoke", "--steps", "5", "--threads", "1"], &set);
+    assert!(base.status.success(), "{}", show(&base));
+    let args =
+        ["fe", "verify", "--scaling", "--scaling-poses", "centre", "--scaling-mesh", "smoke", "--scaling-steps", "5", "--threads", "1"];
+    let o = needle(&args, &set);
+    assert!(o.status.success(), "{}", show(&o));
+    let text = std::fs::read_to_string(set.join("fe/verify.toml")).expect("verify.toml");
+    let runs: Vec<&str> = text.split("[[scaling.runs]]").skip(1).collect();
+    assert_eq!(runs.len(), 2, "{text}");
+    for r in runs {
+        let value = |key: &str| -> f64 {
+            let line = r.lines().find(|l| l.starts_with(&format!("{key} = "))).unwrap_or_else(|| panic!("no {key} in {r}"));
+            line[key.len() + 3..].trim().parse().unwrap_or_else(|e| panic!("{line}: {e}"))
+        };
+        let (s, worst, ratio) = (value("scale"), value("worst_percent"), value("fy_ratio_at_full_depth"));
+        assert!(worst <= 0.5 && (ratio / s - 1.0).abs() < 0.005, "s = {s}: {worst} %, ratio {ratio}\n{text}");
+    }
+    assert!(set.join("fe/.work/verify/scaling-s0.5/centre.csv").exists(), "the scaled runs are kept for resuming");
+    // a scaled run that is there is read, not solved again
+    let again = needle(&args, &set);
+    assert!(again.status.success() && String::from_utf8_lossy(&again.stdout).contains("up to date"), "{}", show(&again));
+}

@@ -1,0 +1,103 @@
+//! Why a pose could not be solved, by class, from the logs its failed FEBio attempts
+//! left in its work folder (`failed-attempt-<n>.log`, kept by the campaign; issue 42:
+//! the failed attempts by class, where and at which depth). `needle fe status` shows the
+//! summary in its cause column.
+
+use super::logs::parse_run_log;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// One failed attempt.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AttemptFailure {
+    /// Attempt number, 1-based (the ladder of `FebioBackend::attempts`).
+    pub attempt: u32,
+    /// The class: `negative jacobian`, `max reformations`, `diverged`, `stopped` (no
+    /// error in the log: killed on a stall, timeout or Ctrl-C) or `other`.
+    pub class: &'static str,
+    /// Depth where it failed, mm (time t = depth): FEBio's "failed to converge at time",
+    /// else the last converged time.
+    pub depth_mm: f64,
+    /// FEBio's own words, when it gave any.
+    pub cause: Option<String>,
+}
+
+/// The class of a failure from FEBio's words (`None`: no error stated).
+pub fn class_of(cause: Option<&str>) -> &'static str {
+    let Some(c) = cause.map(str::to_ascii_lowercase) else { return "stopped" };
+    if c.contains("negative jacobian") {
+        "negative jacobian"
+    } else if c.contains("max nr of reformations") {
+        "max reformations"
+    } else if c.contains("diverg") {
+        "diverged"
+    } else {
+        "other"
+    }
+}
+
+/// Read `failed-attempt-<n>.log` (n = 1, 2, ...) in `work_dir`.
+pub fn read_failures(work_dir: &Path) -> Vec<AttemptFailure> {
+    let mut out = Vec::new();
+    for attempt in 1..=32u32 {
+        let Ok(text) = std::fs::read_to_string(work_dir.join(format!("failed-attempt-{attempt}.log"))) else { continue };
+        let run = parse_run_log(&text);
+        let failed_at = text
+            .lines()
+            .rev()
+            .find_map(|l| l.trim().strip_prefix("------- failed to converge at time :"))
+            .and_then(|t| t.trim().parse::<f64>().ok());
+        out.push(AttemptFailure {
+            attempt,
+            class: class_of(run.cause.as_deref()),
+            depth_mm: failed_at.unwrap_or(run.last_time),
+            cause: run.cause,
+        });
+    }
+    out
+}
+
+/// One line: `5 failed attempt(s), furthest 5.22 mm: negative jacobian x3 (0.6, 0.86, 2.69 mm), max reformations x2 (...)`;
+/// empty when there are none.
+pub fn summary(failures: &[AttemptFailure]) -> String {
+    if failures.is_empty() {
+        return String::new();
+    }
+    let mut by_class: BTreeMap<&str, Vec<f64>> = BTreeMap::new();
+    for f in failures {
+        by_class.entry(f.class).or_default().push(f.depth_mm);
+    }
+    let furthest = failures.iter().map(|f| f.depth_mm).fold(0.0, f64::max);
+    let classes: Vec<String> = by_class
+        .iter()
+        .map(|(c, d)| {
+            format!("{c} x{} ({} mm)", d.len(), d.iter().map(|v| format!("{}", (v * 100.0).round() / 100.0)).collect::<Vec<_>>().join(", "))
+        })
+        .collect();
+    format!("{} failed attempt(s), furthest {:.2} mm: {}", failures.len(), furthest, classes.join("; "))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const BOX: &str = " *************************************************************************\n *                                ERROR                                  *\n";
+
+    #[test]
+    fn failed_attempts_are_classed_with_their_depths() {
+        let d = tempfile::tempdir().expect("tempdir");
+        let log = |n: u32, body: &str| std::fs::write(d.path().join(format!("failed-attempt-{n}.log")), body).expect("write");
+        log(1, &format!(" ------- converged at time : 0.6\n{BOX} * 2 negative jacobians detected.  *\n ***\n\n ------- failed to converge at time : 0.863\n E R R O R   T E R M I N A T I O N\n"));
+        log(2, &format!(" ------- converged at time : 5.1\n{BOX} * Max nr of reformations reached.  *\n ***\n\n ------- failed to converge at time : 5.22\n E R R O R   T E R M I N A T I O N\n"));
+        log(4, " ------- converged at time : 1.5\n");
+        let f = read_failures(d.path());
+        let got: Vec<(u32, &str, f64)> = f.iter().map(|f| (f.attempt, f.class, f.depth_mm)).collect();
+        assert_eq!(got, [(1, "negative jacobian", 0.863), (2, "max reformations", 5.22), (4, "stopped", 1.5)]);
+        let s = summary(&f);
+        assert_eq!(
+            s,
+            "3 failed attempt(s), furthest 5.22 mm: max reformations x1 (5.22 mm); negative jacobian x1 (0.86 mm); stopped x1 (1.5 mm)"
+        );
+        assert_eq!(summary(&[]), "");
+    }
+}

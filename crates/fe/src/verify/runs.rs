@@ -1,0 +1,68 @@
+//! The verification's FE runs go through the campaign's own machinery
+//! ([`campaign::run`]): each variant (a mesh level, a tissue scale) has its own output
+//! folder with a manifest, so an interrupted check resumes where it stopped, failed poses
+//! get the campaign's retry ladder and continuations, and a run already up to date is
+//! read, not solved again.
+
+use crate::campaign::{self, RunOptions};
+use crate::manifest::ManifestEntry;
+use crate::report::Status;
+use crate::results::{self, Row};
+use anyhow::Result;
+use std::collections::BTreeMap;
+
+/// A current result: its rows and how it was made.
+#[derive(Debug, Clone)]
+pub struct Run {
+    /// The CSV's rows, depth 0 first.
+    pub rows: Vec<Row>,
+    /// Its manifest entry.
+    pub entry: ManifestEntry,
+}
+
+/// Each selected pose's result, or why there is none (the run failed, or the result is
+/// not current for this spec).
+pub type PoseRows = BTreeMap<String, std::result::Result<Run, String>>;
+
+/// Solve what is not up to date among the poses `opts` selects (one job), print the
+/// campaign's table, then read every selected pose's result.
+///
+/// # Errors
+/// As [`campaign::run`]: the spec, an option, the manifest (not a failed solve: that is
+/// the pose's `Err`).
+pub fn solve_and_read(opts: &RunOptions) -> Result<PoseRows> {
+    let report = campaign::run(opts)?;
+    print!("{}", report.table());
+    let mut rows = read_current(opts)?;
+    for p in &report.poses {
+        if let (Status::Failed { message, .. }, Some(Err(why))) = (&p.status, rows.get_mut(&p.pose)) {
+            *why = format!("{message} ({why})");
+        }
+    }
+    Ok(rows)
+}
+
+/// Read the selected poses' results without solving: `Ok(rows)` for a result that is up
+/// to date for the spec (hash and content per the manifest), `Err(why)` otherwise.
+///
+/// # Errors
+/// As [`campaign::plan`].
+pub fn read_current(opts: &RunOptions) -> Result<PoseRows> {
+    let plan = campaign::plan(opts)?;
+    let mut out = PoseRows::new();
+    for (i, pose) in plan.selected.iter().enumerate() {
+        let csv = plan.out_dir.join(format!("{}.csv", pose.name));
+        let entry = plan.manifest.pose.get(&pose.name).filter(|_| !plan.to_run.contains(&i));
+        let r = match entry {
+            None => Err(format!("{}: no current result (mesh {}, {} steps)", csv.display(), plan.mesh_name, plan.steps)),
+            Some(e) => results::read_csv(&csv).map(|rows| Run { rows, entry: e.clone() }).map_err(|e| format!("{e:#}")),
+        };
+        out.insert(pose.name.clone(), r);
+    }
+    Ok(out)
+}
+
+/// The depths of `a` and `b` agree row by row (the same must points).
+pub fn same_depths(a: &[Row], b: &[Row]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x.depth_mm - y.depth_mm).abs() <= 1e-9 * (1.0 + x.depth_mm.abs()))
+}
