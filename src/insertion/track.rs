@@ -38,6 +38,8 @@ pub(crate) const TILT_MAX_DEG: f32 = 89.0;
 /// `x^14/14! < 6.5e-9` at the clamp, under f32 round-off (a few 1e-8). `libm::sinf`
 /// works in f64, which costs about a thousand instructions a call on an FPU without
 /// double precision (the Cortex-M4F).
+// f32::clamp asserts `min <= max` (a panic path for the link-time no-panic check)
+#[allow(clippy::manual_clamp)]
 pub(crate) fn sin_cos_deg(deg: f32) -> (f32, f32) {
     let d = if deg > TILT_MAX_DEG {
         TILT_MAX_DEG

@@ -91,6 +91,31 @@ pub extern "C" fn needle_stack_count() -> u32 {
     stacks::ALL.len() as u32
 }
 
+/// Address of stack `stack`'s name (UTF-8, [`needle_stack_name_len`] bytes) in the
+/// module's memory; null for an unknown stack.
+#[no_mangle]
+pub extern "C" fn needle_stack_name(stack: u32) -> *const u8 {
+    stacks::ALL.get(stack as usize).map_or(core::ptr::null(), |s| s.name.as_ptr())
+}
+
+/// Length of stack `stack`'s name in bytes (0 for an unknown stack).
+#[no_mangle]
+pub extern "C" fn needle_stack_name_len(stack: u32) -> u32 {
+    stacks::ALL.get(stack as usize).map_or(0, |s| s.name.len() as u32)
+}
+
+/// Number of layers of stack `stack` (0 for an unknown stack).
+#[no_mangle]
+pub extern "C" fn needle_stack_layer_count(stack: u32) -> u32 {
+    stacks::ALL.get(stack as usize).map_or(0, |s| s.layers.len() as u32)
+}
+
+/// Thickness of layer `layer` of stack `stack`, mm (NaN for an unknown one).
+#[no_mangle]
+pub extern "C" fn needle_stack_thickness_mm(stack: u32, layer: u32) -> f32 {
+    stacks::ALL.get(stack as usize).and_then(|s| s.layers.get(layer as usize)).map_or(f32::NAN, |l| l.thickness_mm)
+}
+
 /// Starts a needle path through stack `stack` (an index below [`needle_stack_count`]),
 /// ticked every `period_s` s, the velocity low-passed with `velocity_time_constant_s` s.
 /// Returns 0, or -1 for an unknown stack, -2 for a period or time constant out of range.
