@@ -241,7 +241,14 @@ mod firmware {
                 let mut label = [0u8; 24];
                 let n = label_of(&mut label, stack.name, name);
                 let status = step(&(ins, pose)).status.bits();
-                report(&mut out, label.get(..n).and_then(|l| core::str::from_utf8(l).ok()).unwrap_or("insertion"), "insertion", tenths, stack_bytes, status);
+                report(
+                    &mut out,
+                    label.get(..n).and_then(|l| core::str::from_utf8(l).ok()).unwrap_or("insertion"),
+                    "insertion",
+                    tenths,
+                    stack_bytes,
+                    status,
+                );
             }
         }
         out.str("needle-bench end\n");

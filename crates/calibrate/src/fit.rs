@@ -10,6 +10,12 @@ use crate::measured::Point;
 
 /// Grid step of the onset and boundary scans, mm.
 pub const SCAN_STEP_MM: f64 = 0.01;
+/// The onset is the least-squares best among those whose model curve crosses the onset
+/// threshold ([`crate::replay::ONSET_FRACTION`] of the first puncture force) within this
+/// distance of the measured curve's crossing, mm (the unconstrained best when none does):
+/// contact onset is a goal of its own, which the least squares over the whole rise,
+/// weighted by the larger forces, would trade away.
+pub const ONSET_MATCH_MM: f64 = 0.25;
 
 /// The fitted values of one layer (boundary from the surface, mm of tip depth).
 #[derive(Debug, Clone, PartialEq)]
@@ -48,16 +54,26 @@ pub fn fit(points: &[Point], punctures: &[Puncture], surrogate: &dyn Fn(f64) -> 
     let pre: Vec<&Point> = points.iter().take(first_peak + 1).collect();
     let peak0 = pre.last().map_or(0.0, |p| p.position_mm);
     let start = points.iter().map(|p| p.position_mm).fold(f64::INFINITY, f64::min);
-    let mut best = (f64::INFINITY, start, 0.0);
+    let peak_force = pre.last().map_or(0.0, |p| p.force_n);
+    let threshold = crate::replay::ONSET_FRACTION * peak_force;
+    let measured_crossing = crate::replay::measured_onset(points, first_peak, threshold);
+    // (sse, onset, scale) of the best candidate whose model crosses the onset threshold
+    // within ONSET_MATCH_MM of the measured crossing, and of the best of all
+    let (mut matched, mut any) = ((f64::INFINITY, start, 0.0), (f64::INFINITY, start, 0.0));
     for onset in scan(start, peak0) {
         let column: Vec<f64> = pre.iter().map(|p| indent(surrogate, p.position_mm - onset)).collect();
         let rhs: Vec<f64> = pre.iter().map(|p| p.force_n).collect();
         let (x, sse) = lsq::non_negative(&[column], &rhs);
-        if sse < best.0 {
-            best = (sse, onset, x[0]);
+        if sse < any.0 {
+            any = (sse, onset, x[0]);
+        }
+        let crossing = crossing_depth(surrogate, threshold, x[0], peak0 - onset).map(|d| onset + d);
+        let near = matches!((crossing, measured_crossing), (Some(c), Some(m)) if (c - m).abs() <= ONSET_MATCH_MM);
+        if near && sse < matched.0 {
+            matched = (sse, onset, x[0]);
         }
     }
-    let (_, onset, scale0) = best;
+    let (_, onset, scale0) = if matched.0.is_finite() { matched } else { any };
     let mut layers = vec![LayerFit {
         boundary_mm: 0.0,
         scale: scale0,
@@ -139,6 +155,24 @@ fn indent(surrogate: &dyn Fn(f64) -> f64, depth_mm: f64) -> f64 {
     } else {
         0.0
     }
+}
+
+/// The depth (below `max_mm`) where `scale` times the surrogate first reaches
+/// `threshold_n`, by bisection on the monotone pre-puncture curve; `None` if it never does.
+fn crossing_depth(surrogate: &dyn Fn(f64) -> f64, threshold_n: f64, scale: f64, max_mm: f64) -> Option<f64> {
+    if scale <= 0.0 || max_mm <= 0.0 || scale * surrogate(max_mm) < threshold_n {
+        return None;
+    }
+    let (mut lo, mut hi) = (0.0, max_mm);
+    for _ in 0..40 {
+        let mid = 0.5 * (lo + hi);
+        if scale * indent(surrogate, mid) < threshold_n {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(hi)
 }
 
 /// `lo, lo + step, ...` below `hi`.
