@@ -61,28 +61,37 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 fn bad_curves_are_refused_with_a_reason() {
     let dir = tempfile::tempdir().expect("temp dir");
     let text = std::fs::read_to_string(curve()).expect("curve");
-    // before the first drop only: no puncture
-    let rising: String = text.lines().take_while(|l| !l.starts_with("19.15")).map(|l| format!("{l}\n")).collect();
+    // up to the first peak (the largest force before 20 mm) only: no drop, no puncture
+    let peak_line = text
+        .lines()
+        .enumerate()
+        .skip(1)
+        .filter_map(|(i, l)| l.split_once(',').and_then(|(p, f)| Some((i, p.parse::<f64>().ok()?, f.parse::<f64>().ok()?))))
+        .filter(|(_, p, _)| *p < 20.0)
+        .max_by(|a, b| a.2.total_cmp(&b.2))
+        .map(|(i, _, _)| i)
+        .expect("a peak");
+    let rising: String = text.lines().take(peak_line + 1).map(|l| format!("{l}\n")).collect();
     let p = write(dir.path(), "rising.csv", &rising);
-    let e = calibrate(&options(&p)).expect_err("no puncture").to_string();
+    let e = calibrate(&options(&p)).err().expect("no puncture: refused").to_string();
     assert!(e.contains("no puncture found"), "{e}");
     // no contact: zero force
     let flat: String = std::iter::once("position_mm,force_n\n".to_string()).chain((0..50).map(|i| format!("{}.0,0.0\n", i))).collect();
     let p = write(dir.path(), "flat.csv", &flat);
-    let e = calibrate(&options(&p)).expect_err("no contact").to_string();
+    let e = calibrate(&options(&p)).err().expect("no contact: refused").to_string();
     assert!(e.contains("no puncture found") || e.contains("no contact"), "{e}");
     // a bad row names its line and column
     let bad = text.replacen("10.14", "10.1x4", 1);
     let line = bad.lines().position(|l| l.contains("10.1x4")).expect("edited") + 1;
     let p = write(dir.path(), "bad.csv", &bad);
-    let e = calibrate(&options(&p)).expect_err("bad row").to_string();
+    let e = calibrate(&options(&p)).err().expect("bad row: refused").to_string();
     assert!(e.contains(&format!("bad.csv:{line}: column position_mm")), "{e}");
     // a missing column
     let p = write(dir.path(), "nocol.csv", &text.replacen("force_n", "load_n", 1));
-    let e = calibrate(&options(&p)).expect_err("no force column").to_string();
+    let e = calibrate(&options(&p)).err().expect("no force column: refused").to_string();
     assert!(e.contains("nocol.csv:1: no column \"force_n\""), "{e}");
     // a needle diameter that is not > 0
     let path = curve();
-    let e = calibrate(&Options { needle_diameter_mm: 0.0, ..options(&path) }).expect_err("diameter").to_string();
+    let e = calibrate(&Options { needle_diameter_mm: 0.0, ..options(&path) }).err().expect("diameter: refused").to_string();
     assert!(e.contains("--needle-diameter-mm"), "{e}");
 }
