@@ -51,6 +51,14 @@ fn the_shipped_liver_stack_is_the_calibration_of_the_shipped_curve() {
     assert_eq!(file.layers, c.stack.layers, "coeffs/default/tissue/liver.toml is stale: rerun needle calibrate (README)");
 }
 
+/// The error of a calibration that must be refused (a short panic when it is not).
+fn refused<T, E: std::fmt::Display>(r: Result<T, E>, what: &str) -> String {
+    match r {
+        Ok(_) => panic!("{what}: accepted"),
+        Err(e) => e.to_string(),
+    }
+}
+
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);
     std::fs::write(&p, text).expect("temp file");
@@ -73,25 +81,25 @@ fn bad_curves_are_refused_with_a_reason() {
         .expect("a peak");
     let rising: String = text.lines().take(peak_line + 1).map(|l| format!("{l}\n")).collect();
     let p = write(dir.path(), "rising.csv", &rising);
-    let e = calibrate(&options(&p)).err().expect("no puncture: refused").to_string();
+    let e = refused(calibrate(&options(&p)), "no puncture: refused");
     assert!(e.contains("no puncture found"), "{e}");
     // no contact: zero force
     let flat: String = std::iter::once("position_mm,force_n\n".to_string()).chain((0..50).map(|i| format!("{}.0,0.0\n", i))).collect();
     let p = write(dir.path(), "flat.csv", &flat);
-    let e = calibrate(&options(&p)).err().expect("no contact: refused").to_string();
+    let e = refused(calibrate(&options(&p)), "no contact: refused");
     assert!(e.contains("no puncture found") || e.contains("no contact"), "{e}");
     // a bad row names its line and column
     let bad = text.replacen("10.14", "10.1x4", 1);
     let line = bad.lines().position(|l| l.contains("10.1x4")).expect("edited") + 1;
     let p = write(dir.path(), "bad.csv", &bad);
-    let e = calibrate(&options(&p)).err().expect("bad row: refused").to_string();
+    let e = refused(calibrate(&options(&p)), "bad row: refused");
     assert!(e.contains(&format!("bad.csv:{line}: column position_mm")), "{e}");
     // a missing column
     let p = write(dir.path(), "nocol.csv", &text.replacen("force_n", "load_n", 1));
-    let e = calibrate(&options(&p)).err().expect("no force column: refused").to_string();
+    let e = refused(calibrate(&options(&p)), "no force column: refused");
     assert!(e.contains("nocol.csv:1: no column \"force_n\""), "{e}");
     // a needle diameter that is not > 0
     let path = curve();
-    let e = calibrate(&Options { needle_diameter_mm: 0.0, ..options(&path) }).err().expect("diameter: refused").to_string();
+    let e = refused(calibrate(&Options { needle_diameter_mm: 0.0, ..options(&path) }), "diameter: refused");
     assert!(e.contains("--needle-diameter-mm"), "{e}");
 }

@@ -12,7 +12,10 @@ fn set() -> std::path::PathBuf {
 #[test]
 fn the_shipped_set_has_a_depth_extension_and_the_library_compiled_it_in() {
     let e = fit(&set()).expect("fit").expect("coeffs/default/fe/deep/centre.csv: the set ships a deep centre run");
-    assert!(needle_haptics::depth_extension::tables::FITTED);
+    assert!(
+        std::hint::black_box(needle_haptics::depth_extension::tables::FITTED),
+        "the library compiled the set's depth-extension.toml in"
+    );
     assert_eq!(needle_haptics::depth_extension::tables::DEPTH_MAX_MM, e.depth_max_mm as f32);
     assert!(e.depth_max_mm > 9.0, "the deep run reaches {} mm", e.depth_max_mm);
 }
