@@ -29,13 +29,15 @@ fn no_panic_firmware_links_and_runs_on_every_core() {
     // The placeholder of an unfitted set has no evaluator to check: require the model.
     let set = firmware::fitted_set(&firmware::compiled_set()).unwrap_or_else(|e| panic!("{e:#}"));
     for core in &CORES {
-        let elfs = build::build_examples(core, &["no_panic", "no_panic_fixed", "no_panic_stiffness"], &set)
-            .unwrap_or_else(|e| panic!("no_panic, no_panic_fixed, no_panic_stiffness for {} ({}): {e:#}", core.core, core.target));
+        let elfs = build::build_examples(core, &["no_panic", "no_panic_fixed", "no_panic_stiffness", "no_panic_insertion"], &set)
+            .unwrap_or_else(|e| {
+                panic!("no_panic, no_panic_fixed, no_panic_stiffness, no_panic_insertion for {} ({}): {e:#}", core.core, core.target)
+            });
         for elf in &elfs {
             let run = qemu::run(core, elf, false, Duration::from_secs(60)).unwrap_or_else(|e| panic!("{e:#}"));
             assert!(run.status.success(), "{} on {} exited with {}: {}{}", elf.display(), core.core, run.status, run.stdout, run.stderr);
         }
-        println!("{} ({}): no_panic, no_panic_fixed and no_panic_stiffness link and run", core.core, core.target);
+        println!("{} ({}): no_panic, no_panic_fixed, no_panic_stiffness and no_panic_insertion link and run", core.core, core.target);
     }
 }
 
