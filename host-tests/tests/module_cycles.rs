@@ -10,7 +10,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// The crates' source folders, from the workspace root.
-const CRATES: [&str; 11] = [
+const CRATES: [&str; 12] = [
     "src",
     "crates/contract/src",
     "crates/codegen/src",
@@ -21,6 +21,7 @@ const CRATES: [&str; 11] = [
     "crates/firmware-host/src",
     "crates/plot/src",
     "crates/explore/src",
+    "crates/calibrate/src",
     "crates/cli/src",
 ];
 
