@@ -85,7 +85,7 @@ pub fn write(out_dir: &Path, f: &Failed<'_>, reached: &[[f64; COMPONENT_COUNT]])
         date: crate::manifest::rfc3339_utc(std::time::SystemTime::now()),
     };
     let toml = format!(
-        "# written by `needle fe run`: the must points of a run that failed every attempt; not a result\n{}",
+        "# written by `needle fe run`: the must points of the furthest failed attempt (of the attempts so far, while a campaign runs); not a result\n{}",
         toml::to_string(&record).context("cannot serialise the partial record")?
     );
     let (csv, rec) = paths(out_dir, &f.pose.name);
