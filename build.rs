@@ -63,6 +63,11 @@ fn run() -> Result<(), String> {
         );
         needle_codegen::generate_unfitted(&set, &out_dir).map_err(|e| e.to_string())?;
     }
+    // The tissue stacks: the folder (a file added or removed) and each file.
+    println!("cargo::rerun-if-changed={}", set_dir.join(needle_codegen::tissue::TISSUE_DIR).display());
+    for path in needle_codegen::generate_tissue(&set_dir, &out_dir).map_err(|e| e.to_string())? {
+        println!("cargo::rerun-if-changed={}", path.display());
+    }
     Ok(())
 }
 

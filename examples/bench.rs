@@ -48,6 +48,7 @@ mod firmware {
     use core::arch::asm;
     use core::hint::black_box;
     use cortex_m::peripheral::SYST;
+    use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, InsertionEvaluation};
     use needle_haptics::{fixed, wrench, wrench_and_stiffness, Pose};
 
     /// Evaluations per timed loop.
@@ -91,6 +92,33 @@ mod firmware {
         elapsed(start, SYST::get_current())
     }
 
+    /// `calls` insertion ticks at `pose` from the state `ins` (each from the same state:
+    /// the state is restored from `start` before each tick, which the empty loop does too).
+    #[inline(never)]
+    fn loop_insertion(start: &Insertion, pose: &Pose, calls: u32, tick: bool) -> u32 {
+        let t0 = SYST::get_current();
+        for _ in 0..calls {
+            let mut ins = *black_box(start);
+            if tick {
+                black_box(&ins.step(black_box(pose)));
+            } else {
+                black_box(&mut ins);
+            }
+        }
+        elapsed(t0, SYST::get_current())
+    }
+
+    /// The state of a needle advanced at 3 mm/s along `pose`'s axis to its depth.
+    fn advanced(stack: &needle_haptics::insertion::Stack<'_>, pose: &Pose) -> Option<Insertion> {
+        let mut ins = Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ).ok()?;
+        let mut d = -0.5f32;
+        while d < pose.depth_mm {
+            ins.step(&Pose { depth_mm: d, ..*pose });
+            d += 0.003;
+        }
+        Some(ins)
+    }
+
     /// Bytes of stack one call of `f` uses below this function's stack pointer.
     #[inline(never)]
     fn stack_use<P, E>(f: fn(&P) -> E, pose: &P) -> usize {
@@ -112,6 +140,18 @@ mod firmware {
             a += 4;
         }
         top - a
+    }
+
+    /// `<stack>-<case>` into `buf` (truncated to fit), its length.
+    fn label_of(buf: &mut [u8; 24], stack: &str, case: &str) -> usize {
+        let mut n = 0;
+        for b in stack.bytes().chain(*b"-").chain(case.bytes()) {
+            if let Some(slot) = buf.get_mut(n) {
+                *slot = b;
+                n += 1;
+            }
+        }
+        n
     }
 
     /// One `needle-bench pose=...` line.
@@ -180,6 +220,35 @@ mod firmware {
                 let tenths = per_call(loop_wrench(eval_fixed_k, q, black_box(CALLS)), loop_empty(q, black_box(CALLS)));
                 let stack = stack_use(eval_fixed_k, q);
                 report(&mut out, name, "fixed+k", tenths, stack, eval_fixed_k(q).status.bits());
+            }
+        }
+        // The insertion model, per stack: a tick deflecting the surface (the surrogate),
+        // and a tick deep inside after the punctures (friction over every layer passed,
+        // the track's hold, cutting or the next boundary's deflection), the tilted pose.
+        for stack in &stacks::ALL {
+            let total: f32 = stack.layers.iter().map(|l| l.thickness_mm).sum();
+            let cases = [("surface", Pose::new(3.0, -2.0, 5.0, -7.0, 4.5)), ("deep", Pose::new(3.0, -2.0, 5.0, -7.0, total + 2.0))];
+            for (name, pose) in cases {
+                let Some(ins) = advanced(stack, &pose) else { continue };
+                let tw = loop_insertion(&ins, &pose, black_box(CALLS), true);
+                let te = loop_insertion(&ins, &pose, black_box(CALLS), false);
+                let tenths = per_call(tw, te);
+                let step: fn(&(Insertion, Pose)) -> InsertionEvaluation = |p| {
+                    let mut i = p.0;
+                    i.step(&p.1)
+                };
+                let stack_bytes = stack_use(step, &(ins, pose));
+                let mut label = [0u8; 24];
+                let n = label_of(&mut label, stack.name, name);
+                let status = step(&(ins, pose)).status.bits();
+                report(
+                    &mut out,
+                    label.get(..n).and_then(|l| core::str::from_utf8(l).ok()).unwrap_or("insertion"),
+                    "insertion",
+                    tenths,
+                    stack_bytes,
+                    status,
+                );
             }
         }
         out.str("needle-bench end\n");

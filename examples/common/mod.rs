@@ -8,6 +8,7 @@
 
 pub mod device;
 pub mod icount;
+pub mod insertion_paths;
 pub mod script;
 pub mod trace;
 

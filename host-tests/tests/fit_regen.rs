@@ -28,7 +28,7 @@ fn committed_model_and_golden_vectors_are_reproducible() {
                 "{}: cannot read ({e}). Run `cargo run --release -p needle-cli -- fit --set coeffs/default` \
                  and commit every file it writes ({:?}).",
                 path.display(),
-                out.files().map(|(n, _)| n)
+                out.files().into_iter().map(|(n, _)| n).collect::<Vec<_>>()
             ),
         };
         if have != want {

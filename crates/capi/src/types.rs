@@ -7,6 +7,11 @@ pub const NEEDLE_LOOP_STORAGE_WORDS: usize = 32;
 /// [`needle_loop_t::magic`] of an initialised loop.
 pub const NEEDLE_LOOP_MAGIC: u32 = 0x4e4c_4f50;
 
+/// 64-bit words of opaque storage in a [`needle_insertion_t`].
+pub const NEEDLE_INSERTION_STORAGE_WORDS: usize = 64;
+/// [`needle_insertion_t::magic`] of an initialised insertion.
+pub const NEEDLE_INSERTION_MAGIC: u32 = 0x4e49_4e53;
+
 /// Success.
 pub const NEEDLE_OK: i32 = 0;
 /// A pointer argument was NULL.
@@ -245,3 +250,30 @@ pub const NEEDLE_LOOP_OUTPUT_ERROR: u16 = 0x0080;
 pub const NEEDLE_LOOP_DISABLED: u16 = 0x0100;
 /// Loop flag: the passivity guard limited the rendered stiffness.
 pub const NEEDLE_LOOP_STIFFNESS_LIMITED: u16 = 0x0200;
+
+/// A needle path through a tissue stack: initialise with `needle_insertion_init`. Plain
+/// data: it may be copied with `memcpy`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct needle_insertion_t {
+    /// Opaque.
+    pub storage: [u64; NEEDLE_INSERTION_STORAGE_WORDS],
+    /// `NEEDLE_INSERTION_MAGIC` once initialised.
+    pub magic: u32,
+}
+
+/// One tick of `needle_insertion_step`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct needle_insertion_result_t {
+    /// The wrench on the needle (N, N·mm about the hub).
+    pub wrench: needle_wrench_t,
+    /// `NEEDLE_STATUS_*` bits of the surrogate (saturation; `ERROR` for a pose that is not finite).
+    pub status: u8,
+    /// Boundaries punctured in this tick.
+    pub punctures: u8,
+    /// Phase code: `0` approach, `0x100 | layer` deflecting, `0x200 | layer` cutting, `0x300 | layer` in the track.
+    pub phase: u16,
+    /// Filtered axial velocity, mm/s (positive inserting).
+    pub velocity_mm_per_s: f32,
+}

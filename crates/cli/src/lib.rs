@@ -1,7 +1,10 @@
 //! The `needle` command line: one module per command group.
 #![forbid(unsafe_code)]
 
+pub mod calibrate;
+pub mod calibrate_figure;
 pub mod eval_batch;
+pub mod eval_insertion;
 pub mod explore;
 pub mod fe;
 pub mod firmware;

@@ -19,6 +19,8 @@ enum Command {
     Fit(needle_cli::fit::FitArgs),
     /// Evaluate the wrench at one pose with the library (the firmware's code).
     Eval(needle_cli::model::EvalArgs),
+    /// Fit a tissue stack (<set>/tissue/<name>.toml) to a measured axial force against needle position.
+    Calibrate(needle_cli::calibrate::CalibrateArgs),
     /// Compare the model with the FE runs it was not fitted on.
     Validate(needle_cli::fit::ValidateArgs),
     /// Serve the model explorer (the firmware's evaluator compiled to wasm) on a local port.
@@ -42,6 +44,7 @@ fn main() -> ExitCode {
         Command::Fit(a) => needle_cli::fit::fit(a),
         Command::Eval(a) => needle_cli::model::eval(a),
         Command::Validate(a) => needle_cli::fit::validate(a),
+        Command::Calibrate(a) => needle_cli::calibrate::calibrate(a),
         Command::Explore(a) => needle_cli::explore::explore(a),
         Command::Plot(a) => needle_cli::plot::plot(a),
         Command::Header(a) => needle_cli::model::header(a),

@@ -35,6 +35,10 @@ pub struct EvalArgs {
     /// theta_z_deg, depth_mm) instead of one pose; one output row per input row.
     #[arg(long, value_name = "FILE.csv")]
     pub poses: Option<PathBuf>,
+    /// With --poses: a scripted insertion through this compiled-in tissue stack (e.g.
+    /// liver): the file needs a time_s column, one row per tick; one wrench row per tick.
+    #[arg(long, value_name = "STACK", requires = "poses", conflicts_with = "json")]
+    pub insertion: Option<String>,
     /// With --poses: write the rows to this file instead of standard output.
     #[arg(long, value_name = "FILE", requires = "poses")]
     pub out: Option<PathBuf>,
@@ -184,6 +188,10 @@ pub fn eval_json(pose: &Pose, e: &Evaluation) -> serde_json::Value {
 /// `--set` is not the set compiled into this build (see [`check_compiled_set`]).
 pub fn eval(a: EvalArgs) -> anyhow::Result<ExitCode> {
     check_compiled_set(&a.set)?;
+    if let (Some(file), Some(stack)) = (&a.poses, &a.insertion) {
+        super::eval_insertion::eval_script(file, stack, a.out.as_deref())?;
+        return Ok(ExitCode::SUCCESS);
+    }
     if let Some(file) = &a.poses {
         return eval_file(file, a.out.as_deref(), a.json);
     }

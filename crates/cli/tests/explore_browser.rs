@@ -78,6 +78,29 @@ fn needle_eval(pose: &[(&str, &str); 5]) -> (Vec<String>, u32) {
     (bits, status)
 }
 
+/// The punctures of the page's insertion script (explorer.js `playInsertion`: depths in
+/// f64 steps of speed * 1 ms from -1 mm to 5 mm past the first stack's layers and back,
+/// each passed to the module as f32) through the library's insertion model.
+fn host_punctures(speed_mm_per_s: f64) -> u32 {
+    use needle_haptics::insertion::{stacks, Insertion, InsertionConfig};
+    let stack = stacks::ALL.first().expect("a shipped stack");
+    let deepest: f64 = stack.layers.iter().map(|l| f64::from(l.thickness_mm)).sum::<f64>() + 5.0;
+    let step = speed_mm_per_s * 0.001;
+    let mut depths = Vec::new();
+    let mut d = -1.0;
+    while d < deepest {
+        depths.push(d);
+        d += step;
+    }
+    let mut d = deepest;
+    while d > -1.0 {
+        depths.push(d);
+        d -= step;
+    }
+    let mut ins = Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ).expect("stack");
+    depths.iter().map(|&d| u32::from(ins.step(&needle_haptics::Pose { depth_mm: d as f32, ..Default::default() }).punctures)).sum()
+}
+
 async fn set_field(c: &fantoccini::Client, name: &str, value: &str) {
     let field = c.find(Locator::Id(&format!("{name}-num"))).await.expect("number field");
     field.clear().await.expect("clear field");
@@ -157,5 +180,28 @@ async fn explorer_page_shows_what_needle_eval_computes() {
     let (bits, status, _) = shown(&c).await;
     let (want_bits, want_status) = needle_eval(&pose);
     assert_eq!((bits, status), (want_bits, want_status), "slider case at {pose:?}");
+
+    // the insertion player: the centred vertical needle in and out of the first stack at
+    // 3 mm/s; the punctures the page counts are the host library's for the same ticks
+    for (name, v) in [("x_mm", "0"), ("z_mm", "0"), ("theta_x_deg", "0"), ("theta_z_deg", "0")] {
+        set_field(&c, name, v).await;
+    }
+    c.find(Locator::Id("play")).await.expect("play button").click().await.expect("click play");
+    let shown_punctures: u32 = c
+        .wait()
+        .at_most(Duration::from_secs(30))
+        .for_element(Locator::Css("body[data-insertion-punctures]"))
+        .await
+        .expect("the insertion ran")
+        .attr("data-insertion-punctures")
+        .await
+        .expect("attr")
+        .expect("punctures")
+        .parse()
+        .expect("a count");
+    let png = c.screenshot().await.expect("screenshot");
+    std::fs::write(shots.join("explorer-insertion.png"), png).expect("save screenshot");
+    assert_eq!(shown_punctures, host_punctures(3.0), "the page's insertion punctures differ from the library's");
+    assert!(shown_punctures > 0, "the insertion crosses at least one puncture");
     c.close().await.expect("close the browser");
 }

@@ -21,6 +21,7 @@
 #![deny(missing_docs)]
 
 pub mod contract;
+pub mod depth_extension;
 mod error;
 pub mod fixed;
 mod fixed_bound;
@@ -29,6 +30,7 @@ mod model;
 mod render;
 mod render_cross;
 mod render_fixed;
+pub mod tissue;
 
 pub use error::{line_of, CodegenError};
 pub use fixed::FixedTables;
@@ -115,6 +117,26 @@ fn write_all(model: Model, model_path: &Path, out_dir: &Path) -> Result<Generate
     write_if_changed(&out_dir.join(RUST_CROSS_FILE), &rust_cross)?;
     write_if_changed(&out_dir.join(RUST_CROSS_FIXED_FILE), &rust_cross_fixed)?;
     Ok(Generated { model, rust, c_header, fixed, rust_fixed, rust_cross, rust_cross_fixed, rust_path, c_header_path })
+}
+
+/// Checks the set's depth extension (`<set>/depth-extension.toml`, optional) and tissue
+/// stacks (`<set>/tissue/*.toml`) and writes [`depth_extension::RUST_FILE`] and
+/// [`tissue::RUST_TISSUE_FILE`] into `out_dir`; returns the files to watch (for
+/// `rerun-if-changed`). A set without a `tissue/` folder gets an empty `ALL`.
+///
+/// # Errors
+/// A tissue file is refused ([`tissue::parse_stack`], with its line) or the output
+/// cannot be written.
+pub fn generate_tissue(set_dir: &Path, out_dir: &Path) -> Result<Vec<PathBuf>, CodegenError> {
+    let extension_path = set_dir.join(depth_extension::FILE);
+    let extension = if extension_path.is_file() { Some(depth_extension::parse(&extension_path)?) } else { None };
+    write_if_changed(&out_dir.join(depth_extension::RUST_FILE), &depth_extension::render(extension.as_ref()))?;
+    let stacks = tissue::read_stacks(set_dir)?;
+    let needle = tissue::read_fe_needle(set_dir)?;
+    write_if_changed(&out_dir.join(tissue::RUST_TISSUE_FILE), &tissue::render_rust_stacks(&stacks, needle))?;
+    let mut read: Vec<PathBuf> = stacks.into_iter().map(|(p, _)| p).collect();
+    read.push(extension_path);
+    Ok(read)
 }
 
 fn write_if_changed(path: &Path, text: &str) -> Result<(), CodegenError> {

@@ -134,6 +134,12 @@ pub const XZ_MAX_MM: f64 = 12.0;
 pub const THETA_MAX_DEG: f64 = 15.0;
 /// Largest depth of the domain, mm (the domain is `0 <= depth <= 6`).
 pub const DEPTH_MAX_MM: f64 = 6.0;
+/// Most layers a tissue stack (`coeffs/<set>/tissue/*.toml`) may have: the library's
+/// insertion state holds this many.
+pub const MAX_TISSUE_LAYERS: usize = 8;
+/// Format version of a tissue stack file.
+pub const TISSUE_FORMAT: i64 = 1;
+
 /// Half-range `V_k` of each sweep (mm, mm, deg, deg): the domain is `|v| <= V_k`.
 pub const HALF_RANGES: [f64; 4] = [XZ_MAX_MM, XZ_MAX_MM, THETA_MAX_DEG, THETA_MAX_DEG];
 

@@ -17,6 +17,7 @@ pub mod coupled;
 pub mod coupled_report;
 pub mod cross_terms;
 pub mod data;
+pub mod depth_extension;
 pub mod depth_floor;
 pub mod error_trend;
 pub mod eval_f32;
@@ -65,18 +66,24 @@ pub struct FitOutput {
     pub golden_stiffness_csv: String,
     /// The text of `golden-stiffness-fixed.csv`.
     pub golden_stiffness_fixed_csv: String,
+    /// The text of `depth-extension.toml`, when the set has a deep centre run.
+    pub depth_extension_toml: Option<String>,
 }
 
 impl FitOutput {
     /// Every file `needle fit` writes into the set folder (name, text), model first.
-    pub fn files(&self) -> [(&'static str, &str); 5] {
-        [
-            (MODEL_FILE, &self.model_toml),
+    pub fn files(&self) -> Vec<(&'static str, &str)> {
+        let mut files = vec![
+            (MODEL_FILE, self.model_toml.as_str()),
             (GOLDEN_FILE, &self.golden_csv),
             (GOLDEN_FIXED_FILE, &self.golden_fixed_csv),
             (GOLDEN_STIFFNESS_FILE, &self.golden_stiffness_csv),
             (GOLDEN_STIFFNESS_FIXED_FILE, &self.golden_stiffness_fixed_csv),
-        ]
+        ];
+        if let Some(text) = &self.depth_extension_toml {
+            files.push((depth_extension::FILE, text));
+        }
+        files
     }
 }
 
@@ -99,7 +106,16 @@ pub fn fit_set(set_dir: &Path) -> Result<FitOutput> {
     let fixed = fixed_formats::TablesFixed::from_model(&model)?;
     let golden_fixed_csv = golden_fixed::to_csv(&fixed)?;
     let golden_stiffness_fixed_csv = golden_stiffness_fixed::to_csv(&fixed)?;
-    Ok(FitOutput { model, model_toml, golden_csv, golden_fixed_csv, golden_stiffness_csv, golden_stiffness_fixed_csv })
+    let depth_extension_toml = depth_extension::fit(set_dir)?.map(|e| depth_extension::to_toml(&e));
+    Ok(FitOutput {
+        model,
+        model_toml,
+        golden_csv,
+        golden_fixed_csv,
+        golden_stiffness_csv,
+        golden_stiffness_fixed_csv,
+        depth_extension_toml,
+    })
 }
 
 /// A plain-text table of the fit residuals (RMS and max, in N or N·mm).

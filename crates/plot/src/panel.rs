@@ -4,6 +4,8 @@
 
 use anyhow::{anyhow, Result};
 use plotters::prelude::*;
+/// The colour type of a [`Series`] (plotters'), for callers that build panels.
+pub use plotters::style::RGBColor;
 
 /// The six components' colours, in contract order (fx, fy, fz, mx, my, mz).
 pub const COMPONENT_COLOURS: [RGBColor; 6] = [

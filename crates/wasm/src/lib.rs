@@ -9,12 +9,16 @@
 //! - [`needle_eval`] evaluates one pose and returns the status bits; the wrench
 //!   components (fx, fy, fz in N; mx, my, mz in N*mm) are left, as f32 bit patterns, in
 //!   the buffer of [`needle_component_count`] words at [`needle_out`];
-//! - [`needle_domain`] the model's domain, [`needle_coupled`] its form.
+//! - [`needle_domain`] the model's domain, [`needle_coupled`] its form;
+//! - the insertion model through the compiled-in tissue stacks: [`needle_stack_count`],
+//!   [`needle_insertion_start`] (one path at a time) and [`needle_insertion_step`], whose
+//!   wrench is left at [`needle_out`] as [`needle_eval`]'s is.
 #![cfg_attr(target_arch = "wasm32", no_std)]
 #![deny(missing_docs)]
 
 use core::sync::atomic::{AtomicU32, Ordering};
 use needle_contract::COMPONENT_COUNT;
+use needle_haptics::insertion::{stacks, Insertion, InsertionConfig};
 use needle_haptics::{model_info, wrench, Pose};
 
 /// The last evaluation: fx, fy, fz (N), mx, my, mz (N*mm) as f32 bits.
@@ -69,6 +73,77 @@ pub extern "C" fn needle_coupled() -> u32 {
     } else {
         u32::from(model_info::COUPLED)
     }
+}
+
+/// The page's one needle path (a wasm instance runs on one thread).
+struct Path(core::cell::RefCell<Option<Insertion>>);
+
+// SAFETY: wasm32-unknown-unknown without the atomics feature has one thread; on the host
+// (tests) nothing shares the static across threads either: the exports are called from
+// one thread at a time by the embedder.
+unsafe impl Sync for Path {}
+
+static PATH: Path = Path(core::cell::RefCell::new(None));
+
+/// Number of compiled-in tissue stacks (indices for [`needle_insertion_start`]).
+#[no_mangle]
+pub extern "C" fn needle_stack_count() -> u32 {
+    stacks::ALL.len() as u32
+}
+
+/// Address of stack `stack`'s name (UTF-8, [`needle_stack_name_len`] bytes) in the
+/// module's memory; null for an unknown stack.
+#[no_mangle]
+pub extern "C" fn needle_stack_name(stack: u32) -> *const u8 {
+    stacks::ALL.get(stack as usize).map_or(core::ptr::null(), |s| s.name.as_ptr())
+}
+
+/// Length of stack `stack`'s name in bytes (0 for an unknown stack).
+#[no_mangle]
+pub extern "C" fn needle_stack_name_len(stack: u32) -> u32 {
+    stacks::ALL.get(stack as usize).map_or(0, |s| s.name.len() as u32)
+}
+
+/// Number of layers of stack `stack` (0 for an unknown stack).
+#[no_mangle]
+pub extern "C" fn needle_stack_layer_count(stack: u32) -> u32 {
+    stacks::ALL.get(stack as usize).map_or(0, |s| s.layers.len() as u32)
+}
+
+/// Thickness of layer `layer` of stack `stack`, mm (NaN for an unknown one).
+#[no_mangle]
+pub extern "C" fn needle_stack_thickness_mm(stack: u32, layer: u32) -> f32 {
+    stacks::ALL.get(stack as usize).and_then(|s| s.layers.get(layer as usize)).map_or(f32::NAN, |l| l.thickness_mm)
+}
+
+/// Starts a needle path through stack `stack` (an index below [`needle_stack_count`]),
+/// ticked every `period_s` s, the velocity low-passed with `velocity_time_constant_s` s.
+/// Returns 0, or -1 for an unknown stack, -2 for a period or time constant out of range.
+#[no_mangle]
+pub extern "C" fn needle_insertion_start(stack: u32, period_s: f32, velocity_time_constant_s: f32) -> i32 {
+    let Some(s) = stacks::ALL.get(stack as usize) else { return -1 };
+    match Insertion::new(s, InsertionConfig { period_s, velocity_time_constant_s }) {
+        Ok(i) => {
+            *PATH.0.borrow_mut() = Some(i);
+            0
+        }
+        Err(_) => -2,
+    }
+}
+
+/// One tick of the started path: the wrench at [`needle_out`]; returns
+/// `status | phase_code << 8 | punctures << 24` (phase code: 0 approach, 0x100 | layer
+/// deflecting, 0x200 | layer cutting, 0x300 | layer in the track), or `u32::MAX` when no
+/// path was started.
+#[no_mangle]
+pub extern "C" fn needle_insertion_step(x_mm: f32, z_mm: f32, theta_x_deg: f32, theta_z_deg: f32, depth_mm: f32) -> u32 {
+    let mut path = PATH.0.borrow_mut();
+    let Some(ins) = path.as_mut() else { return u32::MAX };
+    let e = ins.step(&Pose::new(x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm));
+    for (slot, v) in OUT.iter().zip(e.wrench.to_array()) {
+        slot.store(v.to_bits(), Ordering::Relaxed);
+    }
+    u32::from(e.status.bits()) | u32::from(e.phase.code()) << 8 | u32::from(e.punctures) << 24
 }
 
 /// A wasm module has no one to report a panic to; the library cannot panic (its

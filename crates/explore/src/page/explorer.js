@@ -182,3 +182,63 @@ function drawSide() {
 
 update();
 document.body.dataset.ready = "yes";
+
+// The insertion player: the firmware's insertion model (wasm) through a compiled-in
+// stack, at 1 kHz, in at the chosen speed to 5 mm past the layers and back out.
+function playInsertion() {
+  const s = Number($("stack").value);
+  const stack = model.stacks[s];
+  if (!stack) return;
+  const total = stack.thickness_mm.reduce((a, b) => a + b, 0);
+  const deepest = total + 5;
+  const speed = Math.max(0.1, Number($("speed").value) || 3);
+  const step = speed * 0.001;
+  const poses = [];
+  const at = (depth_mm) => ({ ...pose, depth_mm });
+  for (let dep = -1; dep < deepest; dep += step) poses.push(at(dep));
+  for (let dep = deepest; dep > -1; dep -= step) poses.push(at(dep));
+  const ticks = model.insert(s, poses);
+  const punctures = ticks.filter((t) => t.punctures > 0);
+  $("insertion-summary").textContent = `${ticks.length} ticks, ${punctures.length} puncture(s), largest Fy ${Math.max(...ticks.map((t) => t.fy_n)).toPrecision(3)} N`;
+  document.body.dataset.insertionPunctures = String(punctures.reduce((a, t) => a + t.punctures, 0));
+  const canvas = $("insertion");
+  const g = canvas.getContext("2d");
+  const W = canvas.width, H = canvas.height, L = 60, R = 15, T = 15, B = 40;
+  const fy = ticks.map((t) => t.fy_n);
+  let lo = Math.min(0, ...fy), hi = Math.max(0, ...fy);
+  if (hi - lo < 1e-12) { hi += 1; lo -= 1; }
+  const X = (v) => L + ((W - L - R) * (v + 1)) / (deepest + 1);
+  const Y = (v) => T + ((H - T - B) * (hi - v)) / (hi - lo);
+  g.clearRect(0, 0, W, H);
+  g.strokeStyle = "#888"; g.fillStyle = "#222"; g.font = "12px sans-serif"; g.lineWidth = 1;
+  g.beginPath(); g.moveTo(L, T); g.lineTo(L, H - B); g.lineTo(W - R, H - B); g.stroke();
+  for (let i = 0; i <= 4; i++) {
+    const v = lo + ((hi - lo) * i) / 4;
+    g.fillText(tick(v), L - 6 - g.measureText(tick(v)).width, Y(v) + 4);
+    const dep = -1 + ((deepest + 1) * i) / 4;
+    g.fillText(dep.toFixed(0), X(dep) - 8, H - B + 16);
+  }
+  g.fillText("needle depth (mm)", W / 2 - 50, H - 6);
+  g.setLineDash([4, 4]); g.strokeStyle = "#aaa";
+  let boundary = 0;
+  for (const t of stack.thickness_mm) {
+    g.beginPath(); g.moveTo(X(boundary), T); g.lineTo(X(boundary), H - B); g.stroke();
+    boundary += t;
+  }
+  g.setLineDash([]);
+  g.strokeStyle = "#1f5fbf"; g.lineWidth = 1.5; g.beginPath();
+  ticks.forEach((t, i) => (i ? g.lineTo : g.moveTo).call(g, X(t.depth_mm), Y(t.fy_n)));
+  g.stroke();
+  g.fillStyle = "#c0392b";
+  ticks.forEach((t, i) => {
+    if (t.punctures > 0 && i > 0) { g.beginPath(); g.arc(X(ticks[i - 1].depth_mm), Y(ticks[i - 1].fy_n), 4, 0, 2 * Math.PI); g.fill(); }
+  });
+}
+model.stacks.forEach((st, i) => {
+  const o = document.createElement("option");
+  o.value = String(i);
+  o.textContent = `${st.name} (${st.thickness_mm.length} layers)`;
+  $("stack").appendChild(o);
+});
+if (model.stacks.length === 0) $("insertion-section").hidden = true;
+$("play").addEventListener("click", playInsertion);

@@ -33,8 +33,27 @@ export async function load(bytes) {
     throw new Error(`needle.wasm has ${e.needle_component_count()} components, this page ${COMPONENTS.length}: rebuild it with needle explore`);
   }
   const form = ["paper", "coupled", "unfitted"][e.needle_coupled()] ?? "unknown";
+  // the compiled-in tissue stacks (names and layer thicknesses), for the insertion player
+  const stacks = [];
+  for (let s = 0; s < (e.needle_stack_count?.() ?? 0); s++) {
+    const name = new TextDecoder().decode(new Uint8Array(e.memory.buffer, e.needle_stack_name(s), e.needle_stack_name_len(s)));
+    const thickness_mm = [];
+    for (let l = 0; l < e.needle_stack_layer_count(s); l++) thickness_mm.push(e.needle_stack_thickness_mm(s, l));
+    stacks.push({ name, thickness_mm });
+  }
   return {
     form,
+    stacks,
+    // a scripted insertion through stack `s` at 1 kHz: returns per tick the depth, fy and
+    // the punctures (the firmware's own insertion model)
+    insert(s, poses) {
+      if (e.needle_insertion_start(s, 0.001, 0.005) !== 0) throw new Error(`stack ${s}: cannot start`);
+      return poses.map((p) => {
+        const r = e.needle_insertion_step(p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg, p.depth_mm) >>> 0;
+        const w = new Float32Array(Uint32Array.from(new Uint32Array(e.memory.buffer, e.needle_out(), COMPONENTS.length)).buffer);
+        return { depth_mm: p.depth_mm, fy_n: w[1], punctures: r >>> 24, phase: (r >>> 8) & 0xffff };
+      });
+    },
     domain: {
       x_max_mm: e.needle_domain(0),
       z_max_mm: e.needle_domain(1),

@@ -1,0 +1,79 @@
+//! `needle eval --poses FILE --insertion STACK`: a scripted insertion, one row per tick,
+//! equal to the library's insertion model run on the same rows; bad scripts refused
+//! with their line.
+use needle_haptics::insertion::{stacks, Insertion, InsertionConfig};
+use needle_haptics::Pose;
+use std::process::Command;
+
+fn needle(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_needle")).args(args).output().expect("run needle")
+}
+
+fn set() -> String {
+    format!("{}/../../coeffs/default", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A script in and out of the stack at 10 mm/s, 1 kHz.
+fn script() -> (String, Vec<Pose>) {
+    let mut text = String::from("time_s,x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n");
+    let mut poses = Vec::new();
+    for k in 0..8000u32 {
+        let t = f64::from(k) * 0.001;
+        let d = if k < 4000 { -1.0 + 0.01 * f64::from(k) } else { 39.0 - 0.01 * f64::from(k - 4000) };
+        let p = Pose { x_mm: 1.0, z_mm: -0.5, theta_x_deg: 2.0, theta_z_deg: -1.0, depth_mm: d as f32 };
+        text.push_str(&format!("{t},{:?},{:?},{:?},{:?},{:?}\n", p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg, p.depth_mm));
+        poses.push(p);
+    }
+    (text, poses)
+}
+
+#[test]
+fn a_scripted_insertion_gives_the_librarys_ticks() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (text, poses) = script();
+    let file = dir.path().join("script.csv");
+    std::fs::write(&file, text).expect("script");
+    let out = needle(&["eval", "--set", &set(), "--poses", file.to_str().expect("path"), "--insertion", "liver"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let rows: Vec<&str> = stdout.lines().skip(1).collect();
+    assert_eq!(rows.len(), poses.len(), "one row per tick");
+    let stack = stacks::ALL.iter().find(|s| s.name == "liver").expect("liver");
+    let mut ins = Insertion::new(stack, InsertionConfig { period_s: 0.001, ..InsertionConfig::DEFAULT_1KHZ }).expect("stack");
+    let mut punctures = 0;
+    for (row, p) in rows.iter().zip(&poses) {
+        let e = ins.step(p);
+        let cells: Vec<&str> = row.split(',').collect();
+        let fy: f32 = cells[7].parse().expect("fy");
+        assert_eq!(fy.to_bits(), e.wrench.fy_n.to_bits(), "row {row}");
+        punctures += u32::from(e.punctures);
+        assert_eq!(cells[14].parse::<u8>().expect("punctures"), e.punctures, "row {row}");
+    }
+    assert!(punctures > 0, "the script punctures");
+}
+
+#[test]
+fn bad_scripts_are_refused_with_their_line() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let cases = [
+        ("x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n0,0,0,0,1\n0,0,0,0,2\n", "no column \"time_s\""),
+        (
+            "time_s,x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n0,0,0,0,0,1\n0.001,0,0,0,0,2\n0.003,0,0,0,0,3\n",
+            "script.csv:4: column time_s: step",
+        ),
+        ("time_s,x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n0,0,0,0,0,1\nabc,0,0,0,0,2\n", "script.csv:3: column time_s"),
+        ("time_s,x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n0,0,0,0,0,1\n", "at least two"),
+    ];
+    for (text, want) in cases {
+        let file = dir.path().join("script.csv");
+        std::fs::write(&file, text).expect("script");
+        let out = needle(&["eval", "--set", &set(), "--poses", file.to_str().expect("path"), "--insertion", "liver"]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{want}: accepted");
+        assert!(stderr.contains(want), "{want}: {stderr}");
+    }
+    let file = dir.path().join("script.csv");
+    std::fs::write(&file, "time_s,x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n0,0,0,0,0,1\n0.001,0,0,0,0,2\n").expect("script");
+    let out = needle(&["eval", "--set", &set(), "--poses", file.to_str().expect("path"), "--insertion", "no_such"]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no such tissue stack"), "{}", String::from_utf8_lossy(&out.stderr));
+}

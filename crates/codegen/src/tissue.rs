@@ -1,0 +1,327 @@
+//! Tissue stacks, `coeffs/<set>/tissue/<name>.toml`: the layers a needle passes from the
+//! surface down, each with its stiffness scale against the set's FE tissue, puncture,
+//! cutting, shaft friction and track stiffness (format: `coeffs/README.md`, "Tissue
+//! stacks"). Parsed and checked here (every refusal names the file and the line), so
+//! that `build.rs` and `needle calibrate` refuse the same files in the same words, and
+//! rendered into the library's `tissue_stacks.rs`.
+#![allow(clippy::cast_precision_loss)]
+use crate::error::CodegenError;
+use crate::literal::f32_literal;
+use serde::{Deserialize, Serialize};
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+
+pub use needle_contract::{MAX_TISSUE_LAYERS as MAX_LAYERS, TISSUE_FORMAT};
+/// The folder of a set that holds its tissue stacks.
+pub const TISSUE_DIR: &str = "tissue";
+/// File name of the generated stacks in the output folder.
+pub const RUST_TISSUE_FILE: &str = "tissue_stacks.rs";
+
+/// One layer, from its upper boundary down (units in the names).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Layer {
+    /// What the layer is ("capsule", "ligamentum flavum").
+    pub name: String,
+    /// Thickness along the block's vertical, mm (> 0; the last layer extends below it).
+    pub thickness_mm: f64,
+    /// Stiffness scale s against the set's FE tissue (> 0): the layer's upper boundary
+    /// deflects with s times the FE surrogate's wrench (the scaling law).
+    pub stiffness_scale: f64,
+    /// Axial force at which the upper boundary is punctured, N (> 0).
+    pub puncture_force_n: f64,
+    /// Axial force at the tip while it cuts through the layer, N (>= 0).
+    pub cutting_force_n: f64,
+    /// Karnopp static friction level per mm of shaft in the layer, N/mm (>= 0).
+    pub friction_static_n_per_mm: f64,
+    /// Karnopp Coulomb (sliding) friction level per mm of shaft, N/mm (>= 0).
+    pub friction_coulomb_n_per_mm: f64,
+    /// Viscous friction per mm of shaft, N per (mm/s) per mm (>= 0).
+    pub friction_viscous_n_s_per_mm2: f64,
+    /// Half width of the stick band of axial speed, mm/s (> 0): below it the friction
+    /// rises linearly from zero to the static level.
+    pub stick_band_mm_per_s: f64,
+    /// Lateral stiffness of the cut track per mm of shaft in the layer, N/mm per mm (>= 0).
+    pub track_stiffness_n_per_mm2: f64,
+    /// Where the values come from (a citation, or the `needle calibrate` run).
+    pub source: String,
+}
+
+/// A stack as read from its file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Stack {
+    /// Format version, [`TISSUE_FORMAT`].
+    pub format: i64,
+    /// Short name: the file's stem, a Rust identifier once upper-cased.
+    pub name: String,
+    /// One line on what the stack is.
+    pub description: String,
+    /// Diameter of the needle the values belong to, mm (> 0): the library scales the FE
+    /// surrogate from the set's needle to this one by geometric similarity.
+    pub needle_diameter_mm: f64,
+    /// The layers from the surface down (1 to [`MAX_LAYERS`]).
+    #[serde(rename = "layer")]
+    pub layers: Vec<Layer>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawStack {
+    format: Spanned<i64>,
+    name: Spanned<String>,
+    description: String,
+    needle_diameter_mm: Spanned<f64>,
+    #[serde(rename = "layer")]
+    layers: Spanned<Vec<Spanned<RawLayer>>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawLayer {
+    name: String,
+    thickness_mm: Spanned<f64>,
+    stiffness_scale: Spanned<f64>,
+    puncture_force_n: Spanned<f64>,
+    cutting_force_n: Spanned<f64>,
+    friction_static_n_per_mm: Spanned<f64>,
+    friction_coulomb_n_per_mm: Spanned<f64>,
+    friction_viscous_n_s_per_mm2: Spanned<f64>,
+    stick_band_mm_per_s: Spanned<f64>,
+    track_stiffness_n_per_mm2: Spanned<f64>,
+    source: String,
+}
+
+/// What a value must be.
+#[derive(Clone, Copy)]
+enum Bound {
+    Positive,
+    NonNegative,
+}
+
+/// Reads and checks the tissue file at `path`.
+///
+/// # Errors
+/// Unreadable file, invalid TOML, a missing or unknown field, or a value out of its
+/// range (a thickness, scale, puncture force or stick band <= 0, a force, friction or
+/// stiffness < 0, a name that is not an identifier), each with its line.
+pub fn parse_stack(path: &Path) -> Result<Stack, CodegenError> {
+    let text = std::fs::read_to_string(path).map_err(|e| CodegenError::file(path, format!("cannot read the tissue file: {e}")))?;
+    parse_stack_str(&text, path)
+}
+
+/// Checks `text`, the contents of the tissue file `path` (used in the messages).
+///
+/// # Errors
+/// As [`parse_stack`].
+pub fn parse_stack_str(text: &str, path: &Path) -> Result<Stack, CodegenError> {
+    let raw: RawStack = toml::from_str(text).map_err(|e| {
+        let offset = e.span().map_or(text.trim_end().len(), |s| s.start);
+        CodegenError::at(path, text, offset, e.message().trim_end())
+    })?;
+    let err = |span: Range<usize>, m: String| CodegenError::at(path, text, span.start, m);
+    if *raw.format.get_ref() != TISSUE_FORMAT {
+        return Err(err(raw.format.span(), format!("format = {}: this build reads tissue format {TISSUE_FORMAT}", raw.format.get_ref())));
+    }
+    let name = raw.name.get_ref();
+    let identifier = name.chars().next().is_some_and(|c| c.is_ascii_lowercase())
+        && name.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
+    if !identifier {
+        return Err(err(
+            raw.name.span(),
+            format!("name = {name:?}: a stack name is lower-case ASCII letters, digits and '_', starting with a letter"),
+        ));
+    }
+    check(&raw.needle_diameter_mm, "needle_diameter_mm", Bound::Positive, &err)?;
+    let layers_span = raw.layers.span();
+    let raw_layers = raw.layers.into_inner();
+    if raw_layers.is_empty() || raw_layers.len() > MAX_LAYERS {
+        return Err(err(layers_span, format!("{} [[layer]] entries: a stack has 1 to {MAX_LAYERS}", raw_layers.len())));
+    }
+    let layers = raw_layers.into_iter().map(|l| layer(l.into_inner(), &err)).collect::<Result<Vec<_>, _>>()?;
+    Ok(Stack {
+        format: TISSUE_FORMAT,
+        name: name.clone(),
+        description: raw.description,
+        needle_diameter_mm: *raw.needle_diameter_mm.get_ref(),
+        layers,
+    })
+}
+
+fn layer(l: RawLayer, err: &dyn Fn(Range<usize>, String) -> CodegenError) -> Result<Layer, CodegenError> {
+    use Bound::{NonNegative, Positive};
+    Ok(Layer {
+        thickness_mm: check(&l.thickness_mm, "thickness_mm", Positive, err)?,
+        stiffness_scale: check(&l.stiffness_scale, "stiffness_scale", Positive, err)?,
+        puncture_force_n: check(&l.puncture_force_n, "puncture_force_n", Positive, err)?,
+        cutting_force_n: check(&l.cutting_force_n, "cutting_force_n", NonNegative, err)?,
+        friction_static_n_per_mm: check(&l.friction_static_n_per_mm, "friction_static_n_per_mm", NonNegative, err)?,
+        friction_coulomb_n_per_mm: check(&l.friction_coulomb_n_per_mm, "friction_coulomb_n_per_mm", NonNegative, err)?,
+        friction_viscous_n_s_per_mm2: check(&l.friction_viscous_n_s_per_mm2, "friction_viscous_n_s_per_mm2", NonNegative, err)?,
+        stick_band_mm_per_s: check(&l.stick_band_mm_per_s, "stick_band_mm_per_s", Positive, err)?,
+        track_stiffness_n_per_mm2: check(&l.track_stiffness_n_per_mm2, "track_stiffness_n_per_mm2", NonNegative, err)?,
+        name: l.name,
+        source: l.source,
+    })
+}
+
+/// The value, if it is finite, within f32's range and inside `bound`.
+fn check(v: &Spanned<f64>, key: &str, bound: Bound, err: &dyn Fn(Range<usize>, String) -> CodegenError) -> Result<f64, CodegenError> {
+    let x = *v.get_ref();
+    let (ok, what) = match bound {
+        Bound::Positive => (x > 0.0, "> 0"),
+        Bound::NonNegative => (x >= 0.0, ">= 0"),
+    };
+    if !x.is_finite() || x.abs() > f64::from(f32::MAX) || !ok {
+        return Err(err(v.span(), format!("{key} = {x}: must be finite and {what}")));
+    }
+    Ok(x)
+}
+
+impl Stack {
+    /// The file text of this stack (what `needle calibrate` writes), with `header` as
+    /// leading comment lines.
+    #[must_use]
+    pub fn to_toml(&self, header: &str) -> String {
+        let mut out: String = header.lines().map(|l| format!("# {l}\n").replace("# \n", "#\n")).collect();
+        // plain data with string keys: serialising cannot fail
+        out.push_str(&toml::to_string(self).unwrap_or_default());
+        out
+    }
+}
+
+/// The tissue files of the set `set_dir` (`tissue/*.toml`, by name), checked.
+///
+/// # Errors
+/// A file that [`parse_stack`] refuses, a stem that is not the stack's `name`, or an
+/// unreadable folder.
+pub fn read_stacks(set_dir: &Path) -> Result<Vec<(PathBuf, Stack)>, CodegenError> {
+    let dir = set_dir.join(TISSUE_DIR);
+    if !dir.is_dir() {
+        return Ok(Vec::new());
+    }
+    let entries = std::fs::read_dir(&dir).map_err(|e| CodegenError::file(&dir, format!("cannot list: {e}")))?;
+    let mut paths: Vec<PathBuf> = entries.flatten().map(|e| e.path()).filter(|p| p.extension().is_some_and(|x| x == "toml")).collect();
+    paths.sort();
+    let mut stacks = Vec::with_capacity(paths.len());
+    for path in paths {
+        let stack = parse_stack(&path)?;
+        let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        if stem != stack.name {
+            return Err(CodegenError::file(
+                &path,
+                format!("name = {:?}: a tissue file is named after its stack ({}.toml)", stack.name, stack.name),
+            ));
+        }
+        stacks.push((path, stack));
+    }
+    Ok(stacks)
+}
+
+/// The set's FE needle, from `campaign.toml` `[needle]`: what the stacks are scaled from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FeNeedle {
+    /// Shaft diameter, mm.
+    pub diameter_mm: f64,
+    /// Distance of the wrench's reference point (the hub) from the tip, mm.
+    pub reference_from_tip_mm: f64,
+}
+
+/// The `[needle]` of `<set>/campaign.toml`, or `None` when the set has no campaign file.
+///
+/// # Errors
+/// The file is unreadable, or `[needle] diameter_mm` / `reference_from_tip_mm` is
+/// missing or not a positive number.
+pub fn read_fe_needle(set_dir: &Path) -> Result<Option<FeNeedle>, CodegenError> {
+    let path = set_dir.join("campaign.toml");
+    if !path.is_file() {
+        return Ok(None);
+    }
+    let text = std::fs::read_to_string(&path).map_err(|e| CodegenError::file(&path, format!("cannot read: {e}")))?;
+    let value: toml::Table = toml::from_str(&text).map_err(|e| {
+        let offset = e.span().map_or(text.trim_end().len(), |s| s.start);
+        CodegenError::at(&path, &text, offset, e.message().trim_end())
+    })?;
+    let get = |key: &str| {
+        value
+            .get("needle")
+            .and_then(|n| n.get(key))
+            .and_then(|v| v.as_float().or_else(|| v.as_integer().map(|i| i as f64)))
+            .filter(|v| v.is_finite() && *v > 0.0)
+            .ok_or_else(|| CodegenError::file(&path, format!("[needle] {key}: missing or not a number > 0")))
+    };
+    Ok(Some(FeNeedle { diameter_mm: get("diameter_mm")?, reference_from_tip_mm: get("reference_from_tip_mm")? }))
+}
+
+/// The initial shear modulus `mu0 = sum of [tissue] mu_n_per_mm2` of `<set>/campaign.toml`
+/// (N/mm²), or `None` without a campaign file.
+///
+/// # Errors
+/// The file is unreadable, or `mu_n_per_mm2` is missing, not a list of numbers, or sums
+/// to a value that is not finite and > 0.
+pub fn read_fe_shear_modulus(set_dir: &Path) -> Result<Option<f64>, CodegenError> {
+    let path = set_dir.join("campaign.toml");
+    if !path.is_file() {
+        return Ok(None);
+    }
+    let text = std::fs::read_to_string(&path).map_err(|e| CodegenError::file(&path, format!("cannot read: {e}")))?;
+    let value: toml::Table = toml::from_str(&text).map_err(|e| {
+        let offset = e.span().map_or(text.trim_end().len(), |s| s.start);
+        CodegenError::at(&path, &text, offset, e.message().trim_end())
+    })?;
+    let mu: Option<f64> = value
+        .get("tissue")
+        .and_then(|t| t.get("mu_n_per_mm2"))
+        .and_then(|m| m.as_array())
+        .map(|a| a.iter().map(|v| v.as_float().unwrap_or(f64::NAN)).sum());
+    match mu {
+        Some(m) if m.is_finite() && m > 0.0 => Ok(Some(m)),
+        _ => Err(CodegenError::file(&path, "[tissue] mu_n_per_mm2: missing, not numbers, or a sum that is not > 0")),
+    }
+}
+
+/// The Rust source of the stacks: one `pub const <NAME>: Stack` each and `ALL`, using the
+/// library's `Stack` and `Layer` types (every value an exact f32 literal).
+#[must_use]
+pub fn render_rust_stacks(stacks: &[(PathBuf, Stack)], needle: Option<FeNeedle>) -> String {
+    let mut out = String::from("// Generated by needle-codegen from the set's tissue/*.toml: do not edit.\n\n");
+    let (d, r) = needle.map_or(("f32::NAN".to_string(), "f32::NAN".to_string()), |n| (lit(n.diameter_mm), lit(n.reference_from_tip_mm)));
+    out.push_str(&format!("/// Diameter of the set's FE needle, mm (`campaign.toml` `[needle] diameter_mm`; NaN: no campaign file).\npub const FE_NEEDLE_DIAMETER_MM: f32 = {d};\n"));
+    out.push_str(&format!("/// The model's moment reference (the hub) from the tip, mm (`[needle] reference_from_tip_mm`).\npub const HUB_FROM_TIP_MM: f32 = {r};\n\n"));
+    for (path, s) in stacks {
+        let file = path.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default();
+        out.push_str(&format!("/// `{}` (tissue/{file}): {}\n", s.name, s.description.replace('\n', " ")));
+        out.push_str(&format!("pub const {}: Stack<'static> = Stack {{\n", s.name.to_uppercase()));
+        out.push_str(&format!("    name: {:?},\n    needle_diameter_mm: {},\n    layers: &[\n", s.name, lit(s.needle_diameter_mm)));
+        for l in &s.layers {
+            out.push_str(&format!(
+                "        Layer {{ thickness_mm: {}, stiffness_scale: {}, puncture_force_n: {}, cutting_force_n: {}, friction: Karnopp {{ static_n_per_mm: {}, coulomb_n_per_mm: {}, viscous_n_s_per_mm2: {}, stick_band_mm_per_s: {} }}, track_stiffness_n_per_mm2: {} }}, // {}\n",
+                lit(l.thickness_mm),
+                lit(l.stiffness_scale),
+                lit(l.puncture_force_n),
+                lit(l.cutting_force_n),
+                lit(l.friction_static_n_per_mm),
+                lit(l.friction_coulomb_n_per_mm),
+                lit(l.friction_viscous_n_s_per_mm2),
+                lit(l.stick_band_mm_per_s),
+                lit(l.track_stiffness_n_per_mm2),
+                l.name.replace('\n', " ")
+            ));
+        }
+        out.push_str("    ],\n};\n\n");
+    }
+    let names: Vec<String> = stacks.iter().map(|(_, s)| s.name.to_uppercase()).collect();
+    out.push_str(&format!(
+        "/// Every stack of the set, by file name.\npub const ALL: [Stack<'static>; {}] = [{}];\n",
+        names.len(),
+        names.join(", ")
+    ));
+    out
+}
+
+/// The f32 nearest to `v` (the format checks f32's range), as an exact literal.
+fn lit(v: f64) -> String {
+    #[allow(clippy::cast_possible_truncation)]
+    f32_literal(v as f32)
+}

@@ -1,0 +1,97 @@
+//! The golden insertion trajectories: shared, as source, by the `insertion_golden`
+//! firmware (QEMU) and the host tests that run the same ticks on the host, through the
+//! C API and in wasm (host-tests/tests/insertion_golden.rs includes this file), so every
+//! platform steps the same f32 poses. Plain f32 arithmetic (no FMA, no libm): the same
+//! bits everywhere.
+//!
+//! Each path is a list of waypoints `(ticks to reach it, [x_mm, z_mm, theta_x_deg,
+//! theta_z_deg, depth_mm])` from a start pose above the surface; between two waypoints
+//! every input moves linearly, `a + (b - a) * (k / n)` at tick k of n. 1 kHz.
+#![allow(dead_code)]
+
+/// One waypoint: ticks to reach it from the previous one, and the pose there.
+pub type Waypoint = (u32, [f32; 5]);
+
+/// Five paths: a slow straight insertion and withdrawal; insert, hold, partial
+/// withdrawal, re-insertion past the deepest point, leave; an offset tilted needle that
+/// drifts sideways and tilts inside the track; jitter in depth at a puncture and deep
+/// inside; fast in and out twice.
+pub const PATHS: [&[Waypoint]; 5] = [
+    &[(1, [0.0, 0.0, 0.0, 0.0, -1.0]), (14_000, [0.0, 0.0, 0.0, 0.0, 41.0]), (14_000, [0.0, 0.0, 0.0, 0.0, -1.0])],
+    &[
+        (1, [0.0, 0.0, 0.0, 0.0, -1.0]),
+        (2_600, [0.0, 0.0, 0.0, 0.0, 25.0]),
+        (200, [0.0, 0.0, 0.0, 0.0, 25.0]),
+        (1_500, [0.0, 0.0, 0.0, 0.0, 10.0]),
+        (3_000, [0.0, 0.0, 0.0, 0.0, 35.0]),
+        (300, [0.0, 0.0, 0.0, 0.0, 35.0]),
+        (3_600, [0.0, 0.0, 0.0, 0.0, -1.0]),
+    ],
+    &[
+        (1, [2.0, -1.0, 5.0, -3.0, -1.0]),
+        (6_000, [2.0, -1.0, 5.0, -3.0, 29.0]),
+        (1_000, [2.5, -0.8, 6.0, -2.0, 31.0]),
+        (1_000, [1.5, -1.2, 3.0, -4.0, 31.0]),
+        (6_400, [2.0, -1.0, 5.0, -3.0, -1.0]),
+    ],
+    &[
+        (1, [0.0, 0.0, 0.0, 0.0, -1.0]),
+        (5_000, [0.0, 0.0, 0.0, 0.0, 14.0]),
+        (40, [0.0, 0.0, 0.0, 0.0, 14.3]),
+        (40, [0.0, 0.0, 0.0, 0.0, 13.9]),
+        (40, [0.0, 0.0, 0.0, 0.0, 14.3]),
+        (40, [0.0, 0.0, 0.0, 0.0, 13.9]),
+        (3_000, [0.0, 0.0, 0.0, 0.0, 23.0]),
+        (25, [0.0, 0.0, 0.0, 0.0, 23.2]),
+        (25, [0.0, 0.0, 0.0, 0.0, 22.9]),
+        (25, [0.0, 0.0, 0.0, 0.0, 23.2]),
+        (25, [0.0, 0.0, 0.0, 0.0, 22.9]),
+        (4_000, [0.0, 0.0, 0.0, 0.0, -1.0]),
+    ],
+    &[
+        (1, [-1.0, 1.5, -2.0, 4.0, -1.0]),
+        (1_300, [-1.0, 1.5, -2.0, 4.0, 38.0]),
+        (1_300, [-1.0, 1.5, -2.0, 4.0, -1.0]),
+        (1_300, [-1.0, 1.5, -2.0, 4.0, 38.0]),
+        (1_300, [-1.0, 1.5, -2.0, 4.0, -1.0]),
+    ],
+];
+
+/// Every tick's pose of `path`, in order, passed to `f(tick, pose)`.
+pub fn for_each_tick(path: &[Waypoint], mut f: impl FnMut(u32, [f32; 5])) {
+    let Some(&(_, start)) = path.first() else { return };
+    let mut tick = 0u32;
+    f(tick, start);
+    let mut from = start;
+    for &(n, to) in path.iter().skip(1) {
+        for k in 1..=n {
+            tick += 1;
+            let u = k as f32 / n as f32;
+            let mut p = [0.0f32; 5];
+            for ((q, a), b) in p.iter_mut().zip(from).zip(to) {
+                *q = a + (b - a) * u;
+            }
+            f(tick, p);
+        }
+        from = to;
+    }
+}
+
+/// FNV-1a over 32-bit words: the digest of a path's outputs (each tick's six wrench
+/// bits, status, phase code and punctures).
+#[derive(Clone, Copy)]
+pub struct Digest(pub u64);
+
+impl Digest {
+    /// The empty digest.
+    pub const fn new() -> Self {
+        Self(0xcbf2_9ce4_8422_2325)
+    }
+    /// Adds one word.
+    pub fn word(&mut self, w: u32) {
+        for b in w.to_le_bytes() {
+            self.0 ^= u64::from(b);
+            self.0 = self.0.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+}

@@ -1,0 +1,85 @@
+//! Firmware example `insertion_golden`: every golden insertion trajectory
+//! (`common/insertion_paths.rs`) through every compiled-in tissue stack, at 1 kHz, with
+//! the insertion model; prints per path the tick count, the punctures and the FNV-1a
+//! digest of every tick's output (six wrench bits, status, phase code, punctures), for
+//! the host to compare with its own run of the same ticks
+//! (host-tests/tests/insertion_golden.rs).
+//!
+//! Output (semihosting stdout):
+//!
+//! ```text
+//! needle-insertion-golden target=<triple> set=<SET> stacks=<n> paths=<n>
+//! stack=<name> path=<i> ticks=<n> punctures=<n> digest_hi=0x<8 hex> digest_lo=0x<8 hex>
+//! ...
+//! needle-insertion-golden end
+//! ```
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+#[cfg(target_os = "none")]
+mod common;
+
+#[cfg(target_os = "none")]
+mod firmware {
+    use crate::common::insertion_paths::{for_each_tick, Digest, PATHS};
+    use crate::common::{exit, Out};
+    use needle_haptics::insertion::{stacks, Insertion, InsertionConfig};
+    use needle_haptics::{model_info, Pose};
+
+    #[cortex_m_rt::entry]
+    fn main() -> ! {
+        let mut out = Out::new();
+        out.str("needle-insertion-golden target=");
+        out.str(crate::common::target_name());
+        out.str(" set=");
+        out.str(model_info::SET);
+        out.str(" stacks=");
+        out.dec(stacks::ALL.len() as u64);
+        out.str(" paths=");
+        out.dec(PATHS.len() as u64);
+        out.nl();
+        let mut ok = true;
+        for stack in &stacks::ALL {
+            for (i, path) in PATHS.iter().enumerate() {
+                let Ok(mut insertion) = Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ) else {
+                    ok = false;
+                    continue;
+                };
+                let mut digest = Digest::new();
+                let (mut ticks, mut punctures) = (0u64, 0u64);
+                for_each_tick(path, |_, p| {
+                    let e = insertion.step(&Pose { x_mm: p[0], z_mm: p[1], theta_x_deg: p[2], theta_z_deg: p[3], depth_mm: p[4] });
+                    for c in e.wrench.to_array() {
+                        digest.word(c.to_bits());
+                    }
+                    digest.word(u32::from(e.status.bits()));
+                    digest.word(u32::from(e.phase.code()));
+                    digest.word(u32::from(e.punctures));
+                    ticks += 1;
+                    punctures += u64::from(e.punctures);
+                });
+                out.str("stack=");
+                out.str(stack.name);
+                out.str(" path=");
+                out.dec(i as u64);
+                out.str(" ticks=");
+                out.dec(ticks);
+                out.str(" punctures=");
+                out.dec(punctures);
+                out.str(" digest_hi=");
+                out.hex((digest.0 >> 32) as u32, 8);
+                out.str(" digest_lo=");
+                out.hex(digest.0 as u32, 8);
+                out.nl();
+            }
+        }
+        out.str("needle-insertion-golden end");
+        out.nl();
+        out.flush();
+        exit(ok)
+    }
+}
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    eprintln!("`insertion_golden` is firmware: cargo run --release --example insertion_golden --target thumbv7em-none-eabihf");
+}

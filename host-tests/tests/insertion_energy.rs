@@ -1,0 +1,160 @@
+//! Passivity of the whole insertion on a 1-DOF device: 1,000 random trajectories
+//! (insert, hold, withdraw, re-insert, jitter, leave) through every shipped stack, the
+//! insertion model's force held between ticks (zero-order hold, 1 kHz), the hand moving
+//! the needle along the vertical axis at the centre.
+//!
+//! The hand grips the device's handle and prescribes its motion `d(t)` (depth, mm), a
+//! chain of smoothstep moves `d = d0 + Δ (3u² - 2u³)` that start and end at rest; the
+//! device has mass `m` and physical damping `b`. The energy the device delivers to the
+//! hand over a trajectory that starts and ends at rest, outside the tissue (a closed
+//! cycle: the insertion state is back to its start, the needle above the surface), is
+//!
+//! ```text
+//! E = Σ_k F_k Δd_k - b ∫ ḋ² dt       (N·mm; the mass gives back what it took)
+//! ```
+//!
+//! with `F_k` the rendered axial force of tick k (fy, upward on the needle, resisting a
+//! depth increase, so its power into the hand is `-fy ḋ`... written with the sign here:
+//! the hand does work `fy Δd` against it) held over the tick's depth change `Δd_k`, and
+//! `∫ ḋ² dt = 1.2 Δ² / T` exactly for each smoothstep move of length Δ and duration T.
+//! Passive: `E <= 0` for every trajectory.
+//!
+//! The bound 1e-9 J (1e-6 N·mm) on what f32 round-off may add: the sums run in f64 over
+//! f32 forces; a conservative field evaluated exactly would give `Σ F Δd` = the work
+//! of the field, and f32 rounding of each force (relative 6e-8 of at most a few N)
+//! over a path of at most 400 mm of travel changes it by less than 400 * 3 N * 6e-8 =
+//! 7e-5 N·mm in the worst case, but only its non-cancelling part accumulates: the
+//! dissipation of friction and puncture over any path is orders above it, so the
+//! assertion is `E <= 1e-6 N·mm`.
+use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, Stack};
+use needle_haptics::Pose;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+const PERIOD_S: f64 = 0.001;
+/// Device damping along the insertion, N·s/mm (1 N·s/m).
+const DAMPING_N_S_PER_MM: f64 = 0.001;
+const TRAJECTORIES: usize = 1000;
+const BOUND_NMM: f64 = 1e-6;
+
+/// One smoothstep move: from `from_mm` to `to_mm` over `duration_s`.
+#[derive(Clone, Copy, Debug)]
+struct Move {
+    from_mm: f64,
+    to_mm: f64,
+    duration_s: f64,
+}
+
+impl Move {
+    fn at(&self, t: f64) -> f64 {
+        let u = (t / self.duration_s).clamp(0.0, 1.0);
+        self.from_mm + (self.to_mm - self.from_mm) * u * u * (3.0 - 2.0 * u)
+    }
+    fn damping_integral(&self) -> f64 {
+        // ∫ ḋ² dt over the move
+        if self.duration_s > 0.0 {
+            1.2 * (self.to_mm - self.from_mm).powi(2) / self.duration_s
+        } else {
+            0.0
+        }
+    }
+}
+
+/// Where the hand is at the end of `moves` (it starts 1 mm above the surface).
+fn at(moves: &[Move]) -> f64 {
+    moves.last().map_or(-1.0, |m| m.to_mm)
+}
+
+/// Appends a move from where the hand is to `to_mm` at about `speed_mm_per_s`.
+fn go(moves: &mut Vec<Move>, to_mm: f64, speed_mm_per_s: f64) {
+    let from_mm = at(moves);
+    let duration_s = ((to_mm - from_mm).abs() / speed_mm_per_s).max(0.002);
+    moves.push(Move { from_mm, to_mm, duration_s });
+}
+
+/// A random trajectory: start above the surface, a few random actions, leave.
+fn trajectory(rng: &mut ChaCha8Rng, deepest_mm: f64) -> Vec<Move> {
+    let mut moves = Vec::new();
+    for _ in 0..rng.gen_range(2..8) {
+        match rng.gen_range(0..5) {
+            0 | 1 => {
+                let to = rng.gen_range(0.0..deepest_mm);
+                go(&mut moves, to, rng.gen_range(0.5..30.0));
+            }
+            2 => {
+                let here = at(&moves);
+                moves.push(Move { from_mm: here, to_mm: here, duration_s: rng.gen_range(0.01..0.5) });
+            }
+            3 => {
+                let to = (at(&moves) - rng.gen_range(0.0..10.0)).max(-0.5);
+                go(&mut moves, to, rng.gen_range(0.5..30.0));
+            }
+            _ => {
+                let amplitude = rng.gen_range(0.005..0.5);
+                let centre = at(&moves);
+                for _ in 0..rng.gen_range(2..12) {
+                    go(&mut moves, centre + amplitude, rng.gen_range(1.0..60.0));
+                    go(&mut moves, centre - amplitude, rng.gen_range(1.0..60.0));
+                }
+                go(&mut moves, centre, 10.0);
+            }
+        }
+    }
+    go(&mut moves, -1.0, rng.gen_range(2.0..30.0));
+    moves
+}
+
+/// The hand's depth at time `t` along the chain of moves (the last one's end after it).
+fn depth_at(moves: &[Move], mut t: f64) -> f64 {
+    for m in moves {
+        if t <= m.duration_s {
+            return m.at(t);
+        }
+        t -= m.duration_s;
+    }
+    moves.last().map_or(0.0, |m| m.to_mm)
+}
+
+/// The energy delivered to the hand over the trajectory (N·mm), and the punctures.
+fn energy(stack: &Stack<'_>, moves: &[Move]) -> (f64, usize) {
+    let mut insertion = Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ).expect("shipped stack");
+    let total_s: f64 = moves.iter().map(|m| m.duration_s).sum();
+    let damping: f64 = moves.iter().map(|m| DAMPING_N_S_PER_MM * m.damping_integral()).sum();
+    let (mut work, mut punctures) = (0.0, 0);
+    let mut tick: u64 = 0;
+    loop {
+        let t = tick as f64 * PERIOD_S;
+        if t >= total_s {
+            break;
+        }
+        let d = depth_at(moves, t);
+        let e = insertion.step(&Pose { depth_mm: d as f32, ..Pose::default() });
+        punctures += usize::from(e.punctures);
+        // the force of tick k, held until tick k + 1 (or the end of the trajectory)
+        let next = ((tick + 1) as f64 * PERIOD_S).min(total_s);
+        work += f64::from(e.wrench.fy_n) * (depth_at(moves, next) - d);
+        tick += 1;
+    }
+    // the hand did `work` against the force (fy resists a depth increase): the device
+    // gives `-work` back to the hand, minus what its damping took
+    (-work - damping, punctures)
+}
+
+#[test]
+fn no_closed_cycle_delivers_energy_to_the_hand() {
+    assert!(!stacks::ALL.is_empty(), "the default set ships tissue stacks");
+    let mut rng = ChaCha8Rng::seed_from_u64(20261126);
+    for stack in &stacks::ALL {
+        let deepest: f64 = stack.layers.iter().map(|l| f64::from(l.thickness_mm)).sum::<f64>() + 5.0;
+        let (mut worst, mut punctured) = (f64::NEG_INFINITY, 0);
+        for n in 0..TRAJECTORIES {
+            let moves = trajectory(&mut rng, deepest);
+            let (e, p) = energy(stack, &moves);
+            punctured += usize::from(p > 0);
+            assert!(e <= BOUND_NMM, "{}: trajectory {n} delivered {e:e} N·mm to the hand: {moves:?}", stack.name);
+            worst = worst.max(e);
+        }
+        println!("{}: {TRAJECTORIES} trajectories ({punctured} with a puncture), most energy to the hand {worst:e} N·mm", stack.name);
+        assert!(punctured > TRAJECTORIES / 4, "{}: only {punctured} trajectories punctured: the test must cross punctures", stack.name);
+    }
+}

@@ -1,0 +1,192 @@
+//! Golden insertion sequences: the five trajectories of `examples/common/insertion_paths.rs`
+//! through every shipped tissue stack give the same bits on the host and on the
+//! emulated Cortex-M4F, M3 and M0 (the `insertion_golden` firmware under QEMU): every
+//! tick's six wrench components, status, phase and punctures, compared as a digest per
+//! path (FNV-1a over every tick's words; one differing bit changes it).
+#[path = "../../examples/common/insertion_paths.rs"]
+mod paths;
+
+use needle_firmware_host::{build, core, qemu};
+use needle_haptics::insertion::{stacks, Insertion, InsertionConfig};
+use needle_haptics::Pose;
+use paths::{for_each_tick, Digest, PATHS};
+use std::time::Duration;
+
+/// The host's lines, in the firmware's format.
+fn host_lines() -> Vec<String> {
+    let mut lines = Vec::new();
+    for stack in &stacks::ALL {
+        for (i, path) in PATHS.iter().enumerate() {
+            let mut insertion = Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ).expect("shipped stack");
+            let mut digest = Digest::new();
+            let (mut ticks, mut punctures) = (0u64, 0u64);
+            for_each_tick(path, |_, p| {
+                let e = insertion.step(&Pose { x_mm: p[0], z_mm: p[1], theta_x_deg: p[2], theta_z_deg: p[3], depth_mm: p[4] });
+                for c in e.wrench.to_array() {
+                    digest.word(c.to_bits());
+                }
+                digest.word(u32::from(e.status.bits()));
+                digest.word(u32::from(e.phase.code()));
+                digest.word(u32::from(e.punctures));
+                ticks += 1;
+                punctures += u64::from(e.punctures);
+            });
+            lines.push(format!(
+                "stack={} path={i} ticks={ticks} punctures={punctures} digest_hi={:#010x} digest_lo={:#010x}",
+                stack.name,
+                (digest.0 >> 32) as u32,
+                digest.0 as u32
+            ));
+        }
+    }
+    lines
+}
+
+#[test]
+fn the_golden_paths_cross_punctures_and_withdraw() {
+    assert!(!stacks::ALL.is_empty(), "the default set ships tissue stacks");
+    for line in host_lines() {
+        let punctures: u64 = line.split(' ').find_map(|w| w.strip_prefix("punctures=")).and_then(|v| v.parse().ok()).expect("punctures");
+        assert!(punctures >= 1, "every golden path punctures at least once: {line}");
+    }
+}
+
+fn on(core_name: &str) {
+    let core = core(core_name).unwrap_or_else(|e| panic!("{e:#}"));
+    let set = needle_firmware_host::compiled_set();
+    let elf = build::build_examples(&core, &["insertion_golden"], &set).unwrap_or_else(|e| panic!("{e:#}")).remove(0);
+    let run = qemu::run(&core, &elf, false, Duration::from_secs(900)).unwrap_or_else(|e| panic!("{e:#}"));
+    assert!(run.status.success(), "{core_name}: exit {}: {}\n{}", run.status, run.stdout, run.stderr);
+    let got: Vec<&str> = run.stdout.lines().filter(|l| l.starts_with("stack=")).collect();
+    let want = host_lines();
+    assert_eq!(got.len(), want.len(), "{core_name}: {} paths printed, the host has {}:\n{}", got.len(), want.len(), run.stdout);
+    for (g, w) in got.iter().zip(&want) {
+        assert_eq!(g, w, "{core_name}: the firmware's path differs from the host's");
+    }
+    assert!(run.stdout.lines().any(|l| l == "needle-insertion-golden end"), "{core_name}: no end line");
+    println!("{core_name}: {} golden insertion paths bit-exact ({:.1} s under QEMU)", got.len(), run.elapsed.as_secs_f64());
+}
+
+#[test]
+fn golden_insertions_on_cortex_m4f_mps2_an386() {
+    on("m4f");
+}
+
+#[test]
+fn golden_insertions_on_cortex_m3_mps2_an385() {
+    on("m3");
+}
+
+#[test]
+fn golden_insertions_on_cortex_m0_microbit() {
+    on("m0");
+}
+
+/// The C API's run of the paths (`needle_insertion_*` through their C ABI), in the
+/// firmware's line format.
+fn c_api_lines() -> Vec<String> {
+    use needle_capi::{
+        needle_insertion_init, needle_insertion_result_t, needle_insertion_step, needle_insertion_t, needle_pose_t, NEEDLE_OK,
+    };
+    let mut lines = Vec::new();
+    for stack in &stacks::ALL {
+        let name = std::ffi::CString::new(stack.name).expect("stack name");
+        for (i, path) in PATHS.iter().enumerate() {
+            let mut state = needle_insertion_t { storage: [0; needle_capi::NEEDLE_INSERTION_STORAGE_WORDS], magic: 0 };
+            let config = InsertionConfig::DEFAULT_1KHZ;
+            // SAFETY: valid pointers to local values and a NUL-terminated name.
+            let rc = unsafe { needle_insertion_init(&mut state, name.as_ptr(), config.period_s, config.velocity_time_constant_s) };
+            assert_eq!(rc, NEEDLE_OK, "needle_insertion_init({})", stack.name);
+            let mut digest = Digest::new();
+            let (mut ticks, mut punctures) = (0u64, 0u64);
+            for_each_tick(path, |_, p| {
+                let pose = needle_pose_t { x_mm: p[0], z_mm: p[1], theta_x_deg: p[2], theta_z_deg: p[3], depth_mm: p[4] };
+                let mut out = needle_insertion_result_t::default();
+                // SAFETY: valid pointers to local values; the state was initialised above.
+                assert_eq!(unsafe { needle_insertion_step(&mut state, &pose, &mut out) }, NEEDLE_OK);
+                let w = out.wrench;
+                for c in [w.fx_n, w.fy_n, w.fz_n, w.mx_nmm, w.my_nmm, w.mz_nmm] {
+                    digest.word(c.to_bits());
+                }
+                digest.word(u32::from(out.status));
+                digest.word(u32::from(out.phase));
+                digest.word(u32::from(out.punctures));
+                ticks += 1;
+                punctures += u64::from(out.punctures);
+            });
+            lines.push(format!(
+                "stack={} path={i} ticks={ticks} punctures={punctures} digest_hi={:#010x} digest_lo={:#010x}",
+                stack.name,
+                (digest.0 >> 32) as u32,
+                digest.0 as u32
+            ));
+        }
+    }
+    lines
+}
+
+#[test]
+fn golden_insertions_through_the_c_api() {
+    assert_eq!(c_api_lines(), host_lines());
+}
+
+#[test]
+fn the_c_api_refuses_bad_arguments() {
+    use needle_capi::*;
+    let mut state = needle_insertion_t { storage: [0; NEEDLE_INSERTION_STORAGE_WORDS], magic: 0 };
+    let liver = c"liver";
+    let pose = needle_pose_t::default();
+    let mut out = needle_insertion_result_t::default();
+    // SAFETY: valid or NULL pointers, as each case says.
+    unsafe {
+        assert_eq!(needle_insertion_step(&mut state, &pose, &mut out), NEEDLE_E_UNINIT);
+        assert_eq!(needle_insertion_init(std::ptr::null_mut(), liver.as_ptr(), 0.001, 0.005), NEEDLE_E_NULL);
+        assert_eq!(needle_insertion_init(&mut state, c"no-such-stack".as_ptr(), 0.001, 0.005), NEEDLE_E_ARG);
+        assert_eq!(needle_insertion_init(&mut state, liver.as_ptr(), 0.0, 0.005), NEEDLE_E_CONFIG);
+        assert_eq!(needle_insertion_init(&mut state, liver.as_ptr(), f32::INFINITY, 0.005), NEEDLE_E_CONFIG);
+        assert_eq!(needle_insertion_init(&mut state, liver.as_ptr(), 0.001, f32::NAN), NEEDLE_E_CONFIG);
+        assert_eq!(state.magic, 0, "nothing written on an error");
+        assert_eq!(needle_insertion_init(&mut state, liver.as_ptr(), 0.001, 0.005), NEEDLE_OK);
+        assert_eq!(needle_insertion_step(&mut state, std::ptr::null(), &mut out), NEEDLE_E_NULL);
+        assert_eq!(needle_insertion_set_scales(&mut state, [1.0f32].as_ptr(), 99), NEEDLE_E_ARG);
+        assert_eq!(needle_insertion_set_scales(&mut state, std::ptr::null(), 1), NEEDLE_E_NULL);
+        assert_eq!(needle_insertion_reset(std::ptr::null_mut()), NEEDLE_E_NULL);
+    }
+}
+
+#[test]
+fn golden_insertions_in_wasm_under_node() {
+    let root = needle_firmware_host::workspace_root();
+    let set = root.join("coeffs/default");
+    let wasm = needle_explore::wasm::build(&set).expect("build the wasm evaluator");
+    let dir = tempfile::tempdir().expect("temp dir");
+    let poses = dir.path().join("poses.txt");
+    let mut text = String::new();
+    for (s, _) in stacks::ALL.iter().enumerate() {
+        for (i, path) in PATHS.iter().enumerate() {
+            for_each_tick(path, |_, p| {
+                text.push_str(&format!(
+                    "{s} {i} {:x} {:x} {:x} {:x} {:x}\n",
+                    p[0].to_bits(),
+                    p[1].to_bits(),
+                    p[2].to_bits(),
+                    p[3].to_bits(),
+                    p[4].to_bits()
+                ));
+            });
+        }
+    }
+    std::fs::write(&poses, text).expect("poses file");
+    let names: Vec<&str> = stacks::ALL.iter().map(|s| s.name).collect();
+    let out = std::process::Command::new("node")
+        .arg(root.join("host-tests/tests/explore/insertion.mjs"))
+        .arg(&wasm)
+        .arg(&poses)
+        .env("NEEDLE_STACK_NAMES", names.join(","))
+        .output()
+        .expect("node must be installed (apt nodejs): the wasm check runs under it");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "node: {stdout}{}", String::from_utf8_lossy(&out.stderr));
+    let got: Vec<String> = stdout.lines().map(str::to_string).collect();
+    assert_eq!(got, host_lines(), "the wasm module's insertion differs from the host's");
+}

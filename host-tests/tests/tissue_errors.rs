@@ -1,0 +1,116 @@
+//! Bad tissue files are refused with their file and line, by the one reader that
+//! `build.rs` and `needle calibrate` share (`needle_codegen::tissue`), and a good one
+//! (every shipped stack) is read.
+use needle_codegen::tissue::{parse_stack, parse_stack_str, read_stacks};
+use std::path::Path;
+
+const GOOD: &str = r#"format = 1
+name = "two"
+description = "two layers"
+needle_diameter_mm = 1.27
+
+[[layer]]
+name = "capsule"
+thickness_mm = 10.0
+stiffness_scale = 2.0
+puncture_force_n = 1.4
+cutting_force_n = 0.1
+friction_static_n_per_mm = 0.01
+friction_coulomb_n_per_mm = 0.01
+friction_viscous_n_s_per_mm2 = 0.0
+stick_band_mm_per_s = 1.0
+track_stiffness_n_per_mm2 = 0.0
+source = "test"
+
+[[layer]]
+name = "parenchyma"
+thickness_mm = 20.0
+stiffness_scale = 1.0
+puncture_force_n = 1.0
+cutting_force_n = 0.2
+friction_static_n_per_mm = 0.02
+friction_coulomb_n_per_mm = 0.02
+friction_viscous_n_s_per_mm2 = 0.0
+stick_band_mm_per_s = 1.0
+track_stiffness_n_per_mm2 = 0.0
+source = "test"
+"#;
+
+/// The line (1-based) of the `n`-th occurrence of `key =` in GOOD.
+fn line_of(key: &str, n: usize) -> usize {
+    GOOD.lines().enumerate().filter(|(_, l)| l.starts_with(&format!("{key} ="))).nth(n).map(|(i, _)| i + 1).expect("key in GOOD")
+}
+
+/// GOOD with the `n`-th `key = ...` line replaced by `key = value`.
+fn with(key: &str, n: usize, value: &str) -> String {
+    let target = line_of(key, n);
+    GOOD.lines()
+        .enumerate()
+        .map(|(i, l)| if i + 1 == target { format!("{key} = {value}") } else { l.to_string() })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+#[test]
+fn a_good_file_is_read() {
+    let s = parse_stack_str(GOOD, Path::new("two.toml")).expect("good file");
+    assert_eq!(s.layers.len(), 2);
+    assert_eq!(s.layers[1].name, "parenchyma");
+}
+
+#[test]
+fn out_of_range_values_are_refused_at_their_line() {
+    let cases = [
+        ("thickness_mm", 1, "-1.0"),
+        ("thickness_mm", 0, "0.0"),
+        ("stiffness_scale", 0, "0.0"),
+        ("stiffness_scale", 1, "-2.0"),
+        ("puncture_force_n", 0, "0.0"),
+        ("cutting_force_n", 1, "-0.1"),
+        ("friction_static_n_per_mm", 0, "-0.01"),
+        ("friction_coulomb_n_per_mm", 1, "-0.01"),
+        ("friction_viscous_n_s_per_mm2", 0, "-1e-3"),
+        ("stick_band_mm_per_s", 1, "0.0"),
+        ("track_stiffness_n_per_mm2", 0, "-1.0"),
+        ("needle_diameter_mm", 0, "0.0"),
+        ("thickness_mm", 0, "nan"),
+        ("puncture_force_n", 1, "inf"),
+        ("stiffness_scale", 0, "1e39"),
+    ];
+    for (key, n, value) in cases {
+        let text = with(key, n, value);
+        let e = parse_stack_str(&text, Path::new("bad.toml")).expect_err(&format!("{key} = {value} must be refused"));
+        assert_eq!(e.line, Some(line_of(key, n)), "{key} = {value}: {e}");
+        assert!(e.message.starts_with(&format!("{key} = ")), "{key} = {value}: the message names the field: {e}");
+        assert!(e.to_string().starts_with("bad.toml:"), "{e}");
+    }
+}
+
+#[test]
+fn a_missing_field_an_unknown_field_and_a_bad_name_are_refused() {
+    let target = line_of("cutting_force_n", 1);
+    let missing: String = GOOD.lines().enumerate().filter(|(i, _)| i + 1 != target).map(|(_, l)| format!("{l}\n")).collect();
+    let e = parse_stack_str(&missing, Path::new("bad.toml")).expect_err("missing field");
+    assert!(e.message.contains("cutting_force_n"), "{e}");
+    assert!(e.line.is_some(), "{e}");
+
+    let unknown = GOOD.replacen("source = \"test\"", "source = \"test\"\nfriction = 0.5", 1);
+    let e = parse_stack_str(&unknown, Path::new("bad.toml")).expect_err("unknown field");
+    assert!(e.message.contains("friction"), "{e}");
+
+    let e = parse_stack_str(&with("name", 0, "\"Two Layers\""), Path::new("bad.toml")).expect_err("bad name");
+    assert_eq!(e.line, Some(2), "{e}");
+
+    let e = parse_stack_str(&with("format", 0, "2"), Path::new("bad.toml")).expect_err("format");
+    assert_eq!(e.line, Some(1), "{e}");
+}
+
+#[test]
+fn every_shipped_stack_is_read_and_named_after_its_file() {
+    let set = Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default");
+    let stacks = read_stacks(&set).expect("shipped stacks");
+    assert!(!stacks.is_empty(), "coeffs/default/tissue/ holds the shipped stacks");
+    for (path, stack) in &stacks {
+        assert_eq!(parse_stack(path).expect("readable"), *stack);
+    }
+}

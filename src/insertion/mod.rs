@@ -1,0 +1,410 @@
+//! The whole insertion: an [`Insertion`] follows one needle path through a tissue
+//! [`Stack`], tick by tick, and gives the wrench of every phase.
+//!
+//! **The phases** (the tip at path coordinate `depth_mm`, mm along the needle's axis
+//! below the top surface; layer `j`'s upper boundary at path coordinate
+//! `q_j = (sum of the thicknesses above it) / a_y`, `a_y` the vertical component of the
+//! needle's axis):
+//!
+//! - *approach* (`depth_mm <= 0`): no contact, the zero wrench. The tip leaving the
+//!   tissue ends the path: the next contact is a new insertion (new puncture).
+//! - *deflecting* boundary `m` (the first not yet punctured, `depth_mm > q_m`): the FE
+//!   surrogate [`extended_wrench`](crate::extended_wrench) (past 6 mm the FE depth
+//!   extension) at the indentation `depth_mm - q_m`, times the
+//!   layer's stiffness scale `s_m` (the scaling law), carried from the set's FE needle to
+//!   the stack's by geometric similarity: with `λ = needle_diameter_mm /
+//!   FE_NEEDLE_DIAMETER_MM`, the surrogate is evaluated at `x/λ, z/λ, δ/λ` (tilts
+//!   unchanged) and its forces are scaled by `s λ²`, its moments by `s λ³` (the hub at
+//!   `λ` times the FE needle's). Elastic: withdrawing gives the same force back.
+//! - *puncture*: when the deflection's axial force (along the needle, pushing it back)
+//!   reaches the layer's `puncture_force_n`, the boundary is punctured in that tick: its
+//!   axial force is gone (the cue), its lateral force and moments stay as the track's
+//!   preload, so the five lateral components are continuous. A puncture can be followed
+//!   by the next boundary's in the same tick (a thin layer).
+//! - *cutting* layer `m - 1`: while the tip advances past the deepest point it reached
+//!   (the track's end), the layer's `cutting_force_n` opposes it, ramped in over the
+//!   layer's stick band of speed (zero for a needle at rest).
+//! - *in the track*: behind the track's end (withdrawal, or re-advance after one) only
+//!   friction acts; past the end cutting resumes, with no new puncture.
+//! - everywhere after the first puncture: shaft friction ([`Karnopp`]) per mm of shaft in
+//!   each punctured layer, and the track's lateral hold (`track` module: springs per mm
+//!   of shaft that keep it on the line it had at the first puncture).
+//!
+//! **Velocity** (mm/s along the axis) comes from the pose stream: the backward difference
+//! of `depth_mm` over the tick's period, low-passed by a first-order filter of time
+//! constant [`InsertionConfig::velocity_time_constant_s`]. Friction and cutting use it
+//! only when it has the sign of the last tick's motion (else zero): they never push the
+//! needle the way it last moved, so they only take energy out.
+//!
+//! f32 throughout, `libm` for the trigonometry: the same bits on every target.
+mod stack;
+mod track;
+
+pub use stack::{stacks, Karnopp, Layer, Stack, FE_NEEDLE_DIAMETER_MM, HUB_FROM_TIP_MM, MAX_LAYERS};
+
+use crate::{extended_wrench, Pose, Status, Wrench};
+use track::{axis, dot, Track, Vec3};
+
+/// The insertion's tick settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct InsertionConfig {
+    /// The period of the pose stream, s (finite, > 0; 0.001 at 1 kHz).
+    pub period_s: f32,
+    /// Time constant of the velocity's low-pass filter, s (finite, >= 0; 0: unfiltered).
+    pub velocity_time_constant_s: f32,
+}
+
+impl InsertionConfig {
+    /// 1 kHz, velocity filtered with a 5 ms time constant (cut-off about 32 Hz: the
+    /// hand's motion passes, one tick's quantisation noise of the position is averaged
+    /// over five ticks).
+    pub const DEFAULT_1KHZ: Self = Self { period_s: 0.001, velocity_time_constant_s: 0.005 };
+}
+
+/// Why an [`Insertion`] could not be made or changed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
+pub enum InsertionError {
+    /// The stack has no layer or more than [`MAX_LAYERS`].
+    LayerCount,
+    /// A layer value is out of its range (the tissue file's checks), or the needle
+    /// diameters are not finite and > 0.
+    Value,
+    /// The configuration's period or time constant is out of range.
+    Config,
+    /// [`Insertion::set_scales`] got a count other than the stack's layers, or a scale
+    /// that is not finite and > 0.
+    Scales,
+}
+
+impl core::fmt::Display for InsertionError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            Self::LayerCount => "tissue stack: 1 to 8 layers",
+            Self::Value => "tissue stack: a value out of range (thickness, scale, puncture force, stick band > 0; the rest >= 0)",
+            Self::Config => "insertion config: period_s must be finite and > 0, velocity_time_constant_s finite and >= 0",
+            Self::Scales => "stiffness scales: one per layer, each finite and > 0",
+        })
+    }
+}
+
+impl core::error::Error for InsertionError {}
+
+/// Where the tip is, as the last tick found it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Phase {
+    /// Above the surface: no contact.
+    #[default]
+    Approach,
+    /// Pressing on the upper boundary of this layer (not yet punctured).
+    Deflecting(u8),
+    /// Cutting through this layer (at the track's end, advancing).
+    Cutting(u8),
+    /// Inside the cut track, behind its end, in this layer (withdrawing, holding or
+    /// re-advancing).
+    InTrack(u8),
+}
+
+impl Phase {
+    /// The phase as one number: `0` approach, `0x100 | layer` deflecting,
+    /// `0x200 | layer` cutting, `0x300 | layer` in the track (the C API's and the golden
+    /// sequences' form).
+    #[must_use]
+    pub const fn code(self) -> u16 {
+        match self {
+            Self::Approach => 0,
+            Self::Deflecting(l) => 0x100 | l as u16,
+            Self::Cutting(l) => 0x200 | l as u16,
+            Self::InTrack(l) => 0x300 | l as u16,
+        }
+    }
+}
+
+/// One tick's result.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct InsertionEvaluation {
+    /// The wrench on the needle (block frame; N, N·mm about the hub).
+    pub wrench: Wrench,
+    /// The surrogate's status while deflecting (saturation), `ERROR` for a pose that is
+    /// not finite (then the wrench is zero and the state is unchanged).
+    pub status: Status,
+    /// The phase after this tick.
+    pub phase: Phase,
+    /// Boundaries punctured in this tick (0 in most ticks).
+    pub punctures: u8,
+    /// The filtered axial velocity, mm/s (positive inserting).
+    pub velocity_mm_per_s: f32,
+}
+
+/// The wrench of a boundary indented by `indentation_mm` (along the needle) under the
+/// needle `pose` (its `depth_mm` is not used): the FE surrogate scaled by `scale` and
+/// carried to a needle `similarity` times the FE needle's diameter (the module's rule:
+/// evaluated at `x/λ, z/λ, δ/λ`, forces times `scale λ²`, moments times `scale λ³`).
+/// The status is the surrogate's (saturation beyond its domain); `ERROR` and the zero
+/// wrench for a `similarity` that is not finite and > 0.
+#[must_use]
+pub fn deflection(pose: &Pose, indentation_mm: f32, scale: f32, similarity: f32) -> crate::Evaluation {
+    let lambda = similarity;
+    if !positive(lambda) {
+        return crate::Evaluation { wrench: Wrench::ZERO, status: Status::ERROR };
+    }
+    let fe = Pose { x_mm: pose.x_mm / lambda, z_mm: pose.z_mm / lambda, depth_mm: indentation_mm / lambda, ..*pose };
+    let e = extended_wrench(&fe);
+    let (force, moment) = (scale * lambda * lambda, scale * lambda * lambda * lambda);
+    let [fx, fy, fz, mx, my, mz] = e.wrench.to_array();
+    let scaled = [fx * force, fy * force, fz * force, mx * moment, my * moment, mz * moment];
+    crate::Evaluation { wrench: Wrench::from_array(scaled), status: e.status }
+}
+
+/// The needle's unit axis from tip to hub for the pose's tilts (each clamped to ±89
+/// degrees), as the insertion model computes it: `(-sin θz cos θx, cos θz cos θx, sin θx)`
+/// (the [`orientation`](crate::orientation) convention) with f32 polynomials for sine and
+/// cosine (error below 1e-7 against f64: the `track` module).
+#[must_use]
+pub fn needle_axis(pose: &Pose) -> [f32; 3] {
+    axis(pose.theta_x_deg, pose.theta_z_deg)
+}
+
+/// The state of one needle path through a stack: fixed size, no allocation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Insertion {
+    layers: [Layer; MAX_LAYERS],
+    count: usize,
+    similarity: f32,
+    config: InsertionConfig,
+    punctured: usize,
+    track_end_mm: f32,
+    track: Option<Track>,
+    preload: [f32; 6],
+    last_depth_mm: Option<f32>,
+    velocity_mm_per_s: f32,
+}
+
+fn positive(v: f32) -> bool {
+    v.is_finite() && v > 0.0
+}
+
+fn non_negative(v: f32) -> bool {
+    v.is_finite() && v >= 0.0
+}
+
+fn layer_ok(l: &Layer) -> bool {
+    let k = &l.friction;
+    positive(l.thickness_mm)
+        && positive(l.stiffness_scale)
+        && positive(l.puncture_force_n)
+        && positive(k.stick_band_mm_per_s)
+        && [l.cutting_force_n, k.static_n_per_mm, k.coulomb_n_per_mm, k.viscous_n_s_per_mm2, l.track_stiffness_n_per_mm2]
+            .into_iter()
+            .all(non_negative)
+}
+
+impl Insertion {
+    /// A path through `stack`, the needle above the surface.
+    ///
+    /// # Errors
+    /// [`InsertionError::LayerCount`], [`InsertionError::Value`] (the same checks as the
+    /// tissue file's, for a stack built at run time), [`InsertionError::Config`].
+    pub fn new(stack: &Stack<'_>, config: InsertionConfig) -> Result<Self, InsertionError> {
+        if stack.layers.is_empty() || stack.layers.len() > MAX_LAYERS {
+            return Err(InsertionError::LayerCount);
+        }
+        if !stack.layers.iter().all(layer_ok) || !positive(stack.needle_diameter_mm) || !positive(FE_NEEDLE_DIAMETER_MM) {
+            return Err(InsertionError::Value);
+        }
+        if !positive(config.period_s) || !non_negative(config.velocity_time_constant_s) {
+            return Err(InsertionError::Config);
+        }
+        let mut layers = [stack.layers.first().copied().ok_or(InsertionError::LayerCount)?; MAX_LAYERS];
+        for (slot, l) in layers.iter_mut().zip(stack.layers) {
+            *slot = *l;
+        }
+        Ok(Self {
+            layers,
+            count: stack.layers.len(),
+            similarity: stack.needle_diameter_mm / FE_NEEDLE_DIAMETER_MM,
+            config,
+            punctured: 0,
+            track_end_mm: 0.0,
+            track: None,
+            preload: [0.0; 6],
+            last_depth_mm: None,
+            velocity_mm_per_s: 0.0,
+        })
+    }
+
+    /// Replaces the layers' stiffness scales (a per-trainee or per-patient setup, no
+    /// rebuild); the path's state is kept.
+    ///
+    /// # Errors
+    /// [`InsertionError::Scales`]: not one scale per layer, or one not finite and > 0;
+    /// nothing is changed then.
+    pub fn set_scales(&mut self, scales: &[f32]) -> Result<(), InsertionError> {
+        if scales.len() != self.count || !scales.iter().copied().all(positive) {
+            return Err(InsertionError::Scales);
+        }
+        for (l, s) in self.layers.iter_mut().zip(scales) {
+            l.stiffness_scale = *s;
+        }
+        Ok(())
+    }
+
+    /// The layers in use (the stack's, with any scales set).
+    #[must_use]
+    pub fn layers(&self) -> &[Layer] {
+        self.layers.get(..self.count).unwrap_or(&[])
+    }
+
+    /// Forgets the path: the needle is above the surface again (no track, no velocity).
+    pub fn reset(&mut self) {
+        self.end_path();
+        self.last_depth_mm = None;
+        self.velocity_mm_per_s = 0.0;
+    }
+
+    fn end_path(&mut self) {
+        self.punctured = 0;
+        self.track_end_mm = 0.0;
+        self.track = None;
+        self.preload = [0.0; 6];
+    }
+
+    /// One tick: the pose (entry point on the top surface, tilts, `depth_mm` of the tip
+    /// along the axis past the surface plane, negative above it) in, the wrench out.
+    /// Call it once per period of the configuration.
+    pub fn step(&mut self, pose: &Pose) -> InsertionEvaluation {
+        let finite = [pose.x_mm, pose.z_mm, pose.theta_x_deg, pose.theta_z_deg, pose.depth_mm].into_iter().all(f32::is_finite);
+        if !finite {
+            return self.evaluation(Wrench::ZERO, Status::ERROR, Phase::Approach, 0);
+        }
+        let depth = pose.depth_mm;
+        let step_mm = self.last_depth_mm.map_or(0.0, |last| depth - last);
+        self.filter_velocity(step_mm);
+        self.last_depth_mm = Some(depth);
+        // friction and cutting see the velocity only when it has the last motion's sign
+        let v = if self.velocity_mm_per_s * step_mm > 0.0 { self.velocity_mm_per_s } else { 0.0 };
+        if depth <= 0.0 {
+            self.end_path();
+            return self.evaluation(Wrench::ZERO, Status::OK, Phase::Approach, 0);
+        }
+        let a = axis(pose.theta_x_deg, pose.theta_z_deg);
+        let entry: Vec3 = [pose.x_mm, 0.0, pose.z_mm];
+        let (mut w, status, punctures) = self.deflect(pose, a, entry);
+        let phase = self.shaft(pose, a, entry, v, &mut w);
+        let wrench = Wrench::from_array(w);
+        self.evaluation(wrench, status, phase, punctures)
+    }
+
+    fn evaluation(&self, wrench: Wrench, status: Status, phase: Phase, punctures: u8) -> InsertionEvaluation {
+        InsertionEvaluation { wrench, status, phase, punctures, velocity_mm_per_s: self.velocity_mm_per_s }
+    }
+
+    fn filter_velocity(&mut self, step_mm: f32) {
+        let InsertionConfig { period_s: t, velocity_time_constant_s: tau } = self.config;
+        // t > 0 and tau >= 0 (checked in `new`): the divisions are by positive numbers
+        let raw = step_mm / t;
+        let alpha = t / (tau + t);
+        self.velocity_mm_per_s += alpha * (raw - self.velocity_mm_per_s);
+    }
+
+    /// Path coordinate of layer `j`'s upper boundary for a needle of vertical axis
+    /// component `a_y` (`+inf` past the last layer).
+    fn boundary_mm(&self, j: usize, a_y: f32) -> f32 {
+        if j >= self.count {
+            return f32::INFINITY;
+        }
+        let above: f32 = self.layers.iter().take(j).map(|l| l.thickness_mm).sum();
+        above / a_y
+    }
+
+    /// The deflection of the first intact boundary, with the punctures it causes: the
+    /// wrench so far (preload included), the surrogate's status, the punctures.
+    fn deflect(&mut self, pose: &Pose, a: Vec3, entry: Vec3) -> ([f32; 6], Status, u8) {
+        let mut punctures = 0u8;
+        while self.punctured < self.count {
+            let q = self.boundary_mm(self.punctured, a[1]);
+            if pose.depth_mm <= q {
+                break;
+            }
+            let Some(layer) = self.layers.get(self.punctured).copied() else { break };
+            let (w, status) = self.surrogate(pose, pose.depth_mm - q, layer.stiffness_scale);
+            let axial_n = dot([w[0], w[1], w[2]], a);
+            if axial_n < layer.puncture_force_n {
+                let mut total = self.preload;
+                for (t, x) in total.iter_mut().zip(w) {
+                    *t += x;
+                }
+                return (total, status, punctures);
+            }
+            // puncture: the axial force goes, the lateral force and the moments stay
+            if self.track.is_none() {
+                self.track = Some(Track { entry_mm: entry, axis: a });
+            }
+            let lateral = [w[0] - axial_n * a[0], w[1] - axial_n * a[1], w[2] - axial_n * a[2]];
+            for (p, x) in self.preload.iter_mut().zip([lateral[0], lateral[1], lateral[2], w[3], w[4], w[5]]) {
+                *p += x;
+            }
+            self.punctured += 1;
+            self.track_end_mm = pose.depth_mm;
+            punctures = punctures.saturating_add(1);
+        }
+        (self.preload, Status::OK, punctures)
+    }
+
+    fn surrogate(&self, pose: &Pose, delta_mm: f32, scale: f32) -> ([f32; 6], Status) {
+        let e = deflection(pose, delta_mm, scale, self.similarity);
+        (e.wrench.to_array(), e.status)
+    }
+
+    /// Friction, cutting and the track's hold on the shaft, added to `w`; the phase.
+    fn shaft(&mut self, pose: &Pose, a: Vec3, entry: Vec3, v: f32, w: &mut [f32; 6]) -> Phase {
+        let depth = pose.depth_mm;
+        let m = self.punctured;
+        let index = |j: usize| u8::try_from(j).unwrap_or(u8::MAX);
+        if m == 0 {
+            return if depth > self.boundary_mm(0, a[1]) { Phase::Deflecting(0) } else { Phase::Approach };
+        }
+        let next = self.boundary_mm(m, a[1]);
+        let top = if depth < next { depth } else { next };
+        let hub_q = depth - HUB_FROM_TIP_MM * self.similarity;
+        let deviation = self.track.map(|t| t.deviation(entry, a, hub_q));
+        let mut axial_n = 0.0f32;
+        for j in 0..m {
+            let (Some(layer), lo) = (self.layers.get(j), self.boundary_mm(j, a[1])) else { break };
+            let hi = self.boundary_mm(j + 1, a[1]);
+            let (q1, q2) = (lo, if hi < top { hi } else { top });
+            if q2 <= q1 {
+                continue;
+            }
+            axial_n += (q2 - q1) * layer.friction.per_mm(v);
+            if let Some(d) = &deviation {
+                d.add_hold(layer.track_stiffness_n_per_mm2, q1, q2, w);
+            }
+        }
+        let phase = if depth >= next {
+            Phase::Deflecting(index(m))
+        } else if depth >= self.track_end_mm && v > 0.0 {
+            let cutting = self.layers.get(m - 1).map_or(0.0, |l| {
+                let ramp = v / l.friction.stick_band_mm_per_s;
+                l.cutting_force_n * if ramp < 1.0 { ramp } else { 1.0 }
+            });
+            axial_n += cutting;
+            Phase::Cutting(index(m - 1))
+        } else {
+            let inside = (1..m).take_while(|&j| self.boundary_mm(j, a[1]) < depth).count();
+            Phase::InTrack(index(inside))
+        };
+        if depth > self.track_end_mm && depth < next {
+            self.track_end_mm = depth;
+        }
+        // the force on the needle opposes the motion: along +a (towards the hub) inserting
+        w[0] += axial_n * a[0];
+        w[1] += axial_n * a[1];
+        w[2] += axial_n * a[2];
+        phase
+    }
+}
