@@ -896,14 +896,17 @@ mod tests {
             steps: Some(5),
             ..RunOptions::new(d.path())
         };
+        let (c, _) = spec::load(d.path()).expect("spec");
+        let depth_mm = c.deep.as_ref().map(|d| d.depth_mm).expect("a [deep] section");
         let r = run_with(&deep("centre"), &mut Fake::default()).expect("deep run");
-        assert_eq!((r.done(), r.depth_mm), (1, 15.0), "{}", r.table());
+        assert_eq!((r.done(), r.depth_mm), (1, depth_mm), "{}", r.table());
         let rows = results::read_csv(&d.path().join("fe/deep/centre.csv")).expect("deep csv");
-        assert_eq!(rows.iter().map(|r| r.depth_mm).collect::<Vec<_>>(), [0.0, 3.0, 6.0, 9.0, 12.0, 15.0]);
-        assert_eq!(rows[5].wrench[1], 225.0, "the fake's depth squared at 15 mm");
+        let want: Vec<f64> = (0..=5).map(|k| depth_mm * f64::from(k) / 5.0).collect();
+        assert_eq!(rows.iter().map(|r| r.depth_mm).collect::<Vec<_>>(), want);
+        assert_eq!(rows[5].wrench[1], depth_mm * depth_mm, "the fake's depth squared at the deep depth");
         assert!(!d.path().join("fe/centre.csv").exists(), "nothing written beside the shallow runs");
         let m = read_manifest(&d.path().join("fe/deep").join(MANIFEST)).expect("deep manifest");
-        assert_eq!((m.pose["centre"].depth_mm, m.pose["centre"].steps), (15.0, 5));
+        assert_eq!((m.pose["centre"].depth_mm, m.pose["centre"].steps), (depth_mm, 5));
         let again = run_with(&deep("centre"), &mut Fake::default()).expect("rerun");
         assert_eq!(again.up_to_date(), 1, "resumes like the campaign");
         let e = run_with(&deep("x+02"), &mut Fake::default()).err().map(|e| e.to_string()).unwrap_or_default();
