@@ -30,22 +30,29 @@ fn show(o: &Output) -> String {
     format!("status {:?}\n--- stdout\n{}\n--- stderr\n{}", o.status, String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
 }
 
-/// The centre to the deep depth (15 mm) on the smoke mesh in 5 steps: fe/deep/centre.csv
-/// from 0 to 15 mm with Fy growing, its manifest entry at 15 mm, nothing in fe/.
+/// Load steps of the deep smoke run: about 0.6 mm each (with steps of 2.6 mm the smoke
+/// mesh's contact is never found: Fy = 0 at every depth).
+const STEPS: u32 = 22;
+
+/// The centre to the deep depth on the smoke mesh in [`STEPS`] steps: fe/deep/centre.csv from 0 to
+/// deep.depth_mm with Fy growing, its manifest entry at that depth, nothing in fe/.
 #[test]
 fn deep_centre_run_on_the_smoke_mesh() {
     let (_d, set) = default_set();
-    let o = needle(&["fe", "run", "--deep", "--only", "centre", "--mesh", "smoke", "--steps", "5", "--threads", "1"], &set);
+    let o = needle(&["fe", "run", "--deep", "--only", "centre", "--mesh", "smoke", "--steps", "22", "--threads", "1"], &set);
     assert!(o.status.success(), "{}", show(&o));
+    let (c, _) = needle_fe::spec::load(&set).expect("spec");
+    let depth_mm = c.deep.as_ref().map(|d| d.depth_mm).expect("a [deep] section");
     let rows = results::read_csv(&set.join("fe/deep/centre.csv")).expect("deep csv");
-    assert_eq!(rows.iter().map(|r| r.depth_mm).collect::<Vec<_>>(), [0.0, 3.0, 6.0, 9.0, 12.0, 15.0]);
+    let want: Vec<f64> = (0..=STEPS).map(|k| depth_mm * f64::from(k) / f64::from(STEPS)).collect();
+    assert_eq!(rows.iter().map(|r| r.depth_mm).collect::<Vec<_>>(), want);
     let fy: Vec<f64> = rows.iter().map(results::Row::fy_n).collect();
     assert!(fy.windows(2).all(|w| w[1] > w[0]), "Fy grows with depth: {fy:?}");
     let m = read_manifest(&set.join("fe/deep").join(MANIFEST)).expect("deep manifest");
-    assert_eq!((m.pose["centre"].depth_mm, m.pose["centre"].steps, m.pose["centre"].mesh.as_str()), (15.0, 5, "smoke"));
+    assert_eq!((m.pose["centre"].depth_mm, m.pose["centre"].steps, m.pose["centre"].mesh.as_str()), (depth_mm, STEPS, "smoke"));
     assert!(!set.join("fe/centre.csv").exists(), "the shallow folder is not written");
     // resumed, not solved again
-    let again = needle(&["fe", "run", "--deep", "--only", "centre", "--mesh", "smoke", "--steps", "5", "--threads", "1"], &set);
+    let again = needle(&["fe", "run", "--deep", "--only", "centre", "--mesh", "smoke", "--steps", "22", "--threads", "1"], &set);
     assert!(again.status.success() && String::from_utf8_lossy(&again.stdout).contains("up to date"), "{}", show(&again));
 }
 

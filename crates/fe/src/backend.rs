@@ -76,11 +76,15 @@ pub struct SolveFailure {
     pub message: String,
     /// The end of the solver's output, if it ran.
     pub log_tail: String,
+    /// The wrench at the must points the attempt reached, from step 1 on without a gap
+    /// (the campaign keeps the furthest attempt's as the pose's partial record); empty
+    /// when the engine does not report them.
+    pub reached: Vec<[f64; COMPONENT_COUNT]>,
 }
 
 impl From<anyhow::Error> for SolveFailure {
     fn from(e: anyhow::Error) -> Self {
-        SolveFailure { message: format!("{e:#}"), log_tail: String::new() }
+        SolveFailure { message: format!("{e:#}"), log_tail: String::new(), reached: Vec::new() }
     }
 }
 
@@ -166,9 +170,10 @@ impl Backend for CcxBackend {
                     r.cause.as_deref().map(|c| format!(": {c}")).unwrap_or_default(),
                 ),
                 log_tail: r.log_tail,
+                reached: Vec::new(),
             });
         }
-        let fail = |e: anyhow::Error| SolveFailure { message: format!("{e:#}"), log_tail: r.log_tail.clone() };
+        let fail = |e: anyhow::Error| SolveFailure { message: format!("{e:#}"), log_tail: r.log_tail.clone(), reached: Vec::new() };
         let dat_path = job.work_dir.join(format!("{JOB}.dat"));
         let text = std::fs::read_to_string(&dat_path).with_context(|| format!("{}: cannot read", dat_path.display())).map_err(fail)?;
         let blocks = dat::parse_rf(&text, &deck.print_set).with_context(|| format!("{}", dat_path.display())).map_err(fail)?;

@@ -40,6 +40,7 @@ use crate::deck;
 use crate::engines::backend_for;
 use crate::launcher::Launched;
 use crate::manifest::{manifest_text, read_manifest, rfc3339_utc, Manifest, ManifestEntry, MANIFEST};
+use crate::partial;
 use crate::process;
 use crate::progress::Progress;
 use crate::report::{PoseReport, Report, Status};
@@ -468,13 +469,32 @@ fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
         first_increment: 1.0,
         attempt: 0,
     };
-    let solved = match solve_with_retry(ctx.backend, &job) {
+    // the furthest failed attempt so far is kept as the pose's partial record at once, so
+    // that it is there while the later attempts run
+    let mut keep = |reached: &[[f64; COMPONENT_COUNT]], failure: &str| {
+        let failed = partial::Failed {
+            campaign: ctx.campaign,
+            pose,
+            mesh: ctx.mesh_name,
+            engine: (ctx.backend.engine(), &ctx.solver_version),
+            failure,
+        };
+        match partial::write(ctx.out_dir, &failed, reached) {
+            Ok(()) => format!(" (the {} must point(s) reached are kept in {}.partial.csv)", reached.len(), pose.name),
+            Err(e) => format!(" (the partial record could not be written: {e:#})"),
+        }
+    };
+    let solved = match solve_with_retry(ctx.backend, &job, &mut keep) {
         Ok(s) => s,
-        Err(f) => return fail(f.message, f.log_tail),
+        Err(f) => {
+            let kept = if f.reached.is_empty() { String::new() } else { keep(&f.reached, &f.message) };
+            return fail(format!("{}{kept}", f.message), f.log_tail);
+        }
     };
     let wall_s = (start.elapsed().as_secs_f64() * 1000.0).round() / 1000.0;
     match write_results(ctx, pose, &solved, wall_s) {
         Ok(fy) => {
+            partial::remove(ctx.out_dir, &pose.name);
             // the work folder is only for debugging failed runs; a leftover is harmless
             if !ctx.keep_work {
                 let _ = std::fs::remove_dir_all(&wd);
@@ -494,9 +514,16 @@ fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
 
 /// Solve `job`; when that fails, again with [`deck::RETRY_FIRST_INCREMENT`], up to the
 /// backend's [`Backend::attempts`] (module docs). The failures so far go into the
-/// result's `retry` (or the final failure's message).
-pub(crate) fn solve_with_retry(backend: &dyn Backend, job: &Job<'_>) -> std::result::Result<Solved, SolveFailure> {
+/// result's `retry` (or the final failure's message). `keep` gets the must points of
+/// each failed attempt that reached further than the ones before, with the failures so
+/// far (the final failure carries the furthest in `reached`).
+pub(crate) fn solve_with_retry(
+    backend: &dyn Backend,
+    job: &Job<'_>,
+    keep: &mut dyn FnMut(&[[f64; COMPONENT_COUNT]], &str) -> String,
+) -> std::result::Result<Solved, SolveFailure> {
     let mut failures: Vec<String> = Vec::new();
+    let mut furthest: Vec<[f64; COMPONENT_COUNT]> = Vec::new();
     let attempts = backend.attempts().max(1);
     for attempt in 0..attempts {
         let r = backend.first_increment(attempt);
@@ -506,8 +533,14 @@ pub(crate) fn solve_with_retry(backend: &dyn Backend, job: &Job<'_>) -> std::res
             Err(f) => {
                 let message = if attempt == 0 { f.message } else { format!("retry {attempt} (first increment {r}): {}", f.message) };
                 failures.push(message);
+                if f.reached.len() > furthest.len() {
+                    furthest = f.reached;
+                    if attempt + 1 < attempts {
+                        let _ = keep(&furthest, &failures.join("; "));
+                    }
+                }
                 if attempt + 1 == attempts || process::interrupted() {
-                    return Err(SolveFailure { message: failures.join("; "), log_tail: f.log_tail });
+                    return Err(SolveFailure { message: failures.join("; "), log_tail: f.log_tail, reached: furthest });
                 }
                 eprintln!(
                     "{}: {}; retry {} of {} with each step's first increment at {} of the step",
@@ -520,7 +553,7 @@ pub(crate) fn solve_with_retry(backend: &dyn Backend, job: &Job<'_>) -> std::res
             }
         }
     }
-    Err(SolveFailure { message: failures.join("; "), log_tail: String::new() })
+    Err(SolveFailure { message: failures.join("; "), log_tail: String::new(), reached: furthest })
 }
 
 /// Check the wrenches, write the CSV, then the manifest entry. Returns Fy at the final depth.
@@ -605,6 +638,8 @@ mod tests {
         /// Fails this pose's first attempt only (whole-step first increment).
         fail_first: Option<String>,
         panic_on: Option<String>,
+        /// Fails this pose on every attempt after the first must point (attempt 2: two).
+        fail_reached: Option<String>,
         solves: AtomicUsize,
         prepared: usize,
     }
@@ -628,10 +663,14 @@ mod tests {
                 panic!("fake panic");
             }
             if self.fail.as_deref() == Some(job.pose.name.as_str()) {
-                return Err(SolveFailure { message: "fake exit code 201".into(), log_tail: "*ERROR fake".into() });
+                return Err(SolveFailure { message: "fake exit code 201".into(), log_tail: "*ERROR fake".into(), reached: Vec::new() });
+            }
+            if self.fail_reached.as_deref() == Some(job.pose.name.as_str()) {
+                let reached = (1..=job.attempt.min(1) + 1).map(|k| [0.0, f64::from(k), 0.0, 0.0, 0.0, 0.0]).collect();
+                return Err(SolveFailure { message: format!("fake stop {}", job.attempt), log_tail: String::new(), reached });
             }
             if self.fail_first.as_deref() == Some(job.pose.name.as_str()) && job.first_increment == 1.0 {
-                return Err(SolveFailure { message: "fake stall".into(), log_tail: String::new() });
+                return Err(SolveFailure { message: "fake stall".into(), log_tail: String::new(), reached: Vec::new() });
             }
             let wrenches = (1..=job.steps)
                 .map(|k| {
@@ -857,18 +896,42 @@ mod tests {
             steps: Some(5),
             ..RunOptions::new(d.path())
         };
+        let (c, _) = spec::load(d.path()).expect("spec");
+        let depth_mm = c.deep.as_ref().map(|d| d.depth_mm).expect("a [deep] section");
         let r = run_with(&deep("centre"), &mut Fake::default()).expect("deep run");
-        assert_eq!((r.done(), r.depth_mm), (1, 15.0), "{}", r.table());
+        assert_eq!((r.done(), r.depth_mm), (1, depth_mm), "{}", r.table());
         let rows = results::read_csv(&d.path().join("fe/deep/centre.csv")).expect("deep csv");
-        assert_eq!(rows.iter().map(|r| r.depth_mm).collect::<Vec<_>>(), [0.0, 3.0, 6.0, 9.0, 12.0, 15.0]);
-        assert_eq!(rows[5].wrench[1], 225.0, "the fake's depth squared at 15 mm");
+        let want: Vec<f64> = (0..=5).map(|k| depth_mm * f64::from(k) / 5.0).collect();
+        assert_eq!(rows.iter().map(|r| r.depth_mm).collect::<Vec<_>>(), want);
+        assert_eq!(rows[5].wrench[1], depth_mm * depth_mm, "the fake's depth squared at the deep depth");
         assert!(!d.path().join("fe/centre.csv").exists(), "nothing written beside the shallow runs");
         let m = read_manifest(&d.path().join("fe/deep").join(MANIFEST)).expect("deep manifest");
-        assert_eq!((m.pose["centre"].depth_mm, m.pose["centre"].steps), (15.0, 5));
+        assert_eq!((m.pose["centre"].depth_mm, m.pose["centre"].steps), (depth_mm, 5));
         let again = run_with(&deep("centre"), &mut Fake::default()).expect("rerun");
         assert_eq!(again.up_to_date(), 1, "resumes like the campaign");
         let e = run_with(&deep("x+02"), &mut Fake::default()).err().map(|e| e.to_string()).unwrap_or_default();
         assert!(e.contains("matches no pose (poses: centre, x+04, tz+08, z+04)"), "{e}");
+    }
+
+    /// A pose that fails every attempt keeps the furthest attempt's must points as its
+    /// partial record; solving it later removes the record.
+    #[test]
+    fn a_pose_failing_every_attempt_keeps_its_furthest_must_points() {
+        let d = set_dir();
+        let fe = d.path().join("fe");
+        let mut fake = Fake { fail_reached: Some("x+04".into()), ..Fake::default() };
+        let r = run_with(&opts(d.path(), "x+04", 4), &mut fake).expect("run");
+        assert_eq!(r.failed(), 1, "{}", r.table());
+        assert!(r.table().contains("the 2 must point(s) reached are kept in x+04.partial.csv"), "{}", r.table());
+        let (csv, rec) = partial::paths(&fe, "x+04");
+        let rows = results::read_csv(&csv).expect("partial csv");
+        assert_eq!(rows.iter().map(|r| (r.depth_mm, r.fy_n())).collect::<Vec<_>>(), [(0.0, 0.0), (1.5, 1.0), (3.0, 2.0)]);
+        let text = std::fs::read_to_string(&rec).expect("record");
+        assert!(text.contains("reached_depth_mm = 3.0") && text.contains("fake stop 0; retry 1"), "{text}");
+        assert!(!fe.join("x+04.csv").exists(), "no result");
+        let r = run_with(&opts(d.path(), "x+04", 4), &mut Fake::default()).expect("solved");
+        assert_eq!(r.done(), 1);
+        assert!(!csv.exists() && !rec.exists(), "the record goes once the pose solves");
     }
 
     #[test]

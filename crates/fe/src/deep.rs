@@ -142,9 +142,8 @@ mod tests {
         let text = shipped();
         let line = |key: &str| key_line(&text, "deep", key);
         assert!(line("depth_mm") > 0 && line("mesh") > 0 && line("poses") > 0, "the shipped [deep] names its fields");
-        let depth = text.lines().find(|l| l.starts_with("depth_mm") && l.contains("15")).expect("deep depth line").to_string();
-        let poses = text.lines().find(|l| l.starts_with("poses =")).expect("deep poses line").to_string();
-        let mesh = text.lines().find(|l| l.starts_with("mesh = \"needle8deep\"")).expect("deep mesh line").to_string();
+        let deep_line = |key: &str| text.lines().nth(line(key) - 1).expect("a [deep] line").to_string();
+        let (depth, poses, mesh, steps) = (deep_line("depth_mm"), deep_line("poses"), deep_line("mesh"), deep_line("steps"));
         let cases = [
             (text.replace(&depth, "depth_mm = 5.0"), format!("campaign.toml:{}: deep.depth_mm = 5: must be beyond", line("depth_mm"))),
             (text.replace(&depth, "depth_mm = 31.0"), "inside the block (block.depth_mm = 30 mm)".to_string()),
@@ -164,7 +163,9 @@ mod tests {
             (
                 format!("{text}\n[[pose]]\nname = \"edge\"\nrole = \"mirror\"\nx_mm = 12.0\ntheta_z_deg = 15.0\n")
                     .replace("size_x_mm = 50.0", "size_x_mm = 30.0")
-                    .replace(&poses, "poses = [\"centre\", \"edge\"]"),
+                    .replace(&poses, "poses = [\"centre\", \"edge\"]")
+                    .replace(&depth, "depth_mm = 15.0")
+                    .replace(&steps, "steps = 50"),
                 format!(
                     "campaign.toml:{}: pose \"edge\": x_mm = 12 with a lateral travel of 3.882 mm at full depth (15 mm)",
                     line("poses")
@@ -176,9 +177,8 @@ mod tests {
             let msg = error_of(&spec);
             assert!(msg.contains(&want), "want {want:?} in: {msg}");
         }
-        let zero = text.replace("steps = 50", "steps = 0");
-        assert_ne!(zero, text);
-        assert!(error_of(&zero).contains("deep.steps = 0: must be >= 1"), "{}", error_of(&zero));
+        let zero = text.replace(&steps, "steps = 0");
+        assert!(error_of(&zero).contains(&format!("campaign.toml:{}: deep.steps = 0: must be >= 1", line("steps"))), "{}", error_of(&zero));
     }
 
     #[test]

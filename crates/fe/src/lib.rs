@@ -15,6 +15,7 @@ pub mod launcher;
 pub mod manifest;
 pub mod material;
 pub mod mesh;
+pub mod partial;
 pub mod process;
 mod progress;
 pub mod report;

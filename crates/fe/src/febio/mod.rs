@@ -294,6 +294,7 @@ impl Backend for FebioBackend {
                     run.cause.as_deref().map(|c| format!(": {c}")).unwrap_or_default(),
                 ),
                 log_tail,
+                reached: at_steps.iter().map_while(|v| v.map(|v| expand_mirrors(v.map(|x| REACTION_SIGN * x), feb.symmetry))).collect(),
             });
         }
         let run = logs::RunLog { time_steps: totals.time_steps, iterations: totals.iterations, ..run };

@@ -179,10 +179,10 @@ impl std::fmt::Display for ScalingRun {
         match (&self.failure, self.worst_percent, &self.worst_component) {
             (Some(why), ..) => write!(f, "scaling {:>6} s = {}: no comparison: {why}", self.pose, self.scale),
             (None, Some(w), Some(c)) => {
-                let all: Vec<String> = self.percent_of_peak_fy.iter().map(|(k, v)| format!("{k} {v:.4}")).collect();
+                let all: Vec<String> = self.percent_of_peak_fy.iter().map(|(k, v)| format!("{k} {v:.2e}")).collect();
                 write!(
                     f,
-                    "scaling {:>6} s = {}: largest |W(s) - s W(1)| {w:.4}% of s x peak |Fy| ({c} at {} mm; goal <= {SCALING_GOAL_PERCENT}%), Fy(s)/Fy(1) at full depth {:.6}; per component %: {}",
+                    "scaling {:>6} s = {}: largest |W(s) - s W(1)| {w:.2e}% of s x peak |Fy| ({c} at {} mm; goal <= {SCALING_GOAL_PERCENT}%), Fy(s)/Fy(1) at full depth {:.6}; per component %: {}",
                     self.pose,
                     self.scale,
                     self.worst_depth_mm.unwrap_or(f64::NAN),
