@@ -48,12 +48,7 @@ mod firmware {
                 let (mut ticks, mut punctures) = (0u64, 0u64);
                 for_each_tick(path, |_, p| {
                     let e = insertion.step(&Pose { x_mm: p[0], z_mm: p[1], theta_x_deg: p[2], theta_z_deg: p[3], depth_mm: p[4] });
-                    for c in e.wrench.to_array() {
-                        digest.word(c.to_bits());
-                    }
-                    digest.word(u32::from(e.status.bits()));
-                    digest.word(u32::from(e.phase.code()));
-                    digest.word(u32::from(e.punctures));
+                    digest.tick(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures);
                     ticks += 1;
                     punctures += u64::from(e.punctures);
                 });

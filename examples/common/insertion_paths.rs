@@ -87,6 +87,16 @@ impl Digest {
     pub const fn new() -> Self {
         Self(0xcbf2_9ce4_8422_2325)
     }
+    /// Adds one tick: the six wrench bits, the status, the phase code and the punctures.
+    pub fn tick(&mut self, wrench: [f32; 6], status: u8, phase: u16, punctures: u8) {
+        for c in wrench {
+            self.word(c.to_bits());
+        }
+        self.word(u32::from(status));
+        self.word(u32::from(phase));
+        self.word(u32::from(punctures));
+    }
+
     /// Adds one word.
     pub fn word(&mut self, w: u32) {
         for b in w.to_le_bytes() {

@@ -22,12 +22,7 @@ fn host_lines() -> Vec<String> {
             let (mut ticks, mut punctures) = (0u64, 0u64);
             for_each_tick(path, |_, p| {
                 let e = insertion.step(&Pose { x_mm: p[0], z_mm: p[1], theta_x_deg: p[2], theta_z_deg: p[3], depth_mm: p[4] });
-                for c in e.wrench.to_array() {
-                    digest.word(c.to_bits());
-                }
-                digest.word(u32::from(e.status.bits()));
-                digest.word(u32::from(e.phase.code()));
-                digest.word(u32::from(e.punctures));
+                digest.tick(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures);
                 ticks += 1;
                 punctures += u64::from(e.punctures);
             });
@@ -105,12 +100,7 @@ fn c_api_lines() -> Vec<String> {
                 // SAFETY: valid pointers to local values; the state was initialised above.
                 assert_eq!(unsafe { needle_insertion_step(&mut state, &pose, &mut out) }, NEEDLE_OK);
                 let w = out.wrench;
-                for c in [w.fx_n, w.fy_n, w.fz_n, w.mx_nmm, w.my_nmm, w.mz_nmm] {
-                    digest.word(c.to_bits());
-                }
-                digest.word(u32::from(out.status));
-                digest.word(u32::from(out.phase));
-                digest.word(u32::from(out.punctures));
+                digest.tick([w.fx_n, w.fy_n, w.fz_n, w.mx_nmm, w.my_nmm, w.mz_nmm], out.status, out.phase, out.punctures);
                 ticks += 1;
                 punctures += u64::from(out.punctures);
             });
