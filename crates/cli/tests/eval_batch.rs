@@ -143,3 +143,27 @@ fn a_reader_that_closes_the_pipe_ends_needle_quietly() {
         assert!(o.status.signal() == Some(13) || o.status.success(), "{args:?}: {:?} {err}", o.status);
     }
 }
+
+#[test]
+fn out_onto_a_symlink_or_a_fifo_is_refused_and_left_alone() {
+    let d = tempfile::tempdir().expect("tempdir");
+    let poses = d.path().join("poses.csv");
+    std::fs::write(&poses, "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n1,2,3,4,5\n").expect("write");
+    let target = d.path().join("target.csv");
+    std::fs::write(&target, "keep me\n").expect("write");
+    let link = d.path().join("link.csv");
+    std::os::unix::fs::symlink(&target, &link).expect("symlink");
+    let fifo = d.path().join("fifo.csv");
+    let made = Command::new("mkfifo").arg(&fifo).status().expect("mkfifo (coreutils)");
+    assert!(made.success());
+    let set = default_set();
+    for (out, what) in [(&link, "a symbolic link"), (&fifo, "not a regular file")] {
+        let o = needle(&["eval", "--set", &set.to_string_lossy(), "--poses", &poses.to_string_lossy(), "--out", &out.to_string_lossy()]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(err.contains(&format!("{}: is {what}", out.display())), "{err}");
+    }
+    assert!(std::fs::symlink_metadata(&link).expect("link").file_type().is_symlink(), "the link is still a link");
+    assert_eq!(std::fs::read_to_string(&target).expect("target"), "keep me\n");
+    assert!(!std::fs::symlink_metadata(&fifo).expect("fifo").file_type().is_file(), "the FIFO is still a FIFO");
+}
