@@ -445,3 +445,24 @@ fn a_hand_edited_fe_csv_is_refused_by_fit_and_validate() {
         "{msg}"
     );
 }
+
+/// Issue 38: a manifest entry without `csv_sha256` made the next `fe run` record the hash
+/// of whatever file was there, so an edited CSV became trusted. Now an entry without the
+/// hash vouches for nothing: fit refuses the run, naming the pose and the fix.
+#[test]
+fn a_run_whose_entry_has_no_hash_is_refused() {
+    let (dir, _) = fit_synthetic::fitted();
+    let path = dir.path().join("fe").join(needle_fe::manifest::MANIFEST);
+    let mut m = needle_fe::manifest::read_manifest(&path).expect("manifest");
+    m.pose.get_mut("x+02").expect("entry").csv_sha256 = None;
+    std::fs::write(&path, needle_fe::manifest::manifest_text(&m).expect("manifest text")).expect("write manifest");
+    let e = needle_fit::fit_set(dir.path()).expect_err("the fit must refuse x+02");
+    let msg = format!("{e:#}");
+    assert!(
+        msg.contains("x+02.csv: fe/manifest.toml records no csv_sha256 for x+02") && msg.contains("needle fe run --force --only x+02"),
+        "{msg}"
+    );
+    let entry = m.pose.get("x+02").expect("entry");
+    let bytes = std::fs::read(dir.path().join("fe").join("x+02.csv")).expect("csv");
+    assert!(!entry.content_matches(&bytes), "an entry without a hash matches no content (fe run solves it again)");
+}

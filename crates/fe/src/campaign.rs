@@ -167,7 +167,7 @@ pub struct Plan {
     pub steps: u32,
     /// The output folder (`<set>/fe` unless `--out`).
     pub out_dir: PathBuf,
-    /// The manifest as read (without the csv_sha256 backfill).
+    /// The manifest as read.
     pub manifest: Manifest,
     /// One report per selected pose, in campaign order: [`Status::UpToDate`] (with the
     /// manifest's figures) or a placeholder for the poses in `to_run`.
@@ -292,19 +292,11 @@ pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> 
     let mesh = campaign.mesh_level(&mesh_name)?.clone();
     std::fs::create_dir_all(&out_dir).with_context(|| format!("{}: cannot create", out_dir.display()))?;
     let manifest_path = out_dir.join(MANIFEST);
-    let (hashed, manifest) = {
+    let manifest = {
         let _lock = lock_manifest(&out_dir)?;
         // read again under the lock: another process may have written it since the plan
-        let mut manifest = read_manifest(&manifest_path)?;
-        let hashed = manifest.backfill_csv_hashes(&out_dir);
-        if !hashed.is_empty() {
-            results::write_atomic(&manifest_path, manifest_text(&manifest)?.as_bytes())?;
-        }
-        (hashed, manifest)
+        read_manifest(&manifest_path)?
     };
-    if !hashed.is_empty() {
-        eprintln!("{}: recorded csv_sha256 of {} earlier result(s) ({})", manifest_path.display(), hashed.len(), hashed.join(", "));
-    }
     let to_run: Vec<(usize, &PoseSpec)> = to_run.iter().filter_map(|&i| selected.get(i).map(|p| (i, p))).collect();
     let skipped = reports.len() - to_run.len();
     let jobs = opts.jobs.clamp(1, to_run.len().max(1));

@@ -45,8 +45,9 @@ pub struct ManifestEntry {
     pub mesh: String,
     /// SHA-256 of the CSV as the campaign wrote it ([`results::content_sha256`](crate::results::content_sha256)):
     /// the fitter, validator, plots and explorer refuse a CSV whose content differs
-    /// (`fit::data::read_run`). Entries written before it was recorded get it from
-    /// the next `needle fe run` on their folder ([`Manifest::backfill_csv_hashes`]).
+    /// (`fit::data::read_run`). An entry without it is not trusted: `needle fe run`
+    /// solves its pose again and the fitter refuses its CSV (a hash taken later would
+    /// vouch for whatever file is there then).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub csv_sha256: Option<String>,
     /// The model solved, e.g. "half, mirror plane z = 0".
@@ -129,31 +130,15 @@ impl Manifest {
 }
 
 impl ManifestEntry {
-    /// Whether `bytes` are the CSV this entry was written for: its `csv_sha256` matches,
-    /// or the entry predates the hash.
+    /// Whether `bytes` are the CSV this entry was written for: its `csv_sha256` matches
+    /// (an entry without the hash vouches for nothing: false).
     #[must_use]
     pub fn content_matches(&self, bytes: &[u8]) -> bool {
-        self.csv_sha256.as_ref().is_none_or(|h| *h == crate::results::content_sha256(bytes))
+        self.csv_sha256.as_ref().is_some_and(|h| *h == crate::results::content_sha256(bytes))
     }
 }
 
 impl Manifest {
-    /// Records `csv_sha256` for every entry that has none and whose `<pose>.csv` is in
-    /// `out_dir`, from the file as it is now (entries from before the hash was kept);
-    /// returns the poses it added. Entries that have a hash are never changed.
-    pub fn backfill_csv_hashes(&mut self, out_dir: &std::path::Path) -> Vec<String> {
-        let mut added = Vec::new();
-        for (name, e) in &mut self.pose {
-            if e.csv_sha256.is_none() {
-                if let Ok(bytes) = std::fs::read(out_dir.join(format!("{name}.csv"))) {
-                    e.csv_sha256 = Some(crate::results::content_sha256(&bytes));
-                    added.push(name.clone());
-                }
-            }
-        }
-        added
-    }
-
     /// Wall times in s of the recorded runs of `engine` on mesh level `mesh_name` with `steps` load
     /// steps, by model (e.g. "full block, no mirror plane"), for the ETA of a campaign.
     /// Any spec hash counts: a spec change rarely changes the cost much.

@@ -104,14 +104,24 @@ pub fn read_run(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Result<
 
 /// A run's CSV must be the bytes the campaign wrote: when its manifest entry records a
 /// `csv_sha256`, the file's hash must match (issue 18: a hand-edited CSV was fitted and
-/// validated silently). The original is not kept, so the message gives both hashes.
+/// validated silently), and an entry without the hash is refused (issue 38: a hash
+/// recorded later vouched for an edited file). The original is not kept, so the message
+/// gives both hashes.
 ///
 /// # Errors
 /// The manifest cannot be read, or `bytes` (the file at `path`) differ from the recorded hash.
 fn check_content(set_dir: &Path, pose: &PoseSpec, path: &Path, bytes: &[u8]) -> Result<()> {
     let manifest = read_set_manifest(set_dir)?;
     let Some(entry) = manifest.pose.get(&pose.name) else { return Ok(()) };
-    if let (false, Some(want)) = (entry.content_matches(bytes), entry.csv_sha256.as_ref()) {
+    let Some(want) = entry.csv_sha256.as_ref() else {
+        bail!(
+            "{}: fe/manifest.toml records no csv_sha256 for {}, so nothing vouches for the file's content: rerun the pose with `needle fe run --force --only {}`",
+            path.display(),
+            pose.name,
+            pose.name
+        );
+    };
+    if !entry.content_matches(bytes) {
         let have = needle_fe::results::content_sha256(bytes);
         bail!(
             "{}: content changed since the FE run wrote it (sha256 {} now, {} in fe/manifest.toml): restore it (git checkout) or rerun the pose with `needle fe run --force --only {}`",
