@@ -220,3 +220,42 @@ fn a_timed_out_job_is_reported_and_kept_for_debugging() {
     assert!(stdout.contains(&work.display().to_string()), "{}", show(&out));
     assert!(!read_manifest(&fe.join(MANIFEST)).expect("manifest").pose.contains_key("centre"));
 }
+
+/// Issue 38: after SIGKILL of `needle fe run` (no handler can see it) its solver kept
+/// running as an orphan. The solver now runs with a parent-death signal: killed with
+/// needle, within seconds; a rerun then solves the pose.
+#[test]
+fn a_sigkill_of_needle_takes_its_solver_with_it() {
+    require_ccx();
+    let (_tmp, set) = default_set();
+    let work = set.join("fe").join(".work").join("x+04");
+    let mut child = Command::new(NEEDLE)
+        .args(run_args(&set, "x+04", "3"))
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .process_group(0)
+        .spawn()
+        .expect("spawn needle");
+    let pgid = child.id();
+    let start = Instant::now();
+    while ccx::steps_done(&work, "pose") < 1 {
+        if let Some(status) = child.try_wait().expect("wait") {
+            panic!("the x+04 run ended ({status}) before it could be killed after step 1");
+        }
+        assert!(start.elapsed() < Duration::from_secs(300), "x+04: no step done after 300 s");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.kill().expect("SIGKILL needle alone");
+    child.wait().expect("wait");
+    let gone = Instant::now();
+    let alive = || Command::new("kill").args(["-0", "--", &format!("-{pgid}")]).stderr(Stdio::null()).status().expect("kill -0").success();
+    while alive() {
+        if gone.elapsed() > Duration::from_secs(5) {
+            let _ = Command::new("kill").args(["-KILL", "--", &format!("-{pgid}")]).status();
+            panic!("ccx still running 5 s after needle's SIGKILL (an orphan)");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    assert!(ccx::steps_done(&work, "pose") < 3, "ccx was stopped before its last step");
+}

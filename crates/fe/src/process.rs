@@ -100,8 +100,38 @@ fn peak_rss_kib(pid: u32) -> Option<u64> {
     line.split_whitespace().nth(1)?.parse().ok()
 }
 
+/// `setpriv` of util-linux, which sets the parent-death signal and then runs the solver.
+const SETPRIV: &str = "setpriv";
+
+/// `cmd` run through `setpriv --pdeathsig KILL`: the solver gets SIGKILL when the thread
+/// that started it ends, even when `needle` itself is killed with SIGKILL (which no
+/// handler sees: before, its solvers ran on as orphans). `setpriv` sets the signal and
+/// `exec`s the solver, which keeps the process id (the peak-memory and kill logic
+/// apply to the solver itself). Program, arguments, environment and folder are kept.
+///
+/// # Errors
+/// `setpriv` (util-linux) is not on `PATH`.
+fn dies_with_parent(cmd: &Command) -> Result<Command> {
+    let setpriv = which(Path::new(SETPRIV)).with_context(|| {
+        format!("{SETPRIV} (util-linux) is not on PATH: needed so a solver dies with needle (apt-get install util-linux)")
+    })?;
+    let mut w = Command::new(setpriv);
+    w.args(["--pdeathsig", "KILL", "--"]).arg(cmd.get_program()).args(cmd.get_args());
+    for (k, v) in cmd.get_envs() {
+        match v {
+            Some(v) => w.env(k, v),
+            None => w.env_remove(k),
+        };
+    }
+    if let Some(d) = cmd.get_current_dir() {
+        w.current_dir(d);
+    }
+    Ok(w)
+}
+
 /// Run `cmd` (program, arguments, environment already set) in `work_dir`, stdin from
-/// /dev/null, stdout and stderr to `log_path`. With a `timeout` the process is killed when
+/// /dev/null, stdout and stderr to `log_path`; the solver dies with the thread that runs
+/// this ([`dies_with_parent`]). With a `timeout` the process is killed when
 /// it runs longer (wall clock); with a `stall` limit, when none of `log_path` and
 /// `progress_files` has grown for that long (a solver spinning without output is a
 /// failed run, not a slow one). Polls every 50 ms; kills the process on [`interrupted`].
@@ -110,7 +140,7 @@ fn peak_rss_kib(pid: u32) -> Option<u64> {
 /// The log file cannot be created, or the process cannot be started or waited for. A
 /// process that starts and then fails is not an error: see [`Finished::exit`].
 pub fn run(
-    mut cmd: Command,
+    cmd: Command,
     work_dir: &Path,
     log_path: &Path,
     progress_files: &[PathBuf],
@@ -120,6 +150,7 @@ pub fn run(
     let log = std::fs::File::create(log_path).with_context(|| format!("{}: cannot create", log_path.display()))?;
     let log_err = log.try_clone().with_context(|| format!("{}: cannot reopen", log_path.display()))?;
     let program = cmd.get_program().to_string_lossy().into_owned();
+    let mut cmd = dies_with_parent(&cmd)?;
     let start = Instant::now();
     let mut child = cmd
         .current_dir(work_dir)
