@@ -4,8 +4,11 @@
 //! `theta_z_deg`, `depth_mm` (any order, other columns ignored), one pose per row.
 //! Every row must hold five numbers (NaN and infinities are numbers: the library
 //! answers them with the error status); a row that does not is reported as
-//! `FILE:LINE: column NAME: "TEXT" is not a number`, every such row is listed, and
-//! nothing is written. Output: one row per input row, in input order.
+//! `FILE:LINE: column NAME: "TEXT" is not a number` (a field longer than
+//! [`MAX_ECHO_CHARS`] is cut, its length given), the bad rows are counted and the first
+//! [`MAX_LISTED`] problems listed, and nothing is written. A header naming a pose column
+//! twice is refused (which one would be meant?). Output: one row per input row, in input
+//! order.
 
 use anyhow::{bail, Context, Result};
 use needle_haptics::{wrench, Evaluation, Pose};
@@ -18,8 +21,20 @@ pub const POSE_COLUMNS: [&str; 5] = ["x_mm", "z_mm", "theta_x_deg", "theta_z_deg
 /// Output header of the CSV form.
 pub const OUTPUT_HEADER: &str = "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm,status";
 
-/// Most bad rows listed in one error message (the count is always given).
-const MAX_LISTED: usize = 20;
+/// Most problems listed in one error message (the count of bad rows is always given).
+pub const MAX_LISTED: usize = 20;
+
+/// Most characters of a bad field echoed in a message.
+pub const MAX_ECHO_CHARS: usize = 40;
+
+/// `text` as a message shows it: quoted, cut after [`MAX_ECHO_CHARS`] characters with
+/// its length in bytes.
+fn echo(text: &str) -> String {
+    match text.char_indices().nth(MAX_ECHO_CHARS) {
+        Some((cut, _)) => format!("{:?}... ({} bytes)", &text[..cut], text.len()),
+        None => format!("{text:?}"),
+    }
+}
 
 /// Parse the pose file `text` (named `path` in messages).
 ///
@@ -30,19 +45,24 @@ pub fn parse_poses(text: &str, path: &Path) -> Result<Vec<Pose>> {
     let header = rdr.headers().with_context(|| format!("{}:1: cannot read the header", path.display()))?.clone();
     let mut idx = [0usize; 5];
     for (slot, name) in idx.iter_mut().zip(POSE_COLUMNS) {
-        *slot = header
-            .iter()
-            .position(|h| h == name)
+        let mut at = header.iter().enumerate().filter(|(_, h)| *h == name).map(|(i, _)| i);
+        *slot = at
+            .next()
             .with_context(|| format!("{}:1: no column {name:?} in the header (need {})", path.display(), POSE_COLUMNS.join(", ")))?;
+        if let Some(again) = at.next() {
+            bail!("{}:1: column {name:?} appears twice in the header (columns {} and {})", path.display(), *slot + 1, again + 1);
+        }
     }
     let mut poses = Vec::new();
     let mut bad: Vec<String> = Vec::new();
+    let mut bad_rows = 0usize;
     for rec in rdr.records() {
         let rec = match rec {
             Ok(r) => r,
             Err(e) => {
                 let line = e.position().map_or(0, |p| p.line());
                 bad.push(format!("{}:{line}: {e}", path.display()));
+                bad_rows += 1;
                 continue;
             }
         };
@@ -53,7 +73,7 @@ pub fn parse_poses(text: &str, path: &Path) -> Result<Vec<Pose>> {
             match rec.get(i).map(|t| (t, t.parse::<f32>())) {
                 Some((_, Ok(x))) => *slot = x,
                 Some((t, Err(_))) => {
-                    bad.push(format!("{}:{line}: column {name}: {t:?} is not a number", path.display()));
+                    bad.push(format!("{}:{line}: column {name}: {} is not a number", path.display(), echo(t)));
                     ok = false;
                 }
                 None => {
@@ -64,12 +84,14 @@ pub fn parse_poses(text: &str, path: &Path) -> Result<Vec<Pose>> {
         }
         if ok {
             poses.push(Pose { x_mm: v[0], z_mm: v[1], theta_x_deg: v[2], theta_z_deg: v[3], depth_mm: v[4] });
+        } else {
+            bad_rows += 1;
         }
     }
-    if !bad.is_empty() {
+    if bad_rows > 0 {
         let shown = bad.iter().take(MAX_LISTED).cloned().collect::<Vec<_>>().join("\n");
-        let more = if bad.len() > MAX_LISTED { format!("\n... and {} more", bad.len() - MAX_LISTED) } else { String::new() };
-        bail!("{} bad row(s), nothing evaluated:\n{shown}{more}", bad.len());
+        let more = if bad.len() > MAX_LISTED { format!("\n... and {} more problem(s)", bad.len() - MAX_LISTED) } else { String::new() };
+        bail!("{bad_rows} bad row(s), nothing evaluated:\n{shown}{more}");
     }
     Ok(poses)
 }

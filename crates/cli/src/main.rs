@@ -39,8 +39,28 @@ component by cross-validation). Writes model.toml and the four golden files all 
     Firmware(needle_cli::firmware::FirmwareCommand),
 }
 
+/// SIGPIPE to its default action: a reader that closes the pipe early (`| head`) ends
+/// this process quietly, as it ends `cat` or `grep`. The Rust runtime ignores SIGPIPE,
+/// which turns every later `println!` into a panic (exit 101). Not for the long-running
+/// commands (`fe`, `explore`): a campaign or a server keeps going when its log reader
+/// goes away.
+#[cfg(unix)]
+fn default_sigpipe() {
+    // SAFETY: called first in main, before any thread is started; SIG_DFL is a valid
+    // disposition for SIGPIPE.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
+#[cfg(not(unix))]
+fn default_sigpipe() {}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if !matches!(cli.command, Command::Fe(_) | Command::Explore(_)) {
+        default_sigpipe();
+    }
     let result = match cli.command {
         Command::Fe(c) => needle_cli::fe::run(c),
         Command::Fit(a) => needle_cli::fit::fit(a),

@@ -188,6 +188,12 @@ pub fn eval_json(pose: &Pose, e: &Evaluation) -> serde_json::Value {
 /// `--set` is not the set compiled into this build (see [`check_compiled_set`]).
 pub fn eval(a: EvalArgs) -> anyhow::Result<ExitCode> {
     check_compiled_set(&a.set)?;
+    if let (Some(out), None) = (&a.out, &a.poses) {
+        bail!(
+            "--out {} writes the rows of --poses FILE.csv; a single pose is printed (redirect standard output to keep it)",
+            out.display()
+        );
+    }
     if let (Some(file), Some(stack)) = (&a.poses, &a.insertion) {
         super::eval_insertion::eval_script(file, stack, a.out.as_deref())?;
         return Ok(ExitCode::SUCCESS);

@@ -66,6 +66,7 @@ fn bad_rows_are_named_by_line_and_nothing_is_written() {
     let name = file.display().to_string();
     assert!(err.contains(&format!("{name}:3: column z_mm: \"two\" is not a number")), "{err}");
     assert!(err.contains(&format!("{name}:5: column theta_z_deg: missing")), "{err}");
+    assert!(err.contains("2 bad row(s), nothing evaluated"), "rows are counted, not fields (row 5 misses two): {err}");
     assert!(!out.exists(), "nothing written");
     std::fs::write(&file, "x_mm,z_mm,theta_x_deg,depth_mm\n1,2,3,4\n").expect("write");
     let o = needle(&["eval", "--set", &set.to_string_lossy(), "--poses", &file.to_string_lossy()]);
@@ -74,4 +75,95 @@ fn bad_rows_are_named_by_line_and_nothing_is_written() {
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
+}
+
+#[test]
+fn a_pose_column_named_twice_is_refused() {
+    let d = tempfile::tempdir().expect("tempdir");
+    let file = d.path().join("poses.csv");
+    std::fs::write(&file, "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,x_mm\n1,2,3,4,5,9\n").expect("write");
+    let o = needle(&["eval", "--set", &default_set().to_string_lossy(), "--poses", &file.to_string_lossy()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains(&format!("{}:1: column \"x_mm\" appears twice in the header (columns 1 and 6)", file.display())), "{err}");
+    assert!(o.stdout.is_empty(), "nothing evaluated");
+}
+
+#[test]
+fn a_huge_bad_field_is_cut_in_the_message() {
+    let d = tempfile::tempdir().expect("tempdir");
+    let file = d.path().join("poses.csv");
+    let field = "z".repeat(5_000_000);
+    std::fs::write(&file, format!("x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n1,{field},3,4,5\n")).expect("write");
+    let o = needle(&["eval", "--set", &default_set().to_string_lossy(), "--poses", &file.to_string_lossy()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(err.len() < 2_000, "the message echoes {} bytes", err.len());
+    assert!(
+        err.contains(&format!("{}:2: column z_mm: \"{}\"... (5000000 bytes) is not a number", file.display(), "z".repeat(40))),
+        "{err}"
+    );
+}
+
+#[test]
+fn out_without_poses_is_refused() {
+    let d = tempfile::tempdir().expect("tempdir");
+    let out = d.path().join("w.csv");
+    let set = default_set();
+    let args = ["--x-mm", "0", "--z-mm", "0", "--theta-x-deg", "0", "--theta-z-deg", "0", "--depth-mm", "3", "--out"];
+    let o = needle(&[&["eval", "--set", &set.to_string_lossy()], &args[..], &[&out.to_string_lossy()]].concat());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("--out") && err.contains("--poses"), "{err}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_reader_that_closes_the_pipe_ends_needle_quietly() {
+    use std::os::unix::process::ExitStatusExt;
+    use std::process::Stdio;
+    let set = default_set();
+    let set = set.to_str().expect("utf-8");
+    // 20,000 rows: more output than a pipe buffers (64 KiB), so the writes do hit the
+    // closed pipe
+    let d = tempfile::tempdir().expect("tempdir");
+    let poses = d.path().join("poses.csv");
+    std::fs::write(&poses, format!("x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n{}", "1,2,3,4,5\n".repeat(20_000))).expect("write");
+    let one = ["--x-mm", "0", "--z-mm", "0", "--theta-x-deg", "0", "--theta-z-deg", "0", "--depth-mm", "3"];
+    let single: Vec<&str> = ["eval", "--set", set].into_iter().chain(one).collect();
+    let batch = vec!["eval", "--set", set, "--poses", poses.to_str().expect("utf-8")];
+    for args in [single, batch] {
+        let mut child =
+            Command::new(env!("CARGO_BIN_EXE_needle")).args(&args).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("spawn");
+        drop(child.stdout.take()); // `| head -0`: the reader is gone
+        let o = child.wait_with_output().expect("wait");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        // killed by SIGPIPE like `cat`, or done before it wrote into the closed pipe
+        assert!(o.status.signal() == Some(13) || o.status.success(), "{args:?}: {:?} {err}", o.status);
+    }
+}
+
+#[test]
+fn out_onto_a_symlink_or_a_fifo_is_refused_and_left_alone() {
+    let d = tempfile::tempdir().expect("tempdir");
+    let poses = d.path().join("poses.csv");
+    std::fs::write(&poses, "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n1,2,3,4,5\n").expect("write");
+    let target = d.path().join("target.csv");
+    std::fs::write(&target, "keep me\n").expect("write");
+    let link = d.path().join("link.csv");
+    std::os::unix::fs::symlink(&target, &link).expect("symlink");
+    let fifo = d.path().join("fifo.csv");
+    let made = Command::new("mkfifo").arg(&fifo).status().expect("mkfifo (coreutils)");
+    assert!(made.success());
+    let set = default_set();
+    for (out, what) in [(&link, "a symbolic link"), (&fifo, "not a regular file")] {
+        let o = needle(&["eval", "--set", &set.to_string_lossy(), "--poses", &poses.to_string_lossy(), "--out", &out.to_string_lossy()]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(err.contains(&format!("{}: is {what}", out.display())), "{err}");
+    }
+    assert!(std::fs::symlink_metadata(&link).expect("link").file_type().is_symlink(), "the link is still a link");
+    assert_eq!(std::fs::read_to_string(&target).expect("target"), "keep me\n");
+    assert!(!std::fs::symlink_metadata(&fifo).expect("fifo").file_type().is_file(), "the FIFO is still a FIFO");
 }

@@ -109,9 +109,26 @@ pub fn read_csv(path: &Path) -> Result<Vec<Row>> {
 /// a failed write removes its temporary; stale temporaries of `path` from processes that
 /// are gone are removed first.
 ///
+/// Only a regular file (or nothing) at `path` is replaced: a symlink, a FIFO, a device
+/// or a folder there is refused, untouched (the rename would replace a symlink with a
+/// regular file, and the data would not reach what it points to).
+///
 /// # Errors
-/// The folder cannot be written.
+/// The folder cannot be written; `path` is not a regular file.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    if let Ok(meta) = std::fs::symlink_metadata(path) {
+        let t = meta.file_type();
+        if !t.is_file() {
+            let what = if t.is_symlink() {
+                "a symbolic link"
+            } else if t.is_dir() {
+                "a folder"
+            } else {
+                "not a regular file (a FIFO, socket or device)"
+            };
+            anyhow::bail!("{}: is {what}; only a regular file is replaced (write to a regular path)", path.display());
+        }
+    }
     // temporaries of `path` left by a killed process go first
     remove_stale_temporaries(path);
     let tmp = write_temporary(path, bytes)?;

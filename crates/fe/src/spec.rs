@@ -545,6 +545,17 @@ impl PoseSpec {
     }
 }
 
+/// Most load steps of a run (`loading.steps`, `deep.steps`): each step is one FE
+/// increment of seconds to minutes, so 10,000 is days of solving for one pose, far past
+/// any campaign; the bound keeps a typo (`4e9`) from allocating the results of billions
+/// of steps.
+pub const MAX_LOAD_STEPS: u32 = 10_000;
+
+/// Most generated poses of one kind (`campaign.lhs_count`, `campaign.train_count`): at
+/// minutes per FE run, 10,000 runs are months of solving; the bound keeps a typo from
+/// allocating billions of poses.
+pub const MAX_GENERATED_POSES: u32 = 10_000;
+
 /// Read and validate a campaign spec.
 ///
 /// # Errors
@@ -606,8 +617,13 @@ impl Campaign {
         if !(self.contact.friction.is_finite() && self.contact.friction >= 0.0) {
             bail!("{p}: contact.friction = {}: must be finite and >= 0", self.contact.friction);
         }
-        if self.loading.steps == 0 {
-            bail!("{p}: loading.steps = 0: must be >= 1");
+        if self.loading.steps == 0 || self.loading.steps > MAX_LOAD_STEPS {
+            bail!("{p}: loading.steps = {}: must be 1 ..= {MAX_LOAD_STEPS}", self.loading.steps);
+        }
+        for (name, n) in [("campaign.lhs_count", self.campaign.lhs_count), ("campaign.train_count", self.campaign.train_count)] {
+            if n > MAX_GENERATED_POSES {
+                bail!("{p}: {name} = {n}: must be <= {MAX_GENERATED_POSES}");
+            }
         }
         if self.block.sides != "pinned" || self.block.bottom != "encastre" {
             bail!(
@@ -1031,8 +1047,8 @@ pub fn validate_deep(c: &Campaign, text: &str, path: &Path) -> Result<()> {
             c.block.depth_mm
         );
     }
-    if d.steps == 0 {
-        bail!("{}: deep.steps = 0: must be >= 1", at("steps"));
+    if d.steps == 0 || d.steps > MAX_LOAD_STEPS {
+        bail!("{}: deep.steps = {}: must be 1 ..= {MAX_LOAD_STEPS}", at("steps"), d.steps);
     }
     let Some(level) = c.mesh.get(&d.mesh) else {
         let levels: Vec<&str> = c.mesh.keys().map(String::as_str).collect();
@@ -1129,8 +1145,33 @@ mod deep_tests {
             let msg = error_of(&spec);
             assert!(msg.contains(&want), "want {want:?} in: {msg}");
         }
-        let zero = text.replace(&steps, "steps = 0");
-        assert!(error_of(&zero).contains(&format!("campaign.toml:{}: deep.steps = 0: must be >= 1", line("steps"))), "{}", error_of(&zero));
+        for (n, shown) in [("0", "0"), ("4000000000", "4000000000")] {
+            let bad = text.replace(&steps, &format!("steps = {n}"));
+            let want = format!("campaign.toml:{}: deep.steps = {shown}: must be 1 ..= {MAX_LOAD_STEPS}", line("steps"));
+            assert!(error_of(&bad).contains(&want), "{}", error_of(&bad));
+        }
+    }
+
+    /// A typo of billions (`4e9` read as 4,000,000,000) in a count the campaign
+    /// allocates per item is refused at load, before anything is allocated (it aborted
+    /// `fe status`, `validate` and `fe run` with an allocation failure).
+    #[test]
+    fn counts_of_billions_are_refused_at_load() {
+        let text = shipped();
+        let line_of = |table: &str, key: &str| -> String {
+            let l = key_line(&text, table, key);
+            assert!(l > 0, "the shipped spec has {table}.{key}");
+            text.lines().nth(l - 1).expect("line").to_string()
+        };
+        for (table, key, want) in [
+            ("loading", "steps", format!("loading.steps = 4000000000: must be 1 ..= {MAX_LOAD_STEPS}")),
+            ("campaign", "lhs_count", format!("campaign.lhs_count = 4000000000: must be <= {MAX_GENERATED_POSES}")),
+            ("campaign", "train_count", format!("campaign.train_count = 4000000000: must be <= {MAX_GENERATED_POSES}")),
+        ] {
+            let bad = text.replacen(&line_of(table, key), &format!("{key} = 4000000000"), 1);
+            assert_ne!(bad, text);
+            assert!(error_of(&bad).contains(&want), "want {want:?} in: {}", error_of(&bad));
+        }
     }
 
     #[test]
