@@ -4,12 +4,11 @@
 //! `libneedle_capi.a` at the path the README names (`target/release/`, a link in the
 //! scratch folder); the README's `gcc` line runs there through `sh -c` unchanged, and the
 //! program must print the README's output block byte for byte.
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
-fn workspace_root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..").join("..")
-}
+use common::{run, staticlib, workspace_root};
+use std::path::Path;
+use std::process::Command;
 
 /// The body of the first fenced block that starts with the line "```<info>" after the
 /// first line of `text` that contains `after`.
@@ -19,30 +18,6 @@ fn block_after<'a>(text: &'a str, after: &str, info: &str) -> &'a str {
     let open = start + text[start..].find(&fence).unwrap_or_else(|| panic!("README.md: no {fence:?} after {after:?}")) + fence.len();
     let close = open + text[open..].find("```\n").unwrap_or_else(|| panic!("README.md: block after {after:?} not closed"));
     &text[open..close]
-}
-
-fn run(cmd: &mut Command, what: &str) -> String {
-    let out = cmd.output().unwrap_or_else(|e| panic!("{what}: cannot run {cmd:?}: {e} (is it installed? .ci/test installs it)"));
-    let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
-    assert!(out.status.success(), "{what} failed ({}):\n{text}", out.status);
-    text
-}
-
-/// This build's release staticlib for the host, built into the firmware target folder
-/// (as `c_program.rs` does, so that it does not wait for this test's own cargo lock).
-fn staticlib() -> PathBuf {
-    let dir = workspace_root().join("target").join("firmware");
-    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
-    run(
-        Command::new(cargo)
-            .current_dir(workspace_root())
-            .args(["build", "--release", "-p", "needle-capi", "--lib", "--target-dir"])
-            .arg(&dir),
-        "cargo build -p needle-capi",
-    );
-    let lib = dir.join("release").join("libneedle_capi.a");
-    assert!(lib.is_file(), "{}: not built", lib.display());
-    lib
 }
 
 #[test]
@@ -61,7 +36,7 @@ fn readme_c_example_compiles_links_and_prints_what_the_readme_says() {
     std::fs::write(dir.join("hello_needle.c"), program).expect("write hello_needle.c");
     std::fs::write(dir.join("include").join("needle.h"), needle_capi::HEADER).expect("write needle.h");
     std::fs::write(dir.join("include").join("needle_coeffs.h"), needle_haptics::model_info::C_HEADER).expect("write needle_coeffs.h");
-    let lib = staticlib();
+    let lib = staticlib(None);
     std::os::unix::fs::symlink(&lib, dir.join("target").join("release").join("libneedle_capi.a")).expect("link the staticlib");
 
     run(Command::new("sh").current_dir(&dir).args(["-c", gcc]), "the README's gcc line");
