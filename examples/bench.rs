@@ -17,7 +17,7 @@
 //!   The figure includes the call, the return and the evaluator's stores of its result
 //!   into the caller's slot; the loop keeps the result where the evaluator wrote it
 //!   (`black_box(&result)`), as a caller does, instead of moving it into a second slot
-//!   (`black_box(result)`, measured 2026-11-26 on the M4F: +5.1 instructions for the
+//!   (`black_box(result)`, measured on the M4F: +5.1 instructions for the
 //!   28-byte wrench, +121 for the 100-byte wrench and stiffness, whose move is a
 //!   `memcpy`: a cost of the harness, not of the evaluator). Both
 //!   evaluators run in the same firmware, one after the other, on the same poses (the

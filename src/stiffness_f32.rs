@@ -165,9 +165,8 @@ impl<const C: usize> Column<C> {
 /// on its own, so the FPU's 32 registers hold one component's work (measured on the M4F
 /// for wrench and stiffness: inlined, the compiler interleaved the six components and
 /// spilled, 1,320 instructions and 540 B of stack; with the tables passed at run time,
-/// 1,437; this way 1,255 and 300 B; these under the `bench` harness before 2026-11-26,
-/// which moved the result, +121; two components in one function: no gain, 1,117.0 either
-/// way).
+/// 1,437; this way 1,255 and 300 B; these under an earlier `bench` harness that moved
+/// the result, +121; two components in one function: no gain, 1,117.0 either way).
 #[inline(never)]
 fn component_of<const C: usize>(at: &At) -> Component {
     component(&Column::<C>::TABLES, at)

@@ -48,7 +48,7 @@ fn the_shipped_liver_stack_is_the_calibration_of_the_shipped_curve() {
     let c = calibrate(&options(&path)).unwrap_or_else(|e| panic!("{e:#}"));
     let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default/tissue/liver.toml");
     let file = needle_codegen::tissue::parse_stack(&shipped).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(file.layers, c.stack.layers, "coeffs/default/tissue/liver.toml is stale: rerun needle calibrate (README)");
+    assert_eq!(file.layers, c.stack.layers, "coeffs/default/tissue/liver.toml is stale: rerun needle calibrate (docs/insertion.md)");
 }
 
 /// The error of a calibration that must be refused (a short panic when it is not).

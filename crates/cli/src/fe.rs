@@ -10,24 +10,20 @@ use std::time::Duration;
 /// `needle fe` subcommands.
 #[derive(Subcommand)]
 pub enum FeCommand {
-    /// Run the FE campaign of a set on its engine (FEBio or CalculiX, campaign.toml's
-    /// [solver] engine or --solver): one input and one solver job per pose,
-    /// results in <set>/fe/<pose>.csv (depth in mm, forces in N, moments in N*mm about the
-    /// needle hub) and <set>/fe/manifest.toml. Poses whose result matches the current
-    /// spec are skipped; a killed campaign resumes where it stopped. Exit status 1 when a
-    /// run failed (the others are still written), 2 on an error before any run.
+    /// Solve the set's FE campaign, one solver job per pose; resumable.
+    #[command(after_help = "Each pose's result goes to <set>/fe/<pose>.csv (depth in mm, forces in N, moments in N*mm \
+about the needle hub) and its record to <set>/fe/manifest.toml. Poses whose result matches the current spec are \
+skipped; a failed attempt is retried on the engine's retry ladder (docs/usage.md). Exit status 1 when a run failed \
+(the others are kept), 2 on an error before any run.")]
     Run(RunArgs),
-    /// Verify the FE setup: flat punch against Sneddon (four small solves), mesh
-    /// convergence of the centred needle (two needle solves, the fine one is slow), the
-    /// mirror runs against their counterparts, every result's smoothness in depth (no
-    /// solve) and the stiffness scaling law (four solves). Without --punch, --mesh, --mirror,
-    /// --smooth or --scaling all five run. Prints the table and writes <set>/fe/verify.toml. Exit
-    /// status 1 when a check misses its goal, 2 on an error.
+    /// Verify the FE setup: flat punch, mesh study, mirror runs, smoothness, scaling law.
+    #[command(after_help = "Without --punch, --mesh, --mirror, --smooth or --scaling all five run (the mesh study's \
+fine level is slow). Prints the table and writes <set>/fe/verify.toml. Exit status 1 when a check misses its goal, \
+2 on an error.")]
     Verify(VerifyArgs),
-    /// The state of a set's poses: up to date or why not, and with --launcher slurm
-    /// submissions the queue state of each pose's latest array task (squeue) or the cause
-    /// a task that ended without a result states. With --project-nodes, the campaign's
-    /// wall time on that many nodes, projected from the manifest's measured runs.
+    /// Each pose's state: up to date or why not, its SLURM task, projected wall time.
+    #[command(after_help = "For --launcher slurm submissions: the queue state of each pose's latest array task \
+(squeue), or the cause a task that ended without a result states (docs/cluster.md).")]
     Status(StatusArgs),
     /// Solve one pose as a local job would (one job; threads from SLURM_CPUS_PER_TASK):
     /// what each array task of `needle fe run --launcher slurm` runs.
@@ -38,9 +34,11 @@ pub enum FeCommand {
 /// Where the solver jobs run.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LauncherArg {
-    /// Worker threads of this process (--jobs at once).
+    // Plain comments, not doc comments: clap would list them as the values' help and
+    // turn `--help` into its long layout.
+    // Worker threads of this process (--jobs at once).
     Local,
-    /// One SLURM job array (sbatch), one task per pose still to solve.
+    // One SLURM job array (sbatch), one task per pose still to solve.
     Slurm,
 }
 
@@ -61,16 +59,14 @@ pub struct SpecArgs {
     /// Mesh level of campaign.toml ([mesh.<LEVEL>]); default: campaign.mesh.
     #[arg(long, value_name = "LEVEL")]
     pub mesh: Option<String>,
-    /// Number of load steps instead of loading.steps (smoke runs: rows at N+1 depths from 0
-    /// to loading.depth_mm). Part of the spec hash: results of other step counts are rerun.
+    /// Load steps instead of loading.steps, for smoke runs (part of the spec hash).
     #[arg(long, value_name = "N", allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=10_000))]
     pub steps: Option<u32>,
     /// Output folder for <pose>.csv, manifest.toml and .work/; default: <set>/fe (with
     /// --deep: <set>/fe/deep).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// The deep runs of campaign.toml's [deep] section: its poses (--only selects among
-    /// them) to deep.depth_mm in deep.steps load steps on deep.mesh, into <set>/fe/deep/.
+    /// The runs of campaign.toml's [deep] section (to deep.depth_mm on deep.mesh), into <set>/fe/deep/.
     #[arg(long)]
     pub deep: bool,
 }
@@ -85,12 +81,10 @@ pub struct SolveArgs {
     /// runs too; failed runs always keep theirs.
     #[arg(long)]
     pub keep_work: bool,
-    /// Wall-clock limit of one solver attempt (FEBio, with its continuations from the last
-    /// must point, or ccx), in seconds; an attempt running longer is killed and counted
-    /// failed (the next attempt of the retry ladder follows).
+    /// Wall-clock limit of one solver attempt, seconds; a longer attempt is killed and counted failed.
     #[arg(long, value_name = "S", allow_negative_numbers = true, value_parser = positive_seconds)]
     pub timeout_s: Option<f64>,
-    /// A solver job that writes no output (FEBio: log and rigid-body file; ccx: log, .sta, .cvg) for this many seconds is killed as stalled and counted failed (the next attempt of the retry ladder follows)
+    /// Seconds without solver output (log, result files) after which a job is killed as stalled.
     #[arg(long, value_name = "S", default_value_t = campaign::DEFAULT_STALL.as_secs_f64(), allow_negative_numbers = true, value_parser = positive_seconds)]
     pub stall_s: f64,
 }
@@ -121,20 +115,16 @@ pub struct RunArgs {
     pub threads: Option<u32>,
     #[command(flatten)]
     pub solve: SolveArgs,
-    /// Where the solver jobs run: local (this machine, --jobs at once) or slurm (one
-    /// sbatch job array, one task per pose still to solve, on the shared filesystem;
-    /// `needle fe status` follows it, rerunning the command resumes it).
+    /// Where the solver jobs run: local (this machine) or slurm (one sbatch job array; docs/cluster.md).
     #[arg(long, value_enum, default_value_t = LauncherArg::Local)]
     pub launcher: LauncherArg,
     /// slurm: sbatch --partition (default: the cluster's default partition).
     #[arg(long, value_name = "NAME")]
     pub partition: Option<String>,
-    /// slurm: sbatch --time per task, SLURM's format (minutes, HH:MM:SS, D-HH); default:
-    /// the engine's attempts x the longest measured run on this mesh x 1.5, at least 10 min.
+    /// slurm: sbatch --time per task (default: attempts x longest measured run x 1.5, >= 10 min).
     #[arg(long, value_name = "TIME")]
     pub time: Option<String>,
-    /// slurm: sbatch --mem per task (e.g. 4G); default: the largest measured solver peak
-    /// memory on this mesh x 1.5 + 256 MiB.
+    /// slurm: sbatch --mem per task, e.g. 4G (default: largest measured peak x 1.5 + 256 MiB).
     #[arg(long, value_name = "SIZE")]
     pub mem: Option<String>,
     /// slurm: sbatch --cpus-per-task, also the solver threads of each task (default 1).
@@ -193,24 +183,16 @@ pub struct VerifyArgs {
     /// Run the flat-punch check (Sneddon, goal 5%).
     #[arg(long)]
     pub punch: bool,
-    /// Run the mesh study: the centre on every level of campaign.mesh_study, the poses of
-    /// campaign.mesh_study_poses on the committed level and its refinement (runs in
-    /// <set>/fe/mesh/<level>/, resumed when interrupted); the shape after the best single
-    /// scale between levels (goal 2% RMS, 4% largest of peak |Fy|), the absolute change and
-    /// Richardson's estimate of Fy when in the asymptotic range.
+    /// Run the mesh study: each level against its refinement (goal 2% RMS, 4% largest after the best scale).
     #[arg(long)]
     pub mesh: bool,
     /// Check the mirror runs against their counterparts (goal 1% of peak |Fy|).
     #[arg(long)]
     pub mirror: bool,
-    /// Check every FE result present for a must point off the mean of its neighbours (a
-    /// state accepted off the equilibrium path; goal 3% of peak |Fy|).
+    /// Check every FE result for a must point off its neighbours' mean (goal 3% of peak |Fy|).
     #[arg(long)]
     pub smooth: bool,
-    /// Check the stiffness scaling law: the --scaling-poses solved with every Ogden mu_i
-    /// x 0.5 and x 2 (work files under <work>/scaling-s<s>/, resumed when interrupted)
-    /// against s x their committed fe/<pose>.csv at every must point (goal 0.5% of peak
-    /// |Fy|).
+    /// Check the scaling law: every Ogden mu_i x 0.5 and x 2 scales the wrench (goal 0.5% of peak |Fy|).
     #[arg(long)]
     pub scaling: bool,
     /// Poses of the scaling check, comma-separated exact names.

@@ -7,24 +7,22 @@ use std::process::ExitCode;
 /// `needle firmware` subcommands.
 #[derive(Subcommand)]
 pub enum FirmwareCommand {
-    /// Flash and RAM of the model per core and evaluator, from arm-none-eabi-size and -nm
-    /// on the `no_panic` (f32) and `no_panic_fixed` example ELFs (release): evaluator code,
-    /// tables, compiler runtime, static RAM, with the goals (model flash <= 8 KiB, coupled
-    /// form 16 KiB; no static RAM).
+    /// Flash and RAM of the model per core and evaluator, with the goals.
+    #[command(after_help = "From arm-none-eabi-size and -nm on the no_panic (f32) and no_panic_fixed example ELFs \
+(release): evaluator code, tables, compiler runtime, static RAM; goals: model flash <= 8 KiB (coupled form 16 KiB), \
+no static RAM.")]
     Size(FirmwareArgs),
-    /// Instructions per 6-axis wrench and stack high-water mark per core, f32 and fixed
-    /// point side by side: the `bench` example under QEMU -icount shift=0 (SysTick counts
-    /// instructions), with the goals of the set's model form (paper: f32 <= 900 instructions
-    /// on the M4F, fixed point <= 10,000 on the M0; coupled: 1,500 and 15,000; stack <= 512 B).
+    /// Instructions per wrench and stack per core, f32 and fixed point, with the goals.
+    #[command(after_help = "The bench example under QEMU -icount shift=0 (SysTick counts instructions). Goals of the \
+set's model form: paper f32 <= 900 instructions on the M4F, fixed point <= 10,000 on the M0; coupled 1,500 and \
+15,000; stack <= 512 B.")]
     Bench(FirmwareArgs),
-    /// Run the `golden` example on each core's QEMU board and compare every printed bit
-    /// with the set's golden-f32.csv, and every fixed-point integer with its
-    /// golden-fixed.csv, and every stiffness rate with its golden-stiffness-f32.csv and
-    /// golden-stiffness-fixed.csv. Exit status 1 when a bit differs.
+    /// Run the golden vectors on each core under QEMU; exit 1 when a bit differs.
+    #[command(after_help = "The golden example's output against the set's golden-f32.csv, golden-fixed.csv, \
+golden-stiffness-f32.csv and golden-stiffness-fixed.csv, bit for bit.")]
     Golden(FirmwareArgs),
-    /// Build the library for each core with every combination of its features, and the
-    /// `no_panic` and `no_panic_fixed` examples (link only if the evaluators have no panic
-    /// path).
+    /// Build the library for each core with every feature combination, and the no-panic proofs.
+    #[command(after_help = "The no_panic and no_panic_fixed examples link only if the evaluators have no panic path.")]
     Check(FirmwareArgs),
 }
 

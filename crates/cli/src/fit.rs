@@ -70,7 +70,7 @@ fn check_file(path: &Path, want: &str) -> Result<bool> {
     }
 }
 
-/// `needle fit --set DIR [--check]`: fit the set's FE sweeps and write `model.toml` and
+/// `needle fit --set DIR [--check]`: fit the set's model in its form and write `model.toml` and
 /// the golden vectors ([`fit::FitOutput::files`]) all or nothing ([`write_all_atomic`])
 /// (or, with `--check`, compare them). Exit code 0 on success, 1 when `--check` finds a
 /// difference.

@@ -4,7 +4,7 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "needle", version, about = "needle-haptics: FE campaign, fitter and model tool")]
+#[command(name = "needle", version, about = "needle-haptics: FE campaign, model fit, evaluation and firmware checks")]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -12,25 +12,27 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// FE campaign (FEBio or CalculiX): run, verify.
+    /// FE campaign of a set (FEBio or CalculiX): run, verify, status.
     #[command(subcommand)]
     Fe(needle_cli::fe::FeCommand),
-    /// Fit the paper model to a set's FE sweeps and write model.toml and golden vectors.
+    /// Fit the set's model in its [fit] form (paper or coupled); write model.toml and golden vectors.
+    #[command(after_help = "The form is campaign.toml's [fit] form: paper (the paper's single-axis sweeps, superposed) \
+or coupled (those terms plus cross terms, fitted together on the centre, sweep and training runs, sized per \
+component by cross-validation). Writes model.toml and the four golden files all or nothing; refuses stale FE runs.")]
     Fit(needle_cli::fit::FitArgs),
-    /// Evaluate the wrench at one pose with the library (the firmware's code).
+    /// The wrench at one pose, or at every row of a CSV, from the library (the firmware's code).
     Eval(needle_cli::model::EvalArgs),
-    /// Fit a tissue stack (<set>/tissue/<name>.toml) to a measured axial force against needle position.
+    /// Fit a tissue stack (<set>/tissue/<name>.toml) to a measured force against needle position.
     Calibrate(needle_cli::calibrate::CalibrateArgs),
-    /// Compare the model with the FE runs it was not fitted on.
+    /// Compare the model with the FE runs it was not fitted on; exit 1 when a goal is missed.
     Validate(needle_cli::fit::ValidateArgs),
-    /// Serve the model explorer (the firmware's evaluator compiled to wasm) on a local port.
+    /// Serve the model explorer (the library compiled to wasm) to a browser on a local port.
     Explore(needle_cli::explore::ExploreArgs),
-    /// The set's figures as SVG (the paper's Figs 4, 6, 7, 8, parity, FE verification).
+    /// Draw the set's figures as SVG (Figs 4, 6, 7, 8, parity, FE verification).
     Plot(needle_cli::plot::PlotArgs),
-    /// The fixed-point evaluator's error against f64 on a grid and random poses, beside
-    /// its generated bound.
+    /// The fixed-point evaluator's largest error against f64 on a grid and random poses, beside its bound.
     FixedError(needle_cli::fixed::FixedErrorArgs),
-    /// Copy the generated C header out for C users.
+    /// Write the C headers: needle.h (the C API) and needle_coeffs.h (the model's tables).
     Header(needle_cli::model::HeaderArgs),
     /// The library on Cortex-M under QEMU: size, bench, golden, check.
     #[command(subcommand)]

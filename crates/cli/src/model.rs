@@ -257,8 +257,8 @@ fn eval_file(file: &Path, out: Option<&Path>, json: bool) -> anyhow::Result<Exit
     Ok(ExitCode::SUCCESS)
 }
 
-/// `needle header`: writes the C header generated with the compiled-in tables to
-/// `DIR/needle_coeffs.h`.
+/// `needle header`: writes the C headers to `DIR`: `needle_coeffs.h` (generated with the
+/// compiled-in tables) and `needle.h` (the C API's header, from `needle-capi`).
 ///
 /// # Errors
 /// The folder cannot be created or the file cannot be written.

@@ -172,7 +172,7 @@ fn a_failing_run_keeps_its_log_and_the_campaign_goes_on() {
 }
 
 /// Tolerance of the coarse FEBio punch, %. `punch_mesh_scale = 2` (8 hex8 elements across
-/// the punch, h = a/4) measured +4.90 % (2026-11-24; the verification mesh, 16 across:
+/// the punch, h = a/4) measured +4.90 % (FEBio 4.11; the verification mesh, 16 across:
 /// +2.55 %). The rim's stress singularity makes the error first order in h; 8 % leaves
 /// 3 points for solver and platform differences, while a wrong modulus, boundary
 /// condition, symmetry factor, reaction sign or sum moves it by far more (the locking

@@ -32,7 +32,7 @@ fn copy_dir(from: &Path, to: &Path) {
     }
 }
 
-/// The README shows coeffs/default/figures: they must be current.
+/// The README and docs/usage.md show coeffs/default/figures: they must be current.
 #[test]
 fn committed_figures_are_up_to_date() {
     let set = default_set();

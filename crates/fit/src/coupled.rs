@@ -60,7 +60,7 @@ impl Candidate {
 
 /// Cross-term sizes tried: total degree 2..=3 in the pose, 2..=3 in depth. Degree 4 (31
 /// monomials for fz and mx) is rank deficient on the training runs a campaign can afford
-/// (measured with 17 runs, 2026-11-26) and is left out.
+/// (measured with 17 training runs of the default set) and is left out.
 pub const CROSS_FORMS: [CrossForm; 4] = [
     CrossForm { max_degree: 2, depth_degree: 2 },
     CrossForm { max_degree: 2, depth_degree: 3 },

@@ -145,8 +145,8 @@ impl Backend for FebioBackend {
     /// 5. as 3 with the penalty scaled by `last_attempt_penalty_scale`.
     ///
     /// On the full block (no mirror plane) attempts 1 and 2, and 3 and 4, swap their
-    /// projection rules (`retry_seg_up` first, then `seg_up`): in the rerun of
-    /// 2026-11-26 (rtol 1e-3, needle8) `seg_up` 5 with whole first increments failed on
+    /// projection rules (`retry_seg_up` first, then `seg_up`): in the default set's rerun
+    /// (rtol 1e-3, needle8) `seg_up` 5 with whole first increments failed on
     /// all seven full-block poses tried (lhs-01..03, t2-a..d) between 0.14 and 3.3 mm,
     /// each a deterministic repeat of 50-750 s, while `retry_seg_up` 0 solved lhs-01,
     /// t2-a and t2-c on attempt 2 and lhs-02, t2-d on attempt 4.

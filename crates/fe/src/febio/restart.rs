@@ -7,7 +7,7 @@
 //! `febio_restart` input whose first time step is a fraction of a load step
 //! ([`CONTINUE_STEP_FRACTION`]), the time stepper's lower limit a tenth of the run's, and
 //! otherwise the same model and settings; a run continues again only from a later must
-//! point. Measured 2026-11-25 (needle8, one thread): `t2-b` with the campaign's last
+//! point. Measured on the default set (needle8, one thread): `t2-b` with the campaign's last
 //! attempt stopped at 3.79 mm, continued from its dump at 3.6 mm it passed that point
 //! and reached 4.95 mm; but in the campaign the continuations of `t2-b` (attempts 2, 3)
 //! and `tx+15` (attempts 1, 2) stopped again at the same depth (1.78, 1.47, 0.80,

@@ -2,7 +2,7 @@
 //! furthest from the mean of its two neighbours. No solve: it reads `fe/<pose>.csv`.
 //!
 //! Why: a solver can accept a state that is not in equilibrium (FEBio with `rtol` 0
-//! accepted one where the line search had cut the last step to 0.033, 2026-11-26: tx+04's
+//! accepted one where the line search had cut the last step to 0.033: the default set's tx+04's
 //! Fy at 2.1 mm 6.1 % of peak |Fy| below its neighbours' mean, t2-a's at 4.2 mm 6.1 %
 //! above). The force-depth curves are smooth where the runs are sound: on the 0.3 mm
 //! steps of the campaign the curvature alone puts a point 0.4-0.8 % of peak |Fy| from its
