@@ -106,6 +106,9 @@ fn size_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
 /// Flash of the model with the whole insertion (issue 41): the `insertion` row.
 const INSERTION_FLASH_BYTES: u64 = 24 * 1024;
 
+/// Stack of one insertion step (issue 41), beside the evaluators' 512 B.
+const INSERTION_STACK_BYTES: u64 = 1024;
+
 /// The firmware goals of a model form: f32 instructions per wrench on the M4F, fixed-point
 /// instructions on the M0, model flash (paper form: issues 4 and 5; coupled form: issue 16).
 struct Goals {
@@ -139,7 +142,9 @@ fn bench_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
     println!();
     for f in &figures {
         let Some(t) = f.pose("typical", "f32") else { continue };
-        let max_stack = f.poses.iter().map(|p| p.stack_bytes).max().unwrap_or(0);
+        // the evaluators' stack goal (512 B); the insertion step has its own (issue 41: 1 KiB)
+        let max_stack = f.poses.iter().filter(|p| p.evaluator != "insertion").map(|p| p.stack_bytes).max().unwrap_or(0);
+        let insertion_stack = f.poses.iter().filter(|p| p.evaluator == "insertion").map(|p| p.stack_bytes).max();
         let instr_goal = if f.core.name == "m4f" {
             format!("; <= {} instructions: {}", goals.m4f_f32_instructions, goal(t.instructions <= goals.m4f_f32_instructions))
         } else {
@@ -151,6 +156,13 @@ fn bench_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
             t.instructions,
             goal(max_stack <= 512)
         );
+        if let Some(b) = insertion_stack {
+            println!(
+                "insertion {}: stack of one step {b} B <= {INSERTION_STACK_BYTES} B: {}",
+                f.core.core,
+                goal(b <= INSERTION_STACK_BYTES)
+            );
+        }
         if let Some(k) = f.pose("typical", "f32+k") {
             let ratio = k.instructions / t.instructions;
             println!(

@@ -265,10 +265,10 @@ fn eval_file(file: &Path, out: Option<&Path>, json: bool) -> anyhow::Result<Exit
 pub fn header(a: HeaderArgs) -> anyhow::Result<ExitCode> {
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     let path = a.out.join(needle_codegen::C_HEADER_FILE);
-    needle_fe::results::write_atomic(&path, model_info::C_HEADER.as_bytes())?;
     // the C API's own header (functions, types, NEEDLE_STATUS_* / NEEDLE_LOOP_* constants)
     let api = a.out.join("needle.h");
-    needle_fe::results::write_atomic(&api, needle_capi::HEADER.as_bytes())?;
+    // both or neither: a failure leaves the old pair as it was
+    needle_fe::results::write_all_atomic(&[(&path, model_info::C_HEADER.as_bytes()), (&api, needle_capi::HEADER.as_bytes())])?;
     println!("wrote {} (the C API: link libneedle_capi.a from `cargo build --release -p needle-capi`)", api.display());
     if model_info::FITTED {
         println!("wrote {} (set {}, fe_sha256 {})", path.display(), model_info::SET, model_info::FE_SHA256);

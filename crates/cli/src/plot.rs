@@ -2,7 +2,7 @@
 
 use anyhow::{Context, Result};
 use clap::Args;
-use needle_fe::results::write_atomic;
+use needle_fe::results::write_all_atomic;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -47,9 +47,11 @@ pub fn plot(a: PlotArgs) -> Result<ExitCode> {
         return Ok(if ok { ExitCode::SUCCESS } else { ExitCode::from(1) });
     }
     std::fs::create_dir_all(&out).with_context(|| format!("{}: cannot create", out.display()))?;
-    for (file, svg) in &figures {
-        let path = out.join(file);
-        write_atomic(&path, svg.as_bytes())?;
+    // all or none: a failure (a full disk) leaves the old figures as they were
+    let paths: Vec<std::path::PathBuf> = figures.iter().map(|(file, _)| out.join(file)).collect();
+    let files: Vec<(&std::path::Path, &[u8])> = paths.iter().zip(&figures).map(|(p, (_, svg))| (p.as_path(), svg.as_bytes())).collect();
+    write_all_atomic(&files)?;
+    for (path, (_, svg)) in paths.iter().zip(&figures) {
         println!("wrote {} ({} bytes)", path.display(), svg.len());
     }
     Ok(ExitCode::SUCCESS)

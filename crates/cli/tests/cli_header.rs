@@ -19,3 +19,22 @@ fn header_writes_the_tables_and_the_api_header() {
         assert!(api.contains(item), "needle.h lacks {item}");
     }
 }
+
+/// Issue 38: on a failure between the two headers (a full disk, a refused path) the
+/// first was already replaced, leaving a new needle_coeffs.h beside an old needle.h.
+/// Now both are written or neither.
+#[test]
+fn header_writes_both_or_neither() {
+    let d = tempfile::tempdir().expect("tempdir");
+    let out_dir = d.path().join("include");
+    std::fs::create_dir_all(out_dir.join("needle.h")).expect("a folder where needle.h goes");
+    std::fs::write(out_dir.join("needle_coeffs.h"), "old\n").expect("old header");
+    let out = Command::new(env!("CARGO_BIN_EXE_needle")).args(["header", "--out"]).arg(&out_dir).output().expect("run needle header");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("needle.h: is a folder"), "{err}");
+    assert_eq!(std::fs::read_to_string(out_dir.join("needle_coeffs.h")).expect("kept"), "old\n", "the old header is kept");
+    let names: Vec<String> =
+        std::fs::read_dir(&out_dir).expect("dir").map(|e| e.expect("entry").file_name().to_string_lossy().into_owned()).collect();
+    assert_eq!(names.len(), 2, "no temporary left: {names:?}");
+}

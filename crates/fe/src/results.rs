@@ -116,6 +116,50 @@ pub fn read_csv(path: &Path) -> Result<Vec<Row>> {
 /// # Errors
 /// The folder cannot be written; `path` is not a regular file.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_all_atomic(&[(path, bytes)])
+}
+
+/// [`write_atomic`] for several files that belong together (the C headers, a set's
+/// figures): every path is checked and every temporary written and synced before the
+/// first rename, so a failure (a full disk, a refused path) leaves every old file as it
+/// was and no new one beside them ("nothing written"); the renames then replace them all
+/// (they stay in their folders and do not fail on a checked target; a crash between two
+/// of them can leave the first ones new).
+///
+/// # Errors
+/// As [`write_atomic`], for any of the files; then none is replaced.
+pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<()> {
+    for (path, _) in files {
+        refuse_special(path).context("nothing written")?;
+    }
+    let mut written: Vec<(std::path::PathBuf, &Path)> = Vec::with_capacity(files.len());
+    for (path, bytes) in files {
+        // temporaries of `path` left by a killed process go first
+        remove_stale_temporaries(path);
+        match write_temporary(path, bytes) {
+            Ok(tmp) => written.push((tmp, path)),
+            Err(e) => {
+                for (tmp, _) in &written {
+                    let _ = std::fs::remove_file(tmp);
+                }
+                return Err(e.context("nothing written"));
+            }
+        }
+    }
+    for (i, (tmp, path)) in written.iter().enumerate() {
+        if let Err(e) = std::fs::rename(tmp, path) {
+            for (t, _) in written.iter().skip(i) {
+                let _ = std::fs::remove_file(t);
+            }
+            anyhow::bail!("{}: cannot rename to {}: {e}", tmp.display(), path.display());
+        }
+    }
+    Ok(())
+}
+
+/// Refuses a path where something other than a regular file is (module rule of
+/// [`write_atomic`]).
+fn refuse_special(path: &Path) -> Result<()> {
     if let Ok(meta) = std::fs::symlink_metadata(path) {
         let t = meta.file_type();
         if !t.is_file() {
@@ -129,13 +173,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
             anyhow::bail!("{}: is {what}; only a regular file is replaced (write to a regular path)", path.display());
         }
     }
-    // temporaries of `path` left by a killed process go first
-    remove_stale_temporaries(path);
-    let tmp = write_temporary(path, bytes)?;
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        anyhow::anyhow!("{}: cannot rename to {}: {e}", tmp.display(), path.display())
-    })
+    Ok(())
 }
 
 /// The temporary of `path` for this process: `.<name>.<pid>.tmp` beside it.
@@ -181,36 +219,31 @@ pub fn remove_stale_temporaries(path: &Path) {
     }
 }
 
-/// Write several files all or nothing: every target is checked (not a folder), every
-/// content written to its temporary and synced, and only then are the temporaries
-/// renamed over the targets, one by one. When a check or a write fails, the temporaries
-/// are removed and no target has changed. (The renames are in the same folders and do
-/// not fail on a checked target; a crash between two of them can leave the first ones
-/// new.) Stale temporaries of the targets are removed first.
-///
-/// # Errors
-/// A target is a folder, or a temporary cannot be written.
-pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<()> {
-    for (path, _) in files {
-        remove_stale_temporaries(path);
-        if path.is_dir() {
-            bail!("{}: is a folder, cannot write a file there (nothing written)", path.display());
-        }
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A failure while writing the second file (its folder cannot be made: a file is in
+    /// the way) leaves the first file's old content and no temporary of either.
+    #[test]
+    fn write_all_atomic_replaces_all_or_nothing() {
+        let d = tempfile::tempdir().expect("tempdir");
+        let first = d.path().join("a.txt");
+        std::fs::write(&first, "old").expect("write");
+        std::fs::write(d.path().join("blocker"), "a file, not a folder").expect("write");
+        let second = d.path().join("blocker").join("b.txt");
+        let e = write_all_atomic(&[(&first, b"new"), (&second, b"new")]).expect_err("the second cannot be written");
+        assert!(format!("{e:#}").contains("cannot create"), "{e:#}");
+        assert_eq!(std::fs::read_to_string(&first).expect("read"), "old");
+        let mut names: Vec<String> =
+            std::fs::read_dir(d.path()).expect("dir").map(|e| e.expect("e").file_name().to_string_lossy().into_owned()).collect();
+        names.sort();
+        assert_eq!(names, ["a.txt", "blocker"], "no temporary left");
+        let third = d.path().join("c.txt");
+        write_all_atomic(&[(&first, b"new"), (&third, b"new")]).expect("both writable");
+        assert_eq!(
+            (std::fs::read_to_string(&first).expect("a"), std::fs::read_to_string(&third).expect("c")),
+            ("new".into(), "new".into())
+        );
     }
-    let mut temps = Vec::new();
-    for (path, bytes) in files {
-        match write_temporary(path, bytes) {
-            Ok(t) => temps.push(t),
-            Err(e) => {
-                for t in &temps {
-                    let _ = std::fs::remove_file(t);
-                }
-                return Err(e.context("nothing written"));
-            }
-        }
-    }
-    for (tmp, (path, _)) in temps.iter().zip(files) {
-        std::fs::rename(tmp, path).with_context(|| format!("{}: cannot rename to {}", tmp.display(), path.display()))?;
-    }
-    Ok(())
 }
