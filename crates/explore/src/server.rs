@@ -1,9 +1,16 @@
-//! The explorer's HTTP server: one page, its script, the wasm module and `/set.json`,
-//! on one thread (a local tool for one user; every answer is in memory).
+//! The explorer's HTTP server: one page, its script, the wasm module and `/set.json`
+//! (a local tool for one user; every answer is in memory).
+//!
+//! - Each answer is written on its own thread: a client that sends requests and never
+//!   reads the answers (its socket buffer full) blocks only its own answers.
+//! - Only requests whose `Host` is this server by address (`localhost`, an IP literal)
+//!   and port are answered (else 421): a page of another site whose name the attacker
+//!   points at 127.0.0.1 (DNS rebinding) sends its own name as `Host` and gets nothing.
 
 use anyhow::{anyhow, Result};
 use std::net::SocketAddr;
-use tiny_http::{Header, Response, Server};
+use std::sync::Arc;
+use tiny_http::{Header, Request, Response, Server};
 
 /// The page's files, embedded at compile time: (URL path, content type, bytes).
 const PAGE: [(&str, &str, &[u8]); 4] = [
@@ -47,31 +54,59 @@ impl Explorer {
     }
 
     /// Answers requests until the process ends: GET of the page's files, `/needle.wasm`
-    /// and `/set.json`; 404 for any other path, 405 for other methods. A failed answer (the
-    /// browser went away) is reported on stderr and the server goes on.
+    /// and `/set.json`; 404 for any other path, 405 for other methods, 421 for a `Host`
+    /// that is not this server ([`host_is_local`]). A failed answer (the browser went
+    /// away) is reported on stderr and the server goes on.
     pub fn serve(self) {
+        let port = self.server.server_addr().to_ip().map_or(0, |a| a.port());
+        let content = Arc::new(self.content);
         for request in self.server.incoming_requests() {
-            let path = request.url().split('?').next().unwrap_or("/").to_string();
-            let (status, kind, body): (u16, &str, &[u8]) = if *request.method() != tiny_http::Method::Get {
-                (405, "text/plain; charset=utf-8", b"only GET\n")
-            } else if let Some((_, kind, bytes)) = PAGE.iter().find(|(p, _, _)| *p == path || (path == "/index.html" && *p == "/")) {
-                (200, kind, bytes)
-            } else if path == "/needle.wasm" {
-                (200, "application/wasm", &self.content.wasm)
-            } else if path == "/set.json" {
-                (200, "application/json", self.content.set_json.as_bytes())
-            } else {
-                (404, "text/plain; charset=utf-8", b"not found\n")
-            };
-            let mut response = Response::from_data(body.to_vec()).with_status_code(status);
-            for (name, value) in [("Content-Type", kind), ("Cache-Control", "no-store")] {
-                if let Ok(h) = Header::from_bytes(name.as_bytes(), value.as_bytes()) {
-                    response.add_header(h);
-                }
-            }
-            if let Err(e) = request.respond(response) {
-                eprintln!("needle explore: answering GET {path}: {e}");
-            }
+            let content = Arc::clone(&content);
+            // its own thread: a client that never reads blocks only its own answers
+            std::thread::spawn(move || answer(request, &content, port));
         }
+    }
+}
+
+/// Whether a request's `Host` header names this server: `localhost`, or an IP literal
+/// (IPv4, or IPv6 in brackets), with the server's `port` (or no port at all only when it
+/// is 80). A name of any other site (DNS rebinding) is not.
+#[must_use]
+pub fn host_is_local(host: &str, port: u16) -> bool {
+    let (name, p) = match host.rsplit_once(':') {
+        Some((n, p)) if !p.contains(']') => (n, p.parse::<u16>().ok()),
+        _ => (host, Some(80)),
+    };
+    let name_ok = name.eq_ignore_ascii_case("localhost")
+        || name.parse::<std::net::Ipv4Addr>().is_ok()
+        || name.strip_prefix('[').and_then(|n| n.strip_suffix(']')).is_some_and(|n| n.parse::<std::net::Ipv6Addr>().is_ok());
+    name_ok && p == Some(port)
+}
+
+/// One request's answer (module rules).
+fn answer(request: Request, content: &Content, port: u16) {
+    let path = request.url().split('?').next().unwrap_or("/").to_string();
+    let host = request.headers().iter().find(|h| h.field.equiv("Host")).map(|h| h.value.as_str().to_string());
+    let (status, kind, body): (u16, &str, &[u8]) = if !host.as_deref().is_some_and(|h| host_is_local(h, port)) {
+        (421, "text/plain; charset=utf-8", b"Host is not this server (localhost or its IP address with its port)\n")
+    } else if *request.method() != tiny_http::Method::Get {
+        (405, "text/plain; charset=utf-8", b"only GET\n")
+    } else if let Some((_, kind, bytes)) = PAGE.iter().find(|(p, _, _)| *p == path || (path == "/index.html" && *p == "/")) {
+        (200, kind, bytes)
+    } else if path == "/needle.wasm" {
+        (200, "application/wasm", &content.wasm)
+    } else if path == "/set.json" {
+        (200, "application/json", content.set_json.as_bytes())
+    } else {
+        (404, "text/plain; charset=utf-8", b"not found\n")
+    };
+    let mut response = Response::from_data(body.to_vec()).with_status_code(status);
+    for (name, value) in [("Content-Type", kind), ("Cache-Control", "no-store")] {
+        if let Ok(h) = Header::from_bytes(name.as_bytes(), value.as_bytes()) {
+            response.add_header(h);
+        }
+    }
+    if let Err(e) = request.respond(response) {
+        eprintln!("needle explore: answering GET {path}: {e}");
     }
 }

@@ -9,16 +9,19 @@ use std::path::Path;
 /// The set's name, the folder as given on the command line (for "copy as command"), the
 /// needle and block dimensions (mm, degrees: the side view), and every solved FE run of
 /// the set (`fe/<pose>.csv`): pose, role, depths (mm) and the six wrench components (N,
-/// N*mm) per depth. Poses not solved yet are left out.
+/// N*mm) per depth. Poses not solved yet are left out, and so is a CSV without an entry
+/// in `fe/manifest.toml` (no FE run of the campaign vouches for it: `needle validate`
+/// leaves it out too).
 ///
 /// # Errors
 /// `campaign.toml` cannot be read, or a run file exists but is not a complete run of the
 /// spec's depth grid (the message names the file).
 pub fn set_json(set_dir: &Path) -> Result<Value> {
     let (c, _) = spec::load(set_dir)?;
+    let manifest = needle_fe::manifest::read_manifest(&set_dir.join("fe").join(needle_fe::manifest::MANIFEST))?;
     let mut runs = Vec::new();
     for pose in c.poses() {
-        if !run_path(set_dir, &pose).is_file() {
+        if !run_path(set_dir, &pose).is_file() || !manifest.pose.contains_key(&pose.name) {
             continue;
         }
         let run = read_run(set_dir, &c, &pose).with_context(|| format!("FE run {} of the explorer", pose.name))?;
