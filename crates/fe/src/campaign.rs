@@ -556,6 +556,17 @@ pub(crate) fn solve_with_retry(
     Err(SolveFailure { message: failures.join("; "), log_tail: String::new(), reached: furthest })
 }
 
+/// Why training pose `r.pose` was replaced: the spec's words, then the record of its
+/// furthest failed attempt (`<out>/<pose>.partial.toml`) when there is one.
+fn replaced_because(out_dir: &Path, r: &crate::spec::TrainReplacement) -> String {
+    let (_, record) = crate::partial::paths(out_dir, &r.pose);
+    let partial = std::fs::read_to_string(&record).ok().and_then(|t| toml::from_str::<crate::partial::PartialRecord>(&t).ok());
+    match partial {
+        Some(p) => format!("{} (its record: reached {} mm of {}; {})", r.why, p.reached_depth_mm, p.depth_mm, p.failure),
+        None => r.why.clone(),
+    }
+}
+
 /// Check the wrenches, write the CSV, then the manifest entry. Returns Fy at the final depth.
 fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Result<f64> {
     if s.wrenches.len() != ctx.steps as usize {
@@ -601,6 +612,8 @@ fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Res
         retry: s.retry.clone(),
         launcher: Some(ctx.launcher.name().to_string()),
         batch_job: ctx.launcher.batch_job(),
+        replaces: ctx.campaign.replaced_by(&pose.name).map(|r| r.pose.clone()),
+        replaced_because: ctx.campaign.replaced_by(&pose.name).map(|r| replaced_because(ctx.out_dir, r)),
     };
     update_manifest(ctx, |m| {
         m.pose.insert(pose.name.clone(), entry);

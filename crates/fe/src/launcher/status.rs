@@ -116,9 +116,53 @@ pub fn status(plan: &Plan) -> Result<StatusReport> {
 
 /// The failed attempts a local run left in `<out>/.work/<pose>/`, by class
 /// ([`febio::failures`](crate::febio::failures)); empty when there are none.
+/// Without logs, the attempts of its `.partial.toml` record (the logs' folder is gone
+/// when the campaign ran elsewhere or the work folder was cleaned).
 fn local_failures(out_dir: &Path, pose: &str) -> String {
-    let f = crate::febio::failures::read_failures(&out_dir.join(".work").join(pose));
-    crate::febio::failures::summary(&f)
+    use crate::febio::failures;
+    let f = failures::read_failures(&out_dir.join(".work").join(pose));
+    if !f.is_empty() {
+        return failures::summary(&f);
+    }
+    let (_, record) = crate::partial::paths(out_dir, pose);
+    let Some(r) = std::fs::read_to_string(&record).ok().and_then(|t| toml::from_str::<crate::partial::PartialRecord>(&t).ok()) else {
+        return String::new();
+    };
+    format!("{} (record {})", failures::summary(&failures::failures_from_record(&r.failure)), r.date)
+}
+
+/// The training design's coverage (issue 42): of the first `train_count` poses as drawn
+/// and of the design's slots after the replacements (`campaign.train_replaced`), how
+/// many have an up-to-date result in `plan`'s folder; `None` without training poses.
+pub fn training_coverage(plan: &Plan) -> Option<String> {
+    let c = &plan.campaign;
+    let n = c.campaign.train_count as usize;
+    if n == 0 {
+        return None;
+    }
+    let poses = c.train_poses();
+    let solved = |name: &str| {
+        poses.iter().find(|p| p.name == name).is_some_and(|p| {
+            plan.manifest.current_entry(c, p, &plan.mesh_name).is_ok() && plan.out_dir.join(format!("{name}.csv")).is_file()
+        })
+    };
+    let drawn: Vec<String> = (0..n).map(|i| c.train_name(i)).collect();
+    let first = drawn.iter().filter(|p| solved(p)).count();
+    let design = c.train_design();
+    let slots = design.iter().filter(|p| solved(p)).count();
+    let mut s = format!(
+        "training design: {first} of the first {n} poses as drawn solved; {slots} of its {n} slots after {} replacement(s) (campaign.train_replaced)",
+        c.campaign.train_replaced.len()
+    );
+    for r in &c.campaign.train_replaced {
+        let by = c.replacement_of(&r.pose).unwrap_or_default();
+        let _ = write!(s, "\n  {} -> {by} ({}): {}", r.pose, if solved(&by) { "solved" } else { "not solved yet" }, r.why);
+    }
+    let open: Vec<&String> = design.iter().filter(|p| !solved(p)).collect();
+    if !open.is_empty() {
+        let _ = write!(s, "\n  slots not solved: {}", open.iter().map(|p| p.as_str()).collect::<Vec<_>>().join(", "));
+    }
+    Some(s)
 }
 
 fn reason(q: &QueueState) -> String {
