@@ -3,6 +3,13 @@
 //! channels, write three direction pins, three duties and the enable pin), of the model
 //! evaluation alone, of one telemetry push, and of answering one host-link command.
 //!
+//! Then the tick rendering a whole insertion ([`LoopCore::set_insertion`]) through each
+//! shipped tissue stack, the needle advancing 3 µm per tick (3 mm/s) along the tilted
+//! pose: `insertion-<stack>-surface` deflecting the surface (the FE surrogate),
+//! `insertion-<stack>-deep` 2 mm below the last boundary (friction over every layer
+//! passed, the track's hold, cutting), each without and with the passivity guard
+//! (`+guard`: the deflected boundary's stiffness from the surrogate's depth rate).
+//!
 //! Same method as `bench` (QEMU `-icount shift=0`, SysTick calibrated by a 2-instruction
 //! loop, `CALLS` calls minus the same loop without the call). The outputs are volatile
 //! word stores, like a HAL's register writes.
@@ -26,18 +33,22 @@ mod firmware {
     use core::hint::black_box;
     use cortex_m::peripheral::SYST;
     use needle_haptics::command::{parse, respond};
-    use needle_haptics::control::{Channel, ControlLoop, PoseFault, PoseSource, Sample};
+    use needle_haptics::control::{Channel, ControlLoop, Passivity, PoseFault, PoseSource, Sample};
+    use needle_haptics::insertion::{stacks, Insertion, InsertionConfig};
     use needle_haptics::telemetry::Telemetry;
     use needle_haptics::{wrench, Pose};
 
     const CALLS: u32 = 256;
 
-    /// The pose the encoders "read": the typical pose of `bench`, through black_box.
-    struct Encoders(Pose);
+    /// The pose the encoders "read" (the typical pose of `bench`, through black_box),
+    /// advancing its depth by the second field (mm) after each read.
+    struct Encoders(Pose, f32);
 
     impl PoseSource for Encoders {
         fn read_pose(&mut self) -> Result<Pose, PoseFault> {
-            Ok(black_box(self.0))
+            let p = black_box(self.0);
+            self.0.depth_mm += self.1;
+            Ok(p)
         }
     }
 
@@ -90,6 +101,56 @@ mod firmware {
         out.nl();
     }
 
+    /// The insertion measures (module docs): one loop per stack and case, the needle
+    /// first advanced at 3 mm/s to the start depth, then `CALLS` timed ticks advancing on.
+    fn insertion_ticks(out: &mut Out, cal: &Calibration, pose: Pose) {
+        const STEP_MM: f32 = 0.003;
+        let guard = Passivity { damping_n_s_per_mm: 0.001, period_s: 0.001 };
+        for stack in &stacks::ALL {
+            let total: f32 = stack.layers.iter().map(|l| l.thickness_mm).sum();
+            for (case, depth) in [("surface", 4.5f32), ("deep", total + 2.0)] {
+                for guarded in [false, true] {
+                    let start = Pose { depth_mm: -0.5, ..pose };
+                    let channels = [0, 1, 2].map(|i| Channel { pwm: RegPwm(i), dir: RegPin(3 + i) });
+                    let Ok(mut l) = ControlLoop::new(CONFIG, Encoders(start, STEP_MM), channels, RegPin(6)) else { exit(false) };
+                    let Ok(ins) = Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ) else { exit(false) };
+                    l.core_mut().set_insertion(Some(ins));
+                    if guarded && l.core_mut().set_passivity(Some(guard)).is_err() {
+                        exit(false)
+                    }
+                    let ticks = ((depth + 0.5) / STEP_MM) as u32;
+                    for _ in 0..ticks {
+                        l.tick();
+                    }
+                    let with = time_ticks(&mut l, black_box(CALLS));
+                    let without = time_empty(&mut l, black_box(CALLS));
+                    let mut name = [0u8; 40];
+                    let n = label(&mut name, &["insertion-", stack.name, "-", case, if guarded { "+guard" } else { "" }]);
+                    let what = name.get(..n).and_then(|b| core::str::from_utf8(b).ok()).unwrap_or("insertion");
+                    line(out, cal, what, cal.tenths_per_call(with, without, CALLS));
+                    let phase = l.core().insertion_evaluation().map_or(0, |e| e.phase.code());
+                    out.str("needle-loop-tick insertion_phase=");
+                    out.hex(u32::from(phase), 4);
+                    out.str(" tick_flags=");
+                    out.hex(u32::from(l.core().last().flags.bits()), 4);
+                    out.nl();
+                }
+            }
+        }
+    }
+
+    /// The parts concatenated into `buf` (truncated to fit), the length.
+    fn label(buf: &mut [u8; 40], parts: &[&str]) -> usize {
+        let mut n = 0;
+        for b in parts.iter().flat_map(|p| p.bytes()) {
+            if let Some(slot) = buf.get_mut(n) {
+                *slot = b;
+                n += 1;
+            }
+        }
+        n
+    }
+
     #[cortex_m_rt::entry]
     fn main() -> ! {
         let mut out = Out::new();
@@ -110,7 +171,7 @@ mod firmware {
         }
         let pose = Pose::new(3.0, -2.0, 5.0, -7.0, 4.5);
         let channels = [0, 1, 2].map(|i| Channel { pwm: RegPwm(i), dir: RegPin(3 + i) });
-        let Ok(mut l) = ControlLoop::new(CONFIG, Encoders(pose), channels, RegPin(6)) else { exit(false) };
+        let Ok(mut l) = ControlLoop::new(CONFIG, Encoders(pose, 0.0), channels, RegPin(6)) else { exit(false) };
 
         let with = time_ticks(&mut l, black_box(CALLS));
         let without = time_empty(&mut l, black_box(CALLS));
@@ -156,6 +217,7 @@ mod firmware {
         let none = elapsed(start, SYST::get_current());
         line(&mut out, &cal, "command_status", cal.tenths_per_call(cmd, none, CALLS));
         let _: Sample = s;
+        insertion_ticks(&mut out, &cal, pose);
         out.str("needle-loop-tick end\n");
         out.flush();
         exit(true)

@@ -7,7 +7,7 @@
 //! in that order, each component `w_c(pose, 6) * R`. At `d <= 6` it is [`wrench`]
 //! itself; past `DEPTH_MAX_MM` the depth is clamped and `SAT_DEPTH` set. A set without
 //! the file (`FITTED == false`) saturates at 6 mm as [`wrench`] does.
-use crate::{wrench, Evaluation, Pose, Status, Wrench};
+use crate::{wrench, wrench_and_depth_rate, Evaluation, Pose, Status, Wrench};
 
 /// The generated constants.
 pub mod tables {
@@ -36,4 +36,31 @@ pub fn extended_wrench(pose: &Pose) -> Evaluation {
     let w = at6.wrench.to_array().map(|c| c * r);
     let status = if clamped { at6.status | Status::SAT_DEPTH } else { at6.status };
     Evaluation { wrench: Wrench::from_array(w), status }
+}
+
+/// [`extended_wrench`] and the rate of its three forces with depth, `[dfx, dfy, dfz]`
+/// in N/mm: within the model's domain [`wrench_and_depth_rate`]'s (its wrench is
+/// [`wrench`]'s, bit for bit), past it the law's
+/// derivative `w(pose, 6 mm) R'(d)` with `R' = INV_SPAN_PER_MM (c1 + v (2 c2 + v (3 c3 +
+/// v 4 c4)))`; zero where the depth is clamped (past `DEPTH_MAX_MM`, or at or below 0)
+/// and for an error. The wrench and status are [`extended_wrench`]'s, bit for bit.
+#[must_use]
+pub fn extended_wrench_and_depth_rate(pose: &Pose) -> (Evaluation, [f32; 3]) {
+    let d = pose.depth_mm;
+    if !tables::FITTED || d.is_nan() || d <= MODEL_DEPTH_MAX_MM {
+        return wrench_and_depth_rate(pose);
+    }
+    let (depth, clamped) = if d > tables::DEPTH_MAX_MM { (tables::DEPTH_MAX_MM, true) } else { (d, false) };
+    let at6 = wrench(&Pose { depth_mm: MODEL_DEPTH_MAX_MM, ..*pose });
+    if at6.status.is_error() {
+        return (at6, [0.0; 3]);
+    }
+    let v = (depth - MODEL_DEPTH_MAX_MM) * tables::INV_SPAN_PER_MM;
+    let [c1, c2, c3, c4] = tables::COEFFS;
+    let r = 1.0 + v * (c1 + v * (c2 + v * (c3 + v * c4)));
+    let dr = if clamped { 0.0 } else { tables::INV_SPAN_PER_MM * (c1 + v * (2.0 * c2 + v * (3.0 * c3 + v * (4.0 * c4)))) };
+    let w6 = at6.wrench.to_array();
+    let status = if clamped { at6.status | Status::SAT_DEPTH } else { at6.status };
+    let [fx, fy, fz, ..] = w6;
+    (Evaluation { wrench: Wrench::from_array(w6.map(|c| c * r)), status }, [fx * dr, fy * dr, fz * dr])
 }

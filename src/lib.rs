@@ -56,6 +56,7 @@ pub mod command;
 pub mod control;
 mod cross_f32;
 pub mod depth_extension;
+mod depth_rate_f32;
 mod evaluation;
 pub mod fixed;
 mod horner;
@@ -72,6 +73,7 @@ pub mod telemetry;
 mod wrench;
 
 pub use depth_extension::extended_wrench;
+pub use depth_rate_f32::wrench_and_depth_rate;
 pub use evaluation::Evaluation;
 pub use model_f32::wrench;
 pub use pose::Pose;

@@ -112,25 +112,25 @@ pub fn wrench_and_stiffness(pose: &Pose) -> StiffnessEvaluation {
 
 /// Where the polynomials are evaluated: `t` and the sign (`-1` for a negative value) of
 /// each sweep, and `u`.
-struct At {
-    t: [f32; 4],
-    sign: [f32; 4],
-    u: f32,
+pub(crate) struct At {
+    pub(crate) t: [f32; 4],
+    pub(crate) sign: [f32; 4],
+    pub(crate) u: f32,
 }
 
 /// One component's accumulators: the wrench `w`, and the rates by `u`, by `t_x`, by `t_z`
 /// (before the chain rule's scale).
 #[derive(Clone, Copy)]
-struct Component {
-    w: f32,
-    a: f32,
+pub(crate) struct Component {
+    pub(crate) w: f32,
+    pub(crate) a: f32,
     gx: f32,
     gz: f32,
 }
 
 /// One component's tables: its baseline and where its Horner starts, and per sweep its
 /// deviation matrix, the starts of its Horner evaluations, parity and skip flag.
-struct ComponentTables {
+pub(crate) struct ComponentTables {
     baseline: [f32; TERMS],
     /// Where its Horner starts (`model_f32::BASELINE_STARTS`).
     baseline_start: Start,
@@ -155,10 +155,10 @@ const fn component_tables(c: usize) -> ComponentTables {
 
 /// The tables of component `C` as an associated constant (evaluated at compile time per
 /// `C`; an index out of range is a compile error, not a run-time panic).
-struct Column<const C: usize>;
+pub(crate) struct Column<const C: usize>;
 
 impl<const C: usize> Column<C> {
-    const TABLES: ComponentTables = component_tables(C);
+    pub(crate) const TABLES: ComponentTables = component_tables(C);
 }
 
 /// Component `C` with its tables as constants, not inlined: each component is scheduled
@@ -178,7 +178,7 @@ fn component_of<const C: usize>(at: &At) -> Component {
 /// and `w + (-D)` is `w - D` by definition; `+0 + -0 = +0 = +0 - +0`): one multiply-add
 /// on the FPU and no branch. Every Horner starts where the tables say (`crate::horner`).
 #[inline(always)]
-fn component(tables: &ComponentTables, at: &At) -> Component {
+pub(crate) fn component(tables: &ComponentTables, at: &At) -> Component {
     let ComponentTables { baseline, baseline_start, mats, starts, odd, skip } = tables;
     let u = at.u;
     let (w, a) = horner_with_rate_from(baseline, u, *baseline_start);

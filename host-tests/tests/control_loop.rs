@@ -294,11 +294,11 @@ fn invalid_configurations_are_refused() {
         let c = LoopConfig { force_limit_n: limit, ..ok };
         assert_eq!(c.validate(), Err(ConfigError::ForceLimit), "{limit}");
     }
-    for step in [0.0, -0.1, f32::NAN] {
+    for step in [0.0, -0.1, f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
         let c = LoopConfig { ramp_step_n: step, ..ok };
         assert_eq!(c.validate(), Err(ConfigError::RampStep), "{step}");
     }
-    assert_eq!(LoopConfig { ramp_step_n: f32::INFINITY, ..ok }.validate(), Ok(()));
+    assert_eq!(LoopConfig { ramp_step_n: f32::MAX, ..ok }.validate(), Ok(()), "a finite step above the limit cuts at once");
 }
 
 #[test]

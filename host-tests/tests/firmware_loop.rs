@@ -42,6 +42,26 @@ fn loop_tick_instructions_on_cortex_m4f() {
     assert!(tick < 3200.0, "one loop tick takes {tick} instructions on the M4F (goal < 3,200)");
     assert!(figure("telemetry_push") > 0.0 && figure("command_status") > 0.0);
     assert!(out.lines().any(|l| l == "needle-loop-tick tick_flags=0x0000 model_status=0x00"), "{out}");
+    // The loop rendering the whole insertion (issue 41's budget: <= 1,600 instructions
+    // per tick on the M4F): every shipped stack, deflecting the surface and deep inside,
+    // without and with the passivity guard; the phase each case reached.
+    let insertion: Vec<(&str, f64)> = out
+        .lines()
+        .filter_map(|l| {
+            let what = field(l, "what")?;
+            Some((what, field(l, "instructions")?.parse().ok()?)).filter(|_| what.starts_with("insertion-"))
+        })
+        .collect();
+    assert_eq!(insertion.len(), 4 * needle_haptics::insertion::stacks::ALL.len(), "{out}");
+    for (what, n) in &insertion {
+        assert!(*n <= 1600.0, "{what}: {n} instructions per loop tick (goal <= 1,600)");
+    }
+    let phases: Vec<&str> = out.lines().filter_map(|l| field(l, "insertion_phase")).collect();
+    assert_eq!(phases.len(), insertion.len(), "{out}");
+    for ((what, _), phase) in insertion.iter().zip(&phases) {
+        let want = if what.contains("-surface") { "0x0100" } else { "0x02" };
+        assert!(phase.starts_with(want), "{what}: phase {phase}, want {want}..");
+    }
 }
 
 #[test]

@@ -100,3 +100,27 @@ fn fixed_point_evaluator_has_no_floating_point_on_any_core() {
         );
     }
 }
+
+/// Issue 41's flash budget for the whole insertion: the model, its depth extension, the
+/// insertion model with its guard stiffness and every compiled-in stack, in the
+/// `no_panic_insertion` image (library code + `.rodata` + compiler runtime, the same
+/// accounting as `needle firmware size`), <= 24 KiB on every core.
+#[test]
+fn insertion_flash_within_24_kib_on_every_core() {
+    let set = firmware::fitted_set(&firmware::compiled_set()).unwrap_or_else(|e| panic!("{e:#}"));
+    for core in &CORES {
+        let elfs = build::build_examples(core, &["no_panic", "no_panic_insertion"], &set).unwrap_or_else(|e| panic!("{e:#}"));
+        let model = size::measure(core, &elfs[0], "f32").unwrap_or_else(|e| panic!("{e:#}"));
+        let report = size::measure(core, &elfs[1], "insertion").unwrap_or_else(|e| panic!("{e:#}"));
+        println!(
+            "{} ({}): model + insertion flash {} (model alone {}), static RAM {} B",
+            core.core,
+            core.target,
+            size::bytes(report.model_flash()),
+            size::bytes(model.model_flash()),
+            report.static_ram()
+        );
+        assert!(report.model_flash() > model.model_flash(), "{}: the insertion image holds more than the model", core.core);
+        assert!(report.model_flash() <= 24 * 1024, "{}: model + insertion flash {} B > 24 KiB", core.core, report.model_flash());
+    }
+}

@@ -115,11 +115,22 @@ fn depth_at(moves: &[Move], mut t: f64) -> f64 {
     moves.last().map_or(0.0, |m| m.to_mm)
 }
 
-/// The energy delivered to the hand over the trajectory (N·mm), and the punctures.
+/// The energy delivered to the hand over the trajectory (N·mm), and the punctures: the
+/// insertion model's own force.
 fn energy(stack: &Stack<'_>, moves: &[Move]) -> (f64, usize) {
     let mut insertion = Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ).expect("shipped stack");
+    energy_of(moves, DAMPING_N_S_PER_MM, |p| {
+        let e = insertion.step(&p);
+        (e.wrench.fy_n, e.punctures)
+    })
+}
+
+/// The energy delivered to the hand (N·mm) and the punctures, the force of each tick
+/// from `render(pose)` (its fy and the tick's punctures), on a device of damping
+/// `damping_n_s_per_mm`.
+fn energy_of(moves: &[Move], damping_n_s_per_mm: f64, mut render: impl FnMut(Pose) -> (f32, u8)) -> (f64, usize) {
     let total_s: f64 = moves.iter().map(|m| m.duration_s).sum();
-    let damping: f64 = moves.iter().map(|m| DAMPING_N_S_PER_MM * m.damping_integral()).sum();
+    let damping: f64 = moves.iter().map(|m| damping_n_s_per_mm * m.damping_integral()).sum();
     let (mut work, mut punctures) = (0.0, 0);
     let mut tick: u64 = 0;
     loop {
@@ -128,11 +139,11 @@ fn energy(stack: &Stack<'_>, moves: &[Move]) -> (f64, usize) {
             break;
         }
         let d = depth_at(moves, t);
-        let e = insertion.step(&Pose { depth_mm: d as f32, ..Pose::default() });
-        punctures += usize::from(e.punctures);
+        let (fy_n, p) = render(Pose { depth_mm: d as f32, ..Pose::default() });
+        punctures += usize::from(p);
         // the force of tick k, held until tick k + 1 (or the end of the trajectory)
         let next = ((tick + 1) as f64 * PERIOD_S).min(total_s);
-        work += f64::from(e.wrench.fy_n) * (depth_at(moves, next) - d);
+        work += f64::from(fy_n) * (depth_at(moves, next) - d);
         tick += 1;
     }
     // the hand did `work` against the force (fy resists a depth increase): the device
@@ -156,5 +167,53 @@ fn no_closed_cycle_delivers_energy_to_the_hand() {
         }
         println!("{}: {TRAJECTORIES} trajectories ({punctured} with a puncture), most energy to the hand {worst:e} N·mm", stack.name);
         assert!(punctured > TRAJECTORIES / 4, "{}: only {punctured} trajectories punctured: the test must cross punctures", stack.name);
+    }
+}
+
+/// The same through the control loop: `LoopCore` renders the insertion with the
+/// passivity guard on, on a device of a tenth of the damping above (0.1 N·s/m, so the
+/// guard's stiffness `b / T` = 0.1 N/mm is below the liver's deflection stiffness and the
+/// guard acts), the commanded fy held over each tick. A closed cycle still delivers no
+/// energy: the guard's offset is a function of the path in depth while a boundary
+/// deflects, and a puncture clears it (the force drops; nothing stored is given back).
+#[test]
+fn the_loop_with_the_guard_delivers_no_energy_either() {
+    use needle_haptics::control::{ChannelMap, LoopConfig, LoopCore, LoopFlags, OverLimit, Passivity};
+    const WEAK_DAMPING_N_S_PER_MM: f64 = 0.0001;
+    const LOOP_TRAJECTORIES: usize = 300;
+    let config = LoopConfig {
+        channels: [ChannelMap { gains_per_n: [0.0, 0.01, 0.0], direction_inverted: false }],
+        force_limit_n: 100.0,
+        force_limit_max_n: 100.0,
+        over_limit: OverLimit::Saturate,
+        ramp_step_n: 0.01,
+    };
+    let guard = Passivity { damping_n_s_per_mm: WEAK_DAMPING_N_S_PER_MM as f32, period_s: PERIOD_S as f32 };
+    let mut rng = ChaCha8Rng::seed_from_u64(20261127);
+    for stack in &stacks::ALL {
+        let deepest: f64 = stack.layers.iter().map(|l| f64::from(l.thickness_mm)).sum::<f64>() + 5.0;
+        let (mut worst, mut limited, mut punctured) = (f64::NEG_INFINITY, 0, 0);
+        for n in 0..LOOP_TRAJECTORIES {
+            let moves = trajectory(&mut rng, deepest);
+            let mut core = LoopCore::new(config).expect("config");
+            core.set_passivity(Some(guard)).expect("guard");
+            core.set_insertion(Some(Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ).expect("shipped stack")));
+            let mut was_limited = false;
+            let (e, p) = energy_of(&moves, WEAK_DAMPING_N_S_PER_MM, |pose| {
+                let s = core.step(Ok(pose));
+                was_limited |= s.flags.contains(LoopFlags::STIFFNESS_LIMITED);
+                (s.force_cmd_n[1], core.insertion_evaluation().map_or(0, |e| e.punctures))
+            });
+            limited += usize::from(was_limited);
+            punctured += usize::from(p > 0);
+            assert!(e <= BOUND_NMM, "{}: trajectory {n} through the loop delivered {e:e} N·mm to the hand: {moves:?}", stack.name);
+            worst = worst.max(e);
+        }
+        println!(
+            "{}: {LOOP_TRAJECTORIES} trajectories through the guarded loop ({limited} stiffness-limited, {punctured} punctured), most energy to the hand {worst:e} N·mm",
+            stack.name
+        );
+        assert!(limited > LOOP_TRAJECTORIES / 4, "{}: the guard acted in only {limited} trajectories", stack.name);
+        assert!(punctured > LOOP_TRAJECTORIES / 4, "{}: only {punctured} trajectories punctured", stack.name);
     }
 }

@@ -43,7 +43,9 @@ pub struct LoopConfig<const N: usize> {
     /// What to do above the limit.
     pub over_limit: OverLimit,
     /// During a fault, each commanded force component moves towards zero by at most
-    /// this much per tick, N (> 0; `f32::INFINITY` cuts to zero in one tick).
+    /// this much per tick, N (finite, > 0; a step of `force_limit_max_n` or more cuts to
+    /// zero in one tick). Infinity is refused: it is no ramp, and a configuration
+    /// computed from a bad value (a division by zero) must not slip through as one.
     pub ramp_step_n: f32,
 }
 
@@ -67,7 +69,7 @@ impl core::fmt::Display for ConfigError {
         f.write_str(match self {
             Self::Gain => "loop config refused: a channel gain (duty per N) is NaN or infinite",
             Self::ForceLimit => "loop config refused: force_limit_n must be finite, > 0 N and <= force_limit_max_n",
-            Self::RampStep => "loop config refused: ramp_step_n must be > 0 N per tick",
+            Self::RampStep => "loop config refused: ramp_step_n must be finite and > 0 N per tick",
             Self::Passivity => "passivity guard refused: damping_n_s_per_mm and period_s must be finite and > 0",
         })
     }
@@ -80,13 +82,13 @@ impl<const N: usize> LoopConfig<N> {
     ///
     /// # Errors
     /// The first [`ConfigError`] found: gains must be finite, `0 < force_limit_n <=
-    /// force_limit_max_n` (both finite), `ramp_step_n > 0` (infinity allowed).
+    /// force_limit_max_n` (both finite), `ramp_step_n` finite and > 0.
     pub fn validate(&self) -> Result<(), ConfigError> {
         if !self.channels.iter().all(|c| c.gains_per_n.iter().all(|g| g.is_finite())) {
             return Err(ConfigError::Gain);
         }
         check_limit(self.force_limit_n, self.force_limit_max_n)?;
-        if self.ramp_step_n.is_nan() || self.ramp_step_n <= 0.0 {
+        if !self.ramp_step_n.is_finite() || self.ramp_step_n <= 0.0 {
             return Err(ConfigError::RampStep);
         }
         Ok(())

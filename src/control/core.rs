@@ -4,6 +4,7 @@
 use super::config::check_limit;
 use super::passivity::Guard;
 use super::{ConfigError, LoopConfig, LoopFlags, OverLimit, Passivity, PoseFault, Sample};
+use crate::insertion::{GuardTerms, Insertion, InsertionEvaluation};
 use crate::{Pose, Status, Wrench};
 
 /// One channel's command: a duty fraction and a direction.
@@ -38,6 +39,8 @@ pub struct LoopCore<const N: usize> {
     commands: [ChannelCommand; N],
     passivity: Option<Passivity>,
     guard: Guard,
+    insertion: Option<Insertion>,
+    insertion_last: Option<InsertionEvaluation>,
 }
 
 impl<const N: usize> LoopCore<N> {
@@ -55,6 +58,8 @@ impl<const N: usize> LoopCore<N> {
             commands,
             passivity: None,
             guard: Guard::default(),
+            insertion: None,
+            insertion_last: None,
         })
     }
 
@@ -86,8 +91,9 @@ impl<const N: usize> LoopCore<N> {
     /// Turns the passivity guard on with `Some` (the device's damping and the loop period)
     /// or off with `None` (takes effect at the next tick; the guard starts without
     /// history). With the guard on, each tick evaluates
-    /// [`wrench_and_stiffness`](crate::wrench_and_stiffness) instead of
-    /// [`wrench`](crate::wrench) (the same wrench) and applies the rule of
+    /// [`wrench_and_depth_rate`](crate::wrench_and_depth_rate) instead of
+    /// [`wrench`](crate::wrench) (the same wrench, and the depth rates of
+    /// [`wrench_and_stiffness`](crate::wrench_and_stiffness)) and applies the rule of
     /// [`Passivity`](super::Passivity)'s module.
     ///
     /// # Errors
@@ -109,6 +115,43 @@ impl<const N: usize> LoopCore<N> {
         self.passivity.as_ref()
     }
 
+    /// Renders a whole insertion with `Some` (a needle path through a tissue stack:
+    /// [`Insertion`], in its current state) instead of the block surrogate
+    /// [`wrench`](crate::wrench), or the block surrogate again with `None` (takes effect
+    /// at the next tick).
+    ///
+    /// With an insertion, each tick with a valid pose steps it once
+    /// ([`Insertion::step`], or [`Insertion::step_with_stiffness`] with the passivity
+    /// guard on: the guard's stiffness is then the deflected boundary's `|dF/dδ|`, 0
+    /// in the track, where friction and cutting only dissipate). A stale or missing pose
+    /// does not step it (its velocity filter then sees the whole motion since the last
+    /// valid pose in one tick, smoothed by its time constant). A tick that punctures a
+    /// boundary clears the guard's offset: the force drops to what the track renders and
+    /// no offset stored while deflecting the boundary is given back to the hand.
+    /// The insertion's configuration period should equal the loop's.
+    pub fn set_insertion(&mut self, insertion: Option<Insertion>) {
+        self.insertion = insertion;
+        self.insertion_last = None;
+        self.guard.reset();
+    }
+
+    /// The insertion the loop renders, in its state after the last tick (`None`: the
+    /// block surrogate).
+    #[inline]
+    #[must_use]
+    pub const fn insertion(&self) -> Option<&Insertion> {
+        self.insertion.as_ref()
+    }
+
+    /// The insertion's result of the last tick that stepped it: the phase, the punctures
+    /// and the filtered velocity beside the wrench (`None` before the first, or
+    /// without an insertion).
+    #[inline]
+    #[must_use]
+    pub const fn insertion_evaluation(&self) -> Option<&InsertionEvaluation> {
+        self.insertion_last.as_ref()
+    }
+
     /// Sets what happens above the force limit (takes effect at the next tick).
     #[inline]
     pub fn set_over_limit(&mut self, over_limit: OverLimit) {
@@ -119,7 +162,8 @@ impl<const N: usize> LoopCore<N> {
     ///
     /// 1. the tick count goes up by one (wrapping);
     /// 2. a stale or missing pose is a fault (`POSE_STALE` / `POSE_MISSING`), the model is
-    ///    not evaluated; otherwise `wrench(pose)`, and an `ERROR` status is a fault
+    ///    not evaluated; otherwise `wrench(pose)` (or the insertion's tick:
+    ///    [`set_insertion`](Self::set_insertion)), and an `ERROR` status is a fault
     ///    (`EVAL_ERROR`);
     /// 3. with the passivity guard on ([`set_passivity`](Self::set_passivity)), `F` is the
     ///    guarded force (`STIFFNESS_LIMITED` when the model's stiffness was above the
@@ -148,12 +192,21 @@ impl<const N: usize> LoopCore<N> {
                     s.wrench = wrench;
                     let f = [wrench.fx_n, wrench.fy_n, wrench.fz_n];
                     let f = match stiffness {
-                        Some((p, k)) => {
-                            let (guarded, limited) = self.guard.apply(&p, f, k);
+                        Some((p, terms)) => {
+                            // the guard limits the elastic part; friction and cutting
+                            // pass (none for the block surrogate: its bits unchanged)
+                            let d = terms.dissipative_n;
+                            let dissipates = d != [0.0; 3];
+                            let elastic = if dissipates { [f[0] - d[0], f[1] - d[1], f[2] - d[2]] } else { f };
+                            let (guarded, limited) = self.guard.apply(&p, elastic, terms.stiffness_n_per_mm);
                             if limited {
                                 s.flags |= LoopFlags::STIFFNESS_LIMITED;
                             }
-                            guarded
+                            if dissipates {
+                                [guarded[0] + d[0], guarded[1] + d[1], guarded[2] + d[2]]
+                            } else {
+                                guarded
+                            }
                         }
                         None => f,
                     };
@@ -200,15 +253,30 @@ impl<const N: usize> LoopCore<N> {
         self.last.flags |= flags;
     }
 
-    /// The model at `pose`: the wrench, its status and, with the passivity guard on, the
-    /// guard's configuration with the stiffness along the insertion `|dF/d depth|` (N/mm).
-    fn evaluate(&self, pose: &Pose) -> (Wrench, Status, Option<(Passivity, f32)>) {
+    /// The model at `pose` (the insertion's tick when one is set): the wrench, its status
+    /// and, with the passivity guard on, the guard's configuration with the stiffness
+    /// along the insertion `|dF/d depth|` (N/mm) and the force the guard leaves alone
+    /// (the insertion's friction and cutting; zero for the block surrogate).
+    fn evaluate(&mut self, pose: &Pose) -> (Wrench, Status, Option<(Passivity, GuardTerms)>) {
+        if let Some(ins) = self.insertion.as_mut() {
+            let (e, terms) = match self.passivity {
+                Some(_) => ins.step_with_stiffness(pose),
+                None => (ins.step(pose), GuardTerms::NONE),
+            };
+            self.insertion_last = Some(e);
+            if e.punctures > 0 {
+                // nothing the guard stored while the boundary deflected is given back
+                self.guard.reset();
+            }
+            return (e.wrench, e.status, self.passivity.map(|p| (p, terms)));
+        }
         match self.passivity {
             Some(p) => {
-                let e = crate::wrench_and_stiffness(pose);
-                let r = e.stiffness.by_depth;
-                let k2 = r.dfx_n_per_mm * r.dfx_n_per_mm + r.dfy_n_per_mm * r.dfy_n_per_mm + r.dfz_n_per_mm * r.dfz_n_per_mm;
-                (e.wrench, e.status, Some((p, libm::sqrtf(k2))))
+                // the rates by depth of `wrench_and_stiffness`, bit for bit, without the
+                // rates by x and z the guard does not use
+                let (e, [dfx, dfy, dfz]) = crate::wrench_and_depth_rate(pose);
+                let k2 = dfx * dfx + dfy * dfy + dfz * dfz;
+                (e.wrench, e.status, Some((p, GuardTerms { stiffness_n_per_mm: libm::sqrtf(k2), dissipative_n: [0.0; 3] })))
             }
             None => {
                 let e = crate::wrench(pose);

@@ -42,6 +42,7 @@ mod track;
 
 pub use stack::{stacks, Karnopp, Layer, Stack, FE_NEEDLE_DIAMETER_MM, HUB_FROM_TIP_MM, MAX_LAYERS};
 
+use crate::depth_extension::extended_wrench_and_depth_rate;
 use crate::{extended_wrench, Pose, Status, Wrench};
 use track::{axis, dot, Track, Vec3};
 
@@ -148,16 +149,29 @@ pub struct InsertionEvaluation {
 /// wrench for a `similarity` that is not finite and > 0.
 #[must_use]
 pub fn deflection(pose: &Pose, indentation_mm: f32, scale: f32, similarity: f32) -> crate::Evaluation {
+    deflection_at(pose, indentation_mm, scale, similarity, false).0
+}
+
+/// [`deflection`] and, with `rate`, its stiffness along the path: `|dF/dδ|` of the three
+/// forces, N/mm (`s λ` times the surrogate's depth rate at `δ/λ`: [`extended_wrench_and_depth_rate`]);
+/// without `rate` the stiffness is 0 and the surrogate is [`extended_wrench`]. The same
+/// wrench bits either way.
+fn deflection_at(pose: &Pose, indentation_mm: f32, scale: f32, similarity: f32, rate: bool) -> (crate::Evaluation, f32) {
     let lambda = similarity;
     if !positive(lambda) {
-        return crate::Evaluation { wrench: Wrench::ZERO, status: Status::ERROR };
+        return (crate::Evaluation { wrench: Wrench::ZERO, status: Status::ERROR }, 0.0);
     }
     let fe = Pose { x_mm: pose.x_mm / lambda, z_mm: pose.z_mm / lambda, depth_mm: indentation_mm / lambda, ..*pose };
-    let e = extended_wrench(&fe);
+    let (e, k) = if rate {
+        let (e, [rx, ry, rz]) = extended_wrench_and_depth_rate(&fe);
+        (e, libm::sqrtf(rx * rx + ry * ry + rz * rz) * scale * lambda)
+    } else {
+        (extended_wrench(&fe), 0.0)
+    };
     let (force, moment) = (scale * lambda * lambda, scale * lambda * lambda * lambda);
     let [fx, fy, fz, mx, my, mz] = e.wrench.to_array();
     let scaled = [fx * force, fy * force, fz * force, mx * moment, my * moment, mz * moment];
-    crate::Evaluation { wrench: Wrench::from_array(scaled), status: e.status }
+    (crate::Evaluation { wrench: Wrench::from_array(scaled), status: e.status }, k)
 }
 
 /// The needle's unit axis from tip to hub for the pose's tilts (each clamped to ±89
@@ -171,6 +185,7 @@ pub fn needle_axis(pose: &Pose) -> [f32; 3] {
 
 /// The state of one needle path through a stack: fixed size, no allocation.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Insertion {
     layers: [Layer; MAX_LAYERS],
     count: usize,
@@ -182,6 +197,35 @@ pub struct Insertion {
     preload: [f32; 6],
     last_depth_mm: Option<f32>,
     velocity_mm_per_s: f32,
+}
+
+/// What a passivity guard needs of an insertion tick beside its wrench
+/// ([`Insertion::step_with_stiffness`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct GuardTerms {
+    /// The stiffness along the path of the boundary being deflected, N/mm: `|dF/dδ|` of
+    /// its three forces (the rate of [`deflection`]); 0 when no boundary is deflected
+    /// (approach, or in the track short of the next boundary) and for an error.
+    pub stiffness_n_per_mm: f32,
+    /// The force of shaft friction and cutting in the wrench, N (block frame): it only
+    /// takes energy out, so a guard leaves it as it is and limits the rest (the
+    /// boundary's deflection, the preload and the track's hold: the elastic part).
+    pub dissipative_n: [f32; 3],
+}
+
+impl GuardTerms {
+    /// No stiffness, no dissipative force.
+    pub const NONE: Self = Self { stiffness_n_per_mm: 0.0, dissipative_n: [0.0; 3] };
+}
+
+/// What [`Insertion::deflect`] found: the wrench so far (preload included), the
+/// surrogate's status, the punctures of this tick, the deflected boundary's stiffness.
+struct Deflected {
+    wrench: [f32; 6],
+    status: Status,
+    punctures: u8,
+    stiffness_n_per_mm: f32,
 }
 
 fn positive(v: f32) -> bool {
@@ -277,9 +321,21 @@ impl Insertion {
     /// along the axis past the surface plane, negative above it) in, the wrench out.
     /// Call it once per period of the configuration.
     pub fn step(&mut self, pose: &Pose) -> InsertionEvaluation {
+        self.tick(pose, false).0
+    }
+
+    /// [`step`](Self::step) (the same state change and the same bits) with what a
+    /// passivity guard needs beside the wrench ([`GuardTerms`]): the deflected boundary's
+    /// stiffness and the dissipative part of the force. The control loop's guard takes
+    /// them ([`LoopCore::set_insertion`](crate::control::LoopCore::set_insertion)).
+    pub fn step_with_stiffness(&mut self, pose: &Pose) -> (InsertionEvaluation, GuardTerms) {
+        self.tick(pose, true)
+    }
+
+    fn tick(&mut self, pose: &Pose, rate: bool) -> (InsertionEvaluation, GuardTerms) {
         let finite = [pose.x_mm, pose.z_mm, pose.theta_x_deg, pose.theta_z_deg, pose.depth_mm].into_iter().all(f32::is_finite);
         if !finite {
-            return self.evaluation(Wrench::ZERO, Status::ERROR, Phase::Approach, 0);
+            return (self.evaluation(Wrench::ZERO, Status::ERROR, Phase::Approach, 0), GuardTerms::NONE);
         }
         let depth = pose.depth_mm;
         let step_mm = self.last_depth_mm.map_or(0.0, |last| depth - last);
@@ -289,14 +345,15 @@ impl Insertion {
         let v = if self.velocity_mm_per_s * step_mm > 0.0 { self.velocity_mm_per_s } else { 0.0 };
         if depth <= 0.0 {
             self.end_path();
-            return self.evaluation(Wrench::ZERO, Status::OK, Phase::Approach, 0);
+            return (self.evaluation(Wrench::ZERO, Status::OK, Phase::Approach, 0), GuardTerms::NONE);
         }
         let a = axis(pose.theta_x_deg, pose.theta_z_deg);
         let entry: Vec3 = [pose.x_mm, 0.0, pose.z_mm];
-        let (mut w, status, punctures) = self.deflect(pose, a, entry);
-        let phase = self.shaft(pose, a, entry, v, &mut w);
+        let Deflected { wrench: mut w, status, punctures, stiffness_n_per_mm } = self.deflect(pose, a, entry, rate);
+        let (phase, axial_n) = self.shaft(pose, a, entry, v, &mut w);
         let wrench = Wrench::from_array(w);
-        self.evaluation(wrench, status, phase, punctures)
+        let terms = GuardTerms { stiffness_n_per_mm, dissipative_n: [axial_n * a[0], axial_n * a[1], axial_n * a[2]] };
+        (self.evaluation(wrench, status, phase, punctures), terms)
     }
 
     fn evaluation(&self, wrench: Wrench, status: Status, phase: Phase, punctures: u8) -> InsertionEvaluation {
@@ -321,9 +378,8 @@ impl Insertion {
         above / a_y
     }
 
-    /// The deflection of the first intact boundary, with the punctures it causes: the
-    /// wrench so far (preload included), the surrogate's status, the punctures.
-    fn deflect(&mut self, pose: &Pose, a: Vec3, entry: Vec3) -> ([f32; 6], Status, u8) {
+    /// The deflection of the first intact boundary, with the punctures it causes.
+    fn deflect(&mut self, pose: &Pose, a: Vec3, entry: Vec3, rate: bool) -> Deflected {
         let mut punctures = 0u8;
         while self.punctured < self.count {
             let q = self.boundary_mm(self.punctured, a[1]);
@@ -331,14 +387,15 @@ impl Insertion {
                 break;
             }
             let Some(layer) = self.layers.get(self.punctured).copied() else { break };
-            let (w, status) = self.surrogate(pose, pose.depth_mm - q, layer.stiffness_scale);
+            let (e, k) = deflection_at(pose, pose.depth_mm - q, layer.stiffness_scale, self.similarity, rate);
+            let w = e.wrench.to_array();
             let axial_n = dot([w[0], w[1], w[2]], a);
             if axial_n < layer.puncture_force_n {
                 let mut total = self.preload;
                 for (t, x) in total.iter_mut().zip(w) {
                     *t += x;
                 }
-                return (total, status, punctures);
+                return Deflected { wrench: total, status: e.status, punctures, stiffness_n_per_mm: k };
             }
             // puncture: the axial force goes, the lateral force and the moments stay
             if self.track.is_none() {
@@ -352,21 +409,17 @@ impl Insertion {
             self.track_end_mm = pose.depth_mm;
             punctures = punctures.saturating_add(1);
         }
-        (self.preload, Status::OK, punctures)
+        Deflected { wrench: self.preload, status: Status::OK, punctures, stiffness_n_per_mm: 0.0 }
     }
 
-    fn surrogate(&self, pose: &Pose, delta_mm: f32, scale: f32) -> ([f32; 6], Status) {
-        let e = deflection(pose, delta_mm, scale, self.similarity);
-        (e.wrench.to_array(), e.status)
-    }
-
-    /// Friction, cutting and the track's hold on the shaft, added to `w`; the phase.
-    fn shaft(&mut self, pose: &Pose, a: Vec3, entry: Vec3, v: f32, w: &mut [f32; 6]) -> Phase {
+    /// Friction, cutting and the track's hold on the shaft, added to `w`; the phase and
+    /// the axial force of friction and cutting (N, along `+a`).
+    fn shaft(&mut self, pose: &Pose, a: Vec3, entry: Vec3, v: f32, w: &mut [f32; 6]) -> (Phase, f32) {
         let depth = pose.depth_mm;
         let m = self.punctured;
         let index = |j: usize| u8::try_from(j).unwrap_or(u8::MAX);
         if m == 0 {
-            return if depth > self.boundary_mm(0, a[1]) { Phase::Deflecting(0) } else { Phase::Approach };
+            return (if depth > self.boundary_mm(0, a[1]) { Phase::Deflecting(0) } else { Phase::Approach }, 0.0);
         }
         let next = self.boundary_mm(m, a[1]);
         let top = if depth < next { depth } else { next };
@@ -405,6 +458,6 @@ impl Insertion {
         w[0] += axial_n * a[0];
         w[1] += axial_n * a[1];
         w[2] += axial_n * a[2];
-        phase
+        (phase, axial_n)
     }
 }

@@ -48,7 +48,7 @@ fn config_in(c: &needle_loop_config_t) -> Result<LoopConfig<NEEDLE_CHANNELS>, i3
 ///
 /// Returns `NEEDLE_OK`; `NEEDLE_E_NULL` for a NULL pointer; `NEEDLE_E_ARG` for an
 /// unknown `over_limit`; `NEEDLE_E_CONFIG` when the configuration is invalid (a gain not
-/// finite, not `0 < force_limit_n <= force_limit_max_n`, `ramp_step_n` not > 0). On an
+/// finite, not `0 < force_limit_n <= force_limit_max_n`, `ramp_step_n` not finite and > 0). On an
 /// error `*l` is left as it was.
 ///
 /// # Safety

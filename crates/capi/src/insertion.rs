@@ -1,8 +1,10 @@
 //! The insertion model: `needle_insertion_init`, `needle_insertion_step`,
-//! `needle_insertion_set_scales`, `needle_insertion_reset`.
+//! `needle_insertion_set_scales`, `needle_insertion_reset`, and `needle_loop_set_insertion`
+//! (the control loop renders an insertion).
 //!
 //! The state is `needle_haptics::insertion::Insertion` kept in the opaque storage of a
 //! [`needle_insertion_t`]; the stack is one of the compiled-in ones, by name.
+use crate::control::loop_core;
 use crate::eval::{pose_in, wrench_out_of};
 use crate::types::*;
 use core::ffi::{c_char, CStr};
@@ -132,4 +134,37 @@ pub unsafe extern "C" fn needle_insertion_reset(insertion: *mut needle_insertion
         }
         Err(e) => e,
     }
+}
+
+/// Makes the loop `l` render the insertion `insertion` instead of the block surrogate:
+/// its state is copied into the loop, whose ticks then step the copy (the needle path
+/// goes on from where `*insertion` is; `*insertion` itself is not changed by them);
+/// NULL goes back to the block surrogate. The passivity guard, if on, restarts without
+/// history (`needle_haptics::control::LoopCore::set_insertion`).
+///
+/// Returns `NEEDLE_OK`, `NEEDLE_E_NULL` (a NULL loop) or `NEEDLE_E_UNINIT` (the loop or
+/// the insertion not initialised; the loop is then unchanged).
+///
+/// # Safety
+/// `l` is NULL or set up by `needle_loop_init`; `insertion` is NULL or set up by
+/// `needle_insertion_init`.
+#[no_mangle]
+pub unsafe extern "C" fn needle_loop_set_insertion(l: *mut needle_loop_t, insertion: *const needle_insertion_t) -> i32 {
+    // SAFETY: the caller's contract.
+    let core = match unsafe { loop_core(l) } {
+        Ok(c) => c,
+        Err(e) => return e,
+    };
+    // SAFETY: the caller's contract: NULL or valid.
+    let state = match unsafe { insertion.as_ref() } {
+        None => None,
+        Some(i) if i.magic == NEEDLE_INSERTION_MAGIC => {
+            // SAFETY: the magic says init wrote an Insertion here; size and alignment
+            // are checked at compile time.
+            Some(unsafe { *i.storage.as_ptr().cast::<Insertion>() })
+        }
+        Some(_) => return NEEDLE_E_UNINIT,
+    };
+    core.set_insertion(state);
+    NEEDLE_OK
 }

@@ -3,7 +3,7 @@
 /// Motor channels of the C loop.
 pub const NEEDLE_CHANNELS: usize = 3;
 /// 64-bit words of opaque storage in a [`needle_loop_t`].
-pub const NEEDLE_LOOP_STORAGE_WORDS: usize = 32;
+pub const NEEDLE_LOOP_STORAGE_WORDS: usize = 96;
 /// [`needle_loop_t::magic`] of an initialised loop.
 pub const NEEDLE_LOOP_MAGIC: u32 = 0x4e4c_4f50;
 

@@ -84,23 +84,29 @@ fn size_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
     let goals = Goals::of(&set)?;
     banner("needle firmware size", &set)?;
     println!("model form: {} (its goals below)", goals.form);
-    println!("release profile; f32: `no_panic` example ELF, fixed: `no_panic_fixed`; text/data/bss from size -B, tables = .rodata, symbols from nm -S -C\n");
+    println!(
+        "release profile; f32: `no_panic` example ELF, fixed: `no_panic_fixed`, insertion: `no_panic_insertion` (model, depth extension, insertion, stacks, loop); text/data/bss from size -B, tables = .rodata, symbols from nm -S -C\n"
+    );
     print!("{}", size::table(&reports));
     println!();
     for r in &reports {
+        let limit = if r.evaluator == "insertion" { INSERTION_FLASH_BYTES } else { goals.model_flash_bytes };
         println!(
             "goals {} {}: model flash {} <= {} KiB: {}; static RAM {} B == 0: {}",
             r.core.core,
             r.evaluator,
             size::bytes(r.model_flash()),
-            goals.model_flash_bytes / 1024,
-            goal(r.model_flash() <= goals.model_flash_bytes),
+            limit / 1024,
+            goal(r.model_flash() <= limit),
             r.static_ram(),
             goal(r.static_ram() == 0)
         );
     }
     Ok(ExitCode::SUCCESS)
 }
+
+/// Flash of the model with the whole insertion (issue 41): the `insertion` row.
+const INSERTION_FLASH_BYTES: u64 = 24 * 1024;
 
 /// The firmware goals of a model form: f32 instructions per wrench on the M4F, fixed-point
 /// instructions on the M0, model flash (paper form: issues 4 and 5; coupled form: issue 16).

@@ -195,11 +195,13 @@ pub fn measure(core: &Core, elf: &Path, evaluator: &'static str) -> anyhow::Resu
     })
 }
 
-/// The evaluators and the firmware example that holds each alone.
-pub const EVALUATORS: [(&str, &str); 2] = [("f32", "no_panic"), ("fixed", "no_panic_fixed")];
+/// The evaluators and the firmware example that holds each alone (`insertion`: the f32
+/// model, its depth extension, the insertion model with the guard's stiffness, every
+/// compiled-in tissue stack and a control loop rendering it).
+pub const EVALUATORS: [(&str, &str); 3] = [("f32", "no_panic"), ("fixed", "no_panic_fixed"), ("insertion", "no_panic_insertion")];
 
-/// Builds `no_panic` and `no_panic_fixed` for `core` with the set `set` and measures
-/// both (f32 first).
+/// Builds the [`EVALUATORS`]' examples for `core` with the set `set` and measures each
+/// (in that order).
 ///
 /// # Errors
 /// Build failed or binutils missing.

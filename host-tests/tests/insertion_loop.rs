@@ -1,0 +1,132 @@
+//! The whole insertion inside the control loop (`LoopCore::set_insertion`): the loop
+//! renders the insertion's wrench bit for bit, its passivity guard takes the deflected
+//! boundary's stiffness (`Insertion::step_with_stiffness`: the same ticks as `step`, and
+//! the stiffness the derivative of the scaled surrogate), and a puncture clears the
+//! guard's offset.
+#[path = "../../examples/common/insertion_paths.rs"]
+mod paths;
+
+use needle_haptics::control::{ChannelMap, LoopConfig, LoopCore, LoopFlags, OverLimit, Passivity};
+use needle_haptics::insertion::{deflection, stacks, Insertion, InsertionConfig, Phase, FE_NEEDLE_DIAMETER_MM};
+use needle_haptics::Pose;
+use paths::{for_each_tick, PATHS};
+
+fn pose_of(p: [f32; 5]) -> Pose {
+    Pose { x_mm: p[0], z_mm: p[1], theta_x_deg: p[2], theta_z_deg: p[3], depth_mm: p[4] }
+}
+
+fn new(stack: &needle_haptics::insertion::Stack<'_>) -> Insertion {
+    Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ).expect("shipped stack")
+}
+
+/// A one-channel loop whose limit never binds.
+fn core() -> LoopCore<1> {
+    LoopCore::new(LoopConfig {
+        channels: [ChannelMap { gains_per_n: [0.0, 0.01, 0.0], direction_inverted: false }],
+        force_limit_n: 100.0,
+        force_limit_max_n: 100.0,
+        over_limit: OverLimit::Saturate,
+        ramp_step_n: 0.01,
+    })
+    .expect("config")
+}
+
+#[test]
+fn step_with_stiffness_is_step_and_its_stiffness_is_the_deflections_derivative() {
+    for stack in &stacks::ALL {
+        let lambda = stack.needle_diameter_mm / FE_NEEDLE_DIAMETER_MM;
+        for path in PATHS {
+            let (mut a, mut b) = (new(stack), new(stack));
+            let (mut deflecting, mut checked) = (0, 0);
+            for_each_tick(path, |tick, p| {
+                let pose = pose_of(p);
+                let plain = a.step(&pose);
+                let (e, terms) = b.step_with_stiffness(&pose);
+                let k = terms.stiffness_n_per_mm;
+                assert_eq!(format!("{plain:?}"), format!("{e:?}"), "{} tick {tick}", stack.name);
+                match e.phase {
+                    Phase::Deflecting(j) if e.punctures == 0 => {
+                        deflecting += 1;
+                        assert!(k > 0.0 && k.is_finite(), "{} tick {tick}: stiffness {k} while deflecting", stack.name);
+                        // the boundary's indentation along the path, and the surrogate's
+                        // force change over +-h there (every 50th tick; f32 central
+                        // difference: rounding ~1e-7 N / 2h, truncation ~h^2 F''')
+                        let layer = b.layers()[usize::from(j)];
+                        let above: f32 = b.layers().iter().take(usize::from(j)).map(|l| l.thickness_mm).sum();
+                        let a_y = needle_haptics::insertion::needle_axis(&pose)[1];
+                        let delta = pose.depth_mm - above / a_y;
+                        let h = 0.01f32;
+                        if tick % 50 == 0 && delta > 2.0 * h && delta + h < 12.9 * lambda {
+                            let f = |d: f32| deflection(&pose, d, layer.stiffness_scale, lambda).wrench.to_array();
+                            let (hi, lo) = (f(delta + h), f(delta - h));
+                            let diff: f32 = (0..3).map(|c| (hi[c] - lo[c]).powi(2)).sum::<f32>().sqrt() / (2.0 * h);
+                            assert!(
+                                (k - diff).abs() <= 0.01 * diff + 1e-4,
+                                "{} tick {tick}: stiffness {k} N/mm, central difference {diff}",
+                                stack.name
+                            );
+                            checked += 1;
+                        }
+                    }
+                    _ if e.punctures == 0 => assert_eq!(k, 0.0, "{} tick {tick}: stiffness {k} in {:?}", stack.name, e.phase),
+                    _ => {}
+                }
+            });
+            assert!(deflecting > 100 && checked > 2, "{}: {deflecting} deflecting ticks, {checked} checked", stack.name);
+        }
+    }
+}
+
+#[test]
+fn the_loop_renders_the_insertions_wrench_bit_for_bit() {
+    for stack in &stacks::ALL {
+        for path in PATHS {
+            let mut alone = new(stack);
+            let mut l = core();
+            l.set_insertion(Some(new(stack)));
+            for_each_tick(path, |tick, p| {
+                let pose = pose_of(p);
+                let want = alone.step(&pose);
+                let s = l.step(Ok(pose));
+                assert_eq!(s.wrench.to_array().map(f32::to_bits), want.wrench.to_array().map(f32::to_bits), "{} tick {tick}", stack.name);
+                assert_eq!(s.force_cmd_n.map(f32::to_bits), [want.wrench.fx_n, want.wrench.fy_n, want.wrench.fz_n].map(f32::to_bits));
+                assert_eq!(s.model, want.status);
+                assert_eq!(l.insertion_evaluation(), Some(&want), "{} tick {tick}", stack.name);
+            });
+            assert_eq!(l.insertion(), Some(&alone), "the loop's insertion state is the one stepped alone");
+        }
+    }
+}
+
+#[test]
+fn a_puncture_clears_the_guards_offset() {
+    // a weak device (0.05 N·s/m): the guard's stiffness b / T = 0.05 N/mm is below the
+    // deflection's, so it limits while the boundary deflects and builds an offset
+    let guard = Passivity { damping_n_s_per_mm: 0.00005, period_s: 0.001 };
+    for stack in &stacks::ALL {
+        let mut l = core();
+        l.set_passivity(Some(guard)).expect("guard");
+        l.set_insertion(Some(new(stack)));
+        let (mut limited, mut punctures) = (0, 0);
+        for_each_tick(PATHS[0], |tick, p| {
+            let s = l.step(Ok(pose_of(p)));
+            limited += usize::from(s.flags.contains(LoopFlags::STIFFNESS_LIMITED));
+            let e = *l.insertion_evaluation().expect("stepped");
+            if e.punctures > 0 {
+                punctures += 1;
+                // the guard's offset is gone: the command is the model's force, up to the
+                // f32 rounding of taking friction out and adding it back (an ulp or two)
+                let f = [e.wrench.fx_n, e.wrench.fy_n, e.wrench.fz_n];
+                for (c, w) in s.force_cmd_n.iter().zip(f) {
+                    assert!(
+                        (c - w).abs() <= 1e-6 * w.abs() + 1e-9,
+                        "{} tick {tick}: at a puncture the command {:?} is the model's force {f:?}",
+                        stack.name,
+                        s.force_cmd_n
+                    );
+                }
+            }
+        });
+        assert!(limited > 100 && punctures >= 1, "{}: {limited} limited ticks, {punctures} punctures", stack.name);
+    }
+}
