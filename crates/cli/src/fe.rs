@@ -306,6 +306,12 @@ fn run_status(a: StatusArgs) -> anyhow::Result<ExitCode> {
     let plan = campaign::plan(&spec_options(a.spec)?)?;
     let r = needle_fe::launcher::status::status(&plan)?;
     print!("{}", r.table());
+    print!("{}", needle_fe::launcher::status::attempts_by_class(&plan));
+    if plan.selected.iter().any(|p| p.role == needle_fe::spec::Role::Train) {
+        if let Some(t) = needle_fe::launcher::status::training_coverage(&plan) {
+            println!("{t}");
+        }
+    }
     if !a.project_nodes.is_empty() {
         let per_node =
             a.tasks_per_node.map(|n| n as usize).unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));

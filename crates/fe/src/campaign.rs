@@ -548,6 +548,17 @@ pub(crate) fn solve_with_retry(
     Err(SolveFailure { message: failures.join("; "), log_tail: String::new(), reached: furthest })
 }
 
+/// Why training pose `r.pose` was replaced: the spec's words, then the record of its
+/// furthest failed attempt (`<out>/<pose>.partial.toml`) when there is one.
+fn replaced_because(out_dir: &Path, r: &crate::spec::TrainReplacement) -> String {
+    let (_, record) = crate::partial::paths(out_dir, &r.pose);
+    let partial = std::fs::read_to_string(&record).ok().and_then(|t| toml::from_str::<crate::partial::PartialRecord>(&t).ok());
+    match partial {
+        Some(p) => format!("{} (its record: reached {} mm of {}; {})", r.why, p.reached_depth_mm, p.depth_mm, p.failure),
+        None => r.why.clone(),
+    }
+}
+
 /// Check the wrenches, write the CSV, then the manifest entry. Returns Fy at the final depth.
 fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Result<f64> {
     if s.wrenches.len() != ctx.steps as usize {
@@ -593,6 +604,8 @@ fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Res
         retry: s.retry.clone(),
         launcher: Some(ctx.launcher.name().to_string()),
         batch_job: ctx.launcher.batch_job(),
+        replaces: ctx.campaign.replaced_by(&pose.name).map(|r| r.pose.clone()),
+        replaced_because: ctx.campaign.replaced_by(&pose.name).map(|r| replaced_because(ctx.out_dir, r)),
     };
     update_manifest(ctx, |m| {
         m.pose.insert(pose.name.clone(), entry);
@@ -704,6 +717,37 @@ mod tests {
 
     fn opts(dir: &Path, only: &str, steps: u32) -> RunOptions {
         RunOptions { only: Some(only.into()), steps: Some(steps), mesh: Some("smoke".into()), jobs: 2, ..RunOptions::new(dir) }
+    }
+
+    /// Issue 42, item 3: the replacement of a training pose that failed every attempt
+    /// records which pose it replaces and why (the spec's words and the partial record);
+    /// `needle fe status` counts the design's slots and the failures by class.
+    #[test]
+    fn a_replacement_records_what_it_replaces_and_the_status_counts_the_slots() {
+        let d = set_dir();
+        let (c, _) = spec::load(d.path()).expect("spec");
+        let r = c.campaign.train_replaced.first().expect("the default set replaces a training pose").clone();
+        let by = c.replacement_of(&r.pose).expect("its replacement");
+        let mut fake = Fake { fail_reached: Some(r.pose.clone()), ..Fake::default() };
+        let failed = run_with(&opts(d.path(), &r.pose, 4), &mut fake).expect("run");
+        assert_eq!(failed.failed(), 1, "{}", failed.table());
+        let solved = run_with(&opts(d.path(), &by, 4), &mut Fake::default()).expect("run");
+        assert_eq!(solved.done(), 1, "{}", solved.table());
+        let m = read_manifest(&d.path().join("fe").join(MANIFEST)).expect("manifest");
+        let e = &m.pose[&by];
+        assert_eq!(e.replaces.as_deref(), Some(r.pose.as_str()));
+        let because = e.replaced_because.clone().unwrap_or_default();
+        assert!(
+            because.starts_with(&r.why) && because.contains("its record: reached 3 mm of 6") && because.contains("fake stop"),
+            "{because}"
+        );
+        let plan = plan(&RunOptions { only: Some("train-*".into()), ..opts(d.path(), "", 4) }).expect("plan");
+        let cov = crate::launcher::status::training_coverage(&plan).unwrap_or_default();
+        let n = c.campaign.train_count;
+        assert!(cov.starts_with(&format!("training design: 0 of the first {n} poses as drawn solved; 1 of its {n} slots")), "{cov}");
+        assert!(cov.contains(&format!("{} -> {by} (solved)", r.pose)), "{cov}");
+        let classes = crate::launcher::status::attempts_by_class(&plan);
+        assert!(classes.contains("solved runs by the attempt that solved them: attempt 1: 1"), "{classes}");
     }
 
     #[test]

@@ -103,6 +103,13 @@ pub struct ManifestEntry {
     /// The batch system's job of the run, e.g. "1234_5" (SLURM array job 1234, task 5).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub batch_job: Option<String>,
+    /// The training pose this one replaces in the design (`campaign.train_replaced`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub replaces: Option<String>,
+    /// Why that pose was replaced: the spec's `why`, then the failure of its furthest
+    /// attempt from its `.partial.toml` when there is one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub replaced_because: Option<String>,
 }
 
 impl Manifest {

@@ -434,6 +434,15 @@ pub struct CampaignSettings {
     /// without it, and model.toml names what was left out.
     #[serde(default)]
     pub fit_without: Vec<String>,
+    /// Training poses that failed every attempt of the retry ladder, each replaced by the
+    /// next point of the Sobol sequence (issue 42, item 3): entry k (0-based) is replaced
+    /// by point `train_count + k`, named `train-<train_count + k + 1>`, so the design
+    /// keeps `train_count` runs to fit. A replaced pose stays in the campaign (a record:
+    /// `needle fe run` still tries it, `needle fe status` shows its failures) but is not
+    /// fitted; its replacement's manifest entry names it (`replaces`) and why
+    /// (`replaced_because`). A replacement that fails every attempt is listed in turn.
+    #[serde(default)]
+    pub train_replaced: Vec<TrainReplacement>,
     /// Mesh levels of `needle fe verify --mesh`, coarse to fine, each a 2x refinement of
     /// the one before; the committed level (`mesh`) must be followed by its refinement.
     /// Empty: `[mesh, "fine"]`.
@@ -443,6 +452,17 @@ pub struct CampaignSettings {
     /// refinement (`needle fe verify --mesh`; issue 42: an x, a z and a theta pose).
     #[serde(default)]
     pub mesh_study_poses: Vec<String>,
+}
+
+/// `[[campaign.train_replaced]]`: a training pose replaced by the next point of the
+/// design's sequence.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrainReplacement {
+    /// The training pose that failed every attempt, e.g. `train-31`.
+    pub pose: String,
+    /// Why, from its failed attempts' logs (`needle fe status`): class, depth reached.
+    pub why: String,
 }
 
 /// What a pose is for.
@@ -691,6 +711,27 @@ impl Campaign {
                 bail!("{p}: campaign.mesh_study_poses: {name:?} is not a pose of this campaign");
             }
         }
+        let mut replaced = std::collections::BTreeSet::new();
+        for (k, r) in self.campaign.train_replaced.iter().enumerate() {
+            let replacement = self.train_name(self.campaign.train_count as usize + k);
+            // the pose must be a training pose drawn before its replacement
+            let drawn_before = (0..self.campaign.train_count as usize + k).any(|i| self.train_name(i) == r.pose);
+            if !drawn_before {
+                bail!(
+                    "{p}: campaign.train_replaced[{k}]: {:?} is not a training pose drawn before its replacement {replacement:?}",
+                    r.pose
+                );
+            }
+            if !replaced.insert(r.pose.clone()) {
+                bail!("{p}: campaign.train_replaced: {:?} is listed twice", r.pose);
+            }
+            if r.why.trim().is_empty() {
+                bail!("{p}: campaign.train_replaced[{k}] ({}): `why` is empty (the failure from its logs)", r.pose);
+            }
+            if self.campaign.fit_without.contains(&r.pose) {
+                bail!("{p}: campaign.fit_without: {:?} is in campaign.train_replaced, so it is not fitted already; list it once", r.pose);
+            }
+        }
         for name in &self.campaign.fit_without {
             match every_pose.iter().find(|q| &q.name == name) {
                 None => bail!("{p}: campaign.fit_without: {name:?} is not a pose of this campaign"),
@@ -751,9 +792,12 @@ impl Campaign {
     /// the whole domain, |x|, |z| <= 12 mm and |theta| <= 15 degrees, rounded like the
     /// hypercube. Every prefix of 2^k points is stratified in each input and in each pair
     /// of inputs, which is what the learning curve's nested subsets rely on.
+    /// Then one more point per entry of `campaign.train_replaced`: the replacements
+    /// ([`Campaign::replacement_of`]).
     pub fn train_poses(&self) -> Vec<PoseSpec> {
         let ranges = [X_MAX_MM, Z_MAX_MM, THETA_MAX_DEG, THETA_MAX_DEG];
-        (0..self.campaign.train_count)
+        let drawn = self.campaign.train_count.saturating_add(u32::try_from(self.campaign.train_replaced.len()).unwrap_or(u32::MAX));
+        (0..drawn)
             .map(|i| {
                 let v: Vec<f64> = ranges
                     .iter()
@@ -764,13 +808,51 @@ impl Campaign {
                     })
                     .collect();
                 PoseSpec {
-                    name: format!("train-{:02}", i + 1),
+                    name: self.train_name(i as usize),
                     role: Role::Train,
                     x_mm: v[0],
                     z_mm: v[1],
                     theta_x_deg: v[2],
                     theta_z_deg: v[3],
                 }
+            })
+            .collect()
+    }
+
+    /// Name of point `i` (0-based) of the training sequence: `train-01`, ...
+    pub fn train_name(&self, i: usize) -> String {
+        format!("train-{:02}", i + 1)
+    }
+
+    /// The replacement of training pose `name` listed in `campaign.train_replaced`
+    /// (`None`: not replaced).
+    pub fn replacement_of(&self, name: &str) -> Option<String> {
+        let k = self.campaign.train_replaced.iter().position(|r| r.pose == name)?;
+        Some(self.train_name(self.campaign.train_count as usize + k))
+    }
+
+    /// The entry of `campaign.train_replaced` that pose `name` replaces (`None`: `name`
+    /// is not a replacement).
+    pub fn replaced_by(&self, name: &str) -> Option<&TrainReplacement> {
+        let n = self.campaign.train_count as usize;
+        self.campaign.train_replaced.iter().enumerate().find(|(k, _)| self.train_name(n + k) == name).map(|(_, r)| r)
+    }
+
+    /// Whether training pose `name` is replaced (not fitted: its replacement takes its slot).
+    pub fn is_replaced(&self, name: &str) -> bool {
+        self.campaign.train_replaced.iter().any(|r| r.pose == name)
+    }
+
+    /// The training design's `train_count` slots after the replacements: each pose of
+    /// the first `train_count` as drawn, or the last replacement in its chain.
+    pub fn train_design(&self) -> Vec<String> {
+        (0..self.campaign.train_count as usize)
+            .map(|i| {
+                let mut name = self.train_name(i);
+                while let Some(r) = self.replacement_of(&name) {
+                    name = r;
+                }
+                name
             })
             .collect()
     }
@@ -941,6 +1023,7 @@ mod tests {
     fn training_poses_are_nested_stratified_sobol_prefixes() {
         let set = crate::workspace_root().join("coeffs/default");
         let Ok((mut c, _)) = super::load(&set) else { panic!("cannot load {}", set.display()) };
+        c.campaign.train_replaced.clear();
         c.campaign.train_seed = 7;
         c.campaign.train_count = 16;
         let sixteen = c.train_poses();
@@ -969,6 +1052,61 @@ mod tests {
         c.campaign.train_seed = 8;
         assert_ne!(c.train_poses(), eight, "the seed scrambles the design");
         assert!(c.poses().iter().filter(|p| p.role == Role::Train).count() == 8, "poses() lists the training poses");
+    }
+
+    /// Issue 42, item 3: a training pose that fails every attempt is replaced by the next
+    /// point of the sequence; a replacement that fails is replaced in turn.
+    #[test]
+    fn replaced_training_poses_take_the_next_points_of_the_sequence() {
+        let set = crate::workspace_root().join("coeffs/default");
+        let text = std::fs::read_to_string(set.join("campaign.toml")).expect("campaign.toml");
+        let Ok((mut c, _)) = super::load(&set) else { panic!("cannot load {}", set.display()) };
+        c.campaign.train_replaced.clear();
+        c.campaign.train_count = 10;
+        let ten = c.train_poses();
+        c.campaign.train_count = 8;
+        let why = |p: &str| super::TrainReplacement { pose: p.into(), why: "all attempts failed".into() };
+        c.campaign.train_replaced = vec![why("train-03"), why("train-09")];
+        let got = c.train_poses();
+        assert_eq!(got, ten, "8 drawn + 2 replacements = the first 10 points of the sequence");
+        assert_eq!(c.replacement_of("train-03").as_deref(), Some("train-09"));
+        assert_eq!(c.replacement_of("train-09").as_deref(), Some("train-10"));
+        assert_eq!(c.replacement_of("train-04"), None);
+        assert_eq!(c.replaced_by("train-10").map(|r| r.pose.as_str()), Some("train-09"));
+        assert_eq!(c.replaced_by("train-03").map(|r| r.pose.as_str()), None);
+        assert!(c.is_replaced("train-09") && !c.is_replaced("train-10"));
+        let design = c.train_design();
+        assert_eq!(design.len(), 8);
+        assert_eq!(design[2], "train-10", "slot 3: train-03 -> train-09 -> train-10");
+        assert_eq!(design[3], "train-04");
+        // the spec's checks, on the text: entries appended after the shipped ones (a TOML
+        // array of tables of [campaign] goes after its plain keys, before [deep])
+        let shipped = super::parse(&text, Path::new("campaign.toml")).map(|c| c.campaign.train_replaced.len()).unwrap_or(usize::MAX);
+        let at_end = |entries: &[(&str, &str)]| {
+            let add: String =
+                entries.iter().map(|(p, w)| format!("[[campaign.train_replaced]]\npose = \"{p}\"\nwhy = \"{w}\"\n")).collect();
+            let t = text.replacen("\n[deep]\n", &format!("\n{add}\n[deep]\n"), 1);
+            assert_ne!(t, text, "the test's edit did not apply");
+            super::parse(&t, Path::new("campaign.toml")).map(|c| c.campaign.train_replaced.len())
+        };
+        assert_eq!(at_end(&[("train-09", "x")]).ok(), Some(shipped + 1));
+        let err = |r: anyhow::Result<usize>| r.err().map(|e| e.to_string()).unwrap_or_default();
+        let msg = err(at_end(&[("train-60", "x")]));
+        assert!(msg.contains("\"train-60\" is not a training pose drawn before its replacement"), "{msg}");
+        let msg = err(at_end(&[("train-09", "x"), ("train-09", "y")]));
+        assert!(msg.contains("\"train-09\" is listed twice"), "{msg}");
+        let msg = err(at_end(&[("train-09", " ")]));
+        assert!(msg.contains("`why` is empty"), "{msg}");
+        let both = text.replacen("fit_without = [", "fit_without = [\"train-09\", ", 1).replacen(
+            "\n[deep]\n",
+            "\n[[campaign.train_replaced]]\npose = \"train-09\"\nwhy = \"x\"\n\n[deep]\n",
+            1,
+        );
+        let msg = err(super::parse(&both, Path::new("campaign.toml")).map(|c| c.campaign.train_replaced.len()));
+        assert!(msg.contains("\"train-09\" is in campaign.train_replaced"), "{msg}");
+        // a replacement replaced in turn
+        let first = format!("train-{}", 33 + shipped);
+        assert_eq!(at_end(&[("train-09", "x"), (first.as_str(), "y")]).ok(), Some(shipped + 2));
     }
 
     fn names(poses: &[&PoseSpec]) -> Vec<String> {

@@ -151,15 +151,18 @@ pub fn stale_reason(manifest: &Manifest, campaign: &Campaign, pose: &PoseSpec) -
 }
 
 /// The poses the fitter uses: the centre, every sweep run and, for the coupled form, every
-/// training run, less those listed in `campaign.fit_without` (their files make up
-/// `fe_sha256`).
+/// training run, less those listed in `campaign.fit_without` and the training runs
+/// replaced by the next point of the design (`campaign.train_replaced`; their files make
+/// up `fe_sha256`).
 pub fn fitted_poses(campaign: &Campaign) -> Vec<PoseSpec> {
     let left_out = &campaign.campaign.fit_without;
     let coupled = campaign.fit.form == ModelForm::Coupled;
     campaign
         .poses()
         .into_iter()
-        .filter(|p| (p.role.is_fitted() || (coupled && p.role == Role::Train)) && !left_out.contains(&p.name))
+        .filter(|p| {
+            (p.role.is_fitted() || (coupled && p.role == Role::Train)) && !left_out.contains(&p.name) && !campaign.is_replaced(&p.name)
+        })
         .collect()
 }
 

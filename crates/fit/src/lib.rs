@@ -99,7 +99,17 @@ pub fn fit_set(set_dir: &Path) -> Result<FitOutput> {
     if data.campaign.fit.form == needle_fe::spec::ModelForm::Coupled {
         model = coupled::fit_coupled(&data, &model, data.campaign.needle.reference_from_tip_mm)?;
     }
-    let model_toml = model_file::to_toml(&model, &data.campaign.campaign.fit_without);
+    // replaced training runs (campaign.train_replaced) are not fitted either: named with
+    // their replacement
+    let mut left_out = data.campaign.campaign.fit_without.clone();
+    left_out.extend(
+        data.campaign
+            .campaign
+            .train_replaced
+            .iter()
+            .map(|r| format!("{} (replaced by {})", r.pose, data.campaign.replacement_of(&r.pose).unwrap_or_default())),
+    );
+    let model_toml = model_file::to_toml(&model, &left_out);
     let tables = eval_f32::Tables32::from_model(&model);
     let golden_csv = golden::to_csv(&tables);
     let golden_stiffness_csv = golden_stiffness::to_csv(&tables);

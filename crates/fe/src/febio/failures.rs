@@ -57,6 +57,35 @@ pub fn read_failures(work_dir: &Path) -> Vec<AttemptFailure> {
     out
 }
 
+/// The attempts of a pose's `.partial.toml` record (its `failure`: the campaign's
+/// messages of every attempt, `"; retry "` between them), for a pose whose work folder
+/// and its logs are gone: class from FEBio's words in each message (`stopped` when the
+/// runner killed it: interrupted, timed out or stalled), depth from "failed to converge
+/// at time" or else the message's `t = ... mm`.
+pub fn failures_from_record(failure: &str) -> Vec<AttemptFailure> {
+    failure
+        .split("; retry ")
+        .filter(|m| !m.trim().is_empty())
+        .zip(1u32..)
+        .map(|(m, attempt)| {
+            let after = |key: &str| {
+                m.rfind(key).and_then(|i| m.get(i + key.len()..)).and_then(|r| {
+                    let num: String =
+                        r.trim_start().chars().take_while(|c| c.is_ascii_digit() || *c == '.' || *c == 'e' || *c == '-').collect();
+                    num.parse::<f64>().ok()
+                })
+            };
+            let killed = m.contains("(killed)");
+            AttemptFailure {
+                attempt,
+                class: if killed { "stopped" } else { class_of(Some(m)) },
+                depth_mm: after("failed to converge at time :").or_else(|| after("(t =")).unwrap_or(0.0),
+                cause: Some(m.trim().to_string()),
+            }
+        })
+        .collect()
+}
+
 /// One line: `5 failed attempt(s), furthest 5.22 mm: negative jacobian x3 (0.6, 0.86, 2.69 mm), max reformations x2 (...)`;
 /// empty when there are none.
 pub fn summary(failures: &[AttemptFailure]) -> String {
@@ -99,5 +128,15 @@ mod tests {
             "3 failed attempt(s), furthest 5.22 mm: max reformations x1 (5.22 mm); negative jacobian x1 (0.86 mm); stopped x1 (1.5 mm)"
         );
         assert_eq!(summary(&[]), "");
+    }
+
+    #[test]
+    fn a_partial_record_is_classed_like_the_logs() {
+        // the record of fe/mesh/fine/centre.partial.toml's kind, two attempts
+        let record = "febio4 exit code 1 after 16 of 20 steps (t = 5.04373 mm), 45 time steps, 31 retries, 478.4 s, continued 1 time(s) from the last converged must point (4.8 mm): Negative jacobian detected. (failed to converge at time : 5.04374) (kept as failed-attempt-1.*); retry 1 (first increment 1): febio4 exit code 1 after 13 of 20 steps (t = 4.18753 mm), 30 time steps, 23 retries, 322.7 s: Max nr of reformations reached. (failed to converge at time : 4.18754) (kept as failed-attempt-2.*); retry 2 (first increment 0.25): febio4 interrupted (killed) after 16 of 20 steps (t = 4.8 mm), 42 time steps (kept as failed-attempt-3.*)";
+        let f = failures_from_record(record);
+        let got: Vec<(u32, &str, f64)> = f.iter().map(|f| (f.attempt, f.class, f.depth_mm)).collect();
+        assert_eq!(got, [(1, "negative jacobian", 5.04374), (2, "max reformations", 4.18754), (3, "stopped", 4.8)]);
+        assert!(failures_from_record("").is_empty());
     }
 }

@@ -116,9 +116,103 @@ pub fn status(plan: &Plan) -> Result<StatusReport> {
 
 /// The failed attempts a local run left in `<out>/.work/<pose>/`, by class
 /// ([`febio::failures`](crate::febio::failures)); empty when there are none.
+/// Without logs, the attempts of its `.partial.toml` record (the logs' folder is gone
+/// when the campaign ran elsewhere or the work folder was cleaned).
 fn local_failures(out_dir: &Path, pose: &str) -> String {
-    let f = crate::febio::failures::read_failures(&out_dir.join(".work").join(pose));
-    crate::febio::failures::summary(&f)
+    use crate::febio::failures;
+    let f = failures::read_failures(&out_dir.join(".work").join(pose));
+    if !f.is_empty() {
+        return failures::summary(&f);
+    }
+    let (_, record) = crate::partial::paths(out_dir, pose);
+    let Some(r) = std::fs::read_to_string(&record).ok().and_then(|t| toml::from_str::<crate::partial::PartialRecord>(&t).ok()) else {
+        return String::new();
+    };
+    format!("{} (record {})", failures::summary(&failures::failures_from_record(&r.failure)), r.date)
+}
+
+/// The failed attempts of the selected poses by attempt and class (issue 42, item 2:
+/// where the ladder fails): of solved runs from their manifest entry's `retry` (the
+/// attempts before the one that solved), of unsolved ones from their failed attempts'
+/// logs or partial record; then on which attempt the solved runs solved. Empty when
+/// nothing failed and nothing is solved.
+pub fn attempts_by_class(plan: &Plan) -> String {
+    use crate::febio::failures::{self, AttemptFailure};
+    let mut failed: Vec<AttemptFailure> = Vec::new();
+    let mut solved_on: BTreeMap<u32, usize> = BTreeMap::new();
+    for (i, pose) in plan.selected.iter().enumerate() {
+        let done = !plan.to_run.contains(&i);
+        if done {
+            let retry = plan.manifest.pose.get(&pose.name).and_then(|e| e.retry.clone()).unwrap_or_default();
+            let before = failures::failures_from_record(&retry);
+            *solved_on.entry(before.len() as u32 + 1).or_default() += 1;
+            failed.extend(before);
+        } else {
+            let logs = failures::read_failures(&plan.out_dir.join(".work").join(&pose.name));
+            if logs.is_empty() {
+                let (_, record) = crate::partial::paths(&plan.out_dir, &pose.name);
+                if let Some(r) =
+                    std::fs::read_to_string(&record).ok().and_then(|t| toml::from_str::<crate::partial::PartialRecord>(&t).ok())
+                {
+                    failed.extend(failures::failures_from_record(&r.failure));
+                }
+            } else {
+                failed.extend(logs);
+            }
+        }
+    }
+    let mut s = String::new();
+    if failed.is_empty() && solved_on.is_empty() {
+        return s;
+    }
+    let mut by: BTreeMap<(u32, &str), Vec<f64>> = BTreeMap::new();
+    for f in &failed {
+        by.entry((f.attempt, f.class)).or_default().push(f.depth_mm);
+    }
+    let _ = writeln!(s, "failed attempts by class ({} in all; depth where each stopped, min / median / max mm):", failed.len());
+    for ((attempt, class), d) in &mut by {
+        d.sort_by(f64::total_cmp);
+        let median = d.get(d.len() / 2).copied().unwrap_or(f64::NAN);
+        let (lo, hi) = (d.first().copied().unwrap_or(f64::NAN), d.last().copied().unwrap_or(f64::NAN));
+        let _ = writeln!(s, "  attempt {attempt}: {class:<17} x{:<3} {lo:.2} / {median:.2} / {hi:.2} mm", d.len());
+    }
+    let on: Vec<String> = solved_on.iter().map(|(a, n)| format!("attempt {a}: {n}")).collect();
+    let _ = writeln!(s, "solved runs by the attempt that solved them: {}", on.join(", "));
+    s
+}
+
+/// The training design's coverage (issue 42): of the first `train_count` poses as drawn
+/// and of the design's slots after the replacements (`campaign.train_replaced`), how
+/// many have an up-to-date result in `plan`'s folder; `None` without training poses.
+pub fn training_coverage(plan: &Plan) -> Option<String> {
+    let c = &plan.campaign;
+    let n = c.campaign.train_count as usize;
+    if n == 0 {
+        return None;
+    }
+    let poses = c.train_poses();
+    let solved = |name: &str| {
+        poses.iter().find(|p| p.name == name).is_some_and(|p| {
+            plan.manifest.current_entry(c, p, &plan.mesh_name).is_ok() && plan.out_dir.join(format!("{name}.csv")).is_file()
+        })
+    };
+    let drawn: Vec<String> = (0..n).map(|i| c.train_name(i)).collect();
+    let first = drawn.iter().filter(|p| solved(p)).count();
+    let design = c.train_design();
+    let slots = design.iter().filter(|p| solved(p)).count();
+    let mut s = format!(
+        "training design: {first} of the first {n} poses as drawn solved; {slots} of its {n} slots after {} replacement(s) (campaign.train_replaced)",
+        c.campaign.train_replaced.len()
+    );
+    for r in &c.campaign.train_replaced {
+        let by = c.replacement_of(&r.pose).unwrap_or_default();
+        let _ = write!(s, "\n  {} -> {by} ({}): {}", r.pose, if solved(&by) { "solved" } else { "not solved yet" }, r.why);
+    }
+    let open: Vec<&String> = design.iter().filter(|p| !solved(p)).collect();
+    if !open.is_empty() {
+        let _ = write!(s, "\n  slots not solved: {}", open.iter().map(|p| p.as_str()).collect::<Vec<_>>().join(", "));
+    }
+    Some(s)
 }
 
 fn reason(q: &QueueState) -> String {

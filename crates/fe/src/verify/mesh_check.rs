@@ -93,6 +93,70 @@ pub struct MeshReport {
     pub shape_goal_percent: [f64; 2],
     /// Every pose's shape comparison between successive levels it was run on.
     pub shape: Vec<ShapeComparison>,
+    /// Per pose on three successive levels (the centre): how the shape difference
+    /// changes under refinement.
+    pub shape_trend: Vec<ShapeTrend>,
+}
+
+/// One pose on three successive levels: the shape difference of the finer pair over the
+/// coarser pair's (below 1: the shape converges; the absolute level's counterpart is the
+/// ratio of successive changes of Fy).
+#[derive(Debug, Clone, Serialize)]
+pub struct ShapeTrend {
+    /// Pose name.
+    pub pose: String,
+    /// The three levels, coarse to fine.
+    pub levels: [String; 3],
+    /// Worst component RMS after the best scale, coarser pair then finer pair, %.
+    pub worst_rms_percent: [f64; 2],
+    /// Largest difference after the best scale, coarser pair then finer pair, %.
+    pub worst_max_percent: [f64; 2],
+    /// Finer pair's worst RMS over the coarser pair's.
+    pub rms_ratio: f64,
+    /// Finer pair's largest difference over the coarser pair's.
+    pub max_ratio: f64,
+}
+
+/// The trends of `shape`: each pair of comparisons of one pose that share a level.
+pub fn shape_trends(shape: &[ShapeComparison]) -> Vec<ShapeTrend> {
+    let mut out = Vec::new();
+    for a in shape {
+        for b in shape.iter().filter(|b| b.pose == a.pose && b.coarse == a.fine) {
+            out.push(ShapeTrend {
+                pose: a.pose.clone(),
+                levels: [a.coarse.clone(), a.fine.clone(), b.fine.clone()],
+                worst_rms_percent: [a.worst_rms_percent, b.worst_rms_percent],
+                worst_max_percent: [a.worst_max_percent, b.worst_max_percent],
+                rms_ratio: b.worst_rms_percent / a.worst_rms_percent,
+                max_ratio: b.worst_max_percent / a.worst_max_percent,
+            });
+        }
+    }
+    out
+}
+
+impl std::fmt::Display for ShapeTrend {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "shape trend {:>6} {} -> {} -> {}: worst RMS {:.2}% -> {:.2}% (ratio {:.3}), largest {:.2}% -> {:.2}% (ratio {:.3}): {}",
+            self.pose,
+            self.levels[0],
+            self.levels[1],
+            self.levels[2],
+            self.worst_rms_percent[0],
+            self.worst_rms_percent[1],
+            self.rms_ratio,
+            self.worst_max_percent[0],
+            self.worst_max_percent[1],
+            self.max_ratio,
+            if self.rms_ratio < 1.0 && self.max_ratio < 1.0 {
+                "the shape difference shrinks"
+            } else {
+                "the shape difference does not shrink"
+            }
+        )
+    }
 }
 
 impl MeshReport {
@@ -170,6 +234,9 @@ pub fn mesh_convergence(c: &Campaign, o: &MeshOptions) -> Result<MeshReport> {
     let shape = shape_comparisons(c, &results);
     for s in &shape {
         println!("{s}");
+    }
+    for t in shape_trends(&shape) {
+        println!("{t}");
     }
     Ok(report(c, committed, refined, levels, shape, &plan))
 }
@@ -262,13 +329,37 @@ fn report(
         committed,
         refined,
         levels,
+        shape_trend: shape_trends(&shape),
         shape,
     }
 }
 
 #[cfg(test)]
 mod tests {
-    use super::richardson;
+    use super::{richardson, shape_trends};
+    use crate::results::Row;
+    use crate::verify::shape;
+
+    #[test]
+    fn a_shape_difference_that_halves_is_a_shrinking_trend() {
+        // Fy = d^2 on the finest level; the coarser levels add a bump at 3 mm of 6 % and
+        // 2 % of peak |Fy| (a shape change no scale removes)
+        let level = |bump: f64| -> Vec<Row> {
+            (0..=6)
+                .map(f64::from)
+                .map(|d| Row { depth_mm: d, wrench: [0.0, d * d + if d == 3.0 { bump * 36.0 } else { 0.0 }, 0.0, 0.0, 0.0, 0.0] })
+                .collect()
+        };
+        let (c, m, f) = (level(0.06), level(0.02), level(0.0));
+        let s = vec![shape::compare("p", ("c", "m"), &c, &m, 60.0), shape::compare("p", ("m", "f"), &m, &f, 60.0)];
+        let t = shape_trends(&s);
+        assert_eq!(t.len(), 1);
+        assert_eq!(t[0].levels, ["c".to_string(), "m".into(), "f".into()]);
+        assert!(t[0].rms_ratio > 0.4 && t[0].rms_ratio < 0.6, "{}", t[0]);
+        assert!(t[0].to_string().ends_with("the shape difference shrinks"), "{}", t[0]);
+        let grows = shape_trends(&[s[1].clone(), shape::compare("p", ("f", "g"), &f, &c, 60.0)]);
+        assert!(grows[0].rms_ratio > 1.0 && grows[0].to_string().ends_with("does not shrink"), "{}", grows[0]);
+    }
 
     #[test]
     fn richardson_recovers_a_first_and_second_order_limit() {
