@@ -7,7 +7,7 @@
 //! the compiler drops them: the wrench and the three force rates are its bits exactly
 //! (host-tests/tests/depth_rate.rs compares them on the golden poses).
 use crate::cross_f32::{add_cross, add_cross_rates, COUPLED, CROSS_SCALES};
-use crate::model_f32::{clamp_to_domain, sweep_t, ONE_THIRD, SWEEP_SCALES};
+use crate::model_f32::{clamp_to_domain, ONE_THIRD};
 use crate::stiffness_f32::{component, At, Column};
 use crate::tables::FITTED;
 use crate::{Evaluation, Pose, Status, Wrench};
@@ -25,14 +25,8 @@ pub fn wrench_and_depth_rate(pose: &Pose) -> (Evaluation, [f32; 3]) {
     let Some((clamped, status)) = clamp_to_domain(pose) else {
         return error(Status::ERROR);
     };
-    let Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, depth_mm: d } = clamped;
-    let u = d * ONE_THIRD - 1.0;
-    let [sx, sz, stx, stz] = SWEEP_SCALES;
-    let at = At {
-        t: [sweep_t(x, sx), sweep_t(z, sz), sweep_t(tx, stx), sweep_t(tz, stz)],
-        sign: [x, z, tx, tz].map(|v| if v < 0.0 { -1.0_f32 } else { 1.0 }),
-        u,
-    };
+    let at = At::of(&clamped);
+    let (Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, .. }, u) = (clamped, at.u);
     let columns = [
         column::<0, true>(&at),
         column::<1, true>(&at),

@@ -53,14 +53,10 @@ pub fn wrench_and_stiffness(pose: &Pose) -> StiffnessEvaluation {
     let Some((clamped, status)) = clamp_to_domain(pose) else {
         return error(Status::ERROR);
     };
-    let Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, depth_mm: d } = clamped;
-    let u = d * ONE_THIRD - 1.0;
-    let [sx, sz, stx, stz] = SWEEP_SCALES;
-    let at = At {
-        t: [sweep_t(x, sx), sweep_t(z, sz), sweep_t(tx, stx), sweep_t(tz, stz)],
-        sign: [x, z, tx, tz].map(|v| if v < 0.0 { -1.0_f32 } else { 1.0 }),
-        u,
-    };
+    let at = At::of(&clamped);
+    let Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, .. } = clamped;
+    let [sx, sz, _, _] = SWEEP_SCALES;
+    let u = at.u;
     // Component by component (the contract's order within each component: baseline,
     // then the sweeps x, z, theta_x, theta_z), written out with constant indices so the
     // tables, parities and skip flags are constants in straight-line code and only one
@@ -116,6 +112,20 @@ pub(crate) struct At {
     pub(crate) t: [f32; 4],
     pub(crate) sign: [f32; 4],
     pub(crate) u: f32,
+}
+
+impl At {
+    /// Where the polynomials are evaluated for a pose already clamped to the domain:
+    /// `u = depth/3 - 1`, `t_k = |v_k| * (2/V_k) - 1` and the signs, as for the wrench.
+    pub(crate) fn of(clamped: &Pose) -> Self {
+        let Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, depth_mm: d } = *clamped;
+        let [sx, sz, stx, stz] = SWEEP_SCALES;
+        Self {
+            t: [sweep_t(x, sx), sweep_t(z, sz), sweep_t(tx, stx), sweep_t(tz, stz)],
+            sign: [x, z, tx, tz].map(|v| if v < 0.0 { -1.0_f32 } else { 1.0 }),
+            u: d * ONE_THIRD - 1.0,
+        }
+    }
 }
 
 /// One component's accumulators: the wrench `w`, and the rates by `u`, by `t_x`, by `t_z`

@@ -108,23 +108,31 @@ pub fn to_csv(poses: &[Pose], evals: &[Evaluation]) -> String {
     s.push_str(OUTPUT_HEADER);
     s.push('\n');
     for (p, e) in poses.iter().zip(evals) {
-        let w = e.wrench.to_array();
-        let _ = writeln!(
-            s,
-            "{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:#04x}",
-            p.x_mm,
-            p.z_mm,
-            p.theta_x_deg,
-            p.theta_z_deg,
-            p.depth_mm,
-            w[0],
-            w[1],
-            w[2],
-            w[3],
-            w[4],
-            w[5],
-            e.status.bits()
-        );
+        push_pose_wrench_status(&mut s, p, &e.wrench, e.status);
+        s.push('\n');
     }
     s
+}
+
+/// One row's shared columns, without a line end: the five pose inputs, the six wrench
+/// components (each the shortest decimal that reads back to the same f32) and the status
+/// byte in hex (`0x..`), comma-separated (also the scripted insertion's rows).
+pub fn push_pose_wrench_status(s: &mut String, p: &Pose, w: &needle_haptics::Wrench, status: needle_haptics::Status) {
+    let w = w.to_array();
+    let _ = write!(
+        s,
+        "{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:#04x}",
+        p.x_mm,
+        p.z_mm,
+        p.theta_x_deg,
+        p.theta_z_deg,
+        p.depth_mm,
+        w[0],
+        w[1],
+        w[2],
+        w[3],
+        w[4],
+        w[5],
+        status.bits()
+    );
 }

@@ -7,7 +7,7 @@
 //! the velocity). Output: `time_s`, the pose, the wrench, the status byte, the phase
 //! (`approach`, `deflecting:<layer>`, `cutting:<layer>`, `in-track:<layer>`) and the
 //! punctures of the tick.
-use super::eval_batch::{parse_poses, POSE_COLUMNS};
+use super::eval_batch::{parse_poses, push_pose_wrench_status, POSE_COLUMNS};
 use anyhow::{bail, Context, Result};
 use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, InsertionEvaluation, Phase};
 use needle_haptics::Pose;
@@ -101,25 +101,9 @@ pub fn to_csv(times: &[f64], poses: &[Pose], evals: &[InsertionEvaluation]) -> S
     s.push_str(OUTPUT_HEADER);
     s.push('\n');
     for ((t, p), e) in times.iter().zip(poses).zip(evals) {
-        let w = e.wrench.to_array();
-        let _ = writeln!(
-            s,
-            "{t:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:?},{:#04x},{},{}",
-            p.x_mm,
-            p.z_mm,
-            p.theta_x_deg,
-            p.theta_z_deg,
-            p.depth_mm,
-            w[0],
-            w[1],
-            w[2],
-            w[3],
-            w[4],
-            w[5],
-            e.status.bits(),
-            phase_name(e.phase),
-            e.punctures
-        );
+        let _ = write!(s, "{t:?},");
+        push_pose_wrench_status(&mut s, p, &e.wrench, e.status);
+        let _ = writeln!(s, ",{},{}", phase_name(e.phase), e.punctures);
     }
     s
 }
