@@ -93,6 +93,8 @@ fn synthetic_entry(campaign: &spec::Campaign, pose: &PoseSpec) -> ManifestEntry 
         retry: None,
         launcher: None,
         batch_job: None,
+        replaces: None,
+        replaced_because: None,
     }
 }
 
