@@ -629,7 +629,7 @@ fn update_manifest(ctx: &Ctx<'_>, f: impl FnOnce(&mut Manifest)) -> Result<()> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::deck::MeshSummary;
     use crate::spec::Role;
@@ -638,15 +638,15 @@ mod tests {
     /// A solver that returns a made-up wrench (bookkeeping tests only, no physics), can
     /// fail or panic on one pose, and counts its solves.
     #[derive(Default)]
-    struct Fake {
-        fail: Option<String>,
+    pub(crate) struct Fake {
+        pub(crate) fail: Option<String>,
         /// Fails this pose's first attempt only (whole-step first increment).
-        fail_first: Option<String>,
-        panic_on: Option<String>,
+        pub(crate) fail_first: Option<String>,
+        pub(crate) panic_on: Option<String>,
         /// Fails this pose on every attempt after the first must point (attempt 2: two).
-        fail_reached: Option<String>,
-        solves: AtomicUsize,
-        prepared: usize,
+        pub(crate) fail_reached: Option<String>,
+        pub(crate) solves: AtomicUsize,
+        pub(crate) prepared: usize,
     }
 
     impl Backend for Fake {
@@ -708,20 +708,19 @@ mod tests {
         }
     }
 
-    fn set_dir() -> tempfile::TempDir {
+    pub(crate) fn set_dir() -> tempfile::TempDir {
         let d = tempfile::tempdir().expect("tempdir");
         let src = crate::workspace_root().join("coeffs/default/campaign.toml");
         std::fs::copy(&src, d.path().join("campaign.toml")).expect("copy the default spec");
         d
     }
 
-    fn opts(dir: &Path, only: &str, steps: u32) -> RunOptions {
+    pub(crate) fn opts(dir: &Path, only: &str, steps: u32) -> RunOptions {
         RunOptions { only: Some(only.into()), steps: Some(steps), mesh: Some("smoke".into()), jobs: 2, ..RunOptions::new(dir) }
     }
 
     /// Issue 42, item 3: the replacement of a training pose that failed every attempt
-    /// records which pose it replaces and why (the spec's words and the partial record);
-    /// `needle fe status` counts the design's slots and the failures by class.
+    /// records which pose it replaces and why (the spec's words and the partial record).
     #[test]
     fn a_replacement_records_what_it_replaces_and_the_status_counts_the_slots() {
         let d = set_dir();
@@ -741,13 +740,7 @@ mod tests {
             because.starts_with(&r.why) && because.contains("its record: reached 3 mm of 6") && because.contains("fake stop"),
             "{because}"
         );
-        let plan = plan(&RunOptions { only: Some("train-*".into()), ..opts(d.path(), "", 4) }).expect("plan");
-        let cov = crate::launcher::status::training_coverage(&plan).unwrap_or_default();
-        let n = c.campaign.train_count;
-        assert!(cov.starts_with(&format!("training design: 0 of the first {n} poses as drawn solved; 1 of its {n} slots")), "{cov}");
-        assert!(cov.contains(&format!("{} -> {by} (solved)", r.pose)), "{cov}");
-        let classes = crate::launcher::status::attempts_by_class(&plan);
-        assert!(classes.contains("solved runs by the attempt that solved them: attempt 1: 1"), "{classes}");
+        // the status's counts of the same runs: launcher::status's tests
     }
 
     #[test]

@@ -245,3 +245,31 @@ fn ended_task(out_dir: &Path, task: &str, pose: &str) -> (String, String) {
     }
     ("ended".into(), format!("no result and no stated cause: see {}", path.display()))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::campaign::tests::{opts, set_dir, Fake};
+    use crate::campaign::{plan, run_with, RunOptions};
+    use crate::spec;
+
+    /// Issue 42, item 3: `needle fe status` counts the design's slots (a replacement that
+    /// solved fills the slot of the pose it replaces) and the failed attempts by class.
+    #[test]
+    fn the_status_counts_the_slots_and_the_attempts_by_class() {
+        let d = set_dir();
+        let (c, _) = spec::load(d.path()).expect("spec");
+        let r = c.campaign.train_replaced.first().expect("the default set replaces a training pose").clone();
+        let by = c.replacement_of(&r.pose).expect("its replacement");
+        let mut fake = Fake { fail_reached: Some(r.pose.clone()), ..Fake::default() };
+        run_with(&opts(d.path(), &r.pose, 4), &mut fake).expect("run");
+        run_with(&opts(d.path(), &by, 4), &mut Fake::default()).expect("run");
+        let plan = plan(&RunOptions { only: Some("train-*".into()), ..opts(d.path(), "", 4) }).expect("plan");
+        let cov = training_coverage(&plan).unwrap_or_default();
+        let n = c.campaign.train_count;
+        assert!(cov.starts_with(&format!("training design: 0 of the first {n} poses as drawn solved; 1 of its {n} slots")), "{cov}");
+        assert!(cov.contains(&format!("{} -> {by} (solved)", r.pose)), "{cov}");
+        let classes = attempts_by_class(&plan);
+        assert!(classes.contains("solved runs by the attempt that solved them: attempt 1: 1"), "{classes}");
+    }
+}
