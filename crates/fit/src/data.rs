@@ -322,12 +322,16 @@ pub fn load_validation_runs(set_dir: &Path) -> Result<(Campaign, Vec<Run>, Vec<U
 }
 
 /// The training runs of a set (role train, in spec order: `train-01`, ...) and those that
-/// cannot be used (missing or stale).
+/// cannot be used (missing or stale); a training pose replaced in the design
+/// (`campaign.train_replaced`) is in neither, as in the fit.
 ///
 /// # Errors
 /// As [`load_validation_runs`].
 pub fn load_training_runs(set_dir: &Path) -> Result<(Campaign, Vec<Run>, Vec<Unusable>)> {
-    load_runs_where(set_dir, |r| r == Role::Train)
+    let (campaign, mut runs, mut unusable) = load_runs_where(set_dir, |r| r == Role::Train)?;
+    runs.retain(|r| !campaign.is_replaced(&r.pose.name));
+    unusable.retain(|u| !campaign.is_replaced(&u.pose.name));
+    Ok((campaign, runs, unusable))
 }
 
 fn load_runs_where(set_dir: &Path, keep: impl Fn(Role) -> bool) -> Result<(Campaign, Vec<Run>, Vec<Unusable>)> {
