@@ -332,12 +332,34 @@ pub fn load_validation_runs(set_dir: &Path) -> Result<(Campaign, Vec<Run>, Vec<U
 }
 
 /// The training runs of a set (role train, in spec order: `train-01`, ...) and those that
-/// cannot be used (missing or stale).
+/// cannot be used (missing or stale); a training pose replaced in the design
+/// (`campaign.train_replaced`) is in neither, as in the fit.
 ///
 /// # Errors
 /// As [`load_validation_runs`].
 pub fn load_training_runs(set_dir: &Path) -> Result<(Campaign, Vec<Run>, Vec<Unusable>)> {
-    load_runs_where(set_dir, |r| r == Role::Train)
+    let (campaign, mut runs, mut unusable) = load_runs_where(set_dir, |r| r == Role::Train)?;
+    runs.retain(|r| !campaign.is_replaced(&r.pose.name));
+    unusable.retain(|u| !campaign.is_replaced(&u.pose.name));
+    Ok((campaign, runs, unusable))
+}
+
+/// Why a pose has no result when the campaign kept a record of it (issue 42, item 4:
+/// `<set>/fe/<pose>.partial.toml`, written when every attempt failed): the depth reached
+/// and its attempts by class; `None` without a record of the current spec.
+fn failed_record(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Option<String> {
+    use needle_fe::febio::failures;
+    let (_, path) = needle_fe::partial::paths(&set_dir.join("fe"), &pose.name);
+    let r: needle_fe::partial::PartialRecord = toml::from_str(&std::fs::read_to_string(path).ok()?).ok()?;
+    if r.spec_hash != campaign.run_hash(pose, &campaign.campaign.mesh) {
+        return None;
+    }
+    Some(format!(
+        "no result; its furthest failed attempt reached {} of {} mm; {}",
+        r.reached_depth_mm,
+        r.depth_mm,
+        failures::summary(&failures::failures_from_record(&r.failure))
+    ))
 }
 
 fn load_runs_where(set_dir: &Path, keep: impl Fn(Role) -> bool) -> Result<(Campaign, Vec<Run>, Vec<Unusable>)> {
@@ -350,7 +372,8 @@ fn load_runs_where(set_dir: &Path, keep: impl Fn(Role) -> bool) -> Result<(Campa
             continue;
         }
         if !run_path(set_dir, &pose).is_file() {
-            unusable.push(Unusable { pose, why: "no result file".into() });
+            let why = failed_record(set_dir, &campaign, &pose).unwrap_or_else(|| "no result file".into());
+            unusable.push(Unusable { pose, why });
         } else if let Some(why) = stale_reason(&manifest, &campaign, &pose) {
             unusable.push(Unusable { pose, why });
         } else {
@@ -358,4 +381,41 @@ fn load_runs_where(set_dir: &Path, keep: impl Fn(Role) -> bool) -> Result<(Campa
         }
     }
     Ok((campaign, runs, unusable))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 42, item 4: a validation run that cannot be solved says how far its furthest
+    /// attempt got and why, from the campaign's partial record (of the current spec only).
+    #[test]
+    fn an_unsolved_run_reports_its_partial_record() {
+        let dir = std::env::temp_dir().join(format!("needle-fit-partial-{}", std::process::id()));
+        let fe = dir.join("fe");
+        std::fs::create_dir_all(&fe).expect("temp set");
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        std::fs::copy(root.join("coeffs/default/campaign.toml"), dir.join("campaign.toml")).expect("copy the default spec");
+        let (campaign, _) = spec::load(&dir).expect("spec");
+        let pose = campaign.poses().into_iter().find(|p| p.name == "t2-b").expect("t2-b");
+        let failure = "febio4 exit code 1 after 6 of 20 steps (t = 1.95 mm): Max nr of reformations reached. (failed to converge at time : 1.95); retry 1 (first increment 1): febio4 exit code 1 after 0 of 20 steps (t = 0.2 mm): 9 negative jacobians detected. (failed to converge at time : 0.21)";
+        let failed = needle_fe::partial::Failed {
+            campaign: &campaign,
+            pose: &pose,
+            mesh: &campaign.campaign.mesh,
+            engine: ("febio", "4.11.0"),
+            failure,
+        };
+        let reached: Vec<[f64; 6]> = (1..=6).map(|k| [0.0, 0.001 * f64::from(k), 0.0, 0.0, 0.0, 0.0]).collect();
+        needle_fe::partial::write(&fe, &failed, &reached).expect("partial record");
+        let (_, _, unusable) = load_validation_runs(&dir).expect("load");
+        let why = |name: &str| unusable.iter().find(|u| u.pose.name == name).map(|u| u.why.clone()).unwrap_or_default();
+        let t2b = why("t2-b");
+        let _ = std::fs::remove_dir_all(&dir);
+        assert_eq!(
+            t2b,
+            "no result; its furthest failed attempt reached 1.8 of 6 mm; 2 failed attempt(s), furthest 1.95 mm: max reformations x1 (1.95 mm); negative jacobian x1 (0.21 mm)"
+        );
+        assert_eq!(why("lhs-04"), "no result file", "no record: as before");
+    }
 }
