@@ -106,26 +106,8 @@ fn smoke_campaign_skips_and_resumes_after_a_kill() {
     // 3. a second pose, killed (SIGTERM to needle alone, as `kill PID` does) once ccx
     //    has finished its first of three steps: needle must stop its ccx itself
     let work = fe.join(".work").join("x+04");
-    let mut child = Command::new(NEEDLE)
-        .args(run_args(&set, "x+04", "3"))
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .process_group(0)
-        .spawn()
-        .expect("spawn needle");
+    let mut child = needle_after_first_step(&set, "x+04", "3");
     let pgid = child.id();
-    let start = Instant::now();
-    loop {
-        if let Some(status) = child.try_wait().expect("wait") {
-            panic!("the x+04 run ended ({status}) before it could be interrupted after step 1");
-        }
-        if ccx::steps_done(&work, "pose") >= 1 {
-            break;
-        }
-        assert!(start.elapsed() < Duration::from_secs(300), "x+04: no step done after 300 s");
-        std::thread::sleep(Duration::from_millis(20));
-    }
     // SIGTERM, not SIGINT (Ctrl-C): a shell without job control starts background
     // commands with SIGINT ignored, and needle and ccx inherit that, so a SIGINT would
     // not stop them when the tests run from such a script (seen: the run then finished).
@@ -135,7 +117,7 @@ fn smoke_campaign_skips_and_resumes_after_a_kill() {
     assert_eq!(status.code(), Some(i32::from(ccx::EXIT_INTERRUPTED)), "interrupted run: {status}");
     // wait until ccx (same process group) is gone too
     let gone = Instant::now();
-    while Command::new("kill").args(["-0", "--", &format!("-{pgid}")]).stderr(Stdio::null()).status().expect("kill -0").success() {
+    while group_alive(pgid) {
         assert!(gone.elapsed() < Duration::from_secs(5), "ccx still running 5 s after needle's SIGTERM (an orphan)");
         std::thread::sleep(Duration::from_millis(50));
     }
@@ -221,36 +203,48 @@ fn a_timed_out_job_is_reported_and_kept_for_debugging() {
     assert!(!read_manifest(&fe.join(MANIFEST)).expect("manifest").pose.contains_key("centre"));
 }
 
-/// Issue 38: after SIGKILL of `needle fe run` (no handler can see it) its solver kept
-/// running as an orphan. The solver now runs with a parent-death signal: killed with
-/// needle, within seconds; a rerun then solves the pose.
-#[test]
-fn a_sigkill_of_needle_takes_its_solver_with_it() {
-    require_ccx();
-    let (_tmp, set) = default_set();
-    let work = set.join("fe").join(".work").join("x+04");
+/// `needle fe run` of `pose` with `steps` load steps on ccx, in its own process group
+/// (its id is the child's), returned once ccx has finished the first step.
+fn needle_after_first_step(set: &Path, pose: &str, steps: &str) -> std::process::Child {
+    let work = set.join("fe").join(".work").join(pose);
     let mut child = Command::new(NEEDLE)
-        .args(run_args(&set, "x+04", "3"))
+        .args(run_args(set, pose, steps))
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .process_group(0)
         .spawn()
         .expect("spawn needle");
-    let pgid = child.id();
     let start = Instant::now();
     while ccx::steps_done(&work, "pose") < 1 {
         if let Some(status) = child.try_wait().expect("wait") {
-            panic!("the x+04 run ended ({status}) before it could be killed after step 1");
+            panic!("the {pose} run ended ({status}) before it could be stopped after step 1");
         }
-        assert!(start.elapsed() < Duration::from_secs(300), "x+04: no step done after 300 s");
+        assert!(start.elapsed() < Duration::from_secs(300), "{pose}: no step done after 300 s");
         std::thread::sleep(Duration::from_millis(20));
     }
+    child
+}
+
+/// Whether any process of group `pgid` is still running.
+fn group_alive(pgid: u32) -> bool {
+    Command::new("kill").args(["-0", "--", &format!("-{pgid}")]).stderr(Stdio::null()).status().expect("kill -0").success()
+}
+
+/// Issue 38: after SIGKILL of `needle fe run` (no handler can see it) its solver kept
+/// running as an orphan. The solver now runs with a parent-death signal: it is killed
+/// with needle, within seconds.
+#[test]
+fn a_sigkill_of_needle_takes_its_solver_with_it() {
+    require_ccx();
+    let (_tmp, set) = default_set();
+    let work = set.join("fe").join(".work").join("x+04");
+    let mut child = needle_after_first_step(&set, "x+04", "3");
+    let pgid = child.id();
     child.kill().expect("SIGKILL needle alone");
     child.wait().expect("wait");
     let gone = Instant::now();
-    let alive = || Command::new("kill").args(["-0", "--", &format!("-{pgid}")]).stderr(Stdio::null()).status().expect("kill -0").success();
-    while alive() {
+    while group_alive(pgid) {
         if gone.elapsed() > Duration::from_secs(5) {
             let _ = Command::new("kill").args(["-KILL", "--", &format!("-{pgid}")]).status();
             panic!("ccx still running 5 s after needle's SIGKILL (an orphan)");
