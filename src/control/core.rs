@@ -122,8 +122,9 @@ impl<const N: usize> LoopCore<N> {
     ///
     /// With an insertion, each tick with a valid pose steps it once
     /// ([`Insertion::step`], or [`Insertion::step_with_stiffness`] with the passivity
-    /// guard on: the guard's stiffness is then the deflected boundary's `|dF/dδ|`, 0
-    /// in the track, where friction and cutting only dissipate). A stale or missing pose
+    /// guard on: the guard then limits the elastic part of the force, of the deflected
+    /// boundary's stiffness `|dF/dδ|`, and passes friction and cutting as they are:
+    /// [`Passivity`]'s module). A stale or missing pose
     /// does not step it (its velocity filter then sees the whole motion since the last
     /// valid pose in one tick, smoothed by its time constant). A tick that punctures a
     /// boundary clears the guard's offset: the force drops to what the track renders and
@@ -193,20 +194,11 @@ impl<const N: usize> LoopCore<N> {
                     let f = [wrench.fx_n, wrench.fy_n, wrench.fz_n];
                     let f = match stiffness {
                         Some((p, terms)) => {
-                            // the guard limits the elastic part; friction and cutting
-                            // pass (none for the block surrogate: its bits unchanged)
-                            let d = terms.dissipative_n;
-                            let dissipates = d != [0.0; 3];
-                            let elastic = if dissipates { [f[0] - d[0], f[1] - d[1], f[2] - d[2]] } else { f };
-                            let (guarded, limited) = self.guard.apply(&p, elastic, terms.stiffness_n_per_mm);
+                            let (guarded, limited) = self.guard.apply(&p, f, &terms);
                             if limited {
                                 s.flags |= LoopFlags::STIFFNESS_LIMITED;
                             }
-                            if dissipates {
-                                [guarded[0] + d[0], guarded[1] + d[1], guarded[2] + d[2]]
-                            } else {
-                                guarded
-                            }
+                            guarded
                         }
                         None => f,
                     };

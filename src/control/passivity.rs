@@ -23,7 +23,13 @@
 //! - when `K <= K_g` the offset is kept (the command follows the model's changes one to
 //!   one); it is cleared when the model force is exactly zero and after any fault (the
 //!   first valid tick then follows the model again).
+//! - a whole insertion ([`GuardTerms`]) names the dissipative part `D` of its force
+//!   (shaft friction and cutting): the rule above applies to the elastic part `F - D`
+//!   (with the deflected boundary's stiffness as `K`) and `D` is added back unchanged.
+//!   Scaled into the offset, a friction reversal would keep pushing the needle out
+//!   after a withdrawal starts. The block surrogate has no `D`: its force is guarded whole.
 use super::ConfigError;
+use crate::insertion::GuardTerms;
 
 /// The fraction of Colgate's bound `2 b / T` the guard renders at most.
 pub const GUARD_FRACTION: f32 = 0.5;
@@ -80,9 +86,21 @@ impl Guard {
         *self = Self::default();
     }
 
-    /// The guarded force for the model force `f_n` of stiffness `k_n_per_mm` (the module's
-    /// rule), and whether the stiffness was limited.
-    pub(crate) fn apply(&mut self, p: &Passivity, f_n: [f32; 3], k_n_per_mm: f32) -> ([f32; 3], bool) {
+    /// The guarded force for the model force `f_n` with its stiffness and dissipative
+    /// part `terms` (the module's rule), and whether the stiffness was limited.
+    pub(crate) fn apply(&mut self, p: &Passivity, f_n: [f32; 3], terms: &GuardTerms) -> ([f32; 3], bool) {
+        let d = terms.dissipative_n;
+        // no dissipative part (the block surrogate): the whole force, bits unchanged
+        if d == [0.0; 3] {
+            return self.apply_elastic(p, f_n, terms.stiffness_n_per_mm);
+        }
+        let elastic = [f_n[0] - d[0], f_n[1] - d[1], f_n[2] - d[2]];
+        let (g, limited) = self.apply_elastic(p, elastic, terms.stiffness_n_per_mm);
+        ([g[0] + d[0], g[1] + d[1], g[2] + d[2]], limited)
+    }
+
+    /// The rule on an elastic force `f_n` of stiffness `k_n_per_mm`.
+    fn apply_elastic(&mut self, p: &Passivity, f_n: [f32; 3], k_n_per_mm: f32) -> ([f32; 3], bool) {
         let k_g = p.guard_stiffness_n_per_mm();
         // `k > k_g > 0` (validated), so the division is by a positive, finite number.
         let limited = k_n_per_mm > k_g;
