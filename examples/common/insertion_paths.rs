@@ -77,6 +77,35 @@ pub fn for_each_tick(path: &[Waypoint], mut f: impl FnMut(u32, [f32; 5])) {
     }
 }
 
+/// A waypoint's pose in Q16.16 (mm and degrees times 65536, rounded to nearest): the
+/// fixed-point insertion's input.
+pub fn q16(pose: [f32; 5]) -> [i32; 5] {
+    pose.map(|v| (v * 65536.0 + if v < 0.0 { -0.5 } else { 0.5 }) as i32)
+}
+
+/// Every tick's Q16.16 pose of `path`, in order, passed to `f(tick, pose)`: the
+/// waypoints in Q16.16 ([`q16`]), and between two of them, at tick k of n,
+/// `a + (b - a) k / n` in integers (`i64`, the quotient rounded toward zero).
+pub fn for_each_tick_q16(path: &[Waypoint], mut f: impl FnMut(u32, [i32; 5])) {
+    let Some(&(_, start)) = path.first() else { return };
+    let mut tick = 0u32;
+    let start = q16(start);
+    f(tick, start);
+    let mut from = start;
+    for &(n, to) in path.iter().skip(1) {
+        let to = q16(to);
+        for k in 1..=n {
+            tick += 1;
+            let mut p = [0i32; 5];
+            for ((q, a), b) in p.iter_mut().zip(from).zip(to) {
+                *q = a + ((i64::from(b) - i64::from(a)) * i64::from(k) / i64::from(n)) as i32;
+            }
+            f(tick, p);
+        }
+        from = to;
+    }
+}
+
 /// FNV-1a over 32-bit words: the digest of a path's outputs (each tick's six wrench
 /// bits, status, phase code and punctures).
 #[derive(Clone, Copy)]
@@ -91,6 +120,17 @@ impl Digest {
     pub fn tick(&mut self, wrench: [f32; 6], status: u8, phase: u16, punctures: u8) {
         for c in wrench {
             self.word(c.to_bits());
+        }
+        self.word(u32::from(status));
+        self.word(u32::from(phase));
+        self.word(u32::from(punctures));
+    }
+
+    /// Adds one fixed-point tick: the six wrench integers (µN, µN·mm), the status, the
+    /// phase code and the punctures.
+    pub fn tick_fixed(&mut self, wrench: [i32; 6], status: u8, phase: u16, punctures: u8) {
+        for c in wrench {
+            self.word(c as u32);
         }
         self.word(u32::from(status));
         self.word(u32::from(phase));
