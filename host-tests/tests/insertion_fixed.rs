@@ -122,12 +122,17 @@ fn bad_configurations_and_scales_are_refused() {
     let zero = fx::InsertionConfig { period_us: 0, velocity_time_constant_us: 0 };
     assert_eq!(fx::Insertion::new(stack, zero).err(), Some(InsertionError::Config));
     let empty = fx::Stack { count: 0, ..*stack };
-    assert_eq!(fx::Insertion::new(&empty, fx::InsertionConfig::DEFAULT_1KHZ).err(), Some(InsertionError::LayerCount));
+    let empty = &empty;
+    assert_eq!(fx::Insertion::new(empty, fx::InsertionConfig::DEFAULT_1KHZ).err(), Some(InsertionError::LayerCount));
     let mut ins = fx::Insertion::new(stack, fx::InsertionConfig::DEFAULT_1KHZ).expect("stack");
-    assert_eq!(ins.set_scales(&[1 << 16]).err().filter(|_| stack.count != 1), if stack.count != 1 { Some(InsertionError::Scales) } else { None });
+    assert_eq!(
+        ins.set_scales(&[1 << 16]).err().filter(|_| stack.count != 1),
+        if stack.count != 1 { Some(InsertionError::Scales) } else { None }
+    );
     let zeros = vec![0; stack.count];
     assert_eq!(ins.set_scales(&zeros).err(), Some(InsertionError::Scales));
     let ones = vec![1 << 16; stack.count];
     assert_eq!(ins.set_scales(&ones), Ok(()));
-    assert!(ins.stack().layers().iter().all(|l| l.stiffness_scale_q16 == 1 << 16));
+    assert!(ins.scales_q16().iter().all(|&s| s == 1 << 16));
+    assert_eq!(ins.scales_q16().len(), stack.count);
 }

@@ -2,9 +2,11 @@
 //! module (`src/insertion/track.rs`), with positions and path coordinates in mm Q16.16,
 //! directions in Q30, forces in µN Q16 and moments in µN·mm Q16, all in `i64`.
 //!
-//! Every product is `floor(a b / 2^k)` (an arithmetic shift); the products whose size
-//! depends on the stack's values or on the pose saturate instead of wrapping, so an
-//! absurd input gives a saturated wrench, never a wrapped one.
+//! Every product is `floor(a b / 2^k)` (an arithmetic shift). Products of two pose
+//! quantities are plain `i64` arithmetic, bounded by the insertion's input clamps
+//! ([`Deviation::add_hold`] argues it); products with a value of the stack (stiffness,
+//! friction level) saturate, so an absurd stack gives a saturated wrench, never a
+//! wrapped one.
 
 /// A vector of the block frame (mm in Q16 for points, Q30 for directions).
 pub(super) type Vec3 = [i64; 3];
@@ -23,8 +25,14 @@ pub(super) fn mul_shr(a: i64, b: i64, s: u32) -> i64 {
 #[inline(always)]
 pub(super) fn mul_q30(x: i64, a: i64) -> i64 {
     let (hi, lo) = (x >> 16, x & 0xffff);
-    mul_shr(hi, a, 14).saturating_add((lo * a) >> 30)
+    // |hi a| < 2^31 2^30, |lo a| < 2^16 2^30: wrapping never happens for |x| < 2^47;
+    // beyond, the result wraps (callers bound x: the module's note)
+    (hi.wrapping_mul(a) >> 14).wrapping_add(lo.wrapping_mul(a) >> 30)
 }
+
+/// `round(2^30 / 3)`: [`mul_q30`] by it divides by 3 (within 1), without the `i64`
+/// division a Cortex-M0 calls a library routine for.
+const THIRD_Q30: i64 = 357_913_941;
 
 /// `π / 180` in Q30 (radians per degree).
 const RAD_PER_DEG_Q30: i64 = 18_740_330; // round(2^30 π / 180), checked by `the_constants_are_their_definitions`
@@ -84,9 +92,9 @@ pub(super) struct Track {
 pub(super) struct Deviation {
     /// `perp(E - E0)`, mm Q16.
     d: Vec3,
-    /// `perp(a)`, Q24.
+    /// `perp(a)`, Q30.
     g: Vec3,
-    /// The axis, Q16.
+    /// The axis, Q30.
     a: Vec3,
     /// The hub's path coordinate, mm Q16.
     hub_q16: i64,
@@ -105,8 +113,7 @@ impl Track {
     pub(super) fn deviation(&self, entry_q16: Vec3, a_q30: Vec3, hub_q16: i64) -> Deviation {
         let e0 = self.entry_q16;
         let rel = [entry_q16[0] - e0[0], entry_q16[1] - e0[1], entry_q16[2] - e0[2]];
-        let g = self.perp(a_q30).map(|c| c >> 6);
-        Deviation { d: self.perp(rel), g, a: a_q30.map(|c| c >> 14), hub_q16 }
+        Deviation { d: self.perp(rel), g: self.perp(a_q30), a: a_q30, hub_q16 }
     }
 }
 
@@ -115,32 +122,54 @@ impl Deviation {
     /// `k_q8` (µN/mm per mm, Q8), added to `w` (µN and µN·mm, Q16): `F = -k (D Q1 - G Q2)`,
     /// `M = a × k (D (Q2 - qh Q1) - G (Q3 - qh Q2))` (the f32 `track` module).
     pub(super) fn add_hold(&self, k_q8: i64, q1: i64, q2: i64, w: &mut [i64; 6]) {
-        let (s1, s2) = (mul_shr(q1, q1, 16), mul_shr(q2, q2, 16));
+        // Bounds (mm Q16; the insertion clamps depth to ±128 mm, x and z to ±64 mm, the
+        // hub is at most 8 x 60 mm above the tip): 0 <= q1 < q2 <= 2^23, |qh| < 2^26,
+        // |D| < 2^24, |G| <= 2^30; so s1, s2 <= 2^30, Q1 <= 2^23, Q2 <= 2^29,
+        // |Q3| <= 2^37, |f| <= 2^33, |cd| <= 2^34, |cg| <= 2^40, |lever| <= 2^43 and
+        // every product below stays under 2^59: plain `i64` arithmetic cannot wrap.
+        // The products with the stack's stiffness: `mul_stiffness`.
+        let (s1, s2) = ((q1 * q1) >> 16, (q2 * q2) >> 16);
         let big_q1 = q2 - q1;
         let big_q2 = (s2 - s1) >> 1;
-        let big_q3 = (mul_shr(s2, q2, 16) - mul_shr(s1, q1, 16)) / 3;
+        let big_q3 = mul_q30(((s2 * q2) >> 16) - ((s1 * q1) >> 16), THIRD_Q30);
         let qh = self.hub_q16;
         let (d, g) = (self.d, self.g);
         // D Q1 - G Q2 (mm^2, Q16)
-        let f = [0, 1, 2].map(|i| mul_shr(at(d, i), big_q1, 16) - mul_shr(at(g, i), big_q2, 24));
-        let cd = big_q2 - mul_shr(qh, big_q1, 16);
-        let cg = big_q3 - mul_shr(qh, big_q2, 16);
+        let f = [0, 1, 2].map(|i| ((at(d, i) * big_q1) >> 16) - mul_q30(big_q2, at(g, i)));
+        let cd = big_q2 - ((qh * big_q1) >> 16);
+        let cg = big_q3 - ((qh * big_q2) >> 16);
         // D cd - G cg (mm^3, Q16)
-        let lever = [0, 1, 2].map(|i| mul_shr(at(d, i), cd, 16) - mul_shr(at(g, i), cg, 24));
+        let lever = [0, 1, 2].map(|i| ((at(d, i) * cd) >> 16) - mul_q30(cg, at(g, i)));
         let a = self.a;
         let m = [
-            mul_shr(a[1], lever[2], 16) - mul_shr(a[2], lever[1], 16),
-            mul_shr(a[2], lever[0], 16) - mul_shr(a[0], lever[2], 16),
-            mul_shr(a[0], lever[1], 16) - mul_shr(a[1], lever[0], 16),
+            mul_q30(lever[2], a[1]) - mul_q30(lever[1], a[2]),
+            mul_q30(lever[0], a[2]) - mul_q30(lever[2], a[0]),
+            mul_q30(lever[1], a[0]) - mul_q30(lever[0], a[1]),
         ];
         let [w0, w1, w2, w3, w4, w5] = w;
-        *w0 = w0.saturating_sub(mul_shr(k_q8, f[0], 8));
-        *w1 = w1.saturating_sub(mul_shr(k_q8, f[1], 8));
-        *w2 = w2.saturating_sub(mul_shr(k_q8, f[2], 8));
-        *w3 = w3.saturating_add(mul_shr(k_q8, m[0], 8));
-        *w4 = w4.saturating_add(mul_shr(k_q8, m[1], 8));
-        *w5 = w5.saturating_add(mul_shr(k_q8, m[2], 8));
+        *w0 = w0.saturating_sub(mul_stiffness(k_q8, f[0]));
+        *w1 = w1.saturating_sub(mul_stiffness(k_q8, f[1]));
+        *w2 = w2.saturating_sub(mul_stiffness(k_q8, f[2]));
+        *w3 = w3.saturating_add(mul_stiffness(k_q8, m[0]));
+        *w4 = w4.saturating_add(mul_stiffness(k_q8, m[1]));
+        *w5 = w5.saturating_add(mul_stiffness(k_q8, m[2]));
     }
+}
+
+/// Largest track stiffness, µN/mm per mm in Q8 (8.4 N/mm per mm): `Insertion::new`
+/// refuses a stack above it, so [`mul_stiffness`] cannot wrap.
+pub(super) const TRACK_STIFFNESS_MAX_Q8: i64 = 1 << 31;
+
+/// `floor(k x / 2^8)` for `0 <= k <= 2^31` ([`TRACK_STIFFNESS_MAX_Q8`]) and `x` clamped
+/// to ±2^36 (a force of 2^20 mm² or a moment of 2^20 mm³ of deviation times length, far
+/// beyond a tissue's): with `x = hi 2^16 + lo`, `hi k 2^8 + floor(lo k / 2^8)`, every
+/// product below 2^59 (two plain multiplications; a Cortex-M0 computes a saturating
+/// one in a library routine several times slower).
+#[inline(always)]
+fn mul_stiffness(k: i64, x: i64) -> i64 {
+    let x = x.clamp(-(1 << 36), 1 << 36);
+    let (hi, lo) = (x >> 16, x & 0xffff);
+    ((hi * k) << 8) + ((lo * k) >> 8)
 }
 
 #[cfg(test)]

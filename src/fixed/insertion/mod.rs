@@ -12,7 +12,7 @@
 //! - Internally `i64`: path coordinates in mm Q16, the axis in Q30 ([`geometry`]), forces
 //!   in µN Q16; the output rounds to whole µN and saturates to `i32`.
 //!
-//! **Inputs clamped**: `x`, `z` to ±64 mm, `depth` to ±256 mm, tilts to ±89 degrees (the
+//! **Inputs clamped**: `x`, `z` to ±64 mm, `depth` to ±128 mm, tilts to ±89 degrees (the
 //! f32 model's); the surrogate clamps further to its own domain and reports it.
 //!
 //! **Overflow.** Every product whose size depends on the stack's values or on the pose
@@ -29,13 +29,16 @@
 mod geometry;
 mod stack;
 
-pub use stack::{stacks, Karnopp, Layer, Stack, MAX_LAYERS, SIMILARITY_MAX, STIFFNESS_SCALE_MAX, TOTAL_THICKNESS_MAX_MM};
+pub use stack::{
+    stacks, Karnopp, Layer, Stack, CUTTING_MAX_Q16, FRICTION_LEVEL_MAX_Q16, MAX_LAYERS, SIMILARITY_MAX, STICK_BAND_MAX_Q16,
+    STIFFNESS_SCALE_MAX, TOTAL_THICKNESS_MAX_MM, VISCOUS_MAX_Q16,
+};
 
 use super::depth_extension::saturate_i32;
 use super::{extended_wrench, Pose, Wrench};
 use crate::insertion::{InsertionError, Phase};
 use crate::Status;
-use geometry::{axis, dot, mul_q30, mul_shr, Track, Vec3};
+use geometry::{axis, dot, mul_q30, mul_shr, Track, Vec3, TRACK_STIFFNESS_MAX_Q8};
 
 /// The insertion's tick settings in integers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -72,8 +75,10 @@ pub struct InsertionEvaluation {
 /// The state of one needle path through a stack, in integers: fixed size, no allocation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Insertion {
-    stack: Stack,
+pub struct Insertion<'a> {
+    stack: &'a Stack,
+    /// Per layer the stiffness scale in use, Q16 (the stack's, or [`Insertion::set_scales`]').
+    scales_q16: [i32; MAX_LAYERS],
     /// Per layer `[s λ², s λ³]`, Q16.
     gains_q16: [[i64; 2]; MAX_LAYERS],
     rate_q16: i64,
@@ -94,7 +99,7 @@ struct Deflected {
 }
 
 const X_MAX_Q16: i64 = 64 << 16;
-const DEPTH_MAX_Q16: i64 = 256 << 16;
+const DEPTH_MAX_Q16: i64 = 128 << 16;
 
 fn layer_ok(l: &Layer) -> bool {
     let k = &l.friction;
@@ -102,30 +107,42 @@ fn layer_ok(l: &Layer) -> bool {
         && l.stiffness_scale_q16 > 0
         && l.puncture_force_q16 > 0
         && k.stick_band_q16 > 0
+        && k.in_range()
         && [l.cutting_force_q16, k.static_per_speed_q16, k.coulomb_q16, k.viscous_q16, l.track_stiffness_q8].iter().all(|&v| v >= 0)
+        && l.track_stiffness_q8 <= TRACK_STIFFNESS_MAX_Q8
+        && l.cutting_force_q16 <= CUTTING_MAX_Q16
+        && (l.cutting_per_speed_q16.saturating_mul(k.stick_band_q16) >> 16) <= CUTTING_MAX_Q16
 }
 
-impl Insertion {
+impl<'a> Insertion<'a> {
     /// A path through `stack`, the needle above the surface.
     ///
     /// # Errors
     /// [`InsertionError::LayerCount`] (also for a stack [`Stack::from_f32`] refused),
     /// [`InsertionError::Value`] (a value out of the tissue file's ranges after
-    /// rounding, e.g. a thickness below 2^-17 mm), [`InsertionError::Config`] (a zero
-    /// period).
-    pub fn new(stack: &Stack, config: InsertionConfig) -> Result<Self, InsertionError> {
+    /// rounding, e.g. a thickness below 2^-17 mm, or beyond the integer ranges: a
+    /// stiffness scale above [`STIFFNESS_SCALE_MAX`], a track stiffness above 8.4 N/mm
+    /// per mm), [`InsertionError::Config`] (a zero period).
+    pub fn new(stack: &'a Stack, config: InsertionConfig) -> Result<Self, InsertionError> {
         if stack.count == 0 || stack.count > MAX_LAYERS {
             return Err(InsertionError::LayerCount);
         }
-        if !stack.layers().iter().all(layer_ok) || stack.inv_similarity_q30 <= 0 {
+        let max_scale = (STIFFNESS_SCALE_MAX as i64) << 16;
+        if !stack.layers().iter().all(|l| layer_ok(l) && l.stiffness_scale_q16 <= max_scale) || stack.inv_similarity_q30 <= 0 {
             return Err(InsertionError::Value);
+        }
+        let mut scales_q16 = [0; MAX_LAYERS];
+        for (s, l) in scales_q16.iter_mut().zip(stack.layers()) {
+            // <= 2^30 (checked above)
+            *s = l.stiffness_scale_q16 as i32;
         }
         let period = u64::from(config.period_us);
         let rate_q16 = (1_000_000_u64 << 16).checked_div(period).ok_or(InsertionError::Config)?;
         let whole = period + u64::from(config.velocity_time_constant_us);
         let alpha_q16 = ((period << 16) + (whole >> 1)).checked_div(whole).ok_or(InsertionError::Config)?;
         let mut insertion = Self {
-            stack: *stack,
+            stack,
+            scales_q16,
             gains_q16: [[0; 2]; MAX_LAYERS],
             rate_q16: i64::try_from(rate_q16).map_err(|_| InsertionError::Config)?,
             alpha_q16: i64::try_from(alpha_q16).map_err(|_| InsertionError::Config)?,
@@ -142,8 +159,8 @@ impl Insertion {
 
     fn update_gains(&mut self) {
         let [l2, l3] = self.stack.similarity_pow_q16;
-        for (g, l) in self.gains_q16.iter_mut().zip(self.stack.layers()) {
-            *g = [mul_shr(l.stiffness_scale_q16, l2, 16), mul_shr(l.stiffness_scale_q16, l3, 16)];
+        for (g, &s) in self.gains_q16.iter_mut().zip(&self.scales_q16) {
+            *g = [mul_shr(i64::from(s), l2, 16), mul_shr(i64::from(s), l3, 16)];
         }
     }
 
@@ -158,17 +175,23 @@ impl Insertion {
         if scales_q16.len() != self.stack.count || !scales_q16.iter().all(|&s| s > 0 && i64::from(s) <= max) {
             return Err(InsertionError::Scales);
         }
-        for (l, &s) in self.stack.layers.iter_mut().zip(scales_q16) {
-            l.stiffness_scale_q16 = i64::from(s);
+        for (slot, &s) in self.scales_q16.iter_mut().zip(scales_q16) {
+            *slot = s;
         }
         self.update_gains();
         Ok(())
     }
 
-    /// The stack in use (with any scales set).
+    /// The stack (its own scales; those in use are [`Insertion::scales_q16`]).
     #[must_use]
-    pub fn stack(&self) -> &Stack {
-        &self.stack
+    pub fn stack(&self) -> &'a Stack {
+        self.stack
+    }
+
+    /// The stiffness scales in use, one per layer, Q16.
+    #[must_use]
+    pub fn scales_q16(&self) -> &[i32] {
+        self.scales_q16.get(..self.stack.count).unwrap_or(&[])
     }
 
     /// Forgets the path: the needle is above the surface again (no track, no velocity).
@@ -305,7 +328,7 @@ impl Insertion {
             if q2 <= q1 {
                 continue;
             }
-            axial_q16 = axial_q16.saturating_add(mul_shr(q2 - q1, layer.friction.per_mm_q16(v), 16));
+            axial_q16 += ((q2 - q1) * layer.friction.per_mm_q16(v)) >> 16;
             if let Some(d) = &deviation {
                 d.add_hold(layer.track_stiffness_q8, q1, q2, w);
             }
@@ -315,7 +338,8 @@ impl Insertion {
         } else if depth >= self.track_end_q16 && v > 0 {
             let cutting = self.stack.layers.get(m - 1).map_or(0, |l| {
                 if v < l.friction.stick_band_q16 {
-                    mul_shr(l.cutting_per_speed_q16, v, 16)
+                    // v < band: below `cutting_per_speed * band <= 2^44 2^16` (`layer_ok`)
+                    (l.cutting_per_speed_q16 * v) >> 16
                 } else {
                     l.cutting_force_q16
                 }

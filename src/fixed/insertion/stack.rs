@@ -38,16 +38,24 @@ pub struct Karnopp {
 impl Karnopp {
     /// Friction per mm of shaft at axial speed `v_q16` (mm/s, Q16), µN/mm in Q16: of the
     /// speed's sign, `static * |v| / band` inside the band, `coulomb + viscous |v|` above
-    /// (products `floor(a b / 2^16)`, saturating).
+    /// (products `floor(a b / 2^16)`; the viscous term's speed saturates at 1,024 mm/s,
+    /// the level at 4.2 N/mm).
     #[inline]
     #[must_use]
     pub fn per_mm_q16(&self, v_q16: i64) -> i64 {
-        let speed = v_q16.saturating_abs();
-        let level = if speed < self.stick_band_q16 {
-            self.static_per_speed_q16.saturating_mul(speed) >> 16
+        // Bounds ([`Karnopp::in_range`], checked by `Insertion::new`): inside the band
+        // `static_per_speed * speed < static_per_speed * band <= 2^38 2^16`; above it the
+        // viscous term's speed is clamped to 2^26 and the term to 2^36: 2^62. The level
+        // is clamped to 2^38 (4.2 N per mm of shaft), so times a length below 2^23
+        // (128 mm) the friction force stays below 2^61.
+        let speed = v_q16.unsigned_abs();
+        let level = if speed < self.stick_band_q16.unsigned_abs() {
+            (self.static_per_speed_q16 * speed as i64) >> 16
         } else {
-            self.coulomb_q16.saturating_add(self.viscous_q16.saturating_mul(speed) >> 16)
+            let viscous_speed = speed.min(VISCOUS_SPEED_MAX_Q16) as i64;
+            self.coulomb_q16 + ((self.viscous_q16 * viscous_speed) >> 16)
         };
+        let level = level.min(FRICTION_LEVEL_MAX_Q16);
         if v_q16 < 0 {
             -level
         } else {
@@ -92,6 +100,29 @@ pub struct Stack {
     pub similarity_pow_q16: [i64; 2],
     /// The hub's distance from the tip for this needle (`λ` times the FE needle's), mm, Q16.
     pub hub_from_tip_q16: i64,
+}
+
+/// Largest friction level (static or Coulomb), µN per mm of shaft in Q16 (2^38: 4.2 N/mm).
+pub const FRICTION_LEVEL_MAX_Q16: i64 = 1 << 38;
+/// Largest viscous term, µN/mm per mm/s in Q16 (2^36: 1.05 N/mm per mm/s).
+pub const VISCOUS_MAX_Q16: i64 = 1 << 36;
+/// Largest cutting force, µN in Q16 (2^44: 268 N).
+pub const CUTTING_MAX_Q16: i64 = 1 << 44;
+/// Largest stick band, mm/s in Q16 (2^31: 32,768 mm/s).
+pub const STICK_BAND_MAX_Q16: i64 = 1 << 31;
+/// The speed the viscous term sees is clamped here, mm/s in Q16 (2^26: 1,024 mm/s).
+const VISCOUS_SPEED_MAX_Q16: u64 = 1 << 26;
+
+impl Karnopp {
+    /// Whether the friction's integer products cannot wrap: the static level (the slope
+    /// times the band), the Coulomb level and the viscous term within their maxima.
+    pub(super) fn in_range(&self) -> bool {
+        let static_level = self.static_per_speed_q16.saturating_mul(self.stick_band_q16) >> 16;
+        self.stick_band_q16 <= STICK_BAND_MAX_Q16
+            && static_level <= FRICTION_LEVEL_MAX_Q16
+            && self.coulomb_q16 <= FRICTION_LEVEL_MAX_Q16
+            && self.viscous_q16 <= VISCOUS_MAX_Q16
+    }
 }
 
 /// Largest similarity `λ` and stiffness scale the integer ranges are argued for (the
@@ -164,7 +195,8 @@ impl Stack {
     pub const fn from_f32(s: &f32_insertion::Stack<'static>) -> Self {
         let lambda = s.needle_diameter_mm as f64 / f32_insertion::FE_NEEDLE_DIAMETER_MM as f64;
         let refused = Self { name: s.name, ..EMPTY_STACK };
-        if lambda.is_nan() || lambda > SIMILARITY_MAX || lambda * SIMILARITY_MAX < 1.0 || s.layers.is_empty() || s.layers.len() > MAX_LAYERS {
+        if lambda.is_nan() || lambda > SIMILARITY_MAX || lambda * SIMILARITY_MAX < 1.0 || s.layers.is_empty() || s.layers.len() > MAX_LAYERS
+        {
             return refused;
         }
         let mut layers = [EMPTY_LAYER; MAX_LAYERS];
@@ -207,9 +239,9 @@ pub mod stacks {
     use super::Stack;
     use crate::insertion::stacks as f32_stacks;
 
-    /// Every stack of the set, in integers.
+    /// Every stack of the set, in integers (a `static`: an insertion borrows its stack).
     #[allow(clippy::indexing_slicing)] // const evaluation only: an index out of range is a compile error
-    pub const ALL: [Stack; f32_stacks::ALL.len()] = {
+    pub static ALL: [Stack; f32_stacks::ALL.len()] = {
         let mut out = [super::EMPTY_STACK; f32_stacks::ALL.len()];
         let mut i = 0;
         while i < out.len() {
@@ -220,11 +252,5 @@ pub mod stacks {
     };
 }
 
-const EMPTY_STACK: Stack = Stack {
-    name: "",
-    layers: [EMPTY_LAYER; MAX_LAYERS],
-    count: 0,
-    inv_similarity_q30: 0,
-    similarity_pow_q16: [0, 0],
-    hub_from_tip_q16: 0,
-};
+const EMPTY_STACK: Stack =
+    Stack { name: "", layers: [EMPTY_LAYER; MAX_LAYERS], count: 0, inv_similarity_q30: 0, similarity_pow_q16: [0, 0], hub_from_tip_q16: 0 };
