@@ -211,6 +211,11 @@ impl<'a> Insertion<'a> {
     /// One tick: the pose in, the wrench out (the f32 model's
     /// [`step`](crate::insertion::Insertion::step), in integers). Call it once per
     /// period of the configuration. Never panics.
+    ///
+    /// Never inlined: one function per image, which the no-float check of
+    /// `tests/firmware_no_panic.rs` disassembles (a call costs a few instructions of
+    /// the 5,000-17,000 a step takes).
+    #[inline(never)]
     pub fn step(&mut self, pose: &Pose) -> InsertionEvaluation {
         let depth = i64::from(pose.depth_mm_q16).clamp(-DEPTH_MAX_Q16, DEPTH_MAX_Q16);
         let step_q16 = self.last_depth_q16.map_or(0, |last| depth - last);
