@@ -34,7 +34,7 @@ def needle_cli(poses: np.ndarray, stack: str, tmp_path) -> list[dict[str, str]]:
 
 
 def phase_code(text: str) -> int:
-    kinds = {"approach": 0, "deflecting": 0x100, "cutting": 0x200, "in-track": 0x300, "in_track": 0x300, "track": 0x300}
+    kinds = {"approach": 0, "deflecting": 0x100, "cutting": 0x200, "in-track": 0x300}
     kind, _, layer = text.partition(":")
     return kinds[kind] | (int(layer) if layer else 0)
 
