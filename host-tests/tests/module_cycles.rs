@@ -10,7 +10,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// The crates' source folders, from the workspace root.
-const CRATES: [&str; 12] = [
+const CRATES: [&str; 13] = [
     "src",
     "crates/contract/src",
     "crates/codegen/src",
@@ -23,6 +23,7 @@ const CRATES: [&str; 12] = [
     "crates/explore/src",
     "crates/calibrate/src",
     "crates/cli/src",
+    "crates/bindings-python/src",
 ];
 
 type Graph = BTreeMap<String, BTreeSet<String>>;
