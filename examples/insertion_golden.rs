@@ -20,7 +20,7 @@ mod common;
 
 #[cfg(target_os = "none")]
 mod firmware {
-    use crate::common::insertion_paths::{for_each_tick, Digest, PATHS};
+    use crate::common::insertion_paths::{depth_scale, for_each_tick, Digest, PATHS};
     use crate::common::{exit, Out};
     use needle_haptics::insertion::{stacks, Insertion, InsertionConfig};
     use needle_haptics::{model_info, Pose};
@@ -46,7 +46,7 @@ mod firmware {
                 };
                 let mut digest = Digest::new();
                 let (mut ticks, mut punctures) = (0u64, 0u64);
-                for_each_tick(path, |_, p| {
+                for_each_tick(path, depth_scale(stack), |_, p| {
                     let e = insertion.step(&Pose { x_mm: p[0], z_mm: p[1], theta_x_deg: p[2], theta_z_deg: p[3], depth_mm: p[4] });
                     digest.tick(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures);
                     ticks += 1;

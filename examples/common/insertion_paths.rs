@@ -57,13 +57,57 @@ pub const PATHS: [&[Waypoint]; 5] = [
     ],
 ];
 
-/// Every tick's pose of `path`, in order, passed to `f(tick, pose)`.
-pub fn for_each_tick(path: &[Waypoint], mut f: impl FnMut(u32, [f32; 5])) {
-    let Some(&(_, start)) = path.first() else { return };
+/// The deepest waypoint of [`PATHS`], mm: the stack depth they were drawn for.
+pub const PATHS_DEEPEST_MM: f32 = deepest();
+
+const fn deepest() -> f32 {
+    let mut d = 0.0f32;
+    let mut i = 0;
+    while i < PATHS.len() {
+        if let Some(path) = PATHS.get(i) {
+            let mut k = 0;
+            while k < path.len() {
+                if let Some((_, p)) = path.get(k) {
+                    if p[4] > d {
+                        d = p[4];
+                    }
+                }
+                k += 1;
+            }
+        }
+        i += 1;
+    }
+    d
+}
+
+/// The factor on every waypoint's depth for `stack`: 1 for a stack no thicker than
+/// [`PATHS_DEEPEST_MM`] (the paths as drawn: the `liver`), else its total thickness over
+/// it, so the paths reach as far down a thicker stack (the `epidural`'s epidural space).
+/// Plain f32 (a sum in layer order, one division): the same bits everywhere.
+pub fn depth_scale(stack: &needle_haptics::insertion::Stack<'_>) -> f32 {
+    let mut total = 0.0f32;
+    for l in stack.layers {
+        total += l.thickness_mm;
+    }
+    if total > PATHS_DEEPEST_MM {
+        total / PATHS_DEEPEST_MM
+    } else {
+        1.0
+    }
+}
+
+/// Every tick's pose of `path`, its waypoints' depths times `depth_scale`, in order,
+/// passed to `f(tick, pose)`.
+pub fn for_each_tick(path: &[Waypoint], depth_scale: f32, mut f: impl FnMut(u32, [f32; 5])) {
+    let scaled = |(n, mut p): Waypoint| {
+        p[4] *= depth_scale;
+        (n, p)
+    };
+    let Some(&(_, start)) = path.first().map(|w| scaled(*w)).as_ref() else { return };
     let mut tick = 0u32;
     f(tick, start);
     let mut from = start;
-    for &(n, to) in path.iter().skip(1) {
+    for (n, to) in path.iter().skip(1).map(|w| scaled(*w)) {
         for k in 1..=n {
             tick += 1;
             let u = k as f32 / n as f32;

@@ -14,7 +14,7 @@ use common::{manifest_dir, run, scratch, staticlib};
 use needle_haptics::control::{ChannelMap, LoopConfig, LoopCore, OverLimit};
 use needle_haptics::insertion::{stacks, Insertion, InsertionConfig};
 use needle_haptics::Pose;
-use paths::{for_each_tick, Digest, PATHS};
+use paths::{depth_scale, for_each_tick, Digest, PATHS};
 use std::fmt::Write as _;
 use std::process::Command;
 
@@ -46,7 +46,7 @@ fn ticks_and_expected() -> (String, Vec<String>) {
             l.set_insertion(Some(ins));
             let (mut digest, mut loop_digest) = (Digest::new(), Digest::new());
             let (mut n, mut punctures) = (0u64, 0u64);
-            for_each_tick(path, |_, p| {
+            for_each_tick(path, depth_scale(stack), |_, p| {
                 let _ = writeln!(
                     ticks,
                     "{} {i} {:x} {:x} {:x} {:x} {:x}",
