@@ -62,20 +62,16 @@ pub const PATHS_DEEPEST_MM: f32 = deepest();
 
 const fn deepest() -> f32 {
     let mut d = 0.0f32;
-    let mut i = 0;
-    while i < PATHS.len() {
-        if let Some(path) = PATHS.get(i) {
-            let mut k = 0;
-            while k < path.len() {
-                if let Some((_, p)) = path.get(k) {
-                    if p[4] > d {
-                        d = p[4];
-                    }
-                }
-                k += 1;
+    let mut paths: &[&[Waypoint]] = &PATHS;
+    while let [path, rest @ ..] = paths {
+        let mut waypoints: &[Waypoint] = path;
+        while let [(_, p), more @ ..] = waypoints {
+            if p[4] > d {
+                d = p[4];
             }
+            waypoints = more;
         }
-        i += 1;
+        paths = rest;
     }
     d
 }

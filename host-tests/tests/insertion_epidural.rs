@@ -37,17 +37,19 @@ fn the_force_drops_at_the_ligamentum_flavum_puncture_to_the_epidural_space_level
     let (lf, es) = (index("ligamentum flavum"), index("epidural space"));
     assert_eq!(es, layers.len() - 1, "the epidural space is the last layer");
     let ticks = insert();
-    let into_es = ticks
-        .iter()
-        .position(|t| t.2 > 0 && matches!(t.3, Phase::Cutting(l) | Phase::InTrack(l) if usize::from(l) == es))
-        .expect("the insertion punctures into the epidural space");
+    let in_es = |p: Phase| matches!(p, Phase::Deflecting(l) | Phase::Cutting(l) | Phase::InTrack(l) if usize::from(l) == es);
+    // the tip reaches the epidural space's top (the ligamentum flavum's cutting stops) and
+    // punctures into it within a tick (its boundary has no force of its own)
+    let into_es = ticks.iter().position(|t| in_es(t.3)).expect("the insertion reaches the epidural space");
+    let punctured = ticks.iter().position(|t| t.2 > 0 && in_es(t.3)).expect("the insertion punctures into the epidural space");
+    assert!(punctured - into_es <= 1, "punctured {} ticks after reaching the epidural space", punctured - into_es);
     let (before, at) = (ticks[into_es - 1], ticks[into_es]);
     // before: cutting the ligamentum flavum at full speed, plus the friction of every layer passed
     let friction = |upto: usize| -> f32 { layers.iter().take(upto).map(|l| l.thickness_mm * l.friction.coulomb_n_per_mm).sum() };
     assert_eq!(before.3, Phase::Cutting(u8::try_from(lf).expect("index")), "{before:?}");
     let lf_level = layers[lf].cutting_force_n + friction(lf + 1);
     assert!((before.1 - lf_level).abs() <= 1e-4 * lf_level, "before the drop {} N, the ligamentum flavum's level {lf_level} N", before.1);
-    // at the puncture: the epidural space's level (its cutting force, ramped in from the
+    // from then on: the epidural space's level (its cutting force, ramped in from the
     // stick band at this speed, and the friction of every layer above it)
     let es_level = layers[es].cutting_force_n + friction(es);
     assert!((at.1 - es_level).abs() <= 1e-3, "after the drop {} N, the epidural space's level {es_level} N", at.1);
@@ -59,6 +61,7 @@ fn the_force_drops_at_the_ligamentum_flavum_puncture_to_the_epidural_space_level
     let largest = ticks.windows(2).map(|w| w[0].1 - w[1].1).fold(f32::NEG_INFINITY, f32::max);
     assert_eq!(largest, before.1 - at.1, "the loss of resistance is the largest drop");
     for t in &ticks[into_es..] {
+        assert!(in_es(t.3), "left the epidural space at {} mm", t.0);
         assert!((t.1 - es_level).abs() <= 1e-3, "in the epidural space at {} mm: {} N", t.0, t.1);
     }
     println!("loss of resistance at {:.3} mm: {:.4} N -> {:.4} N", at.0, before.1, at.1);

@@ -15,7 +15,8 @@
 //! 3. stiffness scale: the least-squares `s` of `s g(d - t_j)` against `F(d) - before_j`
 //!    over `t_j < d <= p_j` (`g` the library's deflection at scale 1, the scaling law);
 //! 4. cutting and friction: non-negative least squares of `c + f (d - t_j)` against
-//!    `F(d) - before_j` over the layer past `p_j` (none: both 0);
+//!    `F(d) - before_j` over the layer past `p_j` (none: both 0), `f` kept only when it
+//!    lowers the sum of squares by more than f64 round-off;
 //! 5. a layer whose published force does not rise from its start (the epidural space's
 //!    0 N; the fat, which starts past the skin's peak and only falls) has no boundary
 //!    force of its own: it punctures at contact (the
@@ -200,8 +201,16 @@ pub fn derive(pieces: &[Piece], surrogate: &dyn Fn(f64) -> f64) -> Result<Vec<De
         } else {
             let columns = vec![vec![1.0; advance.len()], advance.iter().map(|s| s.depth_mm - top).collect()];
             let rhs: Vec<f64> = advance.iter().map(|s| s.force_n - before).collect();
-            let (x, _) = lsq::non_negative(&columns, &rhs);
-            (x.first().copied().unwrap_or(0.0), x.get(1).copied().unwrap_or(0.0))
+            let (x, sse) = lsq::non_negative(&columns, &rhs);
+            // the friction column only when it lowers the sum of squares by more than
+            // f64 round-off (a constant published force gives it ~1e-16 N/mm otherwise)
+            let (c, sse_c) = lsq::non_negative(&columns[..1], &rhs);
+            let round_off = f64::EPSILON * rhs.iter().map(|r| r * r).sum::<f64>();
+            if sse_c <= sse + round_off {
+                (c.first().copied().unwrap_or(0.0), 0.0)
+            } else {
+                (x.first().copied().unwrap_or(0.0), x.get(1).copied().unwrap_or(0.0))
+            }
         };
         out.push(Derived {
             name: first.layer.clone(),
