@@ -41,6 +41,7 @@ fn host_lines() -> Vec<String> {
 fn the_golden_paths_cross_punctures_and_withdraw() {
     assert!(!stacks::ALL.is_empty(), "the default set ships tissue stacks");
     for line in host_lines() {
+        println!("{line}");
         let punctures: u64 = line.split(' ').find_map(|w| w.strip_prefix("punctures=")).and_then(|v| v.parse().ok()).expect("punctures");
         assert!(punctures >= 1, "every golden path punctures at least once: {line}");
     }
