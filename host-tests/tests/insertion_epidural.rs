@@ -3,7 +3,7 @@
 //! puncture into the epidural space) from the ligamentum flavum's cutting force to the
 //! epidural space's level, the largest drop of the insertion, and stays there.
 use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, Phase};
-use needle_haptics::Pose;
+use needle_haptics::{Pose, Status};
 
 const SPEED_MM_PER_S: f32 = 3.0;
 
@@ -19,6 +19,9 @@ fn insert() -> Vec<(f32, f32, u8, Phase)> {
         .map(|k| {
             let depth = -1.0 + step * k as f32;
             let e = ins.step(&Pose { depth_mm: depth, ..Pose::default() });
+            // every boundary deflects inside the FE surrogate's domain and its depth
+            // extension (the skin's 14.6 mm is 8.8 mm on the FE needle: lambda = 1.651)
+            assert_eq!(e.status, Status::OK, "status {:?} at {depth} mm", e.status);
             (depth, e.wrench.fy_n, e.punctures, e.phase)
         })
         .collect()
