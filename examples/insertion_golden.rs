@@ -23,7 +23,7 @@ mod common;
 
 #[cfg(target_os = "none")]
 mod firmware {
-    use crate::common::insertion_paths::{for_each_tick, for_each_tick_q16, Digest, PATHS};
+    use crate::common::insertion_paths::{depth_scale, for_each_tick, for_each_tick_q16, Digest, PATHS};
     use crate::common::{exit, Out};
     use needle_haptics::fixed;
     use needle_haptics::fixed::insertion::{stacks as fixed_stacks, Insertion as FixedInsertion, InsertionConfig as FixedConfig};
@@ -68,7 +68,7 @@ mod firmware {
                 };
                 let mut digest = Digest::new();
                 let (mut ticks, mut punctures) = (0u64, 0u64);
-                for_each_tick(path, |_, p| {
+                for_each_tick(path, depth_scale(stack), |_, p| {
                     let e = insertion.step(&Pose { x_mm: p[0], z_mm: p[1], theta_x_deg: p[2], theta_z_deg: p[3], depth_mm: p[4] });
                     digest.tick(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures);
                     ticks += 1;
@@ -78,7 +78,7 @@ mod firmware {
             }
         }
         // the fixed-point insertion on the same paths (Q16.16 poses, integer interpolation)
-        for stack in &fixed_stacks::ALL {
+        for (stack, scale_of) in fixed_stacks::ALL.iter().zip(&stacks::ALL) {
             for (i, path) in PATHS.iter().enumerate() {
                 let Ok(mut insertion) = FixedInsertion::new(stack, FixedConfig::DEFAULT_1KHZ) else {
                     ok = false;
@@ -86,7 +86,7 @@ mod firmware {
                 };
                 let mut digest = Digest::new();
                 let (mut ticks, mut punctures) = (0u64, 0u64);
-                for_each_tick_q16(path, |_, p| {
+                for_each_tick_q16(path, depth_scale(scale_of), |_, p| {
                     let e = insertion.step(&fixed::Pose::new(p[0], p[1], p[2], p[3], p[4]));
                     digest.tick_fixed(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures);
                     ticks += 1;

@@ -11,7 +11,7 @@ use needle_haptics::fixed;
 use needle_haptics::fixed::insertion as fx;
 use needle_haptics::insertion::{stacks, Insertion, InsertionConfig};
 use needle_haptics::Pose;
-use paths::{for_each_tick, for_each_tick_q16, PATHS};
+use paths::{depth_scale, for_each_tick, for_each_tick_q16, PATHS};
 
 /// The fixed-point stack's largest force and moment gains (`s λ²`, `s λ³`) and the depth
 /// extension's largest ratio `R` (at its deepest point, or 1 without it).
@@ -58,12 +58,12 @@ fn fixed_point_insertion_follows_the_f32_one_on_every_golden_path() {
             let mut ins = Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ).expect("shipped stack");
             let mut fins = fx::Insertion::new(fstack, fx::InsertionConfig::DEFAULT_1KHZ).expect("shipped stack in fixed point");
             let mut f32_out = Vec::new();
-            for_each_tick(path, |_, p| {
+            for_each_tick(path, depth_scale(stack), |_, p| {
                 let e = ins.step(&Pose { x_mm: p[0], z_mm: p[1], theta_x_deg: p[2], theta_z_deg: p[3], depth_mm: p[4] });
                 f32_out.push(e);
             });
             let mut fixed_out = Vec::new();
-            for_each_tick_q16(path, |_, p| fixed_out.push(fins.step(&fixed::Pose::new(p[0], p[1], p[2], p[3], p[4]))));
+            for_each_tick_q16(path, depth_scale(stack), |_, p| fixed_out.push(fins.step(&fixed::Pose::new(p[0], p[1], p[2], p[3], p[4]))));
             assert_eq!(f32_out.len(), fixed_out.len());
             let peak: f64 = f32_out.iter().flat_map(|e| e.wrench.to_array()).map(|c| f64::from(c).abs() * 1e6).fold(0.0, f64::max);
             let (mut phase_differs, mut worst, mut worst_rel) = (0usize, [0.0f64; 6], 0.0f64);
@@ -109,6 +109,7 @@ fn the_compiled_stacks_convert_to_integers() {
             assert!((q.thickness_q16 as f64 / 65536.0 - f64::from(l.thickness_mm)).abs() <= 0.5 / 65536.0);
             // µN Q16: a resolution of 1.5e-11 N; 1e-10 N leaves room for the f64 products
             assert!((q.puncture_force_q16 as f64 / 65536.0 / 1e6 - f64::from(l.puncture_force_n)).abs() <= 1e-10);
+            assert!(q.puncture_force_q16 > 0, "{}: a positive puncture force stays positive", stack.name);
             assert!((q.stiffness_scale_q16 as f64 / 65536.0 - f64::from(l.stiffness_scale)).abs() <= 0.5 / 65536.0);
         }
         assert!(fx::Insertion::new(f, fx::InsertionConfig::DEFAULT_1KHZ).is_ok());

@@ -11,9 +11,9 @@ mod paths;
 use needle_firmware_host::{build, core, qemu};
 use needle_haptics::fixed;
 use needle_haptics::fixed::insertion::{stacks as fixed_stacks, Insertion as FixedInsertion, InsertionConfig as FixedConfig};
-use needle_haptics::insertion::{stacks, Insertion, InsertionConfig};
+use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, Phase};
 use needle_haptics::Pose;
-use paths::{for_each_tick, for_each_tick_q16, Digest, PATHS};
+use paths::{depth_scale, for_each_tick, for_each_tick_q16, Digest, PATHS};
 use std::time::Duration;
 
 /// The host's lines, in the firmware's format.
@@ -24,7 +24,7 @@ fn host_lines() -> Vec<String> {
             let mut insertion = Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ).expect("shipped stack");
             let mut digest = Digest::new();
             let (mut ticks, mut punctures) = (0u64, 0u64);
-            for_each_tick(path, |_, p| {
+            for_each_tick(path, depth_scale(stack), |_, p| {
                 let e = insertion.step(&Pose { x_mm: p[0], z_mm: p[1], theta_x_deg: p[2], theta_z_deg: p[3], depth_mm: p[4] });
                 digest.tick(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures);
                 ticks += 1;
@@ -49,12 +49,12 @@ fn line(prefix: &str, name: &str, i: usize, ticks: u64, punctures: u64, digest: 
 /// poses), in the firmware's format.
 fn host_fixed_lines() -> Vec<String> {
     let mut lines = Vec::new();
-    for stack in &fixed_stacks::ALL {
+    for (stack, scale_of) in fixed_stacks::ALL.iter().zip(&stacks::ALL) {
         for (i, path) in PATHS.iter().enumerate() {
             let mut insertion = FixedInsertion::new(stack, FixedConfig::DEFAULT_1KHZ).expect("shipped stack");
             let mut digest = Digest::new();
             let (mut ticks, mut punctures) = (0u64, 0u64);
-            for_each_tick_q16(path, |_, p| {
+            for_each_tick_q16(path, depth_scale(scale_of), |_, p| {
                 let e = insertion.step(&fixed::Pose::new(p[0], p[1], p[2], p[3], p[4]));
                 digest.tick_fixed(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures);
                 ticks += 1;
@@ -70,8 +70,36 @@ fn host_fixed_lines() -> Vec<String> {
 fn the_golden_paths_cross_punctures_and_withdraw() {
     assert!(!stacks::ALL.is_empty(), "the default set ships tissue stacks");
     for line in host_lines() {
+        println!("{line}");
         let punctures: u64 = line.split(' ').find_map(|w| w.strip_prefix("punctures=")).and_then(|v| v.parse().ok()).expect("punctures");
         assert!(punctures >= 1, "every golden path punctures at least once: {line}");
+    }
+}
+
+/// The liver's paths are the paths as drawn (depth factor 1, so their digests are the
+/// ones before the epidural stack); the epidural stack's reach its epidural space: some
+/// path punctures its last layer's boundary (the loss of resistance).
+#[test]
+fn the_golden_paths_reach_the_deepest_layer_of_every_stack() {
+    assert_eq!(depth_scale(&stacks::LIVER).to_bits(), 1.0f32.to_bits(), "the liver's paths are not scaled");
+    let deepest = PATHS.iter().flat_map(|p| p.iter().map(|w| w.1[4])).fold(f32::NEG_INFINITY, f32::max);
+    assert_eq!(paths::PATHS_DEEPEST_MM, deepest);
+    for stack in &stacks::ALL {
+        let last = u8::try_from(stack.layers.len() - 1).expect("layer count");
+        let mut into_last = Vec::new();
+        for (i, path) in PATHS.iter().enumerate() {
+            let mut insertion = Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ).expect("shipped stack");
+            let mut reached = false;
+            for_each_tick(path, depth_scale(stack), |_, p| {
+                let e = insertion.step(&Pose { x_mm: p[0], z_mm: p[1], theta_x_deg: p[2], theta_z_deg: p[3], depth_mm: p[4] });
+                reached |= e.punctures > 0 && matches!(e.phase, Phase::Cutting(l) | Phase::InTrack(l) if l == last);
+            });
+            if reached {
+                into_last.push(i);
+            }
+        }
+        println!("{}: paths {into_last:?} puncture into the last layer ({})", stack.name, last);
+        assert!(!into_last.is_empty(), "{}: no golden path punctures into its last layer", stack.name);
     }
 }
 
@@ -123,7 +151,7 @@ fn c_api_lines() -> Vec<String> {
             assert_eq!(rc, NEEDLE_OK, "needle_insertion_init({})", stack.name);
             let mut digest = Digest::new();
             let (mut ticks, mut punctures) = (0u64, 0u64);
-            for_each_tick(path, |_, p| {
+            for_each_tick(path, depth_scale(stack), |_, p| {
                 let pose = needle_pose_t { x_mm: p[0], z_mm: p[1], theta_x_deg: p[2], theta_z_deg: p[3], depth_mm: p[4] };
                 let mut out = needle_insertion_result_t::default();
                 // SAFETY: valid pointers to local values; the state was initialised above.
@@ -156,7 +184,7 @@ fn c_api_fixed_lines() -> Vec<String> {
         needle_fixed_pose_t, NEEDLE_FIXED_INSERTION_STORAGE_WORDS, NEEDLE_OK,
     };
     let mut lines = Vec::new();
-    for stack in &fixed_stacks::ALL {
+    for (stack, scale_of) in fixed_stacks::ALL.iter().zip(&stacks::ALL) {
         let name = std::ffi::CString::new(stack.name).expect("stack name");
         for (i, path) in PATHS.iter().enumerate() {
             let mut state = needle_fixed_insertion_t { storage: [0; NEEDLE_FIXED_INSERTION_STORAGE_WORDS], magic: 0 };
@@ -166,7 +194,7 @@ fn c_api_fixed_lines() -> Vec<String> {
             assert_eq!(rc, NEEDLE_OK, "needle_fixed_insertion_init({})", stack.name);
             let mut digest = Digest::new();
             let (mut ticks, mut punctures) = (0u64, 0u64);
-            for_each_tick_q16(path, |_, p| {
+            for_each_tick_q16(path, depth_scale(scale_of), |_, p| {
                 let pose = needle_fixed_pose_t {
                     x_mm_q16: p[0],
                     z_mm_q16: p[1],
@@ -248,9 +276,9 @@ fn golden_insertions_in_wasm_under_node() {
     let dir = tempfile::tempdir().expect("temp dir");
     let poses = dir.path().join("poses.txt");
     let mut text = String::new();
-    for (s, _) in stacks::ALL.iter().enumerate() {
+    for (s, stack) in stacks::ALL.iter().enumerate() {
         for (i, path) in PATHS.iter().enumerate() {
-            for_each_tick(path, |_, p| {
+            for_each_tick(path, depth_scale(stack), |_, p| {
                 text.push_str(&format!(
                     "{s} {i} {:x} {:x} {:x} {:x} {:x}\n",
                     p[0].to_bits(),
@@ -278,9 +306,9 @@ fn golden_insertions_in_wasm_under_node() {
 
     // the fixed-point insertion: the Q16.16 poses of the same paths
     let mut text = String::new();
-    for (s, _) in fixed_stacks::ALL.iter().enumerate() {
+    for (s, scale_of) in stacks::ALL.iter().enumerate() {
         for (i, path) in PATHS.iter().enumerate() {
-            for_each_tick_q16(path, |_, p| {
+            for_each_tick_q16(path, depth_scale(scale_of), |_, p| {
                 text.push_str(&format!(
                     "{s} {i} {:x} {:x} {:x} {:x} {:x}\n",
                     p[0] as u32, p[1] as u32, p[2] as u32, p[3] as u32, p[4] as u32

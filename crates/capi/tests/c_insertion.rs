@@ -16,7 +16,7 @@ use common::{manifest_dir, run, scratch, staticlib};
 use needle_haptics::control::{ChannelMap, LoopConfig, LoopCore, OverLimit};
 use needle_haptics::insertion::{stacks, Insertion, InsertionConfig};
 use needle_haptics::Pose;
-use paths::{for_each_tick, for_each_tick_q16, Digest, PATHS};
+use paths::{depth_scale, for_each_tick, for_each_tick_q16, Digest, PATHS};
 use std::fmt::Write as _;
 use std::process::Command;
 
@@ -48,7 +48,7 @@ fn ticks_and_expected() -> (String, Vec<String>) {
             l.set_insertion(Some(ins));
             let (mut digest, mut loop_digest) = (Digest::new(), Digest::new());
             let (mut n, mut punctures) = (0u64, 0u64);
-            for_each_tick(path, |_, p| {
+            for_each_tick(path, depth_scale(stack), |_, p| {
                 let _ = writeln!(
                     ticks,
                     "{} {i} {:x} {:x} {:x} {:x} {:x}",
@@ -114,12 +114,12 @@ fn c_program_steps_the_golden_insertion_paths_bit_for_bit() {
 fn fixed_ticks_and_expected() -> (String, Vec<String>) {
     use needle_haptics::fixed::insertion::{stacks as fixed_stacks, Insertion as FixedInsertion, InsertionConfig as FixedConfig};
     let (mut ticks, mut want) = (String::new(), Vec::new());
-    for stack in &fixed_stacks::ALL {
+    for (stack, scale_of) in fixed_stacks::ALL.iter().zip(&stacks::ALL) {
         for (i, path) in PATHS.iter().enumerate() {
             let mut ins = FixedInsertion::new(stack, FixedConfig::DEFAULT_1KHZ).expect("shipped stack");
             let mut digest = Digest::new();
             let (mut n, mut punctures) = (0u64, 0u64);
-            for_each_tick_q16(path, |_, p| {
+            for_each_tick_q16(path, depth_scale(scale_of), |_, p| {
                 let _ = writeln!(
                     ticks,
                     "{} {i} {:x} {:x} {:x} {:x} {:x}",

@@ -3,6 +3,7 @@
 
 pub mod calibrate;
 pub mod calibrate_figure;
+pub mod calibrate_published;
 pub mod eval_batch;
 pub mod eval_insertion;
 pub mod eval_stream;
