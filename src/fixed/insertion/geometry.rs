@@ -117,29 +117,65 @@ impl Track {
     }
 }
 
-impl Deviation {
-    /// The track's hold on the part `[q1, q2]` (mm Q16) of the shaft with stiffness
-    /// `k_q8` (µN/mm per mm, Q8), added to `w` (µN and µN·mm, Q16): `F = -k (D Q1 - G Q2)`,
-    /// `M = a × k (D (Q2 - qh Q1) - G (Q3 - qh Q2))` (the f32 `track` module).
-    pub(super) fn add_hold(&self, k_q8: i64, q1: i64, q2: i64, w: &mut [i64; 6]) {
-        // Bounds (mm Q16; the insertion clamps depth to ±128 mm, x and z to ±64 mm, the
-        // hub is at most 8 x 60 mm above the tip): 0 <= q1 < q2 <= 2^23, |qh| < 2^26,
-        // |D| < 2^24, |G| <= 2^30; so s1, s2 <= 2^30, Q1 <= 2^23, Q2 <= 2^29,
-        // |Q3| <= 2^37, |f| <= 2^33, |cd| <= 2^34, |cg| <= 2^40, |lever| <= 2^43 and
-        // every product below stays under 2^59: plain `i64` arithmetic cannot wrap.
-        // The products with the stack's stiffness: `mul_stiffness`.
+/// The track's springs summed over the layers the shaft is in: with `k_j` a layer's
+/// stiffness and `Q1_j, Q2_j, Q3_j` its integrals of the shaft's part in it (the module
+/// formulas), `S1 = Σ k Q1` (µN/mm, Q16), `S2 = Σ k Q2` (µN, Q8), `S3 = Σ k Q3`
+/// (µN·mm, Q0). The hold is linear in them ([`Deviation::add_hold`]): three products
+/// with the stiffness per layer, the vector work once per tick.
+#[derive(Default, Clone, Copy)]
+pub(super) struct HoldSums {
+    s1: i64,
+    s2: i64,
+    s3: i64,
+}
+
+impl HoldSums {
+    /// Adds the part `[q1, q2]` (mm Q16) of the shaft held with `k_q8` (µN/mm per mm, Q8).
+    pub(super) fn add(&mut self, k_q8: i64, q1: i64, q2: i64) {
+        // Bounds (mm Q16; the insertion clamps depth to ±128 mm): 0 <= q1 < q2 <= 2^23,
+        // so s1, s2 <= 2^30, Q1 <= 2^23, Q2 <= 2^29, |Q3| <= 2^37: plain `i64`; with
+        // 0 <= k <= 2^31 (`TRACK_STIFFNESS_MAX_Q8`) `k Q1` < 2^54 and the other two
+        // products below 2^59 (`mul_split`).
         let (s1, s2) = ((q1 * q1) >> 16, (q2 * q2) >> 16);
         let big_q1 = q2 - q1;
         let big_q2 = (s2 - s1) >> 1;
         let big_q3 = mul_q30(((s2 * q2) >> 16) - ((s1 * q1) >> 16), THIRD_Q30);
+        self.s1 = self.s1.saturating_add((big_q1 * k_q8) >> 8);
+        self.s2 = self.s2.saturating_add(mul_split(big_q2, k_q8, 16));
+        self.s3 = self.s3.saturating_add(mul_split(big_q3, k_q8, 24));
+    }
+}
+
+/// `x y / 2^s` for `s >= 16`, `|x|` clamped to 2^47 and `|y|` below 2^31: with
+/// `x = hi 2^16 + lo` (`0 <= lo < 2^16`), `floor(hi y / 2^(s-16)) + floor(lo y / 2^s)`
+/// (within 1 of the floor of the whole), every product below 2^62.
+#[inline(always)]
+fn mul_split(x: i64, y: i64, s: u32) -> i64 {
+    let x = x.clamp(-(1 << 47), 1 << 47);
+    let (hi, lo) = (x >> 16, x & 0xffff);
+    ((hi * y) >> s.saturating_sub(16)) + ((lo * y) >> s)
+}
+
+impl Deviation {
+    /// The track's hold on the shaft, from the layers' [`HoldSums`], added to `w` (µN
+    /// and µN·mm, Q16): `F = -(D S1 - G S2)`, `M = a × (D (S2 - qh S1) - G (S3 - qh S2))`
+    /// (the module's formulas summed over the layers: `k` inside the sums).
+    pub(super) fn add_hold(&self, sums: &HoldSums, w: &mut [i64; 6]) {
+        // Formats: D, qh mm Q16 (|D| < 2^24, |qh| < 2^26), G and a Q30; S1 µN/mm Q16,
+        // S2 and CD = S2 - qh S1 µN Q8, S3 and CG = S3 - qh S2 µN·mm Q0, the lever
+        // D CD - G CG µN·mm Q8. `mul_split` clamps its first factor to 2^47, `mul_q30`
+        // needs it below 2^47 (the clamps below): a realistic track's sums are below
+        // 2^42 (the epidural stack's deepest: S1 2^41).
+        let clamp = |v: i64| v.clamp(-(1 << 46), 1 << 46);
+        let HoldSums { s1, s2, s3 } = *sums;
         let qh = self.hub_q16;
+        let cd = clamp(s2 - mul_split(s1, qh, 24));
+        let cg = clamp(s3 - mul_split(s2, qh, 24));
         let (d, g) = (self.d, self.g);
-        // D Q1 - G Q2 (mm^2, Q16)
-        let f = [0, 1, 2].map(|i| ((at(d, i) * big_q1) >> 16) - mul_q30(big_q2, at(g, i)));
-        let cd = big_q2 - ((qh * big_q1) >> 16);
-        let cg = big_q3 - ((qh * big_q2) >> 16);
-        // D cd - G cg (mm^3, Q16)
-        let lever = [0, 1, 2].map(|i| ((at(d, i) * cd) >> 16) - mul_q30(cg, at(g, i)));
+        // force, µN Q16: D S1 (Q16 x Q16 / 2^16) - G S2 (Q8, to Q16)
+        let f = [0, 1, 2].map(|i| mul_split(s1, at(d, i), 16) - (mul_q30(clamp(s2), at(g, i)) << 8));
+        // lever, µN·mm Q8: D CD (Q16 x Q8 / 2^16) - G CG (Q0, to Q8)
+        let lever = [0, 1, 2].map(|i| clamp(mul_split(cd, at(d, i), 16) - (mul_q30(cg, at(g, i)) << 8)));
         let a = self.a;
         let m = [
             mul_q30(lever[2], a[1]) - mul_q30(lever[1], a[2]),
@@ -147,30 +183,18 @@ impl Deviation {
             mul_q30(lever[1], a[0]) - mul_q30(lever[0], a[1]),
         ];
         let [w0, w1, w2, w3, w4, w5] = w;
-        *w0 = w0.saturating_sub(mul_stiffness(k_q8, f[0]));
-        *w1 = w1.saturating_sub(mul_stiffness(k_q8, f[1]));
-        *w2 = w2.saturating_sub(mul_stiffness(k_q8, f[2]));
-        *w3 = w3.saturating_add(mul_stiffness(k_q8, m[0]));
-        *w4 = w4.saturating_add(mul_stiffness(k_q8, m[1]));
-        *w5 = w5.saturating_add(mul_stiffness(k_q8, m[2]));
+        *w0 = w0.saturating_sub(f[0]);
+        *w1 = w1.saturating_sub(f[1]);
+        *w2 = w2.saturating_sub(f[2]);
+        *w3 = w3.saturating_add(m[0] << 8);
+        *w4 = w4.saturating_add(m[1] << 8);
+        *w5 = w5.saturating_add(m[2] << 8);
     }
 }
 
 /// Largest track stiffness, µN/mm per mm in Q8 (8.4 N/mm per mm): `Insertion::new`
-/// refuses a stack above it, so [`mul_stiffness`] cannot wrap.
+/// refuses a stack above it, so the hold's products with it cannot wrap ([`HoldSums::add`]).
 pub(super) const TRACK_STIFFNESS_MAX_Q8: i64 = 1 << 31;
-
-/// `floor(k x / 2^8)` for `0 <= k <= 2^31` ([`TRACK_STIFFNESS_MAX_Q8`]) and `x` clamped
-/// to ±2^36 (a force of 2^20 mm² or a moment of 2^20 mm³ of deviation times length, far
-/// beyond a tissue's): with `x = hi 2^16 + lo`, `hi k 2^8 + floor(lo k / 2^8)`, every
-/// product below 2^59 (two plain multiplications; a Cortex-M0 computes a saturating
-/// one in a library routine several times slower).
-#[inline(always)]
-fn mul_stiffness(k: i64, x: i64) -> i64 {
-    let x = x.clamp(-(1 << 36), 1 << 36);
-    let (hi, lo) = (x >> 16, x & 0xffff);
-    ((hi * k) << 8) + ((lo * k) >> 8)
-}
 
 #[cfg(test)]
 mod tests {

@@ -38,7 +38,7 @@ use super::depth_extension::saturate_i32;
 use super::{extended_wrench, Pose, Wrench};
 use crate::insertion::{InsertionError, Phase};
 use crate::Status;
-use geometry::{axis, dot, mul_q30, mul_shr, Track, Vec3, TRACK_STIFFNESS_MAX_Q8};
+use geometry::{axis, dot, mul_q30, mul_shr, HoldSums, Track, Vec3, TRACK_STIFFNESS_MAX_Q8};
 
 /// The insertion's tick settings in integers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -328,15 +328,17 @@ impl<'a> Insertion<'a> {
         let hub_q = depth - self.stack.hub_from_tip_q16;
         let deviation = self.track.map(|t| t.deviation(entry, a, hub_q));
         let mut axial_q16 = 0_i64;
+        let mut hold = HoldSums::default();
         for (j, layer) in self.stack.layers().iter().enumerate().take(m) {
             let (q1, q2) = (bound(j), bound(j + 1).min(top));
             if q2 <= q1 {
                 continue;
             }
             axial_q16 += ((q2 - q1) * layer.friction.per_mm_q16(v)) >> 16;
-            if let Some(d) = &deviation {
-                d.add_hold(layer.track_stiffness_q8, q1, q2, w);
-            }
+            hold.add(layer.track_stiffness_q8, q1, q2);
+        }
+        if let Some(d) = &deviation {
+            d.add_hold(&hold, w);
         }
         let phase = if depth >= next {
             Phase::Deflecting(index(m))

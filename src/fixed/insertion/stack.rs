@@ -162,7 +162,11 @@ impl Layer {
             stiffness_scale_q16: q16(l.stiffness_scale),
             // at least 1 (1.5e-11 N) for a positive force: a boundary that punctures at
             // contact (the tissue format's smallest force) stays positive
-            puncture_force_q16: if l.puncture_force_n > 0.0 && micro_q16(l.puncture_force_n) < 1 { 1 } else { micro_q16(l.puncture_force_n) },
+            puncture_force_q16: if l.puncture_force_n > 0.0 && micro_q16(l.puncture_force_n) < 1 {
+                1
+            } else {
+                micro_q16(l.puncture_force_n)
+            },
             cutting_force_q16: micro_q16(l.cutting_force_n),
             cutting_per_speed_q16: per_speed_q16(l.cutting_force_n, band),
             friction: Karnopp {
