@@ -163,12 +163,18 @@ fn a_failing_run_keeps_its_log_and_the_campaign_goes_on() {
         [Some(0.0), Some(5.0), Some(0.0), Some(5.0), Some(5.0)],
         "full block: retry_seg_up on attempts 1 and 3, seg_up of campaign.toml on 2, 4 and 5"
     );
+    // attempt 1: whole steps (10 of 0.6 mm); it failed before its first must point, at
+    // first contact, so attempt 2 (whole steps, the other rule) takes the first-contact
+    // steps (`first_contact_depth_mm` 0.6, `first_contact_step_fraction` 0.25: 40 time
+    // steps of 0.15 mm to 6 mm, the first load step's capped at 0.15 mm, whole after);
+    // from attempt 3 on a quarter first increment with the retry tolerances and no cap
+    // (ladder.rs; no attempt reached a must point, so none is continued)
     let steps: Vec<Option<f64>> = (1..=5).map(|n| value(&feb(n), "time_steps")).collect();
-    let s1 = steps[0].unwrap_or(0.0);
-    assert!(
-        s1 > 0.0 && steps == [Some(s1), Some(s1), Some(4.0 * s1), Some(4.0 * s1), Some(4.0 * s1)],
-        "quarter first increments from attempt 3 on: {steps:?}"
-    );
+    assert_eq!(steps, [Some(10.0), Some(40.0), Some(40.0), Some(40.0), Some(40.0)], "{steps:?}");
+    let capped: Vec<bool> = (1..=5).map(|n| feb(n).contains("<pt>0.6,0.15</pt>") && feb(n).contains("<pt>1.2,0.6</pt>")).collect();
+    assert_eq!(capped, [false, true, false, false, false], "first-contact steps after a failure there, on whole-step attempts");
+    let dtol: Vec<Option<f64>> = (1..=5).map(|n| value(&feb(n), "dtol")).collect();
+    assert_eq!(dtol, [Some(1e-3), Some(1e-3), Some(0.0), Some(0.0), Some(0.0)], "the retry tolerances from attempt 3 on");
 }
 
 /// Tolerance of the coarse FEBio punch, %. `punch_mesh_scale = 2` (8 hex8 elements across

@@ -117,6 +117,22 @@ pub trait Backend: Sync {
         }
     }
 
+    /// The first increment of `attempt` for the pose whose work folder is `work_dir`
+    /// (`full_block`: its model has no mirror plane): engines whose ladder depends on
+    /// what the earlier attempts left there (FEBio's continuation of the furthest attempt)
+    /// decide here; the others as [`Backend::first_increment`].
+    fn first_increment_in(&self, work_dir: &Path, attempt: u32, full_block: bool) -> f64 {
+        let _ = (work_dir, full_block);
+        self.first_increment(attempt)
+    }
+
+    /// What `attempt` changes, one phrase for the campaign's log (the insertion:
+    /// `depth_mm` in `steps` load steps).
+    fn describe_attempt(&self, work_dir: &Path, attempt: u32, full_block: bool, depth_mm: f64, steps: u32) -> String {
+        let _ = (depth_mm, steps);
+        format!("with each step's first increment at {} of the step", self.first_increment_in(work_dir, attempt, full_block))
+    }
+
     /// Solve one pose in `job.work_dir`.
     ///
     /// # Errors

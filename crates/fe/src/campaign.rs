@@ -27,8 +27,9 @@
 //! [`RunOptions::stall`]: ccx 2.20 was seen spinning without output at the start of a
 //! step, deterministically, e.g. theta_z = 15 degrees at 5.4 mm) is rerun with every load
 //! step starting at [`deck::RETRY_FIRST_INCREMENT`] of the step instead of the whole step,
-//! up to the engine's [`Backend::attempts`] in all (ccx: one retry; FEBio: two, the last
-//! with a softer contact penalty). The manifest entry records it (`first_increment`,
+//! up to the engine's [`Backend::attempts`] in all (ccx: one retry; FEBio: four, decided
+//! by its ladder, `febio/ladder.rs`: a retry may continue the furthest attempt from its
+//! last converged must point). The manifest entry records it (`first_increment`,
 //! `retry`, `solver_settings`). Only when the last attempt fails too is the pose failed.
 //!
 //! The pieces: [`backend`](crate::backend) solves one pose, [`manifest`](crate::manifest)
@@ -517,8 +518,10 @@ pub(crate) fn solve_with_retry(
     let mut failures: Vec<String> = Vec::new();
     let mut furthest: Vec<[f64; COMPONENT_COUNT]> = Vec::new();
     let attempts = backend.attempts().max(1);
+    let sym = job.pose.symmetry();
+    let full_block = !sym.plane_x && !sym.plane_z;
     for attempt in 0..attempts {
-        let r = backend.first_increment(attempt);
+        let r = backend.first_increment_in(job.work_dir, attempt, full_block);
         let this = Job { first_increment: r, attempt, ..*job };
         match backend.solve(&this) {
             Ok(s) => return Ok(Solved { retry: (!failures.is_empty()).then(|| failures.join("; ")), ..s }),
@@ -535,12 +538,12 @@ pub(crate) fn solve_with_retry(
                     return Err(SolveFailure { message: failures.join("; "), log_tail: f.log_tail, reached: furthest });
                 }
                 eprintln!(
-                    "{}: {}; retry {} of {} with each step's first increment at {} of the step",
+                    "{}: {}; retry {} of {} {}",
                     job.pose.name,
                     failures.last().map(String::as_str).unwrap_or_default(),
                     attempt + 1,
                     attempts - 1,
-                    backend.first_increment(attempt + 1)
+                    backend.describe_attempt(job.work_dir, attempt + 1, full_block, job.campaign.loading.depth_mm, job.steps)
                 );
             }
         }

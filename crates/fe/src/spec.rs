@@ -323,6 +323,18 @@ pub struct FebioSettings {
     /// reformations" in both earlier attempts). The augmentations still hold the gap
     /// below `gap_tolerance_mm`; the manifest's `solver_settings` names the penalty used.
     pub last_attempt_penalty_scale: f64,
+    /// Depth (mm) over which a fresh attempt with whole load steps keeps its time steps at
+    /// most `first_contact_step_fraction` of a load step, its first step included (0: off).
+    /// Issue 42: `seg_up` 5 with whole first increments inverted elements at first
+    /// contact in 17 of its 25 failures, all at 0.19-0.60 mm. A setting of the ladder
+    /// (the path to the must points, not the problem): left out of the run hash, recorded
+    /// in the manifest's `solver_settings` of each run it shaped.
+    #[serde(skip_serializing)]
+    pub first_contact_depth_mm: f64,
+    /// The largest time step within `first_contact_depth_mm`, as a fraction of one load
+    /// step, in (0, 1]. Left out of the run hash like `first_contact_depth_mm`.
+    #[serde(skip_serializing)]
+    pub first_contact_step_fraction: f64,
 }
 
 impl Default for FebioSettings {
@@ -353,6 +365,8 @@ impl Default for FebioSettings {
             retry_dtol: 0.0,
             retry_rtol: 1e-3,
             last_attempt_penalty_scale: 0.1,
+            first_contact_depth_mm: 0.6,
+            first_contact_step_fraction: 0.25,
         }
     }
 }
@@ -396,6 +410,15 @@ impl FebioSettings {
         }
         if !(self.last_attempt_penalty_scale > 0.0 && self.last_attempt_penalty_scale <= 1.0) {
             bail!("{p}: solver.febio.last_attempt_penalty_scale = {}: must be in (0, 1]", self.last_attempt_penalty_scale);
+        }
+        if !(self.first_contact_depth_mm.is_finite() && self.first_contact_depth_mm >= 0.0) {
+            bail!("{p}: solver.febio.first_contact_depth_mm = {}: must be finite and >= 0 (0: off)", self.first_contact_depth_mm);
+        }
+        if !(self.first_contact_step_fraction > 0.0 && self.first_contact_step_fraction <= 1.0) {
+            bail!(
+                "{p}: solver.febio.first_contact_step_fraction = {}: must be in (0, 1] (a fraction of one load step)",
+                self.first_contact_step_fraction
+            );
         }
         if self.dtmin_fraction > 1.0 {
             bail!("{p}: solver.febio.dtmin_fraction = {}: must be <= 1 (a fraction of one load step)", self.dtmin_fraction);
@@ -1014,6 +1037,30 @@ mod tests {
         assert!(penalty.validate(p).is_ok(), "a pure penalty needs no tolerance");
         let negative = FebioSettings { aug_tolerance: -0.1, ..FebioSettings::default() };
         assert!(negative.validate(p).is_err());
+    }
+
+    /// The ladder's first-contact steps are checked, and left out of the run hash (they
+    /// change the path to the must points, not the problem: results solved before them
+    /// stay up to date), unlike a tolerance.
+    #[test]
+    fn first_contact_steps_are_checked_and_not_hashed() {
+        let p = Path::new("campaign.toml");
+        for (depth, fraction, ok) in
+            [(0.6, 0.25, true), (0.0, 1.0, true), (-0.1, 0.25, false), (0.6, 0.0, false), (0.6, 1.5, false), (f64::NAN, 0.25, false)]
+        {
+            let s = FebioSettings { first_contact_depth_mm: depth, first_contact_step_fraction: fraction, ..FebioSettings::default() };
+            assert_eq!(s.validate(p).is_ok(), ok, "depth {depth} mm, fraction {fraction}");
+        }
+        let set = crate::workspace_root().join("coeffs/default");
+        let Ok((c, _)) = super::load(&set) else { panic!("cannot load {}", set.display()) };
+        let centre = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");
+        let h = c.run_hash(&centre, "needle8");
+        let mut other = c.clone();
+        other.solver.febio.first_contact_depth_mm = 1.2;
+        other.solver.febio.first_contact_step_fraction = 0.5;
+        assert_eq!(other.run_hash(&centre, "needle8"), h);
+        other.solver.febio.retry_rtol *= 2.0;
+        assert_ne!(other.run_hash(&centre, "needle8"), h, "a tolerance is part of the problem's hash");
     }
 
     /// The training design: a prefix of the scrambled Sobol sequence, inside the

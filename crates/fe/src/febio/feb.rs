@@ -45,6 +45,43 @@ pub struct Feb {
     pub symmetry: Symmetry,
 }
 
+/// How a run's time stepper starts and converges.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Stepping {
+    /// The first time step as a fraction of a load step, in (0, 1].
+    pub first_step_fraction: f64,
+    /// Converge with `retry_dtol` / `retry_rtol` instead of `dtol` / `rtol`.
+    pub retry_tolerances: bool,
+    /// Time steps of at most `step_fraction` of a load step over the first `depth_mm`
+    /// (the retry ladder's first-contact steps, `ladder.rs`); the first time step too.
+    pub first_contact: Option<FirstContact>,
+}
+
+/// The first-contact steps of [`Stepping`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FirstContact {
+    /// Depth over which the steps are capped, mm.
+    pub depth_mm: f64,
+    /// The cap, as a fraction of a load step, in (0, 1].
+    pub step_fraction: f64,
+}
+
+impl Stepping {
+    /// The old ladder's stepping: a first step of `dt_fraction` of a load step, the retry
+    /// tolerances when it is below 1, no first-contact steps.
+    pub fn first_increment(dt_fraction: f64) -> Self {
+        Stepping { first_step_fraction: dt_fraction, retry_tolerances: dt_fraction < 1.0, first_contact: None }
+    }
+
+    /// The first time step as a fraction of a load step, the first-contact cap included.
+    pub fn first_step(&self) -> f64 {
+        match self.first_contact {
+            Some(fc) if fc.depth_mm > 0.0 => self.first_step_fraction.min(fc.step_fraction),
+            _ => self.first_step_fraction,
+        }
+    }
+}
+
 /// Write the FEBio input of `pose` on mesh level `mesh_level` with `steps` load steps
 /// over the spec's insertion depth. `dt_fraction`: the first automatic time step as a
 /// fraction of a load step (1 on a first attempt; the campaign's retry asks for less,
@@ -53,24 +90,43 @@ pub struct Feb {
 /// # Errors
 /// The spec's values make an empty mesh, `steps` is 0, or `dt_fraction` is not in (0, 1].
 pub fn write(c: &Campaign, pose: &PoseSpec, mesh_level: &MeshLevel, steps: u32, dt_fraction: f64) -> Result<Feb> {
-    write_with_symmetry(c, pose, mesh_level, steps, dt_fraction, pose.symmetry())
+    write_stepped(c, pose, mesh_level, steps, &Stepping::first_increment(dt_fraction))
 }
 
-/// As [`write`], with the mirror planes chosen by the caller (a full model of a
+/// As [`write`], with the time stepper's start given in full ([`Stepping`]).
+///
+/// # Errors
+/// As [`write`]; a first-contact cap outside (0, 1] or a negative depth.
+pub fn write_stepped(c: &Campaign, pose: &PoseSpec, mesh_level: &MeshLevel, steps: u32, stepping: &Stepping) -> Result<Feb> {
+    write_with_symmetry(c, pose, mesh_level, steps, stepping, pose.symmetry())
+}
+
+/// As [`write_stepped`], with the mirror planes chosen by the caller (a full model of a
 /// symmetric pose, for checking the symmetry reduction).
 ///
 /// # Errors
-/// As [`write`]; a mirror plane the pose does not have.
+/// As [`write_stepped`]; a mirror plane the pose does not have.
 pub fn write_with_symmetry(
     c: &Campaign,
     pose: &PoseSpec,
     mesh_level: &MeshLevel,
     steps: u32,
-    dt_fraction: f64,
+    stepping: &Stepping,
     sym: Symmetry,
 ) -> Result<Feb> {
+    let dt_fraction = stepping.first_step_fraction;
     if !(dt_fraction > 0.0 && dt_fraction <= 1.0) {
         bail!("pose {}: first time step {dt_fraction} of a load step: must be in (0, 1]", pose.name);
+    }
+    if let Some(fc) = stepping.first_contact {
+        if !(fc.step_fraction > 0.0 && fc.step_fraction <= 1.0 && fc.depth_mm.is_finite() && fc.depth_mm >= 0.0) {
+            bail!(
+                "pose {}: first-contact steps of {} of a load step over {} mm: the fraction must be in (0, 1], the depth >= 0",
+                pose.name,
+                fc.step_fraction,
+                fc.depth_mm
+            );
+        }
     }
     let depth = c.loading.depth_mm;
     let (t, n) = mesh::pose_meshes(c, pose, mesh_level, steps, sym)?;
@@ -95,7 +151,7 @@ pub fn write_with_symmetry(
     );
     let _ = writeln!(w, r#"<febio_spec version="4.0">"#);
     let _ = writeln!(w, r#"  <Module type="solid"/>"#);
-    write_control(&mut w, s, depth, steps, dt_fraction);
+    write_control(&mut w, s, depth, steps, stepping);
     write_material(&mut w, c, hub);
     let needle0 = t.nodes.len();
     let needle_el0 = t.elements.len();
@@ -107,7 +163,7 @@ pub fn write_with_symmetry(
     write_boundary(&mut w, &t);
     write_rigid(&mut w, n.axis);
     write_contact(&mut w, c);
-    write_load_data(&mut w, depth, steps);
+    write_load_data(&mut w, depth, steps, stepping.first_contact);
     let _ = writeln!(w, "  <Output>");
     let _ = writeln!(w, "    <logfile>");
     let _ =
@@ -118,8 +174,9 @@ pub fn write_with_symmetry(
     Ok(Feb { text: w, summary: MeshSummary::of(&t, &n, sym), steps, symmetry: sym })
 }
 
-fn write_control(w: &mut String, s: &FebioSettings, depth: f64, steps: u32, dt_fraction: f64) {
+fn write_control(w: &mut String, s: &FebioSettings, depth: f64, steps: u32, stepping: &Stepping) {
     let dt = depth / f64::from(steps);
+    let dt_fraction = stepping.first_step();
     // FEBio ends at time_steps * step_size: keep that the insertion depth when the first
     // step is a fraction of a load step (the automatic stepper then grows it to dt)
     let time_steps = (f64::from(steps) / dt_fraction).round().max(1.0) as u64;
@@ -150,9 +207,9 @@ fn write_control(w: &mut String, s: &FebioSettings, depth: f64, steps: u32, dt_f
     let _ = writeln!(w, "      <reform_each_time_step>1</reform_each_time_step>");
     let _ = writeln!(w, "      <diverge_reform>1</diverge_reform>");
     let _ = writeln!(w, "      <min_residual>1e-20</min_residual>");
-    // the campaign's retry (a first step below a whole load step) converges on energy and
-    // residual with `retry_dtol` / `retry_rtol` (FebioSettings docs)
-    let (dtol, rtol) = if dt_fraction < 1.0 { (s.retry_dtol, s.retry_rtol) } else { (s.dtol, s.rtol) };
+    // the campaign's retry converges on energy and residual with `retry_dtol` /
+    // `retry_rtol` (FebioSettings docs)
+    let (dtol, rtol) = if stepping.retry_tolerances { (s.retry_dtol, s.retry_rtol) } else { (s.dtol, s.rtol) };
     let _ = writeln!(w, "      <dtol>{}</dtol>", num(dtol));
     let _ = writeln!(w, "      <etol>{}</etol>", num(s.etol));
     let _ = writeln!(w, "      <rtol>{}</rtol>", num(rtol));
@@ -311,7 +368,10 @@ fn write_contact(w: &mut String, c: &Campaign) {
     let _ = writeln!(w, "  </Contact>");
 }
 
-fn write_load_data(w: &mut String, depth: f64, steps: u32) {
+/// The must points and, as the load curve's values, the largest time step up to each
+/// (FEBio's `dtmax` curve: between must points k-1 and k it is point k's value); within
+/// the first-contact depth the cap of [`FirstContact`].
+fn write_load_data(w: &mut String, depth: f64, steps: u32, first_contact: Option<FirstContact>) {
     let dt = depth / f64::from(steps);
     let _ = writeln!(w, "  <LoadData>");
     let _ = writeln!(w, r#"    <load_controller id="1" name="feed_mm" type="loadcurve">"#);
@@ -322,7 +382,11 @@ fn write_load_data(w: &mut String, depth: f64, steps: u32) {
     let _ = writeln!(w, r#"    <load_controller id="2" name="must_points" type="loadcurve">"#);
     let _ = writeln!(w, "      <interpolate>STEP</interpolate>\n      <extend>CONSTANT</extend>\n      <points>");
     for k in 1..=steps {
-        let _ = writeln!(w, "        <pt>{},{}</pt>", num(depth * f64::from(k) / f64::from(steps)), num(dt));
+        let t = depth * f64::from(k) / f64::from(steps);
+        // the step ending at t starts within the first-contact depth
+        let capped = first_contact.filter(|fc| t - dt < fc.depth_mm - 1e-9 * depth);
+        let dtmax = capped.map_or(dt, |fc| dt * fc.step_fraction);
+        let _ = writeln!(w, "        <pt>{},{}</pt>", num(t), num(dtmax));
     }
     let _ = writeln!(w, "      </points>\n    </load_controller>");
     let _ = writeln!(w, "  </LoadData>");

@@ -9,6 +9,7 @@
 
 pub mod failures;
 pub mod feb;
+pub mod ladder;
 pub mod logs;
 pub mod restart;
 
@@ -134,8 +135,11 @@ impl Backend for FebioBackend {
         "febio"
     }
 
-    /// Five attempts, each changing one thing that was seen to decide convergence:
-    /// 1. the spec's settings;
+    /// Five attempts, decided by the retry ladder (`ladder.rs`) from what the earlier
+    /// attempts did. The attempts from depth 0, in order, each changing one thing that was
+    /// seen to decide convergence:
+    /// 1. the spec's settings (later whole-step attempts take the first-contact steps,
+    ///    `first_contact_depth_mm`, once an attempt failed at first contact);
     /// 2. the contact projections updated by the other rule (`retry_seg_up` instead of
     ///    `seg_up`: freezing them stops a node chattering between two facets, x+02 on
     ///    needle8, but lets other poses, tx+04 and z+10, invert elements at 0.6 mm);
@@ -143,6 +147,10 @@ impl Backend for FebioBackend {
     ///    (`retry_dtol`, `retry_rtol`), `seg_up`;
     /// 4. as 3 with `retry_seg_up`;
     /// 5. as 3 with the penalty scaled by `last_attempt_penalty_scale`.
+    ///
+    /// After a whole-step attempt that got further than any before it, the next attempt
+    /// continues it from its last converged must point with the retry tolerances instead
+    /// (then the fresh ones go on where they were).
     ///
     /// On the full block (no mirror plane) attempts 1 and 2, and 3 and 4, swap their
     /// projection rules (`retry_seg_up` first, then `seg_up`): in the default set's rerun
@@ -167,22 +175,52 @@ impl Backend for FebioBackend {
 
     fn solve(&self, job: &Job<'_>) -> std::result::Result<Solved, SolveFailure> {
         let exe = self.exe.as_deref().context("FebioBackend::solve before prepare")?;
-        let changed;
-        let campaign = match attempt_change(job.attempt, job.pose.symmetry()) {
-            AttemptChange::None => job.campaign,
-            change => {
-                let mut c = job.campaign.clone();
-                let s = &mut c.solver.febio;
-                if change == AttemptChange::RetrySegUp {
-                    s.seg_up = s.retry_seg_up;
-                } else {
-                    s.penalty *= s.last_attempt_penalty_scale;
-                }
-                changed = c;
-                &changed
-            }
+        // the ladder's state: what the earlier attempts at this pose did (none on the first)
+        let mut state = if job.attempt == 0 {
+            remove_if_exists(&job.work_dir.join(ladder::STATE_FILE))?;
+            remove_if_exists(&job.work_dir.join(ladder::FURTHEST_DUMP))?;
+            ladder::State::default()
+        } else {
+            ladder::State::read(job.work_dir)?
         };
-        let feb = feb::write(campaign, job.pose, job.mesh, job.steps, job.first_increment).context("writing the FEBio input")?;
+        let symmetry = job.pose.symmetry();
+        let mut plan = ladder::next(&state, !symmetry.plane_x && !symmetry.plane_z);
+        let resume = match plan {
+            ladder::Plan::Continue { .. } => match &state.furthest {
+                Some(f) if job.work_dir.join(ladder::FURTHEST_DUMP).is_file() => Some(f.clone()),
+                // the dump is gone (a folder cleared by hand): the fresh ladder
+                _ => {
+                    state.furthest = None;
+                    plan = ladder::next(&state, !symmetry.plane_x && !symmetry.plane_z);
+                    None
+                }
+            },
+            ladder::Plan::Fresh(_) => None,
+        };
+        let contact = plan.contact();
+        let changed;
+        let campaign = if contact.seg_up == ladder::SegUp::Spec && !contact.softer {
+            job.campaign
+        } else {
+            let mut c = job.campaign.clone();
+            let s = &mut c.solver.febio;
+            if contact.seg_up == ladder::SegUp::Retry {
+                s.seg_up = s.retry_seg_up;
+            }
+            if contact.softer {
+                s.penalty *= s.last_attempt_penalty_scale;
+            }
+            changed = c;
+            &changed
+        };
+        let fs = &campaign.solver.febio;
+        let contact_steps = ladder::first_contact_steps(fs.first_contact_depth_mm, job.campaign.loading.depth_mm, job.steps);
+        let first_contact = (!plan.retry_tolerances() && ladder::failed_at_first_contact(&state, contact_steps))
+            .then_some(feb::FirstContact { depth_mm: fs.first_contact_depth_mm, step_fraction: fs.first_contact_step_fraction });
+        let stepping =
+            feb::Stepping { first_step_fraction: plan.first_increment(), retry_tolerances: plan.retry_tolerances(), first_contact };
+        // a continuation writes the model too: the record of its contact, kept with its logs
+        let feb = feb::write_stepped(campaign, job.pose, job.mesh, job.steps, &stepping).context("writing the FEBio input")?;
         let input = job.work_dir.join(format!("{JOB}.feb"));
         std::fs::write(&input, &feb.text).with_context(|| format!("{}: cannot write", input.display()))?;
         let rb_path = job.work_dir.join(feb::RIGID_LOG);
@@ -193,22 +231,37 @@ impl Backend for FebioBackend {
             remove_if_exists(&restart::segment_log(job.work_dir, n))?;
             remove_if_exists(&job.work_dir.join(restart::segment_solver_log_name(n)))?;
         }
-        for f in [rb_path.clone(), job.work_dir.join(restart::DUMP), job.work_dir.join(restart::DUMP_FROM)] {
+        for f in [rb_path.clone(), log_path.clone(), job.work_dir.join(restart::DUMP), job.work_dir.join(restart::DUMP_FROM)] {
             remove_if_exists(&f)?;
         }
         let depth = job.campaign.loading.depth_mm;
         let step_mm = depth / f64::from(job.steps.max(1));
+        let dtmin = step_mm * fs.dtmin_fraction * restart::CONTINUE_DTMIN_SCALE;
+        // a continuation's restarts set the retry tolerances: the dump carries the run's own
+        let tolerances = plan.retry_tolerances().then_some(restart::Tolerances { dtol: fs.retry_dtol, rtol: fs.retry_rtol });
         let started = std::time::Instant::now();
         let mut segments: Vec<logs::RigidRecord> = Vec::new();
         let mut cont = restart::Continuations::default();
+        let mut restarting = false;
+        if let Some(f) = &resume {
+            let from = job.work_dir.join(restart::DUMP_FROM);
+            let dump = job.work_dir.join(ladder::FURTHEST_DUMP);
+            std::fs::copy(&dump, &from).with_context(|| format!("{}: cannot copy to {}", dump.display(), from.display()))?;
+            let restart_in = job.work_dir.join(restart::RESTART_INPUT);
+            std::fs::write(&restart_in, restart::restart_input(step_mm * plan.first_increment(), dtmin, tolerances))
+                .with_context(|| format!("{}: cannot write", restart_in.display()))?;
+            segments = f.rigid_records(depth, job.steps);
+            eprintln!("{}: attempt {}: {}", job.pose.name, job.attempt + 1, plan.describe(depth, job.steps));
+            restarting = true;
+        }
         let mut totals = logs::RunLog::default();
         let (done, run, log_tail, at_steps, done_steps) = loop {
             let mut cmd = Command::new(exe);
             cmd.arg("-nosplash");
-            if cont.from_mm.is_empty() {
-                cmd.arg("-i").arg(format!("{JOB}.feb")).arg("-p").arg(format!("{JOB}.xplt"));
-            } else {
+            if restarting {
                 cmd.arg("-r").arg(restart::RESTART_INPUT).arg("-noappend").arg("-p").arg(format!("{JOB}.xplt"));
+            } else {
+                cmd.arg("-i").arg(format!("{JOB}.feb")).arg("-p").arg(format!("{JOB}.xplt"));
             }
             cmd.arg("-o")
                 .arg(format!("{JOB}.log"))
@@ -237,10 +290,15 @@ impl Backend for FebioBackend {
             let done_steps = at_steps.iter().take_while(|w| w.is_some()).count();
             let solved = done.exit == ExitKind::Code(0) && run.normal_termination && done_steps >= job.steps as usize;
             // continue from the last must point when the solver gave up (not on a
-            // timeout, stall or stop) and a dump of a converged must point exists
+            // timeout, stall or stop) and a dump of a converged must point exists; the
+            // must point a continuation of another attempt started from counts as one
             let last_mm = done_steps as f64 * step_mm;
+            let mut tried_from = cont.clone();
+            if let Some(f) = &resume {
+                tried_from.from_mm.insert(0, ladder::depth_at(depth, job.steps, f.steps));
+            }
             let next = (!solved && matches!(done.exit, ExitKind::Code(_)) && done_steps > 0 && !process::interrupted())
-                .then(|| cont.next_fraction(last_mm))
+                .then(|| tried_from.next_fraction(last_mm))
                 .flatten()
                 .filter(|_| job.work_dir.join(restart::DUMP).is_file());
             let Some(fraction) = next else {
@@ -264,17 +322,60 @@ impl Backend for FebioBackend {
             segments = all;
             let from = job.work_dir.join(restart::DUMP_FROM);
             std::fs::copy(job.work_dir.join(restart::DUMP), &from).with_context(|| format!("{}: cannot write", from.display()))?;
-            let dtmin = step_mm * campaign.solver.febio.dtmin_fraction * restart::CONTINUE_DTMIN_SCALE;
             let input = job.work_dir.join(restart::RESTART_INPUT);
-            std::fs::write(&input, restart::restart_input(step_mm * fraction, dtmin))
+            std::fs::write(&input, restart::restart_input(step_mm * fraction, dtmin, tolerances))
                 .with_context(|| format!("{}: cannot write", input.display()))?;
             cont.from_mm.push(last_mm);
+            restarting = true;
         };
+        let line = {
+            let mut line = settings_line(fs, campaign.contact.friction, self.threads, plan.retry_tolerances());
+            if let Some(fc) = first_contact {
+                line.push_str(&format!("; time steps <= {} of a load step to {} mm (first contact)", fc.step_fraction, fc.depth_mm));
+            }
+            if let Some(f) = &resume {
+                line.push_str(&format!(
+                    "; continued attempt {}'s last converged must point ({} mm; to there: {})",
+                    f.attempt,
+                    ladder::depth_at(depth, job.steps, f.steps),
+                    f.settings
+                ));
+            }
+            let continued = cont.describe();
+            if !continued.is_empty() {
+                line.push_str(&format!("; {continued}"));
+            }
+            line
+        };
+        let failed = done.exit != ExitKind::Code(0) || !run.normal_termination || done_steps < job.steps as usize;
+        if failed && !process::interrupted() {
+            // keep the furthest attempt's dump for the ladder's next attempt
+            let steps = done_steps as u32;
+            let dump = job.work_dir.join(restart::DUMP);
+            let mut kept_dump = false;
+            if state.is_further(steps) && dump.is_file() {
+                let furthest = job.work_dir.join(ladder::FURTHEST_DUMP);
+                std::fs::rename(&dump, &furthest).with_context(|| format!("{}: cannot keep as {}", dump.display(), furthest.display()))?;
+                let records = at_steps.iter().take(done_steps).map_while(|v| *v).collect();
+                state.furthest = Some(ladder::Furthest { attempt: job.attempt + 1, steps, records, settings: line.clone() });
+                kept_dump = true;
+            }
+            state.tried.push(ladder::Tried { attempt: job.attempt + 1, plan, reached_steps: steps });
+            state.write(job.work_dir)?;
+            if kept_dump {
+                eprintln!(
+                    "{}: attempt {}'s dump at {} mm kept for the next attempt",
+                    job.pose.name,
+                    job.attempt + 1,
+                    ladder::depth_at(depth, job.steps, steps)
+                );
+            }
+        }
         // the dumps are large (tens of MB) and only needed while the run goes on
         for f in [restart::DUMP, restart::DUMP_FROM] {
             let _ = std::fs::remove_file(job.work_dir.join(f));
         }
-        if done.exit != ExitKind::Code(0) || !run.normal_termination || done_steps < job.steps as usize {
+        if failed {
             let how = match done.exit {
                 ExitKind::Code(0) if run.error_termination => "ended with ERROR TERMINATION".to_string(),
                 ExitKind::Code(0) => "exited 0".to_string(),
@@ -282,14 +383,18 @@ impl Backend for FebioBackend {
             };
             let kept = keep_failed_attempt(job);
             let continued = cont.describe();
+            let resumed = resume
+                .as_ref()
+                .map(|f| format!(", continuing attempt {} from {} mm", f.attempt, ladder::depth_at(depth, job.steps, f.steps)));
             return Err(SolveFailure {
                 message: format!(
-                    "febio4 {how} after {done_steps} of {} steps (t = {} mm), {} time steps, {} retries, {:.1} s{}{}{kept}",
+                    "febio4 {how} after {done_steps} of {} steps (t = {} mm), {} time steps, {} retries, {:.1} s{}{}{}{kept}",
                     job.steps,
                     run.last_time,
                     totals.time_steps,
                     totals.retries,
                     started.elapsed().as_secs_f64(),
+                    resumed.unwrap_or_default(),
                     if continued.is_empty() { String::new() } else { format!(", {continued}") },
                     run.cause.as_deref().map(|c| format!(": {c}")).unwrap_or_default(),
                 ),
@@ -297,6 +402,7 @@ impl Backend for FebioBackend {
                 reached: at_steps.iter().map_while(|v| v.map(|v| expand_mirrors(v.map(|x| REACTION_SIGN * x), feb.symmetry))).collect(),
             });
         }
+        let _ = std::fs::remove_file(job.work_dir.join(ladder::FURTHEST_DUMP));
         let run = logs::RunLog { time_steps: totals.time_steps, iterations: totals.iterations, ..run };
         let wrenches = at_steps
             .into_iter()
@@ -310,20 +416,20 @@ impl Backend for FebioBackend {
             summary: feb.summary,
             increments: run.time_steps,
             iterations: run.iterations,
-            first_increment: job.first_increment,
+            first_increment: plan.first_increment(),
             retry: None,
             element: "hex8, three-field (u-p-J) for the uncoupled Ogden tissue; rigid-body needle".into(),
             peak_rss_mib: done.peak_rss_mib,
-            settings: {
-                let line = settings_line(&campaign.solver.febio, campaign.contact.friction, self.threads, job.first_increment < 1.0);
-                let continued = cont.describe();
-                if continued.is_empty() {
-                    line
-                } else {
-                    format!("{line}; {continued}")
-                }
-            },
+            settings: line,
         })
+    }
+
+    fn first_increment_in(&self, work_dir: &Path, attempt: u32, full_block: bool) -> f64 {
+        self.plan_in(work_dir, attempt, full_block).first_increment()
+    }
+
+    fn describe_attempt(&self, work_dir: &Path, attempt: u32, full_block: bool, depth_mm: f64, steps: u32) -> String {
+        self.plan_in(work_dir, attempt, full_block).describe(depth_mm, steps)
     }
 
     /// Must points logged so far, over the continued segments' logs too.
@@ -334,24 +440,11 @@ impl Backend for FebioBackend {
     }
 }
 
-/// What attempt `attempt` (0-based) changes in the spec's contact settings
-/// (`FebioBackend::attempts`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum AttemptChange {
-    /// The spec's settings.
-    None,
-    /// `seg_up` replaced by `retry_seg_up`.
-    RetrySegUp,
-    /// The penalty scaled by `last_attempt_penalty_scale`.
-    SofterPenalty,
-}
-
-fn attempt_change(attempt: u32, symmetry: crate::spec::Symmetry) -> AttemptChange {
-    let full_block = !symmetry.plane_x && !symmetry.plane_z;
-    match attempt {
-        0..=3 if (attempt % 2 == 1) != full_block => AttemptChange::RetrySegUp,
-        0..=3 => AttemptChange::None,
-        _ => AttemptChange::SofterPenalty,
+impl FebioBackend {
+    /// The ladder's plan for `attempt` (0-based) from the state in `work_dir`.
+    fn plan_in(&self, work_dir: &Path, attempt: u32, full_block: bool) -> ladder::Plan {
+        let state = if attempt == 0 { ladder::State::default() } else { ladder::State::read(work_dir).unwrap_or_default() };
+        ladder::next(&state, full_block)
     }
 }
 
@@ -430,24 +523,38 @@ mod tests {
         assert_eq!(parse_version("version: unknown"), None);
     }
 
+    /// How the fake febio4's restarts behave.
+    #[derive(Clone, Copy, PartialEq)]
+    enum Restarts {
+        /// Every restart logs 4.5 and 6 mm.
+        Pass,
+        /// Every restart gives up again without a new must point.
+        Stuck,
+        /// Only a restart that sets Newton's tolerances (`<solver>`: the retry's) passes.
+        PassWithRetryTolerances,
+    }
+
     /// A stand-in for febio4 (a shell script; bookkeeping only, no physics): the first
     /// run logs the must points at 1.5 and 3 mm, dumps and gives up at 3.2 mm; a restart
-    /// (`-r`) checks its input and archive, then logs 4.5 and 6 mm, or (`stuck`) gives up
-    /// again without a new must point.
-    fn fake_febio(dir: &Path, stuck: bool) -> PathBuf {
+    /// (`-r`) checks its input and archive, then logs 4.5 and 6 mm, or gives up again
+    /// without a new must point ([`Restarts`]).
+    fn fake_febio(dir: &Path, restarts: Restarts) -> PathBuf {
         use std::os::unix::fs::PermissionsExt;
         let rb = |ts: &[(f64, f64)]| -> String {
             ts.iter()
                 .map(|(t, v)| format!("*Step  = 1\\n*Time  = {t}\\n*Data  = Fx;Fy;Fz;Mx;My;Mz\\n2,{v},{v},{v},{v},{v},{v}\\n"))
                 .collect()
         };
-        let restart = if stuck {
-            "printf ' ------- failed to converge at time : 3.1\\n E R R O R   T E R M I N A T I O N\\n' > pose.log; exit 1".to_string()
-        } else {
-            format!(
-                "printf '{}' > needle-rb.txt; printf ' ------- converged at time : 4.5\\n ------- converged at time : 6\\n N O R M A L   T E R M I N A T I O N\\n' > pose.log; exit 0",
-                rb(&[(4.5, 3.0), (6.0, 4.0)])
-            )
+        let stuck =
+            "printf ' ------- failed to converge at time : 3.1\\n E R R O R   T E R M I N A T I O N\\n' > pose.log; exit 1".to_string();
+        let pass = format!(
+            "printf '{}' > needle-rb.txt; printf ' ------- converged at time : 4.5\\n ------- converged at time : 6\\n N O R M A L   T E R M I N A T I O N\\n' > pose.log; exit 0",
+            rb(&[(4.5, 3.0), (6.0, 4.0)])
+        );
+        let restart = match restarts {
+            Restarts::Pass => pass,
+            Restarts::Stuck => stuck,
+            Restarts::PassWithRetryTolerances => format!("if grep -q '<solver>' pose-restart.feb; then {pass}; else {stuck}; fi"),
         };
         let script = format!(
             "#!/bin/sh\n\
@@ -481,7 +588,8 @@ mod tests {
             std::fs::create_dir_all(&work).expect("mkdir");
             // an earlier campaign's attempt 1 that was continued twice
             std::fs::write(work.join("failed-attempt-1.log-1"), "an earlier campaign's").expect("write");
-            let backend = FebioBackend { exe: Some(fake_febio(d.path(), stuck)), threads: 1 };
+            let restarts = if stuck { Restarts::Stuck } else { Restarts::Pass };
+            let backend = FebioBackend { exe: Some(fake_febio(d.path(), restarts)), threads: 1 };
             let job = Job {
                 campaign: &c,
                 pose: &pose,
@@ -523,6 +631,60 @@ mod tests {
                 assert!(restart.contains(&format!("<step_size>{:e}</step_size>", 1.5 * restart::CONTINUE_STEP_FRACTION)), "{restart}");
             }
         }
+    }
+
+    /// The ladder's next attempt continues the furthest attempt from its dump with the
+    /// retry tolerances (not from depth 0), keeps that attempt's must points and says so
+    /// in the manifest's settings; the first attempt's first-contact steps are in its
+    /// input. (Bookkeeping: the fake solves only a restart that sets the tolerances.)
+    #[test]
+    fn the_next_attempt_continues_the_furthest_from_its_dump() {
+        let d = tempfile::tempdir().expect("tempdir");
+        let set = d.path().join("set");
+        std::fs::create_dir_all(&set).expect("mkdir");
+        std::fs::copy(crate::workspace_root().join("coeffs/default/campaign.toml"), set.join("campaign.toml")).expect("copy");
+        let (mut c, _) = crate::spec::load(&set).expect("spec");
+        c.loading.steps = 4;
+        let pose = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");
+        let mesh = c.mesh_level("smoke").expect("smoke").clone();
+        let work = d.path().join("work");
+        std::fs::create_dir_all(&work).expect("mkdir");
+        let backend = FebioBackend { exe: Some(fake_febio(d.path(), Restarts::PassWithRetryTolerances)), threads: 1 };
+        let job = |attempt: u32| Job {
+            campaign: &c,
+            pose: &pose,
+            mesh_name: "smoke",
+            mesh: &mesh,
+            steps: 4,
+            work_dir: &work,
+            timeout: None,
+            stall: None,
+            first_increment: 1.0,
+            attempt,
+        };
+        let f = backend.solve(&job(0)).expect_err("attempt 1: its own continuation has the run's tolerances and is stuck");
+        assert!(f.message.contains("after 2 of 4 steps"), "{}", f.message);
+        let feb1 = std::fs::read_to_string(work.join("failed-attempt-1.feb")).unwrap_or_default();
+        // a first attempt has whole steps: no failure at first contact yet
+        assert!(feb1.contains("<step_size>1.5</step_size>") && feb1.contains("<pt>1.5,1.5</pt>"), "{feb1}");
+        let state = ladder::State::read(&work).expect("state");
+        assert_eq!(state.furthest.as_ref().map(|f| (f.attempt, f.steps)), Some((1, 2)));
+        assert!(work.join(ladder::FURTHEST_DUMP).is_file() && !work.join(restart::DUMP).exists());
+        assert_eq!(backend.first_increment_in(&work, 1, false), crate::deck::RETRY_FIRST_INCREMENT);
+        assert!(backend
+            .describe_attempt(&work, 1, false, 6.0, 4)
+            .starts_with("continuing attempt 1 from its last converged must point (3 mm"));
+        let s = backend.solve(&job(1)).unwrap_or_else(|f| panic!("attempt 2 continues attempt 1: {}", f.message));
+        let fy: Vec<f64> = s.wrenches.iter().map(|w| w[1]).collect();
+        assert_eq!(fy, vec![-4.0, -8.0, -12.0, -16.0], "attempt 1's must points, then the continuation's");
+        assert!(s.settings.contains("continued attempt 1's last converged must point (3 mm; to there: "), "{}", s.settings);
+        assert!(s.settings.contains(&format!("dtol {} etol", c.solver.febio.retry_dtol)), "the retry tolerances: {}", s.settings);
+        assert_eq!(s.first_increment, crate::deck::RETRY_FIRST_INCREMENT);
+        let restart = std::fs::read_to_string(work.join(restart::RESTART_INPUT)).expect("restart input");
+        assert!(restart.contains(&format!("<step_size>{:e}</step_size>", 1.5 * crate::deck::RETRY_FIRST_INCREMENT)), "{restart}");
+        assert!(!work.join(ladder::FURTHEST_DUMP).exists(), "the kept dump goes once the pose solves");
+        // a new campaign's first attempt starts from depth 0 whatever the folder holds
+        assert_eq!(backend.first_increment_in(&work, 0, false), 1.0);
     }
 
     #[test]

@@ -59,8 +59,10 @@ pub fn segment_solver_log_name(n: u32) -> String {
 }
 
 /// The restart input: the archive to read, the first time step (mm of insertion: time is
-/// depth), the time stepper's limits.
-pub fn restart_input(first_step_mm: f64, dtmin_mm: f64) -> String {
+/// depth), the time stepper's limits and, when given, the Newton solver's displacement
+/// and residual tolerances (`dtol`, `rtol`: a continuation of another attempt with the
+/// retry tolerances, `ladder.rs`; FEBio's restart reads `<solver>` parameters).
+pub fn restart_input(first_step_mm: f64, dtmin_mm: f64, tolerances: Option<Tolerances>) -> String {
     let mut s = String::new();
     let _ = writeln!(s, r#"<?xml version="1.0" encoding="ISO-8859-1"?>"#);
     let _ = writeln!(s, "<!-- needle-haptics: continue the run from its last converged must point (fe/febio/restart.rs) -->");
@@ -72,9 +74,24 @@ pub fn restart_input(first_step_mm: f64, dtmin_mm: f64) -> String {
     let _ = writeln!(s, "      <max_retries>{CONTINUE_MAX_RETRIES}</max_retries>");
     let _ = writeln!(s, "      <dtmin>{dtmin_mm:e}</dtmin>");
     let _ = writeln!(s, "    </time_stepper>");
+    if let Some(t) = tolerances {
+        let _ = writeln!(s, "    <solver>");
+        let _ = writeln!(s, "      <dtol>{:e}</dtol>", t.dtol);
+        let _ = writeln!(s, "      <rtol>{:e}</rtol>", t.rtol);
+        let _ = writeln!(s, "    </solver>");
+    }
     let _ = writeln!(s, "  </Control>");
     let _ = writeln!(s, "</febio_restart>");
     s
+}
+
+/// Newton's convergence tolerances a restart sets.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tolerances {
+    /// Displacement (`dtol`; 0: off).
+    pub dtol: f64,
+    /// Residual (`rtol`; 0: off).
+    pub rtol: f64,
 }
 
 /// What the continuations of one attempt did, for the manifest and failure messages.
@@ -120,7 +137,10 @@ mod tests {
         c.from_mm = (0..MAX_CONTINUATIONS).map(f64::from).collect();
         assert_eq!(c.next_fraction(100.0), None);
         assert!(Continuations { from_mm: vec![3.6, 4.5] }.describe().contains("2 time(s)"));
-        let r = restart_input(0.02, 3e-5);
+        let r = restart_input(0.02, 3e-5, None);
         assert!(r.contains("<Archive>pose-from.dmp</Archive>") && r.contains("<step_size>2e-2</step_size>"), "{r}");
+        assert!(!r.contains("<solver>"), "the run's own tolerances: {r}");
+        let r = restart_input(0.075, 3e-5, Some(Tolerances { dtol: 0.0, rtol: 1e-3 }));
+        assert!(r.contains("<solver>\n      <dtol>0e0</dtol>\n      <rtol>1e-3</rtol>\n    </solver>\n  </Control>"), "{r}");
     }
 }
