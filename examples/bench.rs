@@ -99,9 +99,10 @@ mod firmware {
 
     /// An insertion model the bench ticks: the f32 one or the fixed-point one.
     trait Ticks: Copy {
-        type Pose;
+        type Pose: Copy;
         type Out;
         fn tick(&mut self, pose: &Self::Pose) -> Self::Out;
+        fn status_bits(out: &Self::Out) -> u8;
     }
 
     impl Ticks for Insertion {
@@ -110,6 +111,9 @@ mod firmware {
         fn tick(&mut self, pose: &Pose) -> InsertionEvaluation {
             self.step(pose)
         }
+        fn status_bits(out: &InsertionEvaluation) -> u8 {
+            out.status.bits()
+        }
     }
 
     impl Ticks for FixedInsertion<'_> {
@@ -117,6 +121,9 @@ mod firmware {
         type Out = fixed::insertion::InsertionEvaluation;
         fn tick(&mut self, pose: &fixed::Pose) -> fixed::insertion::InsertionEvaluation {
             self.step(pose)
+        }
+        fn status_bits(out: &fixed::insertion::InsertionEvaluation) -> u8 {
+            out.status.bits()
         }
     }
 
@@ -134,6 +141,34 @@ mod firmware {
             }
         }
         elapsed(t0, SYST::get_current())
+    }
+
+    /// One insertion model's line: instructions per step from the state `ins` at `pose`
+    /// (the timed loop minus the empty one), the stack of one step and its status,
+    /// labelled `<stack>-<case>` with the evaluator's name (`what`).
+    fn bench_insertion<T: Ticks>(out: &mut Out, cal: &Calibration, ins: &T, pose: &T::Pose, what: (&str, &str, &str)) {
+        let (stack, case, evaluator) = what;
+        let tenths = cal.tenths_per_call(
+            loop_insertion(ins, pose, black_box(CALLS), true),
+            loop_insertion(ins, pose, black_box(CALLS), false),
+            CALLS,
+        );
+        let step: fn(&(T, T::Pose)) -> T::Out = |p| {
+            let mut i = p.0;
+            i.tick(&p.1)
+        };
+        let stack_bytes = stack_use(step, &(*ins, *pose));
+        let mut label = [0u8; 24];
+        let n = label_of(&mut label, stack, case);
+        let status = T::status_bits(&step(&(*ins, *pose)));
+        report(
+            out,
+            label.get(..n).and_then(|l| core::str::from_utf8(l).ok()).unwrap_or("insertion"),
+            evaluator,
+            tenths,
+            stack_bytes,
+            status,
+        );
     }
 
     /// The fixed-point state of a needle advanced at 3 mm/s along `pose`'s axis to its
@@ -270,25 +305,7 @@ mod firmware {
             let cases = [("surface", Pose::new(3.0, -2.0, 5.0, -7.0, 4.5)), ("deep", Pose::new(3.0, -2.0, 5.0, -7.0, total + 2.0))];
             for (name, pose) in cases {
                 let Some(ins) = advanced(stack, &pose) else { continue };
-                let tw = loop_insertion(&ins, &pose, black_box(CALLS), true);
-                let te = loop_insertion(&ins, &pose, black_box(CALLS), false);
-                let tenths = per_call(tw, te);
-                let step: fn(&(Insertion, Pose)) -> InsertionEvaluation = |p| {
-                    let mut i = p.0;
-                    i.step(&p.1)
-                };
-                let stack_bytes = stack_use(step, &(ins, pose));
-                let mut label = [0u8; 24];
-                let n = label_of(&mut label, stack.name, name);
-                let status = step(&(ins, pose)).status.bits();
-                report(
-                    &mut out,
-                    label.get(..n).and_then(|l| core::str::from_utf8(l).ok()).unwrap_or("insertion"),
-                    "insertion",
-                    tenths,
-                    stack_bytes,
-                    status,
-                );
+                bench_insertion(&mut out, &cal, &ins, &pose, (stack.name, name, "insertion"));
             }
         }
         // The fixed-point insertion, the same cases in Q16.16.
@@ -297,24 +314,7 @@ mod firmware {
             let tilted = |depth| fixed::Pose::new(3 * ONE, -2 * ONE, 5 * ONE, -7 * ONE, depth);
             for (name, pose) in [("surface", tilted(9 * ONE / 2)), ("deep", tilted(total + 2 * ONE))] {
                 let Some(ins) = advanced_fixed(stack, &pose) else { continue };
-                let tenths =
-                    per_call(loop_insertion(&ins, &pose, black_box(CALLS), true), loop_insertion(&ins, &pose, black_box(CALLS), false));
-                let step: fn(&(FixedInsertion<'_>, fixed::Pose)) -> fixed::insertion::InsertionEvaluation = |p| {
-                    let mut i = p.0;
-                    i.step(&p.1)
-                };
-                let stack_bytes = stack_use(step, &(ins, pose));
-                let mut label = [0u8; 24];
-                let n = label_of(&mut label, stack.name, name);
-                let status = step(&(ins, pose)).status.bits();
-                report(
-                    &mut out,
-                    label.get(..n).and_then(|l| core::str::from_utf8(l).ok()).unwrap_or("insertion"),
-                    "fixed-insertion",
-                    tenths,
-                    stack_bytes,
-                    status,
-                );
+                bench_insertion(&mut out, &cal, &ins, &pose, (stack.name, name, "fixed-insertion"));
             }
         }
         out.str("needle-bench end\n");
