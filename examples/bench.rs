@@ -25,6 +25,10 @@
 //!   [`needle_haptics::wrench_and_stiffness`] (the wrench and its 18 rates; its result is
 //!   100 bytes), `fixed+k` [`needle_haptics::fixed::wrench_and_stiffness`] (the same in
 //!   integers).
+//! - **Insertion** (per compiled-in stack, a tick deflecting the surface and a tick deep
+//!   inside, from a state advanced there at 3 mm/s): evaluator `insertion`
+//!   ([`needle_haptics::insertion::Insertion::step`]) and `fixed-insertion`
+//!   ([`needle_haptics::fixed::insertion::Insertion::step`], the same poses in Q16.16).
 //! - **Stack**: the 4 KiB below the caller's stack pointer is painted with a pattern,
 //!   one evaluation runs, and the deepest overwritten word gives the bytes used.
 //!
@@ -32,7 +36,7 @@
 //!
 //! ```text
 //! needle-bench target=<triple> calls=<CALLS> calibration_instructions=<n> calibration_ticks=<n> deterministic=<yes|no>
-//! needle-bench pose=<name> evaluator=<f32|f32+k|fixed|fixed+k> instructions_per_wrench=<n.n> stack_bytes=<n> status=0x<ss>
+//! needle-bench pose=<name> evaluator=<f32|f32+k|fixed|fixed+k|insertion|fixed-insertion> instructions_per_wrench=<n.n> stack_bytes=<n> status=0x<ss>
 //! ...
 //! needle-bench end
 //! ```
@@ -48,6 +52,7 @@ mod firmware {
     use core::arch::asm;
     use core::hint::black_box;
     use cortex_m::peripheral::SYST;
+    use needle_haptics::fixed::insertion::Insertion as FixedInsertion;
     use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, InsertionEvaluation};
     use needle_haptics::{fixed, wrench, wrench_and_stiffness, Pose};
 
@@ -92,20 +97,90 @@ mod firmware {
         elapsed(start, SYST::get_current())
     }
 
+    /// An insertion model the bench ticks: the f32 one or the fixed-point one.
+    trait Ticks: Copy {
+        type Pose: Copy;
+        type Out;
+        fn tick(&mut self, pose: &Self::Pose) -> Self::Out;
+        fn status_bits(out: &Self::Out) -> u8;
+    }
+
+    impl Ticks for Insertion {
+        type Pose = Pose;
+        type Out = InsertionEvaluation;
+        fn tick(&mut self, pose: &Pose) -> InsertionEvaluation {
+            self.step(pose)
+        }
+        fn status_bits(out: &InsertionEvaluation) -> u8 {
+            out.status.bits()
+        }
+    }
+
+    impl Ticks for FixedInsertion<'_> {
+        type Pose = fixed::Pose;
+        type Out = fixed::insertion::InsertionEvaluation;
+        fn tick(&mut self, pose: &fixed::Pose) -> fixed::insertion::InsertionEvaluation {
+            self.step(pose)
+        }
+        fn status_bits(out: &fixed::insertion::InsertionEvaluation) -> u8 {
+            out.status.bits()
+        }
+    }
+
     /// `calls` insertion ticks at `pose` from the state `ins` (each from the same state:
     /// the state is restored from `start` before each tick, which the empty loop does too).
     #[inline(never)]
-    fn loop_insertion(start: &Insertion, pose: &Pose, calls: u32, tick: bool) -> u32 {
+    fn loop_insertion<T: Ticks>(start: &T, pose: &T::Pose, calls: u32, tick: bool) -> u32 {
         let t0 = SYST::get_current();
         for _ in 0..calls {
             let mut ins = *black_box(start);
             if tick {
-                black_box(&ins.step(black_box(pose)));
+                black_box(&ins.tick(black_box(pose)));
             } else {
                 black_box(&mut ins);
             }
         }
         elapsed(t0, SYST::get_current())
+    }
+
+    /// One insertion model's line: instructions per step from the state `ins` at `pose`
+    /// (the timed loop minus the empty one), the stack of one step and its status,
+    /// labelled `<stack>-<case>` with the evaluator's name (`what`).
+    fn bench_insertion<T: Ticks>(out: &mut Out, cal: &Calibration, ins: &T, pose: &T::Pose, what: (&str, &str, &str)) {
+        let (stack, case, evaluator) = what;
+        let tenths = cal.tenths_per_call(
+            loop_insertion(ins, pose, black_box(CALLS), true),
+            loop_insertion(ins, pose, black_box(CALLS), false),
+            CALLS,
+        );
+        let step: fn(&(T, T::Pose)) -> T::Out = |p| {
+            let mut i = p.0;
+            i.tick(&p.1)
+        };
+        let stack_bytes = stack_use(step, &(*ins, *pose));
+        let mut label = [0u8; 24];
+        let n = label_of(&mut label, stack, case);
+        let status = T::status_bits(&step(&(*ins, *pose)));
+        report(
+            out,
+            label.get(..n).and_then(|l| core::str::from_utf8(l).ok()).unwrap_or("insertion"),
+            evaluator,
+            tenths,
+            stack_bytes,
+            status,
+        );
+    }
+
+    /// The fixed-point state of a needle advanced at 3 mm/s along `pose`'s axis to its
+    /// depth.
+    fn advanced_fixed<'a>(stack: &'a fixed::insertion::Stack, pose: &fixed::Pose) -> Option<FixedInsertion<'a>> {
+        let mut ins = FixedInsertion::new(stack, fixed::insertion::InsertionConfig::DEFAULT_1KHZ).ok()?;
+        let mut d = -fixed::Pose::ONE / 2;
+        while d < pose.depth_mm_q16 {
+            ins.step(&fixed::Pose { depth_mm_q16: d, ..*pose });
+            d += 197; // 3 µm in Q16.16 (196.6)
+        }
+        Some(ins)
     }
 
     /// The state of a needle advanced at 3 mm/s along `pose`'s axis to its depth.
@@ -230,25 +305,16 @@ mod firmware {
             let cases = [("surface", Pose::new(3.0, -2.0, 5.0, -7.0, 4.5)), ("deep", Pose::new(3.0, -2.0, 5.0, -7.0, total + 2.0))];
             for (name, pose) in cases {
                 let Some(ins) = advanced(stack, &pose) else { continue };
-                let tw = loop_insertion(&ins, &pose, black_box(CALLS), true);
-                let te = loop_insertion(&ins, &pose, black_box(CALLS), false);
-                let tenths = per_call(tw, te);
-                let step: fn(&(Insertion, Pose)) -> InsertionEvaluation = |p| {
-                    let mut i = p.0;
-                    i.step(&p.1)
-                };
-                let stack_bytes = stack_use(step, &(ins, pose));
-                let mut label = [0u8; 24];
-                let n = label_of(&mut label, stack.name, name);
-                let status = step(&(ins, pose)).status.bits();
-                report(
-                    &mut out,
-                    label.get(..n).and_then(|l| core::str::from_utf8(l).ok()).unwrap_or("insertion"),
-                    "insertion",
-                    tenths,
-                    stack_bytes,
-                    status,
-                );
+                bench_insertion(&mut out, &cal, &ins, &pose, (stack.name, name, "insertion"));
+            }
+        }
+        // The fixed-point insertion, the same cases in Q16.16.
+        for stack in &fixed::insertion::stacks::ALL {
+            let total: i32 = stack.layers().iter().map(|l| l.thickness_q16 as i32).sum();
+            let tilted = |depth| fixed::Pose::new(3 * ONE, -2 * ONE, 5 * ONE, -7 * ONE, depth);
+            for (name, pose) in [("surface", tilted(9 * ONE / 2)), ("deep", tilted(total + 2 * ONE))] {
+                let Some(ins) = advanced_fixed(stack, &pose) else { continue };
+                bench_insertion(&mut out, &cal, &ins, &pose, (stack.name, name, "fixed-insertion"));
             }
         }
         out.str("needle-bench end\n");

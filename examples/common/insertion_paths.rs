@@ -57,19 +57,93 @@ pub const PATHS: [&[Waypoint]; 5] = [
     ],
 ];
 
-/// Every tick's pose of `path`, in order, passed to `f(tick, pose)`.
-pub fn for_each_tick(path: &[Waypoint], mut f: impl FnMut(u32, [f32; 5])) {
-    let Some(&(_, start)) = path.first() else { return };
+/// The deepest waypoint of [`PATHS`], mm: the stack depth they were drawn for.
+pub const PATHS_DEEPEST_MM: f32 = deepest();
+
+const fn deepest() -> f32 {
+    let mut d = 0.0f32;
+    let mut paths: &[&[Waypoint]] = &PATHS;
+    while let [path, rest @ ..] = paths {
+        let mut waypoints: &[Waypoint] = path;
+        while let [(_, p), more @ ..] = waypoints {
+            if p[4] > d {
+                d = p[4];
+            }
+            waypoints = more;
+        }
+        paths = rest;
+    }
+    d
+}
+
+/// The factor on every waypoint's depth for `stack`: 1 for a stack no thicker than
+/// [`PATHS_DEEPEST_MM`] (the paths as drawn: the `liver`), else its total thickness over
+/// it, so the paths reach as far down a thicker stack (the `epidural`'s epidural space).
+/// Plain f32 (a sum in layer order, one division): the same bits everywhere.
+pub fn depth_scale(stack: &needle_haptics::insertion::Stack<'_>) -> f32 {
+    let mut total = 0.0f32;
+    for l in stack.layers {
+        total += l.thickness_mm;
+    }
+    if total > PATHS_DEEPEST_MM {
+        total / PATHS_DEEPEST_MM
+    } else {
+        1.0
+    }
+}
+
+/// Every tick's pose of `path`, its waypoints' depths times `depth_scale`, in order,
+/// passed to `f(tick, pose)`.
+pub fn for_each_tick(path: &[Waypoint], depth_scale: f32, mut f: impl FnMut(u32, [f32; 5])) {
+    let scaled = |(n, mut p): Waypoint| {
+        p[4] *= depth_scale;
+        (n, p)
+    };
+    let Some(&(_, start)) = path.first().map(|w| scaled(*w)).as_ref() else { return };
     let mut tick = 0u32;
     f(tick, start);
     let mut from = start;
-    for &(n, to) in path.iter().skip(1) {
+    for (n, to) in path.iter().skip(1).map(|w| scaled(*w)) {
         for k in 1..=n {
             tick += 1;
             let u = k as f32 / n as f32;
             let mut p = [0.0f32; 5];
             for ((q, a), b) in p.iter_mut().zip(from).zip(to) {
                 *q = a + (b - a) * u;
+            }
+            f(tick, p);
+        }
+        from = to;
+    }
+}
+
+/// A waypoint's pose in Q16.16 (mm and degrees times 65536, rounded to nearest): the
+/// fixed-point insertion's input.
+pub fn q16(pose: [f32; 5]) -> [i32; 5] {
+    pose.map(|v| (v * 65536.0 + if v < 0.0 { -0.5 } else { 0.5 }) as i32)
+}
+
+/// Every tick's Q16.16 pose of `path`, its waypoints' depths times `depth_scale` (in
+/// f32, as [`for_each_tick`]), in order, passed to `f(tick, pose)`: the waypoints in
+/// Q16.16 ([`q16`]), and between two of them, at tick k of n, `a + (b - a) k / n` in
+/// integers (`i64`, the quotient rounded toward zero).
+pub fn for_each_tick_q16(path: &[Waypoint], depth_scale: f32, mut f: impl FnMut(u32, [i32; 5])) {
+    let scaled = |mut p: [f32; 5]| {
+        p[4] *= depth_scale;
+        q16(p)
+    };
+    let Some(&(_, start)) = path.first() else { return };
+    let mut tick = 0u32;
+    let start = scaled(start);
+    f(tick, start);
+    let mut from = start;
+    for &(n, to) in path.iter().skip(1) {
+        let to = scaled(to);
+        for k in 1..=n {
+            tick += 1;
+            let mut p = [0i32; 5];
+            for ((q, a), b) in p.iter_mut().zip(from).zip(to) {
+                *q = a + ((i64::from(b) - i64::from(a)) * i64::from(k) / i64::from(n)) as i32;
             }
             f(tick, p);
         }
@@ -91,6 +165,17 @@ impl Digest {
     pub fn tick(&mut self, wrench: [f32; 6], status: u8, phase: u16, punctures: u8) {
         for c in wrench {
             self.word(c.to_bits());
+        }
+        self.word(u32::from(status));
+        self.word(u32::from(phase));
+        self.word(u32::from(punctures));
+    }
+
+    /// Adds one fixed-point tick: the six wrench integers (µN, µN·mm), the status, the
+    /// phase code and the punctures.
+    pub fn tick_fixed(&mut self, wrench: [i32; 6], status: u8, phase: u16, punctures: u8) {
+        for c in wrench {
+            self.word(c as u32);
         }
         self.word(u32::from(status));
         self.word(u32::from(phase));

@@ -29,15 +29,14 @@ fn no_panic_firmware_links_and_runs_on_every_core() {
     // The placeholder of an unfitted set has no evaluator to check: require the model.
     let set = firmware::fitted_set(&firmware::compiled_set()).unwrap_or_else(|e| panic!("{e:#}"));
     for core in &CORES {
-        let elfs = build::build_examples(core, &["no_panic", "no_panic_fixed", "no_panic_stiffness", "no_panic_insertion"], &set)
-            .unwrap_or_else(|e| {
-                panic!("no_panic, no_panic_fixed, no_panic_stiffness, no_panic_insertion for {} ({}): {e:#}", core.core, core.target)
-            });
+        let names = ["no_panic", "no_panic_fixed", "no_panic_stiffness", "no_panic_insertion", "no_panic_fixed_insertion"];
+        let elfs = build::build_examples(core, &names, &set)
+            .unwrap_or_else(|e| panic!("{} for {} ({}): {e:#}", names.join(", "), core.core, core.target));
         for elf in &elfs {
             let run = qemu::run(core, elf, false, Duration::from_secs(60)).unwrap_or_else(|e| panic!("{e:#}"));
             assert!(run.status.success(), "{} on {} exited with {}: {}{}", elf.display(), core.core, run.status, run.stdout, run.stderr);
         }
-        println!("{} ({}): no_panic, no_panic_fixed, no_panic_stiffness and no_panic_insertion link and run", core.core, core.target);
+        println!("{} ({}): {} link and run", core.core, core.target, names.join(", "));
     }
 }
 
@@ -45,7 +44,8 @@ fn no_panic_firmware_links_and_runs_on_every_core() {
 fn fixed_point_evaluator_has_no_floating_point_on_any_core() {
     let set = firmware::fitted_set(&firmware::compiled_set()).unwrap_or_else(|e| panic!("{e:#}"));
     for core in &CORES {
-        let elfs = build::build_examples(core, &["no_panic", "no_panic_fixed"], &set).unwrap_or_else(|e| panic!("{e:#}"));
+        let elfs = build::build_examples(core, &["no_panic", "no_panic_fixed", "no_panic_fixed_insertion"], &set)
+            .unwrap_or_else(|e| panic!("{e:#}"));
         // The wrench and the stiffness's workers (their entry point only calls these).
         for function in [
             "needle_haptics::fixed::eval::wrench",
@@ -73,10 +73,21 @@ fn fixed_point_evaluator_has_no_floating_point_on_any_core() {
                 core.core, core.target, fixed.function, fixed.instructions, fixed.calls
             );
         }
-        // Nothing in the whole fixed-point image is floating point.
-        let report = size::measure(core, &elfs[1], "fixed").unwrap_or_else(|e| panic!("{e:#}"));
-        let helpers: Vec<&str> = report.runtime.iter().map(|s| s.name.as_str()).filter(|n| float_check::is_float_helper(n)).collect();
-        assert!(helpers.is_empty(), "{}: the fixed-point firmware links float helpers {helpers:?}", core.core);
+        // Nothing in the whole fixed-point image is floating point, with the fixed-point
+        // insertion (its stacks converted at compile time) as without it.
+        for (elf, what) in [(&elfs[1], "fixed"), (&elfs[2], "fixed-insertion")] {
+            let report = size::measure(core, elf, what).unwrap_or_else(|e| panic!("{e:#}"));
+            let helpers: Vec<&str> = report.runtime.iter().map(|s| s.name.as_str()).filter(|n| float_check::is_float_helper(n)).collect();
+            assert!(helpers.is_empty(), "{}: the {what} firmware links float helpers {helpers:?}", core.core);
+        }
+        let step =
+            float_check::analyse_elf(&elfs[2], "needle_haptics::fixed::insertion::Insertion::step").unwrap_or_else(|e| panic!("{e:#}"));
+        assert!(step.instructions > 100, "{}: {} is not the insertion step ({} instructions)", core.core, step.function, step.instructions);
+        assert!(step.float_calls.is_empty() && step.fpu_instructions.is_empty(), "{}: {} uses floating point", core.core, step.function);
+        println!(
+            "{} ({}): {} ({} instructions) calls {:?}, no float",
+            core.core, core.target, step.function, step.instructions, step.calls
+        );
         // The same check on the f32 evaluator does see floating point (soft float on the
         // M0 and M3, FPU instructions on the M4F): it can fail.
         let f32_use = float_check::analyse_elf(&elfs[0], "needle_haptics::model_f32::wrench").unwrap_or_else(|e| panic!("{e:#}"));
@@ -122,5 +133,31 @@ fn insertion_flash_within_24_kib_on_every_core() {
         );
         assert!(report.model_flash() > model.model_flash(), "{}: the insertion image holds more than the model", core.core);
         assert!(report.model_flash() <= 24 * 1024, "{}: model + insertion flash {} B > 24 KiB", core.core, report.model_flash());
+    }
+}
+
+/// The same budget for the fixed-point insertion: the fixed-point model, its depth
+/// extension, `fixed::insertion` and every stack in integers (`no_panic_fixed_insertion`).
+#[test]
+fn fixed_point_insertion_flash_within_24_kib_on_every_core() {
+    let set = firmware::fitted_set(&firmware::compiled_set()).unwrap_or_else(|e| panic!("{e:#}"));
+    for core in &CORES {
+        let elfs = build::build_examples(core, &["no_panic_fixed", "no_panic_fixed_insertion"], &set).unwrap_or_else(|e| panic!("{e:#}"));
+        let model = size::measure(core, &elfs[0], "fixed").unwrap_or_else(|e| panic!("{e:#}"));
+        let report = size::measure(core, &elfs[1], "fixed-insertion").unwrap_or_else(|e| panic!("{e:#}"));
+        println!(
+            "{} ({}): fixed-point model + insertion flash {} (fixed-point model and stiffness {}), static RAM {} B",
+            core.core,
+            core.target,
+            size::bytes(report.model_flash()),
+            size::bytes(model.model_flash()),
+            report.static_ram()
+        );
+        assert!(
+            report.model_flash() <= 24 * 1024,
+            "{}: fixed-point model + insertion flash {} B > 24 KiB",
+            core.core,
+            report.model_flash()
+        );
     }
 }

@@ -1,15 +1,19 @@
 //! Golden insertion sequences: the five trajectories of `examples/common/insertion_paths.rs`
 //! through every shipped tissue stack give the same bits on the host and on the
-//! emulated Cortex-M4F, M3 and M0 (the `insertion_golden` firmware under QEMU): every
+//! emulated Cortex-M4F, M3 and M0 (the `insertion_golden` firmware under QEMU), with the
+//! f32 insertion and with the fixed-point one (`fixed::insertion`), through the C API
+//! and in wasm: every
 //! tick's six wrench components, status, phase and punctures, compared as a digest per
 //! path (FNV-1a over every tick's words; one differing bit changes it).
 #[path = "../../examples/common/insertion_paths.rs"]
 mod paths;
 
 use needle_firmware_host::{build, core, qemu};
-use needle_haptics::insertion::{stacks, Insertion, InsertionConfig};
+use needle_haptics::fixed;
+use needle_haptics::fixed::insertion::{stacks as fixed_stacks, Insertion as FixedInsertion, InsertionConfig as FixedConfig};
+use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, Phase};
 use needle_haptics::Pose;
-use paths::{for_each_tick, Digest, PATHS};
+use paths::{depth_scale, for_each_tick, for_each_tick_q16, Digest, PATHS};
 use std::time::Duration;
 
 /// The host's lines, in the firmware's format.
@@ -20,18 +24,43 @@ fn host_lines() -> Vec<String> {
             let mut insertion = Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ).expect("shipped stack");
             let mut digest = Digest::new();
             let (mut ticks, mut punctures) = (0u64, 0u64);
-            for_each_tick(path, |_, p| {
+            for_each_tick(path, depth_scale(stack), |_, p| {
                 let e = insertion.step(&Pose { x_mm: p[0], z_mm: p[1], theta_x_deg: p[2], theta_z_deg: p[3], depth_mm: p[4] });
                 digest.tick(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures);
                 ticks += 1;
                 punctures += u64::from(e.punctures);
             });
-            lines.push(format!(
-                "stack={} path={i} ticks={ticks} punctures={punctures} digest_hi={:#010x} digest_lo={:#010x}",
-                stack.name,
-                (digest.0 >> 32) as u32,
-                digest.0 as u32
-            ));
+            lines.push(line("", stack.name, i, ticks, punctures, digest));
+        }
+    }
+    lines
+}
+
+/// One path's line, as the firmware prints it.
+fn line(prefix: &str, name: &str, i: usize, ticks: u64, punctures: u64, digest: Digest) -> String {
+    format!(
+        "{prefix}stack={name} path={i} ticks={ticks} punctures={punctures} digest_hi={:#010x} digest_lo={:#010x}",
+        (digest.0 >> 32) as u32,
+        digest.0 as u32
+    )
+}
+
+/// The host's lines of the fixed-point insertion (`fixed::insertion`, the paths' Q16.16
+/// poses), in the firmware's format.
+fn host_fixed_lines() -> Vec<String> {
+    let mut lines = Vec::new();
+    for (stack, scale_of) in fixed_stacks::ALL.iter().zip(&stacks::ALL) {
+        for (i, path) in PATHS.iter().enumerate() {
+            let mut insertion = FixedInsertion::new(stack, FixedConfig::DEFAULT_1KHZ).expect("shipped stack");
+            let mut digest = Digest::new();
+            let (mut ticks, mut punctures) = (0u64, 0u64);
+            for_each_tick_q16(path, depth_scale(scale_of), |_, p| {
+                let e = insertion.step(&fixed::Pose::new(p[0], p[1], p[2], p[3], p[4]));
+                digest.tick_fixed(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures);
+                ticks += 1;
+                punctures += u64::from(e.punctures);
+            });
+            lines.push(line("fixed ", stack.name, i, ticks, punctures, digest));
         }
     }
     lines
@@ -41,8 +70,36 @@ fn host_lines() -> Vec<String> {
 fn the_golden_paths_cross_punctures_and_withdraw() {
     assert!(!stacks::ALL.is_empty(), "the default set ships tissue stacks");
     for line in host_lines() {
+        println!("{line}");
         let punctures: u64 = line.split(' ').find_map(|w| w.strip_prefix("punctures=")).and_then(|v| v.parse().ok()).expect("punctures");
         assert!(punctures >= 1, "every golden path punctures at least once: {line}");
+    }
+}
+
+/// The liver's paths are the paths as drawn (depth factor 1, so their digests are the
+/// ones before the epidural stack); the epidural stack's reach its epidural space: some
+/// path punctures its last layer's boundary (the loss of resistance).
+#[test]
+fn the_golden_paths_reach_the_deepest_layer_of_every_stack() {
+    assert_eq!(depth_scale(&stacks::LIVER).to_bits(), 1.0f32.to_bits(), "the liver's paths are not scaled");
+    let deepest = PATHS.iter().flat_map(|p| p.iter().map(|w| w.1[4])).fold(f32::NEG_INFINITY, f32::max);
+    assert_eq!(paths::PATHS_DEEPEST_MM, deepest);
+    for stack in &stacks::ALL {
+        let last = u8::try_from(stack.layers.len() - 1).expect("layer count");
+        let mut into_last = Vec::new();
+        for (i, path) in PATHS.iter().enumerate() {
+            let mut insertion = Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ).expect("shipped stack");
+            let mut reached = false;
+            for_each_tick(path, depth_scale(stack), |_, p| {
+                let e = insertion.step(&Pose { x_mm: p[0], z_mm: p[1], theta_x_deg: p[2], theta_z_deg: p[3], depth_mm: p[4] });
+                reached |= e.punctures > 0 && matches!(e.phase, Phase::Cutting(l) | Phase::InTrack(l) if l == last);
+            });
+            if reached {
+                into_last.push(i);
+            }
+        }
+        println!("{}: paths {into_last:?} puncture into the last layer ({})", stack.name, last);
+        assert!(!into_last.is_empty(), "{}: no golden path punctures into its last layer", stack.name);
     }
 }
 
@@ -52,8 +109,8 @@ fn on(core_name: &str) {
     let elf = build::build_examples(&core, &["insertion_golden"], &set).unwrap_or_else(|e| panic!("{e:#}")).remove(0);
     let run = qemu::run(&core, &elf, false, Duration::from_secs(900)).unwrap_or_else(|e| panic!("{e:#}"));
     assert!(run.status.success(), "{core_name}: exit {}: {}\n{}", run.status, run.stdout, run.stderr);
-    let got: Vec<&str> = run.stdout.lines().filter(|l| l.starts_with("stack=")).collect();
-    let want = host_lines();
+    let got: Vec<&str> = run.stdout.lines().filter(|l| l.starts_with("stack=") || l.starts_with("fixed stack=")).collect();
+    let want: Vec<String> = host_lines().into_iter().chain(host_fixed_lines()).collect();
     assert_eq!(got.len(), want.len(), "{core_name}: {} paths printed, the host has {}:\n{}", got.len(), want.len(), run.stdout);
     for (g, w) in got.iter().zip(&want) {
         assert_eq!(g, w, "{core_name}: the firmware's path differs from the host's");
@@ -94,7 +151,7 @@ fn c_api_lines() -> Vec<String> {
             assert_eq!(rc, NEEDLE_OK, "needle_insertion_init({})", stack.name);
             let mut digest = Digest::new();
             let (mut ticks, mut punctures) = (0u64, 0u64);
-            for_each_tick(path, |_, p| {
+            for_each_tick(path, depth_scale(stack), |_, p| {
                 let pose = needle_pose_t { x_mm: p[0], z_mm: p[1], theta_x_deg: p[2], theta_z_deg: p[3], depth_mm: p[4] };
                 let mut out = needle_insertion_result_t::default();
                 // SAFETY: valid pointers to local values; the state was initialised above.
@@ -118,6 +175,73 @@ fn c_api_lines() -> Vec<String> {
 #[test]
 fn golden_insertions_through_the_c_api() {
     assert_eq!(c_api_lines(), host_lines());
+}
+
+/// The C API's run of the paths with the fixed-point insertion (`needle_fixed_insertion_*`).
+fn c_api_fixed_lines() -> Vec<String> {
+    use needle_capi::{
+        needle_fixed_insertion_init, needle_fixed_insertion_result_t, needle_fixed_insertion_step, needle_fixed_insertion_t,
+        needle_fixed_pose_t, NEEDLE_FIXED_INSERTION_STORAGE_WORDS, NEEDLE_OK,
+    };
+    let mut lines = Vec::new();
+    for (stack, scale_of) in fixed_stacks::ALL.iter().zip(&stacks::ALL) {
+        let name = std::ffi::CString::new(stack.name).expect("stack name");
+        for (i, path) in PATHS.iter().enumerate() {
+            let mut state = needle_fixed_insertion_t { storage: [0; NEEDLE_FIXED_INSERTION_STORAGE_WORDS], magic: 0 };
+            let c = FixedConfig::DEFAULT_1KHZ;
+            // SAFETY: valid pointers to local values and a NUL-terminated name.
+            let rc = unsafe { needle_fixed_insertion_init(&mut state, name.as_ptr(), c.period_us, c.velocity_time_constant_us) };
+            assert_eq!(rc, NEEDLE_OK, "needle_fixed_insertion_init({})", stack.name);
+            let mut digest = Digest::new();
+            let (mut ticks, mut punctures) = (0u64, 0u64);
+            for_each_tick_q16(path, depth_scale(scale_of), |_, p| {
+                let pose = needle_fixed_pose_t {
+                    x_mm_q16: p[0],
+                    z_mm_q16: p[1],
+                    theta_x_deg_q16: p[2],
+                    theta_z_deg_q16: p[3],
+                    depth_mm_q16: p[4],
+                };
+                let mut out = needle_fixed_insertion_result_t::default();
+                // SAFETY: valid pointers to local values; the state was initialised above.
+                assert_eq!(unsafe { needle_fixed_insertion_step(&mut state, &pose, &mut out) }, NEEDLE_OK);
+                let w = out.wrench;
+                digest.tick_fixed([w.fx_un, w.fy_un, w.fz_un, w.mx_unmm, w.my_unmm, w.mz_unmm], out.status, out.phase, out.punctures);
+                ticks += 1;
+                punctures += u64::from(out.punctures);
+            });
+            lines.push(line("fixed ", stack.name, i, ticks, punctures, digest));
+        }
+    }
+    lines
+}
+
+#[test]
+fn golden_fixed_point_insertions_through_the_c_api() {
+    assert_eq!(c_api_fixed_lines(), host_fixed_lines());
+}
+
+#[test]
+fn the_c_api_refuses_bad_fixed_point_arguments() {
+    use needle_capi::*;
+    let mut state = needle_fixed_insertion_t { storage: [0; NEEDLE_FIXED_INSERTION_STORAGE_WORDS], magic: 0 };
+    let name = std::ffi::CString::new(fixed_stacks::ALL[0].name).expect("stack name");
+    let pose = needle_fixed_pose_t::default();
+    let mut out = needle_fixed_insertion_result_t::default();
+    // SAFETY: valid or NULL pointers, as each case says.
+    unsafe {
+        assert_eq!(needle_fixed_insertion_step(&mut state, &pose, &mut out), NEEDLE_E_UNINIT);
+        assert_eq!(needle_fixed_insertion_init(std::ptr::null_mut(), name.as_ptr(), 1000, 5000), NEEDLE_E_NULL);
+        assert_eq!(needle_fixed_insertion_init(&mut state, c"no-such-stack".as_ptr(), 1000, 5000), NEEDLE_E_ARG);
+        assert_eq!(needle_fixed_insertion_init(&mut state, name.as_ptr(), 0, 5000), NEEDLE_E_CONFIG);
+        assert_eq!(state.magic, 0, "nothing written on an error");
+        assert_eq!(needle_fixed_insertion_init(&mut state, name.as_ptr(), 1000, 5000), NEEDLE_OK);
+        assert_eq!(needle_fixed_insertion_step(&mut state, std::ptr::null(), &mut out), NEEDLE_E_NULL);
+        assert_eq!(needle_fixed_insertion_set_scales(&mut state, [1i32 << 16].as_ptr(), 99), NEEDLE_E_ARG);
+        assert_eq!(needle_fixed_insertion_set_scales(&mut state, std::ptr::null(), 1), NEEDLE_E_NULL);
+        assert_eq!(needle_fixed_insertion_reset(std::ptr::null_mut()), NEEDLE_E_NULL);
+        assert_eq!(needle_fixed_insertion_reset(&mut state), NEEDLE_OK);
+    }
 }
 
 #[test]
@@ -152,9 +276,9 @@ fn golden_insertions_in_wasm_under_node() {
     let dir = tempfile::tempdir().expect("temp dir");
     let poses = dir.path().join("poses.txt");
     let mut text = String::new();
-    for (s, _) in stacks::ALL.iter().enumerate() {
+    for (s, stack) in stacks::ALL.iter().enumerate() {
         for (i, path) in PATHS.iter().enumerate() {
-            for_each_tick(path, |_, p| {
+            for_each_tick(path, depth_scale(stack), |_, p| {
                 text.push_str(&format!(
                     "{s} {i} {:x} {:x} {:x} {:x} {:x}\n",
                     p[0].to_bits(),
@@ -179,4 +303,30 @@ fn golden_insertions_in_wasm_under_node() {
     assert!(out.status.success(), "node: {stdout}{}", String::from_utf8_lossy(&out.stderr));
     let got: Vec<String> = stdout.lines().map(str::to_string).collect();
     assert_eq!(got, host_lines(), "the wasm module's insertion differs from the host's");
+
+    // the fixed-point insertion: the Q16.16 poses of the same paths
+    let mut text = String::new();
+    for (s, scale_of) in stacks::ALL.iter().enumerate() {
+        for (i, path) in PATHS.iter().enumerate() {
+            for_each_tick_q16(path, depth_scale(scale_of), |_, p| {
+                text.push_str(&format!(
+                    "{s} {i} {:x} {:x} {:x} {:x} {:x}\n",
+                    p[0] as u32, p[1] as u32, p[2] as u32, p[3] as u32, p[4] as u32
+                ));
+            });
+        }
+    }
+    std::fs::write(&poses, text).expect("poses file");
+    let out = std::process::Command::new("node")
+        .arg(root.join("host-tests/tests/explore/insertion.mjs"))
+        .arg(&wasm)
+        .arg(&poses)
+        .env("NEEDLE_STACK_NAMES", names.join(","))
+        .env("NEEDLE_FIXED", "1")
+        .output()
+        .expect("node must be installed (apt nodejs): the wasm check runs under it");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "node: {stdout}{}", String::from_utf8_lossy(&out.stderr));
+    let got: Vec<String> = stdout.lines().map(str::to_string).collect();
+    assert_eq!(got, host_fixed_lines(), "the wasm module's fixed-point insertion differs from the host's");
 }

@@ -9,7 +9,7 @@ mod paths;
 use needle_haptics::control::{ChannelMap, LoopConfig, LoopCore, LoopFlags, OverLimit, Passivity};
 use needle_haptics::insertion::{deflection, stacks, Insertion, InsertionConfig, Phase, FE_NEEDLE_DIAMETER_MM};
 use needle_haptics::Pose;
-use paths::{for_each_tick, PATHS};
+use paths::{depth_scale, for_each_tick, PATHS};
 
 fn pose_of(p: [f32; 5]) -> Pose {
     Pose { x_mm: p[0], z_mm: p[1], theta_x_deg: p[2], theta_z_deg: p[3], depth_mm: p[4] }
@@ -38,7 +38,7 @@ fn step_with_stiffness_is_step_and_its_stiffness_is_the_deflections_derivative()
         for path in PATHS {
             let (mut a, mut b) = (new(stack), new(stack));
             let (mut deflecting, mut checked) = (0, 0);
-            for_each_tick(path, |tick, p| {
+            for_each_tick(path, depth_scale(stack), |tick, p| {
                 let pose = pose_of(p);
                 let plain = a.step(&pose);
                 let (e, terms) = b.step_with_stiffness(&pose);
@@ -84,7 +84,7 @@ fn the_loop_renders_the_insertions_wrench_bit_for_bit() {
             let mut alone = new(stack);
             let mut l = core();
             l.set_insertion(Some(new(stack)));
-            for_each_tick(path, |tick, p| {
+            for_each_tick(path, depth_scale(stack), |tick, p| {
                 let pose = pose_of(p);
                 let want = alone.step(&pose);
                 let s = l.step(Ok(pose));
@@ -108,7 +108,7 @@ fn a_puncture_clears_the_guards_offset() {
         l.set_passivity(Some(guard)).expect("guard");
         l.set_insertion(Some(new(stack)));
         let (mut limited, mut punctures) = (0, 0);
-        for_each_tick(PATHS[0], |tick, p| {
+        for_each_tick(PATHS[0], depth_scale(stack), |tick, p| {
             let s = l.step(Ok(pose_of(p)));
             limited += usize::from(s.flags.contains(LoopFlags::STIFFNESS_LIMITED));
             let e = *l.insertion_evaluation().expect("stepped");

@@ -29,13 +29,16 @@
 
 mod arith;
 mod cross;
+mod depth_extension;
 mod eval;
 mod eval_stiffness;
+pub mod insertion;
 mod pose;
 mod stiffness;
 pub mod tables;
 mod wrench;
 
+pub use depth_extension::{extended_wrench, DEPTH_MAX_MM_Q16 as EXTENDED_DEPTH_MAX_MM_Q16};
 pub use eval::wrench;
 pub use eval_stiffness::wrench_and_stiffness;
 pub use pose::Pose;

@@ -10,6 +10,7 @@ use needle_contract::COMPONENT_COUNT;
 /// (1073 N, or N·mm) over the whole domain, or refuses the model; resolution 1 µN, far
 /// below the model's error bound ([`tables::ERROR_BOUND_MICRO`](super::tables::ERROR_BOUND_MICRO)).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Wrench {
     /// Force along x, µN.
     pub fx_un: i32,

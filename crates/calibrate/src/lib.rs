@@ -23,8 +23,10 @@
 
 pub mod events;
 pub mod fit;
+pub mod from_model;
 mod lsq;
 pub mod measured;
+pub mod published;
 pub mod replay;
 
 use anyhow::{bail, Result};

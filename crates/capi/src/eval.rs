@@ -71,6 +71,14 @@ pub unsafe extern "C" fn needle_wrench_and_stiffness(
     e.status.bits()
 }
 
+/// The point the moments are taken about (the hub), as its distance from the tip along
+/// the needle's axis, mm (the set's `[needle] reference_from_tip_mm`): where a device's
+/// handle holds the needle when it applies the wrench's moments unchanged.
+#[no_mangle]
+pub extern "C" fn needle_hub_from_tip_mm() -> f32 {
+    needle_haptics::insertion::HUB_FROM_TIP_MM
+}
+
 /// Copies `s` into `dst` with a NUL, truncated to `dst.len() - 1` bytes.
 fn c_string<const N: usize>(s: &str) -> [u8; N] {
     let mut dst = [0u8; N];

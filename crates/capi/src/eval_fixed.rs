@@ -4,11 +4,11 @@ use crate::types::{needle_fixed_pose_t, needle_fixed_stiffness_t, needle_fixed_w
 use needle_haptics::fixed::{self, Pose, Stiffness, StiffnessEvaluation, Wrench};
 use needle_haptics::Status;
 
-fn pose_in(p: &needle_fixed_pose_t) -> Pose {
+pub(crate) fn pose_in(p: &needle_fixed_pose_t) -> Pose {
     Pose::new(p.x_mm_q16, p.z_mm_q16, p.theta_x_deg_q16, p.theta_z_deg_q16, p.depth_mm_q16)
 }
 
-fn wrench_out_of(w: &Wrench) -> needle_fixed_wrench_t {
+pub(crate) fn wrench_out_of(w: &Wrench) -> needle_fixed_wrench_t {
     let [fx_un, fy_un, fz_un, mx_unmm, my_unmm, mz_unmm] = w.to_array();
     needle_fixed_wrench_t { fx_un, fy_un, fz_un, mx_unmm, my_unmm, mz_unmm }
 }

@@ -12,6 +12,11 @@ pub const NEEDLE_INSERTION_STORAGE_WORDS: usize = 64;
 /// [`needle_insertion_t::magic`] of an initialised insertion.
 pub const NEEDLE_INSERTION_MAGIC: u32 = 0x4e49_4e53;
 
+/// 64-bit words of opaque storage in a [`needle_fixed_insertion_t`].
+pub const NEEDLE_FIXED_INSERTION_STORAGE_WORDS: usize = 48;
+/// [`needle_fixed_insertion_t::magic`] of an initialised fixed-point insertion.
+pub const NEEDLE_FIXED_INSERTION_MAGIC: u32 = 0x4e46_494e;
+
 /// Success.
 pub const NEEDLE_OK: i32 = 0;
 /// A pointer argument was NULL.
@@ -276,4 +281,31 @@ pub struct needle_insertion_result_t {
     pub phase: u16,
     /// Filtered axial velocity, mm/s (positive inserting).
     pub velocity_mm_per_s: f32,
+}
+
+/// A needle path through a tissue stack in integers: initialise with
+/// `needle_fixed_insertion_init`. Plain data: it may be copied with `memcpy`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct needle_fixed_insertion_t {
+    /// Opaque.
+    pub storage: [u64; NEEDLE_FIXED_INSERTION_STORAGE_WORDS],
+    /// `NEEDLE_FIXED_INSERTION_MAGIC` once initialised.
+    pub magic: u32,
+}
+
+/// One tick of `needle_fixed_insertion_step`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct needle_fixed_insertion_result_t {
+    /// The wrench on the needle (µN, µN·mm about the hub).
+    pub wrench: needle_fixed_wrench_t,
+    /// `NEEDLE_STATUS_*` bits of the surrogate (saturation).
+    pub status: u8,
+    /// Boundaries punctured in this tick.
+    pub punctures: u8,
+    /// Phase code, as `needle_insertion_result_t`'s.
+    pub phase: u16,
+    /// Filtered axial velocity, mm/s × 65536 (positive inserting).
+    pub velocity_mm_per_s_q16: i32,
 }

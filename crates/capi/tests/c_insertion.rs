@@ -2,7 +2,9 @@
 //! host's gcc against this build's `libneedle_capi.a` and `needle.h`, steps the golden
 //! insertion paths (examples/common/insertion_paths.rs) through every compiled-in stack
 //! with `needle_insertion_*`, and a C loop rendering each with `needle_loop_set_insertion`;
-//! every path's digest must equal the Rust library's own run, bit for bit.
+//! every path's digest must equal the Rust library's own run, bit for bit; and
+//! `c/capi_fixed_insertion.c` the same with the fixed-point insertion
+//! (`needle_fixed_insertion_*`, the paths' Q16.16 poses).
 //!
 //! Nothing skips: a missing gcc fails with a message (.ci/test installs it).
 #[path = "../../../examples/common/insertion_paths.rs"]
@@ -14,7 +16,7 @@ use common::{manifest_dir, run, scratch, staticlib};
 use needle_haptics::control::{ChannelMap, LoopConfig, LoopCore, OverLimit};
 use needle_haptics::insertion::{stacks, Insertion, InsertionConfig};
 use needle_haptics::Pose;
-use paths::{for_each_tick, Digest, PATHS};
+use paths::{depth_scale, for_each_tick, for_each_tick_q16, Digest, PATHS};
 use std::fmt::Write as _;
 use std::process::Command;
 
@@ -46,7 +48,7 @@ fn ticks_and_expected() -> (String, Vec<String>) {
             l.set_insertion(Some(ins));
             let (mut digest, mut loop_digest) = (Digest::new(), Digest::new());
             let (mut n, mut punctures) = (0u64, 0u64);
-            for_each_tick(path, |_, p| {
+            for_each_tick(path, depth_scale(stack), |_, p| {
                 let _ = writeln!(
                     ticks,
                     "{} {i} {:x} {:x} {:x} {:x} {:x}",
@@ -106,4 +108,62 @@ fn c_program_steps_the_golden_insertion_paths_bit_for_bit() {
     let end = out.lines().find(|l| l.starts_with("capi-insertion ")).unwrap_or_else(|| panic!("no summary:\n{out}"));
     assert_eq!(end, format!("capi-insertion ticks_read={total} failures=0 refusals=ok"));
     println!("{} paths ({total} ticks) through the C API match the library, insertion and loop", want.len() / 2);
+}
+
+/// The Q16.16 ticks file for `capi_fixed_insertion`, and the lines it must print.
+fn fixed_ticks_and_expected() -> (String, Vec<String>) {
+    use needle_haptics::fixed::insertion::{stacks as fixed_stacks, Insertion as FixedInsertion, InsertionConfig as FixedConfig};
+    let (mut ticks, mut want) = (String::new(), Vec::new());
+    for (stack, scale_of) in fixed_stacks::ALL.iter().zip(&stacks::ALL) {
+        for (i, path) in PATHS.iter().enumerate() {
+            let mut ins = FixedInsertion::new(stack, FixedConfig::DEFAULT_1KHZ).expect("shipped stack");
+            let mut digest = Digest::new();
+            let (mut n, mut punctures) = (0u64, 0u64);
+            for_each_tick_q16(path, depth_scale(scale_of), |_, p| {
+                let _ = writeln!(
+                    ticks,
+                    "{} {i} {:x} {:x} {:x} {:x} {:x}",
+                    stack.name, p[0] as u32, p[1] as u32, p[2] as u32, p[3] as u32, p[4] as u32
+                );
+                let e = ins.step(&needle_haptics::fixed::Pose::new(p[0], p[1], p[2], p[3], p[4]));
+                digest.tick_fixed(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures);
+                n += 1;
+                punctures += u64::from(e.punctures);
+            });
+            want.push(format!(
+                "fixed stack={} path={i} ticks={n} punctures={punctures} digest_hi={:#010x} digest_lo={:#010x}",
+                stack.name,
+                (digest.0 >> 32) as u32,
+                digest.0 as u32
+            ));
+        }
+    }
+    (ticks, want)
+}
+
+#[test]
+fn c_program_steps_the_fixed_point_insertion_bit_for_bit() {
+    let dir = scratch("fixed-insertion");
+    let lib = staticlib(None);
+    let exe = dir.join("capi_fixed_insertion");
+    run(
+        Command::new("gcc")
+            .args(["-std=c11", "-O2", "-Wall", "-Wextra", "-Werror", "-I"])
+            .arg(&dir)
+            .arg(manifest_dir().join("c").join("capi_fixed_insertion.c"))
+            .arg(&lib)
+            .args(["-lm", "-lpthread", "-ldl", "-o"])
+            .arg(&exe),
+        "gcc capi_fixed_insertion.c",
+    );
+    let (ticks, want) = fixed_ticks_and_expected();
+    let file = dir.join("ticks.txt");
+    std::fs::write(&file, &ticks).expect("write ticks.txt");
+    let out = run(Command::new(&exe).arg(&file), "capi_fixed_insertion");
+    let got: Vec<&str> = out.lines().filter(|l| l.starts_with("fixed stack=")).collect();
+    assert_eq!(got, want, "the C program's fixed-point run differs from the library's");
+    let total = ticks.lines().count();
+    let end = out.lines().find(|l| l.starts_with("capi-fixed-insertion ")).unwrap_or_else(|| panic!("no summary:\n{out}"));
+    assert_eq!(end, format!("capi-fixed-insertion ticks_read={total} failures=0 refusals=ok"));
+    println!("{} fixed-point paths ({total} ticks) through the C API match the library", want.len());
 }

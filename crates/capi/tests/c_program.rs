@@ -24,6 +24,7 @@ fn header_declares_the_api() {
         "needle_fixed_wrench_and_stiffness(",
         "} needle_fixed_stiffness_t;",
         "needle_model_info(",
+        "needle_hub_from_tip_mm(",
         "needle_loop_init(",
         "needle_loop_tick(",
         "needle_loop_set_force_limit_n(",

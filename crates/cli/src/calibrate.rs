@@ -76,22 +76,7 @@ pub fn calibrate(a: CalibrateArgs) -> Result<ExitCode> {
             needle_calibrate::WINKLER_E_PER_MU * l.scale * mu0
         );
     }
-    let mut all_met = true;
-    for check in &c.checks {
-        let met = check.met();
-        all_met &= met;
-        println!(
-            "{:<58} measured {:>9.4}  model {:>9.4}  error {:>+8.3} {} (goal {} {})  {}",
-            check.what,
-            check.measured,
-            check.model,
-            check.error,
-            check.unit,
-            check.goal,
-            check.unit,
-            if met { "ok" } else { "MISSED" }
-        );
-    }
+    let all_met = print_checks(&c.checks);
     let out = a.out.unwrap_or_else(|| a.set.join(needle_codegen::tissue::TISSUE_DIR).join(format!("{}.toml", a.name)));
     if let Some(dir) = out.parent() {
         std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
@@ -109,9 +94,30 @@ pub fn calibrate(a: CalibrateArgs) -> Result<ExitCode> {
     if let Some(dir) = figure.parent() {
         std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
     }
-    let svg = crate::calibrate_figure::svg(&c, &a.name)?;
+    let svg = crate::calibrate_figure::svg(&c, &a.name, "measured")?;
     needle_fe::results::write_atomic(&figure, svg.as_bytes())?;
     println!("wrote {}", figure.display());
     println!("result: {}", if all_met { "every calibration goal met" } else { "FAIL (a goal is missed)" });
     Ok(if all_met { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}
+
+/// Prints each check (measured, model, error, goal, met) and says whether all are met.
+pub fn print_checks(checks: &[needle_calibrate::replay::Check]) -> bool {
+    let mut all_met = true;
+    for check in checks {
+        let met = check.met();
+        all_met &= met;
+        println!(
+            "{:<58} measured {:>9.4}  model {:>9.4}  error {:>+8.3} {} (goal {} {})  {}",
+            check.what,
+            check.measured,
+            check.model,
+            check.error,
+            check.unit,
+            check.goal,
+            check.unit,
+            if met { "ok" } else { "MISSED" }
+        );
+    }
+    all_met
 }

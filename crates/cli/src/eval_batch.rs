@@ -36,13 +36,11 @@ fn echo(text: &str) -> String {
     }
 }
 
-/// Parse the pose file `text` (named `path` in messages).
+/// The pose columns' indices in `header` (in [`POSE_COLUMNS`] order).
 ///
 /// # Errors
-/// No header or a missing column; rows that are not five numbers (all listed, by line).
-pub fn parse_poses(text: &str, path: &Path) -> Result<Vec<Pose>> {
-    let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).flexible(true).from_reader(text.as_bytes());
-    let header = rdr.headers().with_context(|| format!("{}:1: cannot read the header", path.display()))?.clone();
+/// A missing column, or one named twice (`FILE:1: ...`).
+pub fn pose_columns(header: &csv::StringRecord, path: &Path) -> Result<[usize; 5]> {
     let mut idx = [0usize; 5];
     for (slot, name) in idx.iter_mut().zip(POSE_COLUMNS) {
         let mut at = header.iter().enumerate().filter(|(_, h)| *h == name).map(|(i, _)| i);
@@ -53,6 +51,57 @@ pub fn parse_poses(text: &str, path: &Path) -> Result<Vec<Pose>> {
             bail!("{}:1: column {name:?} appears twice in the header (columns {} and {})", path.display(), *slot + 1, again + 1);
         }
     }
+    Ok(idx)
+}
+
+/// One row's pose from the fields at `idx` (`field(i)` gives field `i`, trimmed), or the
+/// row's problems pushed to `bad` as `FILE:LINE: column NAME: ...`.
+pub fn parse_row<'a>(
+    field: impl Fn(usize) -> Option<&'a [u8]>,
+    len: usize,
+    idx: &[usize; 5],
+    at: (&Path, u64),
+    bad: &mut Vec<String>,
+) -> Option<Pose> {
+    let (path, line) = at;
+    let mut v = [0f32; 5];
+    let mut ok = true;
+    for ((slot, &i), name) in v.iter_mut().zip(idx).zip(POSE_COLUMNS) {
+        match field(i) {
+            Some(bytes) => match std::str::from_utf8(bytes).ok().and_then(|t| t.parse::<f32>().ok()) {
+                Some(x) => *slot = x,
+                None => {
+                    let t = String::from_utf8_lossy(bytes);
+                    bad.push(format!("{}:{line}: column {name}: {} is not a number", path.display(), echo(&t)));
+                    ok = false;
+                }
+            },
+            None => {
+                bad.push(format!("{}:{line}: column {name}: missing ({len} fields in the row)", path.display()));
+                ok = false;
+            }
+        }
+    }
+    ok.then(|| Pose { x_mm: v[0], z_mm: v[1], theta_x_deg: v[2], theta_z_deg: v[3], depth_mm: v[4] })
+}
+
+/// The error for `bad_rows` bad rows with their `problems` (the first [`MAX_LISTED`]
+/// listed, the rest counted).
+pub fn bad_rows_error(bad_rows: usize, problems: &[String]) -> anyhow::Error {
+    let shown = problems.iter().take(MAX_LISTED).cloned().collect::<Vec<_>>().join("\n");
+    let more =
+        if problems.len() > MAX_LISTED { format!("\n... and {} more problem(s)", problems.len() - MAX_LISTED) } else { String::new() };
+    anyhow::anyhow!("{bad_rows} bad row(s), nothing evaluated:\n{shown}{more}")
+}
+
+/// Parse the pose file `text` (named `path` in messages).
+///
+/// # Errors
+/// No header or a missing column; rows that are not five numbers (all listed, by line).
+pub fn parse_poses(text: &str, path: &Path) -> Result<Vec<Pose>> {
+    let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).flexible(true).from_reader(text.as_bytes());
+    let header = rdr.headers().with_context(|| format!("{}:1: cannot read the header", path.display()))?.clone();
+    let idx = pose_columns(&header, path)?;
     let mut poses = Vec::new();
     let mut bad: Vec<String> = Vec::new();
     let mut bad_rows = 0usize;
@@ -67,31 +116,13 @@ pub fn parse_poses(text: &str, path: &Path) -> Result<Vec<Pose>> {
             }
         };
         let line = rec.position().map_or(0, |p| p.line());
-        let mut v = [0f32; 5];
-        let mut ok = true;
-        for ((slot, &i), name) in v.iter_mut().zip(&idx).zip(POSE_COLUMNS) {
-            match rec.get(i).map(|t| (t, t.parse::<f32>())) {
-                Some((_, Ok(x))) => *slot = x,
-                Some((t, Err(_))) => {
-                    bad.push(format!("{}:{line}: column {name}: {} is not a number", path.display(), echo(t)));
-                    ok = false;
-                }
-                None => {
-                    bad.push(format!("{}:{line}: column {name}: missing ({} fields in the row)", path.display(), rec.len()));
-                    ok = false;
-                }
-            }
-        }
-        if ok {
-            poses.push(Pose { x_mm: v[0], z_mm: v[1], theta_x_deg: v[2], theta_z_deg: v[3], depth_mm: v[4] });
-        } else {
-            bad_rows += 1;
+        match parse_row(|i| rec.get(i).map(str::as_bytes), rec.len(), &idx, (path, line), &mut bad) {
+            Some(p) => poses.push(p),
+            None => bad_rows += 1,
         }
     }
     if bad_rows > 0 {
-        let shown = bad.iter().take(MAX_LISTED).cloned().collect::<Vec<_>>().join("\n");
-        let more = if bad.len() > MAX_LISTED { format!("\n... and {} more problem(s)", bad.len() - MAX_LISTED) } else { String::new() };
-        bail!("{bad_rows} bad row(s), nothing evaluated:\n{shown}{more}");
+        return Err(bad_rows_error(bad_rows, &bad));
     }
     Ok(poses)
 }

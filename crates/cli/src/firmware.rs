@@ -109,6 +109,9 @@ const INSERTION_FLASH_BYTES: u64 = 24 * 1024;
 /// Stack of one insertion step (issue 41), beside the evaluators' 512 B.
 const INSERTION_STACK_BYTES: u64 = 1024;
 
+/// Instructions of one fixed-point insertion step on the Cortex-M0 (issue 41).
+const INSERTION_FIXED_M0_INSTRUCTIONS: f64 = 20_000.0;
+
 /// The firmware goals of a model form: f32 instructions per wrench on the M4F, fixed-point
 /// instructions on the M0, model flash (paper form: issues 4 and 5; coupled form: issue 16).
 struct Goals {
@@ -143,8 +146,9 @@ fn bench_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
     for f in &figures {
         let Some(t) = f.pose("typical", "f32") else { continue };
         // the evaluators' stack goal (512 B); the insertion step has its own (issue 41: 1 KiB)
-        let max_stack = f.poses.iter().filter(|p| p.evaluator != "insertion").map(|p| p.stack_bytes).max().unwrap_or(0);
-        let insertion_stack = f.poses.iter().filter(|p| p.evaluator == "insertion").map(|p| p.stack_bytes).max();
+        let is_insertion = |e: &str| e == "insertion" || e == "fixed-insertion";
+        let max_stack = f.poses.iter().filter(|p| !is_insertion(&p.evaluator)).map(|p| p.stack_bytes).max().unwrap_or(0);
+        let insertion_stack = f.poses.iter().filter(|p| is_insertion(&p.evaluator)).map(|p| p.stack_bytes).max();
         let instr_goal = if f.core.name == "m4f" {
             format!("; <= {} instructions: {}", goals.m4f_f32_instructions, goal(t.instructions <= goals.m4f_f32_instructions))
         } else {
@@ -161,6 +165,20 @@ fn bench_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
                 "insertion {}: stack of one step {b} B <= {INSERTION_STACK_BYTES} B: {}",
                 f.core.core,
                 goal(b <= INSERTION_STACK_BYTES)
+            );
+        }
+        let fixed_steps: Vec<f64> = f.poses.iter().filter(|p| p.evaluator == "fixed-insertion").map(|p| p.instructions).collect();
+        if let Some(worst) = fixed_steps.iter().copied().reduce(f64::max) {
+            let m0_goal = if f.core.name == "m0" {
+                format!("; <= {INSERTION_FIXED_M0_INSTRUCTIONS} on the M0: {}", goal(worst <= INSERTION_FIXED_M0_INSTRUCTIONS))
+            } else {
+                String::new()
+            };
+            let insertion_f32 = f.poses.iter().filter(|p| p.evaluator == "insertion").map(|p| p.instructions).reduce(f64::max);
+            let ratio = insertion_f32.map(|t| format!(", {:.2}x the f32 insertion's speed", t / worst)).unwrap_or_default();
+            println!(
+                "fixed-point insertion {}: {worst:.1} instructions per step (most of every stack's surface and deep tick){ratio}{m0_goal}",
+                f.core.core
             );
         }
         if let Some(k) = f.pose("typical", "f32+k") {

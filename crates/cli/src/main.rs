@@ -24,6 +24,8 @@ component by cross-validation). Writes model.toml and the four golden files all 
     Eval(needle_cli::model::EvalArgs),
     /// Fit a tissue stack (<set>/tissue/<name>.toml) to a measured force against needle position.
     Calibrate(needle_cli::calibrate::CalibrateArgs),
+    /// Derive a tissue stack from a published model's force polynomials per layer (no measured curve).
+    CalibratePublished(needle_cli::calibrate_published::CalibratePublishedArgs),
     /// Compare the model with the FE runs it was not fitted on; exit 1 when a goal is missed.
     Validate(needle_cli::fit::ValidateArgs),
     /// Serve the model explorer (the library compiled to wasm) to a browser on a local port.
@@ -67,6 +69,7 @@ fn main() -> ExitCode {
         Command::Eval(a) => needle_cli::model::eval(a),
         Command::Validate(a) => needle_cli::fit::validate(a),
         Command::Calibrate(a) => needle_cli::calibrate::calibrate(a),
+        Command::CalibratePublished(a) => needle_cli::calibrate_published::calibrate_published(a),
         Command::Explore(a) => needle_cli::explore::explore(a),
         Command::Plot(a) => needle_cli::plot::plot(a),
         Command::Header(a) => needle_cli::model::header(a),

@@ -239,11 +239,19 @@ pub fn eval(a: EvalArgs) -> anyhow::Result<ExitCode> {
 /// The file cannot be read, has a bad header or bad rows (all listed, by line), or the
 /// output cannot be written.
 fn eval_file(file: &Path, out: Option<&Path>, json: bool) -> anyhow::Result<ExitCode> {
-    use super::eval_batch::{evaluate, parse_poses, to_csv};
+    use super::eval_batch::{evaluate, parse_poses};
+    if !json {
+        // CSV: streamed, chunk by chunk (memory bounded), on every core
+        let rows = super::eval_stream::eval_csv(file, out)?;
+        if let Some(path) = out {
+            eprintln!("wrote {} ({rows} poses)", path.display());
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
     let text = std::fs::read_to_string(file).with_context(|| format!("{}: cannot read", file.display()))?;
     let poses = parse_poses(&text, file)?;
     let evals = evaluate(&poses);
-    let body = if json { serde_json::to_string_pretty(&to_json(&poses, &evals))? + "\n" } else { to_csv(&poses, &evals) };
+    let body = serde_json::to_string_pretty(&to_json(&poses, &evals))? + "\n";
     match out {
         Some(path) => {
             needle_fe::results::write_atomic(path, body.as_bytes())?;

@@ -167,3 +167,38 @@ fn out_onto_a_symlink_or_a_fifo_is_refused_and_left_alone() {
     assert_eq!(std::fs::read_to_string(&target).expect("target"), "keep me\n");
     assert!(!std::fs::symlink_metadata(&fifo).expect("fifo").file_type().is_file(), "the FIFO is still a FIFO");
 }
+
+/// The streaming path (chunks of 65,536 rows): a bad row after the first chunks were
+/// evaluated still leaves nothing written (the old `--out` file as it was, empty standard
+/// output), and a good file of several chunks gives one row per input row, in order.
+#[test]
+fn a_bad_row_after_several_chunks_leaves_nothing_written() {
+    let d = tempfile::tempdir().expect("tempdir");
+    let file = d.path().join("poses.csv");
+    let rows = needle_cli::eval_stream::CHUNK_ROWS * 2 + 17;
+    let mut text = String::from("x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n");
+    for i in 0..rows {
+        text.push_str(&format!("{},0,0,0,{}\n", i % 7, (i % 60) as f32 / 10.0));
+    }
+    std::fs::write(&file, &text).expect("write");
+    let set = default_set();
+    let (set, poses) = (set.to_string_lossy(), file.to_string_lossy());
+    let out = d.path().join("w.csv");
+    let o = needle(&["eval", "--set", &set, "--poses", &poses, "--out", &out.to_string_lossy()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let written = std::fs::read_to_string(&out).expect("output");
+    assert_eq!(written.lines().count(), rows + 1, "the header and one row per pose");
+    let o = needle(&["eval", "--set", &set, "--poses", &poses]);
+    assert_eq!(String::from_utf8_lossy(&o.stdout), written, "standard output: the same bytes as --out");
+    // a bad row near the end: the first chunks were good, nothing may reach the outputs
+    text.push_str("1,2,3,four,5\n");
+    std::fs::write(&file, &text).expect("write");
+    let o = needle(&["eval", "--set", &set, "--poses", &poses, "--out", &out.to_string_lossy()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains(&format!("{}:{}: column theta_z_deg", file.display(), rows + 2)));
+    assert_eq!(std::fs::read_to_string(&out).expect("output"), written, "the old file is left as it was");
+    assert_eq!(std::fs::read_dir(d.path()).expect("dir").count(), 2, "no temporary left beside it");
+    let o = needle(&["eval", "--set", &set, "--poses", &poses]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(o.stdout.is_empty(), "nothing on standard output");
+}

@@ -119,6 +119,43 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     write_all_atomic(&[(path, bytes)])
 }
 
+/// [`write_atomic`] for output written as it is made: `write` gets a buffered writer on
+/// a temporary in `path`'s folder; when it returns `Ok` the temporary is flushed,
+/// synced and renamed over `path`; when it fails (or the flush does) the temporary is
+/// removed and `path` is left as it was: nothing written. Memory stays bounded by what
+/// `write` holds.
+///
+/// # Errors
+/// As [`write_atomic`], or `write`'s error.
+pub fn write_atomic_streamed<T>(path: &Path, write: impl FnOnce(&mut dyn Write) -> Result<T>) -> Result<T> {
+    refuse_special(path).context("nothing written")?;
+    remove_stale_temporaries(path);
+    let dir = path.parent().with_context(|| format!("{}: no parent folder", path.display()))?;
+    std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
+    let tmp = temporary_of(path)?;
+    let result = (|| -> Result<T> {
+        let f = std::fs::File::create(&tmp).with_context(|| format!("{}: cannot create", tmp.display()))?;
+        let mut w = std::io::BufWriter::with_capacity(1 << 20, f);
+        let value = write(&mut w)?;
+        let f = w.into_inner().map_err(|e| e.into_error()).with_context(|| format!("{}: cannot write", tmp.display()))?;
+        f.sync_all().with_context(|| format!("{}: cannot sync", tmp.display()))?;
+        Ok(value)
+    })();
+    match result {
+        Ok(v) => {
+            if let Err(e) = std::fs::rename(&tmp, path) {
+                let _ = std::fs::remove_file(&tmp);
+                anyhow::bail!("{}: cannot rename to {}: {e}", tmp.display(), path.display());
+            }
+            Ok(v)
+        }
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp);
+            Err(e.context("nothing written"))
+        }
+    }
+}
+
 /// [`write_atomic`] for several files that belong together (the C headers, a set's
 /// figures): every path is checked and every temporary written and synced before the
 /// first rename, so a failure (a full disk, a refused path) leaves every old file as it

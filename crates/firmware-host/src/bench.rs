@@ -10,7 +10,8 @@ use std::time::Duration;
 pub struct PoseFigures {
     /// The firmware's name of the pose (`typical`, `positive`, `saturated`, `nan-input`).
     pub pose: String,
-    /// The evaluator timed: `f32`, `f32+k` (wrench and stiffness), `fixed` or `fixed+k`.
+    /// The evaluator timed: `f32`, `f32+k` (wrench and stiffness), `fixed`, `fixed+k`,
+    /// `insertion` or `fixed-insertion` (one insertion step).
     pub evaluator: String,
     /// Executed instructions per `wrench` call (call, return and result store included).
     pub instructions: f64,

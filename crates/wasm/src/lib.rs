@@ -12,12 +12,16 @@
 //! - [`needle_domain`] the model's domain, [`needle_coupled`] its form;
 //! - the insertion model through the compiled-in tissue stacks: [`needle_stack_count`],
 //!   [`needle_insertion_start`] (one path at a time) and [`needle_insertion_step`], whose
-//!   wrench is left at [`needle_out`] as [`needle_eval`]'s is.
+//!   wrench is left at [`needle_out`] as [`needle_eval`]'s is; the fixed-point insertion
+//!   the same way ([`needle_fixed_insertion_start`], [`needle_fixed_insertion_step`]:
+//!   Q16.16 poses, the wrench in µN and µN·mm as `i32` bits).
 #![cfg_attr(target_arch = "wasm32", no_std)]
 #![deny(missing_docs)]
 
 use core::sync::atomic::{AtomicU32, Ordering};
 use needle_contract::COMPONENT_COUNT;
+use needle_haptics::fixed;
+use needle_haptics::fixed::insertion::{stacks as fixed_stacks, Insertion as FixedInsertion, InsertionConfig as FixedConfig};
 use needle_haptics::insertion::{stacks, Insertion, InsertionConfig};
 use needle_haptics::{model_info, wrench, Pose};
 
@@ -142,6 +146,49 @@ pub extern "C" fn needle_insertion_step(x_mm: f32, z_mm: f32, theta_x_deg: f32, 
     let e = ins.step(&Pose::new(x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm));
     for (slot, v) in OUT.iter().zip(e.wrench.to_array()) {
         slot.store(v.to_bits(), Ordering::Relaxed);
+    }
+    u32::from(e.status.bits()) | u32::from(e.phase.code()) << 8 | u32::from(e.punctures) << 24
+}
+
+/// The fixed-point needle path (`needle_haptics::fixed::insertion`).
+struct FixedPath(core::cell::RefCell<Option<FixedInsertion<'static>>>);
+
+// SAFETY: as `Path`'s: one thread.
+unsafe impl Sync for FixedPath {}
+
+static FIXED_PATH: FixedPath = FixedPath(core::cell::RefCell::new(None));
+
+/// Starts a fixed-point needle path through stack `stack`, ticked every `period_us` µs,
+/// the velocity low-passed with `velocity_time_constant_us` µs. Returns 0, or -1 for an
+/// unknown stack, -2 for a zero period.
+#[no_mangle]
+pub extern "C" fn needle_fixed_insertion_start(stack: u32, period_us: u32, velocity_time_constant_us: u32) -> i32 {
+    let Some(s) = fixed_stacks::ALL.get(stack as usize) else { return -1 };
+    match FixedInsertion::new(s, FixedConfig { period_us, velocity_time_constant_us }) {
+        Ok(i) => {
+            *FIXED_PATH.0.borrow_mut() = Some(i);
+            0
+        }
+        Err(_) => -2,
+    }
+}
+
+/// One tick of the started fixed-point path, the pose in Q16.16 (mm, degrees × 65536):
+/// the wrench (µN, µN·mm, as `i32` bits) at [`needle_out`]; returns what
+/// [`needle_insertion_step`] returns, or `u32::MAX` when no path was started.
+#[no_mangle]
+pub extern "C" fn needle_fixed_insertion_step(
+    x_mm_q16: i32,
+    z_mm_q16: i32,
+    theta_x_deg_q16: i32,
+    theta_z_deg_q16: i32,
+    depth_mm_q16: i32,
+) -> u32 {
+    let mut path = FIXED_PATH.0.borrow_mut();
+    let Some(ins) = path.as_mut() else { return u32::MAX };
+    let e = ins.step(&fixed::Pose::new(x_mm_q16, z_mm_q16, theta_x_deg_q16, theta_z_deg_q16, depth_mm_q16));
+    for (slot, v) in OUT.iter().zip(e.wrench.to_array()) {
+        slot.store(v as u32, Ordering::Relaxed);
     }
     u32::from(e.status.bits()) | u32::from(e.phase.code()) << 8 | u32::from(e.punctures) << 24
 }

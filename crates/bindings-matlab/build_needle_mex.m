@@ -1,0 +1,34 @@
+function out_dir = build_needle_mex()
+% BUILD_NEEDLE_MEX  Builds the needle_haptics MEX function (needle_haptics.c) over the
+% C API and adds its folder to the path: cargo builds libneedle_capi.a and the needle
+% command, `needle header` writes needle.h, then Octave's `mkoctfile --mex` or MATLAB's
+% `mex` compiles and links. The MEX file lands in <repo>/target/bindings-matlab.
+%
+%   octave --eval "run crates/bindings-matlab/build_needle_mex.m"
+here = fileparts(mfilename('fullpath'));
+root = fullfile(here, '..', '..');
+target = fullfile(root, 'target');
+out_dir = fullfile(target, 'bindings-matlab');
+inc = fullfile(out_dir, 'include');
+run_or_fail(sprintf('cd "%s" && cargo build --release -q -p needle-capi -p needle-cli', root));
+run_or_fail(sprintf('"%s" header --out "%s"', fullfile(target, 'release', 'needle'), inc));
+lib = fullfile(target, 'release', 'libneedle_capi.a');
+src = fullfile(here, 'needle_haptics.c');
+if exist('OCTAVE_VERSION', 'builtin')
+  [text, status] = mkoctfile('--mex', ['-I' inc], src, lib, '-lpthread', '-ldl', '-lm', '-o', fullfile(out_dir, 'needle_haptics.mex'));
+  if status ~= 0
+    error('needle:build', 'mkoctfile --mex failed (%d):\n%s', status, text);
+  end
+else
+  mex(['-I' inc], src, lib, '-lpthread', '-ldl', '-outdir', out_dir);
+end
+addpath(out_dir);
+fprintf('built %s\n', fullfile(out_dir, 'needle_haptics'));
+end
+
+function run_or_fail(cmd)
+[status, text] = system(cmd);
+if status ~= 0
+  error('needle:build', '%s failed (%d):\n%s', cmd, status, text);
+end
+end

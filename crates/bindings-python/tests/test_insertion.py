@@ -1,0 +1,74 @@
+"""The insertion model from Python steps the same ticks, with the same bits, as the
+library's own command line (`needle eval --poses --insertion`, the Rust library in the
+`needle` binary): a scripted insertion that punctures, withdraws and re-enters."""
+import csv
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+import needle_haptics as nh
+
+
+def trajectory() -> np.ndarray:
+    """1 kHz: down to 30 mm in 6 s, back to 12 mm, in again to 35 mm, out above the surface."""
+    depth = np.concatenate([np.linspace(-1, 30, 6000), np.linspace(30, 12, 2000), np.linspace(12, 35, 3000), np.linspace(35, -1, 4000)])
+    p = np.zeros((depth.size, 5), dtype=np.float32)
+    p[:, 0], p[:, 1], p[:, 2], p[:, 3] = 1.5, -0.5, 4.0, -2.0
+    p[:, 4] = depth
+    return p
+
+
+def needle_cli(poses: np.ndarray, stack: str, tmp_path) -> list[dict[str, str]]:
+    exe = os.environ.get("NEEDLE_BIN")
+    assert exe and os.path.isfile(exe), "NEEDLE_BIN must name the needle binary (.ci/test-python builds it)"
+    path = tmp_path / "poses.csv"
+    with open(path, "w", encoding="utf-8") as f:
+        f.write("time_s,x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n")
+        for i, row in enumerate(poses):
+            # repr of a float32 widened to float64: exact, so the CLI parses the same f32
+            f.write(f"{i * 0.001!r}," + ",".join(repr(float(v)) for v in row) + "\n")
+    out = subprocess.run([exe, "eval", "--set", nh.SET_DIR, "--poses", str(path), "--insertion", stack], check=True, capture_output=True, text=True)
+    return list(csv.DictReader(out.stdout.splitlines()))
+
+
+def phase_code(text: str) -> int:
+    kinds = {"approach": 0, "deflecting": 0x100, "cutting": 0x200, "in-track": 0x300}
+    kind, _, layer = text.partition(":")
+    return kinds[kind] | (int(layer) if layer else 0)
+
+
+@pytest.mark.parametrize("stack", nh.stack_names())
+def test_insertion_matches_the_library_cli_tick_by_tick(stack, tmp_path):
+    poses = trajectory()
+    got = nh.Insertion(stack).run(poses)
+    want = needle_cli(poses, stack, tmp_path)
+    assert len(want) == poses.shape[0]
+    want_w = np.array([[np.float32(r[c]) for c in nh.COMPONENTS] for r in want], dtype=np.float32)
+    differ = np.flatnonzero((want_w.view(np.uint32) != got.wrench.view(np.uint32)).any(axis=1))
+    assert differ.size == 0, f"{differ.size} ticks differ, first tick {differ[0]}: {want[differ[0]]} vs {got.wrench[differ[0]]}"
+    np.testing.assert_array_equal(got.status, [int(r["status"], 16) for r in want])
+    np.testing.assert_array_equal(got.punctures, [int(r["punctures"]) for r in want])
+    np.testing.assert_array_equal(got.phase, [phase_code(r["phase"]) for r in want])
+    assert got.punctures.sum() >= 1, "the path punctures"
+
+
+def test_state_carries_over_between_calls_and_reset_forgets_it():
+    poses = trajectory()
+    whole = nh.Insertion("liver").run(poses)
+    ins = nh.Insertion("liver")
+    a, b = ins.run(poses[:5000]), ins.run(poses[5000:])
+    np.testing.assert_array_equal(np.concatenate([a.wrench, b.wrench]).view(np.uint32), whole.wrench.view(np.uint32))
+    ins.reset()
+    again = ins.run(poses)
+    np.testing.assert_array_equal(again.wrench.view(np.uint32), whole.wrench.view(np.uint32))
+
+
+def test_bad_stack_and_config_are_value_errors():
+    with pytest.raises(ValueError, match='no tissue stack "kidney".*liver'):
+        nh.Insertion("kidney")
+    with pytest.raises(ValueError, match="period_s must be finite and > 0"):
+        nh.Insertion("liver", period_s=0.0)
+    with pytest.raises(ValueError, match="one per layer"):
+        nh.Insertion("liver").set_scales([1.0] * 99)

@@ -1,0 +1,108 @@
+//! `needle calibrate-published`: a tissue stack from a published piecewise force-depth
+//! model (needle-calibrate's `published` rules), written into the set's `tissue/`, its
+//! published curve sampled into a CSV, and the stack replayed against that curve.
+use crate::model::check_compiled_set;
+use anyhow::{Context, Result};
+use clap::Args;
+use needle_calibrate::from_model::{calibrate_published as run, ModelOptions};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Derive a tissue stack from a published model's force polynomials per layer.
+#[derive(Args)]
+pub struct CalibratePublishedArgs {
+    /// The set whose FE surrogate is scaled (the one compiled in).
+    #[arg(long, default_value = "coeffs/default")]
+    pub set: PathBuf,
+    /// The published pieces: CSV with piece, layer, thickness_mm, c0_n .. c3_n_per_mm3.
+    #[arg(long)]
+    pub pieces: PathBuf,
+    /// The citation of every layer: CSV with layer, source (written into the layer's source).
+    #[arg(long)]
+    pub layer_sources: PathBuf,
+    /// Name of the stack (the tissue file is <set>/tissue/<name>.toml).
+    #[arg(long)]
+    pub name: String,
+    /// The stack's one-line description.
+    #[arg(long)]
+    pub description: String,
+    /// Diameter of the stack's needle, mm (the FE needle is carried to it by geometric similarity).
+    #[arg(long)]
+    pub needle_diameter_mm: f64,
+    /// Speed of the replay along the published curve, mm/s (for the comparison only).
+    #[arg(long)]
+    pub replay_speed_mm_per_s: f64,
+    /// Write the sampled published curve (position_mm, force_n) here.
+    #[arg(long)]
+    pub sampled_out: PathBuf,
+    /// Write the stack here instead of <set>/tissue/<name>.toml.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Write the figure here instead of <set>/figures/calibration-<name>.svg.
+    #[arg(long)]
+    pub figure: Option<PathBuf>,
+}
+
+/// Runs `needle calibrate-published`. The comparison with the published curve is printed,
+/// not held to the calibration goals: exit 0 once the files are written.
+///
+/// # Errors
+/// The set is not the compiled-in one, a file is refused, or a file cannot be written.
+pub fn calibrate_published(a: CalibratePublishedArgs) -> Result<ExitCode> {
+    check_compiled_set(&a.set)?;
+    let mu0 = needle_codegen::tissue::read_fe_shear_modulus(&a.set)?
+        .with_context(|| format!("{}: no campaign.toml: the FE tissue's shear modulus sets the track stiffness", a.set.display()))?;
+    let opts = ModelOptions {
+        pieces: &a.pieces,
+        layer_sources: &a.layer_sources,
+        name: a.name.clone(),
+        description: a.description.clone(),
+        needle_diameter_mm: a.needle_diameter_mm,
+        replay_speed_mm_per_s: a.replay_speed_mm_per_s,
+        fe_shear_modulus_n_per_mm2: mu0,
+    };
+    let c = run(&opts)?;
+    println!(
+        "{} published pieces sampled every {} mm ({} points); geometric similarity: needle {} mm / FE needle {} mm = {:.4}",
+        needle_calibrate::published::read_pieces(&a.pieces)?.len(),
+        needle_calibrate::published::STEP_MM,
+        c.points.len(),
+        a.needle_diameter_mm,
+        needle_haptics::insertion::FE_NEEDLE_DIAMETER_MM,
+        c.similarity
+    );
+    for (l, f) in c.stack.layers.iter().zip(&c.fit.layers) {
+        println!(
+            "{:<22} top {:>6.2} mm, thickness {:>6.2} mm, s = {:.4}, puncture {:.4} N, cutting {:.4} N, friction {:.5} N/mm, track {:.5} N/mm^2",
+            l.name, f.boundary_mm, l.thickness_mm, l.stiffness_scale, l.puncture_force_n, l.cutting_force_n, l.friction_coulomb_n_per_mm, l.track_stiffness_n_per_mm2
+        );
+    }
+    crate::calibrate::print_checks(&c.checks);
+    let mut sampled = String::from("position_mm,force_n\n");
+    for p in &c.points {
+        sampled.push_str(&format!("{},{}\n", p.position_mm, p.force_n));
+    }
+    write(&a.sampled_out, &sampled)?;
+    let out = a.out.unwrap_or_else(|| a.set.join(needle_codegen::tissue::TISSUE_DIR).join(format!("{}.toml", a.name)));
+    let header = format!(
+        "Tissue stack `{}`, written by `needle calibrate-published` (format: coeffs/README.md, \"Tissue stacks\"; rules: crates/calibrate/src/published.rs).\nPublished model: {} (provenance: its folder's README.md); citations per layer: {}; needle {} mm.",
+        a.name,
+        a.pieces.display(),
+        a.layer_sources.display(),
+        a.needle_diameter_mm
+    );
+    write(&out, &c.stack.to_toml(&header))?;
+    let figure = a.figure.unwrap_or_else(|| a.set.join("figures").join(format!("calibration-{}.svg", a.name)));
+    write(&figure, &crate::calibrate_figure::svg(&c, &a.name, "published model (sampled)")?)?;
+    println!("result: stack derived by the published-model rules (the comparison above is reported, not a goal)");
+    Ok(ExitCode::SUCCESS)
+}
+
+fn write(path: &std::path::Path, text: &str) -> Result<()> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
+    }
+    needle_fe::results::write_atomic(path, text.as_bytes())?;
+    println!("wrote {}", path.display());
+    Ok(())
+}

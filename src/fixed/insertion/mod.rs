@@ -1,0 +1,369 @@
+//! The whole insertion in integers: [`Insertion`] is [`crate::insertion::Insertion`]'s
+//! state machine (the same phases, punctures, cutting, friction and track, documented
+//! there) computed without floating point, for cores without an FPU.
+//!
+//! - Input: [`fixed::Pose`](super::Pose) (Q16.16 mm and degrees), one per tick.
+//! - Output: [`fixed::Wrench`](super::Wrench) in µN and µN·mm, the status, the phase,
+//!   the punctures and the filtered axial velocity (mm/s, Q16).
+//! - The stacks: [`stacks::ALL`], the compiled-in f32 stacks converted at compile time
+//!   ([`Stack::from_f32`]).
+//! - The surrogate: [`fixed::extended_wrench`](super::extended_wrench) at `x/λ, z/λ, δ/λ`,
+//!   scaled by `s λ²` (forces) and `s λ³` (moments), each gain `s λ^k` in Q16.
+//! - Internally `i64`: path coordinates in mm Q16, the axis in Q30 ([`geometry`]), forces
+//!   in µN Q16; the output rounds to whole µN and saturates to `i32`.
+//!
+//! **Inputs clamped**: `x`, `z` to ±64 mm, `depth` to ±128 mm, tilts to ±89 degrees (the
+//! f32 model's); the surrogate clamps further to its own domain and reports it.
+//!
+//! **Overflow.** Every product whose size depends on the stack's values or on the pose
+//! saturates (`i64::saturating_mul`); within the stacks [`Stack::from_f32`] accepts
+//! (`λ <= 8`, `s <= 16384`, total thickness <= 512 mm) and the clamped inputs, the
+//! wrench of a realistic tissue stays far below saturation (the accuracy test compares
+//! it with the f32 model over the golden paths of every shipped stack).
+//!
+//! **Velocity**: the backward difference of the depth times the tick rate
+//! (`1e6 / period_us`, Q16, computed once in [`Insertion::new`]), low-passed with
+//! `alpha = period / (period + tau)` (Q16, once): `v += floor(alpha (raw - v) / 2^16)`.
+//! No division per tick but one: the path coordinate of a boundary is its depth below
+//! the surface over the axis's vertical component (`2^60 / a_y`, once per tick).
+mod geometry;
+mod stack;
+
+pub use stack::{
+    stacks, Karnopp, Layer, Stack, CUTTING_MAX_Q16, FRICTION_LEVEL_MAX_Q16, MAX_LAYERS, SIMILARITY_MAX, STICK_BAND_MAX_Q16,
+    STIFFNESS_SCALE_MAX, TOTAL_THICKNESS_MAX_MM, VISCOUS_MAX_Q16,
+};
+
+use super::depth_extension::saturate_i32;
+use super::{extended_wrench, Pose, Wrench};
+use crate::insertion::{InsertionError, Phase};
+use crate::Status;
+use geometry::{axis, dot, mul_q30, mul_shr, HoldSums, Track, Vec3, TRACK_STIFFNESS_MAX_Q8};
+
+/// The insertion's tick settings in integers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct InsertionConfig {
+    /// The period of the pose stream, µs (> 0; 1000 at 1 kHz).
+    pub period_us: u32,
+    /// Time constant of the velocity's low-pass filter, µs (0: unfiltered).
+    pub velocity_time_constant_us: u32,
+}
+
+impl InsertionConfig {
+    /// 1 kHz, velocity filtered with a 5 ms time constant (the f32 model's
+    /// [`DEFAULT_1KHZ`](crate::insertion::InsertionConfig::DEFAULT_1KHZ)).
+    pub const DEFAULT_1KHZ: Self = Self { period_us: 1000, velocity_time_constant_us: 5000 };
+}
+
+/// One tick's result.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct InsertionEvaluation {
+    /// The wrench on the needle (block frame; µN, µN·mm about the hub).
+    pub wrench: Wrench,
+    /// The surrogate's status while deflecting (saturation).
+    pub status: Status,
+    /// The phase after this tick.
+    pub phase: Phase,
+    /// Boundaries punctured in this tick.
+    pub punctures: u8,
+    /// The filtered axial velocity, mm/s in Q16 (positive inserting), saturated to `i32`.
+    pub velocity_mm_per_s_q16: i32,
+}
+
+/// The state of one needle path through a stack, in integers: fixed size, no allocation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Insertion<'a> {
+    stack: &'a Stack,
+    /// Per layer the stiffness scale in use, Q16 (the stack's, or [`Insertion::set_scales`]').
+    scales_q16: [i32; MAX_LAYERS],
+    /// Per layer `[s λ², s λ³]`, Q16.
+    gains_q16: [[i64; 2]; MAX_LAYERS],
+    rate_q16: i64,
+    alpha_q16: i64,
+    punctured: usize,
+    track_end_q16: i64,
+    track: Option<Track>,
+    preload_q16: [i64; 6],
+    last_depth_q16: Option<i64>,
+    velocity_q16: i64,
+}
+
+/// What [`Insertion::deflect`] found.
+struct Deflected {
+    wrench_q16: [i64; 6],
+    status: Status,
+    punctures: u8,
+}
+
+const X_MAX_Q16: i64 = 64 << 16;
+const DEPTH_MAX_Q16: i64 = 128 << 16;
+
+fn layer_ok(l: &Layer) -> bool {
+    let k = &l.friction;
+    l.thickness_q16 > 0
+        && l.stiffness_scale_q16 > 0
+        && l.puncture_force_q16 > 0
+        && k.stick_band_q16 > 0
+        && k.in_range()
+        && [l.cutting_force_q16, k.static_per_speed_q16, k.coulomb_q16, k.viscous_q16, l.track_stiffness_q8].iter().all(|&v| v >= 0)
+        && l.track_stiffness_q8 <= TRACK_STIFFNESS_MAX_Q8
+        && l.cutting_force_q16 <= CUTTING_MAX_Q16
+        && (l.cutting_per_speed_q16.saturating_mul(k.stick_band_q16) >> 16) <= CUTTING_MAX_Q16
+}
+
+impl<'a> Insertion<'a> {
+    /// A path through `stack`, the needle above the surface.
+    ///
+    /// # Errors
+    /// [`InsertionError::LayerCount`] (also for a stack [`Stack::from_f32`] refused),
+    /// [`InsertionError::Value`] (a value out of the tissue file's ranges after
+    /// rounding, e.g. a thickness below 2^-17 mm, or beyond the integer ranges: a
+    /// stiffness scale above [`STIFFNESS_SCALE_MAX`], a track stiffness above 8.4 N/mm
+    /// per mm), [`InsertionError::Config`] (a zero period).
+    pub fn new(stack: &'a Stack, config: InsertionConfig) -> Result<Self, InsertionError> {
+        if stack.count == 0 || stack.count > MAX_LAYERS {
+            return Err(InsertionError::LayerCount);
+        }
+        let max_scale = (STIFFNESS_SCALE_MAX as i64) << 16;
+        if !stack.layers().iter().all(|l| layer_ok(l) && l.stiffness_scale_q16 <= max_scale) || stack.inv_similarity_q30 <= 0 {
+            return Err(InsertionError::Value);
+        }
+        let mut scales_q16 = [0; MAX_LAYERS];
+        for (s, l) in scales_q16.iter_mut().zip(stack.layers()) {
+            // <= 2^30 (checked above)
+            *s = l.stiffness_scale_q16 as i32;
+        }
+        let period = u64::from(config.period_us);
+        let rate_q16 = (1_000_000_u64 << 16).checked_div(period).ok_or(InsertionError::Config)?;
+        let whole = period + u64::from(config.velocity_time_constant_us);
+        let alpha_q16 = ((period << 16) + (whole >> 1)).checked_div(whole).ok_or(InsertionError::Config)?;
+        let mut insertion = Self {
+            stack,
+            scales_q16,
+            gains_q16: [[0; 2]; MAX_LAYERS],
+            rate_q16: i64::try_from(rate_q16).map_err(|_| InsertionError::Config)?,
+            alpha_q16: i64::try_from(alpha_q16).map_err(|_| InsertionError::Config)?,
+            punctured: 0,
+            track_end_q16: 0,
+            track: None,
+            preload_q16: [0; 6],
+            last_depth_q16: None,
+            velocity_q16: 0,
+        };
+        insertion.update_gains();
+        Ok(insertion)
+    }
+
+    fn update_gains(&mut self) {
+        let [l2, l3] = self.stack.similarity_pow_q16;
+        for (g, &s) in self.gains_q16.iter_mut().zip(&self.scales_q16) {
+            *g = [mul_shr(i64::from(s), l2, 16), mul_shr(i64::from(s), l3, 16)];
+        }
+    }
+
+    /// Replaces the layers' stiffness scales (Q16.16, one per layer, each > 0 and at most
+    /// [`STIFFNESS_SCALE_MAX`]); the path's state is kept.
+    ///
+    /// # Errors
+    /// [`InsertionError::Scales`]: not one scale per layer, or one out of range; nothing
+    /// is changed then.
+    pub fn set_scales(&mut self, scales_q16: &[i32]) -> Result<(), InsertionError> {
+        let max = (STIFFNESS_SCALE_MAX as i64) << 16;
+        if scales_q16.len() != self.stack.count || !scales_q16.iter().all(|&s| s > 0 && i64::from(s) <= max) {
+            return Err(InsertionError::Scales);
+        }
+        for (slot, &s) in self.scales_q16.iter_mut().zip(scales_q16) {
+            *slot = s;
+        }
+        self.update_gains();
+        Ok(())
+    }
+
+    /// The stack (its own scales; those in use are [`Insertion::scales_q16`]).
+    #[must_use]
+    pub fn stack(&self) -> &'a Stack {
+        self.stack
+    }
+
+    /// The stiffness scales in use, one per layer, Q16.
+    #[must_use]
+    pub fn scales_q16(&self) -> &[i32] {
+        self.scales_q16.get(..self.stack.count).unwrap_or(&[])
+    }
+
+    /// Forgets the path: the needle is above the surface again (no track, no velocity).
+    pub fn reset(&mut self) {
+        self.end_path();
+        self.last_depth_q16 = None;
+        self.velocity_q16 = 0;
+    }
+
+    fn end_path(&mut self) {
+        self.punctured = 0;
+        self.track_end_q16 = 0;
+        self.track = None;
+        self.preload_q16 = [0; 6];
+    }
+
+    /// One tick: the pose in, the wrench out (the f32 model's
+    /// [`step`](crate::insertion::Insertion::step), in integers). Call it once per
+    /// period of the configuration. Never panics.
+    ///
+    /// Never inlined: one function per image, which the no-float check of
+    /// `tests/firmware_no_panic.rs` disassembles (a call costs a few instructions of
+    /// the 5,000-17,000 a step takes).
+    #[inline(never)]
+    pub fn step(&mut self, pose: &Pose) -> InsertionEvaluation {
+        let depth = i64::from(pose.depth_mm_q16).clamp(-DEPTH_MAX_Q16, DEPTH_MAX_Q16);
+        let step_q16 = self.last_depth_q16.map_or(0, |last| depth - last);
+        self.filter_velocity(step_q16);
+        self.last_depth_q16 = Some(depth);
+        // friction and cutting see the velocity only when it has the last motion's sign
+        let v = if (self.velocity_q16 > 0 && step_q16 > 0) || (self.velocity_q16 < 0 && step_q16 < 0) { self.velocity_q16 } else { 0 };
+        if depth <= 0 {
+            self.end_path();
+            return self.evaluation([0; 6], Status::OK, Phase::Approach, 0);
+        }
+        let a = axis(pose.theta_x_deg_q16, pose.theta_z_deg_q16);
+        let x = i64::from(pose.x_mm_q16).clamp(-X_MAX_Q16, X_MAX_Q16);
+        let z = i64::from(pose.z_mm_q16).clamp(-X_MAX_Q16, X_MAX_Q16);
+        let entry: Vec3 = [x, 0, z];
+        let bounds = self.boundaries(a[1]);
+        let Deflected { wrench_q16: mut w, status, punctures } = self.deflect(pose, depth, a, entry, &bounds);
+        let phase = self.shaft(depth, a, entry, v, &bounds, &mut w);
+        self.evaluation(w, status, phase, punctures)
+    }
+
+    fn evaluation(&self, w_q16: [i64; 6], status: Status, phase: Phase, punctures: u8) -> InsertionEvaluation {
+        let wrench = Wrench::from_array(w_q16.map(|c| saturate_i32(c.saturating_add(1 << 15) >> 16)));
+        InsertionEvaluation { wrench, status, phase, punctures, velocity_mm_per_s_q16: saturate_i32(self.velocity_q16) }
+    }
+
+    fn filter_velocity(&mut self, step_q16: i64) {
+        let raw = mul_shr(step_q16, self.rate_q16, 16);
+        self.velocity_q16 = self.velocity_q16.saturating_add(mul_shr(self.alpha_q16, raw.saturating_sub(self.velocity_q16), 16));
+    }
+
+    /// Path coordinates of the layers' upper boundaries (mm Q16) for a needle of
+    /// vertical axis component `a_y` (Q30, `> 0` for tilts within ±89 degrees), and
+    /// `i64::MAX` past the last layer: `(sum of the thicknesses above) 2^30 / a_y`.
+    fn boundaries(&self, a_y_q30: i64) -> [i64; MAX_LAYERS + 1] {
+        // cos(89°)^2 2^30 > 327,000: the division is by a positive number; `checked_div`
+        // keeps the no-panic proof without relying on it
+        let inv_ay_q30 = (1_i64 << 60).checked_div(a_y_q30).unwrap_or(i64::MAX);
+        let mut q = [i64::MAX; MAX_LAYERS + 1];
+        let mut above = 0_i64;
+        for (slot, l) in q.iter_mut().zip(self.stack.layers()) {
+            *slot = mul_shr(above, inv_ay_q30, 30);
+            above = above.saturating_add(l.thickness_q16);
+        }
+        q
+    }
+
+    /// The deflection of the first intact boundary, with the punctures it causes.
+    fn deflect(&mut self, pose: &Pose, depth: i64, a: Vec3, entry: Vec3, bounds: &[i64; MAX_LAYERS + 1]) -> Deflected {
+        let mut punctures = 0u8;
+        while self.punctured < self.stack.count {
+            let (Some(&q), Some(layer), Some(&[gf, gm])) =
+                (bounds.get(self.punctured), self.stack.layers.get(self.punctured), self.gains_q16.get(self.punctured))
+            else {
+                break;
+            };
+            if depth <= q {
+                break;
+            }
+            let e = self.surrogate(pose, entry, depth - q);
+            let [fx, fy, fz, mx, my, mz] = e.wrench.to_array().map(i64::from);
+            let f = [fx, fy, fz].map(|c| c.saturating_mul(gf));
+            let moments = [mx, my, mz].map(|c| c.saturating_mul(gm));
+            let axial = dot(f, a);
+            let [ax, ay, az] = a;
+            let [px, py, pz, pmx, pmy, pmz] = self.preload_q16;
+            if axial < layer.puncture_force_q16 {
+                let sum = |p: i64, x: i64| p.saturating_add(x);
+                let total = [sum(px, f[0]), sum(py, f[1]), sum(pz, f[2]), sum(pmx, moments[0]), sum(pmy, moments[1]), sum(pmz, moments[2])];
+                return Deflected { wrench_q16: total, status: e.status, punctures };
+            }
+            // puncture: the axial force goes, the lateral force and the moments stay
+            if self.track.is_none() {
+                self.track = Some(Track { entry_q16: entry, axis_q30: a });
+            }
+            let lateral = [f[0] - mul_q30(axial, ax), f[1] - mul_q30(axial, ay), f[2] - mul_q30(axial, az)];
+            for (p, x) in self.preload_q16.iter_mut().zip([lateral[0], lateral[1], lateral[2], moments[0], moments[1], moments[2]]) {
+                *p = p.saturating_add(x);
+            }
+            self.punctured += 1;
+            self.track_end_q16 = depth;
+            punctures = punctures.saturating_add(1);
+        }
+        Deflected { wrench_q16: self.preload_q16, status: Status::OK, punctures }
+    }
+
+    /// The FE surrogate for this stack's needle at indentation `delta_q16` (mm Q16):
+    /// evaluated at `x/λ, z/λ, δ/λ` (the clamped entry point's x and z).
+    fn surrogate(&self, pose: &Pose, entry: Vec3, delta_q16: i64) -> super::Evaluation {
+        let inv = self.stack.inv_similarity_q30;
+        let fe = Pose {
+            x_mm_q16: saturate_i32(mul_shr(entry[0], inv, 30)),
+            z_mm_q16: saturate_i32(mul_shr(entry[2], inv, 30)),
+            depth_mm_q16: saturate_i32(mul_shr(delta_q16, inv, 30)),
+            ..*pose
+        };
+        extended_wrench(&fe)
+    }
+
+    /// Friction, cutting and the track's hold on the shaft, added to `w`; the phase.
+    fn shaft(&mut self, depth: i64, a: Vec3, entry: Vec3, v: i64, bounds: &[i64; MAX_LAYERS + 1], w: &mut [i64; 6]) -> Phase {
+        let m = self.punctured;
+        let index = |j: usize| u8::try_from(j).unwrap_or(u8::MAX);
+        let bound = |j: usize| bounds.get(j).copied().unwrap_or(i64::MAX);
+        if m == 0 {
+            return if depth > bound(0) { Phase::Deflecting(0) } else { Phase::Approach };
+        }
+        let next = bound(m);
+        let top = depth.min(next);
+        let hub_q = depth - self.stack.hub_from_tip_q16;
+        let deviation = self.track.map(|t| t.deviation(entry, a, hub_q));
+        let mut axial_q16 = 0_i64;
+        let mut hold = HoldSums::default();
+        for (j, layer) in self.stack.layers().iter().enumerate().take(m) {
+            let (q1, q2) = (bound(j), bound(j + 1).min(top));
+            if q2 <= q1 {
+                continue;
+            }
+            axial_q16 += ((q2 - q1) * layer.friction.per_mm_q16(v)) >> 16;
+            hold.add(layer.track_stiffness_q8, q1, q2);
+        }
+        if let Some(d) = &deviation {
+            d.add_hold(&hold, w);
+        }
+        let phase = if depth >= next {
+            Phase::Deflecting(index(m))
+        } else if depth >= self.track_end_q16 && v > 0 {
+            let cutting = self.stack.layers.get(m - 1).map_or(0, |l| {
+                if v < l.friction.stick_band_q16 {
+                    // v < band: below `cutting_per_speed * band <= 2^44 2^16` (`layer_ok`)
+                    (l.cutting_per_speed_q16 * v) >> 16
+                } else {
+                    l.cutting_force_q16
+                }
+            });
+            axial_q16 = axial_q16.saturating_add(cutting);
+            Phase::Cutting(index(m - 1))
+        } else {
+            let inside = (1..m).take_while(|&j| bound(j) < depth).count();
+            Phase::InTrack(index(inside))
+        };
+        if depth > self.track_end_q16 && depth < next {
+            self.track_end_q16 = depth;
+        }
+        // the force on the needle opposes the motion: along +a (towards the hub) inserting
+        for (wc, &ac) in w.iter_mut().zip(&a) {
+            *wc = wc.saturating_add(mul_q30(axial_q16, ac));
+        }
+        phase
+    }
+}
