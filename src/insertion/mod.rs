@@ -17,13 +17,22 @@
 //!   unchanged) and its forces are scaled by `s λ²`, its moments by `s λ³` (the hub at
 //!   `λ` times the FE needle's). Elastic: withdrawing gives the same force back.
 //! - *puncture*: when the deflection's axial force (along the needle, pushing it back)
-//!   reaches the layer's `puncture_force_n`, the boundary is punctured in that tick: its
-//!   axial force is gone (the cue), its lateral force and moments stay as the track's
-//!   preload, so the five lateral components are continuous. A puncture can be followed
-//!   by the next boundary's in the same tick (a thin layer).
+//!   plus the cutting force carried from the layer above (below) reaches the layer's
+//!   `puncture_force_n`, the boundary is punctured in that tick: its axial force is gone
+//!   (the cue), its lateral force and moments stay as the track's preload, so the five
+//!   lateral components are continuous. A puncture can be followed by the next
+//!   boundary's in the same tick (a thin layer, or a boundary weaker than the cutting
+//!   force carried onto it: punctured at contact).
 //! - *cutting* layer `m - 1`: while the tip advances past the deepest point it reached
 //!   (the track's end), the layer's `cutting_force_n` opposes it, ramped in over the
 //!   layer's stick band of speed (zero for a needle at rest).
+//! - *carried cutting*: while the tip, advancing, deflects boundary `m >= 1`, the
+//!   cutting force of layer `m - 1` stays on it (ramped the same way): the tissue at the
+//!   boundary carries the load the tip was cutting with, so the force does not drop
+//!   where the tip meets a boundary (only a puncture drops it: no false loss of
+//!   resistance). Boundary `m` punctures when its deflection's axial force reaches
+//!   `puncture_force_n - cutting_force_n` of the layer above (the full cutting force,
+//!   whatever the speed: where it punctures does not depend on the speed).
 //! - *in the track*: behind the track's end (withdrawal, or re-advance after one) only
 //!   friction acts; past the end cutting resumes, with no new puncture.
 //! - everywhere after the first puncture: shaft friction ([`Karnopp`]) per mm of shaft in
@@ -390,7 +399,7 @@ impl Insertion {
             let (e, k) = deflection_at(pose, pose.depth_mm - q, layer.stiffness_scale, self.similarity, rate);
             let w = e.wrench.to_array();
             let axial_n = dot([w[0], w[1], w[2]], a);
-            if axial_n < layer.puncture_force_n {
+            if axial_n + self.carried_cutting_n() < layer.puncture_force_n {
                 let mut total = self.preload;
                 for (t, x) in total.iter_mut().zip(w) {
                     *t += x;
@@ -410,6 +419,12 @@ impl Insertion {
             punctures = punctures.saturating_add(1);
         }
         Deflected { wrench: self.preload, status: Status::OK, punctures, stiffness_n_per_mm: 0.0 }
+    }
+
+    /// The cutting force of the last punctured layer (N; 0 before the first puncture):
+    /// what the tip carries onto the next boundary.
+    fn carried_cutting_n(&self) -> f32 {
+        self.punctured.checked_sub(1).and_then(|j| self.layers.get(j)).map_or(0.0, |l| l.cutting_force_n)
     }
 
     /// Friction, cutting and the track's hold on the shaft, added to `w`; the phase and
@@ -438,14 +453,20 @@ impl Insertion {
                 d.add_hold(layer.track_stiffness_n_per_mm2, q1, q2, w);
             }
         }
-        let phase = if depth >= next {
-            Phase::Deflecting(index(m))
-        } else if depth >= self.track_end_mm && v > 0.0 {
-            let cutting = self.layers.get(m - 1).map_or(0.0, |l| {
+        // cutting layer m - 1, or carrying its cutting force onto boundary m
+        let cutting = |v: f32| {
+            self.layers.get(m - 1).map_or(0.0, |l| {
                 let ramp = v / l.friction.stick_band_mm_per_s;
                 l.cutting_force_n * if ramp < 1.0 { ramp } else { 1.0 }
-            });
-            axial_n += cutting;
+            })
+        };
+        let phase = if depth >= next {
+            if v > 0.0 {
+                axial_n += cutting(v);
+            }
+            Phase::Deflecting(index(m))
+        } else if depth >= self.track_end_mm && v > 0.0 {
+            axial_n += cutting(v);
             Phase::Cutting(index(m - 1))
         } else {
             let inside = (1..m).take_while(|&j| self.boundary_mm(j, a[1]) < depth).count();
