@@ -358,8 +358,9 @@ impl Insertion {
         }
         let a = axis(pose.theta_x_deg, pose.theta_z_deg);
         let entry: Vec3 = [pose.x_mm, 0.0, pose.z_mm];
-        let Deflected { wrench: mut w, status, punctures, stiffness_n_per_mm } = self.deflect(pose, a, entry, rate);
-        let (phase, axial_n) = self.shaft(pose, a, entry, v, &mut w);
+        let bounds = self.boundaries(a[1]);
+        let Deflected { wrench: mut w, status, punctures, stiffness_n_per_mm } = self.deflect(pose, a, entry, &bounds, rate);
+        let (phase, axial_n) = self.shaft(pose, a, entry, v, &bounds, &mut w);
         let wrench = Wrench::from_array(w);
         let terms = GuardTerms { stiffness_n_per_mm, dissipative_n: [axial_n * a[0], axial_n * a[1], axial_n * a[2]] };
         (self.evaluation(wrench, status, phase, punctures), terms)
@@ -377,21 +378,24 @@ impl Insertion {
         self.velocity_mm_per_s += alpha * (raw - self.velocity_mm_per_s);
     }
 
-    /// Path coordinate of layer `j`'s upper boundary for a needle of vertical axis
-    /// component `a_y` (`+inf` past the last layer).
-    fn boundary_mm(&self, j: usize, a_y: f32) -> f32 {
-        if j >= self.count {
-            return f32::INFINITY;
+    /// Path coordinates of the layers' upper boundaries for a needle of vertical axis
+    /// component `a_y`, `+inf` past the last layer: `q_j = (sum of the thicknesses above
+    /// it) / a_y` (`a_y >= cos 89°` for the clamped tilts), computed once per tick.
+    fn boundaries(&self, a_y: f32) -> [f32; MAX_LAYERS + 1] {
+        let mut q = [f32::INFINITY; MAX_LAYERS + 1];
+        let mut above = 0.0f32;
+        for (slot, l) in q.iter_mut().zip(self.layers()) {
+            *slot = above / a_y;
+            above += l.thickness_mm;
         }
-        let above: f32 = self.layers.iter().take(j).map(|l| l.thickness_mm).sum();
-        above / a_y
+        q
     }
 
     /// The deflection of the first intact boundary, with the punctures it causes.
-    fn deflect(&mut self, pose: &Pose, a: Vec3, entry: Vec3, rate: bool) -> Deflected {
+    fn deflect(&mut self, pose: &Pose, a: Vec3, entry: Vec3, bounds: &[f32; MAX_LAYERS + 1], rate: bool) -> Deflected {
         let mut punctures = 0u8;
         while self.punctured < self.count {
-            let q = self.boundary_mm(self.punctured, a[1]);
+            let q = bounds.get(self.punctured).copied().unwrap_or(f32::INFINITY);
             if pose.depth_mm <= q {
                 break;
             }
@@ -429,21 +433,22 @@ impl Insertion {
 
     /// Friction, cutting and the track's hold on the shaft, added to `w`; the phase and
     /// the axial force of friction and cutting (N, along `+a`).
-    fn shaft(&mut self, pose: &Pose, a: Vec3, entry: Vec3, v: f32, w: &mut [f32; 6]) -> (Phase, f32) {
+    fn shaft(&mut self, pose: &Pose, a: Vec3, entry: Vec3, v: f32, bounds: &[f32; MAX_LAYERS + 1], w: &mut [f32; 6]) -> (Phase, f32) {
         let depth = pose.depth_mm;
         let m = self.punctured;
         let index = |j: usize| u8::try_from(j).unwrap_or(u8::MAX);
+        let bound = |j: usize| bounds.get(j).copied().unwrap_or(f32::INFINITY);
         if m == 0 {
-            return (if depth > self.boundary_mm(0, a[1]) { Phase::Deflecting(0) } else { Phase::Approach }, 0.0);
+            return (if depth > bound(0) { Phase::Deflecting(0) } else { Phase::Approach }, 0.0);
         }
-        let next = self.boundary_mm(m, a[1]);
+        let next = bound(m);
         let top = if depth < next { depth } else { next };
         let hub_q = depth - HUB_FROM_TIP_MM * self.similarity;
         let deviation = self.track.map(|t| t.deviation(entry, a, hub_q));
         let mut axial_n = 0.0f32;
         for j in 0..m {
-            let (Some(layer), lo) = (self.layers.get(j), self.boundary_mm(j, a[1])) else { break };
-            let hi = self.boundary_mm(j + 1, a[1]);
+            let (Some(layer), lo) = (self.layers.get(j), bound(j)) else { break };
+            let hi = bound(j + 1);
             let (q1, q2) = (lo, if hi < top { hi } else { top });
             if q2 <= q1 {
                 continue;
@@ -469,7 +474,7 @@ impl Insertion {
             axial_n += cutting(v);
             Phase::Cutting(index(m - 1))
         } else {
-            let inside = (1..m).take_while(|&j| self.boundary_mm(j, a[1]) < depth).count();
+            let inside = (1..m).take_while(|&j| bound(j) < depth).count();
             Phase::InTrack(index(inside))
         };
         if depth > self.track_end_mm && depth < next {
