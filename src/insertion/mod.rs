@@ -17,7 +17,7 @@
 //!   unchanged) and its forces are scaled by `s λ²`, its moments by `s λ³` (the hub at
 //!   `λ` times the FE needle's). Elastic: withdrawing gives the same force back.
 //! - *puncture*: when the deflection's axial force (along the needle, pushing it back)
-//!   plus the cutting force carried from the layer above (below) reaches the layer's
+//!   plus the cutting force carried from the layer above (see below) reaches the layer's
 //!   `puncture_force_n`, the boundary is punctured in that tick: its axial force is gone
 //!   (the cue), its lateral force and moments stay as the track's preload, so the five
 //!   lateral components are continuous. A puncture can be followed by the next
