@@ -178,6 +178,25 @@ impl PronyTerms {
         Self::new(converted.get(..terms.len()).unwrap_or(&[]))
     }
 
+    /// All [`MAX_TERMS`] slots (those past [`len`](Self::len) zero) and the count, for
+    /// compile-time conversions (the fixed-point stacks).
+    #[must_use]
+    pub const fn as_array(&self) -> ([PronyTerm; MAX_TERMS], u8) {
+        (self.terms, self.count)
+    }
+
+    /// The number of terms.
+    #[must_use]
+    pub const fn len(&self) -> usize {
+        self.count as usize
+    }
+
+    /// Whether there is no term (elastic).
+    #[must_use]
+    pub const fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
     /// The terms.
     #[must_use]
     pub fn as_slice(&self) -> &[PronyTerm] {
@@ -308,14 +327,18 @@ impl QlvState {
     /// viscoelastic wrench out. Without terms the input is returned and the state left
     /// at rest.
     pub fn step(&mut self, coefficients: &QlvCoefficients, elastic: [f32; COMPONENT_COUNT]) -> [f32; COMPONENT_COUNT] {
-        if !coefficients.is_active() {
-            return elastic;
-        }
         let mut out = elastic;
-        for (o, s) in out.iter_mut().zip(self.state.iter_mut()) {
-            *o = coefficients.step_one(s, *o);
+        if coefficients.is_active() {
+            self.filter(coefficients, &mut out);
         }
         out
+    }
+
+    /// The six components in place.
+    fn filter(&mut self, coefficients: &QlvCoefficients, w: &mut [f32; COMPONENT_COUNT]) {
+        for (o, s) in w.iter_mut().zip(self.state.iter_mut()) {
+            *o = coefficients.step_one(s, *o);
+        }
     }
 
     /// Back to rest.

@@ -180,3 +180,37 @@ fn bad_terms_are_refused() {
         assert_eq!(Qlv::new(&terms(), tick), Err(QlvError::Tick));
     }
 }
+
+/// The fixed-point filter (`needle_haptics::fixed::viscoelastic`, integers only) on the
+/// same ramp-and-hold, in µN Q16, against the same closed form; and through its
+/// conversion from the f32 terms.
+#[test]
+fn the_fixed_point_filter_matches_the_closed_form() {
+    use needle_haptics::fixed::viscoelastic as fx;
+    let terms = terms();
+    let fixed_terms = fx::PronyTerms::from_f32(&terms);
+    let k = fx::QlvCoefficients::new(&fixed_terms, 1000).expect("in range");
+    // forces of a few newtons, in µN Q16 (6 N at the end of the ramp)
+    let unit = 1.0e6 * 65536.0;
+    for (rate, ramp_ticks) in [(1.0f64, 6000usize), (3.0, 2000), (10.0, 600)] {
+        let mut state = fx::QlvState::REST;
+        let ramp_s = ramp_ticks as f64 * 1e-3;
+        let (mut peak, mut worst) = (0.0f64, 0.0f64);
+        for n in 1..=ramp_ticks + 30_000 {
+            let t = n as f64 * 1e-3;
+            let elastic = (rate * t.min(ramp_s) * unit).round() as i64;
+            let out = state.step(&k, [elastic, -elastic, elastic / 3, 0, elastic * 2, -elastic / 7]);
+            let want = ramp_hold_exact(&terms, rate, ramp_s, t);
+            peak = peak.max(want.abs());
+            worst = worst.max((out[0] as f64 / unit - want).abs()).max((-(out[1] as f64) / unit - want).abs());
+            assert_eq!(out[3], 0, "a zero input stays zero");
+        }
+        println!("fixed, rate {rate}/s: largest error {worst:.3e} of peak {peak:.4}");
+        assert!(worst <= 2e-6 * peak, "rate {rate}: error {worst:e} against peak {peak}");
+    }
+    // out of the integer ranges: refused
+    let mut bad = fixed_terms;
+    bad.g_q16[0] = 10 << 16;
+    assert_eq!(fx::QlvCoefficients::new(&bad, 1000), None);
+    assert_eq!(fx::QlvCoefficients::new(&fixed_terms, 0), None);
+}

@@ -357,6 +357,9 @@ impl Insertion {
         self.tick(pose, true)
     }
 
+    // Never inlined: LLVM 22 (rustc 1.95) crashed in register allocation on x86-64 with
+    // the grown state inlined into a large caller (host-tests/tests/insertion_fixed.rs).
+    #[inline(never)]
     fn tick(&mut self, pose: &Pose, rate: bool) -> (InsertionEvaluation, GuardTerms) {
         let finite = [pose.x_mm, pose.z_mm, pose.theta_x_deg, pose.theta_z_deg, pose.depth_mm].into_iter().all(f32::is_finite);
         if !finite {

@@ -13,7 +13,7 @@ pub const NEEDLE_INSERTION_STORAGE_WORDS: usize = 128;
 pub const NEEDLE_INSERTION_MAGIC: u32 = 0x4e49_4e53;
 
 /// 64-bit words of opaque storage in a [`needle_fixed_insertion_t`].
-pub const NEEDLE_FIXED_INSERTION_STORAGE_WORDS: usize = 48;
+pub const NEEDLE_FIXED_INSERTION_STORAGE_WORDS: usize = 112;
 /// [`needle_fixed_insertion_t::magic`] of an initialised fixed-point insertion.
 pub const NEEDLE_FIXED_INSERTION_MAGIC: u32 = 0x4e46_494e;
 

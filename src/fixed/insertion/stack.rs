@@ -12,7 +12,9 @@
 //! | puncture and cutting force | µN × 2^16 |
 //! | friction levels | µN per mm of shaft × 2^16; the stick band's slope and the viscous term µN/mm per mm/s × 2^16 |
 //! | track stiffness | µN/mm per mm of shaft × 2^8 |
+//! | Prony terms | `g` × 2^16, `tau` µs ([`PronyTerms::from_f32`]) |
 use crate::fixed::depth_extension::round_i64;
+use crate::fixed::viscoelastic::PronyTerms;
 use crate::insertion as f32_insertion;
 
 /// Most layers a stack has.
@@ -82,6 +84,8 @@ pub struct Layer {
     pub friction: Karnopp,
     /// Lateral stiffness of the track, µN/mm per mm of shaft, Q8.
     pub track_stiffness_q8: i64,
+    /// The boundary's relaxation function ([`crate::fixed::viscoelastic`]).
+    pub prony: PronyTerms,
 }
 
 /// A stack in integers: the layers and the needle's similarity to the FE needle.
@@ -176,6 +180,7 @@ impl Layer {
                 stick_band_q16: q16(l.friction.stick_band_mm_per_s),
             },
             track_stiffness_q8: round_i64(l.track_stiffness_n_per_mm2 as f64 * MICRO * 256.0),
+            prony: PronyTerms::from_f32(&l.prony),
         }
     }
 }
@@ -188,6 +193,7 @@ const EMPTY_LAYER: Layer = Layer {
     cutting_per_speed_q16: 0,
     friction: Karnopp { static_per_speed_q16: 0, coulomb_q16: 0, viscous_q16: 0, stick_band_q16: 0 },
     track_stiffness_q8: 0,
+    prony: PronyTerms::NONE,
 };
 
 impl Stack {
