@@ -14,13 +14,18 @@ run_or_fail(sprintf('cd "%s" && cargo build --release -q -p needle-capi -p needl
 run_or_fail(sprintf('"%s" header --out "%s"', fullfile(target, 'release', 'needle'), inc));
 lib = fullfile(target, 'release', 'libneedle_capi.a');
 src = fullfile(here, 'needle_haptics.c');
+% One list of flags for both compilers: the header's folder, the source, the C API's
+% static library and what a Rust static library needs on Linux (threads, dl, libm).
+flags = {['-I' inc], src, lib, '-lpthread', '-ldl', '-lm'};
 if exist('OCTAVE_VERSION', 'builtin')
-  [text, status] = mkoctfile('--mex', ['-I' inc], src, lib, '-lpthread', '-ldl', '-lm', '-o', fullfile(out_dir, 'needle_haptics.mex'));
+  [text, status] = mkoctfile('--mex', flags{:}, '-o', fullfile(out_dir, 'needle_haptics.mex'));
   if status ~= 0
     error('needle:build', 'mkoctfile --mex failed (%d):\n%s', status, text);
   end
 else
-  mex(['-I' inc], src, lib, '-lpthread', '-ldl', '-outdir', out_dir);
+  % MATLAB's mex: the same flags; it names the file after the source
+  % (needle_haptics.mexa64 on Linux) in -outdir. Not run in CI (no MATLAB there).
+  mex(flags{:}, '-outdir', out_dir);
 end
 addpath(out_dir);
 fprintf('built %s\n', fullfile(out_dir, 'needle_haptics'));

@@ -71,7 +71,6 @@ fn the_derived_values_follow_the_published_table() {
     // others at the ends of the rising pieces
     let fat_peak = force(1, (0.4516f64 / (2.0 * 0.5287) / 0.01).round() * 0.01);
     assert!((layer("skin").puncture_force_n - fat_peak).abs() < 1e-12);
-    assert!((layer("muscle").puncture_force_n - force(3, 0.0)).abs() < 1e-12, "MS after starts at the muscle's peak");
     assert!((layer("interspinous ligament").puncture_force_n - force(5, 0.0)).abs() < 1e-12, "the plateau's first point");
     assert!((layer("ligamentum flavum").puncture_force_n - force(7, 0.0)).abs() < 1e-12, "LF after starts at the LF's peak");
     // the advancing force: the plateau is all cutting, falling pieces their mean, no friction
@@ -79,8 +78,11 @@ fn the_derived_values_follow_the_published_table() {
     for l in &c.stack.layers {
         assert_eq!(l.friction_coulomb_n_per_mm, 0.0, "{}: no published advancing force grows with the inserted length", l.name);
     }
-    // rule 5: the fat (past the skin's peak it only falls) and the epidural space (0 N)
-    for (name, above) in [("fat", "skin"), ("epidural space", "ligamentum flavum")] {
+    // rule 5: the fat (past the skin's peak it only falls), the muscle (its peak, where
+    // MS after starts, lies below the fat's cutting force carried onto its boundary) and
+    // the epidural space (0 N)
+    assert!(force(3, 0.0) < layer("fat").cutting_force_n, "MS after starts at the muscle's peak");
+    for (name, above) in [("fat", "skin"), ("muscle", "fat"), ("epidural space", "ligamentum flavum")] {
         assert_eq!(layer(name).puncture_force_n, NO_RESISTANCE_N, "{name}");
         assert_eq!(layer(name).stiffness_scale, layer(above).stiffness_scale, "{name}");
     }

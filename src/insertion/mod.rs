@@ -28,13 +28,22 @@
 //!   ending): no stored force is pushed into the hand, and the next boundary starts
 //!   from rest.
 //! - *puncture*: when the deflection's axial force (along the needle, pushing it back)
-//!   reaches the layer's `puncture_force_n`, the boundary is punctured in that tick: its
-//!   axial force is gone (the cue), its lateral force and moments stay as the track's
-//!   preload, so the five lateral components are continuous. A puncture can be followed
-//!   by the next boundary's in the same tick (a thin layer).
+//!   plus the cutting force carried from the layer above (below) reaches the layer's
+//!   `puncture_force_n`, the boundary is punctured in that tick: its axial force is gone
+//!   (the cue), its lateral force and moments stay as the track's preload, so the five
+//!   lateral components are continuous. A puncture can be followed by the next
+//!   boundary's in the same tick (a thin layer, or a boundary weaker than the cutting
+//!   force carried onto it: punctured at contact).
 //! - *cutting* layer `m - 1`: while the tip advances past the deepest point it reached
 //!   (the track's end), the layer's `cutting_force_n` opposes it, ramped in over the
 //!   layer's stick band of speed (zero for a needle at rest).
+//! - *carried cutting*: while the tip, advancing, deflects boundary `m >= 1`, the
+//!   cutting force of layer `m - 1` stays on it (ramped the same way): the tissue at the
+//!   boundary carries the load the tip was cutting with, so the force does not drop
+//!   where the tip meets a boundary (only a puncture drops it: no false loss of
+//!   resistance). Boundary `m` punctures when its deflection's axial force reaches
+//!   `puncture_force_n - cutting_force_n` of the layer above (the full cutting force,
+//!   whatever the speed: where it punctures does not depend on the speed).
 //! - *in the track*: behind the track's end (withdrawal, or re-advance after one) only
 //!   friction acts; past the end cutting resumes, with no new puncture.
 //! - everywhere after the first puncture: shaft friction ([`Karnopp`]) per mm of shaft in
@@ -377,8 +386,9 @@ impl Insertion {
         }
         let a = axis(pose.theta_x_deg, pose.theta_z_deg);
         let entry: Vec3 = [pose.x_mm, 0.0, pose.z_mm];
-        let Deflected { wrench: mut w, status, punctures, stiffness_n_per_mm } = self.deflect(pose, a, entry, rate);
-        let (phase, axial_n) = self.shaft(pose, a, entry, v, &mut w);
+        let bounds = self.boundaries(a[1]);
+        let Deflected { wrench: mut w, status, punctures, stiffness_n_per_mm } = self.deflect(pose, a, entry, &bounds, rate);
+        let (phase, axial_n) = self.shaft(pose, a, entry, v, &bounds, &mut w);
         let wrench = Wrench::from_array(w);
         let terms = GuardTerms { stiffness_n_per_mm, dissipative_n: [axial_n * a[0], axial_n * a[1], axial_n * a[2]] };
         (self.evaluation(wrench, status, phase, punctures), terms)
@@ -396,14 +406,17 @@ impl Insertion {
         self.velocity_mm_per_s += alpha * (raw - self.velocity_mm_per_s);
     }
 
-    /// Path coordinate of layer `j`'s upper boundary for a needle of vertical axis
-    /// component `a_y` (`+inf` past the last layer).
-    fn boundary_mm(&self, j: usize, a_y: f32) -> f32 {
-        if j >= self.count {
-            return f32::INFINITY;
+    /// Path coordinates of the layers' upper boundaries for a needle of vertical axis
+    /// component `a_y`, `+inf` past the last layer: `q_j = (sum of the thicknesses above
+    /// it) / a_y` (`a_y >= cos 89°` for the clamped tilts), computed once per tick.
+    fn boundaries(&self, a_y: f32) -> [f32; MAX_LAYERS + 1] {
+        let mut q = [f32::INFINITY; MAX_LAYERS + 1];
+        let mut above = 0.0f32;
+        for (slot, l) in q.iter_mut().zip(self.layers()) {
+            *slot = above / a_y;
+            above += l.thickness_mm;
         }
-        let above: f32 = self.layers.iter().take(j).map(|l| l.thickness_mm).sum();
-        above / a_y
+        q
     }
 
     /// The deflection of the first intact boundary, with the punctures it causes.
@@ -413,10 +426,10 @@ impl Insertion {
     /// releases the boundary's stored viscous force (the filter is reset: the lateral
     /// part kept as preload is the elastic one), as does the tip leaving the boundary
     /// (no deflected boundary in this tick): nothing stored is pushed into the hand.
-    fn deflect(&mut self, pose: &Pose, a: Vec3, entry: Vec3, rate: bool) -> Deflected {
+    fn deflect(&mut self, pose: &Pose, a: Vec3, entry: Vec3, bounds: &[f32; MAX_LAYERS + 1], rate: bool) -> Deflected {
         let mut punctures = 0u8;
         while self.punctured < self.count {
-            let q = self.boundary_mm(self.punctured, a[1]);
+            let q = bounds.get(self.punctured).copied().unwrap_or(f32::INFINITY);
             if pose.depth_mm <= q {
                 break;
             }
@@ -425,7 +438,7 @@ impl Insertion {
             let elastic = e.wrench.to_array();
             let w = self.qlv_state.step(qlv, elastic);
             let axial_n = dot([w[0], w[1], w[2]], a);
-            if axial_n < layer.puncture_force_n {
+            if axial_n + self.carried_cutting_n() < layer.puncture_force_n {
                 let mut total = self.preload;
                 for (t, x) in total.iter_mut().zip(w) {
                     *t += x;
@@ -451,23 +464,30 @@ impl Insertion {
         Deflected { wrench: self.preload, status: Status::OK, punctures, stiffness_n_per_mm: 0.0 }
     }
 
+    /// The cutting force of the last punctured layer (N; 0 before the first puncture):
+    /// what the tip carries onto the next boundary.
+    fn carried_cutting_n(&self) -> f32 {
+        self.punctured.checked_sub(1).and_then(|j| self.layers.get(j)).map_or(0.0, |l| l.cutting_force_n)
+    }
+
     /// Friction, cutting and the track's hold on the shaft, added to `w`; the phase and
     /// the axial force of friction and cutting (N, along `+a`).
-    fn shaft(&mut self, pose: &Pose, a: Vec3, entry: Vec3, v: f32, w: &mut [f32; 6]) -> (Phase, f32) {
+    fn shaft(&mut self, pose: &Pose, a: Vec3, entry: Vec3, v: f32, bounds: &[f32; MAX_LAYERS + 1], w: &mut [f32; 6]) -> (Phase, f32) {
         let depth = pose.depth_mm;
         let m = self.punctured;
         let index = |j: usize| u8::try_from(j).unwrap_or(u8::MAX);
+        let bound = |j: usize| bounds.get(j).copied().unwrap_or(f32::INFINITY);
         if m == 0 {
-            return (if depth > self.boundary_mm(0, a[1]) { Phase::Deflecting(0) } else { Phase::Approach }, 0.0);
+            return (if depth > bound(0) { Phase::Deflecting(0) } else { Phase::Approach }, 0.0);
         }
-        let next = self.boundary_mm(m, a[1]);
+        let next = bound(m);
         let top = if depth < next { depth } else { next };
         let hub_q = depth - HUB_FROM_TIP_MM * self.similarity;
         let deviation = self.track.map(|t| t.deviation(entry, a, hub_q));
         let mut axial_n = 0.0f32;
         for j in 0..m {
-            let (Some(layer), lo) = (self.layers.get(j), self.boundary_mm(j, a[1])) else { break };
-            let hi = self.boundary_mm(j + 1, a[1]);
+            let (Some(layer), lo) = (self.layers.get(j), bound(j)) else { break };
+            let hi = bound(j + 1);
             let (q1, q2) = (lo, if hi < top { hi } else { top });
             if q2 <= q1 {
                 continue;
@@ -477,17 +497,23 @@ impl Insertion {
                 d.add_hold(layer.track_stiffness_n_per_mm2, q1, q2, w);
             }
         }
-        let phase = if depth >= next {
-            Phase::Deflecting(index(m))
-        } else if depth >= self.track_end_mm && v > 0.0 {
-            let cutting = self.layers.get(m - 1).map_or(0.0, |l| {
+        // cutting layer m - 1, or carrying its cutting force onto boundary m
+        let cutting = |v: f32| {
+            self.layers.get(m - 1).map_or(0.0, |l| {
                 let ramp = v / l.friction.stick_band_mm_per_s;
                 l.cutting_force_n * if ramp < 1.0 { ramp } else { 1.0 }
-            });
-            axial_n += cutting;
+            })
+        };
+        let phase = if depth >= next {
+            if v > 0.0 {
+                axial_n += cutting(v);
+            }
+            Phase::Deflecting(index(m))
+        } else if depth >= self.track_end_mm && v > 0.0 {
+            axial_n += cutting(v);
             Phase::Cutting(index(m - 1))
         } else {
-            let inside = (1..m).take_while(|&j| self.boundary_mm(j, a[1]) < depth).count();
+            let inside = (1..m).take_while(|&j| bound(j) < depth).count();
             Phase::InTrack(index(inside))
         };
         if depth > self.track_end_mm && depth < next {

@@ -26,7 +26,7 @@
 #include <string>
 #include <vector>
 
-#include "ScriptedDevice.hpp"
+#include "HapticReplay.hpp"
 #include "chai3d.h"
 #include "needle.h"
 #include "needle_chai3d/NeedleTissue.hpp"
@@ -49,12 +49,6 @@ static float f32(unsigned long bits) {
   return f;
 }
 
-static uint32_t bits(float f) {
-  uint32_t b;
-  std::memcpy(&b, &f, 4);
-  return b;
-}
-
 static bool presentable(const GoldenRow &r) {
   for (int c = 0; c < 5; c++) {
     float v = r.pose[c];
@@ -64,28 +58,6 @@ static bool presentable(const GoldenRow &r) {
          r.pose[4] >= 0 && r.pose[4] <= 1000 && !std::signbit(r.pose[4]);
 }
 
-
-static cScriptedDevice *g_device;
-static needle_chai3d::cNeedleTissue *g_tissue;
-static std::vector<needle_chai3d::TissueTick> g_ticks;
-static std::vector<double> g_period_s;
-static std::atomic<bool> g_done(false);
-
-static void haptics_loop(void *) {
-  cPrecisionClock clock;
-  clock.start(true);
-  double next = 0.0, last = -1.0;
-  do {
-    while (clock.getCurrentTimeSeconds() < next) {
-    }
-    double now = clock.getCurrentTimeSeconds();
-    if (last >= 0) g_period_s.push_back(now - last);
-    last = now;
-    next += 0.001;  // 1 kHz
-    g_ticks[g_device->tick()] = g_tissue->update(*g_device);
-  } while (g_device->advance());
-  g_done = true;
-}
 
 int main(int argc, char **argv) {
   if (argc != 2) {
@@ -127,51 +99,32 @@ int main(int argc, char **argv) {
 
   // The world: a tissue block at the origin, its local frame the world's.
   cWorld *world = new cWorld();
-  g_tissue = new needle_chai3d::cNeedleTissue();
-  world->addChild(g_tissue);
+  needle_chai3d::cNeedleTissue *tissue = new needle_chai3d::cNeedleTissue();
+  world->addChild(tissue);
   world->computeGlobalPositions(true);
-  double hub_from_tip_mm = needle_hub_from_tip_mm();
-
   std::vector<ScriptedPose> script;
-  for (const GoldenRow &r : rows) {
-    NeedlePose p = {true, r.pose[0], r.pose[1], r.pose[2], r.pose[3], r.pose[4]};
-    Vec3 hub, axis;
-    needle_chai3d::device_pose(p, hub_from_tip_mm, hub, axis);
-    // A rotation whose z column is the tip-to-hub axis.
-    cVector3d z(axis.x, axis.y, axis.z), x = cVector3d(1, 0, 0) - cDot(cVector3d(1, 0, 0), z) * z;
-    x.normalize();
-    cMatrix3d rot;
-    rot.setCol(x, cCross(z, x), z);
-    script.push_back({cVector3d(hub.x, hub.y, hub.z), rot});
-  }
-  g_device = new cScriptedDevice(script);
-  g_device->open();
-  g_ticks.resize(script.size());
-  g_period_s.reserve(script.size());
-
-  cThread *thread = new cThread();
-  thread->start(haptics_loop, CTHREAD_PRIORITY_HAPTICS, nullptr);
-  while (!g_done) cSleepMs(10);
+  for (const GoldenRow &r : rows) script.push_back(presenting(r.pose, needle_hub_from_tip_mm()));
+  cScriptedDevice device(script);
+  device.open();
+  std::vector<double> periods;
+  std::vector<needle_chai3d::TissueTick> ticks = replay_on_haptic_thread(device, *tissue, periods);
 
   int pose_mismatch = 0, wrench_mismatch = 0;
   for (size_t i = 0; i < rows.size(); i++) {
     const GoldenRow &r = rows[i];
-    const needle_chai3d::TissueTick &t = g_ticks[i];
+    const needle_chai3d::TissueTick &t = ticks[i];
     float got[5] = {t.pose_f32.x_mm, t.pose_f32.z_mm, t.pose_f32.theta_x_deg, t.pose_f32.theta_z_deg, t.pose_f32.depth_mm};
     bool pose_ok = t.pose.valid;
-    for (int c = 0; c < 5; c++) pose_ok = pose_ok && bits(got[c]) == bits(r.pose[c] == 0.0f ? 0.0f : r.pose[c]);
+    for (int c = 0; c < 5; c++) pose_ok = pose_ok && f32_bits(got[c]) == f32_bits(r.pose[c] == 0.0f ? 0.0f : r.pose[c]);
     if (!pose_ok) {
       if (pose_mismatch++ < 5)
         std::printf("golden line %d: pose (%.9g %.9g %.9g %.9g %.9g) from the device, want (%.9g %.9g %.9g %.9g %.9g)\n", r.line, got[0], got[1], got[2],
                     got[3], got[4], r.pose[0], r.pose[1], r.pose[2], r.pose[3], r.pose[4]);
       continue;
     }
-    // Expected on the device: the golden wrench widened to double, in the world frame
-    // (x_world = x_lib, y_world = -z_lib, z_world = y_lib), moments in N*m.
-    const float *w = r.wrench;
-    cVector3d want_f((double)w[0], -(double)w[2], (double)w[1]);
-    cVector3d want_t((double)w[3] * 1e-3, -((double)w[5] * 1e-3), (double)w[4] * 1e-3);
-    const cVector3d &f = g_device->forces[i], &m = g_device->torques[i];
+    cVector3d want_f, want_t;
+    expected_on_device(r.wrench, want_f, want_t);
+    const cVector3d &f = device.forces[i], &m = device.torques[i];
     bool ok = t.status == r.status && f.x() == want_f.x() && f.y() == want_f.y() && f.z() == want_f.z() && m.x() == want_t.x() && m.y() == want_t.y() &&
               m.z() == want_t.z();
     if (!ok && wrench_mismatch++ < 5)
@@ -179,19 +132,10 @@ int main(int argc, char **argv) {
                   r.line, t.status, f.x(), f.y(), f.z(), m.x(), m.y(), m.z(), r.status, want_f.x(), want_f.y(), want_f.z(), want_t.x(), want_t.y(),
                   want_t.z());
   }
-  std::vector<double> p = g_period_s;
-  std::sort(p.begin(), p.end());
-  auto q = [&](double f) { return p.empty() ? 0.0 : p[std::min(p.size() - 1, (size_t)(f * (p.size() - 1)))] * 1e6; };
-  double mean = 0;
-  for (double v : p) mean += v;
-  mean = p.empty() ? 0 : mean / p.size() * 1e6;
-  size_t late = std::count_if(p.begin(), p.end(), [](double v) { return v > 0.0011; });
   std::printf("chai3d-replay golden_rows=%d replayed=%zu trajectories=%d not_presentable=%zu\n", total, rows.size(), trajectories, (size_t)total - rows.size());
-  std::printf("chai3d-replay tick_period_us min=%.1f p1=%.1f p50=%.1f mean=%.1f p99=%.1f max=%.1f over_1100us=%zu of %zu\n", q(0), q(0.01), q(0.5), mean, q(0.99),
-              q(1.0), late, p.size());
+  print_periods("chai3d-replay", periods);
   std::printf("chai3d-replay pose_mismatches=%d wrench_mismatches=%d\n", pose_mismatch, wrench_mismatch);
   bool pass = pose_mismatch == 0 && wrench_mismatch == 0 && rows.size() > 4000;
   std::printf("chai3d: %d passed, %d failed\n", pass ? 1 : 0, pass ? 0 : 1);
-  thread->stop();
   return pass ? 0 : 1;
 }

@@ -8,11 +8,14 @@
 //! `ValueError`) naming the row and column.
 use pyo3::prelude::*;
 
+mod calibrate;
+mod calibration;
 mod eval;
 mod info;
 mod insertion;
 mod poses;
 mod rows;
+mod toml_py;
 
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -20,6 +23,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(eval::wrench, m)?)?;
     m.add_function(wrap_pyfunction!(eval::wrench_and_stiffness, m)?)?;
     m.add_class::<insertion::Insertion>()?;
+    m.add("CurveError", m.py().get_type::<calibrate::CurveError>())?;
+    m.add_function(wrap_pyfunction!(calibrate::calibrate, m)?)?;
+    m.add_class::<calibration::Calibration>()?;
     info::add(m)?;
     Ok(())
 }

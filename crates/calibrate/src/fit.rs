@@ -98,7 +98,8 @@ pub fn fit(points: &[Point], punctures: &[Puncture], surrogate: &dyn Fn(f64) -> 
             let friction = before + fitted.friction_n_per_mm * (boundary - top);
             let measured = points.get(end).map_or(0.0, |p| p.force_n);
             let deflection = scale * indent(surrogate, depth(end) - boundary);
-            let puncture = if measured - friction > 0.0 { measured - friction } else { deflection };
+            // the model punctures when deflection plus the carried cutting force reach it
+            let puncture = if measured - friction > 0.0 { measured - friction } else { deflection + fitted.cutting_n };
             layers.push(LayerFit {
                 boundary_mm: boundary,
                 scale,
@@ -119,7 +120,9 @@ struct IntervalFit {
 
 /// One interval after a puncture: the tip cuts the layer below `top` (friction `before`
 /// from the layers above), then, when `scan` gives the range of the next boundary,
-/// deflects that boundary until the interval's last point.
+/// deflects that boundary until the interval's last point, the cutting force carried
+/// onto it (the insertion model's carried cutting: the cutting column is 1 over the
+/// whole interval).
 fn interval_fit(
     points: &[(f64, f64)],
     top: f64,
@@ -136,7 +139,7 @@ fn interval_fit(
     let mut best: Option<(f64, IntervalFit)> = None;
     for boundary in scan(lo.max(top), hi) {
         let columns = vec![
-            points.iter().map(|(d, _)| if *d < boundary { 1.0 } else { 0.0 }).collect(),
+            vec![1.0; points.len()],
             points.iter().map(|(d, _)| d.min(boundary) - top).collect(),
             points.iter().map(|(d, _)| indent(surrogate, d - boundary)).collect(),
         ];

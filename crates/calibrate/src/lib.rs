@@ -88,19 +88,18 @@ pub struct Calibration {
 /// The curve cannot be read (with its line), it shows no contact or no puncture, the
 /// needle diameter or speed is not finite and > 0, or the library has no fitted model.
 pub fn calibrate(opts: &Options<'_>) -> Result<Calibration> {
-    if !(opts.needle_diameter_mm.is_finite() && opts.needle_diameter_mm > 0.0) {
-        bail!("--needle-diameter-mm {}: must be finite and > 0", opts.needle_diameter_mm);
-    }
-    if !(opts.fe_shear_modulus_n_per_mm2.is_finite() && opts.fe_shear_modulus_n_per_mm2 > 0.0) {
-        bail!("FE shear modulus {} N/mm^2: must be finite and > 0", opts.fe_shear_modulus_n_per_mm2);
-    }
-    if !(opts.speed_mm_per_s.is_finite() && opts.speed_mm_per_s > 0.0) {
-        bail!("--speed-mm-per-s {}: must be finite and > 0", opts.speed_mm_per_s);
-    }
-    if !needle_haptics::model_info::FITTED {
-        bail!("the library was built without a fitted model: run `needle fit` first");
-    }
-    let points = measured::read_curve(opts.curve)?;
+    check_options(opts)?;
+    calibrate_points(opts, measured::read_curve(opts.curve)?)
+}
+
+/// Calibrates a stack on `points` (from [`measured::read_curve`] or
+/// [`measured::from_columns`]); `opts.curve` only names them in messages and in the
+/// tissue file's `description` and `source`.
+///
+/// # Errors
+/// As [`calibrate`], but for reading the curve.
+pub fn calibrate_points(opts: &Options<'_>, points: Vec<measured::Point>) -> Result<Calibration> {
+    check_options(opts)?;
     let events = events::punctures(&points, opts.rule);
     if events.is_empty() {
         bail!(
@@ -138,6 +137,22 @@ pub fn calibrate(opts: &Options<'_>) -> Result<Calibration> {
     let replay = replay::replay(&lib_stack, fit.onset_mm, start, end, opts.speed_mm_per_s);
     let checks = replay::checks(&points, &events, &replay);
     Ok(Calibration { points, events, fit, stack, replay, checks, similarity })
+}
+
+fn check_options(opts: &Options<'_>) -> Result<()> {
+    if !(opts.needle_diameter_mm.is_finite() && opts.needle_diameter_mm > 0.0) {
+        bail!("--needle-diameter-mm {}: must be finite and > 0", opts.needle_diameter_mm);
+    }
+    if !(opts.fe_shear_modulus_n_per_mm2.is_finite() && opts.fe_shear_modulus_n_per_mm2 > 0.0) {
+        bail!("FE shear modulus {} N/mm^2: must be finite and > 0", opts.fe_shear_modulus_n_per_mm2);
+    }
+    if !(opts.speed_mm_per_s.is_finite() && opts.speed_mm_per_s > 0.0) {
+        bail!("--speed-mm-per-s {}: must be finite and > 0", opts.speed_mm_per_s);
+    }
+    if !needle_haptics::model_info::FITTED {
+        bail!("the library was built without a fitted model: run `needle fit` first");
+    }
+    Ok(())
 }
 
 fn to_file(opts: &Options<'_>, fit: &fit::Fit) -> file::Stack {

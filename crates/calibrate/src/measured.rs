@@ -1,5 +1,7 @@
-//! The measured curve: axial force against needle position, from a CSV file.
+//! The measured curve: axial force against needle position, from a CSV file or from two
+//! columns of numbers.
 use anyhow::{bail, Context, Result};
+use std::fmt;
 use std::path::Path;
 
 /// One measured point, in the file's order (digitised drops can repeat a position).
@@ -9,19 +11,48 @@ pub struct Point {
     pub position_mm: f64,
     /// Axial force on the needle, N (positive resisting the insertion).
     pub force_n: f64,
-    /// 1-based line of the point in its file.
+    /// 1-based line of the point in its file (from columns: the 1-based row).
     pub line: usize,
 }
 
 /// The columns a measured file must have.
 pub const COLUMNS: [&str; 2] = ["position_mm", "force_n"];
 
+/// Fewest points a calibration takes.
+pub const MIN_POINTS: usize = 10;
+
+/// A curve refused at a known place: a value (its row and column) or a column of the
+/// header. Displayed as `WHERE: PROBLEM`; carried inside the `anyhow` error so that
+/// callers (the Python binding) can say the row and column.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CurveError {
+    /// Where, as printed: `FILE:LINE` or `force_n[ROW]`.
+    pub at: String,
+    /// 1-based line of the file (None for columns given as numbers).
+    pub line: Option<usize>,
+    /// 0-based data row (None: the header, or the columns as a whole).
+    pub row: Option<usize>,
+    /// The column (None: the columns as a whole).
+    pub column: Option<&'static str>,
+    /// What is wrong.
+    pub problem: String,
+}
+
+impl fmt::Display for CurveError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}", self.at, self.problem)
+    }
+}
+
+impl std::error::Error for CurveError {}
+
 /// Reads `path`: a header naming `position_mm` and `force_n` (other columns, such as
 /// `time_s`, are allowed and ignored), one point per row.
 ///
 /// # Errors
 /// Unreadable file, a missing or duplicated column, or a row whose value is not a
-/// finite number: `FILE:LINE: column NAME: ...`; fewer than 10 points.
+/// finite number: `FILE:LINE: column NAME: ...` (a [`CurveError`] inside); fewer than
+/// [`MIN_POINTS`] points.
 pub fn read_curve(path: &Path) -> Result<Vec<Point>> {
     let mut reader =
         csv::ReaderBuilder::new().trim(csv::Trim::All).from_path(path).with_context(|| format!("{}: cannot read", path.display()))?;
@@ -29,36 +60,71 @@ pub fn read_curve(path: &Path) -> Result<Vec<Point>> {
     let mut index = [0usize; 2];
     for (slot, name) in index.iter_mut().zip(COLUMNS) {
         let found: Vec<usize> = header.iter().enumerate().filter(|(_, h)| *h == name).map(|(i, _)| i).collect();
-        match found.as_slice() {
-            [i] => *slot = *i,
-            [] => bail!(
-                "{}:1: no column {name:?} (the header has {:?}; needed: {:?})",
-                path.display(),
-                header.iter().collect::<Vec<_>>(),
-                COLUMNS
-            ),
-            _ => bail!("{}:1: column {name:?} appears {} times", path.display(), found.len()),
-        }
+        let problem = match found.as_slice() {
+            [i] => {
+                *slot = *i;
+                continue;
+            }
+            [] => format!("no column {name:?} (the header has {:?}; needed: {:?})", header.iter().collect::<Vec<_>>(), COLUMNS),
+            _ => format!("column {name:?} appears {} times", found.len()),
+        };
+        let at = format!("{}:1", path.display());
+        return Err(CurveError { at, line: Some(1), row: None, column: Some(name), problem }.into());
     }
     let mut points = Vec::new();
-    for record in reader.records() {
+    for (row, record) in reader.records().enumerate() {
         let record = record.with_context(|| format!("{}: malformed CSV", path.display()))?;
         let line = record.position().map_or(0, |p| p.line() as usize);
-        let value = |i: usize, name: &str| -> Result<f64> {
+        let value = |i: usize, name: &'static str| -> Result<f64, CurveError> {
             let text = record.get(i).unwrap_or("");
             let shown: String = text.chars().take(40).collect();
-            let v: f64 =
-                text.parse().map_err(|_| anyhow::anyhow!("{}:{line}: column {name}: {shown:?} is not a number", path.display()))?;
-            if !v.is_finite() {
-                bail!("{}:{line}: column {name}: {shown:?} is not finite", path.display());
+            let refuse = |what: &str| CurveError {
+                at: format!("{}:{line}", path.display()),
+                line: Some(line),
+                row: Some(row),
+                column: Some(name),
+                problem: format!("column {name}: {shown:?} is not {what}"),
+            };
+            let v: f64 = text.parse().map_err(|_| refuse("a number"))?;
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(refuse("finite"))
             }
-            Ok(v)
         };
         let [ip, iforce] = index;
         points.push(Point { position_mm: value(ip, COLUMNS[0])?, force_n: value(iforce, COLUMNS[1])?, line });
     }
-    if points.len() < 10 {
-        bail!("{}: {} points: a calibration needs at least 10", path.display(), points.len());
+    enough(points, &path.display().to_string())
+}
+
+/// The curve from two columns of numbers (`position_mm[i]`, `force_n[i]`), checked like
+/// a file's rows.
+///
+/// # Errors
+/// The columns differ in length, a value is not finite (`force_n[ROW]: ...`, a
+/// [`CurveError`] inside), or there are fewer than [`MIN_POINTS`] points.
+pub fn from_columns(position_mm: &[f64], force_n: &[f64]) -> Result<Vec<Point>> {
+    if position_mm.len() != force_n.len() {
+        let problem = format!("{} positions and {} forces: one force per position", position_mm.len(), force_n.len());
+        return Err(CurveError { at: "position_mm, force_n".into(), line: None, row: None, column: None, problem }.into());
+    }
+    let mut points = Vec::with_capacity(position_mm.len());
+    for (row, (&p, &f)) in position_mm.iter().zip(force_n).enumerate() {
+        for (v, name) in [(p, COLUMNS[0]), (f, COLUMNS[1])] {
+            if !v.is_finite() {
+                let problem = format!("is {v}: every value must be finite");
+                return Err(CurveError { at: format!("{name}[{row}]"), line: None, row: Some(row), column: Some(name), problem }.into());
+            }
+        }
+        points.push(Point { position_mm: p, force_n: f, line: row + 1 });
+    }
+    enough(points, "the curve")
+}
+
+fn enough(points: Vec<Point>, what: &str) -> Result<Vec<Point>> {
+    if points.len() < MIN_POINTS {
+        bail!("{what}: {} points: a calibration needs at least {MIN_POINTS}", points.len());
     }
     Ok(points)
 }

@@ -12,13 +12,18 @@
 //! 2. puncture: where the published force stops rising from the layer's top (`p_j`, the
 //!    peak before its drop; it may lie in the layer below, whose rise then starts past
 //!    it), the puncture force is `F(p_j) - before_j`;
-//! 3. stiffness scale: the least-squares `s` of `s g(d - t_j)` against `F(d) - before_j`
-//!    over `t_j < d <= p_j` (`g` the library's deflection at scale 1, the scaling law);
+//! 3. stiffness scale: the least-squares `s` of `s g(d - t_j)` against
+//!    `F(d) - before_j - c_{j-1}` over `t_j < d <= p_j` (`g` the library's deflection at
+//!    scale 1, the scaling law; `c_{j-1}` the cutting force of the layer above, which the
+//!    insertion model carries onto the boundary: the published model, too, starts each
+//!    rise from the level reached before it);
 //! 4. cutting and friction: non-negative least squares of `c + f (d - t_j)` against
 //!    `F(d) - before_j` over the layer past `p_j` (none: both 0), `f` kept only when it
 //!    lowers the sum of squares by more than f64 round-off;
 //! 5. a layer whose published force does not rise from its start (the epidural space's
-//!    0 N; the fat, which starts past the skin's peak and only falls) has no boundary
+//!    0 N; the fat, which starts past the skin's peak and only falls), or whose peak
+//!    `F(p_j) - before_j` does not exceed the cutting force carried onto it (the muscle:
+//!    its published peak, 4.35 N, lies below the fat's cutting force), has no boundary
 //!    force of its own: it punctures at contact (the
 //!    smallest positive normal f32 as its puncture force, [`NO_RESISTANCE_N`]: the
 //!    format refuses 0) and takes the stiffness scale of the layer above (its upper
@@ -181,11 +186,12 @@ pub fn derive(pieces: &[Piece], surrogate: &dyn Fn(f64) -> f64) -> Result<Vec<De
             peak += 1;
         }
         let peak_force = all.get(peak).map_or(0.0, |s| s.force_n);
-        let rises = peak > start && peak_force - before > 0.0;
+        let carried = out.last().map_or(0.0, |l| l.fit.cutting_force_n);
+        let rises = peak > start && peak_force - before - carried > 0.0;
         let (scale, puncture_force_n, drop_from) = if rises {
             let (sg, gg) = all.get(start + 1..=peak).unwrap_or(&[]).iter().fold((0.0, 0.0), |(sg, gg), s| {
                 let g = surrogate(s.depth_mm - top);
-                (sg + g * (s.force_n - before), gg + g * g)
+                (sg + g * (s.force_n - before - carried), gg + g * g)
             });
             (sg / gg, peak_force - before, peak)
         } else {

@@ -122,6 +122,24 @@ pub fn checks(points: &[Point], events: &[Puncture], model: &Replay) -> Vec<Chec
             unit: "mm",
         });
     }
+    puncture_checks(points, events, model, &mut out);
+    let onset = measured_onset(points, first.peak, threshold).unwrap_or(f64::NEG_INFINITY);
+    let pre: Vec<&Point> = points.iter().take(first.peak + 1).filter(|p| p.position_mm >= onset).collect();
+    let rms = (pre.iter().map(|p| (model.at(p.position_mm) - p.force_n).powi(2)).sum::<f64>() / pre.len().max(1) as f64).sqrt();
+    out.push(Check {
+        what: "pre-puncture RMS (onset to puncture 1), % of its force".into(),
+        measured: 0.0,
+        model: rms,
+        error: 100.0 * rms / peak0,
+        goal: 5.0,
+        unit: "%",
+    });
+    interval_checks(points, events, model, &mut out);
+    out
+}
+
+/// Position and force of every puncture against the model's.
+fn puncture_checks(points: &[Point], events: &[Puncture], model: &Replay, out: &mut Vec<Check>) {
     for (k, e) in events.iter().enumerate() {
         let Some(peak) = points.get(e.peak) else { continue };
         let Some(&(mp, mf)) = model.punctures.get(k) else {
@@ -152,17 +170,10 @@ pub fn checks(points: &[Point], events: &[Puncture], model: &Replay) -> Vec<Chec
             unit: "%",
         });
     }
-    let onset = measured_onset(points, first.peak, threshold).unwrap_or(f64::NEG_INFINITY);
-    let pre: Vec<&Point> = points.iter().take(first.peak + 1).filter(|p| p.position_mm >= onset).collect();
-    let rms = (pre.iter().map(|p| (model.at(p.position_mm) - p.force_n).powi(2)).sum::<f64>() / pre.len().max(1) as f64).sqrt();
-    out.push(Check {
-        what: "pre-puncture RMS (onset to puncture 1), % of its force".into(),
-        measured: 0.0,
-        model: rms,
-        error: 100.0 * rms / peak0,
-        goal: 5.0,
-        unit: "%",
-    });
+}
+
+/// The mean force over each interval between punctures (and after the last).
+fn interval_checks(points: &[Point], events: &[Puncture], model: &Replay, out: &mut Vec<Check>) {
     for (k, e) in events.iter().enumerate() {
         let end = events.get(k + 1).map_or(points.len() - 1, |n| n.peak);
         let span: Vec<&Point> = points.get(e.bottom..=end).map(|s| s.iter().collect()).unwrap_or_default();
@@ -188,5 +199,4 @@ pub fn checks(points: &[Point], events: &[Puncture], model: &Replay) -> Vec<Chec
         };
         out.push(Check { what: label, measured: mean_m, model: mean_p, error, goal: 10.0, unit: "%" });
     }
-    out
 }

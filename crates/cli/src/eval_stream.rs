@@ -1,9 +1,11 @@
 //! The streaming form of `needle eval --poses FILE` (CSV out): the file is read in chunks
-//! of [`CHUNK_ROWS`] rows, each chunk evaluated and formatted on every core (one slice
-//! per thread, written in input order), so memory stays bounded (a few chunks of rows
-//! and their text) however long the file is. The rows and messages are those of
-//! [`eval_batch`](super::eval_batch): the same parse, the same output bytes (the floats
-//! through [`float_text::push_f32`](super::float_text::push_f32), `{:?}`'s text).
+//! of [`CHUNK_ROWS`] records; each chunk is parsed, evaluated and formatted on every core
+//! (one slice per thread, written in input order) while the reader splits the next one,
+//! so memory stays bounded (two chunks of records and one of text) however long the
+//! file is. The rows and messages are those of [`eval_batch`](super::eval_batch): the
+//! same parse ([`parse_row`]), the same output bytes (the floats through
+//! [`float_text::push_f32`](super::float_text::push_f32), `{:?}`'s text), the problems
+//! listed in line order.
 //!
 //! Nothing is written when a row is bad: the output goes to a temporary renamed at the
 //! end (`--out`), or, for standard output, the file is checked in a first pass before
@@ -15,15 +17,34 @@ use needle_haptics::{wrench, Pose};
 use std::io::Write;
 use std::path::Path;
 
-/// Rows per chunk (65,536: about 2.4 MB of input, 7 MB of output text).
+/// Records per chunk (65,536: about 2.4 MB of input, 7 MB of output text).
 pub const CHUNK_ROWS: usize = 1 << 16;
+
+/// One chunk as the reader split it: its records (the first `len` of `records`, reused
+/// from chunk to chunk) and the problems of records it could not read (line, message).
+#[derive(Default)]
+struct Chunk {
+    records: Vec<csv::ByteRecord>,
+    len: usize,
+    unreadable: Vec<(u64, String)>,
+}
+
+/// What a thread made of its slice of a chunk: the rows parsed, bad rows, problems
+/// (line, message), and the formatted output when every row was good.
+#[derive(Default)]
+struct Slice {
+    rows: usize,
+    bad_rows: usize,
+    problems: Vec<(u64, String)>,
+    text: String,
+}
 
 /// Reads `file` chunk by chunk; with `sink` evaluates and writes every row (the header
 /// first), without it only checks the rows. Returns the number of rows.
 ///
 /// # Errors
-/// The file cannot be read, a bad header, bad rows (counted, the first listed; the
-/// writes stop at the first), or the output cannot be written.
+/// The file cannot be read, a bad header, bad rows (counted, the first listed in line
+/// order; the writes stop at the first chunk with one), or the output cannot be written.
 pub fn stream(file: &Path, mut sink: Option<&mut dyn Write>) -> Result<usize> {
     let mut rdr = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
@@ -37,68 +58,101 @@ pub fn stream(file: &Path, mut sink: Option<&mut dyn Write>) -> Result<usize> {
         writeln!(w, "{OUTPUT_HEADER}").context("writing the output")?;
     }
     let threads = std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get);
-    let mut texts: Vec<String> = vec![String::new(); threads];
+    let mut slices: Vec<Slice> = (0..threads).map(|_| Slice::default()).collect();
+    let (mut current, mut next) = (Chunk::default(), Chunk::default());
     let (mut rows, mut bad_rows, mut problems) = (0usize, 0usize, Vec::new());
-    let mut rec = csv::ByteRecord::new();
-    let mut chunk: Vec<Pose> = Vec::with_capacity(CHUNK_ROWS);
+    let mut more = read_chunk(&mut rdr, file, &mut current);
     loop {
-        chunk.clear();
-        let mut more = true;
-        while chunk.len() < CHUNK_ROWS {
-            match rdr.read_byte_record(&mut rec) {
-                Ok(false) => {
-                    more = false;
-                    break;
-                }
-                Ok(true) => {
-                    let line = rec.position().map_or(0, csv::Position::line);
-                    match parse_row(|i| rec.get(i), rec.len(), &idx, (file, line), &mut problems) {
-                        Some(p) => chunk.push(p),
-                        None => bad_rows += 1,
-                    }
-                }
-                Err(e) => {
-                    let line = e.position().map_or(0, csv::Position::line);
-                    problems.push(format!("{}:{line}: {e}", file.display()));
-                    bad_rows += 1;
-                }
+        let write = sink.is_some() && bad_rows == 0;
+        // the workers take this chunk while the reader splits the next one
+        std::thread::scope(|scope| {
+            let per = current.len.div_ceil(threads).max(1);
+            let mut parts = current.records.get(..current.len).unwrap_or(&[]).chunks(per);
+            for slice in &mut slices {
+                let part = parts.next().unwrap_or(&[]);
+                let idx = &idx;
+                scope.spawn(move || process(part, idx, file, write, slice));
             }
+            if more {
+                more = read_chunk(&mut rdr, file, &mut next);
+            } else {
+                next.len = 0;
+                next.unreadable.clear();
+            }
+        });
+        bad_rows += current.unreadable.len();
+        problems.append(&mut current.unreadable);
+        for slice in &mut slices {
+            rows += slice.rows;
+            bad_rows += slice.bad_rows;
+            problems.append(&mut slice.problems);
         }
-        rows += chunk.len();
         if bad_rows == 0 {
             if let Some(w) = sink.as_deref_mut() {
-                format_chunk(&chunk, &mut texts);
-                for t in &texts {
-                    w.write_all(t.as_bytes()).context("writing the output")?;
+                for slice in &slices {
+                    w.write_all(slice.text.as_bytes()).context("writing the output")?;
                 }
             }
         }
-        if !more {
+        std::mem::swap(&mut current, &mut next);
+        if current.len == 0 && current.unreadable.is_empty() {
             break;
         }
     }
     if bad_rows > 0 {
-        return Err(bad_rows_error(bad_rows, &problems));
+        problems.sort_by_key(|(line, _)| *line);
+        let listed: Vec<String> = problems.into_iter().map(|(_, p)| p).collect();
+        return Err(bad_rows_error(bad_rows, &listed));
     }
     Ok(rows)
 }
 
-/// Evaluates and formats `chunk` into `texts` (one slice of the chunk per text, in
-/// order), each on its own thread.
-fn format_chunk(chunk: &[Pose], texts: &mut [String]) {
-    let per = chunk.len().div_ceil(texts.len().max(1)).max(1);
-    std::thread::scope(|scope| {
-        let mut slices = chunk.chunks(per);
-        for text in texts.iter_mut() {
-            let slice = slices.next().unwrap_or(&[]);
-            text.clear();
-            scope.spawn(move || format_rows(slice, text));
+/// Splits up to [`CHUNK_ROWS`] records into `chunk`; whether the file may have more.
+fn read_chunk(rdr: &mut csv::Reader<std::fs::File>, file: &Path, chunk: &mut Chunk) -> bool {
+    chunk.len = 0;
+    chunk.unreadable.clear();
+    while chunk.len < CHUNK_ROWS {
+        if chunk.records.len() <= chunk.len {
+            chunk.records.push(csv::ByteRecord::new());
         }
-    });
+        let Some(rec) = chunk.records.get_mut(chunk.len) else { return false };
+        match rdr.read_byte_record(rec) {
+            Ok(false) => return false,
+            Ok(true) => chunk.len += 1,
+            Err(e) => {
+                let line = e.position().map_or(0, csv::Position::line);
+                chunk.unreadable.push((line, format!("{}:{line}: {e}", file.display())));
+            }
+        }
+    }
+    true
 }
 
-/// The rows of `poses` (each its inputs, wrench and status: `eval_batch`'s row) appended
-/// to `text`.
+/// Parses `records` (pose columns `idx`); with `write` and every row good, evaluates
+/// and formats them (each its inputs, wrench and status: `eval_batch`'s row) into
+/// `out.text`.
+fn process(records: &[csv::ByteRecord], idx: &[usize; 5], file: &Path, write: bool, out: &mut Slice) {
+    out.rows = 0;
+    out.bad_rows = 0;
+    out.problems.clear();
+    out.text.clear();
+    let mut poses = Vec::with_capacity(records.len());
+    let mut messages = Vec::new();
+    for rec in records {
+        let line = rec.position().map_or(0, csv::Position::line);
+        match parse_row(|i| rec.get(i), rec.len(), idx, (file, line), &mut messages) {
+            Some(p) => poses.push(p),
+            None => out.bad_rows += 1,
+        }
+        out.problems.extend(messages.drain(..).map(|m| (line, m)));
+    }
+    out.rows = poses.len();
+    if write && out.bad_rows == 0 {
+        format_rows(&poses, &mut out.text);
+    }
+}
+
+/// The rows of `poses` appended to `text`.
 fn format_rows(poses: &[Pose], text: &mut String) {
     let mut ryu = ryu::Buffer::new();
     text.reserve(poses.len() * 150);

@@ -19,38 +19,17 @@ pub fn push_f32(out: &mut String, v: f32, ryu: &mut ryu::Buffer) {
         Some(rest) => (true, rest),
         None => (false, text),
     };
-    let (mantissa, exp) = match text.bytes().position(|b| b == b'e' || b == b'E') {
-        Some(i) => (text.get(..i).unwrap_or(""), text.get(i + 1..).and_then(|e| e.parse::<i32>().ok()).unwrap_or(0)),
-        None => (text, 0),
-    };
-    let (int, frac) = match mantissa.bytes().position(|b| b == b'.') {
-        Some(i) => (mantissa.get(..i).unwrap_or(""), mantissa.get(i + 1..).unwrap_or("")),
-        None => (mantissa, ""),
-    };
-    // the digits without the point, and where the point is (value = 0.DIGITS x 10^point)
-    // ryu writes at most 9 significant digits and 7 leading zeros for an f32 ("0.0000001")
-    let mut buf = [0u8; 48];
-    let mut n = 0;
-    for b in int.bytes().chain(frac.bytes()) {
-        if let Some(slot) = buf.get_mut(n) {
-            *slot = b;
-            n += 1;
-        }
-    }
-    let all = buf.get(..n).unwrap_or(&[]);
-    let lead = all.iter().take_while(|&&d| d == b'0').count();
-    let trail = all.iter().rev().take_while(|&&d| d == b'0').count();
-    let digits = all.get(lead..n.saturating_sub(trail).max(lead)).unwrap_or(&[]);
-    let mut point = int.len() as i32 + exp - lead as i32;
+    let significant = Significant::of(text);
+    let mut point = significant.point;
     // a tie: `v` exactly halfway between two shortest candidates; ryu takes the even
     // one, `{:?}` the one of larger magnitude
     let mut rounded = [0u8; 48];
-    let digits = match tie_rounded_up(v, digits, &mut rounded) {
+    let digits = match tie_rounded_up(v, significant.digits(), &mut rounded) {
         Some((len, carried)) => {
             point += i32::from(carried);
             rounded.get(..len).unwrap_or(&[])
         }
-        None => digits,
+        None => significant.digits(),
     };
     let mut text = Text { buf: [0; 48], len: 0 };
     if negative {
@@ -59,49 +38,50 @@ pub fn push_f32(out: &mut String, v: f32, ryu: &mut ryu::Buffer) {
     if digits.is_empty() {
         text.push(b"0.0");
     } else if (1e-4..1e16).contains(&v.abs()) {
-        let n = digits.len() as i32;
-        if point <= 0 {
-            text.push(b"0.");
-            text.zeros((-point) as usize);
-            text.push(digits);
-        } else if point >= n {
-            text.push(digits);
-            text.zeros((point - n) as usize);
-            text.push(b".0");
-        } else {
-            let (a, b) = digits.split_at(point as usize);
-            text.push(a);
-            text.push(b".");
-            text.push(b);
-        }
+        text.plain(digits, point);
     } else {
-        let (first, rest) = digits.split_at(1);
-        text.push(first);
-        if !rest.is_empty() {
-            text.push(b".");
-            text.push(rest);
-        }
-        text.push(b"e");
-        let mut itoa = [0u8; 12];
-        let e = point - 1;
-        let mut k = itoa.len();
-        let mut x = e.unsigned_abs();
-        loop {
-            k -= 1;
-            if let Some(slot) = itoa.get_mut(k) {
-                *slot = b'0' + (x % 10) as u8;
-            }
-            x /= 10;
-            if x == 0 {
-                break;
-            }
-        }
-        if e < 0 {
-            text.push(b"-");
-        }
-        text.push(itoa.get(k..).unwrap_or(&[]));
+        text.scientific(digits, point);
     }
     out.push_str(std::str::from_utf8(text.buf.get(..text.len).unwrap_or(&[])).unwrap_or(""));
+}
+
+/// The significant digits of ryu's text of a finite, non-negative f32 and where the
+/// decimal point is: value = `0.DIGITS x 10^point`.
+struct Significant {
+    buf: [u8; 48],
+    start: usize,
+    end: usize,
+    point: i32,
+}
+
+impl Significant {
+    fn of(text: &str) -> Self {
+        let (mantissa, exp) = match text.bytes().position(|b| b == b'e' || b == b'E') {
+            Some(i) => (text.get(..i).unwrap_or(""), text.get(i + 1..).and_then(|e| e.parse::<i32>().ok()).unwrap_or(0)),
+            None => (text, 0),
+        };
+        let (int, frac) = match mantissa.bytes().position(|b| b == b'.') {
+            Some(i) => (mantissa.get(..i).unwrap_or(""), mantissa.get(i + 1..).unwrap_or("")),
+            None => (mantissa, ""),
+        };
+        // ryu writes at most 9 significant digits and 7 leading zeros for an f32 ("0.0000001")
+        let mut buf = [0u8; 48];
+        let mut n = 0;
+        for b in int.bytes().chain(frac.bytes()) {
+            if let Some(slot) = buf.get_mut(n) {
+                *slot = b;
+                n += 1;
+            }
+        }
+        let all = buf.get(..n).unwrap_or(&[]);
+        let lead = all.iter().take_while(|&&d| d == b'0').count();
+        let trail = all.iter().rev().take_while(|&&d| d == b'0').count();
+        Self { buf, start: lead, end: n.saturating_sub(trail).max(lead), point: int.len() as i32 + exp - lead as i32 }
+    }
+
+    fn digits(&self) -> &[u8] {
+        self.buf.get(self.start..self.end).unwrap_or(&[])
+    }
 }
 
 /// A float's text, assembled in place (ASCII only).
@@ -124,6 +104,54 @@ impl Text {
         for _ in 0..n {
             self.push(b"0");
         }
+    }
+
+    /// `0.000DIGITS`, `DIGITS000.0` or `DIG.ITS` (value `0.DIGITS x 10^point`).
+    fn plain(&mut self, digits: &[u8], point: i32) {
+        let n = digits.len() as i32;
+        if point <= 0 {
+            self.push(b"0.");
+            self.zeros((-point) as usize);
+            self.push(digits);
+        } else if point >= n {
+            self.push(digits);
+            self.zeros((point - n) as usize);
+            self.push(b".0");
+        } else {
+            let (a, b) = digits.split_at(point as usize);
+            self.push(a);
+            self.push(b".");
+            self.push(b);
+        }
+    }
+
+    /// `D.IGITSe<exp>` (value `0.DIGITS x 10^point`, `exp = point - 1`).
+    fn scientific(&mut self, digits: &[u8], point: i32) {
+        let (first, rest) = digits.split_at(1);
+        self.push(first);
+        if !rest.is_empty() {
+            self.push(b".");
+            self.push(rest);
+        }
+        self.push(b"e");
+        let mut itoa = [0u8; 12];
+        let e = point - 1;
+        let mut k = itoa.len();
+        let mut x = e.unsigned_abs();
+        loop {
+            k -= 1;
+            if let Some(slot) = itoa.get_mut(k) {
+                *slot = b'0' + (x % 10) as u8;
+            }
+            x /= 10;
+            if x == 0 {
+                break;
+            }
+        }
+        if e < 0 {
+            self.push(b"-");
+        }
+        self.push(itoa.get(k..).unwrap_or(&[]));
     }
 }
 

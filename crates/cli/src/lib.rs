@@ -14,5 +14,6 @@ pub mod fit;
 pub mod fixed;
 pub mod fixed_error;
 pub mod float_text;
+pub mod insertion_paths;
 pub mod model;
 pub mod plot;

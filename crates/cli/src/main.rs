@@ -22,6 +22,8 @@ component by cross-validation). Writes model.toml and the four golden files all 
     Fit(needle_cli::fit::FitArgs),
     /// The wrench at one pose, or at every row of a CSV, from the library (the firmware's code).
     Eval(needle_cli::model::EvalArgs),
+    /// Write the golden insertion paths as scripts for `needle eval --poses FILE --insertion STACK`.
+    InsertionPaths(needle_cli::insertion_paths::InsertionPathsArgs),
     /// Fit a tissue stack (<set>/tissue/<name>.toml) to a measured force against needle position.
     Calibrate(needle_cli::calibrate::CalibrateArgs),
     /// Derive a tissue stack from a published model's force polynomials per layer (no measured curve).
@@ -68,6 +70,7 @@ fn main() -> ExitCode {
         Command::Fit(a) => needle_cli::fit::fit(a),
         Command::Eval(a) => needle_cli::model::eval(a),
         Command::Validate(a) => needle_cli::fit::validate(a),
+        Command::InsertionPaths(a) => needle_cli::insertion_paths::insertion_paths(a),
         Command::Calibrate(a) => needle_cli::calibrate::calibrate(a),
         Command::CalibratePublished(a) => needle_cli::calibrate_published::calibrate_published(a),
         Command::Explore(a) => needle_cli::explore::explore(a),

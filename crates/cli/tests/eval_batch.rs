@@ -202,3 +202,26 @@ fn a_bad_row_after_several_chunks_leaves_nothing_written() {
     assert_eq!(o.status.code(), Some(2));
     assert!(o.stdout.is_empty(), "nothing on standard output");
 }
+
+/// Every core parses a slice of each chunk: the problems of bad rows in different
+/// slices and chunks are still listed in line order, each with its own line.
+#[test]
+fn bad_rows_in_several_slices_are_listed_in_line_order() {
+    let d = tempfile::tempdir().expect("tempdir");
+    let file = d.path().join("poses.csv");
+    let chunk = needle_cli::eval_stream::CHUNK_ROWS;
+    // 0-based rows: early in the first slice, late in the chunk (the last slice), next chunk
+    let bad = [3, chunk - 2, chunk + 5];
+    let mut text = String::from("x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n");
+    for i in 0..chunk + 10 {
+        text.push_str(if bad.contains(&i) { "1,x,0,0,1\n" } else { "1,0,0,0,1\n" });
+    }
+    std::fs::write(&file, &text).expect("write");
+    let set = default_set();
+    let o = needle(&["eval", "--set", &set.to_string_lossy(), "--poses", &file.to_string_lossy()]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("3 bad row(s)"), "{err}");
+    let at: Vec<usize> = bad.iter().map(|i| err.find(&format!("{}:{}: column z_mm", file.display(), i + 2)).expect("listed")).collect();
+    assert!(at.windows(2).all(|w| w[0] < w[1]), "in line order: {err}");
+}

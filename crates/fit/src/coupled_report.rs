@@ -194,6 +194,15 @@ pub fn measure(set_dir: &Path) -> Result<CoupledReport> {
 /// The report as plain text.
 pub fn to_table(r: &CoupledReport) -> String {
     let mut s = String::new();
+    write_runs(&mut s, r);
+    write_selection(&mut s, r);
+    write_learning_curve(&mut s, r);
+    write_held_out(&mut s, r);
+    s
+}
+
+/// The training and held-out run counts, with the unusable runs.
+fn write_runs(s: &mut String, r: &CoupledReport) {
     let _ = writeln!(
         s,
         "coupled form: {} training runs{}; held out: {} validation runs (table2, lhs)",
@@ -205,6 +214,10 @@ pub fn to_table(r: &CoupledReport) -> String {
         },
         r.held_out_runs
     );
+}
+
+/// The cross-validation of the candidate forms and the choice per component.
+fn write_selection(s: &mut String, r: &CoupledReport) {
     if let Some(sel) = &r.selection {
         let _ = writeln!(
             s,
@@ -236,6 +249,10 @@ pub fn to_table(r: &CoupledReport) -> String {
             sel.choices.iter().zip(crate::contract::COMPONENTS).map(|(f, name)| format!("{name} {}", f.label())).collect();
         let _ = writeln!(s, "  chosen per component (*): {}", names.join(", "));
     }
+}
+
+/// Held-out errors of the coupled form fitted on the first n training runs.
+fn write_learning_curve(s: &mut String, r: &CoupledReport) {
     let _ = writeln!(s, "learning curve (held-out errors of the coupled form fitted on the first n training runs):");
     let _ = writeln!(
         s,
@@ -264,6 +281,10 @@ pub fn to_table(r: &CoupledReport) -> String {
     if let Some(v) = curve_verdict(&r.curve) {
         let _ = writeln!(s, "  {v}");
     }
+}
+
+/// Held-out errors of both forms.
+fn write_held_out(s: &mut String, r: &CoupledReport) {
     let _ = writeln!(s, "held-out errors, both forms ({} runs):", r.held_out_runs);
     let _ = writeln!(s, "  {:<8} {:>12} {:>12} {:>12} {:>10}", "form", "lhs rms %", "t2 rms %", "t2 Fy max %", "max %");
     let mut row = |name: &str, h: &HeldOut| {
@@ -277,7 +298,6 @@ pub fn to_table(r: &CoupledReport) -> String {
     if let Some(c) = &r.coupled {
         row("coupled", c);
     }
-    s
 }
 
 #[cfg(test)]

@@ -338,6 +338,18 @@ fn pass(b: bool) -> &'static str {
 /// The report as a plain-text table.
 pub fn to_table(r: &Report) -> String {
     let mut s = String::new();
+    write_header(&mut s, r);
+    write_component_errors(&mut s, r);
+    write_run_summaries(&mut s, r);
+    write_goals(&mut s, r);
+    write_paper_form(&mut s, r);
+    write_floor_and_trends(&mut s, r);
+    let _ = writeln!(s, "result: {}", pass(r.passed));
+    s
+}
+
+/// The table's title, units and the stale-model warning.
+fn write_header(s: &mut String, r: &Report) {
     let _ = writeln!(s, "validation of {}/model.toml against the FE runs it was not fitted on", r.set_dir);
     let _ = writeln!(
         s,
@@ -347,6 +359,10 @@ pub fn to_table(r: &Report) -> String {
     if !r.model_matches_fe {
         let _ = writeln!(s, "WARNING: model.toml's fe_sha256 does not match the fitted FE files in the set (refit with `needle fit`)");
     }
+}
+
+/// Every run's RMS and largest error per component.
+fn write_component_errors(s: &mut String, r: &Report) {
     let _ = writeln!(s);
     let _ = writeln!(s, "{:<8} {:<7} {:<7} {:>11} {:>11} {:<5} {:>8} {:>8}", "run", "role", "comp", "rms", "max", "unit", "rms %", "max %");
     for run in &r.runs {
@@ -365,6 +381,10 @@ pub fn to_table(r: &Report) -> String {
             );
         }
     }
+}
+
+/// One line per run: pose, peak |Fy|, worst errors, paper form, depth floor, goal.
+fn write_run_summaries(s: &mut String, r: &Report) {
     let _ = writeln!(s);
     let coupled = r.goals.form == "coupled";
     let _ = writeln!(
@@ -412,18 +432,14 @@ pub fn to_table(r: &Report) -> String {
             run.worst_max_pct
         );
     }
+}
+
+/// Missing runs and the goals of the set's form.
+fn write_goals(s: &mut String, r: &Report) {
     let _ = writeln!(s);
     if !r.missing.is_empty() {
         let _ = writeln!(s, "missing or stale FE runs (goal cannot be met): {}", r.missing.join(", "));
     }
-    let worst = |role: &str, f: fn(&RunReport) -> f64| -> String {
-        let v: Vec<f64> = r.runs.iter().filter(|x| x.role == role).map(f).collect();
-        if v.is_empty() {
-            "no runs".to_string()
-        } else {
-            format!("worst {:.3} % over {} runs", v.iter().copied().fold(0.0, f64::max), v.len())
-        }
-    };
     let g = &r.goals;
     let _ = writeln!(s, "goals of the {} form:", g.form);
     let _ = writeln!(
@@ -431,7 +447,7 @@ pub fn to_table(r: &Report) -> String {
         "goal table2: Fy within {} % of FE at every depth >= {TABLE2_MIN_DEPTH_MM} mm, and the rms and max goals below: {} ({})",
         g.table2_fy_pct,
         pass(r.table2_goal_met),
-        worst("table2", |x| x.fy_rel_max_pct)
+        worst(r, "table2", |x| x.fy_rel_max_pct)
     );
     let _ = writeln!(
         s,
@@ -439,8 +455,8 @@ pub fn to_table(r: &Report) -> String {
         g.rms_pct,
         g.max_pct.map(|m| format!(", largest error <= {m} %")).unwrap_or_default(),
         pass(r.lhs_goal_met),
-        worst("lhs", |x| x.worst_rms_pct),
-        if g.max_pct.is_some() { format!("; max {}", worst("lhs", |x| x.worst_max_pct)) } else { String::new() }
+        worst(r, "lhs", |x| x.worst_rms_pct),
+        if g.max_pct.is_some() { format!("; max {}", worst(r, "lhs", |x| x.worst_max_pct)) } else { String::new() }
     );
     if let Some(stretch) = g.rms_stretch_pct {
         let all: Vec<f64> = r.runs.iter().filter(|x| x.goal_met.is_some()).map(|x| x.worst_rms_pct).collect();
@@ -452,6 +468,11 @@ pub fn to_table(r: &Report) -> String {
             all.len()
         );
     }
+}
+
+/// The paper form of the same set, when the set is coupled.
+fn write_paper_form(s: &mut String, r: &Report) {
+    let coupled = r.goals.form == "coupled";
     if coupled && !r.runs.iter().any(|x| x.paper_part.is_some()) {
         let _ = writeln!(s, "paper form of the same set: not fitted (its centre or sweep runs are missing or stale)");
     } else if coupled {
@@ -467,6 +488,11 @@ pub fn to_table(r: &Report) -> String {
             pw("lhs", |p| p.worst_max_pct)
         );
     }
+}
+
+/// The depth floor, the mirror runs, the error trend and the f32 check.
+fn write_floor_and_trends(s: &mut String, r: &Report) {
+    let g = &r.goals;
     let floor = |role: &str, f: fn(&DepthFloor) -> f64| -> f64 {
         r.runs.iter().filter(|x| x.role == role).filter_map(|x| x.floor.as_ref().map(f)).fold(0.0, f64::max)
     };
@@ -480,7 +506,7 @@ pub fn to_table(r: &Report) -> String {
         floor("lhs", DepthFloor::worst_rms_pct),
         g.rms_stretch_pct.unwrap_or(g.rms_pct)
     );
-    let _ = writeln!(s, "mirror runs (symmetry check, no goal): rms {}", worst("mirror", |x| x.worst_rms_pct));
+    let _ = writeln!(s, "mirror runs (symmetry check, no goal): rms {}", worst(r, "mirror", |x| x.worst_rms_pct));
     if let Some(t) = r.error_trend {
         let _ = writeln!(
             s,
@@ -489,6 +515,14 @@ pub fn to_table(r: &Report) -> String {
         );
     }
     let _ = writeln!(s, "f32 model vs f64 model: largest difference {:.3e} % of scale", r.f32_vs_f64_max_pct);
-    let _ = writeln!(s, "result: {}", pass(r.passed));
-    s
+}
+
+/// `worst X % over N runs` of `f` over the runs of `role` (`no runs` without one).
+fn worst(r: &Report, role: &str, f: fn(&RunReport) -> f64) -> String {
+    let v: Vec<f64> = r.runs.iter().filter(|x| x.role == role).map(f).collect();
+    if v.is_empty() {
+        "no runs".to_string()
+    } else {
+        format!("worst {:.3} % over {} runs", v.iter().copied().fold(0.0, f64::max), v.len())
+    }
 }

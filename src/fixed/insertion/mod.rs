@@ -303,7 +303,7 @@ impl<'a> Insertion<'a> {
             let moments = [mx, my, mz].map(|c| c.saturating_mul(gm));
             let [vfx, vfy, vfz, vmx, vmy, vmz] = self.qlv_state.step(qlv, [f[0], f[1], f[2], moments[0], moments[1], moments[2]]);
             let [px, py, pz, pmx, pmy, pmz] = self.preload_q16;
-            if dot([vfx, vfy, vfz], a) < layer.puncture_force_q16 {
+            if dot([vfx, vfy, vfz], a).saturating_add(self.carried_cutting_q16()) < layer.puncture_force_q16 {
                 let sum = |p: i64, x: i64| p.saturating_add(x);
                 let total = [sum(px, vfx), sum(py, vfy), sum(pz, vfz), sum(pmx, vmx), sum(pmy, vmy), sum(pmz, vmz)];
                 return Deflected { wrench_q16: total, status: e.status, punctures };
@@ -341,6 +341,12 @@ impl<'a> Insertion<'a> {
         extended_wrench(&fe)
     }
 
+    /// The cutting force of the last punctured layer (µN Q16; 0 before the first
+    /// puncture): what the tip carries onto the next boundary.
+    fn carried_cutting_q16(&self) -> i64 {
+        self.punctured.checked_sub(1).and_then(|j| self.stack.layers.get(j)).map_or(0, |l| l.cutting_force_q16)
+    }
+
     /// Friction, cutting and the track's hold on the shaft, added to `w`; the phase.
     fn shaft(&mut self, depth: i64, a: Vec3, entry: Vec3, v: i64, bounds: &[i64; MAX_LAYERS + 1], w: &mut [i64; 6]) -> Phase {
         let m = self.punctured;
@@ -366,18 +372,24 @@ impl<'a> Insertion<'a> {
         if let Some(d) = &deviation {
             d.add_hold(&hold, w);
         }
-        let phase = if depth >= next {
-            Phase::Deflecting(index(m))
-        } else if depth >= self.track_end_q16 && v > 0 {
-            let cutting = self.stack.layers.get(m - 1).map_or(0, |l| {
+        // cutting layer m - 1, or carrying its cutting force onto boundary m
+        let cutting = |v: i64| {
+            self.stack.layers.get(m - 1).map_or(0, |l| {
                 if v < l.friction.stick_band_q16 {
-                    // v < band: below `cutting_per_speed * band <= 2^44 2^16` (`layer_ok`)
+                    // 0 < v < band: below `cutting_per_speed * band <= 2^44 2^16` (`layer_ok`)
                     (l.cutting_per_speed_q16 * v) >> 16
                 } else {
                     l.cutting_force_q16
                 }
-            });
-            axial_q16 = axial_q16.saturating_add(cutting);
+            })
+        };
+        let phase = if depth >= next {
+            if v > 0 {
+                axial_q16 = axial_q16.saturating_add(cutting(v));
+            }
+            Phase::Deflecting(index(m))
+        } else if depth >= self.track_end_q16 && v > 0 {
+            axial_q16 = axial_q16.saturating_add(cutting(v));
             Phase::Cutting(index(m - 1))
         } else {
             let inside = (1..m).take_while(|&j| bound(j) < depth).count();

@@ -1,5 +1,6 @@
 """Type hints of the Rust extension module (src/*.rs)."""
-from typing import Final, Optional
+import os
+from typing import Any, Final, Optional, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -53,3 +54,70 @@ class Insertion:
     def set_scales(self, scales: list[float]) -> None: ...
     def reset(self) -> None: ...
     def run(self, poses: npt.NDArray[np.float32]) -> Trajectory: ...
+
+class CurveError(ValueError):
+    """A measured curve `calibrate` cannot take. `row`: 0-based data row; `column`:
+    "position_mm" or "force_n"; `line`: 1-based line of the CSV file (None when not known
+    or not one place)."""
+
+    row: Optional[int]
+    column: Optional[str]
+    line: Optional[int]
+
+class Calibration:
+    """The result of `calibrate`: the tissue stack, the model along the curve, the residuals."""
+
+    @property
+    def toml(self) -> str:
+        """The tissue file's text as `needle calibrate` writes it (without its # header)."""
+    @property
+    def stack(self) -> dict[str, Any]:
+        """The same stack: format, name, description, needle_diameter_mm, layer (list of dicts, the file's keys)."""
+    @property
+    def onset_mm(self) -> float:
+        """Needle position of contact (depth 0), mm."""
+    @property
+    def similarity(self) -> float:
+        """Measured needle diameter over the FE needle's."""
+    @property
+    def position_mm(self) -> npt.NDArray[np.float64]:
+        """(m,) the measured needle positions, mm."""
+    @property
+    def force_n(self) -> npt.NDArray[np.float64]:
+        """(m,) the measured axial force, N."""
+    @property
+    def model_force_n(self) -> npt.NDArray[np.float64]:
+        """(m,) the calibrated stack's force at each measured position (nearest 1 kHz tick), N."""
+    @property
+    def residual_n(self) -> npt.NDArray[np.float64]:
+        """(m,) force_n - model_force_n, N."""
+    @property
+    def replay(self) -> npt.NDArray[np.float64]:
+        """(t, 2) the model per tick: needle position mm, axial force N."""
+    @property
+    def measured_punctures(self) -> npt.NDArray[np.float64]:
+        """(k, 2) the punctures found in the curve: position mm, peak force N."""
+    @property
+    def model_punctures(self) -> npt.NDArray[np.float64]:
+        """(k', 2) the model's punctures: position mm, force N just before."""
+    @property
+    def checks(self) -> list[dict[str, Any]]:
+        """Model against curve: what, measured, model, error, goal, unit, met."""
+    @property
+    def all_met(self) -> bool:
+        """Whether every check is met (`needle calibrate` exits 1 otherwise)."""
+
+def calibrate(
+    curve: Union[str, "os.PathLike[str]", tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]],
+    /,
+    *,
+    name: str,
+    needle_diameter_mm: float,
+    speed_mm_per_s: float,
+    drop_fraction: float = ...,
+    label: Optional[str] = None,
+) -> Calibration:
+    """`needle calibrate` on a CSV file (columns position_mm, force_n) or on (position_mm,
+    force_n) float64 arrays, against the set compiled in. `label` names the curve in the
+    stack's description and source (default: the path, or "arrays"). Raises CurveError
+    (row, column, line) for a bad curve, ValueError when it cannot calibrate."""

@@ -1,0 +1,53 @@
+//! `needle insertion-paths`: the golden insertion paths (`examples/common/insertion_paths.rs`,
+//! the ones the firmware, the C API and wasm replay) written as scripts for `needle eval
+//! --poses FILE --insertion STACK`: one CSV per path, `time_s` and the five pose columns,
+//! one row per 1 kHz tick, the depths scaled for the stack as the golden tests scale them.
+//! Other programs (the CHAI3D binding's test) replay the same ticks from these files.
+#[path = "../../../examples/common/insertion_paths.rs"]
+mod paths;
+
+use anyhow::{Context, Result};
+use clap::Args;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Write the golden insertion paths as `needle eval --insertion` scripts.
+#[derive(Args)]
+pub struct InsertionPathsArgs {
+    /// The compiled-in tissue stack whose depth the paths are scaled to (e.g. liver).
+    #[arg(long)]
+    pub stack: String,
+    /// Folder for the scripts: <stack>-path<i>.csv, i = 0..4.
+    #[arg(long)]
+    pub out_dir: PathBuf,
+}
+
+/// The tick period of the paths, s (1 kHz).
+pub const PERIOD_S: f64 = 0.001;
+
+/// The script of path `i` for `stack`: `time_s,x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm`,
+/// the f32 values in their shortest exact text.
+#[must_use]
+pub fn script(path: &[paths::Waypoint], stack: &needle_haptics::insertion::Stack<'_>) -> String {
+    let mut s = String::from("time_s,x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n");
+    paths::for_each_tick(path, paths::depth_scale(stack), |tick, p| {
+        let _ = writeln!(s, "{:?},{:?},{:?},{:?},{:?},{:?}", f64::from(tick) * PERIOD_S, p[0], p[1], p[2], p[3], p[4]);
+    });
+    s
+}
+
+/// Runs `needle insertion-paths`.
+///
+/// # Errors
+/// No such stack; the folder or a file cannot be written.
+pub fn insertion_paths(a: InsertionPathsArgs) -> Result<ExitCode> {
+    let stack = crate::eval_insertion::stack(&a.stack)?;
+    std::fs::create_dir_all(&a.out_dir).with_context(|| format!("{}: cannot create", a.out_dir.display()))?;
+    for (i, path) in paths::PATHS.iter().enumerate() {
+        let file = a.out_dir.join(format!("{}-path{i}.csv", stack.name));
+        needle_fe::results::write_atomic(&file, script(path, stack).as_bytes())?;
+        println!("wrote {}", file.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}
