@@ -69,6 +69,10 @@ pub struct SpecArgs {
     /// The runs of campaign.toml's [deep] section (to deep.depth_mm on deep.mesh), into <set>/fe/deep/.
     #[arg(long)]
     pub deep: bool,
+    /// The viscoelastic ramp-and-hold runs of campaign.toml's [viscoelastic] section (each
+    /// pose at each speed, --steps must points on the ramp), into <set>/fe/visco/.
+    #[arg(long, conflicts_with = "deep")]
+    pub visco: bool,
 }
 
 /// How each pose is solved (shared by `fe run` and the array tasks' `fe run-one`).
@@ -254,6 +258,9 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
         RunOptions { jobs, threads: a.threads.map(|t| t as usize).unwrap_or((cores / jobs).max(1)), ..spec_options(a.spec)? },
         &a.solve,
     );
+    if a.launcher == LauncherArg::Slurm && opts.visco {
+        anyhow::bail!("--visco runs locally only (--launcher local): each speed is its own campaign run");
+    }
     if a.launcher == LauncherArg::Slurm {
         let slurm = SlurmOptions {
             partition: a.partition,
@@ -268,12 +275,26 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     needle_fe::process::stop_jobs_on_termination()?;
-    let report = campaign::run(&opts)?;
-    print!("{}", report.table());
-    if needle_fe::process::interrupted() {
-        return Ok(ExitCode::from(needle_fe::process::EXIT_INTERRUPTED));
+    let mut failed = 0;
+    for opts in visco_variants(opts)? {
+        let report = campaign::run(&opts)?;
+        print!("{}", report.table());
+        if needle_fe::process::interrupted() {
+            return Ok(ExitCode::from(needle_fe::process::EXIT_INTERRUPTED));
+        }
+        failed += report.failed();
     }
-    Ok(if report.failed() > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS })
+    Ok(if failed > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+/// `opts` as it is, or with `visco`: once per speed of `[viscoelastic]`, in order.
+fn visco_variants(opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
+    if !opts.visco {
+        return Ok(vec![opts]);
+    }
+    let (c, path) = needle_fe::spec::load(&opts.set_dir)?;
+    let v = c.viscoelastic.ok_or_else(|| anyhow::anyhow!("{}: --visco: the spec has no [viscoelastic] section", path.display()))?;
+    Ok(v.speeds_mm_per_s.iter().map(|&s| RunOptions { visco_speed_mm_per_s: Some(s), ..opts.clone() }).collect())
 }
 
 /// What `needle fe run --launcher slurm` prints.
@@ -303,7 +324,13 @@ fn submit_summary(r: &slurm::SubmitReport) -> String {
 }
 
 fn run_status(a: StatusArgs) -> anyhow::Result<ExitCode> {
-    let plan = campaign::plan(&spec_options(a.spec)?)?;
+    let variants = visco_variants(spec_options(a.spec)?)?;
+    for extra in variants.iter().skip(1) {
+        let plan = campaign::plan(extra)?;
+        print!("{}", needle_fe::launcher::status::status(&plan)?.table());
+    }
+    let Some(first) = variants.first() else { return Ok(ExitCode::SUCCESS) };
+    let plan = campaign::plan(first)?;
     let r = needle_fe::launcher::status::status(&plan)?;
     print!("{}", r.table());
     print!("{}", needle_fe::launcher::status::attempts_by_class(&plan));
@@ -330,6 +357,7 @@ fn spec_options(spec: SpecArgs) -> anyhow::Result<RunOptions> {
         steps: spec.steps,
         out_dir: spec.out,
         deep: spec.deep,
+        visco: spec.visco,
         ..RunOptions::new(spec.set)
     })
 }
