@@ -222,7 +222,9 @@ fn write_control(w: &mut String, s: &FebioSettings, loading: &Loading, steps: u3
     let _ = writeln!(w, "      <max_refs>{}</max_refs>", s.max_refs);
     let _ = writeln!(w, "      <reform_each_time_step>1</reform_each_time_step>");
     let _ = writeln!(w, "      <diverge_reform>1</diverge_reform>");
-    let _ = writeln!(w, "      <min_residual>1e-20</min_residual>");
+    // FEBio compares the squared norm; a ramp-and-hold run sets its floor (`crate::visco`)
+    let min_residual = loading.ramp_hold.as_ref().map_or(1e-20, |r| r.min_residual_n * r.min_residual_n);
+    let _ = writeln!(w, "      <min_residual>{}</min_residual>", num(min_residual));
     // the campaign's retry converges on energy and residual with `retry_dtol` /
     // `retry_rtol` (FebioSettings docs)
     let (dtol, rtol) = if stepping.retry_tolerances { (s.retry_dtol, s.retry_rtol) } else { (s.dtol, s.rtol) };

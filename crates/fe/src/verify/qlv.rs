@@ -42,6 +42,8 @@ pub struct QlvOptions {
     pub steps: Option<u32>,
     /// Mesh level of both (`None`: `viscoelastic.mesh`).
     pub mesh: Option<String>,
+    /// Poses among `viscoelastic.poses` (empty: all of them).
+    pub poses: Vec<String>,
     /// Solver threads of each run.
     pub threads: usize,
     /// Solve the runs that are not up to date (false: compare what is there).
@@ -109,13 +111,18 @@ pub fn cases(opts: &QlvOptions) -> Result<Vec<std::result::Result<QlvCase, (Stri
             read_current(o)
         }
     };
-    let elastic = read(&RunOptions { only: Some(v.poses.join(",")), ..base.clone() })?;
+    let poses: Vec<String> = if opts.poses.is_empty() { v.poses.clone() } else { opts.poses.clone() };
+    if let Some(p) = poses.iter().find(|p| !v.poses.contains(p)) {
+        anyhow::bail!("{}: --qlv-poses {p:?}: not in viscoelastic.poses ({})", path.display(), v.poses.join(", "));
+    }
+    let elastic = read(&RunOptions { only: Some(poses.join(",")), ..base.clone() })?;
     let mut out = Vec::new();
     for &speed in &v.speeds_mm_per_s {
-        let o = RunOptions { visco_speed_mm_per_s: Some(speed), ..base.clone() };
+        let only = poses.iter().map(|p| run_name(p, speed)).collect::<Vec<_>>().join(",");
+        let o = RunOptions { visco_speed_mm_per_s: Some(speed), only: Some(only), ..base.clone() };
         let visco = read(&o)?;
         let plan = crate::campaign::plan(&o)?;
-        for pose in &v.poses {
+        for pose in &poses {
             let run = run_name(pose, speed);
             let fe = visco.get(&run).cloned().unwrap_or_else(|| Err("not selected".into()));
             let el = elastic.get(pose).cloned().unwrap_or_else(|| Err("not selected".into()));

@@ -37,8 +37,14 @@ pub fn apply(c: &Campaign, v: &ViscoSettings, speed_mm_per_s: f64, ramp_steps: u
     let mut run = c.clone();
     run.tissue.prony = Some(Prony { g: v.g.clone(), tau_s: v.tau_s.clone() });
     run.loading.steps = ramp_steps + v.hold_steps;
-    run.loading.ramp_hold =
-        Some(RampHold { speed_mm_per_s, ramp_steps, hold_s: v.hold_s, hold_steps: v.hold_steps, hold_first_s: v.hold_first_s });
+    run.loading.ramp_hold = Some(RampHold {
+        speed_mm_per_s,
+        ramp_steps,
+        hold_s: v.hold_s,
+        hold_steps: v.hold_steps,
+        hold_first_s: v.hold_first_s,
+        min_residual_n: v.min_residual_n,
+    });
     let every = c.poses();
     let poses = v
         .poses
@@ -55,7 +61,7 @@ pub fn describe(c: &Campaign) -> Option<String> {
     let (p, r) = (c.tissue.prony.as_ref()?, c.loading.ramp_hold.as_ref()?);
     let terms: Vec<String> = p.g.iter().zip(&p.tau_s).map(|(g, t)| format!("g {g} tau {t} s")).collect();
     Some(format!(
-        "uncoupled viscoelastic (FEBio normalisation, g0 = 1) {}; ramp to {} mm at {} mm/s ({} s, {} must points), hold {} s ({} must points from {} s)",
+        "uncoupled viscoelastic (FEBio normalisation, g0 = 1) {}; ramp to {} mm at {} mm/s ({} s, {} must points), hold {} s ({} must points from {} s); Newton's residual floor {} N",
         terms.join(", "),
         c.loading.depth_mm,
         r.speed_mm_per_s,
@@ -63,7 +69,8 @@ pub fn describe(c: &Campaign) -> Option<String> {
         r.ramp_steps,
         r.hold_s,
         r.hold_steps,
-        r.hold_first_s
+        r.hold_first_s,
+        r.min_residual_n
     ))
 }
 
@@ -120,6 +127,9 @@ pub fn validate(c: &Campaign, text: &str, path: &Path) -> Result<()> {
     }
     if !(v.hold_first_s.is_finite() && v.hold_first_s > 0.0 && v.hold_first_s <= v.hold_s) {
         bail!("{}: viscoelastic.hold_first_s = {} s: must be in (0, hold_s = {} s]", at("hold_first_s"), v.hold_first_s, v.hold_s);
+    }
+    if !(v.min_residual_n.is_finite() && v.min_residual_n >= 0.0) {
+        bail!("{}: viscoelastic.min_residual_n = {} N: must be finite and >= 0", at("min_residual_n"), v.min_residual_n);
     }
     if !c.mesh.contains_key(&v.mesh) {
         let levels: Vec<&str> = c.mesh.keys().map(String::as_str).collect();

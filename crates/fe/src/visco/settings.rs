@@ -28,6 +28,11 @@ pub struct ViscoSettings {
     /// The first must point of the hold, s after the ramp's end; the others follow
     /// geometrically to `hold_s`.
     pub hold_first_s: f64,
+    /// Newton's absolute floor on the residual, N (FEBio's `min_residual`, squared): below
+    /// it an iteration is converged whatever the relative criteria say. In the hold the
+    /// relaxation moves the tissue by round-off-sized steps and the relative criteria
+    /// chase contact chatter (measured, coeffs/README.md).
+    pub min_residual_n: f64,
     /// Mesh level of the runs.
     pub mesh: String,
     /// Pose names of the campaign, solved in this order (the centre first: quarter model).
@@ -62,6 +67,8 @@ pub struct RampHold {
     pub hold_steps: u32,
     /// First hold must point, s after the ramp's end.
     pub hold_first_s: f64,
+    /// Newton's absolute residual floor, N ([`ViscoSettings::min_residual_n`]).
+    pub min_residual_n: f64,
 }
 
 impl RampHold {
@@ -101,7 +108,7 @@ mod tests {
 
     #[test]
     fn must_points_ramp_then_hold() {
-        let r = RampHold { speed_mm_per_s: 10.0, ramp_steps: 20, hold_s: 30.0, hold_steps: 5, hold_first_s: 0.03 };
+        let r = RampHold { speed_mm_per_s: 10.0, ramp_steps: 20, hold_s: 30.0, hold_steps: 5, hold_first_s: 0.03, min_residual_n: 1e-5 };
         assert!((r.ramp_s(6.0) - 0.6).abs() < 1e-15);
         assert_eq!(r.time_s(6.0, 0), 0.0);
         assert!((r.time_s(6.0, 20) - 0.6).abs() < 1e-15);
