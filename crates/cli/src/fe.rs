@@ -209,8 +209,22 @@ pub struct VerifyArgs {
     /// Load steps of the scaling check's runs and of the s = 1 runs (default: loading.steps).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=10_000))]
     pub scaling_steps: Option<u32>,
-    /// Solve none of the scaling and mesh-study runs: compare the results already there
-    /// and name the missing ones.
+    /// Compare the viscoelastic ramp-and-hold runs ([viscoelastic], fe/visco/) with the
+    /// library's QLV filter on the elastic runs (goal RMS 3%, must 5%, largest 6% of peak |Fy|).
+    #[arg(long)]
+    pub qlv: bool,
+    /// Poses of the QLV check, comma-separated exact names (default: viscoelastic.poses).
+    #[arg(long, value_name = "NAME,...", value_delimiter = ',')]
+    pub qlv_poses: Vec<String>,
+    /// Mesh level of the QLV check's runs, viscoelastic and elastic (default: viscoelastic.mesh).
+    #[arg(long, value_name = "LEVEL")]
+    pub qlv_mesh: Option<String>,
+    /// Must points on the ramp of the QLV check's runs and load steps of the elastic ones
+    /// (default: loading.steps).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=10_000))]
+    pub qlv_steps: Option<u32>,
+    /// Solve none of the scaling, mesh-study and QLV runs: compare the results already
+    /// there and name the missing ones.
     #[arg(long)]
     pub no_solve: bool,
     /// Coarsen the flat-punch mesh by this factor (1 = the verification mesh; the goal
@@ -381,6 +395,28 @@ fn run_one(a: RunOneArgs) -> anyhow::Result<ExitCode> {
 fn run_verify(a: VerifyArgs) -> anyhow::Result<ExitCode> {
     if !(a.punch_mesh_scale.is_finite() && a.punch_mesh_scale >= 1.0) {
         anyhow::bail!("--punch-mesh-scale {}: must be a number >= 1", a.punch_mesh_scale);
+    }
+    if a.qlv && !(a.punch || a.mesh || a.mirror || a.smooth || a.scaling) {
+        // the QLV check alone (it is not part of the default five: its runs are the
+        // viscoelastic campaign's, `needle fe run --visco`)
+        needle_fe::process::stop_jobs_on_termination()?;
+        let threads = a.threads.map(|t| t as usize).unwrap_or(1);
+        let opts = needle_fe::verify::qlv::QlvOptions {
+            set_dir: a.set.clone(),
+            steps: a.qlv_steps,
+            mesh: a.qlv_mesh.clone(),
+            poses: a.qlv_poses.clone(),
+            threads,
+            solve: !a.no_solve,
+        };
+        let ok = crate::fe_qlv::check(&opts)?;
+        if !ok {
+            eprintln!("needle fe verify --qlv: a run missed its bound or has no comparison");
+        }
+        return Ok(if ok { ExitCode::SUCCESS } else { ExitCode::from(1) });
+    }
+    if a.qlv {
+        anyhow::bail!("--qlv runs alone (not with --punch, --mesh, --mirror, --smooth, --scaling)");
     }
     let all = !(a.punch || a.mesh || a.mirror || a.smooth || a.scaling);
     let threads = a.threads.map(|t| t as usize).unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));

@@ -104,6 +104,15 @@ pub fn validate(c: &Campaign, text: &str, path: &Path) -> Result<()> {
     if let Some(t) = v.tau_s.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
         bail!("{}: viscoelastic.tau_s = {t} s: every tau_i must be finite and > 0 s", at("tau_s"));
     }
+    let sum: f64 = v.g.iter().sum();
+    if sum > needle_contract::PRONY_G_SUM_MAX {
+        bail!(
+            "{}: viscoelastic.g sums to {sum}: must be <= {} (the instantaneous response at most {} times the long-term one)",
+            at("g"),
+            needle_contract::PRONY_G_SUM_MAX,
+            needle_contract::PRONY_G_SUM_MAX + 1.0
+        );
+    }
     if v.speeds_mm_per_s.is_empty() {
         bail!("{}: viscoelastic.speeds_mm_per_s is empty: name at least one speed", at("speeds_mm_per_s"));
     }
@@ -212,6 +221,7 @@ mod tests {
         let cases = [
             ("g", "g = [-0.1, 0.4]", "every g_i must be finite and >= 0"),
             ("g", "g = [0.1, 0.1, 0.1, 0.1]", "must be 1 ..= 3"),
+            ("g", "g = [5.0, 4.5]", "sums to 9.5: must be <= 9"),
             ("tau_s", "tau_s = [0.0, 5.0]", "must be finite and > 0 s"),
             ("tau_s", "tau_s = [1.0]", "one tau_s per g"),
             ("speeds_mm_per_s", "speeds_mm_per_s = [1.0, 1.0]", "listed twice"),

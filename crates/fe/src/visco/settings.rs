@@ -5,9 +5,9 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Most Prony terms of one tissue (issue 39: up to 3 per layer, as the library's filter;
-/// FEBio's `uncoupled viscoelastic` takes up to 6).
-pub const MAX_PRONY_TERMS: usize = 3;
+/// Most Prony terms of one tissue: the contract's, as the library's filter (FEBio's
+/// `uncoupled viscoelastic` takes up to 6).
+pub use needle_contract::MAX_PRONY_TERMS;
 
 /// `[viscoelastic]`: the Prony series and the ramp-and-hold loadings of
 /// `needle fe run --visco` (module docs of `crate::visco`).
