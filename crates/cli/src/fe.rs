@@ -308,7 +308,19 @@ fn visco_variants(opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
     }
     let (c, path) = needle_fe::spec::load(&opts.set_dir)?;
     let v = c.viscoelastic.ok_or_else(|| anyhow::anyhow!("{}: --visco: the spec has no [viscoelastic] section", path.display()))?;
-    Ok(v.speeds_mm_per_s.iter().map(|&s| RunOptions { visco_speed_mm_per_s: Some(s), ..opts.clone() }).collect())
+    // the speeds with a run that --only selects (a speed without one is no error)
+    let selects = |speed: f64| -> bool {
+        let (_, runs) = needle_fe::visco::apply(&c, &v, speed, c.loading.steps);
+        needle_fe::spec::select(&runs, opts.only.as_deref()).is_ok_and(|r| !r.is_empty())
+    };
+    let speeds: Vec<f64> = v.speeds_mm_per_s.iter().copied().filter(|&s| selects(s)).collect();
+    if speeds.is_empty() {
+        anyhow::bail!(
+            "--visco --only {:?}: matches no run (names: <pose>_<speed>mm-s, e.g. centre_10mm-s)",
+            opts.only.as_deref().unwrap_or("")
+        );
+    }
+    Ok(speeds.into_iter().map(|s| RunOptions { visco_speed_mm_per_s: Some(s), ..opts.clone() }).collect())
 }
 
 /// What `needle fe run --launcher slurm` prints.

@@ -351,7 +351,7 @@ impl Backend for FebioBackend {
                     f.settings
                 ));
             }
-            let continued = cont.describe();
+            let continued = cont.describe_in(loading.time_unit());
             if !continued.is_empty() {
                 line.push_str(&format!("; {continued}"));
             }
@@ -392,13 +392,14 @@ impl Backend for FebioBackend {
                 e => e.to_string(),
             };
             let kept = keep_failed_attempt(job);
-            let continued = cont.describe();
+            let continued = cont.describe_in(loading.time_unit());
             let resumed = resume.as_ref().map(|f| format!(", continuing attempt {} from {} mm", f.attempt, loading.depth_at(f.steps)));
             return Err(SolveFailure {
                 message: format!(
-                    "febio4 {how} after {done_steps} of {} steps (t = {} mm), {} time steps, {} retries, {:.1} s{}{}{}{kept}",
+                    "febio4 {how} after {done_steps} of {} steps (t = {} {}), {} time steps, {} retries, {:.1} s{}{}{}{kept}",
                     job.steps,
                     run.last_time,
+                    loading.time_unit(),
                     totals.time_steps,
                     totals.retries,
                     started.elapsed().as_secs_f64(),

@@ -65,12 +65,16 @@ pub struct QlvCase {
     pub fe: Vec<Row>,
     /// The elastic FE run of the pose, one row per depth.
     pub elastic: Vec<Row>,
+    /// The viscoelastic run failed every attempt: `fe` is its partial record (the must
+    /// points of its furthest attempt, `fe/visco/<run>.partial.csv`), compared as far as
+    /// it goes and reported as such; a miss of the check.
+    pub partial: bool,
 }
 
 impl QlvCase {
     /// The must points' times, s.
     pub fn times_s(&self) -> Vec<f64> {
-        (0..=self.loading.steps).map(|k| self.loading.time_at(k)).collect()
+        (0..self.fe.len() as u32).map(|k| self.loading.time_at(k)).collect()
     }
 
     /// The elastic wrench along the run's depth-time path at time `t_s`: the elastic
@@ -125,6 +129,7 @@ pub fn cases(opts: &QlvOptions) -> Result<Vec<std::result::Result<QlvCase, (Stri
         for pose in &poses {
             let run = run_name(pose, speed);
             let fe = visco.get(&run).cloned().unwrap_or_else(|| Err("not selected".into()));
+            let partial = fe.as_ref().err().and_then(|_| read_partial(&plan, &run));
             let el = elastic.get(pose).cloned().unwrap_or_else(|| Err("not selected".into()));
             out.push(match (fe, el) {
                 (Ok(fe), Ok(el)) => Ok(QlvCase {
@@ -134,6 +139,16 @@ pub fn cases(opts: &QlvOptions) -> Result<Vec<std::result::Result<QlvCase, (Stri
                     prony: plan.campaign.tissue.prony.clone().unwrap_or(Prony { g: Vec::new(), tau_s: Vec::new() }),
                     fe: fe.rows,
                     elastic: el.rows,
+                    partial: false,
+                }),
+                (Err(_), Ok(el)) if partial.is_some() => Ok(QlvCase {
+                    pose: pose.clone(),
+                    run,
+                    loading: plan.campaign.loading.clone(),
+                    prony: plan.campaign.tissue.prony.clone().unwrap_or(Prony { g: Vec::new(), tau_s: Vec::new() }),
+                    fe: partial.unwrap_or_default(),
+                    elastic: el.rows,
+                    partial: true,
                 }),
                 (Err(why), _) => Err((run, why)),
                 (_, Err(why)) => Err((run, format!("the elastic run of {pose}: {why}"))),
@@ -179,6 +194,20 @@ pub fn report(runs: Vec<QlvRun>, missing: Vec<String>) -> QlvReport {
     }
 }
 
+/// The rows of `run`'s partial record in the plan's folder when it is of the current spec
+/// (a failed run: its furthest attempt's must points from 0 on).
+fn read_partial(plan: &crate::campaign::Plan, run: &str) -> Option<Vec<Row>> {
+    let pose = plan.selected.iter().find(|p| p.name == run)?;
+    let (csv, rec) = crate::partial::paths(&plan.out_dir, run);
+    let record: crate::partial::PartialRecord = toml::from_str(&std::fs::read_to_string(rec).ok()?).ok()?;
+    if record.spec_hash != plan.campaign.run_hash(pose, &plan.mesh_name) {
+        return None;
+    }
+    let text = std::fs::read_to_string(&csv).ok()?;
+    // timed since the record keeps the times; earlier ones have the depth only
+    crate::results::parse_timed_csv(&text, &csv).map(|(_, r)| r).or_else(|_| crate::results::parse_csv(&text, &csv)).ok()
+}
+
 /// One run's comparison.
 #[derive(Debug, Clone, Serialize)]
 pub struct QlvRun {
@@ -192,6 +221,11 @@ pub struct QlvRun {
     pub tick_s: f64,
     /// Must points compared (ramp and hold, 0 included).
     pub must_points: usize,
+    /// The FE run failed every attempt: compared on its partial record only, to
+    /// `reached_time_s` (a miss).
+    pub partial: bool,
+    /// Time of the last must point compared, s.
+    pub reached_time_s: f64,
     /// Peak |Fy| of the viscoelastic FE run, N (the error scale).
     pub peak_fy_n: f64,
     /// Fy at the end of the ramp and of the hold: FE, filter, and the elastic run, N.
@@ -223,7 +257,7 @@ pub struct QlvRun {
 impl QlvRun {
     /// Within the bounds (RMS <= [`QLV_MUST_RMS_PERCENT`], largest <= [`QLV_MAX_PERCENT`]).
     pub fn ok(&self) -> bool {
-        self.worst_rms_percent <= QLV_MUST_RMS_PERCENT && self.worst_max_percent <= QLV_MAX_PERCENT
+        !self.partial && self.worst_rms_percent <= QLV_MUST_RMS_PERCENT && self.worst_max_percent <= QLV_MAX_PERCENT
     }
 }
 
@@ -248,7 +282,13 @@ impl std::fmt::Display for QlvRun {
             self.fe_fy_end_of_hold_n,
             self.filter_fy_end_of_hold_n,
             self.elastic_fy_full_depth_n,
-            if self.ok() { "" } else { "  MISSED" }
+            if self.partial {
+                format!("  PARTIAL: the FE run failed every attempt, compared to {:.3} s only", self.reached_time_s)
+            } else if self.ok() {
+                String::new()
+            } else {
+                "  MISSED".to_string()
+            }
         )
     }
 }
@@ -291,6 +331,8 @@ pub fn score(case: &QlvCase, filtered: &[[f64; COMPONENT_COUNT]], tick_s: f64, l
         speed_mm_per_s: case.loading.ramp_hold.as_ref().map_or(0.0, |r| r.speed_mm_per_s),
         tick_s,
         must_points: fe.len(),
+        partial: case.partial,
+        reached_time_s: times.last().copied().unwrap_or(0.0),
         peak_fy_n: peak,
         fe_fy_end_of_ramp_n: fy(&fe, ramp_end),
         filter_fy_end_of_ramp_n: fy(filtered, ramp_end),
