@@ -307,7 +307,7 @@ fn visco_variants(opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
         return Ok(vec![opts]);
     }
     let (c, path) = needle_fe::spec::load(&opts.set_dir)?;
-    let v = c.viscoelastic.ok_or_else(|| anyhow::anyhow!("{}: --visco: the spec has no [viscoelastic] section", path.display()))?;
+    let v = c.viscoelastic.clone().ok_or_else(|| anyhow::anyhow!("{}: --visco: the spec has no [viscoelastic] section", path.display()))?;
     // the speeds with a run that --only selects (a speed without one is no error)
     let selects = |speed: f64| -> bool {
         let (_, runs) = needle_fe::visco::apply(&c, &v, speed, c.loading.steps);
