@@ -9,6 +9,8 @@ pub mod eval_insertion;
 pub mod eval_stream;
 pub mod explore;
 pub mod fe;
+pub mod fe_qlv;
+pub mod fe_qlv_figure;
 pub mod firmware;
 pub mod fit;
 pub mod fixed;
