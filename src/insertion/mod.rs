@@ -28,7 +28,7 @@
 //!   ending): no stored force is pushed into the hand, and the next boundary starts
 //!   from rest.
 //! - *puncture*: when the deflection's axial force (along the needle, pushing it back)
-//!   plus the cutting force carried from the layer above (below) reaches the layer's
+//!   plus the cutting force carried from the layer above (see below) reaches the layer's
 //!   `puncture_force_n`, the boundary is punctured in that tick: its axial force is gone
 //!   (the cue), its lateral force and moments stay as the track's preload, so the five
 //!   lateral components are continuous. A puncture can be followed by the next
