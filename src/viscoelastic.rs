@@ -34,6 +34,9 @@
 
 use needle_contract::{COMPONENT_COUNT, MAX_PRONY_TERMS, PRONY_G_SUM_MAX};
 
+#[cfg(not(feature = "viscoelastic"))]
+pub(crate) mod identity;
+
 /// Most Prony terms of a relaxation function.
 pub const MAX_TERMS: usize = MAX_PRONY_TERMS;
 

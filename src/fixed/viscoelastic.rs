@@ -1,9 +1,10 @@
 //! The quasi-linear viscoelastic filter ([`crate::viscoelastic`]: the same
 //! normalisation and recursion) in integers, for cores without an FPU.
 //!
-//! - Terms ([`PronyTerms`]): `g` in Q16, `tau` in whole µs (clamped to
-//!   [`TAU_MAX_US`]), converted from the f32 terms in `const` evaluation
-//!   ([`PronyTerms::from_f32`]).
+//! - Terms ([`PronyTerms`]): `g` in Q16 (`i32`), `tau` in whole µs (`u32`, clamped to
+//!   [`TAU_MAX_US`], 71.6 min: a slower term relaxes in fixed point as one of 71.6 min
+//!   would), converted from the f32 terms in `const` evaluation ([`PronyTerms::from_f32`]).
+//!   32-bit fields: every layer slot of every compiled-in stack carries them (flash).
 //! - Coefficients ([`QlvCoefficients::new`], once per configuration, integers only):
 //!   `x = period / tau` in Q32, `e = exp(-x)` in Q32 (`exp(-1)^floor(x)` times the Taylor
 //!   series of the fraction, in `u64`), `a = e` in Q30 and `b = g (1 - e) / x` in Q27
@@ -19,10 +20,13 @@
 use needle_contract::COMPONENT_COUNT;
 
 use super::depth_extension::round_i64;
+
+#[cfg(not(feature = "viscoelastic"))]
+pub(crate) mod identity;
 use crate::viscoelastic::{PronyTerms as F32PronyTerms, MAX_TERMS};
 
-/// Largest time constant, µs (2^40: 12.7 days; a longer one is clamped here).
-pub const TAU_MAX_US: i64 = 1 << 40;
+/// Largest time constant, µs (`u32::MAX`: 71.6 min; a longer one is clamped here).
+pub const TAU_MAX_US: u32 = u32::MAX;
 
 /// A relaxation function in integers: `g` in Q16 (`0 ..= 9 * 2^16`), `tau` in µs
 /// (`1 ..= TAU_MAX_US`); the first `count` are used.
@@ -30,9 +34,9 @@ pub const TAU_MAX_US: i64 = 1 << 40;
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct PronyTerms {
     /// Weights relative to the long-term response, Q16.
-    pub g_q16: [i64; MAX_TERMS],
+    pub g_q16: [i32; MAX_TERMS],
     /// Time constants, µs.
-    pub tau_us: [i64; MAX_TERMS],
+    pub tau_us: [u32; MAX_TERMS],
     /// Terms in use (0 to [`MAX_TERMS`]).
     pub count: u8,
 }
@@ -57,18 +61,26 @@ impl PronyTerms {
         let n = usize::from(self.count);
         let g_max = 9 << 16;
         n <= MAX_TERMS
-            && self.g_q16.iter().zip(&self.tau_us).take(n).all(|(&g, &t)| (0..=g_max).contains(&g) && (1..=TAU_MAX_US).contains(&t))
-            && self.g_q16.iter().take(n).sum::<i64>() <= g_max
+            && self.g_q16.iter().zip(&self.tau_us).take(n).all(|(&g, &t)| (0..=g_max).contains(&g) && t >= 1)
+            && self.g_q16.iter().take(n).map(|&g| i64::from(g)).sum::<i64>() <= i64::from(g_max)
     }
 }
 
-const fn q16(v: f32) -> i64 {
-    round_i64(v as f64 * 65536.0)
+/// `v` in Q16, within `0 ..= 9 * 2^16` (the f32 terms' range: `0 <= g <= 9`).
+const fn q16(v: f32) -> i32 {
+    let q = round_i64(v as f64 * 65536.0);
+    if q < 0 {
+        0
+    } else if q > 9 << 16 {
+        9 << 16
+    } else {
+        q as i32
+    }
 }
 
 /// `v` s in whole µs, within `1 ..= TAU_MAX_US` (`0` for a value that is not > 0,
 /// which the f32 terms never hold).
-const fn micro(v: f32) -> i64 {
+const fn micro(v: f32) -> u32 {
     let us = v as f64 * 1.0e6;
     if us.is_nan() || us <= 0.0 {
         0
@@ -77,7 +89,8 @@ const fn micro(v: f32) -> i64 {
     } else if us < 1.0 {
         1
     } else {
-        round_i64(us)
+        // below 2^32 (checked above)
+        round_i64(us) as u32
     }
 }
 
@@ -142,7 +155,7 @@ impl QlvCoefficients {
         let n = usize::from(terms.count);
         for (((a, b), &g), &tau) in out.a_q30.iter_mut().zip(out.b_q27.iter_mut()).zip(&terms.g_q16).zip(&terms.tau_us).take(n) {
             // tau >= 1 (in_range): x = period / tau in Q32, below 2^64
-            let x_q32 = (u64::from(period_us) << 32).checked_div(u64::try_from(tau).ok()?)?;
+            let x_q32 = (u64::from(period_us) << 32).checked_div(u64::from(tau))?;
             let e = exp_neg_q32(x_q32);
             // a <= 2^30 (e <= 2^32): fits i32
             *a = i32::try_from((e + 2) >> 2).ok()?;

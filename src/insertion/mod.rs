@@ -63,6 +63,9 @@ mod track;
 pub use stack::{stacks, Karnopp, Layer, Stack, FE_NEEDLE_DIAMETER_MM, HUB_FROM_TIP_MM, MAX_LAYERS};
 
 use crate::depth_extension::extended_wrench_and_depth_rate;
+#[cfg(not(feature = "viscoelastic"))]
+use crate::viscoelastic::identity::{QlvCoefficients, QlvState};
+#[cfg(feature = "viscoelastic")]
 use crate::viscoelastic::{QlvCoefficients, QlvState};
 use crate::{extended_wrench, Pose, Status, Wrench};
 use track::{axis, dot, Track, Vec3};
@@ -99,6 +102,9 @@ pub enum InsertionError {
     /// [`Insertion::set_scales`] got a count other than the stack's layers, or a scale
     /// that is not finite and > 0.
     Scales,
+    /// A layer has Prony terms and the library was built without its `viscoelastic`
+    /// feature.
+    NeedsViscoelastic,
 }
 
 impl core::fmt::Display for InsertionError {
@@ -108,6 +114,7 @@ impl core::fmt::Display for InsertionError {
             Self::Value => "tissue stack: a value out of range (thickness, scale, puncture force, stick band > 0; the rest >= 0)",
             Self::Config => "insertion config: period_s must be finite and > 0, velocity_time_constant_s finite and >= 0",
             Self::Scales => "stiffness scales: one per layer, each finite and > 0",
+            Self::NeedsViscoelastic => "tissue stack: a layer has Prony terms; build needle-haptics with its `viscoelastic` feature",
         })
     }
 }
@@ -287,6 +294,9 @@ impl Insertion {
         }
         if !positive(config.period_s) || !non_negative(config.velocity_time_constant_s) {
             return Err(InsertionError::Config);
+        }
+        if cfg!(not(feature = "viscoelastic")) && stack.layers.iter().any(|l| !l.prony.as_slice().is_empty()) {
+            return Err(InsertionError::NeedsViscoelastic);
         }
         let mut qlv = [QlvCoefficients::NONE; MAX_LAYERS];
         for (k, l) in qlv.iter_mut().zip(stack.layers) {

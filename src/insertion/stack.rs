@@ -86,6 +86,28 @@ pub mod stacks {
     #[allow(unused_imports)] // a set without tissue files uses none
     use super::{Karnopp, Layer, PronyTerm, PronyTerms, Stack};
     include!(concat!(env!("OUT_DIR"), "/tissue_stacks.rs"));
+
+    /// Whether no layer of `stacks` has a Prony term.
+    #[cfg(not(feature = "viscoelastic"))]
+    #[allow(clippy::indexing_slicing)] // const evaluation only: out of range is a compile error
+    const fn elastic(stacks: &[Stack<'static>]) -> bool {
+        let mut i = 0;
+        while i < stacks.len() {
+            let layers = stacks[i].layers;
+            let mut j = 0;
+            while j < layers.len() {
+                if layers[j].prony.as_array().1 > 0 {
+                    return false;
+                }
+                j += 1;
+            }
+            i += 1;
+        }
+        true
+    }
+
+    #[cfg(not(feature = "viscoelastic"))]
+    const _: () = assert!(elastic(&ALL), "a tissue file of the set has Prony terms: build needle-haptics with its `viscoelastic` feature");
 }
 
 pub use stacks::{FE_NEEDLE_DIAMETER_MM, HUB_FROM_TIP_MM};

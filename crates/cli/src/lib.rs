@@ -19,3 +19,4 @@ pub mod float_text;
 pub mod insertion_paths;
 pub mod model;
 pub mod plot;
+pub mod qlv_filtered;

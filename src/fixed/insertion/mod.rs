@@ -35,6 +35,9 @@ pub use stack::{
 };
 
 use super::depth_extension::saturate_i32;
+#[cfg(not(feature = "viscoelastic"))]
+use super::viscoelastic::identity::{QlvCoefficients, QlvState};
+#[cfg(feature = "viscoelastic")]
 use super::viscoelastic::{QlvCoefficients, QlvState};
 use super::{extended_wrench, Pose, Wrench};
 use crate::insertion::{InsertionError, Phase};
@@ -136,7 +139,9 @@ impl<'a> Insertion<'a> {
         if !stack.layers().iter().all(|l| layer_ok(l) && l.stiffness_scale_q16 <= max_scale) || stack.inv_similarity_q30 <= 0 {
             return Err(InsertionError::Value);
         }
+        #[cfg_attr(not(feature = "viscoelastic"), allow(unused_mut))]
         let mut qlv = [QlvCoefficients::NONE; MAX_LAYERS];
+        #[cfg(feature = "viscoelastic")]
         for (k, l) in qlv.iter_mut().zip(stack.layers()) {
             // terms out of the integer ranges (or a zero period: `Config` below)
             *k = QlvCoefficients::new(&l.prony, config.period_us).ok_or(if config.period_us == 0 {
