@@ -8,6 +8,8 @@ use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+mod visco;
+
 /// The domain of the model (docs/architecture.md section 3); poses outside it are refused.
 pub const X_MAX_MM: f64 = 12.0;
 /// Largest |z| of a pose, mm.
@@ -660,7 +662,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Campaign> {
     })?;
     campaign.validate(path)?;
     validate_deep(&campaign, text, path)?;
-    crate::visco::validate(&campaign, text, path)?;
+    visco::validate(&campaign, text, path)?;
     Ok(campaign)
 }
 
