@@ -76,6 +76,7 @@ pub fn describe(c: &Campaign) -> Option<String> {
 mod tests {
     use super::*;
     use crate::deep::key_line;
+    use std::path::Path;
 
     fn shipped() -> String {
         std::fs::read_to_string(crate::workspace_root().join("coeffs/default/campaign.toml")).expect("campaign.toml")
