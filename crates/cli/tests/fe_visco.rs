@@ -6,32 +6,22 @@
 //! (`.ci/install-febio`); without it they fail, they are not skipped. The bounds are
 //! judged on the campaign's runs (host-tests/tests/fe_qlv_bounds.rs), not on this mesh.
 
-use needle_fe::manifest::{read_manifest, MANIFEST};
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+mod fe_common;
 
-const NEEDLE: &str = env!("CARGO_BIN_EXE_needle");
+use fe_common::{default_set, show};
+use needle_fe::manifest::{read_manifest, MANIFEST};
+use std::ffi::OsStr;
+use std::path::Path;
+use std::process::Output;
 
 /// Must points on the ramp (1.2 mm each; the smoke mesh finds the contact at this step).
 const RAMP_STEPS: &str = "5";
 
-fn default_set() -> (tempfile::TempDir, PathBuf) {
-    let d = tempfile::tempdir().expect("tempdir");
-    let set = d.path().join("set");
-    std::fs::create_dir_all(&set).expect("mkdir");
-    let src = needle_firmware_host::workspace_root().join("coeffs/default/campaign.toml");
-    std::fs::copy(&src, set.join("campaign.toml")).expect("copy the default spec");
-    (d, set)
-}
-
+/// `needle <args> --set <set>`.
 fn needle(args: &[&str], set: &Path) -> Output {
-    let mut c = Command::new(NEEDLE);
-    c.args(args).arg("--set").arg(set).stdin(Stdio::null());
-    c.output().expect("run needle")
-}
-
-fn show(o: &Output) -> String {
-    format!("status {:?}\n--- stdout\n{}\n--- stderr\n{}", o.status, String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+    let mut all: Vec<&OsStr> = args.iter().map(OsStr::new).collect();
+    all.extend([OsStr::new("--set"), set.as_os_str()]);
+    fe_common::needle(&all, &[])
 }
 
 #[test]
