@@ -20,8 +20,8 @@
 //!   load step with automatic time stepping between; the log file records the rigid
 //!   body's reaction force and moment at the must points only.
 
-use crate::deck::{model_name, MeshSummary};
 use crate::mesh::{self, NeedleMesh, TissueMesh, FACES};
+use crate::mesh_summary::{model_name, MeshSummary};
 use crate::spec::{Campaign, FebioSettings, MeshLevel, PoseSpec, Symmetry};
 use anyhow::{bail, Result};
 use std::fmt::Write;
