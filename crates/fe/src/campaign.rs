@@ -38,8 +38,7 @@
 
 use crate::backend::{Backend, Job, SolveFailure, Solved};
 use crate::engines::backend_for;
-use crate::launcher::Launched;
-use crate::manifest::{manifest_text, read_manifest, rfc3339_utc, Manifest, ManifestEntry, MANIFEST};
+use crate::manifest::{manifest_text, read_manifest, rfc3339_utc, Launched, Manifest, ManifestEntry, MANIFEST};
 use crate::mesh_summary;
 use crate::partial;
 use crate::process;
