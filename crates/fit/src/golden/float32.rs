@@ -1,5 +1,5 @@
 //! `golden-f32.csv` (coeffs/README.md, "Golden vectors"): the poses, and the expected f32
-//! wrench and status of each from this crate's own evaluator ([`super::eval_f32`]).
+//! wrench and status of each from this crate's own evaluator ([`crate::eval::float32`]).
 //!
 //! The pose list is fixed in code and reproducible: a 5^5 grid over the domain, 1,000
 //! ChaCha8 random poses from [`GOLDEN_SEED`], the domain's bounds (on, one ulp inside, one
@@ -7,10 +7,10 @@
 //! negative zeros, NaNs (quiet, with payload, negative, signalling), infinities and
 //! subnormals in each input.
 
-use super::eval_f32::{eval, Tables32};
-use super::model_file::{hex32, parse_hex32};
 use crate::contract::COMPONENT_COUNT;
-use anyhow::{bail, Result};
+use crate::eval::float32::{eval, Tables32};
+use crate::model_file::{hex32, parse_hex32};
+use anyhow::Result;
 use rand::RngCore;
 use rand::SeedableRng;
 use std::fmt::Write as _;
@@ -66,25 +66,6 @@ fn with(i: usize, v: f32) -> [f32; 5] {
     p
 }
 
-/// Every pose with one of the five `levels[i]` for each input `i` (x, z, theta_x,
-/// theta_z, depth), input 0 varying slowest: 5^5 poses in file order. Both golden files
-/// start with this grid.
-pub fn grid<T: Copy>(levels: &[[T; 5]]) -> Vec<[T; 5]> {
-    let mut out = Vec::with_capacity(3125);
-    for &x in &levels[0] {
-        for &z in &levels[1] {
-            for &tx in &levels[2] {
-                for &tz in &levels[3] {
-                    for &d in &levels[4] {
-                        out.push([x, z, tx, tz, d]);
-                    }
-                }
-            }
-        }
-    }
-    out
-}
-
 /// Every golden pose `[x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm]`, in file order.
 pub fn poses() -> Vec<[f32; 5]> {
     let mut out = Vec::with_capacity(4500);
@@ -94,7 +75,7 @@ pub fn poses() -> Vec<[f32; 5]> {
         [lo, lo + (hi - lo) * 0.25, lo + (hi - lo) * 0.5, lo + (hi - lo) * 0.75, hi]
     };
     let g: Vec<[f32; 5]> = (0..5).map(lin).collect();
-    out.extend(grid(&g));
+    out.extend(crate::golden::grid(&g));
     // 2. random poses, uniform over the domain
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(GOLDEN_SEED);
     for _ in 0..RANDOM_POSES {
@@ -202,7 +183,7 @@ pub struct GoldenRow {
 /// Wrong header, a row without `6 + COMPONENT_COUNT` fields, a malformed hex field (`path:line` in the
 /// message).
 pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<GoldenRow>> {
-    parse_rows(text, path, &header(), |field, at| {
+    crate::golden::parse_rows(text, path, &header(), |field, at| {
         let value = |s: &str| parse_hex32(s).ok_or_else(|| anyhow::anyhow!("{at}: field {s:?} is not 0x + 8 hex digits"));
         let (mut pose, mut wrench) = ([0.0f32; 5], [0.0f32; COMPONENT_COUNT]);
         for (j, dst) in pose.iter_mut().chain(wrench.iter_mut()).enumerate() {
@@ -212,45 +193,6 @@ pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<GoldenRow>> {
         Ok((pose, wrench))
     })
     .map(|rows| rows.into_iter().map(|(pose, status, wrench)| GoldenRow { pose, status, wrench }).collect())
-}
-
-/// The layout every golden file shares: `header`, then rows of `fields` fields (as many
-/// as the header has) `5 pose values, status (0x + 2 hex digits), the outputs`. `values`
-/// reads the pose and the outputs of one row from its fields; its second argument is
-/// the row's `path:line` for messages.
-///
-/// # Errors
-/// Wrong header, a row with another number of fields, a malformed status, or `values`'
-/// error.
-#[allow(clippy::type_complexity)]
-pub(crate) fn parse_rows<P, W>(
-    text: &str,
-    path: &Path,
-    header: &str,
-    values: impl Fn(&[&str], &str) -> Result<(P, W)>,
-) -> Result<Vec<(P, u8, W)>> {
-    let fields = header.split(',').count();
-    let p = path.display();
-    let mut lines = text.lines();
-    if lines.next() != Some(header) {
-        bail!("{p}:1: expected the header {header:?}");
-    }
-    let mut rows = Vec::new();
-    for (n, line) in lines.enumerate() {
-        let at = format!("{p}:{}", n + 2);
-        let f: Vec<&str> = line.split(',').collect();
-        if f.len() != fields {
-            bail!("{at}: {} fields, expected {fields}", f.len());
-        }
-        let status = f[5]
-            .strip_prefix("0x")
-            .filter(|h| h.len() == 2)
-            .and_then(|h| u8::from_str_radix(h, 16).ok())
-            .ok_or_else(|| anyhow::anyhow!("{at}: status {:?} is not 0x + 2 hex digits", f[5]))?;
-        let (pose, wrench) = values(&f, &at)?;
-        rows.push((pose, status, wrench));
-    }
-    Ok(rows)
 }
 
 #[cfg(test)]
