@@ -1,7 +1,7 @@
 //! `[block]`: the tissue block and its boundary conditions.
 
+use super::error::{SpecError, SpecResult};
 use super::positive;
-use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -27,17 +27,16 @@ impl Block {
     /// # Errors
     /// A size not finite and > 0; boundary conditions other than pinned sides and an
     /// encastre bottom.
-    pub fn validate(&self, path: &Path) -> Result<()> {
+    pub fn validate(&self, path: &Path) -> SpecResult<()> {
         for (name, v) in [("block.size_x_mm", self.size_x_mm), ("block.size_z_mm", self.size_z_mm), ("block.depth_mm", self.depth_mm)] {
             positive(path, name, v)?;
         }
         if self.sides != "pinned" || self.bottom != "encastre" {
-            bail!(
-                "{}: block: sides = {:?}, bottom = {:?}: only \"pinned\" and \"encastre\" are implemented",
+            return Err(SpecError::range(
                 path.display(),
-                self.sides,
-                self.bottom
-            );
+                "block.sides",
+                format!("block: sides = {:?}, bottom = {:?}: only \"pinned\" and \"encastre\" are implemented", self.sides, self.bottom),
+            ));
         }
         Ok(())
     }

@@ -2,7 +2,7 @@
 //! Sobol training poses and their replacements), the runs the fit leaves out, the mesh
 //! study.
 
-use anyhow::{bail, Result};
+use super::error::{SpecError, SpecResult};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -75,10 +75,10 @@ impl CampaignSettings {
     ///
     /// # Errors
     /// A generated count above [`MAX_GENERATED_POSES`].
-    pub fn validate(&self, path: &Path) -> Result<()> {
+    pub fn validate(&self, path: &Path) -> SpecResult<()> {
         for (name, n) in [("campaign.lhs_count", self.lhs_count), ("campaign.train_count", self.train_count)] {
             if n > MAX_GENERATED_POSES {
-                bail!("{}: {name} = {n}: must be <= {MAX_GENERATED_POSES}", path.display());
+                return Err(SpecError::range(path.display(), name, format!("{name} = {n}: must be <= {MAX_GENERATED_POSES}")));
             }
         }
         Ok(())

@@ -1,7 +1,7 @@
 //! `[contact]`: the needle-tissue contact and its friction.
 
+use super::error::{SpecError, SpecResult};
 use super::positive;
-use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -26,15 +26,19 @@ impl Contact {
     /// # Errors
     /// A slope not finite and > 0, a negative or non-finite friction, a contact type
     /// other than surface-to-surface.
-    pub fn validate(&self, path: &Path) -> Result<()> {
+    pub fn validate(&self, path: &Path) -> SpecResult<()> {
         positive(path, "contact.penalty_slope_n_per_mm3", self.penalty_slope_n_per_mm3)?;
         positive(path, "contact.stick_slope_n_per_mm3", self.stick_slope_n_per_mm3)?;
         let p = path.display();
         if !(self.friction.is_finite() && self.friction >= 0.0) {
-            bail!("{p}: contact.friction = {}: must be finite and >= 0", self.friction);
+            return Err(SpecError::range(&p, "contact.friction", format!("contact.friction = {}: must be finite and >= 0", self.friction)));
         }
         if self.kind != "surface-to-surface" {
-            bail!("{p}: contact.type = {:?}: only \"surface-to-surface\" converges (node-to-surface did not)", self.kind);
+            return Err(SpecError::range(
+                &p,
+                "contact.type",
+                format!("contact.type = {:?}: only \"surface-to-surface\" converges (node-to-surface did not)", self.kind),
+            ));
         }
         Ok(())
     }

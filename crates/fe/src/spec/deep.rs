@@ -1,10 +1,10 @@
 //! `[deep]` (`crate::deep`) checked and applied beside the rest of the spec: the
 //! section's type lives in `deep`, which does not depend on `spec`.
 
+use super::error::{SpecError, SpecResult};
 use super::loading::{Loading, MAX_LOAD_STEPS};
 use super::pose::check_pose_in_block;
 use super::Campaign;
-use anyhow::{bail, Result};
 use std::path::Path;
 
 impl crate::deep::DeepSettings {
@@ -23,44 +23,52 @@ impl crate::deep::DeepSettings {
 /// A depth not beyond `loading.depth_mm` or not inside the block, 0 steps, an unknown
 /// mesh level or one whose fine layers stop above the depth, no poses, an unknown or
 /// repeated pose, or a pose whose needle leaves the block at the deep depth.
-pub fn validate_deep(c: &Campaign, text: &str, path: &Path) -> Result<()> {
+pub fn validate_deep(c: &Campaign, text: &str, path: &Path) -> SpecResult<()> {
     let Some(d) = &c.deep else { return Ok(()) };
     let at = |key: &str| format!("{}:{}", path.display(), crate::deep::key_line(text, "deep", key));
     if !(d.depth_mm.is_finite() && d.depth_mm > c.loading.depth_mm && d.depth_mm < c.block.depth_mm) {
-        bail!(
-            "{}: deep.depth_mm = {}: must be beyond loading.depth_mm ({} mm) and inside the block (block.depth_mm = {} mm)",
+        return Err(SpecError::range(
             at("depth_mm"),
-            d.depth_mm,
-            c.loading.depth_mm,
-            c.block.depth_mm
-        );
+            "deep.depth_mm",
+            format!(
+                "deep.depth_mm = {}: must be beyond loading.depth_mm ({} mm) and inside the block (block.depth_mm = {} mm)",
+                d.depth_mm, c.loading.depth_mm, c.block.depth_mm
+            ),
+        ));
     }
     if d.steps == 0 || d.steps > MAX_LOAD_STEPS {
-        bail!("{}: deep.steps = {}: must be 1 ..= {MAX_LOAD_STEPS}", at("steps"), d.steps);
+        return Err(SpecError::range(at("steps"), "deep.steps", format!("deep.steps = {}: must be 1 ..= {MAX_LOAD_STEPS}", d.steps)));
     }
     let Some(level) = c.mesh.get(&d.mesh) else {
         let levels: Vec<&str> = c.mesh.keys().map(String::as_str).collect();
-        bail!("{}: deep.mesh = {:?}: no [mesh.{}] level (levels: {})", at("mesh"), d.mesh, d.mesh, levels.join(", "));
+        let message = format!("deep.mesh = {:?}: no [mesh.{}] level (levels: {})", d.mesh, d.mesh, levels.join(", "));
+        return Err(SpecError::unknown(at("mesh"), "deep.mesh", &d.mesh, message));
     };
     if level.fine_depth_mm < d.depth_mm {
-        bail!(
-            "{}: deep.mesh = {:?}: its fine layers end at fine_depth_mm = {} mm, above deep.depth_mm = {} mm (the tip would cut through coarse layers)",
+        return Err(SpecError::inconsistent(
             at("mesh"),
-            d.mesh,
-            level.fine_depth_mm,
-            d.depth_mm
-        );
+            "deep.mesh",
+            format!(
+                "deep.mesh = {:?}: its fine layers end at fine_depth_mm = {} mm, above deep.depth_mm = {} mm (the tip would cut through coarse layers)",
+                d.mesh, level.fine_depth_mm, d.depth_mm
+            ),
+        ));
     }
     if d.poses.is_empty() {
-        bail!("{}: deep.poses is empty: name at least one pose (e.g. \"centre\")", at("poses"));
+        return Err(SpecError::range(at("poses"), "deep.poses", "deep.poses is empty: name at least one pose (e.g. \"centre\")"));
     }
     let every = c.poses();
     for (k, name) in d.poses.iter().enumerate() {
         if d.poses[..k].contains(name) {
-            bail!("{}: deep.poses: {name:?} is listed twice", at("poses"));
+            return Err(SpecError::duplicate(at("poses"), "deep.poses", name, format!("deep.poses: {name:?} is listed twice")));
         }
         let Some(pose) = every.iter().find(|p| &p.name == name) else {
-            bail!("{}: deep.poses: {name:?} is not a pose of this campaign", at("poses"));
+            return Err(SpecError::unknown(
+                at("poses"),
+                "deep.poses",
+                name,
+                format!("deep.poses: {name:?} is not a pose of this campaign"),
+            ));
         };
         let radius_mm = c.needle.diameter_mm / 2.0;
         check_pose_in_block(pose, &c.block, radius_mm, d.depth_mm, &at("poses"))?;
@@ -72,14 +80,17 @@ pub fn validate_deep(c: &Campaign, text: &str, path: &Path) -> Result<()> {
 mod deep_tests {
     use super::*;
     use crate::deep::key_line;
-    use crate::spec::{parse, MAX_GENERATED_POSES};
+    use crate::spec::parse;
 
     fn shipped() -> String {
         std::fs::read_to_string(crate::workspace_root().join("coeffs/default/campaign.toml")).expect("campaign.toml")
     }
 
-    fn error_of(text: &str) -> String {
-        parse(text, Path::new("campaign.toml")).err().map(|e| e.to_string()).unwrap_or_default()
+    fn refusal(text: &str) -> SpecError {
+        match parse(text, Path::new("campaign.toml")) {
+            Ok(_) => panic!("the spec was accepted"),
+            Err(e) => e,
+        }
     }
 
     #[test]
@@ -101,20 +112,21 @@ mod deep_tests {
         assert!(line("depth_mm") > 0 && line("mesh") > 0 && line("poses") > 0, "the shipped [deep] names its fields");
         let deep_line = |key: &str| text.lines().nth(line(key) - 1).expect("a [deep] line").to_string();
         let (depth, poses, mesh, steps) = (deep_line("depth_mm"), deep_line("poses"), deep_line("mesh"), deep_line("steps"));
-        let cases = [
-            (text.replace(&depth, "depth_mm = 5.0"), format!("campaign.toml:{}: deep.depth_mm = 5: must be beyond", line("depth_mm"))),
-            (text.replace(&depth, "depth_mm = 31.0"), "inside the block (block.depth_mm = 30 mm)".to_string()),
-            (
-                text.replace(&mesh, "mesh = \"needle8\""),
-                format!("campaign.toml:{}: deep.mesh = \"needle8\": its fine layers end at fine_depth_mm = 0.4 mm", line("mesh")),
-            ),
-            (text.replace(&mesh, "mesh = \"huge\""), "deep.mesh = \"huge\": no [mesh.huge] level".to_string()),
-            (text.replace(&poses, "poses = []"), format!("campaign.toml:{}: deep.poses is empty", line("poses"))),
-            (
-                text.replace(&poses, "poses = [\"centre\", \"nowhere\"]"),
-                "deep.poses: \"nowhere\" is not a pose of this campaign".to_string(),
-            ),
-            (text.replace(&poses, "poses = [\"centre\", \"centre\"]"), "deep.poses: \"centre\" is listed twice".to_string()),
+        type Is = fn(&SpecError) -> bool;
+        let range: Is = |e| matches!(e, SpecError::OutOfRange { .. });
+        let inconsistent: Is = |e| matches!(e, SpecError::Inconsistent { .. });
+        let unknown: Is = |e| matches!(e, SpecError::Unknown { .. });
+        let duplicate: Is = |e| matches!(e, SpecError::Duplicate { .. });
+        let outside: Is = |e| matches!(e, SpecError::OutsideBlock { pose, .. } if pose == "edge");
+        let cases: [(String, Is, &str, &str); 8] = [
+            (text.replace(&depth, "depth_mm = 5.0"), range, "deep.depth_mm", "depth_mm"),
+            (text.replace(&depth, "depth_mm = 31.0"), range, "deep.depth_mm", "depth_mm"),
+            // its fine layers end at 0.4 mm
+            (text.replace(&mesh, "mesh = \"needle8\""), inconsistent, "deep.mesh", "mesh"),
+            (text.replace(&mesh, "mesh = \"huge\""), unknown, "deep.mesh", "mesh"),
+            (text.replace(&poses, "poses = []"), range, "deep.poses", "poses"),
+            (text.replace(&poses, "poses = [\"centre\", \"nowhere\"]"), unknown, "deep.poses", "poses"),
+            (text.replace(&poses, "poses = [\"centre\", \"centre\"]"), duplicate, "deep.poses", "poses"),
             // x = 12 mm tilted 15 degrees outwards: inside a 30 mm wide block at 6 mm
             // (reach 14.05 mm), outside at 15 mm (16.38 mm)
             (
@@ -123,21 +135,24 @@ mod deep_tests {
                     .replace(&poses, "poses = [\"centre\", \"edge\"]")
                     .replace(&depth, "depth_mm = 15.0")
                     .replace(&steps, "steps = 50"),
-                format!(
-                    "campaign.toml:{}: pose \"edge\": x_mm = 12 with a lateral travel of 3.882 mm at full depth (15 mm)",
-                    line("poses")
-                ),
+                outside,
+                "pose",
+                "poses",
             ),
         ];
-        for (spec, want) in cases {
-            assert_ne!(spec, text, "the test's edit did not apply ({want})");
-            let msg = error_of(&spec);
-            assert!(msg.contains(&want), "want {want:?} in: {msg}");
+        for (spec, is, field, key) in cases {
+            assert_ne!(spec, text, "the test's edit did not apply ({field})");
+            let e = refusal(&spec);
+            assert!(is(&e) && e.field() == field, "want {field} refused: {e:?}");
+            assert_eq!(e.at(), format!("campaign.toml:{}", line(key)), "{e}");
+            assert!(e.to_string().starts_with(&format!("campaign.toml:{}: ", line(key))), "file:line first: {e}");
         }
-        for (n, shown) in [("0", "0"), ("4000000000", "4000000000")] {
-            let bad = text.replace(&steps, &format!("steps = {n}"));
-            let want = format!("campaign.toml:{}: deep.steps = {shown}: must be 1 ..= {MAX_LOAD_STEPS}", line("steps"));
-            assert!(error_of(&bad).contains(&want), "{}", error_of(&bad));
+        for n in ["0", "4000000000"] {
+            let e = refusal(&text.replace(&steps, &format!("steps = {n}")));
+            assert!(
+                matches!(&e, SpecError::OutOfRange { field, at, .. } if field == "deep.steps" && *at == format!("campaign.toml:{}", line("steps"))),
+                "{e:?}"
+            );
         }
     }
 
@@ -152,14 +167,15 @@ mod deep_tests {
             assert!(l > 0, "the shipped spec has {table}.{key}");
             text.lines().nth(l - 1).expect("line").to_string()
         };
-        for (table, key, want) in [
-            ("loading", "steps", format!("loading.steps = 4000000000: must be 1 ..= {MAX_LOAD_STEPS}")),
-            ("campaign", "lhs_count", format!("campaign.lhs_count = 4000000000: must be <= {MAX_GENERATED_POSES}")),
-            ("campaign", "train_count", format!("campaign.train_count = 4000000000: must be <= {MAX_GENERATED_POSES}")),
+        for (table, key, field) in [
+            ("loading", "steps", "loading.steps"),
+            ("campaign", "lhs_count", "campaign.lhs_count"),
+            ("campaign", "train_count", "campaign.train_count"),
         ] {
             let bad = text.replacen(&line_of(table, key), &format!("{key} = 4000000000"), 1);
             assert_ne!(bad, text);
-            assert!(error_of(&bad).contains(&want), "want {want:?} in: {}", error_of(&bad));
+            let e = refusal(&bad);
+            assert!(matches!(&e, SpecError::OutOfRange { field: f, .. } if f == field), "want {field} refused: {e:?}");
         }
     }
 

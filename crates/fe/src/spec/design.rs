@@ -4,9 +4,9 @@
 //! of what `[campaign]` names among the poses.
 
 use super::campaign::TrainReplacement;
+use super::error::{SpecError, SpecResult};
 use super::pose::{PoseSpec, Role, THETA_MAX_DEG, X_MAX_MM, Z_MAX_MM};
 use super::Campaign;
-use anyhow::{bail, Result};
 use rand::{seq::SliceRandom, Rng, SeedableRng};
 use std::path::Path;
 
@@ -128,12 +128,17 @@ impl Campaign {
     /// An unknown pose, a replaced pose not drawn before its replacement or listed twice
     /// or without its reason, a pose both replaced and left out, a left-out pose whose
     /// role is always or never fitted.
-    pub(super) fn validate_design(&self, path: &Path) -> Result<()> {
+    pub(super) fn validate_design(&self, path: &Path) -> SpecResult<()> {
         let p = path.display();
         let every_pose = self.poses();
         for name in &self.campaign.mesh_study_poses {
             if !every_pose.iter().any(|q| &q.name == name) {
-                bail!("{p}: campaign.mesh_study_poses: {name:?} is not a pose of this campaign");
+                return Err(SpecError::unknown(
+                    &p,
+                    "campaign.mesh_study_poses",
+                    name,
+                    format!("campaign.mesh_study_poses: {name:?} is not a pose of this campaign"),
+                ));
             }
         }
         let mut replaced = std::collections::BTreeSet::new();
@@ -142,29 +147,58 @@ impl Campaign {
             // the pose must be a training pose drawn before its replacement
             let drawn_before = (0..self.campaign.train_count as usize + k).any(|i| self.train_name(i) == r.pose);
             if !drawn_before {
-                bail!(
-                    "{p}: campaign.train_replaced[{k}]: {:?} is not a training pose drawn before its replacement {replacement:?}",
-                    r.pose
-                );
+                return Err(SpecError::inconsistent(
+                    &p,
+                    "campaign.train_replaced",
+                    format!(
+                        "campaign.train_replaced[{k}]: {:?} is not a training pose drawn before its replacement {replacement:?}",
+                        r.pose
+                    ),
+                ));
             }
             if !replaced.insert(r.pose.clone()) {
-                bail!("{p}: campaign.train_replaced: {:?} is listed twice", r.pose);
+                return Err(SpecError::duplicate(
+                    &p,
+                    "campaign.train_replaced",
+                    &r.pose,
+                    format!("campaign.train_replaced: {:?} is listed twice", r.pose),
+                ));
             }
             if r.why.trim().is_empty() {
-                bail!("{p}: campaign.train_replaced[{k}] ({}): `why` is empty (the failure from its logs)", r.pose);
+                return Err(SpecError::range(
+                    &p,
+                    "campaign.train_replaced.why",
+                    format!("campaign.train_replaced[{k}] ({}): `why` is empty (the failure from its logs)", r.pose),
+                ));
             }
             if self.campaign.fit_without.contains(&r.pose) {
-                bail!("{p}: campaign.fit_without: {:?} is in campaign.train_replaced, so it is not fitted already; list it once", r.pose);
+                return Err(SpecError::duplicate(
+                    &p,
+                    "campaign.fit_without",
+                    &r.pose,
+                    format!("campaign.fit_without: {:?} is in campaign.train_replaced, so it is not fitted already; list it once", r.pose),
+                ));
             }
         }
         for name in &self.campaign.fit_without {
             match every_pose.iter().find(|q| &q.name == name) {
-                None => bail!("{p}: campaign.fit_without: {name:?} is not a pose of this campaign"),
+                None => {
+                    return Err(SpecError::unknown(
+                        &p,
+                        "campaign.fit_without",
+                        name,
+                        format!("campaign.fit_without: {name:?} is not a pose of this campaign"),
+                    ))
+                }
                 Some(q) if !q.role.may_be_left_out() => {
-                    bail!(
-                        "{p}: campaign.fit_without: pose {name:?} has role {:?}; only sweep and training runs can be left out of the fit",
-                        q.role
-                    )
+                    return Err(SpecError::inconsistent(
+                        &p,
+                        "campaign.fit_without",
+                        format!(
+                            "campaign.fit_without: pose {name:?} has role {:?}; only sweep and training runs can be left out of the fit",
+                            q.role
+                        ),
+                    ));
                 }
                 Some(_) => {}
             }
@@ -175,7 +209,7 @@ impl Campaign {
 
 #[cfg(test)]
 mod tests {
-    use crate::spec::{load, parse, Role, THETA_MAX_DEG, X_MAX_MM, Z_MAX_MM};
+    use crate::spec::{load, parse, Role, SpecError, THETA_MAX_DEG, X_MAX_MM, Z_MAX_MM};
     use std::path::Path;
 
     /// The training design: a prefix of the scrambled Sobol sequence, inside the
@@ -252,20 +286,25 @@ mod tests {
             parse(&t, Path::new("campaign.toml")).map(|c| c.campaign.train_replaced.len())
         };
         assert_eq!(at_end(&[("train-09", "x")]).ok(), Some(shipped + 1));
-        let err = |r: anyhow::Result<usize>| r.err().map(|e| e.to_string()).unwrap_or_default();
-        let msg = err(at_end(&[("train-60", "x")]));
-        assert!(msg.contains("\"train-60\" is not a training pose drawn before its replacement"), "{msg}");
-        let msg = err(at_end(&[("train-09", "x"), ("train-09", "y")]));
-        assert!(msg.contains("\"train-09\" is listed twice"), "{msg}");
-        let msg = err(at_end(&[("train-09", " ")]));
-        assert!(msg.contains("`why` is empty"), "{msg}");
+        let r = at_end(&[("train-60", "x")]);
+        assert!(matches!(&r, Err(SpecError::Inconsistent { field, .. }) if field == "campaign.train_replaced"), "{r:?}");
+        let r = at_end(&[("train-09", "x"), ("train-09", "y")]);
+        assert!(
+            matches!(&r, Err(SpecError::Duplicate { field, name, .. }) if field == "campaign.train_replaced" && name == "train-09"),
+            "{r:?}"
+        );
+        let r = at_end(&[("train-09", " ")]);
+        assert!(matches!(&r, Err(SpecError::OutOfRange { field, .. }) if field == "campaign.train_replaced.why"), "{r:?}");
         let both = text.replacen("fit_without = [", "fit_without = [\"train-09\", ", 1).replacen(
             "\n[deep]\n",
             "\n[[campaign.train_replaced]]\npose = \"train-09\"\nwhy = \"x\"\n\n[deep]\n",
             1,
         );
-        let msg = err(parse(&both, Path::new("campaign.toml")).map(|c| c.campaign.train_replaced.len()));
-        assert!(msg.contains("\"train-09\" is in campaign.train_replaced"), "{msg}");
+        let r = parse(&both, Path::new("campaign.toml")).map(|c| c.campaign.train_replaced.len());
+        assert!(
+            matches!(&r, Err(SpecError::Duplicate { field, name, .. }) if field == "campaign.fit_without" && name == "train-09"),
+            "{r:?}"
+        );
         // a replacement replaced in turn
         let first = format!("train-{}", 33 + shipped);
         assert_eq!(at_end(&[("train-09", "x"), (first.as_str(), "y")]).ok(), Some(shipped + 2));

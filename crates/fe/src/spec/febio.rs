@@ -1,6 +1,6 @@
 //! `[solver.febio]`: the FEBio model's numerical settings.
 
-use anyhow::{bail, Result};
+use super::error::{SpecError, SpecResult};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -131,14 +131,22 @@ impl FebioSettings {
     /// # Errors
     /// An unknown contact type or primary surface, a value out of its range, an
     /// augmented Lagrangian without a tolerance to stop its augmentations.
-    pub fn validate(&self, path: &Path) -> Result<()> {
+    pub fn validate(&self, path: &Path) -> SpecResult<()> {
         let p = path.display();
         const CONTACTS: [&str; 3] = ["sliding-elastic", "sliding-facet-on-facet", "sliding-node-on-facet"];
         if !CONTACTS.contains(&self.contact.as_str()) {
-            bail!("{p}: solver.febio.contact = {:?}: must be one of {}", self.contact, CONTACTS.join(", "));
+            return Err(SpecError::range(
+                &p,
+                "solver.febio.contact",
+                format!("solver.febio.contact = {:?}: must be one of {}", self.contact, CONTACTS.join(", ")),
+            ));
         }
         if !matches!(self.primary.as_str(), "tissue" | "needle") {
-            bail!("{p}: solver.febio.primary = {:?}: must be \"tissue\" or \"needle\"", self.primary);
+            return Err(SpecError::range(
+                &p,
+                "solver.febio.primary",
+                format!("solver.febio.primary = {:?}: must be \"tissue\" or \"needle\"", self.primary),
+            ));
         }
         for (name, v) in [
             ("penalty", self.penalty),
@@ -148,7 +156,11 @@ impl FebioSettings {
             ("etol", self.etol),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                bail!("{p}: solver.febio.{name} = {v}: must be finite and > 0");
+                return Err(SpecError::range(
+                    &p,
+                    format!("solver.febio.{name}"),
+                    format!("solver.febio.{name} = {v}: must be finite and > 0"),
+                ));
             }
         }
         for (name, v) in [
@@ -161,29 +173,49 @@ impl FebioSettings {
             ("retry_rtol", self.retry_rtol),
         ] {
             if !(v.is_finite() && v >= 0.0) {
-                bail!("{p}: solver.febio.{name} = {v}: must be finite and >= 0");
+                return Err(SpecError::range(
+                    &p,
+                    format!("solver.febio.{name}"),
+                    format!("solver.febio.{name} = {v}: must be finite and >= 0"),
+                ));
             }
         }
         if self.augmented && self.aug_tolerance == 0.0 && self.gap_tolerance_mm == 0.0 {
-            bail!("{p}: solver.febio: augmented = true needs aug_tolerance > 0 or gap_tolerance_mm > 0 (with both 0 FEBio skips every augmentation: set augmented = false for a pure penalty)");
+            return Err(SpecError::inconsistent(&p, "solver.febio.augmented", "solver.febio: augmented = true needs aug_tolerance > 0 or gap_tolerance_mm > 0 (with both 0 FEBio skips every augmentation: set augmented = false for a pure penalty)"));
         }
         if !(self.last_attempt_penalty_scale > 0.0 && self.last_attempt_penalty_scale <= 1.0) {
-            bail!("{p}: solver.febio.last_attempt_penalty_scale = {}: must be in (0, 1]", self.last_attempt_penalty_scale);
+            return Err(SpecError::range(
+                &p,
+                "solver.febio.last_attempt_penalty_scale",
+                format!("solver.febio.last_attempt_penalty_scale = {}: must be in (0, 1]", self.last_attempt_penalty_scale),
+            ));
         }
         if !(self.first_contact_depth_mm.is_finite() && self.first_contact_depth_mm >= 0.0) {
-            bail!("{p}: solver.febio.first_contact_depth_mm = {}: must be finite and >= 0 (0: off)", self.first_contact_depth_mm);
+            return Err(SpecError::range(
+                &p,
+                "solver.febio.first_contact_depth_mm",
+                format!("solver.febio.first_contact_depth_mm = {}: must be finite and >= 0 (0: off)", self.first_contact_depth_mm),
+            ));
         }
         if !(self.first_contact_step_fraction > 0.0 && self.first_contact_step_fraction <= 1.0) {
-            bail!(
-                "{p}: solver.febio.first_contact_step_fraction = {}: must be in (0, 1] (a fraction of one load step)",
-                self.first_contact_step_fraction
-            );
+            return Err(SpecError::range(
+                &p,
+                "solver.febio.first_contact_step_fraction",
+                format!(
+                    "solver.febio.first_contact_step_fraction = {}: must be in (0, 1] (a fraction of one load step)",
+                    self.first_contact_step_fraction
+                ),
+            ));
         }
         if self.dtmin_fraction > 1.0 {
-            bail!("{p}: solver.febio.dtmin_fraction = {}: must be <= 1 (a fraction of one load step)", self.dtmin_fraction);
+            return Err(SpecError::range(
+                &p,
+                "solver.febio.dtmin_fraction",
+                format!("solver.febio.dtmin_fraction = {}: must be <= 1 (a fraction of one load step)", self.dtmin_fraction),
+            ));
         }
         if self.max_refs == 0 || self.opt_iter == 0 {
-            bail!("{p}: solver.febio.max_refs and opt_iter must be >= 1");
+            return Err(SpecError::range(&p, "solver.febio.max_refs", "solver.febio.max_refs and opt_iter must be >= 1"));
         }
         Ok(())
     }
@@ -196,6 +228,7 @@ fn is_zero_u32(v: &u32) -> bool {
 #[cfg(test)]
 mod tests {
     use super::FebioSettings;
+    use crate::spec::SpecError;
     use std::path::Path;
 
     #[test]
@@ -204,8 +237,8 @@ mod tests {
         let gap_only = FebioSettings { aug_tolerance: 0.0, ..FebioSettings::default() };
         assert!(gap_only.validate(p).is_ok(), "gap tolerance alone stops the augmentations");
         let neither = FebioSettings { aug_tolerance: 0.0, gap_tolerance_mm: 0.0, ..FebioSettings::default() };
-        let msg = neither.validate(p).err().map(|e| e.to_string()).unwrap_or_default();
-        assert!(msg.contains("aug_tolerance > 0 or gap_tolerance_mm > 0"), "{msg}");
+        let r = neither.validate(p);
+        assert!(matches!(&r, Err(SpecError::Inconsistent { field, .. }) if field == "solver.febio.augmented"), "{r:?}");
         let penalty = FebioSettings { augmented: false, ..neither };
         assert!(penalty.validate(p).is_ok(), "a pure penalty needs no tolerance");
         let negative = FebioSettings { aug_tolerance: -0.1, ..FebioSettings::default() };

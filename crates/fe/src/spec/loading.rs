@@ -1,7 +1,7 @@
 //! `[loading]`: the insertion's depth and load steps.
 
+use super::error::{SpecError, SpecResult};
 use super::positive;
-use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -31,10 +31,14 @@ impl Loading {
     ///
     /// # Errors
     /// A depth not finite and > 0; steps not in 1 ..= [`MAX_LOAD_STEPS`].
-    pub fn validate(&self, path: &Path) -> Result<()> {
+    pub fn validate(&self, path: &Path) -> SpecResult<()> {
         positive(path, "loading.depth_mm", self.depth_mm)?;
         if self.steps == 0 || self.steps > MAX_LOAD_STEPS {
-            bail!("{}: loading.steps = {}: must be 1 ..= {MAX_LOAD_STEPS}", path.display(), self.steps);
+            return Err(SpecError::range(
+                path.display(),
+                "loading.steps",
+                format!("loading.steps = {}: must be 1 ..= {MAX_LOAD_STEPS}", self.steps),
+            ));
         }
         Ok(())
     }

@@ -1,7 +1,7 @@
 //! `[mesh.<level>]`: the named mesh levels.
 
+use super::error::{SpecError, SpecResult};
 use super::positive;
-use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -31,13 +31,15 @@ impl MeshLevel {
     /// # Errors
     /// An odd or too small element count, fewer than 2 facets per quarter, a size not
     /// finite and > 0, a growth below 1.
-    pub fn validate(&self, path: &Path, name: &str) -> Result<()> {
+    pub fn validate(&self, path: &Path, name: &str) -> SpecResult<()> {
         let p = path.display();
         if self.core_elements < 2 || !self.core_elements.is_multiple_of(2) {
-            bail!("{p}: mesh.{name}.core_elements = {}: must be even and >= 2", self.core_elements);
+            let field = format!("mesh.{name}.core_elements");
+            return Err(SpecError::range(&p, &field, format!("{field} = {}: must be even and >= 2", self.core_elements)));
         }
         if self.needle_facets_per_quarter < 2 {
-            bail!("{p}: mesh.{name}.needle_facets_per_quarter = {}: must be >= 2", self.needle_facets_per_quarter);
+            let field = format!("mesh.{name}.needle_facets_per_quarter");
+            return Err(SpecError::range(&p, &field, format!("{field} = {}: must be >= 2", self.needle_facets_per_quarter)));
         }
         for (f, v) in [
             ("core_half_mm", self.core_half_mm),
@@ -48,7 +50,8 @@ impl MeshLevel {
             positive(path, &format!("mesh.{name}.{f}"), v)?;
         }
         if !(self.growth.is_finite() && self.growth >= 1.0) {
-            bail!("{p}: mesh.{name}.growth = {}: must be >= 1", self.growth);
+            let field = format!("mesh.{name}.growth");
+            return Err(SpecError::range(&p, &field, format!("{field} = {}: must be >= 1", self.growth)));
         }
         Ok(())
     }

@@ -13,6 +13,7 @@ pub mod campaign;
 pub mod contact;
 pub mod deep;
 pub mod design;
+pub mod error;
 pub mod febio;
 pub mod fit;
 pub mod hash;
@@ -28,6 +29,7 @@ pub use block::Block;
 pub use campaign::{CampaignSettings, TrainReplacement, MAX_GENERATED_POSES};
 pub use contact::Contact;
 pub use deep::validate_deep;
+pub use error::{SpecError, SpecResult};
 pub use febio::FebioSettings;
 pub use fit::{FitSettings, ModelForm};
 pub use hash::hex;
@@ -39,7 +41,7 @@ pub use set::SetInfo;
 pub use solver::{Engine, Solver};
 pub use tissue::Tissue;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -83,9 +85,12 @@ pub struct Campaign {
 /// # Errors
 /// The file cannot be read, is not valid TOML for [`Campaign`] (the message has the file
 /// and line), or a value is out of range (the message names the field and the value).
-pub fn load(set_dir: &Path) -> Result<(Campaign, PathBuf)> {
+pub fn load(set_dir: &Path) -> SpecResult<(Campaign, PathBuf)> {
     let path = set_dir.join("campaign.toml");
-    let text = std::fs::read_to_string(&path).with_context(|| format!("{}: cannot read the campaign spec", path.display()))?;
+    let text = match std::fs::read_to_string(&path) {
+        Ok(text) => text,
+        Err(source) => return Err(SpecError::Read { path, source }),
+    };
     let campaign = parse(&text, &path)?;
     Ok((campaign, path))
 }
@@ -94,10 +99,10 @@ pub fn load(set_dir: &Path) -> Result<(Campaign, PathBuf)> {
 ///
 /// # Errors
 /// As [`load`].
-pub fn parse(text: &str, path: &Path) -> Result<Campaign> {
+pub fn parse(text: &str, path: &Path) -> SpecResult<Campaign> {
     let campaign: Campaign = toml::from_str(text).map_err(|e| {
         let line = e.span().map(|s| text[..s.start.min(text.len())].lines().count().max(1)).unwrap_or(0);
-        anyhow::anyhow!("{}:{}: {}", path.display(), line, e.message())
+        SpecError::Syntax { path: path.to_path_buf(), line, message: e.message().to_string() }
     })?;
     campaign.validate(path)?;
     validate_deep(&campaign, text, path)?;
@@ -106,7 +111,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Campaign> {
 
 impl Campaign {
     /// Every section's own checks, then the checks across sections.
-    fn validate(&self, path: &Path) -> Result<()> {
+    fn validate(&self, path: &Path) -> SpecResult<()> {
         self.tissue.validate(path)?;
         self.needle.validate(path)?;
         self.block.validate(path)?;
@@ -123,20 +128,25 @@ impl Campaign {
 
     /// The levels `[campaign]` names exist; the solver's settings (checked between the
     /// two, in the order of the checks before the sections checked themselves).
-    fn validate_mesh_levels(&self, path: &Path) -> Result<()> {
+    fn validate_mesh_levels(&self, path: &Path) -> SpecResult<()> {
         let p = path.display();
         if !self.mesh.contains_key(&self.campaign.mesh) {
-            bail!(
-                "{p}: campaign.mesh = {:?}: no [mesh.{}] level (levels: {})",
-                self.campaign.mesh,
-                self.campaign.mesh,
-                self.mesh.keys().cloned().collect::<Vec<_>>().join(", ")
-            );
+            return Err(SpecError::unknown(
+                &p,
+                "campaign.mesh",
+                &self.campaign.mesh,
+                format!(
+                    "campaign.mesh = {:?}: no [mesh.{}] level (levels: {})",
+                    self.campaign.mesh,
+                    self.campaign.mesh,
+                    self.mesh.keys().cloned().collect::<Vec<_>>().join(", ")
+                ),
+            ));
         }
         self.solver.validate(path)?;
         for level in &self.campaign.mesh_study {
             if !self.mesh.contains_key(level) {
-                bail!("{p}: campaign.mesh_study: no [mesh.{level}] level");
+                return Err(SpecError::unknown(&p, "campaign.mesh_study", level, format!("campaign.mesh_study: no [mesh.{level}] level")));
             }
         }
         Ok(())
@@ -144,20 +154,28 @@ impl Campaign {
 
     /// Each listed pose on its own, inside the block, listed once, of a role that is
     /// listed (not generated).
-    fn validate_listed_poses(&self, path: &Path) -> Result<()> {
+    fn validate_listed_poses(&self, path: &Path) -> SpecResult<()> {
         let p = path.display();
         let mut seen = std::collections::BTreeSet::new();
         for pose in &self.pose {
             pose.validate(&p.to_string())?;
             pose::check_pose_in_block(pose, &self.block, self.needle.diameter_mm / 2.0, self.loading.depth_mm, &p.to_string())?;
             if !seen.insert(pose.name.clone()) {
-                bail!("{p}: pose {:?} is listed twice", pose.name);
+                return Err(SpecError::duplicate(&p, "pose", &pose.name, format!("pose {:?} is listed twice", pose.name)));
             }
             if pose.role == Role::Lhs {
-                bail!("{p}: pose {:?}: role lhs is generated from campaign.lhs_seed, not listed", pose.name);
+                return Err(SpecError::inconsistent(
+                    &p,
+                    "pose.role",
+                    format!("pose {:?}: role lhs is generated from campaign.lhs_seed, not listed", pose.name),
+                ));
             }
             if pose.role == Role::Train {
-                bail!("{p}: pose {:?}: role train is generated from campaign.train_seed, not listed", pose.name);
+                return Err(SpecError::inconsistent(
+                    &p,
+                    "pose.role",
+                    format!("pose {:?}: role train is generated from campaign.train_seed, not listed", pose.name),
+                ));
             }
         }
         Ok(())
@@ -185,9 +203,9 @@ impl Campaign {
 }
 
 /// `name = v` must be finite and > 0; the message starts with the spec's `path`.
-fn positive(path: &Path, name: &str, v: f64) -> Result<()> {
+fn positive(path: &Path, name: &str, v: f64) -> SpecResult<()> {
     if !(v.is_finite() && v > 0.0) {
-        bail!("{}: {name} = {v}: must be finite and > 0", path.display());
+        return Err(SpecError::range(path.display(), name, format!("{name} = {v}: must be finite and > 0")));
     }
     Ok(())
 }

@@ -1,7 +1,7 @@
 //! `[needle]`: the rigid needle's geometry and the wrench's reference point.
 
+use super::error::{SpecError, SpecResult};
 use super::positive;
-use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -26,7 +26,7 @@ impl Needle {
     ///
     /// # Errors
     /// A length or angle not finite and > 0; a wedge half angle of 90 degrees or more.
-    pub fn validate(&self, path: &Path) -> Result<()> {
+    pub fn validate(&self, path: &Path) -> SpecResult<()> {
         for (name, v) in [
             ("needle.diameter_mm", self.diameter_mm),
             ("needle.length_mm", self.length_mm),
@@ -37,7 +37,11 @@ impl Needle {
             positive(path, name, v)?;
         }
         if self.wedge_half_angle_deg >= 90.0 {
-            bail!("{}: needle.wedge_half_angle_deg = {}: must be < 90", path.display(), self.wedge_half_angle_deg);
+            return Err(SpecError::range(
+                path.display(),
+                "needle.wedge_half_angle_deg",
+                format!("needle.wedge_half_angle_deg = {}: must be < 90", self.wedge_half_angle_deg),
+            ));
         }
         Ok(())
     }

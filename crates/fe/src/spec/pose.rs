@@ -2,6 +2,7 @@
 //! checks, and the selection of poses by name.
 
 use super::block::Block;
+use super::error::{SpecError, SpecResult};
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
@@ -117,7 +118,7 @@ impl PoseSpec {
     /// # Errors
     /// A name that is not a file stem, a value outside the domain, a sweep pose that
     /// varies another input than its own.
-    pub fn validate(&self, p: &str) -> Result<()> {
+    pub fn validate(&self, p: &str) -> SpecResult<()> {
         check_pose(self, p)?;
         check_pose_role(self, p)
     }
@@ -125,7 +126,7 @@ impl PoseSpec {
 
 /// A sweep pose varies its own axis only (the centre none): the fitter reads a sweep
 /// run as the deviation along that axis alone.
-fn check_pose_role(pose: &PoseSpec, p: &str) -> Result<()> {
+fn check_pose_role(pose: &PoseSpec, p: &str) -> SpecResult<()> {
     let own = match pose.role {
         Role::Centre => None,
         Role::SweepX => Some("x_mm"),
@@ -137,7 +138,7 @@ fn check_pose_role(pose: &PoseSpec, p: &str) -> Result<()> {
     for (f, v) in [("x_mm", pose.x_mm), ("z_mm", pose.z_mm), ("theta_x_deg", pose.theta_x_deg), ("theta_z_deg", pose.theta_z_deg)] {
         if Some(f) != own && v != 0.0 {
             let what = own.map_or("the centre pose has all four at 0".to_string(), |o| format!("a {:?} pose varies {o} only", pose.role));
-            bail!("{p}: pose {:?}: {f} = {v}: must be 0 ({what})", pose.name);
+            return Err(SpecError::inconsistent(p, format!("pose.{f}"), format!("pose {:?}: {f} = {v}: must be 0 ({what})", pose.name)));
         }
     }
     Ok(())
@@ -145,24 +146,28 @@ fn check_pose_role(pose: &PoseSpec, p: &str) -> Result<()> {
 
 /// The needle stays inside the block: at entry and at full depth (after the lateral
 /// travel of the tilt), the needle's axis is at least its radius from each side face.
-pub(crate) fn check_pose_in_block(pose: &PoseSpec, block: &Block, radius_mm: f64, depth_mm: f64, p: &str) -> Result<()> {
+pub(crate) fn check_pose_in_block(pose: &PoseSpec, block: &Block, radius_mm: f64, depth_mm: f64, p: &str) -> SpecResult<()> {
     let (tx, tz) = pose.lateral_travel(depth_mm);
     for (f, entry, travel, half) in [("x_mm", pose.x_mm, tx, block.size_x_mm / 2.0), ("z_mm", pose.z_mm, tz, block.size_z_mm / 2.0)] {
         let reach = entry.abs().max((entry + travel).abs()) + radius_mm;
         if reach > half {
-            bail!(
-                "{p}: pose {:?}: {f} = {entry} with a lateral travel of {travel:.3} mm at full depth ({depth_mm} mm): the needle (radius {radius_mm} mm) reaches {reach:.3} mm from the centre, beyond the block's side at {half} mm",
-                pose.name
-            );
+            return Err(SpecError::OutsideBlock {
+                at: p.to_string(),
+                pose: pose.name.clone(),
+                message: format!(
+                    "pose {:?}: {f} = {entry} with a lateral travel of {travel:.3} mm at full depth ({depth_mm} mm): the needle (radius {radius_mm} mm) reaches {reach:.3} mm from the centre, beyond the block's side at {half} mm",
+                    pose.name
+                ),
+            });
         }
     }
     Ok(())
 }
 
 /// The name is a file stem and the pose inside the domain.
-fn check_pose(pose: &PoseSpec, p: &str) -> Result<()> {
+fn check_pose(pose: &PoseSpec, p: &str) -> SpecResult<()> {
     if pose.name.is_empty() || !pose.name.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '+' | '_')) {
-        bail!("{p}: pose name {:?}: use letters, digits, '-', '+', '_' only", pose.name);
+        return Err(SpecError::range(p, "pose.name", format!("pose name {:?}: use letters, digits, '-', '+', '_' only", pose.name)));
     }
     for (f, v, max, unit) in [
         ("x_mm", pose.x_mm, X_MAX_MM, "mm"),
@@ -171,7 +176,11 @@ fn check_pose(pose: &PoseSpec, p: &str) -> Result<()> {
         ("theta_z_deg", pose.theta_z_deg, THETA_MAX_DEG, "deg"),
     ] {
         if !(v.is_finite() && v.abs() <= max) {
-            bail!("{p}: pose {:?}: {f} = {v}: outside the domain |{f}| <= {max} {unit}", pose.name);
+            return Err(SpecError::range(
+                p,
+                format!("pose.{f}"),
+                format!("pose {:?}: {f} = {v}: outside the domain |{f}| <= {max} {unit}", pose.name),
+            ));
         }
     }
     Ok(())
@@ -199,7 +208,7 @@ pub fn select<'a>(poses: &'a [PoseSpec], pattern: Option<&str>) -> Result<Vec<&'
 #[cfg(test)]
 mod tests {
     use super::{select, PoseSpec, Role};
-    use crate::spec::parse;
+    use crate::spec::{parse, SpecError};
     use std::path::Path;
 
     fn names(poses: &[&PoseSpec]) -> Vec<String> {
@@ -225,25 +234,23 @@ mod tests {
     fn poses_outside_the_block_or_off_their_sweep_axis_are_refused() {
         let set = crate::workspace_root().join("coeffs/default");
         let text = std::fs::read_to_string(set.join("campaign.toml")).expect("campaign.toml");
-        let cases = [
-            // block 10 mm wide: x+06 (the first listed pose beyond 4.5 mm) is outside
-            (
-                text.replace("size_x_mm = 50.0", "size_x_mm = 10.0"),
-                "pose \"x+06\": x_mm = 6 with a lateral travel of 0.000 mm at full depth (6 mm): the needle (radius 0.5 mm) reaches 6.500 mm from the centre, beyond the block's side at 5 mm",
-            ),
-            // a sweep-x pose with z = 3
-            (text.replacen("role = \"sweep-x\"\nx_mm = 2.0", "role = \"sweep-x\"\nx_mm = 2.0\nz_mm = 3.0", 1), "pose \"x+02\": z_mm = 3: must be 0 (a SweepX pose varies x_mm only)"),
-        ];
-        for (spec, want) in cases {
-            assert_ne!(spec, text, "the test's edit did not apply");
-            let msg = parse(&spec, Path::new("campaign.toml")).err().map(|e| e.to_string()).unwrap_or_default();
-            assert!(msg.contains(want), "{msg}");
-        }
+        // block 10 mm wide: x+06 (the first listed pose beyond 4.5 mm) is outside
+        let narrow = text.replace("size_x_mm = 50.0", "size_x_mm = 10.0");
+        assert_ne!(narrow, text, "the test's edit did not apply");
+        let r = parse(&narrow, Path::new("campaign.toml"));
+        assert!(matches!(&r, Err(SpecError::OutsideBlock { at, pose, .. }) if at == "campaign.toml" && pose == "x+06"), "{r:?}");
+        // a sweep-x pose with z = 3
+        let off_axis = text.replacen("role = \"sweep-x\"\nx_mm = 2.0", "role = \"sweep-x\"\nx_mm = 2.0\nz_mm = 3.0", 1);
+        assert_ne!(off_axis, text, "the test's edit did not apply");
+        let r = parse(&off_axis, Path::new("campaign.toml"));
+        assert!(matches!(&r, Err(SpecError::Inconsistent { field, .. }) if field == "pose.z_mm"), "{r:?}");
         assert!(parse(&text, Path::new("campaign.toml")).is_ok(), "the shipped spec passes");
         // a malformed value: file and line
         let line = text.lines().position(|l| l.starts_with("bulk_to_shear =")).expect("bulk_to_shear line") + 1;
         let bad = text.replace("bulk_to_shear = 100.0", "bulk_to_shear = abc");
-        let msg = parse(&bad, Path::new("campaign.toml")).err().map(|e| e.to_string()).unwrap_or_default();
-        assert!(msg.starts_with(&format!("campaign.toml:{line}: ")), "{msg}");
+        let e = parse(&bad, Path::new("campaign.toml")).err();
+        assert!(matches!(&e, Some(SpecError::Syntax { line: l, .. }) if *l == line), "{e:?}");
+        let msg = e.map(|e| e.to_string()).unwrap_or_default();
+        assert!(msg.starts_with(&format!("campaign.toml:{line}: ")), "the message starts with file:line: {msg}");
     }
 }

@@ -1,5 +1,6 @@
 //! `[solver]`: the FE engine of the campaign and its settings.
 
+use super::error::SpecResult;
 use super::febio::FebioSettings;
 use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
@@ -57,7 +58,7 @@ impl Solver {
     ///
     /// # Errors
     /// As [`FebioSettings::validate`].
-    pub fn validate(&self, path: &Path) -> Result<()> {
+    pub fn validate(&self, path: &Path) -> SpecResult<()> {
         self.febio.validate(path)
     }
 }

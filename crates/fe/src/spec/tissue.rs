@@ -1,7 +1,7 @@
 //! `[tissue]`: the Ogden hyperelastic tissue.
 
+use super::error::{SpecError, SpecResult};
 use super::positive;
-use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -36,14 +36,17 @@ impl Tissue {
     /// # Errors
     /// `mu_n_per_mm2` and `alpha` of different lengths or empty; `bulk_to_shear` not
     /// finite and > 0.
-    pub fn validate(&self, path: &Path) -> Result<()> {
+    pub fn validate(&self, path: &Path) -> SpecResult<()> {
         if self.mu_n_per_mm2.is_empty() || self.mu_n_per_mm2.len() != self.alpha.len() {
-            bail!(
-                "{}: tissue: mu_n_per_mm2 has {} terms and alpha {}; they must match and be non-empty",
+            return Err(SpecError::inconsistent(
                 path.display(),
-                self.mu_n_per_mm2.len(),
-                self.alpha.len()
-            );
+                "tissue.mu_n_per_mm2",
+                format!(
+                    "tissue: mu_n_per_mm2 has {} terms and alpha {}; they must match and be non-empty",
+                    self.mu_n_per_mm2.len(),
+                    self.alpha.len()
+                ),
+            ));
         }
         positive(path, "tissue.bulk_to_shear", self.bulk_to_shear)
     }
