@@ -27,6 +27,7 @@ pub mod golden;
 pub mod lsq;
 pub mod model;
 pub mod model_file;
+pub mod model_file_error;
 pub mod poly;
 pub mod validate;
 
