@@ -10,6 +10,7 @@
 use crate::contract::COMPONENT_COUNT;
 use crate::eval::fixed::{eval, DEPTH_DIVISOR, DEPTH_MAX_Q16, DIVISORS, HALF_RANGE_Q16, ONE};
 use crate::fixed_formats::TablesFixed;
+use crate::golden::GoldenCsvError;
 use anyhow::{anyhow, Result};
 use rand::{RngCore, SeedableRng};
 use std::fmt::Write as _;
@@ -154,9 +155,9 @@ pub struct FixedRow {
 ///
 /// # Errors
 /// Wrong header, a row without 12 fields, a malformed field (`path:line` in the message).
-pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<FixedRow>> {
+pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<FixedRow>, GoldenCsvError> {
     crate::golden::parse_rows(text, path, &header(), |field, at| {
-        let int = |s: &str| s.parse::<i32>().map_err(|_| anyhow!("{at}: {s:?} is not an i32"));
+        let int = |s: &str| s.parse::<i32>().map_err(|_| GoldenCsvError::int(at, s));
         let mut pose = [0; 5];
         for (d, s) in pose.iter_mut().zip(&field[..5]) {
             *d = int(s)?;

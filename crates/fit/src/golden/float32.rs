@@ -9,6 +9,7 @@
 
 use crate::contract::COMPONENT_COUNT;
 use crate::eval::float32::{eval, Tables32};
+use crate::golden::GoldenCsvError;
 use crate::model_file::{hex32, parse_hex32};
 use anyhow::Result;
 use rand::RngCore;
@@ -182,9 +183,9 @@ pub struct GoldenRow {
 /// # Errors
 /// Wrong header, a row without `6 + COMPONENT_COUNT` fields, a malformed hex field (`path:line` in the
 /// message).
-pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<GoldenRow>> {
+pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<GoldenRow>, GoldenCsvError> {
     crate::golden::parse_rows(text, path, &header(), |field, at| {
-        let value = |s: &str| parse_hex32(s).ok_or_else(|| anyhow::anyhow!("{at}: field {s:?} is not 0x + 8 hex digits"));
+        let value = |s: &str| parse_hex32(s).ok_or_else(|| GoldenCsvError::hex32(at, s));
         let (mut pose, mut wrench) = ([0.0f32; 5], [0.0f32; COMPONENT_COUNT]);
         for (j, dst) in pose.iter_mut().chain(wrench.iter_mut()).enumerate() {
             // field 5 is the status, read by parse_rows
@@ -199,8 +200,8 @@ pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<GoldenRow>> {
 mod tests {
     use super::*;
 
-    fn err(text: &str) -> String {
-        format!("{:#}", parse_csv(text, Path::new("g.csv")).expect_err("must be refused"))
+    fn err(text: &str) -> GoldenCsvError {
+        parse_csv(text, Path::new("g.csv")).expect_err("must be refused")
     }
 
     #[test]
@@ -216,9 +217,14 @@ mod tests {
         let good = format!("{}\n{}\n", header(), row("0x01", one));
         let rows = parse_csv(&good, Path::new("g.csv")).expect("good file");
         assert_eq!(rows, [GoldenRow { pose: [1.0; 5], status: 1, wrench: [1.0; COMPONENT_COUNT] }]);
-        assert_eq!(err("x\n"), format!("g.csv:1: expected the header {:?}", header()));
-        assert_eq!(err(&format!("{}\n{}\n0x1\n", header(), row("0x00", one))), "g.csv:3: 1 fields, expected 12");
-        assert_eq!(err(&format!("{}\n{}\n", header(), row("0x1", one))), "g.csv:2: status \"0x1\" is not 0x + 2 hex digits");
-        assert_eq!(err(&format!("{}\n{}\n", header(), row("0x00", "1.0"))), "g.csv:2: field \"1.0\" is not 0x + 8 hex digits");
+        let e = err("x\n");
+        assert_eq!(e, GoldenCsvError::Header { path: "g.csv".into(), expected: header() });
+        assert!(e.to_string().starts_with("g.csv:1: "), "file:line first: {e}");
+        let e = err(&format!("{}\n{}\n0x1\n", header(), row("0x00", one)));
+        assert_eq!(e, GoldenCsvError::FieldCount { at: "g.csv:3".into(), found: 1, expected: 12 });
+        let e = err(&format!("{}\n{}\n", header(), row("0x1", one)));
+        assert_eq!(e, GoldenCsvError::Status { at: "g.csv:2".into(), value: "0x1".into() });
+        let e = err(&format!("{}\n{}\n", header(), row("0x00", "1.0")));
+        assert!(matches!(&e, GoldenCsvError::Value { at, value, .. } if at == "g.csv:2" && value == "1.0"), "{e:?}");
     }
 }

@@ -5,12 +5,13 @@
 //! [`stiffness_fixed`] (`golden-stiffness-fixed.csv`); here, what they share: the grid
 //! every pose list starts with and the rows' layout.
 
+pub mod error;
 pub mod fixed;
 pub mod float32;
 pub mod stiffness_fixed;
 pub mod stiffness_float32;
 
-use anyhow::{bail, Result};
+pub use error::GoldenCsvError;
 use std::path::Path;
 
 /// Every pose with one of the five `levels[i]` for each input `i` (x, z, theta_x,
@@ -45,26 +46,26 @@ pub(crate) fn parse_rows<P, W>(
     text: &str,
     path: &Path,
     header: &str,
-    values: impl Fn(&[&str], &str) -> Result<(P, W)>,
-) -> Result<Vec<(P, u8, W)>> {
+    values: impl Fn(&[&str], &str) -> Result<(P, W), GoldenCsvError>,
+) -> Result<Vec<(P, u8, W)>, GoldenCsvError> {
     let fields = header.split(',').count();
     let p = path.display();
     let mut lines = text.lines();
     if lines.next() != Some(header) {
-        bail!("{p}:1: expected the header {header:?}");
+        return Err(GoldenCsvError::Header { path: p.to_string(), expected: header.to_string() });
     }
     let mut rows = Vec::new();
     for (n, line) in lines.enumerate() {
         let at = format!("{p}:{}", n + 2);
         let f: Vec<&str> = line.split(',').collect();
         if f.len() != fields {
-            bail!("{at}: {} fields, expected {fields}", f.len());
+            return Err(GoldenCsvError::FieldCount { at, found: f.len(), expected: fields });
         }
         let status = f[5]
             .strip_prefix("0x")
             .filter(|h| h.len() == 2)
             .and_then(|h| u8::from_str_radix(h, 16).ok())
-            .ok_or_else(|| anyhow::anyhow!("{at}: status {:?} is not 0x + 2 hex digits", f[5]))?;
+            .ok_or_else(|| GoldenCsvError::Status { at: at.clone(), value: f[5].to_string() })?;
         let (pose, wrench) = values(&f, &at)?;
         rows.push((pose, status, wrench));
     }

@@ -7,6 +7,7 @@ use crate::eval::fixed::eval_rates;
 use crate::fixed_formats::TablesFixed;
 use crate::golden::fixed::poses;
 use crate::golden::stiffness_float32::rate_columns;
+use crate::golden::GoldenCsvError;
 use anyhow::{anyhow, Result};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -55,9 +56,9 @@ pub struct FixedStiffnessRow {
 ///
 /// # Errors
 /// Wrong header, a row without 24 fields, a malformed field (`path:line` in the message).
-pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<FixedStiffnessRow>> {
+pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<FixedStiffnessRow>, GoldenCsvError> {
     crate::golden::parse_rows(text, path, &header(), |field, at| {
-        let int = |s: &str| s.parse::<i32>().map_err(|_| anyhow!("{at}: {s:?} is not an i32"));
+        let int = |s: &str| s.parse::<i32>().map_err(|_| GoldenCsvError::int(at, s));
         let mut pose = [0; 5];
         for (d, s) in pose.iter_mut().zip(field) {
             *d = int(s)?;

@@ -7,6 +7,7 @@ use crate::contract::COMPONENT_COUNT;
 use crate::eval::float32::Tables32;
 use crate::eval::rate_float32::eval_rates;
 use crate::golden::float32::poses;
+use crate::golden::GoldenCsvError;
 use crate::model_file::{hex32, parse_hex32};
 use anyhow::Result;
 use std::fmt::Write as _;
@@ -71,9 +72,9 @@ pub struct StiffnessRow {
 ///
 /// # Errors
 /// Wrong header, a row without 24 fields, a malformed hex field or status (`path:line`).
-pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<StiffnessRow>> {
+pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<StiffnessRow>, GoldenCsvError> {
     crate::golden::parse_rows(text, path, &header(), |field, at| {
-        let value = |s: &str| parse_hex32(s).ok_or_else(|| anyhow::anyhow!("{at}: field {s:?} is not 0x + 8 hex digits"));
+        let value = |s: &str| parse_hex32(s).ok_or_else(|| GoldenCsvError::hex32(at, s));
         let mut pose = [0.0f32; 5];
         for (dst, s) in pose.iter_mut().zip(field) {
             *dst = value(s)?;
