@@ -155,13 +155,7 @@ impl FebioSettings {
             ("dtmin_fraction", self.dtmin_fraction),
             ("etol", self.etol),
         ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(SpecError::range(
-                    &p,
-                    format!("solver.febio.{name}"),
-                    format!("solver.febio.{name} = {v}: must be finite and > 0"),
-                ));
-            }
+            super::positive(path, &format!("solver.febio.{name}"), v)?;
         }
         for (name, v) in [
             ("aug_tolerance", self.aug_tolerance),
@@ -180,6 +174,13 @@ impl FebioSettings {
                 ));
             }
         }
+        self.validate_ladder(path)
+    }
+
+    /// The augmentations' stop and the retry ladder's settings (after the values
+    /// `validate` checks, in the order the checks were written in).
+    fn validate_ladder(&self, path: &Path) -> SpecResult<()> {
+        let p = path.display();
         if self.augmented && self.aug_tolerance == 0.0 && self.gap_tolerance_mm == 0.0 {
             return Err(SpecError::inconsistent(&p, "solver.febio.augmented", "solver.febio: augmented = true needs aug_tolerance > 0 or gap_tolerance_mm > 0 (with both 0 FEBio skips every augmentation: set augmented = false for a pure penalty)"));
         }
