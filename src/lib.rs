@@ -65,6 +65,7 @@ mod pose;
 mod status;
 mod stiffness;
 pub mod telemetry;
+pub mod viscoelastic;
 mod wrench;
 
 pub use depth_extension::extended_wrench;

@@ -11,7 +11,7 @@ impl crate::deep::DeepSettings {
     /// The campaign's spec as a deep run sees it: `[loading]` to the deep depth and steps.
     pub fn apply(&self, c: &Campaign) -> Campaign {
         let mut deep = c.clone();
-        deep.loading = Loading { depth_mm: self.depth_mm, steps: self.steps };
+        deep.loading = Loading { depth_mm: self.depth_mm, steps: self.steps, ramp_hold: None };
         deep
     }
 }

@@ -75,6 +75,10 @@ pub enum SpecError {
         /// The message.
         message: String,
     },
+    /// A refusal of the `[viscoelastic]` section (`spec::visco`, not yet split by kind:
+    /// its message has the file, the line and the field).
+    #[error(transparent)]
+    Viscoelastic(anyhow::Error),
     /// A pose whose needle leaves the block (at entry or at full depth).
     #[error("{at}: {message}")]
     OutsideBlock {
@@ -112,6 +116,7 @@ impl SpecError {
     pub fn at(&self) -> String {
         match self {
             SpecError::Read { path, .. } => path.display().to_string(),
+            SpecError::Viscoelastic(e) => e.to_string().split(": ").next().unwrap_or_default().to_string(),
             SpecError::Syntax { path, line, .. } => format!("{}:{line}", path.display()),
             SpecError::OutOfRange { at, .. }
             | SpecError::Inconsistent { at, .. }
@@ -126,6 +131,7 @@ impl SpecError {
     pub fn field(&self) -> &str {
         match self {
             SpecError::Read { .. } | SpecError::Syntax { .. } => "",
+            SpecError::Viscoelastic(_) => "viscoelastic",
             SpecError::OutsideBlock { .. } => "pose",
             SpecError::OutOfRange { field, .. }
             | SpecError::Inconsistent { field, .. }

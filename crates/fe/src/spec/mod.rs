@@ -24,6 +24,7 @@ pub mod pose;
 pub mod set;
 pub mod solver;
 pub mod tissue;
+mod visco;
 
 pub use block::Block;
 pub use campaign::{CampaignSettings, TrainReplacement, MAX_GENERATED_POSES};
@@ -40,6 +41,8 @@ pub use pose::{select, PoseSpec, Role, Symmetry, THETA_MAX_DEG, X_MAX_MM, Z_MAX_
 pub use set::SetInfo;
 pub use solver::{Engine, Solver};
 pub use tissue::Tissue;
+
+use pose::check_pose_in_block;
 
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
@@ -75,6 +78,9 @@ pub struct Campaign {
     /// The deep runs of `needle fe run --deep` (`crate::deep`); absent: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub deep: Option<crate::deep::DeepSettings>,
+    /// The ramp-and-hold runs of `needle fe run --visco` (`crate::visco`); absent: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub viscoelastic: Option<crate::visco::settings::ViscoSettings>,
     /// The named poses as written (the Latin hypercube poses are added by [`Campaign::poses`]).
     #[serde(rename = "pose", default)]
     pub pose: Vec<PoseSpec>,
@@ -106,6 +112,7 @@ pub fn parse(text: &str, path: &Path) -> SpecResult<Campaign> {
     })?;
     campaign.validate(path)?;
     validate_deep(&campaign, text, path)?;
+    visco::validate(&campaign, text, path).map_err(SpecError::Viscoelastic)?;
     Ok(campaign)
 }
 
@@ -159,7 +166,7 @@ impl Campaign {
         let mut seen = std::collections::BTreeSet::new();
         for pose in &self.pose {
             pose.validate(&p.to_string())?;
-            pose::check_pose_in_block(pose, &self.block, self.needle.diameter_mm / 2.0, self.loading.depth_mm, &p.to_string())?;
+            check_pose_in_block(pose, &self.block, self.needle.diameter_mm / 2.0, self.loading.depth_mm, &p.to_string())?;
             if !seen.insert(pose.name.clone()) {
                 return Err(SpecError::duplicate(&p, "pose", &pose.name, format!("pose {:?} is listed twice", pose.name)));
             }
