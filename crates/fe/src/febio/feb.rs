@@ -24,8 +24,8 @@
 //!   stress; the bulk modulus stays the Ogden's) and its time is seconds: the feed curve
 //!   ramps to the depth at the set speed and holds, the must points are the run's.
 
-use crate::deck::{model_name, MeshSummary};
 use crate::mesh::{self, NeedleMesh, TissueMesh, FACES};
+use crate::mesh_summary::{model_name, MeshSummary};
 use crate::spec::{Campaign, FebioSettings, Loading, MeshLevel, PoseSpec, Symmetry};
 use anyhow::{bail, Result};
 use std::fmt::Write;
