@@ -261,12 +261,6 @@ fn top_level(g: &Graph) -> Graph {
     out
 }
 
-/// Top-level cycles known and not yet broken: (crate, a module of the cycle). `fe`'s
-/// `visco` (issue 39): `spec` holds `visco::settings` types while `visco` reads `spec`,
-/// and `visco`'s tests write a `.feb` (`febio`), which reads `spec`. To break: the
-/// settings types into `spec/visco`, the `.feb` test into `febio`.
-const KNOWN_TOP_LEVEL: [(&str, &str); 1] = [("crates/fe/src", "visco")];
-
 #[test]
 fn no_crate_has_an_import_cycle_between_its_top_level_modules() {
     let folded: Graph = [("campaign", vec!["launcher"]), ("launcher::slurm", vec!["campaign"])]
@@ -280,9 +274,6 @@ fn no_crate_has_an_import_cycle_between_its_top_level_modules() {
     for c in CRATES {
         let g = top_level(&graph(&ws.join(c)));
         for cy in cycles(&g) {
-            if KNOWN_TOP_LEVEL.iter().any(|(kc, m)| *kc == c && cy.iter().any(|x| x == m)) {
-                continue;
-            }
             let inside: Vec<String> =
                 cy.iter().flat_map(|a| g[a].iter().filter(|b| cy.contains(b)).map(move |b| format!("{a} -> {b}"))).collect();
             all.push(format!("{c}: {} ({})", cy.join(" <-> "), inside.join(", ")));

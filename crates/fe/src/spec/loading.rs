@@ -23,7 +23,7 @@ pub struct Loading {
     /// The time course of a viscoelastic ramp-and-hold run (`crate::visco::apply`; never
     /// in the file); absent: quasi-static, time = depth in mm.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub ramp_hold: Option<crate::visco::settings::RampHold>,
+    pub ramp_hold: Option<super::visco::RampHold>,
 }
 
 impl Loading {

@@ -24,7 +24,7 @@ pub mod pose;
 pub mod set;
 pub mod solver;
 pub mod tissue;
-mod visco;
+pub mod visco;
 
 pub use block::Block;
 pub use campaign::{CampaignSettings, TrainReplacement, MAX_GENERATED_POSES};
@@ -80,7 +80,7 @@ pub struct Campaign {
     pub deep: Option<crate::deep::DeepSettings>,
     /// The ramp-and-hold runs of `needle fe run --visco` (`crate::visco`); absent: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub viscoelastic: Option<crate::visco::settings::ViscoSettings>,
+    pub viscoelastic: Option<visco::ViscoSettings>,
     /// The named poses as written (the Latin hypercube poses are added by [`Campaign::poses`]).
     #[serde(rename = "pose", default)]
     pub pose: Vec<PoseSpec>,

@@ -22,7 +22,7 @@ pub struct Tissue {
     /// The Prony series of a viscoelastic run (`crate::visco::apply`; never in the
     /// file); absent: elastic.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub prony: Option<crate::visco::settings::Prony>,
+    pub prony: Option<super::visco::Prony>,
 }
 
 impl Tissue {
