@@ -22,7 +22,6 @@ pub const VISCO_DIR: &str = "visco";
 /// Header of a ramp-and-hold result: the time, s, before the FE result's columns.
 pub const TIME_COLUMN: &str = "time_s";
 
-
 /// The campaign as the runs at `speed_mm_per_s` see it (`ramp_steps` must points on the
 /// ramp), and their poses (renamed by [`run_name`]).
 pub fn apply(c: &Campaign, v: &ViscoSettings, speed_mm_per_s: f64, ramp_steps: u32) -> (Campaign, Vec<PoseSpec>) {

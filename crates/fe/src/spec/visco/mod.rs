@@ -4,8 +4,8 @@
 use super::{check_pose_in_block, Campaign, MAX_LOAD_STEPS};
 pub mod settings;
 
-pub use settings::{run_name, Prony, RampHold, ViscoSettings, MAX_PRONY_TERMS};
 use anyhow::{bail, Result};
+pub use settings::{run_name, Prony, RampHold, ViscoSettings, MAX_PRONY_TERMS};
 use std::path::Path;
 
 /// Check `[viscoelastic]` against the rest of the spec (and that `[tissue]` / `[loading]`
