@@ -32,6 +32,9 @@ pub const CONTINUE_DTMIN_SCALE: f64 = 0.1;
 pub const CONTINUE_MAX_RETRIES: u32 = 12;
 /// Continuations of one attempt at most.
 pub const MAX_CONTINUATIONS: u32 = 12;
+/// Segments (processes) of one attempt whose logs are kept at most: its continuations
+/// and the restarts of an attempt interrupted by a killed campaign (`running.rs`).
+pub const MAX_SEGMENTS: u32 = 64;
 /// Continuations from the same must point at most: one (module docs).
 pub const MAX_FROM_SAME_POINT: u32 = 1;
 
