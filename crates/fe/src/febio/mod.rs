@@ -2,6 +2,11 @@
 //! and reading the rigid needle's reaction back ([`logs`]), behind the campaign's
 //! [`Backend`] trait.
 //!
+//! Each FEBio process of an attempt is recorded in `running.toml` ([`running`]), so that
+//! an attempt a killed campaign left running goes on from its last dump (`pose.dmp`, at
+//! its last must point) when the campaign resumes the pose (`crate::resume`); nothing at
+//! the start of an attempt removes that dump before the decision.
+//!
 //! `febio4` is found, in order: `$FEBIO` (must be an executable; a bad path is an
 //! error, not a silent fallback), the build of `.ci/install-febio` in the cache folder
 //! (`$NEEDLE_CACHE`, default `~/.cache/needle-haptics`, `febio-4.11/bin/febio4`), a

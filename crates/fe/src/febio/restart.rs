@@ -19,7 +19,10 @@
 //! points (the time step sizes) changes, as it does between the campaign's attempts.
 //! The manifest's `solver_settings` says how often and from where a run was continued.
 //! Each segment's rigid-body log is kept (`needle-rb-<n>.txt`), since FEBio starts the
-//! log afresh on a restart; the must points are read from all of them.
+//! log afresh on a restart; the must points are read from all of them. The restart of an
+//! attempt interrupted by a killed campaign (`running.rs`) is a segment too, not a
+//! continuation: it starts with the attempt's own first step and does not count against
+//! [`MAX_CONTINUATIONS`].
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
