@@ -4,7 +4,7 @@
 //! ([`RECORD_FILE`]).
 //!
 //! The campaign writes it atomically ([`results::write_atomic`]) at the start of each
-//! attempt and after each failed attempt ([`write`]), and removes it when the pose is
+//! attempt and after each failed attempt ([`write()`]), and removes it when the pose is
 //! solved. It holds what identifies the run ([`Identity`]: spec hash, engine and its
 //! version, mesh level, steps), the attempt running (or, after a failure, the next one),
 //! the failure messages of the finished attempts and the furthest attempt's must points.
