@@ -479,8 +479,12 @@ impl FebioBackend {
             cont.from_mm.push(last_mm);
             restarting = true;
         };
-        // the attempt ended: nothing to go on from, whatever its bookkeeping below
-        running::remove(job.work_dir);
+        // the attempt ended: nothing to go on from, whatever its bookkeeping below; one
+        // stopped by Ctrl-C or kill keeps its record and dump, which the rerun goes on from
+        let stopped = process::interrupted();
+        if !stopped {
+            running::remove(job.work_dir);
+        }
         let line = {
             let mut line = settings_line(fs, campaign.contact.friction, self.threads, plan.retry_tolerances());
             if let Some(fc) = first_contact {
@@ -531,7 +535,7 @@ impl FebioBackend {
             }
         }
         // the dumps are large (tens of MB) and only needed while the run goes on
-        for f in [restart::DUMP, restart::DUMP_FROM] {
+        for f in [restart::DUMP, restart::DUMP_FROM].into_iter().filter(|_| !stopped) {
             let _ = std::fs::remove_file(job.work_dir.join(f));
         }
         if failed {
