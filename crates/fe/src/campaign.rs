@@ -720,6 +720,10 @@ fn update_manifest(ctx: &Ctx<'_>, f: impl FnOnce(&mut Manifest)) -> Result<()> {
 }
 
 #[cfg(test)]
+#[path = "campaign_resume_tests.rs"]
+mod resume_tests;
+
+#[cfg(test)]
 pub(crate) mod tests {
     use super::*;
     use crate::deck::MeshSummary;
