@@ -339,7 +339,7 @@ impl FebioBackend {
         // segment logs kept so far (a continuation or a resumed run keeps the one before)
         let mut segment: u32 = 0;
         // the must point a resumed run goes on from, mm, and whether its first process runs
-        let mut resumed_at: Option<f64> = None;
+        let mut resumed_at_mm: Option<f64> = None;
         let mut resumed_first = false;
         if let Some((r, p)) = &resumed {
             for (from, to) in [
@@ -359,7 +359,7 @@ impl FebioBackend {
             let restart_in = job.work_dir.join(restart::RESTART_INPUT);
             std::fs::write(&restart_in, restart::restart_input(step_after(p.steps) * plan.first_increment(), dtmin, tolerances))
                 .with_context(|| format!("{}: cannot write", restart_in.display()))?;
-            resumed_at = Some(loading.depth_at(p.steps));
+            resumed_at_mm = Some(loading.depth_at(p.steps));
             resumed_first = true;
             eprintln!(
                 "{}: attempt {}: going on from its dump at {} {} ({})",
@@ -502,7 +502,7 @@ impl FebioBackend {
             if !continued.is_empty() {
                 line.push_str(&format!("; {continued}"));
             }
-            if let Some(at) = resumed_at {
+            if let Some(at) = resumed_at_mm {
                 line.push_str(&format!("; resumed after an interruption at {at} mm"));
             }
             for n in &notes {
@@ -548,7 +548,7 @@ impl FebioBackend {
             let continued = cont.describe_in(loading.time_unit());
             let resumed = resume.as_ref().map(|f| format!(", continuing attempt {} from {} mm", f.attempt, loading.depth_at(f.steps)));
             let resumed =
-                resumed.into_iter().chain(resumed_at.map(|at| format!(", resumed after an interruption at {at} mm"))).collect::<String>();
+                resumed.into_iter().chain(resumed_at_mm.map(|at| format!(", resumed after an interruption at {at} mm"))).collect::<String>();
             return Err(SolveFailure {
                 message: format!(
                     "febio4 {how} after {done_steps} of {} steps (t = {} {}), {} time steps, {} retries, {:.1} s{}{}{}{kept}",
