@@ -547,8 +547,10 @@ impl FebioBackend {
             let kept = keep_failed_attempt(job);
             let continued = cont.describe_in(loading.time_unit());
             let resumed = resume.as_ref().map(|f| format!(", continuing attempt {} from {} mm", f.attempt, loading.depth_at(f.steps)));
-            let resumed =
-                resumed.into_iter().chain(resumed_at_mm.map(|at| format!(", resumed after an interruption at {at} mm"))).collect::<String>();
+            let resumed = resumed
+                .into_iter()
+                .chain(resumed_at_mm.map(|at| format!(", resumed after an interruption at {at} mm")))
+                .collect::<String>();
             return Err(SolveFailure {
                 message: format!(
                     "febio4 {how} after {done_steps} of {} steps (t = {} {}), {} time steps, {} retries, {:.1} s{}{}{}{kept}",
