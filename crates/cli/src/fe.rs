@@ -10,11 +10,14 @@ use std::time::Duration;
 /// `needle fe` subcommands.
 #[derive(Subcommand)]
 pub enum FeCommand {
-    /// Solve the set's FE campaign, one solver job per pose; resumable.
+    /// Solve the set's FE campaign, one solver job per pose; resumable, an interrupted pose where it was.
     #[command(after_help = "Each pose's result goes to <set>/fe/<pose>.csv (depth in mm, forces in N, moments in N*mm \
 about the needle hub) and its record to <set>/fe/manifest.toml. Poses whose result matches the current spec are \
-skipped; a failed attempt is retried on the engine's retry ladder (docs/usage.md). Exit status 1 when a run failed \
-(the others are kept), 2 on an error before any run.")]
+skipped; a failed attempt is retried on the engine's retry ladder (docs/usage.md). A run killed in the middle of a \
+pose (Ctrl-C, kill -9, the end of a session) resumes it on the rerun at the attempt it was in \
+(<out>/.work/<pose>/progress.toml): FEBio goes on from the attempt's last dump (its last must point), ccx reruns the \
+attempt from its start; --force, another spec or a pose whose attempts all failed start afresh. Exit status 1 when a \
+run failed (the others are kept), 2 on an error before any run.")]
     Run(RunArgs),
     /// Verify the FE setup: flat punch, mesh study, mirror runs, smoothness, scaling law.
     #[command(after_help = "Without --punch, --mesh, --mirror, --smooth or --scaling all five run (the mesh study's \
@@ -78,7 +81,8 @@ pub struct SpecArgs {
 /// How each pose is solved (shared by `fe run` and the array tasks' `fe run-one`).
 #[derive(Args, Debug)]
 pub struct SolveArgs {
-    /// Rerun the selected poses even when their results are up to date.
+    /// Rerun the selected poses even when their results are up to date; an interrupted
+    /// pose starts afresh instead of resuming.
     #[arg(long)]
     pub force: bool,
     /// Keep the work folder (<out>/.work/<pose>: solver input and logs) of successful

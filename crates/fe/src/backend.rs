@@ -30,7 +30,9 @@ pub struct Job<'a> {
     /// Load steps (= `campaign.loading.steps`).
     pub steps: u32,
     /// The solver's folder, emptied before a pose's first attempt (the retry reuses it;
-    /// a failed attempt's log is kept there as `failed-first-increment-<r>.*`).
+    /// a failed attempt's log is kept there as `failed-first-increment-<r>.*`); not
+    /// emptied when a killed run resumes in it (`crate::resume`): then it holds what the
+    /// interrupted attempt left, which the engine may go on from (FEBio) or ignore.
     pub work_dir: &'a Path,
     /// Wall-clock limit of the solve.
     pub timeout: Option<Duration>,

@@ -11,7 +11,15 @@
 //! - `manifest.toml.lock`: the lock ([`lock_manifest`]) under which every process
 //!   (this one's jobs, SLURM array tasks, another `needle fe run`) rewrites the manifest.
 //! - `.work/<pose>/`: the solver's input and files of a run; removed when the run
-//!   succeeds (unless `keep_work`), kept for debugging when it fails.
+//!   succeeds (unless `keep_work`), kept for debugging when it fails. Its
+//!   `progress.toml` ([`resume`]) records the attempt running, the finished attempts'
+//!   failures and the furthest must points: a run killed in the middle of a pose (a
+//!   session's end) resumes on the rerun at the attempt it was in, which the engine
+//!   continues from its last dump (FEBio) or reruns from its start (ccx), with
+//!   `<pose>: resuming attempt K of N (interrupted at X mm)` on stderr. Another run's
+//!   record (spec hash, engine and version, mesh, steps), an unreadable one, one whose
+//!   attempts all failed, or `--force`: the folder is cleared and attempt 1 starts, with
+//!   the reason on stderr.
 //!
 //! A pose is up to date, and skipped, when its CSV exists with `steps + 1` rows and its
 //! manifest entry has the spec hash of the current run ([`Campaign::run_hash`] of the
@@ -45,6 +53,7 @@ use crate::process;
 use crate::progress::Progress;
 use crate::report::{PoseReport, Report, Status};
 use crate::results::{self, Row};
+use crate::resume;
 use crate::spec::{self, Campaign, Engine, MeshLevel, PoseSpec};
 use anyhow::{bail, Context, Result};
 use needle_contract::COMPONENT_COUNT;
@@ -157,6 +166,8 @@ struct Ctx<'a> {
     solver_version: String,
     manifest_lock: Mutex<()>,
     keep_work: bool,
+    /// `--force`: a pose's progress record is not resumed.
+    force: bool,
     launcher: &'a Launched,
 }
 
@@ -346,6 +357,7 @@ pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> 
             solver_version,
             manifest_lock: Mutex::new(()),
             keep_work: opts.keep_work,
+            force: opts.force,
             launcher: &opts.launcher,
         };
         let earlier_walls_s = manifest.wall_times_s(ctx.campaign.solver.engine.name(), &mesh_name, steps);
@@ -461,18 +473,47 @@ fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
     let start = Instant::now();
     let wd = work_dir(ctx.out_dir, &pose.name);
     let fail = |message: String, log_tail: String| failed_report(pose, ctx, message, log_tail);
-    let prepared = (|| -> Result<()> {
-        if wd.exists() {
-            std::fs::remove_dir_all(&wd).with_context(|| format!("{}: cannot clear", wd.display()))?;
+    let run = resume::Identity {
+        spec_hash: ctx.campaign.run_hash(pose, ctx.mesh_name),
+        engine: ctx.backend.engine().to_string(),
+        engine_version: ctx.solver_version.clone(),
+        mesh: ctx.mesh_name.to_string(),
+        steps: ctx.steps,
+    };
+    let attempts = ctx.backend.attempts().max(1);
+    // an interrupted run of the same pose resumes at its attempt (`resume`); anything
+    // else starts afresh in an empty folder
+    let decision = if wd.exists() { resume::decide(&wd, &run, attempts, ctx.force) } else { resume::Decision::Fresh(None) };
+    let from = match decision {
+        resume::Decision::Resume(start) => {
+            let reached = ctx.backend.steps_done(&wd);
+            eprintln!(
+                "{}: resuming attempt {} of {attempts} (interrupted at {} mm)",
+                pose.name,
+                start.attempt + 1,
+                ctx.campaign.loading.depth_at(reached.min(ctx.steps))
+            );
+            start
         }
-        std::fs::create_dir_all(&wd).with_context(|| format!("{}: cannot create", wd.display()))?;
-        // The earlier result and its entry stay until the new ones replace them: a failed
-        // or interrupted rerun (`--force`) costs nothing (module docs).
-        Ok(())
-    })();
-    if let Err(e) = prepared {
-        return fail(format!("{e:#}"), String::new());
-    }
+        resume::Decision::Fresh(why) => {
+            if let Some(why) = why {
+                eprintln!("{}: starting afresh: {why}", pose.name);
+            }
+            let prepared = (|| -> Result<()> {
+                if wd.exists() {
+                    std::fs::remove_dir_all(&wd).with_context(|| format!("{}: cannot clear", wd.display()))?;
+                }
+                std::fs::create_dir_all(&wd).with_context(|| format!("{}: cannot create", wd.display()))?;
+                // The earlier result and its entry stay until the new ones replace them: a
+                // failed or interrupted rerun (`--force`) costs nothing (module docs).
+                Ok(())
+            })();
+            if let Err(e) = prepared {
+                return fail(format!("{e:#}"), String::new());
+            }
+            resume::Start::default()
+        }
+    };
     let job = Job {
         campaign: ctx.campaign,
         pose,
@@ -500,8 +541,18 @@ fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
             Err(e) => format!(" (the partial record could not be written: {e:#})"),
         }
     };
-    let solved = match solve_with_retry(ctx.backend, &job, &mut keep) {
-        Ok(s) => s,
+    // a record that cannot be written costs the resumability only, not the run
+    let mut record = |at: &resume::Start| {
+        if let Err(e) = resume::write(&wd, &run, attempts, at) {
+            eprintln!("{}: {e:#} (an interruption would restart this pose from attempt 1)", pose.name);
+        }
+    };
+    let solved = match solve_with_retry(ctx.backend, &job, from, &mut keep, &mut record) {
+        // solved: nothing to resume, even if its results cannot be written below
+        Ok(s) => {
+            resume::remove(&wd);
+            s
+        }
         Err(f) => {
             let kept = if f.reached.is_empty() { String::new() } else { keep(&f.reached, &f.message) };
             return fail(format!("{}{kept}", f.message), f.log_tail);
@@ -529,23 +580,28 @@ fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
 }
 
 /// Solve `job`; when that fails, again with [`RETRY_FIRST_INCREMENT`](crate::backend::RETRY_FIRST_INCREMENT), up to the
-/// backend's [`Backend::attempts`] (module docs). The failures so far go into the
-/// result's `retry` (or the final failure's message). `keep` gets the must points of
+/// backend's [`Backend::attempts`] (module docs), starting at `start` (attempt 0 with no
+/// failures, or where an interrupted run was: [`resume`]). The failures so far go into
+/// the result's `retry` (or the final failure's message). `keep` gets the must points of
 /// each failed attempt that reached further than the ones before, with the failures so
-/// far (the final failure carries the furthest in `reached`).
+/// far (the final failure carries the furthest in `reached`). `record` gets where the
+/// pose stands at the start of each attempt and after each failed one (the attempt to
+/// run next; `attempts` once all failed).
 pub(crate) fn solve_with_retry(
     backend: &dyn Backend,
     job: &Job<'_>,
+    start: resume::Start,
     keep: &mut dyn FnMut(&[[f64; COMPONENT_COUNT]], &str) -> String,
+    record: &mut dyn FnMut(&resume::Start),
 ) -> std::result::Result<Solved, SolveFailure> {
-    let mut failures: Vec<String> = Vec::new();
-    let mut furthest: Vec<[f64; COMPONENT_COUNT]> = Vec::new();
+    let resume::Start { attempt: first, mut failures, mut furthest } = start;
     let attempts = backend.attempts().max(1);
     let sym = job.pose.symmetry();
     let full_block = !sym.plane_x && !sym.plane_z;
-    for attempt in 0..attempts {
+    for attempt in first..attempts {
         let r = backend.first_increment_in(job.work_dir, attempt, full_block);
         let this = Job { first_increment: r, attempt, ..*job };
+        record(&resume::Start { attempt, failures: failures.clone(), furthest: furthest.clone() });
         match backend.solve(&this) {
             Ok(s) => return Ok(Solved { retry: (!failures.is_empty()).then(|| failures.join("; ")), ..s }),
             Err(f) => {
@@ -556,6 +612,10 @@ pub(crate) fn solve_with_retry(
                     if attempt + 1 < attempts {
                         let _ = keep(&furthest, &failures.join("; "));
                     }
+                }
+                // an interrupted attempt (Ctrl-C) is not finished: a rerun runs it again
+                if !process::interrupted() {
+                    record(&resume::Start { attempt: attempt + 1, failures: failures.clone(), furthest: furthest.clone() });
                 }
                 if attempt + 1 == attempts || process::interrupted() {
                     return Err(SolveFailure { message: failures.join("; "), log_tail: f.log_tail, reached: furthest });
@@ -659,6 +719,10 @@ fn update_manifest(ctx: &Ctx<'_>, f: impl FnOnce(&mut Manifest)) -> Result<()> {
 }
 
 #[cfg(test)]
+#[path = "campaign_resume_tests.rs"]
+mod resume_tests;
+
+#[cfg(test)]
 pub(crate) mod tests {
     use super::*;
     use crate::mesh_summary::MeshSummary;
@@ -691,12 +755,17 @@ pub(crate) mod tests {
             self.solves.fetch_add(1, Ordering::SeqCst);
             assert!(job.work_dir.is_dir(), "work dir exists");
             if job.first_increment == 1.0 {
-                assert_eq!(std::fs::read_dir(job.work_dir).map(|d| d.count()).unwrap_or(9), 0, "work dir is empty");
+                let others = std::fs::read_dir(job.work_dir)
+                    .map(|d| d.flatten().filter(|e| e.file_name() != resume::RECORD_FILE).count())
+                    .unwrap_or(9);
+                assert_eq!(others, 0, "work dir is empty but for the progress record");
             }
-            std::fs::write(job.work_dir.join("pose.log"), "fake log\n").map_err(anyhow::Error::from)?;
+            // a panic leaves the folder as a killed run does: only the progress record, so
+            // that the rerun's resumed first attempt finds it empty too
             if self.panic_on.as_deref() == Some(job.pose.name.as_str()) {
                 panic!("fake panic");
             }
+            std::fs::write(job.work_dir.join("pose.log"), "fake log\n").map_err(anyhow::Error::from)?;
             if self.fail.as_deref() == Some(job.pose.name.as_str()) {
                 return Err(SolveFailure { message: "fake exit code 201".into(), log_tail: "*ERROR fake".into(), reached: Vec::new() });
             }

@@ -178,10 +178,16 @@ impl JobResult {
 /// starts and then fails is not an error: see [`JobResult::exit`].
 pub fn run_job(ccx: &Path, work_dir: &Path, job: &str, timeout: Option<Duration>, stall: Option<Duration>) -> Result<JobResult> {
     let log_path = work_dir.join(format!("{job}.log"));
-    // a spooles.out left by an earlier attempt in this folder would be taken for this one's
+    // the files of an earlier attempt in this folder (a failed one, or the same attempt of
+    // a campaign killed while it ran: `crate::resume` reruns it from its start) would be
+    // taken for this one's if ccx stopped before rewriting them
     let spooles_path = work_dir.join("spooles.out");
-    if spooles_path.exists() {
-        std::fs::remove_file(&spooles_path).with_context(|| format!("{}: cannot remove the earlier attempt's", spooles_path.display()))?;
+    for p in [spooles_path.clone(), sta_path(work_dir, job), work_dir.join(format!("{job}.dat")), work_dir.join(format!("{job}.cvg"))] {
+        match std::fs::remove_file(&p) {
+            Ok(()) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => return Err(e).with_context(|| format!("{}: cannot remove the earlier attempt's", p.display())),
+        }
     }
     let mut cmd = Command::new(ccx);
     cmd.arg("-i")
@@ -254,6 +260,15 @@ mod tests {
         assert_eq!(r.exit, ExitKind::Code(201));
         assert!(!d.path().join("spooles.out").exists());
         assert_eq!(r.cause.as_deref(), Some("*ERROR in checkslavedof: bad node"));
+
+        // a campaign killed in the middle of an attempt left its .sta and .dat: the rerun
+        // of the attempt (crate::resume) does not take them for its own
+        std::fs::write(sta_path(d.path(), "job"), "  1  1  1  3  1.0  1.0  1.0\n").expect("the killed attempt's sta");
+        std::fs::write(d.path().join("job.dat"), "the killed attempt's").expect("dat");
+        assert_eq!(steps_done(d.path(), "job"), 1, "the killed attempt had done a step");
+        let r = run_job(&fake_ccx(d.path(), "echo starting; exit 0"), d.path(), "job", None, None).expect("run");
+        assert_eq!((r.exit, r.sta.steps_done()), (ExitKind::Code(0), 0));
+        assert!(!d.path().join("job.dat").exists());
 
         // prints every 0.1 s for 1.5 s: never silent for 0.7 s, so it runs to its end
         let talking = fake_ccx(d.path(), "i=0; while [ $i -lt 15 ]; do echo $i; sleep 0.1; i=$((i+1)); done");

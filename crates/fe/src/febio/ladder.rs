@@ -220,7 +220,8 @@ impl State {
         }
     }
 
-    /// Write [`STATE_FILE`] in `work_dir`.
+    /// Write [`STATE_FILE`] in `work_dir` atomically (a campaign killed while writing it
+    /// leaves the earlier state, which its resumed attempt reads: `crate::resume`).
     ///
     /// # Errors
     /// It cannot be written.
@@ -230,7 +231,7 @@ impl State {
             "# the FEBio retry ladder's state of this pose (fe/febio/ladder.rs); removed with the work folder\n{}",
             toml::to_string(self).context("cannot serialise the ladder's state")?
         );
-        std::fs::write(&p, text).with_context(|| format!("{}: cannot write", p.display()))
+        crate::results::write_atomic(&p, text.as_bytes())
     }
 
     /// Whether a failed attempt that reached `steps` must points is further than the kept

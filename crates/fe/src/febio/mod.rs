@@ -2,6 +2,11 @@
 //! and reading the rigid needle's reaction back ([`logs`]), behind the campaign's
 //! [`Backend`] trait.
 //!
+//! Each FEBio process of an attempt is recorded in `running.toml` ([`running`]), so that
+//! an attempt a killed campaign left running goes on from its last dump (`pose.dmp`, at
+//! its last must point) when the campaign resumes the pose (`crate::resume`); nothing at
+//! the start of an attempt removes that dump before the decision.
+//!
 //! `febio4` is found, in order: `$FEBIO` (must be an executable; a bad path is an
 //! error, not a silent fallback), the build of `.ci/install-febio` in the cache folder
 //! (`$NEEDLE_CACHE`, default `~/.cache/needle-haptics`, `febio-4.11/bin/febio4`), a
@@ -12,6 +17,7 @@ pub mod feb;
 pub mod ladder;
 pub mod logs;
 pub mod restart;
+pub mod running;
 
 use crate::backend::{Backend, Job, SolveFailure, Solved};
 use crate::process::{self, ExitKind, LOG_TAIL_LINES};
@@ -173,15 +179,63 @@ impl Backend for FebioBackend {
         }
     }
 
+    /// One attempt as the ladder plans it (the trait's docs above). An attempt that a
+    /// killed campaign left running (`running.toml`, `pose.dmp`: `running.rs`) goes on
+    /// from its dump; when FEBio cannot read that dump the attempt is run again from its
+    /// start, and the settings line says so.
     fn solve(&self, job: &Job<'_>) -> std::result::Result<Solved, SolveFailure> {
+        let mut unreadable = None;
+        let r = self.solve_attempt(job, true, &mut unreadable, None);
+        match unreadable {
+            Some(why) => {
+                eprintln!("{}: attempt {}: {why}; the attempt starts again from its start", job.pose.name, job.attempt + 1);
+                self.solve_attempt(job, false, &mut None, Some(why))
+            }
+            None => r,
+        }
+    }
+
+    fn first_increment_in(&self, work_dir: &Path, attempt: u32, full_block: bool) -> f64 {
+        self.plan_in(work_dir, attempt, full_block).first_increment()
+    }
+
+    fn describe_attempt(&self, work_dir: &Path, attempt: u32, full_block: bool, depth_mm: f64, steps: u32) -> String {
+        self.plan_in(work_dir, attempt, full_block).describe(depth_mm, steps)
+    }
+
+    /// Must points logged so far, over the continued segments' logs too.
+    fn steps_done(&self, work_dir: &Path) -> u32 {
+        let count = |p: PathBuf| std::fs::read_to_string(p).ok().and_then(|t| logs::parse_rigid_log(&t).ok()).map(|r| r.len() as u32);
+        let segments: u32 = (0..restart::MAX_SEGMENTS).map_while(|n| count(restart::segment_log(work_dir, n))).sum();
+        segments + count(work_dir.join(feb::RIGID_LOG)).unwrap_or(0)
+    }
+}
+
+impl FebioBackend {
+    /// [`Backend::solve`] of one attempt: from the interrupted run's dump when `may_resume`
+    /// and the work folder holds one for this attempt; `unreadable` is set (and the attempt
+    /// returns at once) when FEBio's restart could not read that dump; `note` goes into the
+    /// settings line.
+    fn solve_attempt(
+        &self,
+        job: &Job<'_>,
+        may_resume: bool,
+        unreadable: &mut Option<String>,
+        note: Option<String>,
+    ) -> std::result::Result<Solved, SolveFailure> {
         let exe = self.exe.as_deref().context("FebioBackend::solve before prepare")?;
+        // an attempt a killed campaign left running, with its dump, goes on from there
+        let interrupted = if may_resume { interrupted_run(job) } else { None };
         // the ladder's state: what the earlier attempts at this pose did (none on the first)
-        let mut state = if job.attempt == 0 {
+        let mut state = if job.attempt == 0 && interrupted.is_none() {
             remove_if_exists(&job.work_dir.join(ladder::STATE_FILE))?;
             remove_if_exists(&job.work_dir.join(ladder::FURTHEST_DUMP))?;
             ladder::State::default()
         } else {
-            ladder::State::read(job.work_dir)?
+            let mut s = ladder::State::read(job.work_dir)?;
+            // an attempt rerun after a kill in its bookkeeping is not one of the earlier ones
+            s.tried.retain(|t| t.attempt <= job.attempt);
+            s
         };
         let symmetry = job.pose.symmetry();
         let mut plan = ladder::next(&state, !symmetry.plane_x && !symmetry.plane_z);
@@ -196,6 +250,11 @@ impl Backend for FebioBackend {
                 }
             },
             ladder::Plan::Fresh(_) => None,
+        };
+        // the interrupted attempt's own plan (the ladder's state has not changed since)
+        let (plan, resume) = match &interrupted {
+            Some(r) => (r.plan, r.continued.clone()),
+            None => (plan, resume),
         };
         let contact = plan.contact();
         let changed;
@@ -232,13 +291,39 @@ impl Backend for FebioBackend {
         let rb_path = job.work_dir.join(feb::RIGID_LOG);
         let log_path = job.work_dir.join(format!("{JOB}.log"));
         let out_path = job.work_dir.join("febio.out");
-        // files of an earlier attempt in this folder would be taken for this one's
-        for n in 0..=restart::MAX_CONTINUATIONS {
-            remove_if_exists(&restart::segment_log(job.work_dir, n))?;
-            remove_if_exists(&job.work_dir.join(restart::segment_solver_log_name(n)))?;
-        }
-        for f in [rb_path.clone(), log_path.clone(), job.work_dir.join(restart::DUMP), job.work_dir.join(restart::DUMP_FROM)] {
-            remove_if_exists(&f)?;
+        let mut notes: Vec<String> = note.map(|n| format!("{n}: rerun from its start")).into_iter().collect();
+        let resumed = interrupted.and_then(|r| {
+            let current = std::fs::read_to_string(&rb_path).ok().and_then(|t| logs::parse_rigid_log(&t).ok()).unwrap_or_default();
+            let dump = job.work_dir.join(restart::DUMP);
+            let point = running::resume_point(&dump, &r.earlier, &current, loading, job.steps).and_then(|p| {
+                if r.segments + 1 < restart::MAX_SEGMENTS {
+                    Ok(p)
+                } else {
+                    Err(format!("{} segments run already", r.segments))
+                }
+            });
+            match point {
+                Ok(p) => Some((r, p)),
+                Err(why) => {
+                    eprintln!(
+                        "{}: attempt {}: the interrupted run cannot go on from its dump ({why}); the attempt starts again from its start",
+                        job.pose.name,
+                        job.attempt + 1
+                    );
+                    notes.push(format!("an interrupted run could not go on from its dump ({why}): rerun from its start"));
+                    None
+                }
+            }
+        });
+        if resumed.is_none() {
+            // files of an earlier attempt in this folder would be taken for this one's
+            for n in 0..=restart::MAX_SEGMENTS {
+                remove_if_exists(&restart::segment_log(job.work_dir, n))?;
+                remove_if_exists(&job.work_dir.join(restart::segment_solver_log_name(n)))?;
+            }
+            for f in [rb_path.clone(), log_path.clone(), job.work_dir.join(restart::DUMP), job.work_dir.join(restart::DUMP_FROM)] {
+                remove_if_exists(&f)?;
+            }
         }
         let depth = loading.depth_mm;
         // the load step after must point k, in the solver's time (mm of depth, or s)
@@ -251,7 +336,41 @@ impl Backend for FebioBackend {
         let mut segments: Vec<logs::RigidRecord> = Vec::new();
         let mut cont = restart::Continuations::default();
         let mut restarting = false;
-        if let Some(f) = &resume {
+        // segment logs kept so far (a continuation or a resumed run keeps the one before)
+        let mut segment: u32 = 0;
+        // the must point a resumed run goes on from, mm, and whether its first process runs
+        let mut resumed_at_mm: Option<f64> = None;
+        let mut resumed_first = false;
+        if let Some((r, p)) = &resumed {
+            for (from, to) in [
+                (&rb_path, restart::segment_log(job.work_dir, r.segments)),
+                (&log_path, job.work_dir.join(restart::segment_solver_log_name(r.segments))),
+            ] {
+                if from.exists() {
+                    std::fs::rename(from, &to).with_context(|| format!("{}: cannot keep as {}", from.display(), to.display()))?;
+                }
+            }
+            segment = r.segments + 1;
+            segments = p.records.clone();
+            cont = restart::Continuations { from_mm: r.continued_from.clone() };
+            let from = job.work_dir.join(restart::DUMP_FROM);
+            let dump = job.work_dir.join(restart::DUMP);
+            std::fs::copy(&dump, &from).with_context(|| format!("{}: cannot copy to {}", dump.display(), from.display()))?;
+            let restart_in = job.work_dir.join(restart::RESTART_INPUT);
+            std::fs::write(&restart_in, restart::restart_input(step_after(p.steps) * plan.first_increment(), dtmin, tolerances))
+                .with_context(|| format!("{}: cannot write", restart_in.display()))?;
+            resumed_at_mm = Some(loading.depth_at(p.steps));
+            resumed_first = true;
+            eprintln!(
+                "{}: attempt {}: going on from its dump at {} {} ({})",
+                job.pose.name,
+                job.attempt + 1,
+                loading.time_at(p.steps),
+                loading.time_unit(),
+                plan.describe(loading.depth_mm, job.steps)
+            );
+            restarting = true;
+        } else if let Some(f) = &resume {
             let from = job.work_dir.join(restart::DUMP_FROM);
             let dump = job.work_dir.join(ladder::FURTHEST_DUMP);
             std::fs::copy(&dump, &from).with_context(|| format!("{}: cannot copy to {}", dump.display(), from.display()))?;
@@ -277,6 +396,17 @@ impl Backend for FebioBackend {
                 .arg(restart::DUMP)
                 .env("OMP_NUM_THREADS", self.threads.to_string())
                 .env("MKL_NUM_THREADS", self.threads.to_string());
+            let now = running::Running {
+                attempt: job.attempt,
+                plan,
+                continued: resume.clone(),
+                earlier: segments.clone(),
+                continued_from: cont.from_mm.clone(),
+                segments: segment,
+            };
+            if let Err(e) = running::write(job.work_dir, &now) {
+                eprintln!("{}: {e:#} (a killed campaign would rerun this attempt from its start)", job.pose.name);
+            }
             let timeout = job.timeout.map(|t| t.saturating_sub(started.elapsed()));
             let done = process::run(cmd, job.work_dir, &out_path, &[log_path.clone(), rb_path.clone()], timeout, job.stall)?;
             let log_text = std::fs::read_to_string(&log_path).unwrap_or_default();
@@ -297,6 +427,16 @@ impl Backend for FebioBackend {
             let at_steps = pick_steps(&all, loading, job.steps);
             let done_steps = at_steps.iter().take_while(|w| w.is_some()).count();
             let solved = done.exit == ExitKind::Code(0) && run.normal_termination && done_steps >= job.steps as usize;
+            // a resumed run whose restart exited without reading its dump: from the start
+            let restart_failed = matches!(done.exit, ExitKind::Code(c) if c != 0)
+                && !done.log_text.contains(running::RESTARTED)
+                && !log_text.contains(running::RESTARTED);
+            if std::mem::take(&mut resumed_first) && restart_failed && !process::interrupted() {
+                running::remove(job.work_dir);
+                let why = format!("FEBio's restart could not read the interrupted run's dump ({})", process::tail(&log_tail, 2).trim());
+                *unreadable = Some(why.clone());
+                return Err(SolveFailure { message: why, log_tail, reached: Vec::new() });
+            }
             // continue from the last must point when the solver gave up (not on a
             // timeout, stall or stop) and a dump of a converged must point exists; the
             // must point a continuation of another attempt started from counts as one
@@ -313,7 +453,7 @@ impl Backend for FebioBackend {
             let Some(fraction) = next else {
                 break (done, run, log_tail, at_steps, done_steps);
             };
-            let n = cont.from_mm.len() as u32;
+            let n = segment;
             eprintln!(
                 "{}: febio4 stopped at t = {} {unit} ({}); continuing from the must point at {last_mm} {unit} with a first time step of {} {unit}",
                 job.pose.name,
@@ -329,6 +469,7 @@ impl Backend for FebioBackend {
                     std::fs::rename(from, &to).with_context(|| format!("{}: cannot keep as {}", from.display(), to.display()))?;
                 }
             }
+            segment += 1;
             segments = all;
             let from = job.work_dir.join(restart::DUMP_FROM);
             std::fs::copy(job.work_dir.join(restart::DUMP), &from).with_context(|| format!("{}: cannot write", from.display()))?;
@@ -338,6 +479,12 @@ impl Backend for FebioBackend {
             cont.from_mm.push(last_mm);
             restarting = true;
         };
+        // the attempt ended: nothing to go on from, whatever its bookkeeping below; one
+        // stopped by Ctrl-C or kill keeps its record and dump, which the rerun goes on from
+        let stopped = process::interrupted();
+        if !stopped {
+            running::remove(job.work_dir);
+        }
         let line = {
             let mut line = settings_line(fs, campaign.contact.friction, self.threads, plan.retry_tolerances());
             if let Some(fc) = first_contact {
@@ -354,6 +501,12 @@ impl Backend for FebioBackend {
             let continued = cont.describe_in(loading.time_unit());
             if !continued.is_empty() {
                 line.push_str(&format!("; {continued}"));
+            }
+            if let Some(at) = resumed_at_mm {
+                line.push_str(&format!("; resumed after an interruption at {at} mm"));
+            }
+            for n in &notes {
+                line.push_str(&format!("; {n}"));
             }
             line
         };
@@ -382,7 +535,7 @@ impl Backend for FebioBackend {
             }
         }
         // the dumps are large (tens of MB) and only needed while the run goes on
-        for f in [restart::DUMP, restart::DUMP_FROM] {
+        for f in [restart::DUMP, restart::DUMP_FROM].into_iter().filter(|_| !stopped) {
             let _ = std::fs::remove_file(job.work_dir.join(f));
         }
         if failed {
@@ -394,6 +547,10 @@ impl Backend for FebioBackend {
             let kept = keep_failed_attempt(job);
             let continued = cont.describe_in(loading.time_unit());
             let resumed = resume.as_ref().map(|f| format!(", continuing attempt {} from {} mm", f.attempt, loading.depth_at(f.steps)));
+            let resumed = resumed
+                .into_iter()
+                .chain(resumed_at_mm.map(|at| format!(", resumed after an interruption at {at} mm")))
+                .collect::<String>();
             return Err(SolveFailure {
                 message: format!(
                     "febio4 {how} after {done_steps} of {} steps (t = {} {}), {} time steps, {} retries, {:.1} s{}{}{}{kept}",
@@ -403,7 +560,7 @@ impl Backend for FebioBackend {
                     totals.time_steps,
                     totals.retries,
                     started.elapsed().as_secs_f64(),
-                    resumed.unwrap_or_default(),
+                    resumed,
                     if continued.is_empty() { String::new() } else { format!(", {continued}") },
                     run.cause.as_deref().map(|c| format!(": {c}")).unwrap_or_default(),
                 ),
@@ -433,23 +590,6 @@ impl Backend for FebioBackend {
         })
     }
 
-    fn first_increment_in(&self, work_dir: &Path, attempt: u32, full_block: bool) -> f64 {
-        self.plan_in(work_dir, attempt, full_block).first_increment()
-    }
-
-    fn describe_attempt(&self, work_dir: &Path, attempt: u32, full_block: bool, depth_mm: f64, steps: u32) -> String {
-        self.plan_in(work_dir, attempt, full_block).describe(depth_mm, steps)
-    }
-
-    /// Must points logged so far, over the continued segments' logs too.
-    fn steps_done(&self, work_dir: &Path) -> u32 {
-        let count = |p: PathBuf| std::fs::read_to_string(p).ok().and_then(|t| logs::parse_rigid_log(&t).ok()).map(|r| r.len() as u32);
-        let segments: u32 = (0..restart::MAX_CONTINUATIONS).map_while(|n| count(restart::segment_log(work_dir, n))).sum();
-        segments + count(work_dir.join(feb::RIGID_LOG)).unwrap_or(0)
-    }
-}
-
-impl FebioBackend {
     /// The ladder's plan for `attempt` (0-based) from the state in `work_dir`.
     fn plan_in(&self, work_dir: &Path, attempt: u32, full_block: bool) -> ladder::Plan {
         let state = if attempt == 0 { ladder::State::default() } else { ladder::State::read(work_dir).unwrap_or_default() };
@@ -494,6 +634,19 @@ fn pick_steps(records: &[logs::RigidRecord], loading: &crate::spec::Loading, ste
         .collect()
 }
 
+/// The record of the attempt `job` as a killed campaign left it running, when its dump
+/// is there too (`running.rs`); an unreadable record is reported and not resumed.
+fn interrupted_run(job: &Job<'_>) -> Option<running::Running> {
+    let r = match running::read(job.work_dir) {
+        Ok(r) => r?,
+        Err(e) => {
+            eprintln!("{}: {e:#}; the attempt starts from its start", job.pose.name);
+            return None;
+        }
+    };
+    (r.attempt == job.attempt && job.work_dir.join(restart::DUMP).is_file()).then_some(r)
+}
+
 fn remove_if_exists(p: &Path) -> Result<()> {
     match std::fs::remove_file(p) {
         Ok(()) => Ok(()),
@@ -514,7 +667,7 @@ fn keep_failed_attempt(job: &Job<'_>) -> String {
         ("febio.out".to_string(), "out".to_string()),
         (feb::RIGID_LOG.to_string(), "rb.txt".to_string()),
     ];
-    for n in 0..restart::MAX_CONTINUATIONS {
+    for n in 0..restart::MAX_SEGMENTS {
         files.push((restart::segment_solver_log_name(n), format!("log-{n}")));
         files.push((restart::segment_log_name(n), format!("rb-{n}.txt")));
     }

@@ -19,7 +19,10 @@
 //! points (the time step sizes) changes, as it does between the campaign's attempts.
 //! The manifest's `solver_settings` says how often and from where a run was continued.
 //! Each segment's rigid-body log is kept (`needle-rb-<n>.txt`), since FEBio starts the
-//! log afresh on a restart; the must points are read from all of them.
+//! log afresh on a restart; the must points are read from all of them. The restart of an
+//! attempt interrupted by a killed campaign (`running.rs`) is a segment too, not a
+//! continuation: it starts with the attempt's own first step and does not count against
+//! [`MAX_CONTINUATIONS`].
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -32,6 +35,9 @@ pub const CONTINUE_DTMIN_SCALE: f64 = 0.1;
 pub const CONTINUE_MAX_RETRIES: u32 = 12;
 /// Continuations of one attempt at most.
 pub const MAX_CONTINUATIONS: u32 = 12;
+/// Segments (processes) of one attempt whose logs are kept at most: its continuations
+/// and the restarts of an attempt interrupted by a killed campaign (`running.rs`).
+pub const MAX_SEGMENTS: u32 = 64;
 /// Continuations from the same must point at most: one (module docs).
 pub const MAX_FROM_SAME_POINT: u32 = 1;
 
