@@ -202,6 +202,16 @@ fn load_fit_data_in(set_dir: &Path, form: Option<ModelForm>) -> Result<FitData> 
         );
     }
     let fitted = fitted_poses(&campaign);
+    check_fitted_runs_current(set_dir, &campaign, &fitted)?;
+    let centre = centre_run(set_dir, &campaign, &spec_path, &fitted)?;
+    let sweeps = sweep_points(set_dir, &campaign, &spec_path, &fitted, &centre)?;
+    let train = fitted.iter().filter(|p| p.role == Role::Train).map(|p| read_run(set_dir, &campaign, p)).collect::<Result<Vec<_>>>()?;
+    let fe_sha256 = fitted_fe_sha256(set_dir, &fitted)?;
+    Ok(FitData { campaign, centre, sweeps, train, fe_sha256 })
+}
+
+/// Every fitted pose has a result and it is current (the manifest's record of the spec).
+fn check_fitted_runs_current(set_dir: &Path, campaign: &Campaign, fitted: &[PoseSpec]) -> Result<()> {
     let missing: Vec<&str> = fitted.iter().filter(|p| !run_path(set_dir, p).is_file()).map(|p| p.name.as_str()).collect();
     if !missing.is_empty() {
         bail!(
@@ -213,10 +223,9 @@ fn load_fit_data_in(set_dir: &Path, form: Option<ModelForm>) -> Result<FitData> 
             set_dir.display()
         );
     }
-
     let manifest = read_set_manifest(set_dir)?;
     let stale: Vec<String> =
-        fitted.iter().filter_map(|p| stale_reason(&manifest, &campaign, p).map(|why| format!("{}: {why}", p.name))).collect();
+        fitted.iter().filter_map(|p| stale_reason(&manifest, campaign, p).map(|why| format!("{}: {why}", p.name))).collect();
     if !stale.is_empty() {
         bail!(
             "{} of the {} fitted FE runs in {} are stale:\n  {}\n(run `needle fe run --set {}`: it solves exactly the poses whose result is not current)",
@@ -227,7 +236,11 @@ fn load_fit_data_in(set_dir: &Path, form: Option<ModelForm>) -> Result<FitData> 
             set_dir.display()
         );
     }
+    Ok(())
+}
 
+/// The run of the one pose with role centre, at x = z = theta_x = theta_z = 0.
+fn centre_run(set_dir: &Path, campaign: &Campaign, spec_path: &Path, fitted: &[PoseSpec]) -> Result<Run> {
     let centres: Vec<&PoseSpec> = fitted.iter().filter(|p| p.role == Role::Centre).collect();
     let centre_pose = match centres.as_slice() {
         [one] => (*one).clone(),
@@ -236,13 +249,18 @@ fn load_fit_data_in(set_dir: &Path, form: Option<ModelForm>) -> Result<FitData> 
     if centre_pose.x_mm != 0.0 || centre_pose.z_mm != 0.0 || centre_pose.theta_x_deg != 0.0 || centre_pose.theta_z_deg != 0.0 {
         bail!("{}: pose {:?} (role centre) is not at x = z = theta_x = theta_z = 0", spec_path.display(), centre_pose.name);
     }
-    let centre = read_run(set_dir, &campaign, &centre_pose)?;
+    read_run(set_dir, campaign, &centre_pose)
+}
 
+/// Each sweep's points (the centre run at 0 first), sorted by the swept value: every
+/// sweep pose varies only its own input, within (0, half range], and each sweep has at
+/// least [`NCOEF`] distinct values.
+fn sweep_points(set_dir: &Path, campaign: &Campaign, spec_path: &Path, fitted: &[PoseSpec], centre: &Run) -> Result<[Vec<SweepPoint>; 4]> {
     let mut sweeps: [Vec<SweepPoint>; 4] = Default::default();
     for k in Sweep::ALL {
         sweeps[k.index()].push(SweepPoint { value: 0.0, run: centre.clone() });
     }
-    for pose in &fitted {
+    for pose in fitted {
         let Some(k) = sweep_of(pose.role) else { continue };
         let (v, others) = sweep_value(pose, k);
         if others != 0.0 {
@@ -262,7 +280,7 @@ fn load_fit_data_in(set_dir: &Path, form: Option<ModelForm>) -> Result<FitData> 
                 k.half_range()
             );
         }
-        let run = read_run(set_dir, &campaign, pose)?;
+        let run = read_run(set_dir, campaign, pose)?;
         sweeps[k.index()].push(SweepPoint { value: v, run });
     }
     for k in Sweep::ALL {
@@ -279,10 +297,7 @@ fn load_fit_data_in(set_dir: &Path, form: Option<ModelForm>) -> Result<FitData> 
             );
         }
     }
-
-    let train = fitted.iter().filter(|p| p.role == Role::Train).map(|p| read_run(set_dir, &campaign, p)).collect::<Result<Vec<_>>>()?;
-    let fe_sha256 = fitted_fe_sha256(set_dir, &fitted)?;
-    Ok(FitData { campaign, centre, sweeps, train, fe_sha256 })
+    Ok(sweeps)
 }
 
 /// `fe_sha256` of the runs of `poses` in `set_dir` (their `<pose>.csv` files).
