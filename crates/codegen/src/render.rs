@@ -130,6 +130,18 @@ pub fn render_rust(model: &Model) -> String {
 pub fn render_c_header(model: &Model) -> String {
     let mut s = String::new();
     let w = &mut s;
+    render_c_preamble(w, model);
+    render_c_constants(w);
+    render_c_tables(w, model);
+    let _ = write!(w, "{}", crate::render_cross::render_c_cross(model));
+    let _ = writeln!(w);
+    let _ = writeln!(w, "#endif /* NEEDLE_COEFFS_H */");
+    s
+}
+
+/// The header's comment (the model, the evaluation algorithm), its guard, includes and
+/// the model's identity.
+fn render_c_preamble(w: &mut String, model: &Model) {
     let _ = writeln!(w, "/*");
     for line in header_lines(model, " *").lines() {
         let _ = writeln!(w, "{line}");
@@ -159,6 +171,11 @@ pub fn render_c_header(model: &Model) -> String {
     let _ = writeln!(w, "#define NEEDLE_COEFFS_SET \"{}\"", model.set);
     let _ = writeln!(w, "#define NEEDLE_COEFFS_FE_SHA256 \"{}\"", model.fe_sha256);
     let _ = writeln!(w);
+}
+
+/// The domain, the normalisation constants, the status bits, the indices and the odd
+/// components.
+fn render_c_constants(w: &mut String) {
     let _ = writeln!(w, "/* Domain: |x|, |z| <= 12 mm, |theta_x|, |theta_z| <= 15 deg, 0 <= depth <= 6 mm. */");
     for (name, v) in [
         ("NEEDLE_X_MAX_MM", HALF_RANGES[0]),
@@ -199,6 +216,10 @@ pub fn render_c_header(model: &Model) -> String {
     }
     let _ = writeln!(w, "}};");
     let _ = writeln!(w);
+}
+
+/// The baselines and the deviation matrices.
+fn render_c_tables(w: &mut String, model: &Model) {
     let _ = writeln!(w, "/* Baselines B_c(u), [component][i]: coefficient of u^i; {DEPTH_DOMAIN}. */");
     let _ = writeln!(w, "static const float NEEDLE_BASELINE[6][{TERMS}] = {{");
     for b in &model.baseline {
@@ -245,8 +266,4 @@ pub fn render_c_header(model: &Model) -> String {
     }
     let _ = writeln!(w, "}};");
     let _ = writeln!(w);
-    let _ = write!(w, "{}", crate::render_cross::render_c_cross(model));
-    let _ = writeln!(w);
-    let _ = writeln!(w, "#endif /* NEEDLE_COEFFS_H */");
-    s
 }
