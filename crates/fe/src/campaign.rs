@@ -481,38 +481,9 @@ fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
         steps: ctx.steps,
     };
     let attempts = ctx.backend.attempts().max(1);
-    // an interrupted run of the same pose resumes at its attempt (`resume`); anything
-    // else starts afresh in an empty folder
-    let decision = if wd.exists() { resume::decide(&wd, &run, attempts, ctx.force) } else { resume::Decision::Fresh(None) };
-    let from = match decision {
-        resume::Decision::Resume(start) => {
-            let reached = ctx.backend.steps_done(&wd);
-            eprintln!(
-                "{}: resuming attempt {} of {attempts} (interrupted at {} mm)",
-                pose.name,
-                start.attempt + 1,
-                ctx.campaign.loading.depth_at(reached.min(ctx.steps))
-            );
-            start
-        }
-        resume::Decision::Fresh(why) => {
-            if let Some(why) = why {
-                eprintln!("{}: starting afresh: {why}", pose.name);
-            }
-            let prepared = (|| -> Result<()> {
-                if wd.exists() {
-                    std::fs::remove_dir_all(&wd).with_context(|| format!("{}: cannot clear", wd.display()))?;
-                }
-                std::fs::create_dir_all(&wd).with_context(|| format!("{}: cannot create", wd.display()))?;
-                // The earlier result and its entry stay until the new ones replace them: a
-                // failed or interrupted rerun (`--force`) costs nothing (module docs).
-                Ok(())
-            })();
-            if let Err(e) = prepared {
-                return fail(format!("{e:#}"), String::new());
-            }
-            resume::Start::default()
-        }
+    let from = match starting_point(ctx, pose, &wd, &run, attempts) {
+        Ok(from) => from,
+        Err(e) => return fail(format!("{e:#}"), String::new()),
     };
     let job = Job {
         campaign: ctx.campaign,
@@ -576,6 +547,39 @@ fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
             }
         }
         Err(e) => fail(format!("{e:#}"), String::new()),
+    }
+}
+
+/// Where `pose` starts: an interrupted run of the same pose resumes at its attempt
+/// ([`resume`]); anything else starts afresh in an empty work folder `wd`. The earlier
+/// result and its entry stay until the new ones replace them: a failed or interrupted
+/// rerun (`--force`) costs nothing (module docs).
+///
+/// # Errors
+/// The work folder cannot be cleared or made.
+fn starting_point(ctx: &Ctx<'_>, pose: &PoseSpec, wd: &Path, run: &resume::Identity, attempts: u32) -> Result<resume::Start> {
+    let decision = if wd.exists() { resume::decide(wd, run, attempts, ctx.force) } else { resume::Decision::Fresh(None) };
+    match decision {
+        resume::Decision::Resume(start) => {
+            let reached = ctx.backend.steps_done(wd);
+            eprintln!(
+                "{}: resuming attempt {} of {attempts} (interrupted at {} mm)",
+                pose.name,
+                start.attempt + 1,
+                ctx.campaign.loading.depth_at(reached.min(ctx.steps))
+            );
+            Ok(start)
+        }
+        resume::Decision::Fresh(why) => {
+            if let Some(why) = why {
+                eprintln!("{}: starting afresh: {why}", pose.name);
+            }
+            if wd.exists() {
+                std::fs::remove_dir_all(wd).with_context(|| format!("{}: cannot clear", wd.display()))?;
+            }
+            std::fs::create_dir_all(wd).with_context(|| format!("{}: cannot create", wd.display()))?;
+            Ok(resume::Start::default())
+        }
     }
 }
 
