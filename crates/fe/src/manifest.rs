@@ -46,7 +46,7 @@ pub struct ManifestEntry {
     pub mesh: String,
     /// SHA-256 of the CSV as the campaign wrote it ([`results::content_sha256`](crate::results::content_sha256)):
     /// the fitter, validator, plots and explorer refuse a CSV whose content differs
-    /// (`fit::data::read_run`). An entry without it is not trusted: `needle fe run`
+    /// (`fit::data::FeRuns::read`). An entry without it is not trusted: `needle fe run`
     /// solves its pose again and the fitter refuses its CSV (a hash taken later would
     /// vouch for whatever file is there then).
     #[serde(default, skip_serializing_if = "Option::is_none")]
