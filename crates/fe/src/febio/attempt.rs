@@ -189,14 +189,40 @@ impl<'j, 'a> Setup<'j, 'a> {
         self.plan.retry_tolerances().then_some(restart::Tolerances { dtol: fs.retry_dtol, rtol: fs.retry_rtol })
     }
 
-    /// Copy `dump` to `pose-from.dmp` and write the restart input with a first time step
-    /// of `first_step`.
-    fn restart_from(&self, dump: &Path, first_step: f64) -> Result<()> {
-        let from = self.job.work_dir.join(restart::DUMP_FROM);
-        std::fs::copy(dump, &from).with_context(|| format!("{}: cannot copy to {}", dump.display(), from.display()))?;
+    /// The first-contact caps of the run whose dump this attempt's restarts read: this
+    /// attempt's own, or for a continuation of another attempt that attempt's (its dump
+    /// carries its must-point curve; a restart redefines the curve, `restart.rs`).
+    fn dump_first_contact(&self) -> Option<feb::FirstContact> {
+        match self.plan {
+            ladder::Plan::Fresh(_) => self.first_contact,
+            ladder::Plan::Continue { from_attempt, .. } => {
+                let before = ladder::State {
+                    tried: self.state.tried.iter().filter(|t| t.attempt < from_attempt).cloned().collect(),
+                    ..ladder::State::default()
+                };
+                let fs = self.fs();
+                ladder::failed_at_first_contact(&before, first_contact_steps(fs, self.loading(), self.job.steps))
+                    .then_some(feb::FirstContact { depth_mm: fs.first_contact_depth_mm, step_fraction: fs.first_contact_step_fraction })
+            }
+        }
+    }
+
+    /// Copy `dump` (the state at must point `from`) to `pose-from.dmp` and write the
+    /// restart input with a first time step of `fraction` of the load step after it.
+    fn restart_from(&self, dump: &Path, from: u32, fraction: f64) -> Result<()> {
+        let from_dump = self.job.work_dir.join(restart::DUMP_FROM);
+        std::fs::copy(dump, &from_dump).with_context(|| format!("{}: cannot copy to {}", dump.display(), from_dump.display()))?;
         let restart_in = self.job.work_dir.join(restart::RESTART_INPUT);
-        std::fs::write(&restart_in, restart::restart_input(first_step, self.dtmin(), self.tolerances()))
-            .with_context(|| format!("{}: cannot write", restart_in.display()))
+        let must_points = feb::must_points(self.loading(), self.job.steps, self.dump_first_contact());
+        let r = restart::Restart {
+            must_points: &must_points,
+            from,
+            first_step: self.step_after(from) * fraction,
+            dtmin: self.dtmin(),
+            tolerances: self.tolerances(),
+        };
+        let text = restart::restart_input(&r).with_context(|| format!("{}", restart_in.display()))?;
+        std::fs::write(&restart_in, text).with_context(|| format!("{}: cannot write", restart_in.display()))
     }
 
     /// Keep the running process's logs as segment `n`.
@@ -235,7 +261,7 @@ impl<'j, 'a> Setup<'j, 'a> {
             progress.segment = r.segments + 1;
             progress.segments = p.records.clone();
             progress.cont = restart::Continuations { from_mm: r.continued_from.clone() };
-            self.restart_from(&job.work_dir.join(restart::DUMP), self.step_after(p.steps) * self.plan.first_increment())?;
+            self.restart_from(&job.work_dir.join(restart::DUMP), p.steps, self.plan.first_increment())?;
             progress.resumed_at_mm = Some(loading.depth_at(p.steps));
             progress.resumed_first = true;
             eprintln!(
@@ -258,7 +284,7 @@ impl<'j, 'a> Setup<'j, 'a> {
             remove_if_exists(&f)?;
         }
         if let Some(f) = &self.resume {
-            self.restart_from(&job.work_dir.join(ladder::FURTHEST_DUMP), self.step_after(f.steps) * self.plan.first_increment())?;
+            self.restart_from(&job.work_dir.join(ladder::FURTHEST_DUMP), f.steps, self.plan.first_increment())?;
             progress.segments = f.rigid_records(loading);
             eprintln!("{}: attempt {}: {}", job.pose.name, job.attempt + 1, self.plan.describe(loading.depth_mm, job.steps));
             progress.restarting = true;
@@ -330,7 +356,7 @@ impl<'j, 'a> Setup<'j, 'a> {
             self.keep_segment_logs(p.segment)?;
             p.segment += 1;
             p.segments = all;
-            self.restart_from(&job.work_dir.join(restart::DUMP), self.step_after(done_steps as u32) * fraction)?;
+            self.restart_from(&job.work_dir.join(restart::DUMP), done_steps as u32, fraction)?;
             p.cont.from_mm.push(last_mm);
             p.restarting = true;
         }

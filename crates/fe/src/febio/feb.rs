@@ -406,9 +406,54 @@ fn write_contact(w: &mut String, c: &Campaign) {
     let _ = writeln!(w, "  </Contact>");
 }
 
-/// The must points and, as the load curve's values, the largest time step up to each
-/// (FEBio's `dtmax` curve: between must points k-1 and k it is point k's value); within
-/// the first-contact depth the cap of [`FirstContact`].
+/// The load controller (1-based id) of the must points, which is also the time stepper's
+/// `dtmax` curve (`<dtmax lc="2">`); a restart redefines it (`restart.rs`).
+pub const MUST_POINT_LC: u32 = 2;
+
+/// One point of the must-point curve: a must point and the largest time step up to it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MustPoint {
+    /// The solver's time of the must point (the end of a load step): mm of depth, or s of
+    /// a ramp-and-hold run.
+    pub time: f64,
+    /// The largest time step of the load step that ends here, in the same unit.
+    pub dtmax: f64,
+}
+
+/// The must points 1..=`steps` of `loading` and, as the load curve's values, the largest
+/// time step up to each: the load step itself, or within the first-contact depth
+/// ([`FirstContact`]) that fraction of it. FEBio reads the curve with STEP interpolation
+/// (`PointCurve::value`): at a time in (t(k-1), t(k)) it is point k's value; at a must
+/// point t(k) itself it is point k+1's (the first point after the time), except at the
+/// first and the last must point, whose own values FEBio returns at their times.
+pub fn must_points(loading: &Loading, steps: u32, first_contact: Option<FirstContact>) -> Vec<MustPoint> {
+    let depth = loading.depth_mm;
+    (1..=steps)
+        .map(|k| {
+            let dt = loading.step_time(k);
+            // the step ending at t starts within the first-contact depth
+            let capped = first_contact.filter(|fc| loading.depth_at(k - 1) < fc.depth_mm - 1e-9 * depth);
+            MustPoint { time: loading.time_at(k), dtmax: capped.map_or(dt, |fc| dt * fc.step_fraction) }
+        })
+        .collect()
+}
+
+/// The `<load_controller>` element of the must-point curve ([`MUST_POINT_LC`]), indented
+/// for `<LoadData>`: the `.feb` writes it, a restart redefines it with the same text but
+/// for the values (`restart.rs`).
+pub fn must_point_controller(points: &[MustPoint]) -> String {
+    let mut w = String::new();
+    let _ = writeln!(w, r#"    <load_controller id="{MUST_POINT_LC}" name="must_points" type="loadcurve">"#);
+    let _ = writeln!(w, "      <interpolate>STEP</interpolate>\n      <extend>CONSTANT</extend>\n      <points>");
+    for p in points {
+        let _ = writeln!(w, "        <pt>{},{}</pt>", num(p.time), num(p.dtmax));
+    }
+    let _ = writeln!(w, "      </points>\n    </load_controller>");
+    w
+}
+
+/// The feed curve (load controller 1) and the must points ([`must_points`], load
+/// controller [`MUST_POINT_LC`]).
 fn write_load_data(w: &mut String, loading: &Loading, steps: u32, first_contact: Option<FirstContact>) {
     let depth = loading.depth_mm;
     let _ = writeln!(w, "  <LoadData>");
@@ -434,22 +479,12 @@ fn write_load_data(w: &mut String, loading: &Loading, steps: u32, first_contact:
     }
     let _ = writeln!(w, "    </load_controller>");
     let _ = writeln!(w, "    <!-- must points: the end of every load step; value: the largest time step -->");
-    let _ = writeln!(w, r#"    <load_controller id="2" name="must_points" type="loadcurve">"#);
-    let _ = writeln!(w, "      <interpolate>STEP</interpolate>\n      <extend>CONSTANT</extend>\n      <points>");
-    for k in 1..=steps {
-        let t = loading.time_at(k);
-        let dt = loading.step_time(k);
-        // the step ending at t starts within the first-contact depth
-        let capped = first_contact.filter(|fc| loading.depth_at(k - 1) < fc.depth_mm - 1e-9 * depth);
-        let dtmax = capped.map_or(dt, |fc| dt * fc.step_fraction);
-        let _ = writeln!(w, "        <pt>{},{}</pt>", num(t), num(dtmax));
-    }
-    let _ = writeln!(w, "      </points>\n    </load_controller>");
+    w.push_str(&must_point_controller(&must_points(loading, steps, first_contact)));
     let _ = writeln!(w, "  </LoadData>");
 }
 
 /// A number as FEBio reads it: Rust's shortest round-trip form.
-fn num(v: f64) -> String {
+pub(super) fn num(v: f64) -> String {
     let v = if v == 0.0 { 0.0 } else { v };
     format!("{v:?}")
 }
