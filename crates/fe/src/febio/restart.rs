@@ -5,15 +5,39 @@
 //! inside a step (an element inverted in an iterate, or contact chattering between two
 //! states at a time step near `dtmin`), the run restarts from that dump with a
 //! `febio_restart` input whose first time step is a fraction of a load step
-//! ([`CONTINUE_STEP_FRACTION`]), the time stepper's lower limit a tenth of the run's, and
+//! ([`CONTINUE_STEP_FRACTION`]; how it is set: below), the time stepper's lower limit a
+//! tenth of the run's, and
 //! otherwise the same model and settings; a run continues again only from a later must
 //! point. Measured on the default set (needle8, one thread): `t2-b` with the campaign's last
 //! attempt stopped at 3.79 mm, continued from its dump at 3.6 mm it passed that point
 //! and reached 4.95 mm; but in the campaign the continuations of `t2-b` (attempts 2, 3)
 //! and `tx+15` (attempts 1, 2) stopped again at the same depth (1.78, 1.47, 0.80,
-//! 5.82 mm) with first steps of 1/16 and 1/64 of a load step: those are limit points of
-//! the static equilibrium path, which no step size passes. A second continuation from
-//! the same point is therefore not tried.
+//! 5.82 mm) with first steps asked of 1/16 and 1/64 of a load step (taken: the dump's own
+//! step, below): those were read as limit points of the static equilibrium path, which no
+//! step size passes, and a second continuation from the same point is not tried.
+//!
+//! **A continuation's first time step.** FEBio's first step after a restart is its time
+//! stepper's (`FEAnalysis::Solve` calls `AutoTimeStep(niter)` when the step has time
+//! steps behind it; `niter` is 0 after a restart): the dump's own last step (`m_dtp`, not
+//! the input's `<step_size>`, which only sets `m_dt`), at least `dtmin`, at most `dtmax`,
+//! which with a must-point curve is the curve's value at the current time
+//! (`FETimeStepController::AutoTimeStep`, FEBio 4.11; `dtn = MIN(dtn, dtmax)` whatever
+//! `niter`). So the restart input redefines the must-point curve (`<LoadData>`, load
+//! controller [`feb::MUST_POINT_LC`]: FEBio's restart creates a new controller and
+//! replaces the dump's, `FEModel::ReplaceLoadController`, its points not appended) with
+//! the load step after the must point capped at the first step ([`continuation_curve`]).
+//! The guarantee: no time step of that load step is longer than the first step, and the
+//! first one is the first step when the dump's step is longer (otherwise the dump's
+//! step, or `dtmin` when that is longer). The cap holds for the whole load step, not only its first time step
+//! (the stepper cannot grow past it there); from the next must point on, the curve's own
+//! values (a whole load step, or a first-contact cap) and the stepper grows as usual.
+//! That is intended: the load step the run failed in is crossed in small steps.
+//! Measured on the smoke mesh (centre, 10 load steps of 0.6 mm, restart from must point
+//! 3 at 1.8 mm, 1/16 of a load step asked: `tests/febio_restart_first_step.rs`): 1.8 ->
+//! 1.8375 mm with the curve; 1.8 -> 2.4 mm, the dump's step, without it. Before
+//! 2026-11-27 the input set only `<step_size>`: every continuation and resumed run so far
+//! started with the dump's own step (e.g. 9.6 -> 9.66704 mm), and the manifests' settings
+//! lines of those runs ("first time step 1/16" or "0.25 of a load step") overstate it.
 //!
 //! The equilibrium at each must point is the same problem's: only the path between must
 //! points (the time step sizes) changes, as it does between the campaign's attempts.
