@@ -196,12 +196,8 @@ impl<'j, 'a> Setup<'j, 'a> {
         match self.plan {
             ladder::Plan::Fresh(_) => self.first_contact,
             ladder::Plan::Continue { from_attempt, .. } => {
-                let before = ladder::State {
-                    tried: self.state.tried.iter().filter(|t| t.attempt < from_attempt).cloned().collect(),
-                    ..ladder::State::default()
-                };
                 let fs = self.fs();
-                ladder::failed_at_first_contact(&before, first_contact_steps(fs, self.loading(), self.job.steps))
+                ladder::had_first_contact_steps(&self.state, from_attempt, first_contact_steps(fs, self.loading(), self.job.steps))
                     .then_some(feb::FirstContact { depth_mm: fs.first_contact_depth_mm, step_fraction: fs.first_contact_step_fraction })
             }
         }

@@ -251,6 +251,16 @@ pub fn failed_at_first_contact(state: &State, first_contact_steps: u32) -> bool 
     state.tried.iter().any(|t| matches!(t.plan, Plan::Fresh(_)) && t.reached_steps < first_contact_steps)
 }
 
+/// Whether attempt `attempt`, a fresh one with whole load steps, ran with the first-contact
+/// steps: an attempt before it failed at first contact ([`failed_at_first_contact`] of the
+/// attempts before it, as when it was decided). Its dump carries that must-point curve,
+/// which a continuation of it redefines (`restart.rs`); a spec whose first-contact
+/// settings changed since is read as it is now.
+pub fn had_first_contact_steps(state: &State, attempt: u32, first_contact_steps: u32) -> bool {
+    let before = State { tried: state.tried.iter().filter(|t| t.attempt < attempt).cloned().collect(), furthest: None };
+    failed_at_first_contact(&before, first_contact_steps)
+}
+
 /// The load steps (of `steps` to `depth_mm`) that start within `first_contact_depth_mm`.
 pub fn first_contact_steps(first_contact_depth_mm: f64, depth_mm: f64, steps: u32) -> u32 {
     (1..=steps).take_while(|&k| depth_at(depth_mm, steps, k - 1) < first_contact_depth_mm - 1e-9 * depth_mm).count() as u32
@@ -370,6 +380,11 @@ mod tests {
         assert!(!failed_at_first_contact(&at(2), 2), "past 0.6 mm: another class");
         let cont = State { tried: vec![tried(2, Plan::Continue { from_attempt: 1, from_steps: 1, contact: a[0] }, 1)], furthest: None };
         assert!(!failed_at_first_contact(&cont, 2), "a continuation starts past the surface");
+        // the attempts before attempt 2 failed at first contact: it had the steps, attempt 1 not
+        let mut s = at(0);
+        s.tried.push(tried(2, Plan::Fresh(fresh_order(false)[1]), 7));
+        assert!(had_first_contact_steps(&s, 2, 2) && !had_first_contact_steps(&s, 1, 2));
+        assert!(!had_first_contact_steps(&s, 2, 0), "off");
     }
 
     #[test]
