@@ -7,7 +7,7 @@
 //! the compiler drops them: the wrench and the three force rates are its bits exactly
 //! (host-tests/tests/depth_rate.rs compares them on the golden poses).
 use crate::cross_f32::{add_cross, add_cross_rates, COUPLED, CROSS_SCALES};
-use crate::model_f32::{clamp_to_domain, ONE_THIRD};
+use crate::model_f32::{clamp_to_domain, unsolved_flag, ONE_THIRD};
 use crate::stiffness_f32::{component, At, Column};
 use crate::tables::FITTED;
 use crate::{Evaluation, Pose, Status, Wrench};
@@ -41,9 +41,10 @@ pub fn wrench_and_depth_rate(pose: &Pose) -> (Evaluation, [f32; 3]) {
         *wc = cw;
         *dc = ca * ONE_THIRD;
     }
+    let [cx, cz, ctx, ctz] = CROSS_SCALES;
+    let n = [x * cx, z * cz, tx * ctx, tz * ctz];
+    let status = status | unsolved_flag(n, clamped.depth_mm);
     if COUPLED {
-        let [cx, cz, ctx, ctz] = CROSS_SCALES;
-        let n = [x * cx, z * cz, tx * ctx, tz * ctz];
         add_cross(n, u, &mut w);
         let (mut unused_x, mut unused_z) = ([0.0_f32; COMPONENT_COUNT], [0.0_f32; COMPONENT_COUNT]);
         add_cross_rates(n, u, &mut by_depth, &mut unused_x, &mut unused_z);

@@ -70,6 +70,7 @@ mod stiffness;
 mod stiffness_f32;
 mod tables;
 pub mod telemetry;
+mod unsolved;
 mod wrench;
 
 pub use depth_extension::extended_wrench;

@@ -358,7 +358,9 @@ pub(crate) fn clamp_to_domain(pose: &Pose) -> Option<(Pose, Status)> {
 ///    `w_c = w_c ± D_c(t, u)`, minus when the sweep value is negative and the component
 ///    is odd under that sweep's mirror;
 /// 5. coupled form only ([`model_info::COUPLED`](crate::model_info::COUPLED)): the cross
-///    terms, `w_c = w_c + m * P(u)` per term with `m` a product of the normalised inputs.
+///    terms, `w_c = w_c + m * P(u)` per term with `m` a product of the normalised inputs;
+/// 6. [`Status::FE_UNSOLVED`] when the clamped pose lies in the set's unsolved region
+///    (where its FE campaign could not solve; the wrench is still the model's).
 ///
 /// The wrench is that of the clamped pose; forces in N, moments in N·mm about the
 /// needle's reference point (see [`Wrench`]).
@@ -388,9 +390,22 @@ pub fn wrench(pose: &Pose) -> Evaluation {
 
     let u = d * ONE_THIRD - 1.0;
     let mut w = superpose([x, z, tx, tz], u);
+    let [rx, rz, rtx, rtz] = CROSS_SCALES;
+    let n = [x * rx, z * rz, tx * rtx, tz * rtz];
     if COUPLED {
-        let [rx, rz, rtx, rtz] = CROSS_SCALES;
-        add_cross([x * rx, z * rz, tx * rtx, tz * rtz], u, &mut w);
+        add_cross(n, u, &mut w);
     }
-    Evaluation { wrench: Wrench::from_array(w), status }
+    Evaluation { wrench: Wrench::from_array(w), status: status | unsolved_flag(n, d) }
+}
+
+/// Step 7 of the contract: [`Status::FE_UNSOLVED`] when the clamped pose, `n` its
+/// normalised inputs (the coupled form's `n_k`) and `d` its depth, lies in the set's
+/// unsolved region (`crate::unsolved`), else [`Status::OK`]. The wrench is not changed.
+#[inline(always)]
+pub(crate) fn unsolved_flag(n: [f32; 4], d: f32) -> Status {
+    if crate::unsolved::in_region_f32(n, d) {
+        Status::FE_UNSOLVED
+    } else {
+        Status::OK
+    }
 }

@@ -2,7 +2,7 @@
 //! ("Stiffness") bit for bit, sharing the wrench's operations.
 use crate::cross_f32::{add_cross, add_cross_rates, COUPLED, CROSS_SCALES};
 use crate::horner::{horner_from, horner_with_rate_from, MatrixStarts, Start};
-use crate::model_f32::{clamp_to_domain, skip_sweep, sweep_t, BASELINE_STARTS, ODD, ONE_THIRD, STARTS, SWEEP_SCALES};
+use crate::model_f32::{clamp_to_domain, skip_sweep, unsolved_flag, sweep_t, BASELINE_STARTS, ODD, ONE_THIRD, STARTS, SWEEP_SCALES};
 use crate::stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
 use crate::tables::{BASELINE, DEVIATION, FITTED};
 use crate::{Pose, Status, Wrench};
@@ -79,12 +79,13 @@ pub fn wrench_and_stiffness(pose: &Pose) -> StiffnessEvaluation {
         *xc = r.gx * sx;
         *zc = r.gz * sz;
     }
+    let [cx, cz, ctx, ctz] = CROSS_SCALES;
+    let n = [x * cx, z * cz, tx * ctx, tz * ctz];
     if COUPLED {
-        let [cx, cz, ctx, ctz] = CROSS_SCALES;
-        let n = [x * cx, z * cz, tx * ctx, tz * ctz];
         add_cross(n, u, &mut w);
         add_cross_rates(n, u, &mut by_depth, &mut by_x, &mut by_z);
     }
+    let status = status | unsolved_flag(n, clamped.depth_mm);
     // The rates along clamped inputs are zeroed after the result is built (a branch per
     // input, taken only when clamped), not selected while building it (measured on the
     // M4F: 1,134.1 instructions with the selects, 1,117.0 this way).

@@ -28,7 +28,9 @@ use needle_contract::TERMS;
 /// 4. coupled form only: `N_k = sign(v_k) * ((|v_k| + V_k) / (2 V_k))` (Q15) and per cross
 ///    term `A_i += (P[i] * M >> 15) >> shift` with `M` the Q15 monomial (generated code);
 /// 5. `W = h(A, U)`, and the result `(W + 2^(G-1)) >> G` in µN or µN·mm
-///    ([`tables::FRAC_BITS`](super::tables::FRAC_BITS) = G).
+///    ([`tables::FRAC_BITS`](super::tables::FRAC_BITS) = G);
+/// 6. [`Status::FE_UNSOLVED`] when the clamped pose lies in the set's unsolved region
+///    (integer comparisons on the `N_k` and the depth; the wrench is not changed).
 ///
 /// No intermediate can overflow: the code generator bounds every one of them over the
 /// whole domain and chose the formats so that all stay within ±2^30. The result differs
@@ -56,15 +58,15 @@ pub fn wrench(pose: &Pose) -> Evaluation {
 
 /// Steps 2 and 3: the clamped inputs, the status, `U`, the `T_k` and the signs.
 pub(super) struct Inputs {
-    /// The clamped x, z, theta_x, theta_z (Q16.16).
-    pub v: [i32; 4],
+    /// Step 6's signed cross-term inputs `N_k` of the clamped x, z, theta_x, theta_z (Q15).
+    pub n: [i32; 4],
     /// `T_k` (Q15).
     pub t: [i32; 4],
     /// `V_k < 0`.
     pub negative: [bool; 4],
     /// `U` (Q15).
     pub u: i32,
-    /// The saturation flags.
+    /// The saturation flags and [`Status::FE_UNSOLVED`].
     pub status: Status,
 }
 
@@ -80,8 +82,12 @@ impl Inputs {
             u8::from(sat_x) | u8::from(sat_z) << 1 | u8::from(sat_tx) << 2 | u8::from(sat_tz) << 3 | u8::from(sat_d) << 4,
         );
         let [dx, dz, dtx, dtz] = SWEEP_DIVISORS;
+        let [cx, cz, ctx, ctz] = CROSS_DIVISORS;
+        let n = [cross_input(x, cx), cross_input(z, cz), cross_input(tx, ctx), cross_input(tz, ctz)];
+        // step 7: the unsolved region, on the clamped pose
+        let status = if crate::unsolved::in_region_fixed(n, d) { status | Status::FE_UNSOLVED } else { status };
         Self {
-            v: [x, z, tx, tz],
+            n,
             t: [
                 normalise(x.unsigned_abs(), dx),
                 normalise(z.unsigned_abs(), dz),
@@ -97,9 +103,7 @@ impl Inputs {
     /// Step 6's signed cross-term inputs `N_k` (Q15).
     #[inline(always)]
     pub(super) fn cross_inputs(&self) -> [i32; 4] {
-        let [x, z, tx, tz] = self.v;
-        let [cx, cz, ctx, ctz] = CROSS_DIVISORS;
-        [cross_input(x, cx), cross_input(z, cz), cross_input(tx, ctx), cross_input(tz, ctz)]
+        self.n
     }
 }
 

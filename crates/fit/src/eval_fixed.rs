@@ -7,7 +7,7 @@
 //! [`Overflow`] (the library, which computes in wrapping i32, would have produced garbage
 //! there). Products are floored with `div_euclid`, not shifts.
 
-use super::contract::{Sweep, NCOEF, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z};
+use super::contract::{Sweep, NCOEF, STATUS_FE_UNSOLVED, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z};
 use super::fixed_formats::{TablesFixed, LIMIT};
 use crate::contract::COMPONENT_COUNT;
 use std::fmt;
@@ -154,6 +154,10 @@ fn accumulate(t: &TablesFixed, pose: [i32; 5]) -> Result<Accumulated, Overflow> 
                 a[c][i] = check(a[c][i].checked_add(shifted), || format!("A[{c}][{i}] after cross {e:?}"))?;
             }
         }
+    }
+    // 7. the unsolved region (on the clamped pose)
+    if crate::unsolved::inside_fixed(&t.unsolved, n, d) {
+        status |= STATUS_FE_UNSOLVED;
     }
     Ok(Accumulated { v, u, tk, n, status, a })
 }
