@@ -249,3 +249,59 @@ pub fn render_c(r: &Region) -> String {
     let _ = writeln!(s, "static const float NEEDLE_UNSOLVED_DEPTH_MM[{}] = {{{}}};", r.balls.len(), list.join(", "));
     s
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const ONE: &str = "format = 1\nset = \"s\"\n\n[[failed]]\npose = \"tx+15\"\nsource = \"campaign.fit_without\"\nx_mm = 0.0\nz_mm = 0.0\ntheta_x_deg = 15.0\ntheta_z_deg = 0.0\ncause = \"c\"\nnearest_solved = \"tx+12\"\nnearest_solved_distance = 0.2\nradius_q15 = 3276\ndepth_q16 = 0\ncentres_q15 = [[0, 0, 32768, 0], [0, 0, -32768, 0]]\n";
+
+    fn err(text: &str) -> String {
+        parse_str(text, Path::new("unsolved.toml")).expect_err("must be refused").to_string()
+    }
+
+    #[test]
+    fn a_region_is_read_and_a_bad_one_refused_with_its_line() {
+        let r = parse_str(ONE, Path::new("unsolved.toml")).expect("good file");
+        assert_eq!(r.balls.len(), 2);
+        assert_eq!(r.balls[1], Ball { centre_q15: [0, 0, -32768, 0], radius_q15: 3276, depth_q16: 0, pose: 0 });
+        assert_eq!(err(&ONE.replace("format = 1", "format = 2")), "unsolved.toml:1: format = 2: this build reads unsolved format 1");
+        assert_eq!(err(&ONE.replace("radius_q15 = 3276", "radius_q15 = 40000")), "unsolved.toml:14: radius_q15 = 40000: must be in 0 ..= 32768");
+        assert_eq!(err(&ONE.replace("depth_q16 = 0", "depth_q16 = -1")), "unsolved.toml:15: depth_q16 = -1: must be in 0 ..= 393216 (0 .. 6 mm)");
+        assert!(err(&ONE.replace("32768, 0], [0", "32769, 0], [0")).starts_with("unsolved.toml:16: centres_q15: [0, 0, 32769, 0]"));
+        assert!(err(&ONE.replace("cause = \"c\"\n", "")).contains("missing field `cause`"));
+        assert!(err(&ONE.replace("cause = ", "why = ")).starts_with("unsolved.toml:"));
+        let many = format!("format = 1\nset = \"s\"\n{}", ONE.split_once("\n\n").map_or("", |(_, f)| f).repeat(33));
+        assert!(err(&format!("\n{many}")).contains("at most 64"), "{}", err(&many));
+        let none = parse_str("format = 1\nset = \"s\"\n", Path::new("unsolved.toml")).expect("no failed pose");
+        assert!(none.balls.is_empty());
+        assert!(render(&none).contains("pub const COUNT: usize = 0;"));
+        assert_eq!(render_c(&none).lines().last(), Some("#define NEEDLE_UNSOLVED_COUNT 0"));
+    }
+
+    /// The prefilter keeps every ball that holds a pose: for poses on a fine grid along
+    /// each input, a ball whose extent contains the coordinate has its bit in the bin.
+    #[test]
+    fn the_bin_masks_cover_each_balls_extent() {
+        let r = parse_str(ONE, Path::new("unsolved.toml")).expect("good file");
+        let masks = bin_masks(&r);
+        for (i, ball) in r.balls.iter().enumerate() {
+            for k in 0..4 {
+                let c = ball.centre_q15[k] as f64 / Q15 as f64;
+                let rad = ball.radius_q15 as f64 / Q15 as f64;
+                for step in 0..=2000 {
+                    let n = -1.0 + f64::from(step) / 1000.0;
+                    if (n - c).abs() <= rad {
+                        #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+                        let b = (((n + 1.0) * 8.0) as usize).min(BINS - 1);
+                        assert!(masks[k][b] & (1 << i) != 0, "ball {i}, input {k}, n = {n}: bin {b} lacks it");
+                    }
+                }
+            }
+        }
+        // tx+15's balls are near theta_x = +-1 only
+        assert_eq!(masks[2][0], 0b10);
+        assert_eq!(masks[2][BINS - 1], 0b01);
+        assert_eq!(masks[2][8], 0);
+    }
+}
