@@ -13,13 +13,29 @@
 //!
 //! Cost when the set has no region (`COUNT == 0`): nothing, the tests are compiled out.
 
+/// One ball of the region, the integers of `unsolved.toml`.
+#[derive(Clone, Copy)]
+pub(crate) struct Ball {
+    /// Centre `C_k` in Q15 of the normalised inputs.
+    pub centre_q15: [i16; 4],
+    /// Radius `R` in Q15.
+    pub radius_q15: u16,
+    /// Depth threshold `Dq` in Q16.16 mm: inside only deeper than it.
+    pub depth_q16: i32,
+}
+
 /// The generated constants.
 pub(crate) mod tables {
-    #![allow(dead_code, clippy::unreadable_literal, clippy::excessive_precision)]
+    #![allow(dead_code, clippy::unreadable_literal)]
     include!(concat!(env!("OUT_DIR"), "/unsolved.rs"));
 }
 
-use tables::{Mask, ALL, BIN_MASKS, COUNT};
+use tables::{Mask, ALL, BALLS, BIN_MASKS, COUNT};
+
+/// `2^-15`, `2^-16` and `2^-30` (exact in f32).
+const INV_Q15: f32 = 1.0 / 32768.0;
+const INV_Q16: f32 = 1.0 / 65536.0;
+const INV_Q30: f32 = 1.0 / 1_073_741_824.0;
 
 /// The balls that may hold a pose whose inputs fall in `bins` (one bin per input; a bin
 /// outside the table, which cannot happen, selects every ball).
@@ -32,13 +48,13 @@ fn candidates(bins: [usize; 4]) -> Mask {
     m
 }
 
-/// Calls `inside` with the index of every ball of `m` until one answers `true`.
+/// Calls `inside` with every ball of `m` until one answers `true`.
 #[inline(always)]
-fn any_ball(mut m: Mask, mut inside: impl FnMut(usize) -> bool) -> bool {
+fn any_ball(mut m: Mask, mut inside: impl FnMut(&Ball) -> bool) -> bool {
     while m != 0 {
         let i = m.trailing_zeros() as usize;
         m &= m.wrapping_sub(1);
-        if inside(i) {
+        if BALLS.get(i).is_some_and(&mut inside) {
             return true;
         }
     }
@@ -59,20 +75,25 @@ fn bin_f32(n: f32) -> usize {
 
 /// The f32 test: `n` the clamped inputs times the f32 nearest `1 / V_k` (the coupled
 /// form's `n_k`), `depth` the clamped depth (mm). Inside a ball when `depth > D` and
-/// `((q0*q0 + q1*q1) + q2*q2) + q3*q3 < R2` with `q_k = n_k - C_k`, each operation
-/// rounded on its own, as the contract writes it.
+/// `((q0*q0 + q1*q1) + q2*q2) + q3*q3 < R2` with `q_k = n_k - c_k`, each operation
+/// rounded on its own, as the contract writes it; `c_k = C_k / 2^15` and `D = Dq / 2^16`
+/// are exact, and `R2`, `R^2` converted to f32 (rounded to nearest) times `2^-30`, is the
+/// f32 nearest `R^2 / 2^30`.
 #[inline(always)]
 pub(crate) fn in_region_f32(n: [f32; 4], depth: f32) -> bool {
-    if COUNT == 0 {
-        return false;
-    }
+    COUNT != 0 && in_balls_f32(n, depth)
+}
+
+/// [`in_region_f32`] on a region with balls. Not inlined: one copy for every evaluator.
+#[inline(never)]
+fn in_balls_f32(n: [f32; 4], depth: f32) -> bool {
     let m = candidates(n.map(bin_f32));
-    any_ball(m, |i| {
-        let (Some(c), Some(&r2), Some(&d)) = (tables::CENTRES_F32.get(i), tables::RADIUS2_F32.get(i), tables::DEPTH_F32.get(i)) else {
-            return false;
-        };
+    any_ball(m, |b| {
         let [n0, n1, n2, n3] = n;
-        let [c0, c1, c2, c3] = *c;
+        let [c0, c1, c2, c3] = b.centre_q15.map(|c| f32::from(c) * INV_Q15);
+        let r = u32::from(b.radius_q15);
+        let r2 = (r * r) as f32 * INV_Q30;
+        let d = b.depth_q16 as f32 * INV_Q16;
         let (q0, q1, q2, q3) = (n0 - c0, n1 - c1, n2 - c2, n3 - c3);
         let s = ((q0 * q0 + q1 * q1) + q2 * q2) + q3 * q3;
         depth > d && s < r2
@@ -96,27 +117,26 @@ fn bin_q15(n: i32) -> usize {
 /// square is under 2^30, so the sum of four fits a `u32`.
 #[inline(always)]
 pub(crate) fn in_region_fixed(n: [i32; 4], depth_q16: i32) -> bool {
-    if COUNT == 0 {
-        return false;
-    }
+    COUNT != 0 && in_balls_fixed(n, depth_q16)
+}
+
+/// [`in_region_fixed`] on a region with balls. Not inlined: one copy for every evaluator.
+#[inline(never)]
+fn in_balls_fixed(n: [i32; 4], depth_q16: i32) -> bool {
     let m = candidates(n.map(bin_q15));
-    any_ball(m, |i| {
-        let (Some(c), Some(&r), Some(&r2), Some(&d)) =
-            (tables::CENTRES_Q15.get(i), tables::RADIUS_Q15.get(i), tables::RADIUS2_Q30.get(i), tables::DEPTH_Q16.get(i))
-        else {
-            return false;
-        };
-        if depth_q16 <= d {
+    any_ball(m, |b| {
+        if depth_q16 <= b.depth_q16 {
             return false;
         }
+        let r = u32::from(b.radius_q15);
         let mut s: u32 = 0;
-        for (&nk, &ck) in n.iter().zip(c.iter()) {
-            let e = nk.wrapping_sub(ck).unsigned_abs();
+        for (&nk, &ck) in n.iter().zip(b.centre_q15.iter()) {
+            let e = nk.wrapping_sub(i32::from(ck)).unsigned_abs();
             if e >= r {
                 return false;
             }
             s = s.wrapping_add(e.wrapping_mul(e));
         }
-        s < r2
+        s < r.wrapping_mul(r)
     })
 }

@@ -56,7 +56,8 @@ pub struct FailedPose {
     pub radius_q15: i64,
     /// The depth threshold, Q16.16 mm (`round(reached * 2^16)`, 0 when unknown).
     pub depth_q16: i64,
-    /// The ball centres: the pose and its distinct mirror images, Q15 normalised.
+    /// The ball centres: the pose and its distinct mirror images, Q15 normalised
+    /// (`round(n * 2^15)` within `±(2^15 - 1)`: an `i16`).
     pub centres_q15: Vec<[i64; 4]>,
 }
 
@@ -182,7 +183,7 @@ pub fn region(set_dir: &Path) -> Result<Region> {
         let depth_q16 = round_i64(reached_depth_mm.unwrap_or(0.0).clamp(0.0, DEPTH_MAX_MM) * Q16 as f64);
         let mut centres_q15: Vec<[i64; 4]> = Vec::new();
         for image in mirror_images(n) {
-            let c = image.map(|v| round_i64(v * Q15 as f64).clamp(-Q15, Q15));
+            let c = image.map(|v| round_i64(v * Q15 as f64).clamp(-(Q15 - 1), Q15 - 1));
             if !centres_q15.contains(&c) {
                 centres_q15.push(c);
             }
@@ -497,7 +498,7 @@ mod tests {
                 nearest_distance: 0.2,
                 radius_q15: 3276,
                 depth_q16: 275_251,
-                centres_q15: vec![[0, 0, 32768, 0], [0, 0, -32768, 0]],
+                centres_q15: vec![[0, 0, 32767, 0], [0, 0, -32767, 0]],
             }],
             solved: Vec::new(),
         };
