@@ -25,8 +25,10 @@ pub fn wrench_and_depth_rate(pose: &Pose) -> (Evaluation, [f32; 3]) {
     let Some((clamped, status)) = clamp_to_domain(pose) else {
         return error(Status::ERROR);
     };
+    let Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, .. } = clamped;
+    let status = status | unsolved_flag([x, z, tx, tz], clamped.depth_mm);
     let at = At::of(&clamped);
-    let (Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, .. }, u) = (clamped, at.u);
+    let u = at.u;
     let columns = [
         column::<0, true>(&at),
         column::<1, true>(&at),
@@ -41,10 +43,9 @@ pub fn wrench_and_depth_rate(pose: &Pose) -> (Evaluation, [f32; 3]) {
         *wc = cw;
         *dc = ca * ONE_THIRD;
     }
-    let [cx, cz, ctx, ctz] = CROSS_SCALES;
-    let n = [x * cx, z * cz, tx * ctx, tz * ctz];
-    let status = status | unsolved_flag(n, clamped.depth_mm);
     if COUPLED {
+        let [cx, cz, ctx, ctz] = CROSS_SCALES;
+        let n = [x * cx, z * cz, tx * ctx, tz * ctz];
         add_cross(n, u, &mut w);
         let (mut unused_x, mut unused_z) = ([0.0_f32; COMPONENT_COUNT], [0.0_f32; COMPONENT_COUNT]);
         add_cross_rates(n, u, &mut by_depth, &mut unused_x, &mut unused_z);

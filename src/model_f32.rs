@@ -388,22 +388,22 @@ pub fn wrench(pose: &Pose) -> Evaluation {
     };
     let Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, depth_mm: d } = clamped;
 
+    let status = status | unsolved_flag([x, z, tx, tz], d);
     let u = d * ONE_THIRD - 1.0;
     let mut w = superpose([x, z, tx, tz], u);
-    let [rx, rz, rtx, rtz] = CROSS_SCALES;
-    let n = [x * rx, z * rz, tx * rtx, tz * rtz];
     if COUPLED {
-        add_cross(n, u, &mut w);
+        let [rx, rz, rtx, rtz] = CROSS_SCALES;
+        add_cross([x * rx, z * rz, tx * rtx, tz * rtz], u, &mut w);
     }
-    Evaluation { wrench: Wrench::from_array(w), status: status | unsolved_flag(n, d) }
+    Evaluation { wrench: Wrench::from_array(w), status }
 }
 
-/// Step 7 of the contract: [`Status::FE_UNSOLVED`] when the clamped pose, `n` its
-/// normalised inputs (the coupled form's `n_k`) and `d` its depth, lies in the set's
-/// unsolved region (`crate::unsolved`), else [`Status::OK`]. The wrench is not changed.
+/// Step 7 of the contract: [`Status::FE_UNSOLVED`] when the clamped pose, `v` its x, z,
+/// theta_x, theta_z and `d` its depth, lies in the set's unsolved region
+/// (`crate::unsolved`), else [`Status::OK`]. The wrench is not changed.
 #[inline(always)]
-pub(crate) fn unsolved_flag(n: [f32; 4], d: f32) -> Status {
-    if crate::unsolved::in_region_f32(n, d) {
+pub(crate) fn unsolved_flag(v: [f32; 4], d: f32) -> Status {
+    if crate::unsolved::in_region_f32(v, d) {
         Status::FE_UNSOLVED
     } else {
         Status::OK

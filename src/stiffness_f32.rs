@@ -53,8 +53,9 @@ pub fn wrench_and_stiffness(pose: &Pose) -> StiffnessEvaluation {
     let Some((clamped, status)) = clamp_to_domain(pose) else {
         return error(Status::ERROR);
     };
-    let at = At::of(&clamped);
     let Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, .. } = clamped;
+    let status = status | unsolved_flag([x, z, tx, tz], clamped.depth_mm);
+    let at = At::of(&clamped);
     let [sx, sz, _, _] = SWEEP_SCALES;
     let u = at.u;
     // Component by component (the contract's order within each component: baseline,
@@ -79,13 +80,12 @@ pub fn wrench_and_stiffness(pose: &Pose) -> StiffnessEvaluation {
         *xc = r.gx * sx;
         *zc = r.gz * sz;
     }
-    let [cx, cz, ctx, ctz] = CROSS_SCALES;
-    let n = [x * cx, z * cz, tx * ctx, tz * ctz];
     if COUPLED {
+        let [cx, cz, ctx, ctz] = CROSS_SCALES;
+        let n = [x * cx, z * cz, tx * ctx, tz * ctz];
         add_cross(n, u, &mut w);
         add_cross_rates(n, u, &mut by_depth, &mut by_x, &mut by_z);
     }
-    let status = status | unsolved_flag(n, clamped.depth_mm);
     // The rates along clamped inputs are zeroed after the result is built (a branch per
     // input, taken only when clamped), not selected while building it (measured on the
     // M4F: 1,134.1 instructions with the selects, 1,117.0 this way).

@@ -61,11 +61,13 @@ fn any_ball(mut m: Mask, mut inside: impl FnMut(&Ball) -> bool) -> bool {
     false
 }
 
-/// The prefilter's bin of a normalised f32 input: `floor((n + 1) * 8)` in `0..=15`
-/// (saturating conversion: NaN and values below -1 give 0).
+/// The prefilter's bin of a clamped f32 input `v` with half-range `1 / r` (`r` the f32
+/// nearest `1 / V_k`): `floor(v * (8 r) + 8)` (about `floor((n + 1) * 8)`, the masks'
+/// margin covers the difference) in `0..=15` (saturating conversion: values below -1
+/// give 0).
 #[inline(always)]
-fn bin_f32(n: f32) -> usize {
-    let b = ((n + 1.0) * 8.0) as usize;
+fn bin_f32(v: f32, eight_r: f32) -> usize {
+    let b = (v * eight_r + 8.0) as usize;
     if b > tables::BINS - 1 {
         tables::BINS - 1
     } else {
@@ -73,23 +75,31 @@ fn bin_f32(n: f32) -> usize {
     }
 }
 
-/// The f32 test: `n` the clamped inputs times the f32 nearest `1 / V_k` (the coupled
-/// form's `n_k`), `depth` the clamped depth (mm). Inside a ball when `depth > D` and
-/// `((q0*q0 + q1*q1) + q2*q2) + q3*q3 < R2` with `q_k = n_k - c_k`, each operation
-/// rounded on its own, as the contract writes it; `c_k = C_k / 2^15` and `D = Dq / 2^16`
-/// are exact, and `R2`, `R^2` converted to f32 (rounded to nearest) times `2^-30`, is the
-/// f32 nearest `R^2 / 2^30`.
+/// The f32 test: `v` the clamped inputs x, z, theta_x, theta_z, `depth` the clamped depth
+/// (mm); `n_k = v_k * r_k` (the f32 nearest `1 / V_k`: the coupled form's `n_k`). Inside
+/// a ball when `depth > D` and `((q0*q0 + q1*q1) + q2*q2) + q3*q3 < R2` with `q_k = n_k -
+/// c_k`, each operation rounded on its own, as the contract writes it; `c_k = C_k / 2^15`
+/// and `D = Dq / 2^16` are exact, and `R2`, `R^2` converted to f32 (rounded to nearest)
+/// times `2^-30`, is the f32 nearest `R^2 / 2^30`.
 #[inline(always)]
-pub(crate) fn in_region_f32(n: [f32; 4], depth: f32) -> bool {
-    COUNT != 0 && in_balls_f32(n, depth)
+pub(crate) fn in_region_f32(v: [f32; 4], depth: f32) -> bool {
+    let [x, z, tx, tz] = v;
+    COUNT != 0 && in_balls_f32(x, z, tx, tz, depth)
 }
 
-/// [`in_region_f32`] on a region with balls. Not inlined: one copy for every evaluator.
+/// [`in_region_f32`] on a region with balls. Not inlined (one copy for every evaluator);
+/// scalar arguments, so they come in registers.
 #[inline(never)]
-fn in_balls_f32(n: [f32; 4], depth: f32) -> bool {
-    let m = candidates(n.map(bin_f32));
+fn in_balls_f32(x: f32, z: f32, tx: f32, tz: f32, depth: f32) -> bool {
+    let r = needle_contract::CROSS_SCALES_F32;
+    let [rx, rz, rtx, rtz] = r;
+    let [ex, ez, etx, etz] = r.map(|rk| rk * 8.0);
+    let m = candidates([bin_f32(x, ex), bin_f32(z, ez), bin_f32(tx, etx), bin_f32(tz, etz)]);
+    if m == 0 {
+        return false;
+    }
+    let (n0, n1, n2, n3) = (x * rx, z * rz, tx * rtx, tz * rtz);
     any_ball(m, |b| {
-        let [n0, n1, n2, n3] = n;
         let [c0, c1, c2, c3] = b.centre_q15.map(|c| f32::from(c) * INV_Q15);
         let r = u32::from(b.radius_q15);
         let r2 = (r * r) as f32 * INV_Q30;
@@ -117,12 +127,15 @@ fn bin_q15(n: i32) -> usize {
 /// square is under 2^30, so the sum of four fits a `u32`.
 #[inline(always)]
 pub(crate) fn in_region_fixed(n: [i32; 4], depth_q16: i32) -> bool {
-    COUNT != 0 && in_balls_fixed(n, depth_q16)
+    let [n0, n1, n2, n3] = n;
+    COUNT != 0 && in_balls_fixed(n0, n1, n2, n3, depth_q16)
 }
 
-/// [`in_region_fixed`] on a region with balls. Not inlined: one copy for every evaluator.
+/// [`in_region_fixed`] on a region with balls. Not inlined (one copy for every
+/// evaluator); scalar arguments, so they come in registers.
 #[inline(never)]
-fn in_balls_fixed(n: [i32; 4], depth_q16: i32) -> bool {
+fn in_balls_fixed(n0: i32, n1: i32, n2: i32, n3: i32, depth_q16: i32) -> bool {
+    let n = [n0, n1, n2, n3];
     let m = candidates(n.map(bin_q15));
     any_ball(m, |b| {
         if depth_q16 <= b.depth_q16 {

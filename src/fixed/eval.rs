@@ -51,22 +51,22 @@ pub fn wrench(pose: &Pose) -> Evaluation {
     if !FITTED {
         return Evaluation { wrench: Wrench::ZERO, status: Status::NO_MODEL | Status::ERROR };
     }
-    let at = Inputs::of(pose);
-    let a = accumulators(&at);
+    let mut at = Inputs::of(pose);
+    let a = accumulators(&mut at, pose);
     Evaluation { wrench: Wrench::from_array(output(&a, at.u)), status: at.status }
 }
 
 /// Steps 2 and 3: the clamped inputs, the status, `U`, the `T_k` and the signs.
 pub(super) struct Inputs {
-    /// Step 6's signed cross-term inputs `N_k` of the clamped x, z, theta_x, theta_z (Q15).
-    pub n: [i32; 4],
+    /// The clamped x, z, theta_x, theta_z (Q16.16).
+    pub v: [i32; 4],
     /// `T_k` (Q15).
     pub t: [i32; 4],
     /// `V_k < 0`.
     pub negative: [bool; 4],
     /// `U` (Q15).
     pub u: i32,
-    /// The saturation flags and [`Status::FE_UNSOLVED`].
+    /// The saturation flags ([`accumulators`] adds [`Status::FE_UNSOLVED`]).
     pub status: Status,
 }
 
@@ -82,12 +82,8 @@ impl Inputs {
             u8::from(sat_x) | u8::from(sat_z) << 1 | u8::from(sat_tx) << 2 | u8::from(sat_tz) << 3 | u8::from(sat_d) << 4,
         );
         let [dx, dz, dtx, dtz] = SWEEP_DIVISORS;
-        let [cx, cz, ctx, ctz] = CROSS_DIVISORS;
-        let n = [cross_input(x, cx), cross_input(z, cz), cross_input(tx, ctx), cross_input(tz, ctz)];
-        // step 7: the unsolved region, on the clamped pose
-        let status = if crate::unsolved::in_region_fixed(n, d) { status | Status::FE_UNSOLVED } else { status };
         Self {
-            n,
+            v: [x, z, tx, tz],
             t: [
                 normalise(x.unsigned_abs(), dx),
                 normalise(z.unsigned_abs(), dz),
@@ -103,7 +99,9 @@ impl Inputs {
     /// Step 6's signed cross-term inputs `N_k` (Q15).
     #[inline(always)]
     pub(super) fn cross_inputs(&self) -> [i32; 4] {
-        self.n
+        let [x, z, tx, tz] = self.v;
+        let [cx, cz, ctx, ctz] = CROSS_DIVISORS;
+        [cross_input(x, cx), cross_input(z, cz), cross_input(tx, ctx), cross_input(tz, ctz)]
     }
 }
 
@@ -137,10 +135,19 @@ pub(super) const ROW_STARTS: [[[u8; TERMS]; 4]; COMPONENT_COUNT] = {
 /// any order, and so the clamped inputs and `N_k` are dead before the sweeps' rows are
 /// computed (measured with a coupled model, `needle firmware bench`: the fixed-point
 /// stiffness's stack 524 -> 492 B on the M4F, 520 -> 504 B on the M0).
+///
+/// Step 7 here too, on the same `N_k`: [`Status::FE_UNSOLVED`] into `at.status` when the
+/// clamped pose lies in the set's unsolved region (`pose` gives the depth, clamped again
+/// here rather than kept in [`Inputs`]: the stack).
 #[inline(always)]
-pub(super) fn accumulators(at: &Inputs) -> [[i32; TERMS]; COMPONENT_COUNT] {
+pub(super) fn accumulators(at: &mut Inputs, pose: &Pose) -> [[i32; TERMS]; COMPONENT_COUNT] {
     let mut a = BASELINE;
-    add_cross(at.cross_inputs(), &mut a);
+    let n = at.cross_inputs();
+    add_cross(n, &mut a);
+    let (d, _) = clamp(pose.depth_mm_q16, 0, DEPTH_MAX_MM_Q16);
+    if crate::unsolved::in_region_fixed(n, d) {
+        at.status |= Status::FE_UNSOLVED;
+    }
     let tables = ROWS.iter().zip(SHIFTS.iter()).zip(ODD.iter()).zip(ROW_STARTS.iter());
     for (ac, (((rows, shifts), odd), starts)) in a.iter_mut().zip(tables) {
         for (((((rows_k, shifts_k), &tk), &neg), &o), starts_k) in
