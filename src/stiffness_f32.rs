@@ -2,7 +2,7 @@
 //! ("Stiffness") bit for bit, sharing the wrench's operations.
 use crate::cross_f32::{add_cross, add_cross_rates, COUPLED, CROSS_SCALES};
 use crate::horner::{horner_from, horner_with_rate_from, MatrixStarts, Start};
-use crate::model_f32::{clamp_to_domain, skip_sweep, unsolved_flag, sweep_t, BASELINE_STARTS, ODD, ONE_THIRD, STARTS, SWEEP_SCALES};
+use crate::model_f32::{clamp_to_domain, skip_sweep, sweep_t, unsolved_flag, BASELINE_STARTS, ODD, ONE_THIRD, STARTS, SWEEP_SCALES};
 use crate::stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
 use crate::tables::{BASELINE, DEVIATION, FITTED};
 use crate::{Pose, Status, Wrench};

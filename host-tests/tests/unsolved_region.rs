@@ -90,7 +90,8 @@ fn every_failed_pose_is_flagged_and_no_solved_run_is() {
         for image in unsolved::mirror_images(n) {
             for step in 0..=20 {
                 let d = 0.3 * f64::from(step);
-                let at: [f32; 5] = [(image[0] * V[0]) as f32, (image[1] * V[1]) as f32, (image[2] * V[2]) as f32, (image[3] * V[3]) as f32, d as f32];
+                let at: [f32; 5] =
+                    [(image[0] * V[0]) as f32, (image[1] * V[1]) as f32, (image[2] * V[2]) as f32, (image[3] * V[3]) as f32, d as f32];
                 assert!(!f32_flag(at), "solved run {} (image {image:?}) flagged at {d} mm", p.name);
                 assert!(!fixed_flag(at.map(|v| (f64::from(v) * Q16).round() as i32)), "solved run {} flagged (fixed) at {d} mm", p.name);
                 checked += 1;
@@ -173,7 +174,8 @@ fn the_prefilter_drops_no_ball() {
             let v: [f64; 4] = std::array::from_fn(|k| (e.centre_q15[k] as f64 / Q15 + rng.gen_range(-1.5..1.5) * r) * V[k]);
             let d: f64 = rng.gen_range(-0.5..6.5);
             let p = [v[0] as f32, v[1] as f32, v[2] as f32, v[3] as f32, d as f32];
-            let c: [f32; 5] = [p[0].clamp(-12.0, 12.0), p[1].clamp(-12.0, 12.0), p[2].clamp(-15.0, 15.0), p[3].clamp(-15.0, 15.0), p[4].clamp(0.0, 6.0)];
+            let c: [f32; 5] =
+                [p[0].clamp(-12.0, 12.0), p[1].clamp(-12.0, 12.0), p[2].clamp(-15.0, 15.0), p[3].clamp(-15.0, 15.0), p[4].clamp(0.0, 6.0)];
             let want = unsolved::inside_f32(&entries, [c[0] * rx, c[1] * rz, c[2] * rtx, c[3] * rtz], c[4]);
             assert_eq!(f32_flag(p), want, "f32 pose {p:?}");
             let q = p.map(|v| (f64::from(v) * Q16).round() as i32);

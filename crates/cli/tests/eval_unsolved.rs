@@ -33,7 +33,12 @@ fn eval_names_the_flag_and_keeps_the_wrench() {
         String::from_utf8_lossy(&o.stdout).into_owned()
     };
     let text = run("15", false);
-    assert!(text.contains("status  = 0x20 (FE_UNSOLVED): in the domain; FE_UNSOLVED: the pose lies where the set's FE campaign could not solve"), "{text}");
+    assert!(
+        text.contains(
+            "status  = 0x20 (FE_UNSOLVED): in the domain; FE_UNSOLVED: the pose lies where the set's FE campaign could not solve"
+        ),
+        "{text}"
+    );
     let v: serde_json::Value = serde_json::from_str(&run("15", true)).expect("json");
     assert_eq!(v["status"]["bits"], "0x20");
     assert_eq!(v["status"]["fe_unsolved"], true);

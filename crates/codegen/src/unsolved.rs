@@ -112,7 +112,10 @@ pub fn parse_str(text: &str, path: &Path) -> Result<Region, CodegenError> {
     })?;
     let at = |span: std::ops::Range<usize>, m: String| CodegenError::at(path, text, span.start, m);
     if *raw.format.get_ref() != UNSOLVED_FORMAT {
-        return Err(at(raw.format.span(), format!("format = {}: this build reads unsolved format {UNSOLVED_FORMAT}", raw.format.get_ref())));
+        return Err(at(
+            raw.format.span(),
+            format!("format = {}: this build reads unsolved format {UNSOLVED_FORMAT}", raw.format.get_ref()),
+        ));
     }
     let _ = &raw.set;
     let depth_max = (DEPTH_MAX_MM as i64) * Q16;
@@ -128,7 +131,10 @@ pub fn parse_str(text: &str, path: &Path) -> Result<Region, CodegenError> {
         }
         let centres = f.centres_q15.get_ref();
         if centres.is_empty() || centres.len() > 4 {
-            return Err(at(f.centres_q15.span(), format!("centres_q15: {} centres, expected 1 to 4 (the pose and its mirror images)", centres.len())));
+            return Err(at(
+                f.centres_q15.span(),
+                format!("centres_q15: {} centres, expected 1 to 4 (the pose and its mirror images)", centres.len()),
+            ));
         }
         for c in centres {
             if c.iter().any(|v| !(-(Q15 - 1)..=Q15 - 1).contains(v)) {
@@ -258,8 +264,14 @@ mod tests {
         assert_eq!(r.balls.len(), 2);
         assert_eq!(r.balls[1], Ball { centre_q15: [0, 0, -32767, 0], radius_q15: 3276, depth_q16: 0, pose: 0 });
         assert_eq!(err(&ONE.replace("format = 1", "format = 2")), "unsolved.toml:1: format = 2: this build reads unsolved format 1");
-        assert_eq!(err(&ONE.replace("radius_q15 = 3276", "radius_q15 = 40000")), "unsolved.toml:14: radius_q15 = 40000: must be in 0 ..= 32768");
-        assert_eq!(err(&ONE.replace("depth_q16 = 0", "depth_q16 = -1")), "unsolved.toml:15: depth_q16 = -1: must be in 0 ..= 393216 (0 .. 6 mm)");
+        assert_eq!(
+            err(&ONE.replace("radius_q15 = 3276", "radius_q15 = 40000")),
+            "unsolved.toml:14: radius_q15 = 40000: must be in 0 ..= 32768"
+        );
+        assert_eq!(
+            err(&ONE.replace("depth_q16 = 0", "depth_q16 = -1")),
+            "unsolved.toml:15: depth_q16 = -1: must be in 0 ..= 393216 (0 .. 6 mm)"
+        );
         assert!(err(&ONE.replace("32767, 0], [0", "32768, 0], [0")).starts_with("unsolved.toml:16: centres_q15: [0, 0, 32768, 0]"));
         assert!(err(&ONE.replace("cause = \"c\"\n", "")).contains("missing field `cause`"));
         assert!(err(&ONE.replace("cause = ", "why = ")).starts_with("unsolved.toml:"));

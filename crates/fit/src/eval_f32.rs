@@ -3,7 +3,9 @@
 //! not call the `needle-haptics` library. Every operation is a plain binary32 `*`, `+`
 //! or `-` (Rust never fuses them), each rounded to nearest even on its own.
 
-use super::contract::{NCOEF, STATUS_ERROR, STATUS_FE_UNSOLVED, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z};
+use super::contract::{
+    NCOEF, STATUS_ERROR, STATUS_FE_UNSOLVED, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z,
+};
 use super::model::Model;
 use crate::contract::COMPONENT_COUNT;
 use needle_contract::{DEPTH_MAX_MM, HALF_RANGES};
