@@ -71,6 +71,7 @@ mod stiffness_f32;
 mod tables;
 pub mod telemetry;
 mod unsolved;
+pub mod viscoelastic;
 mod wrench;
 
 pub use depth_extension::extended_wrench;

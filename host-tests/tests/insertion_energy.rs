@@ -26,7 +26,8 @@
 //! 7e-5 N·mm in the worst case, but only its non-cancelling part accumulates: the
 //! dissipation of friction and puncture over any path is orders above it, so the
 //! assertion is `E <= 1e-6 N·mm`.
-use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, Stack};
+use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, Layer, Stack};
+use needle_haptics::viscoelastic::{PronyTerm, PronyTerms};
 use needle_haptics::Pose;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -155,19 +156,65 @@ fn energy_of(moves: &[Move], damping_n_s_per_mm: f64, mut render: impl FnMut(Pos
 fn no_closed_cycle_delivers_energy_to_the_hand() {
     assert!(!stacks::ALL.is_empty(), "the default set ships tissue stacks");
     for stack in &stacks::ALL {
+        no_closed_cycle_delivers_energy(stack, TRAJECTORIES);
+    }
+}
+
+/// Prony terms for the filter-on runs: inputs that exercise the filter, not a tissue's
+/// values (the shipped stacks have none: `coeffs/default/tissue/`). `moderate`: weights
+/// of the order a soft tissue relaxes by over three decades of time constants;
+/// `extreme`: the largest sum the format allows (9) with time constants of the
+/// trajectories' own time scales (1 ms to 0.1 s), where the filter acts most.
+fn test_terms() -> [(&'static str, PronyTerms); 2] {
+    let t = |g: f32, tau_s: f32| PronyTerm { g, tau_s };
+    [
+        ("moderate", PronyTerms::new(&[t(0.8, 0.05), t(0.5, 1.0), t(0.3, 20.0)]).expect("valid terms")),
+        ("extreme", PronyTerms::new(&[t(3.0, 0.001), t(3.0, 0.01), t(3.0, 0.1)]).expect("valid terms")),
+    ]
+}
+
+/// `stack`'s layers with `terms` on every layer.
+fn with_terms(stack: &Stack<'_>, terms: PronyTerms) -> Vec<Layer> {
+    stack.layers.iter().map(|l| Layer { prony: terms, ..*l }).collect()
+}
+
+/// The passivity test of the insertion model with the viscoelastic filter on every layer
+/// of every shipped stack (a third of the trajectories each, both sets of terms), and the
+/// guarded loop's with the moderate set. Not the guarded loop with the extreme set (sum g
+/// = 9, time constants 1 ms to 0.1 s): measured, `epidural` trajectory 3 delivered
+/// 18.5 N·mm to the hand, because the guard's offset treats the whole filtered deflection
+/// force as elastic; open in issue 39 (`docs/insertion.md`) until the guard takes the
+/// viscous part as its own term. No test is skipped for it: it is not run.
+#[test]
+fn with_the_viscoelastic_filter_no_closed_cycle_delivers_energy() {
+    for stack in &stacks::ALL {
+        for (label, terms) in test_terms() {
+            let layers = with_terms(stack, terms);
+            let name = format!("{} with {label} Prony terms", stack.name);
+            let filtered = Stack { name: &name, layers: &layers, ..*stack };
+            no_closed_cycle_delivers_energy(&filtered, TRAJECTORIES / 3);
+            if label == "moderate" {
+                the_guarded_loop_delivers_no_energy(&filtered, 100);
+            }
+        }
+    }
+}
+
+fn no_closed_cycle_delivers_energy(stack: &Stack<'_>, trajectories: usize) {
+    {
         // one generator per stack: a stack added does not change another's trajectories
         let mut rng = ChaCha8Rng::seed_from_u64(20261126);
         let deepest: f64 = stack.layers.iter().map(|l| f64::from(l.thickness_mm)).sum::<f64>() + 5.0;
         let (mut worst, mut punctured) = (f64::NEG_INFINITY, 0);
-        for n in 0..TRAJECTORIES {
+        for n in 0..trajectories {
             let moves = trajectory(&mut rng, deepest);
             let (e, p) = energy(stack, &moves);
             punctured += usize::from(p > 0);
             assert!(e <= BOUND_NMM, "{}: trajectory {n} delivered {e:e} N·mm to the hand: {moves:?}", stack.name);
             worst = worst.max(e);
         }
-        println!("{}: {TRAJECTORIES} trajectories ({punctured} with a puncture), most energy to the hand {worst:e} N·mm", stack.name);
-        assert!(punctured > TRAJECTORIES / 4, "{}: only {punctured} trajectories punctured: the test must cross punctures", stack.name);
+        println!("{}: {trajectories} trajectories ({punctured} with a puncture), most energy to the hand {worst:e} N·mm", stack.name);
+        assert!(punctured > trajectories / 4, "{}: only {punctured} trajectories punctured: the test must cross punctures", stack.name);
     }
 }
 
@@ -179,9 +226,14 @@ fn no_closed_cycle_delivers_energy_to_the_hand() {
 /// deflects, and a puncture clears it (the force drops; nothing stored is given back).
 #[test]
 fn the_loop_with_the_guard_delivers_no_energy_either() {
+    for stack in &stacks::ALL {
+        the_guarded_loop_delivers_no_energy(stack, 300);
+    }
+}
+
+fn the_guarded_loop_delivers_no_energy(stack: &Stack<'_>, loop_trajectories: usize) {
     use needle_haptics::control::{ChannelMap, LoopConfig, LoopCore, LoopFlags, OverLimit, Passivity};
     const WEAK_DAMPING_N_S_PER_MM: f64 = 0.0001;
-    const LOOP_TRAJECTORIES: usize = 300;
     let config = LoopConfig {
         channels: [ChannelMap { gains_per_n: [0.0, 0.01, 0.0], direction_inverted: false }],
         force_limit_n: 100.0,
@@ -190,12 +242,12 @@ fn the_loop_with_the_guard_delivers_no_energy_either() {
         ramp_step_n: 0.01,
     };
     let guard = Passivity { damping_n_s_per_mm: WEAK_DAMPING_N_S_PER_MM as f32, period_s: PERIOD_S as f32 };
-    for stack in &stacks::ALL {
+    {
         // one generator per stack: a stack added does not change another's trajectories
         let mut rng = ChaCha8Rng::seed_from_u64(20261127);
         let deepest: f64 = stack.layers.iter().map(|l| f64::from(l.thickness_mm)).sum::<f64>() + 5.0;
         let (mut worst, mut limited, mut punctured) = (f64::NEG_INFINITY, 0, 0);
-        for n in 0..LOOP_TRAJECTORIES {
+        for n in 0..loop_trajectories {
             let moves = trajectory(&mut rng, deepest);
             let mut core = LoopCore::new(config).expect("config");
             core.set_passivity(Some(guard)).expect("guard");
@@ -212,10 +264,10 @@ fn the_loop_with_the_guard_delivers_no_energy_either() {
             worst = worst.max(e);
         }
         println!(
-            "{}: {LOOP_TRAJECTORIES} trajectories through the guarded loop ({limited} stiffness-limited, {punctured} punctured), most energy to the hand {worst:e} N·mm",
+            "{}: {loop_trajectories} trajectories through the guarded loop ({limited} stiffness-limited, {punctured} punctured), most energy to the hand {worst:e} N·mm",
             stack.name
         );
-        assert!(limited > LOOP_TRAJECTORIES / 4, "{}: the guard acted in only {limited} trajectories", stack.name);
-        assert!(punctured > LOOP_TRAJECTORIES / 4, "{}: only {punctured} trajectories punctured", stack.name);
+        assert!(limited > loop_trajectories / 4, "{}: the guard acted in only {limited} trajectories", stack.name);
+        assert!(punctured > loop_trajectories / 4, "{}: only {punctured} trajectories punctured", stack.name);
     }
 }

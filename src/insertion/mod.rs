@@ -15,7 +15,18 @@
 //!   the stack's by geometric similarity: with `λ = needle_diameter_mm /
 //!   FE_NEEDLE_DIAMETER_MM`, the surrogate is evaluated at `x/λ, z/λ, δ/λ` (tilts
 //!   unchanged) and its forces are scaled by `s λ²`, its moments by `s λ³` (the hub at
-//!   `λ` times the FE needle's). Elastic: withdrawing gives the same force back.
+//!   `λ` times the FE needle's). Elastic for a layer without Prony terms: withdrawing
+//!   gives the same force back. With terms ([`Layer::prony`]) each of the six components
+//!   passes the layer's quasi-linear viscoelastic filter
+//!   ([`viscoelastic`](crate::viscoelastic), the state in the insertion): faster
+//!   indentation gives more force, a held needle feels it relax to the elastic one;
+//!   withdrawing, the filter keeps running (the force falls below the elastic one). The
+//!   puncture threshold compares the filtered axial force.
+//! - *viscous force released*: a puncture resets the filter (the boundary's stored
+//!   viscous force goes with its axial force; the lateral preload kept is the elastic
+//!   one), and so does the tip leaving the boundary (moving above it, or the path
+//!   ending): no stored force is pushed into the hand, and the next boundary starts
+//!   from rest.
 //! - *puncture*: when the deflection's axial force (along the needle, pushing it back)
 //!   plus the cutting force carried from the layer above (see below) reaches the layer's
 //!   `puncture_force_n`, the boundary is punctured in that tick: its axial force is gone
@@ -52,6 +63,10 @@ mod track;
 pub use stack::{stacks, Karnopp, Layer, Stack, FE_NEEDLE_DIAMETER_MM, HUB_FROM_TIP_MM, MAX_LAYERS};
 
 use crate::depth_extension::extended_wrench_and_depth_rate;
+#[cfg(not(feature = "viscoelastic"))]
+use crate::viscoelastic::identity::{QlvCoefficients, QlvState};
+#[cfg(feature = "viscoelastic")]
+use crate::viscoelastic::{QlvCoefficients, QlvState};
 use crate::{extended_wrench, Pose, Status, Wrench};
 use track::{axis, dot, Track, Vec3};
 
@@ -87,6 +102,9 @@ pub enum InsertionError {
     /// [`Insertion::set_scales`] got a count other than the stack's layers, or a scale
     /// that is not finite and > 0.
     Scales,
+    /// A layer has Prony terms and the library was built without its `viscoelastic`
+    /// feature.
+    NeedsViscoelastic,
 }
 
 impl core::fmt::Display for InsertionError {
@@ -96,6 +114,7 @@ impl core::fmt::Display for InsertionError {
             Self::Value => "tissue stack: a value out of range (thickness, scale, puncture force, stick band > 0; the rest >= 0)",
             Self::Config => "insertion config: period_s must be finite and > 0, velocity_time_constant_s finite and >= 0",
             Self::Scales => "stiffness scales: one per layer, each finite and > 0",
+            Self::NeedsViscoelastic => "tissue stack: a layer has Prony terms; build needle-haptics with its `viscoelastic` feature",
         })
     }
 }
@@ -206,6 +225,10 @@ pub struct Insertion {
     preload: [f32; 6],
     last_depth_mm: Option<f32>,
     velocity_mm_per_s: f32,
+    /// Per layer the relaxation's per-tick coefficients (computed once, in `new`).
+    qlv: [QlvCoefficients; MAX_LAYERS],
+    /// The viscoelastic filter of the deflected boundary's wrench.
+    qlv_state: QlvState,
 }
 
 /// What a passivity guard needs of an insertion tick beside its wrench
@@ -272,6 +295,15 @@ impl Insertion {
         if !positive(config.period_s) || !non_negative(config.velocity_time_constant_s) {
             return Err(InsertionError::Config);
         }
+        if cfg!(not(feature = "viscoelastic")) && stack.layers.iter().any(|l| !l.prony.as_slice().is_empty()) {
+            return Err(InsertionError::NeedsViscoelastic);
+        }
+        let mut qlv = [QlvCoefficients::NONE; MAX_LAYERS];
+        for (k, l) in qlv.iter_mut().zip(stack.layers) {
+            // a run-time stack's terms are checked like the file's (`PronyTerms::new`)
+            let terms = crate::viscoelastic::PronyTerms::new(l.prony.as_slice()).map_err(|_| InsertionError::Value)?;
+            *k = QlvCoefficients::new(&terms, config.period_s).map_err(|_| InsertionError::Config)?;
+        }
         let mut layers = [stack.layers.first().copied().ok_or(InsertionError::LayerCount)?; MAX_LAYERS];
         for (slot, l) in layers.iter_mut().zip(stack.layers) {
             *slot = *l;
@@ -287,6 +319,8 @@ impl Insertion {
             preload: [0.0; 6],
             last_depth_mm: None,
             velocity_mm_per_s: 0.0,
+            qlv,
+            qlv_state: QlvState::REST,
         })
     }
 
@@ -324,6 +358,7 @@ impl Insertion {
         self.track_end_mm = 0.0;
         self.track = None;
         self.preload = [0.0; 6];
+        self.qlv_state.reset();
     }
 
     /// One tick: the pose (entry point on the top surface, tilts, `depth_mm` of the tip
@@ -341,6 +376,9 @@ impl Insertion {
         self.tick(pose, true)
     }
 
+    // Never inlined: LLVM 22 (rustc 1.95) crashed in register allocation on x86-64 with
+    // the grown state inlined into a large caller (host-tests/tests/insertion_fixed.rs).
+    #[inline(never)]
     fn tick(&mut self, pose: &Pose, rate: bool) -> (InsertionEvaluation, GuardTerms) {
         let finite = [pose.x_mm, pose.z_mm, pose.theta_x_deg, pose.theta_z_deg, pose.depth_mm].into_iter().all(f32::is_finite);
         if !finite {
@@ -392,6 +430,12 @@ impl Insertion {
     }
 
     /// The deflection of the first intact boundary, with the punctures it causes.
+    ///
+    /// The boundary's wrench passes the layer's viscoelastic filter (the `viscoelastic`
+    /// module; its stiffness times the filter's tick gain `1 + sum b_i`). A puncture
+    /// releases the boundary's stored viscous force (the filter is reset: the lateral
+    /// part kept as preload is the elastic one), as does the tip leaving the boundary
+    /// (no deflected boundary in this tick): nothing stored is pushed into the hand.
     fn deflect(&mut self, pose: &Pose, a: Vec3, entry: Vec3, bounds: &[f32; MAX_LAYERS + 1], rate: bool) -> Deflected {
         let mut punctures = 0u8;
         while self.punctured < self.count {
@@ -399,17 +443,21 @@ impl Insertion {
             if pose.depth_mm <= q {
                 break;
             }
-            let Some(layer) = self.layers.get(self.punctured).copied() else { break };
+            let (Some(layer), Some(qlv)) = (self.layers.get(self.punctured).copied(), self.qlv.get(self.punctured)) else { break };
             let (e, k) = deflection_at(pose, pose.depth_mm - q, layer.stiffness_scale, self.similarity, rate);
-            let w = e.wrench.to_array();
+            let elastic = e.wrench.to_array();
+            let w = self.qlv_state.step(qlv, elastic);
             let axial_n = dot([w[0], w[1], w[2]], a);
             if axial_n + self.carried_cutting_n() < layer.puncture_force_n {
                 let mut total = self.preload;
                 for (t, x) in total.iter_mut().zip(w) {
                     *t += x;
                 }
-                return Deflected { wrench: total, status: e.status, punctures, stiffness_n_per_mm: k };
+                return Deflected { wrench: total, status: e.status, punctures, stiffness_n_per_mm: k * qlv.tick_gain() };
             }
+            let w = elastic;
+            let axial_n = dot([w[0], w[1], w[2]], a);
+            self.qlv_state.reset();
             // puncture: the axial force goes, the lateral force and the moments stay
             if self.track.is_none() {
                 self.track = Some(Track { entry_mm: entry, axis: a });
@@ -422,6 +470,7 @@ impl Insertion {
             self.track_end_mm = pose.depth_mm;
             punctures = punctures.saturating_add(1);
         }
+        self.qlv_state.reset();
         Deflected { wrench: self.preload, status: Status::OK, punctures, stiffness_n_per_mm: 0.0 }
     }
 

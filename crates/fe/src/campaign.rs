@@ -92,6 +92,13 @@ pub struct RunOptions {
     /// `needle fe verify --scaling`. Part of the run hash through the tissue; needs `out_dir`
     /// (scaled runs never go into `<set>/fe/`).
     pub tissue_scale: Option<f64>,
+    /// The ramp-and-hold runs of `[viscoelastic]` at this speed, mm/s (`crate::visco`):
+    /// its poses, mesh and Prony series, `--steps` must points on the ramp, output in
+    /// `<set>/fe/visco/` unless `out_dir`.
+    pub visco_speed_mm_per_s: Option<f64>,
+    /// Every speed of `[viscoelastic]` is meant (the CLI's `--visco`: one run of the
+    /// campaign per speed, each with `visco_speed_mm_per_s`); not read by [`run`].
+    pub visco: bool,
 }
 
 impl RunOptions {
@@ -113,6 +120,8 @@ impl RunOptions {
             launcher: Launched::Local,
             deep: false,
             tissue_scale: None,
+            visco_speed_mm_per_s: None,
+            visco: false,
         }
     }
 }
@@ -223,7 +232,10 @@ pub fn plan(opts: &RunOptions) -> Result<Plan> {
         // a CSV whose content is not what the campaign wrote is not up to date
         let rows = entry
             .and_then(|e| std::fs::read_to_string(&csv).ok().filter(|text| e.content_matches(text.as_bytes())))
-            .and_then(|text| results::parse_csv(&text, &csv).ok())
+            .and_then(|text| match campaign.loading.ramp_hold {
+                Some(_) => results::parse_timed_csv(&text, &csv).ok().map(|(_, rows)| rows),
+                None => results::parse_csv(&text, &csv).ok(),
+            })
             .filter(|r| r.len() == steps as usize + 1);
         let mut report = PoseReport {
             pose: pose.name.clone(),
@@ -273,6 +285,18 @@ fn apply_variant(opts: &RunOptions, campaign: &mut Campaign, spec_path: &Path) -
             bail!("--steps 0: must be >= 1");
         }
         campaign.loading.steps = s;
+    }
+    if let Some(speed) = opts.visco_speed_mm_per_s {
+        let v = campaign
+            .viscoelastic
+            .clone()
+            .with_context(|| format!("{}: --visco: the spec has no [viscoelastic] section", spec_path.display()))?;
+        if opts.deep {
+            bail!("--visco and --deep: the ramp-and-hold runs go to loading.depth_mm only");
+        }
+        let (run, poses) = crate::visco::apply(campaign, &v, speed, campaign.loading.steps);
+        *campaign = run;
+        return Ok(Variant { mesh: v.mesh, poses: Some(poses), out_dir: opts.set_dir.join("fe").join(crate::visco::VISCO_DIR) });
     }
     if let Some(s) = opts.tissue_scale {
         if !(s.is_finite() && s > 0.0) || opts.out_dir.is_none() {
@@ -575,7 +599,10 @@ fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Res
         rows.push(Row { depth_mm: ctx.campaign.loading.depth_at(k), wrench: *w });
     }
     let csv = ctx.out_dir.join(format!("{}.csv", pose.name));
-    let text = results::to_csv(&rows);
+    let text = match ctx.campaign.loading.ramp_hold {
+        Some(_) => results::to_timed_csv(&(0..=ctx.steps).map(|k| ctx.campaign.loading.time_at(k)).collect::<Vec<_>>(), &rows),
+        None => results::to_csv(&rows),
+    };
     results::write_atomic(&csv, text.as_bytes())?;
     let entry = ManifestEntry {
         spec_hash: ctx.campaign.run_hash(pose, ctx.mesh_name),
@@ -609,6 +636,7 @@ fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Res
         batch_job: ctx.launcher.batch_job(),
         replaces: ctx.campaign.replaced_by(&pose.name).map(|r| r.pose.clone()),
         replaced_because: ctx.campaign.replaced_by(&pose.name).map(|r| replaced_because(ctx.out_dir, r)),
+        viscoelastic: crate::visco::describe(ctx.campaign),
     };
     update_manifest(ctx, |m| {
         m.pose.insert(pose.name.clone(), entry);

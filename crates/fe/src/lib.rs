@@ -23,6 +23,7 @@ pub mod results;
 pub mod spec;
 pub mod verify;
 pub mod versions;
+pub mod visco;
 pub mod wrench;
 
 /// The workspace root (this crate is `crates/fe`), for the unit tests' `coeffs/default`.

@@ -8,6 +8,8 @@ use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+mod visco;
+
 /// The domain of the model (docs/architecture.md section 3); poses outside it are refused.
 pub const X_MAX_MM: f64 = 12.0;
 /// Largest |z| of a pose, mm.
@@ -44,6 +46,9 @@ pub struct Campaign {
     /// The deep runs of `needle fe run --deep` (`crate::deep`); absent: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub deep: Option<crate::deep::DeepSettings>,
+    /// The ramp-and-hold runs of `needle fe run --visco` (`crate::visco`); absent: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub viscoelastic: Option<crate::visco::settings::ViscoSettings>,
     /// The named poses as written (the Latin hypercube poses are added by [`Campaign::poses`]).
     #[serde(rename = "pose", default)]
     pub pose: Vec<PoseSpec>,
@@ -73,6 +78,10 @@ pub struct Tissue {
     pub stretch_min: f64,
     /// Largest principal stretch the stability check covers.
     pub stretch_max: f64,
+    /// The Prony series of a viscoelastic run (`crate::visco::apply`; never in the
+    /// file); absent: elastic.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub prony: Option<crate::visco::settings::Prony>,
 }
 
 impl Tissue {
@@ -139,14 +148,45 @@ pub struct Contact {
 pub struct Loading {
     /// Final depth along the needle axis, mm.
     pub depth_mm: f64,
-    /// Number of equal load steps (results at steps + 1 depths, 0 included).
+    /// Number of equal load steps (results at steps + 1 depths, 0 included); of a
+    /// ramp-and-hold run, its must points on the ramp and the hold.
     pub steps: u32,
+    /// The time course of a viscoelastic ramp-and-hold run (`crate::visco::apply`; never
+    /// in the file); absent: quasi-static, time = depth in mm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ramp_hold: Option<crate::visco::settings::RampHold>,
 }
 
 impl Loading {
     /// Depth after step `k` (0 ..= steps), mm.
     pub fn depth_at(&self, k: u32) -> f64 {
-        self.depth_mm * f64::from(k) / f64::from(self.steps)
+        match &self.ramp_hold {
+            Some(r) => r.depth_mm(self.depth_mm, k),
+            None => self.depth_mm * f64::from(k) / f64::from(self.steps),
+        }
+    }
+
+    /// The solver's time at must point `k` (0 ..= steps): the depth in mm of a
+    /// quasi-static run, seconds of a ramp-and-hold run.
+    pub fn time_at(&self, k: u32) -> f64 {
+        match &self.ramp_hold {
+            Some(r) => r.time_s(self.depth_mm, k),
+            None => self.depth_at(k),
+        }
+    }
+
+    /// The load step ending at must point `k` (1 ..= steps), in the solver's time.
+    pub fn step_time(&self, k: u32) -> f64 {
+        self.time_at(k) - self.time_at(k.saturating_sub(1))
+    }
+
+    /// The unit of [`Loading::time_at`], for messages.
+    pub fn time_unit(&self) -> &'static str {
+        if self.ramp_hold.is_some() {
+            "s"
+        } else {
+            "mm"
+        }
     }
 }
 
@@ -622,6 +662,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Campaign> {
     })?;
     campaign.validate(path)?;
     validate_deep(&campaign, text, path)?;
+    visco::validate(&campaign, text, path)?;
     Ok(campaign)
 }
 
@@ -1208,7 +1249,7 @@ impl crate::deep::DeepSettings {
     /// The campaign's spec as a deep run sees it: `[loading]` to the deep depth and steps.
     pub fn apply(&self, c: &Campaign) -> Campaign {
         let mut deep = c.clone();
-        deep.loading = Loading { depth_mm: self.depth_mm, steps: self.steps };
+        deep.loading = Loading { depth_mm: self.depth_mm, steps: self.steps, ramp_hold: None };
         deep
     }
 }

@@ -190,9 +190,9 @@ pub struct Furthest {
 }
 
 impl Furthest {
-    /// The records as the rigid-body log's, at t = depth of each must point.
-    pub fn rigid_records(&self, depth_mm: f64, steps: u32) -> Vec<RigidRecord> {
-        (1u32..).zip(&self.records).map(|(k, v)| RigidRecord { time: depth_at(depth_mm, steps, k), values: *v }).collect()
+    /// The records as the rigid-body log's, at the solver's time of each must point.
+    pub fn rigid_records(&self, loading: &crate::spec::Loading) -> Vec<RigidRecord> {
+        (1u32..).zip(&self.records).map(|(k, v)| RigidRecord { time: loading.time_at(k), values: *v }).collect()
     }
 }
 
@@ -379,7 +379,11 @@ mod tests {
         };
         s.write(d.path()).expect("write");
         assert_eq!(State::read(d.path()).expect("read"), s);
-        let r = s.furthest.as_ref().map(|f| f.rigid_records(6.0, 20)).unwrap_or_default();
+        let r = s
+            .furthest
+            .as_ref()
+            .map(|f| f.rigid_records(&crate::spec::Loading { depth_mm: 6.0, steps: 20, ramp_hold: None }))
+            .unwrap_or_default();
         assert_eq!(r.iter().map(|r| r.time).collect::<Vec<_>>(), [0.3, 0.6]);
         std::fs::write(d.path().join(STATE_FILE), "tried = 3").expect("write");
         assert!(State::read(d.path()).is_err(), "a corrupt state is an error, not a fresh ladder");

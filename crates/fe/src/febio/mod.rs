@@ -214,7 +214,13 @@ impl Backend for FebioBackend {
             &changed
         };
         let fs = &campaign.solver.febio;
-        let contact_steps = ladder::first_contact_steps(fs.first_contact_depth_mm, job.campaign.loading.depth_mm, job.steps);
+        let loading = &job.campaign.loading;
+        let contact_steps = if loading.ramp_hold.is_some() {
+            // uneven must points: the steps that start within the first-contact depth
+            (1..=job.steps).take_while(|&k| loading.depth_at(k - 1) < fs.first_contact_depth_mm - 1e-9 * loading.depth_mm).count() as u32
+        } else {
+            ladder::first_contact_steps(fs.first_contact_depth_mm, loading.depth_mm, job.steps)
+        };
         let first_contact = (!plan.retry_tolerances() && ladder::failed_at_first_contact(&state, contact_steps))
             .then_some(feb::FirstContact { depth_mm: fs.first_contact_depth_mm, step_fraction: fs.first_contact_step_fraction });
         let stepping =
@@ -234,9 +240,11 @@ impl Backend for FebioBackend {
         for f in [rb_path.clone(), log_path.clone(), job.work_dir.join(restart::DUMP), job.work_dir.join(restart::DUMP_FROM)] {
             remove_if_exists(&f)?;
         }
-        let depth = job.campaign.loading.depth_mm;
-        let step_mm = depth / f64::from(job.steps.max(1));
-        let dtmin = step_mm * fs.dtmin_fraction * restart::CONTINUE_DTMIN_SCALE;
+        let depth = loading.depth_mm;
+        // the load step after must point k, in the solver's time (mm of depth, or s)
+        let step_after = |k: u32| loading.step_time((k + 1).min(job.steps.max(1)));
+        let shortest = (1..=job.steps.max(1)).map(|k| loading.step_time(k)).fold(f64::INFINITY, f64::min);
+        let dtmin = shortest * fs.dtmin_fraction * restart::CONTINUE_DTMIN_SCALE;
         // a continuation's restarts set the retry tolerances: the dump carries the run's own
         let tolerances = plan.retry_tolerances().then_some(restart::Tolerances { dtol: fs.retry_dtol, rtol: fs.retry_rtol });
         let started = std::time::Instant::now();
@@ -248,9 +256,9 @@ impl Backend for FebioBackend {
             let dump = job.work_dir.join(ladder::FURTHEST_DUMP);
             std::fs::copy(&dump, &from).with_context(|| format!("{}: cannot copy to {}", dump.display(), from.display()))?;
             let restart_in = job.work_dir.join(restart::RESTART_INPUT);
-            std::fs::write(&restart_in, restart::restart_input(step_mm * plan.first_increment(), dtmin, tolerances))
+            std::fs::write(&restart_in, restart::restart_input(step_after(f.steps) * plan.first_increment(), dtmin, tolerances))
                 .with_context(|| format!("{}: cannot write", restart_in.display()))?;
-            segments = f.rigid_records(depth, job.steps);
+            segments = f.rigid_records(loading);
             eprintln!("{}: attempt {}: {}", job.pose.name, job.attempt + 1, plan.describe(depth, job.steps));
             restarting = true;
         }
@@ -286,16 +294,17 @@ impl Backend for FebioBackend {
             if let Ok(r) = &records {
                 all.extend_from_slice(r);
             }
-            let at_steps = pick_steps(&all, depth, job.steps);
+            let at_steps = pick_steps(&all, loading, job.steps);
             let done_steps = at_steps.iter().take_while(|w| w.is_some()).count();
             let solved = done.exit == ExitKind::Code(0) && run.normal_termination && done_steps >= job.steps as usize;
             // continue from the last must point when the solver gave up (not on a
             // timeout, stall or stop) and a dump of a converged must point exists; the
             // must point a continuation of another attempt started from counts as one
-            let last_mm = done_steps as f64 * step_mm;
+            // the must point reached, in the solver's time (mm of depth, or s)
+            let last_mm = loading.time_at(done_steps as u32);
             let mut tried_from = cont.clone();
             if let Some(f) = &resume {
-                tried_from.from_mm.insert(0, ladder::depth_at(depth, job.steps, f.steps));
+                tried_from.from_mm.insert(0, loading.time_at(f.steps));
             }
             let next = (!solved && matches!(done.exit, ExitKind::Code(_)) && done_steps > 0 && !process::interrupted())
                 .then(|| tried_from.next_fraction(last_mm))
@@ -306,11 +315,12 @@ impl Backend for FebioBackend {
             };
             let n = cont.from_mm.len() as u32;
             eprintln!(
-                "{}: febio4 stopped at t = {} mm ({}); continuing from the must point at {last_mm} mm with a first time step of {} mm",
+                "{}: febio4 stopped at t = {} {unit} ({}); continuing from the must point at {last_mm} {unit} with a first time step of {} {unit}",
                 job.pose.name,
                 run.last_time,
                 run.cause.as_deref().unwrap_or("no stated cause"),
-                step_mm * fraction
+                step_after(done_steps as u32) * fraction,
+                unit = loading.time_unit()
             );
             for (from, to) in
                 [(&rb_path, restart::segment_log(job.work_dir, n)), (&log_path, job.work_dir.join(restart::segment_solver_log_name(n)))]
@@ -323,7 +333,7 @@ impl Backend for FebioBackend {
             let from = job.work_dir.join(restart::DUMP_FROM);
             std::fs::copy(job.work_dir.join(restart::DUMP), &from).with_context(|| format!("{}: cannot write", from.display()))?;
             let input = job.work_dir.join(restart::RESTART_INPUT);
-            std::fs::write(&input, restart::restart_input(step_mm * fraction, dtmin, tolerances))
+            std::fs::write(&input, restart::restart_input(step_after(done_steps as u32) * fraction, dtmin, tolerances))
                 .with_context(|| format!("{}: cannot write", input.display()))?;
             cont.from_mm.push(last_mm);
             restarting = true;
@@ -337,11 +347,11 @@ impl Backend for FebioBackend {
                 line.push_str(&format!(
                     "; continued attempt {}'s last converged must point ({} mm; to there: {})",
                     f.attempt,
-                    ladder::depth_at(depth, job.steps, f.steps),
+                    loading.depth_at(f.steps),
                     f.settings
                 ));
             }
-            let continued = cont.describe();
+            let continued = cont.describe_in(loading.time_unit());
             if !continued.is_empty() {
                 line.push_str(&format!("; {continued}"));
             }
@@ -367,7 +377,7 @@ impl Backend for FebioBackend {
                     "{}: attempt {}'s dump at {} mm kept for the next attempt",
                     job.pose.name,
                     job.attempt + 1,
-                    ladder::depth_at(depth, job.steps, steps)
+                    loading.depth_at(steps)
                 );
             }
         }
@@ -382,15 +392,14 @@ impl Backend for FebioBackend {
                 e => e.to_string(),
             };
             let kept = keep_failed_attempt(job);
-            let continued = cont.describe();
-            let resumed = resume
-                .as_ref()
-                .map(|f| format!(", continuing attempt {} from {} mm", f.attempt, ladder::depth_at(depth, job.steps, f.steps)));
+            let continued = cont.describe_in(loading.time_unit());
+            let resumed = resume.as_ref().map(|f| format!(", continuing attempt {} from {} mm", f.attempt, loading.depth_at(f.steps)));
             return Err(SolveFailure {
                 message: format!(
-                    "febio4 {how} after {done_steps} of {} steps (t = {} mm), {} time steps, {} retries, {:.1} s{}{}{}{kept}",
+                    "febio4 {how} after {done_steps} of {} steps (t = {} {}), {} time steps, {} retries, {:.1} s{}{}{}{kept}",
                     job.steps,
                     run.last_time,
+                    loading.time_unit(),
                     totals.time_steps,
                     totals.retries,
                     started.elapsed().as_secs_f64(),
@@ -475,11 +484,12 @@ pub fn settings_line(s: &crate::spec::FebioSettings, friction: f64, threads: usi
 /// The record at each must point t_k = depth * k / steps, k = 1..=steps (None where the
 /// log has none; FEBio logs must points only, but a retried step may log twice: the last
 /// record at a time wins).
-fn pick_steps(records: &[logs::RigidRecord], depth: f64, steps: u32) -> Vec<Option<[f64; COMPONENT_COUNT]>> {
+fn pick_steps(records: &[logs::RigidRecord], loading: &crate::spec::Loading, steps: u32) -> Vec<Option<[f64; COMPONENT_COUNT]>> {
+    let end = loading.time_at(steps);
     (1..=steps)
         .map(|k| {
-            let t = depth * f64::from(k) / f64::from(steps);
-            records.iter().rev().find(|r| (r.time - t).abs() <= 1e-6 * depth).map(|r| r.values)
+            let t = loading.time_at(k);
+            records.iter().rev().find(|r| (r.time - t).abs() <= 1e-6 * end).map(|r| r.values)
         })
         .collect()
 }
@@ -691,8 +701,9 @@ mod tests {
     fn must_points_are_picked_by_time() {
         let r = |t: f64, v: f64| logs::RigidRecord { time: t, values: [v; COMPONENT_COUNT] };
         let recs = [r(3.0, 1.0), r(3.0, 2.0), r(6.0, 3.0)];
-        let got = pick_steps(&recs, 6.0, 2);
+        let loading = crate::spec::Loading { depth_mm: 6.0, steps: 2, ramp_hold: None };
+        let got = pick_steps(&recs, &loading, 2);
         assert_eq!(got, vec![Some([2.0; COMPONENT_COUNT]), Some([3.0; COMPONENT_COUNT])]);
-        assert_eq!(pick_steps(&recs[..1], 6.0, 2), vec![Some([1.0; COMPONENT_COUNT]), None]);
+        assert_eq!(pick_steps(&recs[..1], &loading, 2), vec![Some([1.0; COMPONENT_COUNT]), None]);
     }
 }

@@ -104,11 +104,17 @@ pub struct Continuations {
 impl Continuations {
     /// `continued 2 times from must points (3.6, 4.5 mm)`, or nothing.
     pub fn describe(&self) -> String {
+        self.describe_in("mm")
+    }
+
+    /// As [`Continuations::describe`], the must points in `unit` (a ramp-and-hold run's
+    /// time is seconds: `crate::visco`).
+    pub fn describe_in(&self, unit: &str) -> String {
         if self.from_mm.is_empty() {
             return String::new();
         }
         let at: Vec<String> = self.from_mm.iter().map(|d| format!("{d}")).collect();
-        format!("continued {} time(s) from the last converged must point ({} mm)", self.from_mm.len(), at.join(", "))
+        format!("continued {} time(s) from the last converged must point ({} {unit})", self.from_mm.len(), at.join(", "))
     }
 
     /// The first step fraction of the next continuation from `from_mm`, or `None` when the

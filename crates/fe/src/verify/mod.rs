@@ -13,11 +13,15 @@
 //!    solver accepted off the equilibrium path shows as such a point.
 //! 5. **Scaling law** ([`scaling`]): the centre and a half-model pose with every Ogden
 //!    mu_i scaled by 0.5 and 2 against s times the committed run (goal 0.5 % of peak |Fy|).
+//! 6. **Viscoelastic ramp and hold** ([`qlv`]): the `[viscoelastic]` runs against the
+//!    library's QLV filter on the elastic run (run by the CLI, `needle fe verify --qlv`;
+//!    goal RMS 3 %, must 5 %, largest 6 % of peak |Fy|), written with [`write_tables`].
 
 pub mod mesh_check;
 mod mirror;
 pub mod punch;
 pub mod punch_febio;
+pub mod qlv;
 pub mod runs;
 pub mod scaling;
 pub mod shape;
@@ -174,8 +178,6 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
         ok &= m.ok();
         report.mesh = Some(m);
     }
-    let path = opts.set_dir.join("fe").join("verify.toml");
-    let mut old: toml::Table = std::fs::read_to_string(&path).ok().and_then(|t| t.parse().ok()).unwrap_or_default();
     let mut new: toml::Table = toml::Table::try_from(&report).context("cannot serialise the verify report")?;
     // only the checks that ran replace their part of an earlier verify.toml
     if !opts.mirror {
@@ -184,11 +186,33 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
     if !opts.smooth {
         new.remove("smooth");
     }
+    write_tables(&opts.set_dir, new)?;
+    Ok((report, ok))
+}
+
+/// Replace the table `name` of `<set>/fe/verify.toml` with `value` ([`write_tables`]).
+///
+/// # Errors
+/// `value` does not serialise as TOML, or the file cannot be written.
+pub fn write_table(set_dir: &std::path::Path, name: &str, value: &impl Serialize) -> Result<()> {
+    let mut t = toml::Table::new();
+    t.insert(name.to_string(), toml::Value::try_from(value).with_context(|| format!("cannot serialise verify.toml's [{name}]"))?);
+    write_tables(set_dir, t)
+}
+
+/// Replace the tables of `new` in `<set>/fe/verify.toml` (atomically), keeping the
+/// others: a check that did not run keeps its table from the last run that did.
+///
+/// # Errors
+/// The file cannot be written.
+pub fn write_tables(set_dir: &std::path::Path, new: toml::Table) -> Result<()> {
+    let path = set_dir.join("fe").join("verify.toml");
+    let mut old: toml::Table = std::fs::read_to_string(&path).ok().and_then(|t| t.parse().ok()).unwrap_or_default();
     for (k, v) in new {
         old.insert(k, v);
     }
     let text = format!("# written by `needle fe verify`; do not edit\n{}", toml::to_string(&old)?);
     results::write_atomic(&path, text.as_bytes())?;
     println!("wrote {}", path.display());
-    Ok((report, ok))
+    Ok(())
 }
