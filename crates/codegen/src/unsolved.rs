@@ -290,15 +290,15 @@ mod tests {
         let r = parse_str(ONE, Path::new("unsolved.toml")).expect("good file");
         let masks = bin_masks(&r);
         for (i, ball) in r.balls.iter().enumerate() {
-            for k in 0..4 {
-                let c = ball.centre_q15[k] as f64 / Q15 as f64;
+            for (k, (row, &ck)) in masks.iter().zip(&ball.centre_q15).enumerate() {
+                let c = ck as f64 / Q15 as f64;
                 let rad = ball.radius_q15 as f64 / Q15 as f64;
                 for step in 0..=2000 {
                     let n = -1.0 + f64::from(step) / 1000.0;
                     if (n - c).abs() <= rad {
                         #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
                         let b = (((n + 1.0) * 8.0) as usize).min(BINS - 1);
-                        assert!(masks[k][b] & (1 << i) != 0, "ball {i}, input {k}, n = {n}: bin {b} lacks it");
+                        assert!(row[b] & (1 << i) != 0, "ball {i}, input {k}, n = {n}: bin {b} lacks it");
                     }
                 }
             }
