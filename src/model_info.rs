@@ -3,15 +3,15 @@
 //! Everything here comes from the coefficient set selected at build time
 //! (`NEEDLE_COEFFS`, default `coeffs/default`), through `build.rs` and `needle-codegen`.
 
-pub use crate::tables::{BASELINE, DEPTH_MAX_MM, DEVIATION, FE_SHA256, FITTED, FORMAT, SET, THETA_MAX_DEG, X_MAX_MM, Z_MAX_MM};
+pub use crate::float::tables::{BASELINE, DEPTH_MAX_MM, DEVIATION, FE_SHA256, FITTED, FORMAT, SET, THETA_MAX_DEG, X_MAX_MM, Z_MAX_MM};
 use needle_contract::COMPONENT_COUNT;
 
-pub use crate::cross_f32::{COUPLED, CROSS_SCALES, CROSS_TERMS, CV_RMS_PCT, CV_SCALE, TRAINING_RUNS};
+pub use crate::float::cross::{COUPLED, CROSS_SCALES, CROSS_TERMS, CV_RMS_PCT, CV_SCALE, TRAINING_RUNS};
 
 /// `ODD[k][c]`: wrench component `c` (fx, fy, fz, mx, my, mz) changes sign under the
 /// mirror of sweep `k` (x, z, theta_x, theta_z). Fixed by the geometry (coeffs/README.md);
 /// every model file is checked against it at build time.
-pub const ODD: [[bool; COMPONENT_COUNT]; 4] = crate::model_f32::ODD;
+pub const ODD: [[bool; COMPONENT_COUNT]; 4] = crate::float::eval::ODD;
 
 /// Absolute path of the set folder this build was generated from (on the build machine).
 pub const SET_DIR: &str = env!("NEEDLE_SET_DIR");

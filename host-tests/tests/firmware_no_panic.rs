@@ -91,7 +91,7 @@ fn fixed_point_evaluator_has_no_floating_point_on_any_core() {
         );
         // The same check on the f32 evaluator does see floating point (soft float on the
         // M0 and M3, FPU instructions on the M4F): it can fail.
-        let f32_use = float_check::analyse_elf(&elfs[0], "needle_haptics::model_f32::wrench").unwrap_or_else(|e| panic!("{e:#}"));
+        let f32_use = float_check::analyse_elf(&elfs[0], "needle_haptics::float::eval::wrench").unwrap_or_else(|e| panic!("{e:#}"));
         if core.name == "m4f" {
             assert!(!f32_use.fpu_instructions.is_empty(), "{}: no FPU instruction found in {}", core.core, f32_use.function);
         } else {

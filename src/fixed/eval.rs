@@ -5,7 +5,7 @@ use super::tables::{
     BASELINE, DEPTH_DIVISOR, DEPTH_MAX_MM_Q16, FRAC_BITS, ODD, ROWS, SHIFTS, SWEEP_DIVISORS, THETA_MAX_DEG_Q16, X_MAX_MM_Q16, Z_MAX_MM_Q16,
 };
 use super::{Evaluation, Pose, Wrench};
-use crate::tables::FITTED;
+use crate::float::tables::FITTED;
 use crate::Status;
 use needle_contract::COMPONENT_COUNT;
 use needle_contract::TERMS;

@@ -6,7 +6,7 @@ use super::eval::{accumulators, output, Inputs};
 use super::stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
 use super::tables::{FRAC_BITS, ODD, RATE_ROWS, RATE_SHIFTS, SHIFTS};
 use super::{Pose, Wrench};
-use crate::tables::FITTED;
+use crate::float::tables::FITTED;
 use crate::Status;
 use needle_contract::COMPONENT_COUNT;
 use needle_contract::{DEGREE, TERMS};

@@ -2,7 +2,7 @@
 use clap::{Args, Subcommand};
 use needle_fe::campaign::{self, RunOptions};
 use needle_fe::launcher::slurm::{self, SlurmOptions};
-use needle_fe::launcher::Launched;
+use needle_fe::manifest::Launched;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;

@@ -26,7 +26,7 @@
 //! A run that fails (solver error, no convergence, timeout) or stalls (no output for
 //! [`RunOptions::stall`]: ccx 2.20 was seen spinning without output at the start of a
 //! step, deterministically, e.g. theta_z = 15 degrees at 5.4 mm) is rerun with every load
-//! step starting at [`deck::RETRY_FIRST_INCREMENT`] of the step instead of the whole step,
+//! step starting at [`RETRY_FIRST_INCREMENT`](crate::backend::RETRY_FIRST_INCREMENT) of the step instead of the whole step,
 //! up to the engine's [`Backend::attempts`] in all (ccx: one retry; FEBio: four, decided
 //! by its ladder, `febio/ladder.rs`: a retry may continue the furthest attempt from its
 //! last converged must point). The manifest entry records it (`first_increment`,
@@ -37,10 +37,9 @@
 //! `progress` the display.
 
 use crate::backend::{Backend, Job, SolveFailure, Solved};
-use crate::deck;
 use crate::engines::backend_for;
-use crate::launcher::Launched;
-use crate::manifest::{manifest_text, read_manifest, rfc3339_utc, Manifest, ManifestEntry, MANIFEST};
+use crate::manifest::{manifest_text, read_manifest, rfc3339_utc, Launched, Manifest, ManifestEntry, MANIFEST};
+use crate::mesh_summary;
 use crate::partial;
 use crate::process;
 use crate::progress::Progress;
@@ -393,7 +392,7 @@ fn run_workers(
 ) {
     let queue: Mutex<VecDeque<usize>> = Mutex::new((0..to_run.len()).collect());
     let (tx, rx) = mpsc::channel::<Event>();
-    let runs = to_run.iter().map(|(_, p)| (p.name.clone(), deck::model_name(p.symmetry()).to_string())).collect();
+    let runs = to_run.iter().map(|(_, p)| (p.name.clone(), mesh_summary::model_name(p.symmetry()).to_string())).collect();
     let mut progress = Progress::new(runs, ctx.steps, jobs, earlier_walls_s);
     std::thread::scope(|s| {
         for _ in 0..jobs {
@@ -529,7 +528,7 @@ fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
     }
 }
 
-/// Solve `job`; when that fails, again with [`deck::RETRY_FIRST_INCREMENT`], up to the
+/// Solve `job`; when that fails, again with [`RETRY_FIRST_INCREMENT`](crate::backend::RETRY_FIRST_INCREMENT), up to the
 /// backend's [`Backend::attempts`] (module docs). The failures so far go into the
 /// result's `retry` (or the final failure's message). `keep` gets the must points of
 /// each failed attempt that reached further than the ones before, with the failures so
@@ -662,7 +661,7 @@ fn update_manifest(ctx: &Ctx<'_>, f: impl FnOnce(&mut Manifest)) -> Result<()> {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::deck::MeshSummary;
+    use crate::mesh_summary::MeshSummary;
     use crate::spec::Role;
     use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -938,7 +937,7 @@ pub(crate) mod tests {
         let m = read_manifest(&d.path().join("fe").join(MANIFEST)).expect("manifest");
         let (x2, x4) = (&m.pose["x+02"], &m.pose["x+04"]);
         assert_eq!((x2.first_increment, x2.retry.as_deref()), (None, None));
-        assert_eq!((x4.first_increment, x4.retry.as_deref()), (Some(deck::RETRY_FIRST_INCREMENT), Some("fake stall")));
+        assert_eq!((x4.first_increment, x4.retry.as_deref()), (Some(crate::backend::RETRY_FIRST_INCREMENT), Some("fake stall")));
         let text = std::fs::read_to_string(d.path().join("fe").join(MANIFEST)).expect("manifest text");
         assert_eq!(text.matches("first_increment = 0.25").count(), 1, "{text}");
         assert_eq!(text.matches("retry = \"fake stall\"").count(), 1, "{text}");

@@ -24,8 +24,8 @@
 //!   stress; the bulk modulus stays the Ogden's) and its time is seconds: the feed curve
 //!   ramps to the depth at the set speed and holds, the must points are the run's.
 
-use crate::deck::{model_name, MeshSummary};
 use crate::mesh::{self, NeedleMesh, TissueMesh, FACES};
+use crate::mesh_summary::{model_name, MeshSummary};
 use crate::spec::{Campaign, FebioSettings, Loading, MeshLevel, PoseSpec, Symmetry};
 use anyhow::{bail, Result};
 use std::fmt::Write;
@@ -452,4 +452,32 @@ fn write_load_data(w: &mut String, loading: &Loading, steps: u32, first_contact:
 fn num(v: f64) -> String {
     let v = if v == 0.0 { 0.0 } else { v };
     format!("{v:?}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    fn shipped() -> String {
+        std::fs::read_to_string(crate::workspace_root().join("coeffs/default/campaign.toml")).expect("campaign.toml")
+    }
+
+    #[test]
+    fn the_feb_wraps_the_ogden_and_runs_in_seconds() {
+        let c = crate::spec::parse(&shipped(), Path::new("campaign.toml")).expect("the shipped spec");
+        let v = c.viscoelastic.clone().expect("[viscoelastic]");
+        let (run, poses) = crate::visco::apply(&c, &v, 1.0, 4);
+        let pose = poses.first().expect("a pose");
+        let mesh = run.mesh_level("smoke").expect("smoke").clone();
+        let feb = write(&run, pose, &mesh, run.loading.steps, 1.0).expect("feb");
+        let t = &feb.text;
+        assert!(t.contains(r#"type="uncoupled viscoelastic""#) && t.contains(r#"<elastic type="Ogden">"#), "wrapped");
+        assert!(t.contains("<g1>0.6</g1>") && t.contains("<t2>5.0</t2>"), "the Prony terms");
+        // the feed: 6 mm at 1 mm/s, then held to 36 s; the last must point at 36 s
+        assert!(t.contains("<pt>6.0,6.0</pt>") && t.contains("<pt>36.0,6.0</pt>"), "feed curve");
+        assert!(t.contains("<pt>1.5,1.5</pt>") && t.contains("<pt>36.0,"), "must points");
+        let elastic = write(&c, pose, &mesh, 4, 1.0).expect("feb");
+        assert!(!elastic.text.contains("viscoelastic"), "an elastic run stays elastic");
+    }
 }

@@ -34,7 +34,7 @@
 //! ([`STATE_FILE`], beside the dump), so that each attempt decides from what is on disk.
 
 use super::logs::RigidRecord;
-use crate::deck::RETRY_FIRST_INCREMENT;
+use crate::backend::RETRY_FIRST_INCREMENT;
 use anyhow::{Context, Result};
 use needle_contract::COMPONENT_COUNT;
 use serde::{Deserialize, Serialize};

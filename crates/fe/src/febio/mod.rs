@@ -169,7 +169,7 @@ impl Backend for FebioBackend {
         if attempt < 2 {
             1.0
         } else {
-            crate::deck::RETRY_FIRST_INCREMENT
+            crate::backend::RETRY_FIRST_INCREMENT
         }
     }
 
@@ -680,7 +680,7 @@ mod tests {
         let state = ladder::State::read(&work).expect("state");
         assert_eq!(state.furthest.as_ref().map(|f| (f.attempt, f.steps)), Some((1, 2)));
         assert!(work.join(ladder::FURTHEST_DUMP).is_file() && !work.join(restart::DUMP).exists());
-        assert_eq!(backend.first_increment_in(&work, 1, false), crate::deck::RETRY_FIRST_INCREMENT);
+        assert_eq!(backend.first_increment_in(&work, 1, false), crate::backend::RETRY_FIRST_INCREMENT);
         assert!(backend
             .describe_attempt(&work, 1, false, 6.0, 4)
             .starts_with("continuing attempt 1 from its last converged must point (3 mm"));
@@ -689,9 +689,9 @@ mod tests {
         assert_eq!(fy, vec![-4.0, -8.0, -12.0, -16.0], "attempt 1's must points, then the continuation's");
         assert!(s.settings.contains("continued attempt 1's last converged must point (3 mm; to there: "), "{}", s.settings);
         assert!(s.settings.contains(&format!("dtol {} etol", c.solver.febio.retry_dtol)), "the retry tolerances: {}", s.settings);
-        assert_eq!(s.first_increment, crate::deck::RETRY_FIRST_INCREMENT);
+        assert_eq!(s.first_increment, crate::backend::RETRY_FIRST_INCREMENT);
         let restart = std::fs::read_to_string(work.join(restart::RESTART_INPUT)).expect("restart input");
-        assert!(restart.contains(&format!("<step_size>{:e}</step_size>", 1.5 * crate::deck::RETRY_FIRST_INCREMENT)), "{restart}");
+        assert!(restart.contains(&format!("<step_size>{:e}</step_size>", 1.5 * crate::backend::RETRY_FIRST_INCREMENT)), "{restart}");
         assert!(!work.join(ladder::FURTHEST_DUMP).exists(), "the kept dump goes once the pose solves");
         // a new campaign's first attempt starts from depth 0 whatever the folder holds
         assert_eq!(backend.first_increment_in(&work, 0, false), 1.0);

@@ -12,9 +12,7 @@
 //! FEBio's time is then seconds; the must points are [`RampHold::time_s`].
 //! `needle fe verify --qlv` compares these runs with the library's filter.
 
-pub mod settings;
-
-pub use settings::{Prony, RampHold, ViscoSettings, MAX_PRONY_TERMS};
+pub use crate::spec::visco::{run_name, Prony, RampHold, ViscoSettings, MAX_PRONY_TERMS};
 
 use crate::spec::{Campaign, PoseSpec};
 
@@ -23,11 +21,6 @@ pub const VISCO_DIR: &str = "visco";
 
 /// Header of a ramp-and-hold result: the time, s, before the FE result's columns.
 pub const TIME_COLUMN: &str = "time_s";
-
-/// The run name of `pose` at `speed_mm_per_s`: `centre_10mm-s`, `x+04_1p5mm-s`.
-pub fn run_name(pose: &str, speed_mm_per_s: f64) -> String {
-    format!("{pose}_{}mm-s", format!("{speed_mm_per_s}").replace('.', "p"))
-}
 
 /// The campaign as the runs at `speed_mm_per_s` see it (`ramp_steps` must points on the
 /// ramp), and their poses (renamed by [`run_name`]).
@@ -102,24 +95,6 @@ mod tests {
         let text = describe(&run).expect("a ramp-and-hold run");
         assert!(text.contains("at 10 mm/s (0.6 s") && text.contains("tau 0.5 s"), "{text}");
         assert_eq!(run_name("x+04", 1.5), "x+04_1p5mm-s");
-    }
-
-    #[test]
-    fn the_feb_wraps_the_ogden_and_runs_in_seconds() {
-        let c = crate::spec::parse(&shipped(), Path::new("campaign.toml")).expect("the shipped spec");
-        let v = c.viscoelastic.clone().expect("[viscoelastic]");
-        let (run, poses) = apply(&c, &v, 1.0, 4);
-        let pose = poses.first().expect("a pose");
-        let mesh = run.mesh_level("smoke").expect("smoke").clone();
-        let feb = crate::febio::feb::write(&run, pose, &mesh, run.loading.steps, 1.0).expect("feb");
-        let t = &feb.text;
-        assert!(t.contains(r#"type="uncoupled viscoelastic""#) && t.contains(r#"<elastic type="Ogden">"#), "wrapped");
-        assert!(t.contains("<g1>0.6</g1>") && t.contains("<t2>5.0</t2>"), "the Prony terms");
-        // the feed: 6 mm at 1 mm/s, then held to 36 s; the last must point at 36 s
-        assert!(t.contains("<pt>6.0,6.0</pt>") && t.contains("<pt>36.0,6.0</pt>"), "feed curve");
-        assert!(t.contains("<pt>1.5,1.5</pt>") && t.contains("<pt>36.0,"), "must points");
-        let elastic = crate::febio::feb::write(&c, pose, &mesh, 4, 1.0).expect("feb");
-        assert!(!elastic.text.contains("viscoelastic"), "an elastic run stays elastic");
     }
 
     #[test]

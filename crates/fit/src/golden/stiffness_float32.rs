@@ -1,13 +1,14 @@
 //! `golden-stiffness-f32.csv` (coeffs/README.md, "Stiffness"): for every pose of
 //! `golden-f32.csv`, in the same order, the status and the 18 rates of this crate's own
-//! evaluator ([`super::eval_rate_f32`]): by depth, by x, by z, each fx .. mz.
+//! evaluator ([`crate::eval::rate_float32`]): by depth, by x, by z, each fx .. mz.
 
-use super::contract::COMPONENTS;
-use super::eval_f32::Tables32;
-use super::eval_rate_f32::eval_rates;
-use super::golden::poses;
-use super::model_file::{hex32, parse_hex32};
+use crate::contract::COMPONENTS;
 use crate::contract::COMPONENT_COUNT;
+use crate::eval::float32::Tables32;
+use crate::eval::rate_float32::eval_rates;
+use crate::golden::float32::poses;
+use crate::golden::GoldenCsvError;
+use crate::model_file::{hex32, parse_hex32};
 use anyhow::Result;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -71,9 +72,9 @@ pub struct StiffnessRow {
 ///
 /// # Errors
 /// Wrong header, a row without 24 fields, a malformed hex field or status (`path:line`).
-pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<StiffnessRow>> {
-    super::golden::parse_rows(text, path, &header(), |field, at| {
-        let value = |s: &str| parse_hex32(s).ok_or_else(|| anyhow::anyhow!("{at}: field {s:?} is not 0x + 8 hex digits"));
+pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<StiffnessRow>, GoldenCsvError> {
+    crate::golden::parse_rows(text, path, &header(), |field, at| {
+        let value = |s: &str| parse_hex32(s).ok_or_else(|| GoldenCsvError::hex32(at, s));
         let mut pose = [0.0f32; 5];
         for (dst, s) in pose.iter_mut().zip(field) {
             *dst = value(s)?;

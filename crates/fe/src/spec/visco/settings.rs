@@ -9,8 +9,13 @@ use serde::{Deserialize, Serialize};
 /// `uncoupled viscoelastic` takes up to 6).
 pub use needle_contract::MAX_PRONY_TERMS;
 
+/// The run name of `pose` at `speed_mm_per_s`: `centre_10mm-s`, `x+04_1p5mm-s`.
+pub fn run_name(pose: &str, speed_mm_per_s: f64) -> String {
+    format!("{pose}_{}mm-s", format!("{speed_mm_per_s}").replace('.', "p"))
+}
+
 /// `[viscoelastic]`: the Prony series and the ramp-and-hold loadings of
-/// `needle fe run --visco` (module docs of `crate::visco`).
+/// `needle fe run --visco` (module docs of `crate::visco`, which applies them).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ViscoSettings {

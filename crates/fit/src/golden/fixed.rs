@@ -1,6 +1,6 @@
 //! `golden-fixed.csv` (coeffs/README.md, "Golden vectors"): Q16.16 poses and the expected
 //! integer wrench and status of each, from this crate's own fixed-point implementation
-//! ([`super::eval_fixed`], tables from [`super::fixed_formats`]).
+//! ([`crate::eval::fixed`], tables from [`crate::fixed_formats`]).
 //!
 //! The pose list is fixed in code: a 5^5 grid over the domain, 1,000 ChaCha8 random poses
 //! from [`GOLDEN_FIXED_SEED`], every input on, one unit inside and one unit outside its
@@ -8,9 +8,10 @@
 //! `i32::MAX`), zeros, inputs on both sides of the normalisation's rounding points, and
 //! poses in and around the set's unsolved region.
 
-use super::eval_fixed::{eval, DEPTH_DIVISOR, DEPTH_MAX_Q16, DIVISORS, HALF_RANGE_Q16, ONE};
-use super::fixed_formats::TablesFixed;
 use crate::contract::COMPONENT_COUNT;
+use crate::eval::fixed::{eval, DEPTH_DIVISOR, DEPTH_MAX_Q16, DIVISORS, HALF_RANGE_Q16, ONE};
+use crate::fixed_formats::TablesFixed;
+use crate::golden::GoldenCsvError;
 use anyhow::{anyhow, Result};
 use rand::{RngCore, SeedableRng};
 use std::fmt::Write as _;
@@ -50,7 +51,7 @@ pub fn poses(unsolved: &[crate::unsolved::Entry]) -> Vec<[i32; 5]> {
     let mut out = Vec::with_capacity(4600);
     // 1. grid 5^5 with the edges (the bounds are multiples of 4)
     let g: Vec<[i32; 5]> = (0..5).map(|i| std::array::from_fn(|n| (min[i] + (max[i] - min[i]) * n as i64 / 4) as i32)).collect();
-    out.extend(super::golden::grid(&g));
+    out.extend(crate::golden::grid(&g));
     // 2. random poses, uniform over the domain
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(GOLDEN_FIXED_SEED);
     for _ in 0..RANDOM_POSES {
@@ -159,9 +160,9 @@ pub struct FixedRow {
 ///
 /// # Errors
 /// Wrong header, a row without 12 fields, a malformed field (`path:line` in the message).
-pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<FixedRow>> {
-    super::golden::parse_rows(text, path, &header(), |field, at| {
-        let int = |s: &str| s.parse::<i32>().map_err(|_| anyhow!("{at}: {s:?} is not an i32"));
+pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<FixedRow>, GoldenCsvError> {
+    crate::golden::parse_rows(text, path, &header(), |field, at| {
+        let int = |s: &str| s.parse::<i32>().map_err(|_| GoldenCsvError::int(at, s));
         let mut pose = [0; 5];
         for (d, s) in pose.iter_mut().zip(&field[..5]) {
             *d = int(s)?;

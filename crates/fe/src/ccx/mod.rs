@@ -1,6 +1,15 @@
-//! Running CalculiX (`ccx`): finding the binary, its version, one job in a work folder
-//! with one thread, a wall-clock timeout, and the job's `.sta` status file (increments,
-//! iterations, and the last completed step while the job runs).
+//! The CalculiX engine: the deck ([`deck`]), the `.dat` reader ([`dat`]), the reduction of
+//! the needle's reactions ([`reactions`]) and [`CcxBackend`] behind the campaign's
+//! `Backend` trait; here, running `ccx`: finding the binary, its version, one job in a
+//! work folder with one thread, a wall-clock timeout, and the job's `.sta` status file
+//! (increments, iterations, and the last completed step while the job runs).
+
+pub mod backend;
+pub mod dat;
+pub mod deck;
+pub mod reactions;
+
+pub use backend::CcxBackend;
 
 use crate::process;
 use anyhow::{bail, Context, Result};
@@ -102,7 +111,7 @@ pub fn parse_sta(text: &str) -> StaSummary {
             Some(a) => (a, true),
             None => (*att, false),
         };
-        let (Ok(_), Ok(itrs), Some(tot)) = (att.parse::<u32>(), itrs.parse::<u32>(), crate::dat::parse_fortran(tot)) else {
+        let (Ok(_), Ok(itrs), Some(tot)) = (att.parse::<u32>(), itrs.parse::<u32>(), dat::parse_fortran(tot)) else {
             continue;
         };
         s.iterations += itrs;

@@ -1,12 +1,13 @@
 //! `golden-stiffness-fixed.csv` (coeffs/README.md, "Fixed-point stiffness"): for every
 //! pose of `golden-fixed.csv`, in the same order, the status and the 18 integer rates of
-//! this crate's own fixed-point implementation ([`super::eval_fixed::eval_rates`]).
+//! this crate's own fixed-point implementation ([`crate::eval::fixed::eval_rates`]).
 
-use super::eval_fixed::eval_rates;
-use super::fixed_formats::TablesFixed;
-use super::golden_fixed::poses;
-use super::golden_stiffness::rate_columns;
 use crate::contract::COMPONENT_COUNT;
+use crate::eval::fixed::eval_rates;
+use crate::fixed_formats::TablesFixed;
+use crate::golden::fixed::poses;
+use crate::golden::stiffness_float32::rate_columns;
+use crate::golden::GoldenCsvError;
 use anyhow::{anyhow, Result};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -55,9 +56,9 @@ pub struct FixedStiffnessRow {
 ///
 /// # Errors
 /// Wrong header, a row without 24 fields, a malformed field (`path:line` in the message).
-pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<FixedStiffnessRow>> {
-    super::golden::parse_rows(text, path, &header(), |field, at| {
-        let int = |s: &str| s.parse::<i32>().map_err(|_| anyhow!("{at}: {s:?} is not an i32"));
+pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<FixedStiffnessRow>, GoldenCsvError> {
+    crate::golden::parse_rows(text, path, &header(), |field, at| {
+        let int = |s: &str| s.parse::<i32>().map_err(|_| GoldenCsvError::int(at, s));
         let mut pose = [0; 5];
         for (d, s) in pose.iter_mut().zip(field) {
             *d = int(s)?;

@@ -3,11 +3,9 @@
 //! not call the `needle-haptics` library. Every operation is a plain binary32 `*`, `+`
 //! or `-` (Rust never fuses them), each rounded to nearest even on its own.
 
-use super::contract::{
-    NCOEF, STATUS_ERROR, STATUS_FE_UNSOLVED, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z,
-};
-use super::model::Model;
 use crate::contract::COMPONENT_COUNT;
+use crate::contract::{NCOEF, STATUS_ERROR, STATUS_FE_UNSOLVED, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z};
+use crate::model::Model;
 use needle_contract::{DEPTH_MAX_MM, HALF_RANGES};
 
 /// The f32 nearest 1/3 (IEEE division is correctly rounded): 0x3eaaaaab.
@@ -212,7 +210,7 @@ mod tests {
 
     #[test]
     fn odd_table_matches_contract() {
-        use super::super::contract::Sweep;
+        use crate::contract::Sweep;
         for k in Sweep::ALL {
             for (c, odd) in ODD[k.index()].iter().enumerate() {
                 assert_eq!(k.is_odd(c), *odd);

@@ -1,16 +1,16 @@
 //! The contract's evaluation algorithm (coeffs/README.md) in f64 on the f64 coefficients:
 //! the reference for validation and for the f32 evaluator's error.
 
-use super::contract::{
+use crate::contract::COMPONENT_COUNT;
+use crate::contract::{
     u_of, Sweep, DEPTH_MAX_MM, NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z,
 };
-use super::cross_terms::{cross_value, CrossTerms};
-use super::model::Model;
-use crate::contract::COMPONENT_COUNT;
+use crate::cross_terms::{cross_value, CrossTerms};
+use crate::model::Model;
 
-pub use super::poly::{deviation, horner};
+pub use crate::poly::{deviation, horner};
 
-pub use super::contract::Pose64;
+pub use crate::contract::Pose64;
 
 /// Evaluate the model at `pose`, in its form: the paper part ([`eval_paper`]) plus, for
 /// the coupled form, its cross terms ([`eval_with_cross`]).

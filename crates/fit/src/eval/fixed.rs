@@ -7,11 +7,9 @@
 //! [`Overflow`] (the library, which computes in wrapping i32, would have produced garbage
 //! there). Products are floored with `div_euclid`, not shifts.
 
-use super::contract::{
-    Sweep, NCOEF, STATUS_FE_UNSOLVED, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z,
-};
-use super::fixed_formats::{TablesFixed, LIMIT};
 use crate::contract::COMPONENT_COUNT;
+use crate::contract::{Sweep, NCOEF, STATUS_FE_UNSOLVED, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z};
+use crate::fixed_formats::{TablesFixed, LIMIT};
 use std::fmt;
 
 /// 1 mm or 1 degree in the Q16.16 pose.

@@ -1,7 +1,7 @@
 //! The paper model in f32: the evaluation algorithm of `coeffs/README.md`, bit-exact.
-use crate::cross_f32::{add_cross, COUPLED, CROSS_SCALES};
-use crate::horner::{horner_from, matrix_starts, start, MatrixStarts, Start, MINUS_ZERO};
-use crate::tables::{BASELINE, DEPTH_MAX_MM, DEVIATION, FITTED, THETA_MAX_DEG, X_MAX_MM, Z_MAX_MM};
+use crate::float::cross::{add_cross, COUPLED, CROSS_SCALES};
+use crate::float::horner::{horner_from, matrix_starts, start, MatrixStarts, Start, MINUS_ZERO};
+use crate::float::tables::{BASELINE, DEPTH_MAX_MM, DEVIATION, FITTED, THETA_MAX_DEG, X_MAX_MM, Z_MAX_MM};
 use crate::{Evaluation, Pose, Status, Wrench};
 use needle_contract::COMPONENT_COUNT;
 use needle_contract::TERMS;
@@ -45,7 +45,7 @@ pub(crate) const fn is_plus_zero_matrix(m: &[[f32; TERMS]; TERMS]) -> bool {
     true
 }
 
-/// `BASELINE_STARTS[c]`: where the Horner of `B_c` starts (`crate::horner`, exact;
+/// `BASELINE_STARTS[c]`: where the Horner of `B_c` starts (`crate::float::horner`, exact;
 /// 0 with `p0 = +0.0` for an all-zero baseline, which is then the constant
 /// `+0.0`), decided at compile time.
 #[allow(clippy::indexing_slicing)] // const evaluation only: an index out of range is a compile error
@@ -81,7 +81,7 @@ const SKIP_DEVIATION: [[bool; COMPONENT_COUNT]; 4] = {
 ///   `-0.0`. For such a component nothing is skipped.
 ///
 /// `with_rates`: the same for an evaluation that also accumulates `B_c'(u)` (the
-/// stiffness, `stiffness_f32::SKIP`), which must not start at `-0.0` either: its last
+/// stiffness, `float::eval_stiffness::SKIP`), which must not start at `-0.0` either: its last
 /// addition adds `b1` ([`rate_starts_not_neg_zero`]).
 #[allow(clippy::indexing_slicing)] // const evaluation only: an index out of range is a compile error
 pub(crate) const fn skip_sweep(mats: &[[[f32; TERMS]; TERMS]; COMPONENT_COUNT], with_rates: bool) -> [bool; COMPONENT_COUNT] {
@@ -110,13 +110,13 @@ pub(crate) const fn starts_not_neg_zero(b: &[f32; TERMS]) -> bool {
 }
 
 /// `B_c(u)` from its start (`+0.0` without evaluating it when every coefficient is
-/// `+0.0`: see [`skip_sweep`] and `crate::horner`).
+/// `+0.0`: see [`skip_sweep`] and `crate::float::horner`).
 #[inline(always)]
 pub(crate) fn baseline(b: &[f32; TERMS], start: Start, u: f32) -> f32 {
     horner_from(b, u, start)
 }
 
-/// `STARTS[k][c]`: where each Horner evaluation of `D_kc` starts (`crate::horner`,
+/// `STARTS[k][c]`: where each Horner evaluation of `D_kc` starts (`crate::float::horner`,
 /// exact), decided at compile time.
 #[allow(clippy::indexing_slicing)] // const evaluation only: an index out of range is a compile error
 pub(crate) const STARTS: [[MatrixStarts; COMPONENT_COUNT]; 4] = {
@@ -136,7 +136,7 @@ pub(crate) const STARTS: [[MatrixStarts; COMPONENT_COUNT]; 4] = {
 
 /// `D_kc(t, u)` of one deviation matrix `m`: Horner in `t` along each row (`r_i`),
 /// then Horner in `u` over the `r_i` (step 4 of the contract), each from its start `s`
-/// (the steps left out change no bit, `crate::horner`).
+/// (the steps left out change no bit, `crate::float::horner`).
 #[inline(always)]
 fn deviation(m: &[[f32; TERMS]; TERMS], s: &MatrixStarts, t: f32, u: f32) -> f32 {
     let [m0, m1, m2, m3, m4] = m;
@@ -372,7 +372,7 @@ pub(crate) fn clamp_to_domain(pose: &Pose) -> Option<(Pose, Status)> {
 /// f32 operations (24 deviation polynomials of 5x5 and 6 quartics); polynomials whose
 /// coefficients are all `+0.0` are left out at compile time, exactly (12 of the 24
 /// and 5 of the 6 in the default set), and every Horner starts at its highest
-/// coefficient that is not `+0.0` (`crate::horner`: the same bits; the coupled form's
+/// coefficient that is not `+0.0` (`crate::float::horner`: the same bits; the coupled form's
 /// sweeps are of degree 1-4 in t). Inputs outside the domain, NaN or infinite take a
 /// slower path for steps 1 and 2.
 ///

@@ -6,10 +6,10 @@
 //! by component, with the rates by x and z and the moments' depth rates left unused, so
 //! the compiler drops them: the wrench and the three force rates are its bits exactly
 //! (host-tests/tests/depth_rate.rs compares them on the golden poses).
-use crate::cross_f32::{add_cross, add_cross_rates, COUPLED, CROSS_SCALES};
-use crate::model_f32::{clamp_to_domain, unsolved_flag, ONE_THIRD};
-use crate::stiffness_f32::{component, At, Column};
-use crate::tables::FITTED;
+use crate::float::cross::{add_cross, add_cross_rates, COUPLED, CROSS_SCALES};
+use crate::float::eval::{clamp_to_domain, unsolved_flag, ONE_THIRD};
+use crate::float::eval_stiffness::{component, At, Column};
+use crate::float::tables::FITTED;
 use crate::{Evaluation, Pose, Status, Wrench};
 use needle_contract::COMPONENT_COUNT;
 
@@ -56,7 +56,7 @@ pub fn wrench_and_depth_rate(pose: &Pose) -> (Evaluation, [f32; 3]) {
 }
 
 /// Component `C`: its wrench and, with `RATE`, its rate by `u` (else `0.0`, and the
-/// compiler drops the rate's operations); not inlined, as in `stiffness_f32`.
+/// compiler drops the rate's operations); not inlined, as in `float::eval_stiffness`.
 #[inline(never)]
 fn column<const C: usize, const RATE: bool>(at: &At) -> (f32, f32) {
     let c = component(&Column::<C>::TABLES, at);

@@ -14,10 +14,10 @@
 //! - `*FRICTION` second value: stick slope (ABAQUS: `SLIP TOLERANCE` / `ELASTIC SLIP`);
 //! - `*TIME POINTS` and `TIME POINTS=` on print requests (ABAQUS: `*OUTPUT, TIME POINTS=`).
 
-use super::mesh::{self, NeedleMesh, TissueMesh};
-use super::spec::{Campaign, MeshLevel, PoseSpec, Symmetry};
+use crate::mesh::{self, NeedleMesh, TissueMesh};
+use crate::mesh_summary::{model_name, MeshSummary};
+use crate::spec::{Campaign, MeshLevel, PoseSpec, Symmetry};
 use anyhow::{bail, Result};
-use serde::Serialize;
 use std::fmt::Write;
 
 /// Version of the mesh and deck generator ([`versions::CCX_DECK`](crate::versions::CCX_DECK)).
@@ -46,23 +46,6 @@ impl NeedleIds {
 /// Name of the node set whose reaction forces are printed every step.
 pub const PRINT_SET: &str = "NPRINT";
 
-/// Size of the model, for the manifest.
-#[derive(Debug, Clone, Serialize)]
-pub struct MeshSummary {
-    /// Tissue nodes.
-    pub tissue_nodes: usize,
-    /// Tissue elements (C3D8).
-    pub tissue_elements: usize,
-    /// Needle nodes (all with prescribed motion).
-    pub needle_nodes: usize,
-    /// Needle elements (C3D8, contact master faces only).
-    pub needle_elements: usize,
-    /// Which part of the block is modelled, e.g. "half, mirror plane z = 0".
-    pub model: String,
-    /// The tissue mesh in words.
-    pub tissue_mesh: String,
-}
-
 /// A written deck and what is needed to read its results back.
 #[derive(Debug, Clone)]
 pub struct Deck {
@@ -82,30 +65,6 @@ pub struct Deck {
     pub symmetry: Symmetry,
 }
 
-impl MeshSummary {
-    /// The summary of a pose's tissue and needle meshes with mirror planes `sym`.
-    pub fn of(t: &TissueMesh, n: &NeedleMesh, sym: Symmetry) -> Self {
-        MeshSummary {
-            tissue_nodes: t.nodes.len(),
-            tissue_elements: t.elements.len(),
-            needle_nodes: n.nodes.len(),
-            needle_elements: n.elements.len(),
-            model: model_name(sym).to_string(),
-            tissue_mesh: t.info.clone(),
-        }
-    }
-}
-
-/// Describe the modelled part for a symmetry.
-pub fn model_name(sym: Symmetry) -> &'static str {
-    match (sym.plane_x, sym.plane_z) {
-        (true, true) => "quarter, mirror planes x = 0 and z = 0",
-        (false, true) => "half, mirror plane z = 0",
-        (true, false) => "half, mirror plane x = 0",
-        (false, false) => "full block, no mirror plane",
-    }
-}
-
 /// Write the deck of `pose` on mesh level `mesh`, with `steps` load steps over the full
 /// insertion depth of the spec.
 ///
@@ -115,12 +74,8 @@ pub fn write_deck(c: &Campaign, pose: &PoseSpec, mesh_level: &MeshLevel, steps: 
     write_deck_with_symmetry(c, pose, mesh_level, steps, pose.symmetry())
 }
 
-/// The first increment of every load step, as a fraction of the step (`*STATIC`'s first
-/// value), when the step is not tried in one increment. The campaign's retry of a failed
-/// or stalled run (see `campaign`) uses it; ccx cuts back from there as usual.
-pub const RETRY_FIRST_INCREMENT: f64 = 0.25;
-
 /// As [`write_deck`], with every load step starting at `first_increment` of the step
+/// (the retries: [`RETRY_FIRST_INCREMENT`](crate::backend::RETRY_FIRST_INCREMENT))
 /// (`*STATIC` first value; 1 is [`write_deck`]'s). The model and the loads are the same:
 /// only ccx's incrementation within a step differs.
 ///

@@ -1,13 +1,13 @@
 //! The wrench's exact partial derivatives by depth, x and z in f64 on the f64
 //! coefficients (coeffs/README.md, "Stiffness"): the reference the f32 stiffness is
 //! measured against, itself checked against central differences of
-//! [`super::eval_f64::eval`] (tests below).
+//! [`crate::eval::float64::eval`] (tests below).
 
-use super::contract::{u_of, Sweep, DEPTH_MAX_MM, NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_X, STATUS_SAT_Z};
-use super::cross_terms::{mono, normalised, poly};
-use super::eval_f64::{eval, horner, Pose64};
-use super::model::Model;
 use crate::contract::COMPONENT_COUNT;
+use crate::contract::{u_of, Sweep, DEPTH_MAX_MM, NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_X, STATUS_SAT_Z};
+use crate::cross_terms::{mono, normalised, poly};
+use crate::eval::float64::{eval, horner, Pose64};
+use crate::model::Model;
 
 /// `p'(w)` of the polynomial `p` (`p[i]` multiplies `w^i`).
 pub fn horner_rate(p: &[f64], w: f64) -> f64 {

@@ -1,5 +1,5 @@
 //! `golden-f32.csv` (coeffs/README.md, "Golden vectors"): the poses, and the expected f32
-//! wrench and status of each from this crate's own evaluator ([`super::eval_f32`]).
+//! wrench and status of each from this crate's own evaluator ([`crate::eval::float32`]).
 //!
 //! The pose list is fixed in code and reproducible: a 5^5 grid over the domain, 1,000
 //! ChaCha8 random poses from [`GOLDEN_SEED`], the domain's bounds (on, one ulp inside, one
@@ -9,10 +9,11 @@
 //! balls' centres, depths either side of their thresholds, offsets of half and twice the
 //! radius).
 
-use super::eval_f32::{eval, Tables32};
-use super::model_file::{hex32, parse_hex32};
 use crate::contract::COMPONENT_COUNT;
-use anyhow::{bail, Result};
+use crate::eval::float32::{eval, Tables32};
+use crate::golden::GoldenCsvError;
+use crate::model_file::{hex32, parse_hex32};
+use anyhow::Result;
 use rand::RngCore;
 use rand::SeedableRng;
 use std::fmt::Write as _;
@@ -68,25 +69,6 @@ fn with(i: usize, v: f32) -> [f32; 5] {
     p
 }
 
-/// Every pose with one of the five `levels[i]` for each input `i` (x, z, theta_x,
-/// theta_z, depth), input 0 varying slowest: 5^5 poses in file order. Both golden files
-/// start with this grid.
-pub fn grid<T: Copy>(levels: &[[T; 5]]) -> Vec<[T; 5]> {
-    let mut out = Vec::with_capacity(3125);
-    for &x in &levels[0] {
-        for &z in &levels[1] {
-            for &tx in &levels[2] {
-                for &tz in &levels[3] {
-                    for &d in &levels[4] {
-                        out.push([x, z, tx, tz, d]);
-                    }
-                }
-            }
-        }
-    }
-    out
-}
-
 /// Every golden pose `[x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm]`, in file order,
 /// for a set whose unsolved region has the balls `unsolved` (section 8: poses in and
 /// around each ball, [`crate::unsolved::golden_poses_f32`]).
@@ -98,7 +80,7 @@ pub fn poses(unsolved: &[crate::unsolved::Entry]) -> Vec<[f32; 5]> {
         [lo, lo + (hi - lo) * 0.25, lo + (hi - lo) * 0.5, lo + (hi - lo) * 0.75, hi]
     };
     let g: Vec<[f32; 5]> = (0..5).map(lin).collect();
-    out.extend(grid(&g));
+    out.extend(crate::golden::grid(&g));
     // 2. random poses, uniform over the domain
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(GOLDEN_SEED);
     for _ in 0..RANDOM_POSES {
@@ -207,9 +189,9 @@ pub struct GoldenRow {
 /// # Errors
 /// Wrong header, a row without `6 + COMPONENT_COUNT` fields, a malformed hex field (`path:line` in the
 /// message).
-pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<GoldenRow>> {
-    parse_rows(text, path, &header(), |field, at| {
-        let value = |s: &str| parse_hex32(s).ok_or_else(|| anyhow::anyhow!("{at}: field {s:?} is not 0x + 8 hex digits"));
+pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<GoldenRow>, GoldenCsvError> {
+    crate::golden::parse_rows(text, path, &header(), |field, at| {
+        let value = |s: &str| parse_hex32(s).ok_or_else(|| GoldenCsvError::hex32(at, s));
         let (mut pose, mut wrench) = ([0.0f32; 5], [0.0f32; COMPONENT_COUNT]);
         for (j, dst) in pose.iter_mut().chain(wrench.iter_mut()).enumerate() {
             // field 5 is the status, read by parse_rows
@@ -220,51 +202,12 @@ pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<GoldenRow>> {
     .map(|rows| rows.into_iter().map(|(pose, status, wrench)| GoldenRow { pose, status, wrench }).collect())
 }
 
-/// The layout every golden file shares: `header`, then rows of `fields` fields (as many
-/// as the header has) `5 pose values, status (0x + 2 hex digits), the outputs`. `values`
-/// reads the pose and the outputs of one row from its fields; its second argument is
-/// the row's `path:line` for messages.
-///
-/// # Errors
-/// Wrong header, a row with another number of fields, a malformed status, or `values`'
-/// error.
-#[allow(clippy::type_complexity)]
-pub(crate) fn parse_rows<P, W>(
-    text: &str,
-    path: &Path,
-    header: &str,
-    values: impl Fn(&[&str], &str) -> Result<(P, W)>,
-) -> Result<Vec<(P, u8, W)>> {
-    let fields = header.split(',').count();
-    let p = path.display();
-    let mut lines = text.lines();
-    if lines.next() != Some(header) {
-        bail!("{p}:1: expected the header {header:?}");
-    }
-    let mut rows = Vec::new();
-    for (n, line) in lines.enumerate() {
-        let at = format!("{p}:{}", n + 2);
-        let f: Vec<&str> = line.split(',').collect();
-        if f.len() != fields {
-            bail!("{at}: {} fields, expected {fields}", f.len());
-        }
-        let status = f[5]
-            .strip_prefix("0x")
-            .filter(|h| h.len() == 2)
-            .and_then(|h| u8::from_str_radix(h, 16).ok())
-            .ok_or_else(|| anyhow::anyhow!("{at}: status {:?} is not 0x + 2 hex digits", f[5]))?;
-        let (pose, wrench) = values(&f, &at)?;
-        rows.push((pose, status, wrench));
-    }
-    Ok(rows)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn err(text: &str) -> String {
-        format!("{:#}", parse_csv(text, Path::new("g.csv")).expect_err("must be refused"))
+    fn err(text: &str) -> GoldenCsvError {
+        parse_csv(text, Path::new("g.csv")).expect_err("must be refused")
     }
 
     #[test]
@@ -280,9 +223,14 @@ mod tests {
         let good = format!("{}\n{}\n", header(), row("0x01", one));
         let rows = parse_csv(&good, Path::new("g.csv")).expect("good file");
         assert_eq!(rows, [GoldenRow { pose: [1.0; 5], status: 1, wrench: [1.0; COMPONENT_COUNT] }]);
-        assert_eq!(err("x\n"), format!("g.csv:1: expected the header {:?}", header()));
-        assert_eq!(err(&format!("{}\n{}\n0x1\n", header(), row("0x00", one))), "g.csv:3: 1 fields, expected 12");
-        assert_eq!(err(&format!("{}\n{}\n", header(), row("0x1", one))), "g.csv:2: status \"0x1\" is not 0x + 2 hex digits");
-        assert_eq!(err(&format!("{}\n{}\n", header(), row("0x00", "1.0"))), "g.csv:2: field \"1.0\" is not 0x + 8 hex digits");
+        let e = err("x\n");
+        assert_eq!(e, GoldenCsvError::Header { path: "g.csv".into(), expected: header() });
+        assert!(e.to_string().starts_with("g.csv:1: "), "file:line first: {e}");
+        let e = err(&format!("{}\n{}\n0x1\n", header(), row("0x00", one)));
+        assert_eq!(e, GoldenCsvError::FieldCount { at: "g.csv:3".into(), found: 1, expected: 12 });
+        let e = err(&format!("{}\n{}\n", header(), row("0x1", one)));
+        assert_eq!(e, GoldenCsvError::Status { at: "g.csv:2".into(), value: "0x1".into() });
+        let e = err(&format!("{}\n{}\n", header(), row("0x00", "1.0")));
+        assert!(matches!(&e, GoldenCsvError::Value { at, value, .. } if at == "g.csv:2" && value == "1.0"), "{e:?}");
     }
 }

@@ -1,12 +1,12 @@
 //! An independent f32 implementation of the contract's stiffness (coeffs/README.md,
 //! "Stiffness"): the exact partial derivatives of the wrench by depth, x and z. It writes
-//! `golden-stiffness-f32.csv`, so like [`super::eval_f32`] it must not call the
+//! `golden-stiffness-f32.csv`, so like [`crate::eval::float32`] it must not call the
 //! `needle-haptics` library; it skips nothing (no zero-matrix shortcut) and computes
 //! every derivative coefficient at run time.
 
-use super::contract::{NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_X, STATUS_SAT_Z};
-use super::eval_f32::{clamp32, eval, h32, horner_n32, monomial32, Tables32, ODD, ONE_THIRD, R_THETA, R_XZ, S_THETA, S_XZ};
 use crate::contract::COMPONENT_COUNT;
+use crate::contract::{NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_X, STATUS_SAT_Z};
+use crate::eval::float32::{clamp32, eval, h32, horner_n32, monomial32, Tables32, ODD, ONE_THIRD, R_THETA, R_XZ, S_THETA, S_XZ};
 
 /// `(h(p, w), h'(p, w))` in f32: the value by [`h32`]'s operations, the derivative
 /// accumulated alongside (`d = p4`, then `d = d*w + b` after the steps for p3, p2, p1,

@@ -23,7 +23,7 @@ pub(crate) const MINUS_ZERO: u32 = 0x8000_0000;
 
 /// Where a Horner evaluation starts: the index of its first coefficient, so `4` (the
 /// contract's degree) is every step. One byte, so that the tables of starts cost little
-/// flash (`model_f32::STARTS`: 7 B per matrix).
+/// flash (`float::eval::STARTS`: 7 B per matrix).
 pub(crate) type Start = u8;
 
 /// Every step: the start at the top coefficient (index `DEGREE`, 4).

@@ -1,17 +1,17 @@
 //! The wrench and its stiffness in f32: the evaluation algorithm of `coeffs/README.md`
 //! ("Stiffness") bit for bit, sharing the wrench's operations.
-use crate::cross_f32::{add_cross, add_cross_rates, COUPLED, CROSS_SCALES};
-use crate::horner::{horner_from, horner_with_rate_from, MatrixStarts, Start};
-use crate::model_f32::{clamp_to_domain, skip_sweep, sweep_t, unsolved_flag, BASELINE_STARTS, ODD, ONE_THIRD, STARTS, SWEEP_SCALES};
+use crate::float::cross::{add_cross, add_cross_rates, COUPLED, CROSS_SCALES};
+use crate::float::eval::{clamp_to_domain, skip_sweep, sweep_t, unsolved_flag, BASELINE_STARTS, ODD, ONE_THIRD, STARTS, SWEEP_SCALES};
+use crate::float::horner::{horner_from, horner_with_rate_from, MatrixStarts, Start};
+use crate::float::tables::{BASELINE, DEVIATION, FITTED};
 use crate::stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
-use crate::tables::{BASELINE, DEVIATION, FITTED};
 use crate::{Pose, Status, Wrench};
 use needle_contract::COMPONENT_COUNT;
 use needle_contract::TERMS;
 
 /// `SKIP[k][c]`: `D_kc` and all its derivatives are `+0.0` and adding them changes no
 /// accumulator, so they are left out exactly: the matrix is all `+0.0` (see
-/// `model_f32::skip_sweep`), and neither `B_c(u)` nor `B_c'(u)` can be `-0.0`
+/// `float::eval::skip_sweep`), and neither `B_c(u)` nor `B_c'(u)` can be `-0.0`
 /// (`skip_sweep`'s `with_rates`). The x and z rates of a skipped matrix start from `+0.0` and
 /// stay `+0.0` (`+0 - +0 = +0`).
 const SKIP: [[bool; COMPONENT_COUNT]; 4] = {
@@ -143,7 +143,7 @@ pub(crate) struct Component {
 /// deviation matrix, the starts of its Horner evaluations, parity and skip flag.
 pub(crate) struct ComponentTables {
     baseline: [f32; TERMS],
-    /// Where its Horner starts (`model_f32::BASELINE_STARTS`).
+    /// Where its Horner starts (`float::eval::BASELINE_STARTS`).
     baseline_start: Start,
     mats: [[[f32; TERMS]; TERMS]; 4],
     starts: [MatrixStarts; 4],
@@ -186,7 +186,7 @@ fn component_of<const C: usize>(at: &At) -> Component {
 /// One component: the baseline and its rate, then per sweep `w ± D`, `a ± dD/du`, and for
 /// x and z `g ± dD/dt`. `w + sign * D` is `w - D` for `sign = -1` (the product is exact,
 /// and `w + (-D)` is `w - D` by definition; `+0 + -0 = +0 = +0 - +0`): one multiply-add
-/// on the FPU and no branch. Every Horner starts where the tables say (`crate::horner`).
+/// on the FPU and no branch. Every Horner starts where the tables say (`crate::float::horner`).
 #[inline(always)]
 pub(crate) fn component(tables: &ComponentTables, at: &At) -> Component {
     let ComponentTables { baseline, baseline_start, mats, starts, odd, skip } = tables;

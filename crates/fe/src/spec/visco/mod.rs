@@ -2,15 +2,17 @@
 //! ramp-and-hold runs, `crate::visco`).
 
 use super::{check_pose_in_block, Campaign, MAX_LOAD_STEPS};
-use crate::visco::{run_name, MAX_PRONY_TERMS};
+pub mod settings;
+
 use anyhow::{bail, Result};
+pub use settings::{run_name, Prony, RampHold, ViscoSettings, MAX_PRONY_TERMS};
 use std::path::Path;
 
 /// Check `[viscoelastic]` against the rest of the spec (and that `[tissue]` / `[loading]`
 /// do not set what only it sets); messages start with `file:line:` and name the field.
 ///
 /// # Errors
-/// No or more than [`MAX_PRONY_TERMS`](crate::visco::MAX_PRONY_TERMS) terms, `g` and `tau_s` of different lengths, a
+/// No or more than [`MAX_PRONY_TERMS`] terms, `g` and `tau_s` of different lengths, a
 /// g_i < 0 or not finite, a tau_i <= 0 or not finite, a speed <= 0 or repeated, a hold
 /// or its first point out of range, an unknown mesh level, an unknown or repeated pose.
 pub(crate) fn validate(c: &Campaign, text: &str, path: &Path) -> Result<()> {
