@@ -110,7 +110,7 @@ fn f32_and_fixed_point_agree_on_the_flag_at_every_golden_pose() {
     let entries = entries();
     let band = 1e-4;
     // golden-fixed.csv: the Q16.16 poses, and the same poses in f32 (exact: |v| < 2^24 / 2^16)
-    let fixed_rows = needle_fit::golden_fixed::parse_csv(
+    let fixed_rows = needle_fit::golden::fixed::parse_csv(
         &std::fs::read_to_string(set_dir().join("golden-fixed.csv")).expect("golden-fixed.csv"),
         Path::new("golden-fixed.csv"),
     )
@@ -132,7 +132,7 @@ fn f32_and_fixed_point_agree_on_the_flag_at_every_golden_pose() {
         }
     }
     // golden-f32.csv: the finite poses, and their nearest Q16.16 pose
-    let f32_rows = needle_fit::golden::parse_csv(
+    let f32_rows = needle_fit::golden::float32::parse_csv(
         &std::fs::read_to_string(set_dir().join("golden-f32.csv")).expect("golden-f32.csv"),
         Path::new("golden-f32.csv"),
     )

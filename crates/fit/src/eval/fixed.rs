@@ -8,7 +8,9 @@
 //! there). Products are floored with `div_euclid`, not shifts.
 
 use crate::contract::COMPONENT_COUNT;
-use crate::contract::{Sweep, NCOEF, STATUS_FE_UNSOLVED, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z};
+use crate::contract::{
+    Sweep, NCOEF, STATUS_FE_UNSOLVED, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z,
+};
 use crate::fixed_formats::{TablesFixed, LIMIT};
 use std::fmt;
 

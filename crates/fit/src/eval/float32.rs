@@ -4,7 +4,9 @@
 //! or `-` (Rust never fuses them), each rounded to nearest even on its own.
 
 use crate::contract::COMPONENT_COUNT;
-use crate::contract::{NCOEF, STATUS_ERROR, STATUS_FE_UNSOLVED, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z};
+use crate::contract::{
+    NCOEF, STATUS_ERROR, STATUS_FE_UNSOLVED, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z,
+};
 use crate::model::Model;
 use needle_contract::{DEPTH_MAX_MM, HALF_RANGES};
 
