@@ -613,3 +613,71 @@ fn worst(r: &Report, role: &str, f: fn(&RunReport) -> f64) -> String {
         format!("worst {:.3} % over {} runs", v.iter().copied().fold(0.0, f64::max), v.len())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::unsolved::{inside_f32, normalised, solved_inside, to_toml, FILE};
+    use needle_fe::spec;
+
+    /// A copy of the default set's spec, FE runs and model in a temporary folder.
+    fn temp_set(tag: &str) -> std::path::PathBuf {
+        let root = crate::workspace_root().join("coeffs/default");
+        let dir = std::env::temp_dir().join(format!("needle-fit-unsolved-{tag}-{}", std::process::id()));
+        let fe = dir.join("fe");
+        std::fs::create_dir_all(&fe).expect("temp set");
+        for f in ["campaign.toml", "model.toml"] {
+            std::fs::copy(root.join(f), dir.join(f)).expect("copy");
+        }
+        for e in std::fs::read_dir(root.join("fe")).expect("fe").flatten() {
+            let p = e.path();
+            if p.is_file() {
+                std::fs::copy(&p, fe.join(e.file_name())).expect("copy a run");
+            }
+        }
+        dir
+    }
+
+    /// Issue 42, item 4: a held-out pose that failed every attempt joins the region from
+    /// its partial record (deeper than it reached), `needle validate` names it beside the
+    /// goals as a run the FE cannot solve, and no solved run lies in any ball.
+    #[test]
+    fn a_partial_record_joins_the_region_and_validate_names_it() {
+        let dir = temp_set("record");
+        let (campaign, _) = spec::load(&dir).expect("spec");
+        let pose = campaign.poses().into_iter().find(|p| p.name == "t2-b").expect("t2-b");
+        let failed = needle_fe::partial::Failed {
+            campaign: &campaign,
+            pose: &pose,
+            mesh: &campaign.campaign.mesh,
+            engine: ("febio", "4.11.0"),
+            failure:
+                "febio4 exit code 1 after 6 of 20 steps (t = 1.95 mm): Max nr of reformations reached. (failed to converge at time : 1.95)",
+        };
+        let reached: Vec<[f64; 6]> = (1..=6).map(|k| [0.0, 0.001 * f64::from(k), 0.0, 0.0, 0.0, 0.0]).collect();
+        needle_fe::partial::write(&dir.join("fe"), &failed, &reached).expect("partial record");
+        let r = crate::unsolved::region(&dir).expect("region");
+        let t2b = r.failed.iter().find(|f| f.pose == "t2-b").expect("t2-b is in the region").clone();
+        assert_eq!((t2b.source.as_str(), t2b.reached_depth_mm, t2b.depth_q16), ("fe/t2-b.partial.toml", Some(1.8), 117_965));
+        assert!(t2b.cause.contains("max reformations"), "{}", t2b.cause);
+        assert!(r.failed.iter().all(|f| f.pose != "lhs-04"), "no record, not fitted without: not in the region");
+        assert!(solved_inside(&r).is_empty(), "a ball reaches half way to the nearest solved run: {:?}", solved_inside(&r));
+        let entries = r.entries();
+        let n = normalised(t2b.at).map(|v| v as f32);
+        assert!(!inside_f32(&entries, n, 1.8) && inside_f32(&entries, n, 2.1), "deeper than it reached only");
+        // the model carries it once `needle fit` writes unsolved.toml; validate then says so
+        std::fs::write(dir.join(FILE), to_toml("default", &r)).expect("unsolved.toml");
+        let report = validate(&dir).expect("validate");
+        let table = to_table(&report);
+        let _ = std::fs::remove_dir_all(&dir);
+        let u = report.unsolved.iter().find(|u| u.name == "t2-b").expect("t2-b reported");
+        assert!(u.failed_every_attempt && u.flagged_from_mm == Some(2.1), "{u:?}");
+        assert!(
+            table.contains(
+                "held-out runs the FE cannot solve (every attempt failed; counted as missed): t2-b (table2; FE_UNSOLVED from 2.1 mm)"
+            ),
+            "{table}"
+        );
+        assert!(!report.table2_goal_met, "an unsolved held-out run still counts as missed");
+    }
+}
