@@ -268,7 +268,7 @@ impl<const N: usize> LoopCore<N> {
                 // rates by x and z the guard does not use
                 let (e, [dfx, dfy, dfz]) = crate::wrench_and_depth_rate(pose);
                 let k2 = dfx * dfx + dfy * dfy + dfz * dfz;
-                (e.wrench, e.status, Some((p, GuardTerms { stiffness_n_per_mm: libm::sqrtf(k2), dissipative_n: [0.0; 3] })))
+                (e.wrench, e.status, Some((p, GuardTerms { stiffness_n_per_mm: libm::sqrtf(k2), ..GuardTerms::NONE })))
             }
             None => {
                 let e = crate::wrench(pose);

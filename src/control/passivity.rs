@@ -72,12 +72,14 @@ impl Passivity {
     }
 }
 
-/// The guard's state: the offset between model and command, and the last model force.
+/// The guard's state: the offset between model and command, the last model force, and
+/// (with the `viscoelastic` feature) the guard's own filter of the guarded deflection.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub(crate) struct Guard {
     offset_n: [f32; 3],
     last_model_n: Option<[f32; 3]>,
+    filter: GuardFilter,
 }
 
 impl Guard {
@@ -89,26 +91,52 @@ impl Guard {
     /// The guarded force for the model force `f_n` with its stiffness and dissipative
     /// part `terms` (the module's rule), and whether the stiffness was limited.
     pub(crate) fn apply(&mut self, p: &Passivity, f_n: [f32; 3], terms: &GuardTerms) -> ([f32; 3], bool) {
+        #[cfg(feature = "viscoelastic")]
+        if terms.filter.coefficients.is_active() {
+            return self.apply_filtered(p, f_n, terms);
+        }
+        self.filter.rest();
         let d = terms.dissipative_n;
         // no dissipative part (the block surrogate): the whole force, bits unchanged
         if d == [0.0; 3] {
-            return self.apply_elastic(p, f_n, terms.stiffness_n_per_mm);
+            let (g, limited, _) = self.apply_elastic(p, f_n, terms.stiffness_n_per_mm);
+            return (g, limited);
         }
         let elastic = [f_n[0] - d[0], f_n[1] - d[1], f_n[2] - d[2]];
-        let (g, limited) = self.apply_elastic(p, elastic, terms.stiffness_n_per_mm);
+        let (g, limited, _) = self.apply_elastic(p, elastic, terms.stiffness_n_per_mm);
         ([g[0] + d[0], g[1] + d[1], g[2] + d[2]], limited)
     }
 
-    /// The rule on an elastic force `f_n` of stiffness `k_n_per_mm`.
-    fn apply_elastic(&mut self, p: &Passivity, f_n: [f32; 3], k_n_per_mm: f32) -> ([f32; 3], bool) {
+    /// The rule with the deflected boundary's viscoelastic filter: the elastic part
+    /// `F - D - V` through [`apply_elastic`](Self::apply_elastic) at the effective
+    /// stiffness `rho K` (`terms.stiffness_n_per_mm`), then the guard's own filter run on
+    /// the guarded deflection force (its increments `s dE`, `s` the rule's scale), then
+    /// `D` unchanged.
+    #[cfg(feature = "viscoelastic")]
+    fn apply_filtered(&mut self, p: &Passivity, f_n: [f32; 3], terms: &GuardTerms) -> ([f32; 3], bool) {
+        let (d, v) = (terms.dissipative_n, terms.filter.viscous_n);
+        let elastic = [f_n[0] - d[0] - v[0], f_n[1] - d[1] - v[1], f_n[2] - d[2] - v[2]];
+        let (g, limited, scale) = self.apply_elastic(p, elastic, terms.stiffness_n_per_mm);
+        let h = self.filter.step(&terms.filter.coefficients, terms.filter.deflection_n, scale);
+        ([g[0] + h[0] + d[0], g[1] + h[1] + d[1], g[2] + h[2] + d[2]], limited)
+    }
+
+    /// The rule on an elastic force `f_n` of stiffness `k_n_per_mm`; the guarded force,
+    /// whether the stiffness was limited, and the scale the force's change of this
+    /// tick entered the command with (`k_g / k` when limited, else 1; `None` without a
+    /// last force: the first tick after a reset follows the model).
+    fn apply_elastic(&mut self, p: &Passivity, f_n: [f32; 3], k_n_per_mm: f32) -> ([f32; 3], bool, Option<f32>) {
         let k_g = p.guard_stiffness_n_per_mm();
         // `k > k_g > 0` (validated), so the division is by a positive, finite number.
         let limited = k_n_per_mm > k_g;
+        let mut scale = self.last_model_n.map(|_| 1.0);
         if let (Some(last), true) = (self.last_model_n, limited) {
-            let keep = 1.0 - k_g / k_n_per_mm;
+            let pass = k_g / k_n_per_mm;
+            let keep = 1.0 - pass;
             for ((o, f), l) in self.offset_n.iter_mut().zip(f_n).zip(last) {
                 *o += keep * (f - l);
             }
+            scale = Some(pass);
         }
         if f_n == [0.0; 3] {
             self.offset_n = [0.0; 3];
@@ -116,6 +144,56 @@ impl Guard {
         self.last_model_n = Some(f_n);
         let [o0, o1, o2] = self.offset_n;
         let [f0, f1, f2] = f_n;
-        ([f0 - o0, f1 - o1, f2 - o2], limited)
+        ([f0 - o0, f1 - o1, f2 - o2], limited, scale)
     }
+}
+
+/// The guard's own viscoelastic filter of the guarded deflection force: the last
+/// deflection force `E` it saw and the terms' state `h_i` per force component. At rest
+/// (nothing stored, last `E` 0) whenever the tick has no filter (no boundary with
+/// Prony terms deflected: the insertion's filter is at rest too); without history
+/// (nothing stored, no last `E`: it starts relaxed at the next `E`) after a puncture
+/// and after a fault.
+#[cfg(feature = "viscoelastic")]
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct GuardFilter {
+    last_deflection_n: Option<[f32; 3]>,
+    h_n: [[f32; crate::viscoelastic::MAX_TERMS]; 3],
+}
+
+#[cfg(feature = "viscoelastic")]
+impl GuardFilter {
+    /// At rest as the insertion's filter is without a deflected boundary: nothing
+    /// stored, the last deflection force 0 (the next boundary's first force enters
+    /// whole, as in the insertion's filter).
+    fn rest(&mut self) {
+        *self = Self { last_deflection_n: Some([0.0; 3]), ..Self::default() };
+    }
+
+    /// One tick: the deflection force `e_n` whose change since the last tick enters the
+    /// filter times `scale` (the guard's rule; with `scale` `None`, the first tick after
+    /// a reset, or no last force: nothing enters, the filter starts relaxed at `E`);
+    /// the filter's viscous force out.
+    fn step(&mut self, c: &crate::viscoelastic::QlvCoefficients, e_n: [f32; 3], scale: Option<f32>) -> [f32; 3] {
+        let d = match (self.last_deflection_n, scale) {
+            (Some(l), Some(s)) => [s * (e_n[0] - l[0]), s * (e_n[1] - l[1]), s * (e_n[2] - l[2])],
+            _ => [0.0; 3],
+        };
+        self.last_deflection_n = Some(e_n);
+        c.step_increments(&mut self.h_n, d)
+    }
+}
+
+/// Without the `viscoelastic` feature: no filter, nothing stored.
+#[cfg(not(feature = "viscoelastic"))]
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct GuardFilter;
+
+#[cfg(not(feature = "viscoelastic"))]
+impl GuardFilter {
+    /// Nothing to reset.
+    #[inline]
+    fn rest(&mut self) {}
 }

@@ -244,11 +244,50 @@ pub struct GuardTerms {
     /// takes energy out, so a guard leaves it as it is and limits the rest (the
     /// boundary's deflection, the preload and the track's hold: the elastic part).
     pub dissipative_n: [f32; 3],
+    /// The viscoelastic filter's share (zero-sized without the `viscoelastic` feature).
+    pub(crate) filter: FilterTerms,
 }
 
 impl GuardTerms {
     /// No stiffness, no dissipative force.
-    pub const NONE: Self = Self { stiffness_n_per_mm: 0.0, dissipative_n: [0.0; 3] };
+    pub const NONE: Self = Self { stiffness_n_per_mm: 0.0, dissipative_n: [0.0; 3], filter: FilterTerms::NONE };
+}
+
+/// What a guard needs of the deflected boundary's viscoelastic filter: the filter's
+/// coefficients (`NONE` when no boundary with Prony terms is deflected: the insertion's
+/// filter is then at rest), the unfiltered elastic deflection force `E` and the
+/// filter's part `V` of the wrench's forces (filtered minus `E`). The guard renders
+/// `F - D - V` (the elastic part, a function of the path) through its rule and adds
+/// its own filter run on the guarded `E` (`control::passivity`).
+#[cfg(feature = "viscoelastic")]
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub(crate) struct FilterTerms {
+    /// The deflected layer's per-tick coefficients.
+    pub(crate) coefficients: QlvCoefficients,
+    /// The boundary's deflection force before the filter, N (block frame).
+    pub(crate) deflection_n: [f32; 3],
+    /// The filter's part of the wrench's forces, N: the filtered deflection force
+    /// minus `deflection_n`.
+    pub(crate) viscous_n: [f32; 3],
+}
+
+#[cfg(feature = "viscoelastic")]
+impl FilterTerms {
+    /// No filter in this tick.
+    pub(crate) const NONE: Self = Self { coefficients: QlvCoefficients::NONE, deflection_n: [0.0; 3], viscous_n: [0.0; 3] };
+}
+
+/// Without the `viscoelastic` feature there is no filter: nothing.
+#[cfg(not(feature = "viscoelastic"))]
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub(crate) struct FilterTerms;
+
+#[cfg(not(feature = "viscoelastic"))]
+impl FilterTerms {
+    /// Nothing.
+    pub(crate) const NONE: Self = Self;
 }
 
 /// What [`Insertion::deflect`] found: the wrench so far (preload included), the
@@ -258,6 +297,25 @@ struct Deflected {
     status: Status,
     punctures: u8,
     stiffness_n_per_mm: f32,
+    filter: FilterTerms,
+}
+
+/// The guard's share of the deflected boundary's filter ([`FilterTerms`]): the
+/// coefficients, the elastic deflection force and the filtered minus the elastic one.
+#[cfg(feature = "viscoelastic")]
+fn filter_terms(qlv: &QlvCoefficients, elastic: &[f32; 6], filtered: &[f32; 6]) -> FilterTerms {
+    if !qlv.is_active() {
+        return FilterTerms::NONE;
+    }
+    let [ex, ey, ez, ..] = *elastic;
+    let [fx, fy, fz, ..] = *filtered;
+    FilterTerms { coefficients: *qlv, deflection_n: [ex, ey, ez], viscous_n: [fx - ex, fy - ey, fz - ez] }
+}
+
+/// Without the filter: nothing.
+#[cfg(not(feature = "viscoelastic"))]
+fn filter_terms(_qlv: &QlvCoefficients, _elastic: &[f32; 6], _filtered: &[f32; 6]) -> FilterTerms {
+    FilterTerms
 }
 
 fn positive(v: f32) -> bool {
@@ -397,10 +455,10 @@ impl Insertion {
         let a = axis(pose.theta_x_deg, pose.theta_z_deg);
         let entry: Vec3 = [pose.x_mm, 0.0, pose.z_mm];
         let bounds = self.boundaries(a[1]);
-        let Deflected { wrench: mut w, status, punctures, stiffness_n_per_mm } = self.deflect(pose, a, entry, &bounds, rate);
+        let Deflected { wrench: mut w, status, punctures, stiffness_n_per_mm, filter } = self.deflect(pose, a, entry, &bounds, rate);
         let (phase, axial_n) = self.shaft(pose, a, entry, v, &bounds, &mut w);
         let wrench = Wrench::from_array(w);
-        let terms = GuardTerms { stiffness_n_per_mm, dissipative_n: [axial_n * a[0], axial_n * a[1], axial_n * a[2]] };
+        let terms = GuardTerms { stiffness_n_per_mm, dissipative_n: [axial_n * a[0], axial_n * a[1], axial_n * a[2]], filter };
         (self.evaluation(wrench, status, phase, punctures), terms)
     }
 
@@ -432,7 +490,9 @@ impl Insertion {
     /// The deflection of the first intact boundary, with the punctures it causes.
     ///
     /// The boundary's wrench passes the layer's viscoelastic filter (the `viscoelastic`
-    /// module; its stiffness times the filter's tick gain `1 + sum b_i`). A puncture
+    /// module; its stiffness times the filter's effective stiffness ratio `rho`,
+    /// [`QlvCoefficients::effective_stiffness_ratio`], and with `rate` the filter's
+    /// share for a guard: [`GuardTerms`]). A puncture
     /// releases the boundary's stored viscous force (the filter is reset: the lateral
     /// part kept as preload is the elastic one), as does the tip leaving the boundary
     /// (no deflected boundary in this tick): nothing stored is pushed into the hand.
@@ -453,7 +513,14 @@ impl Insertion {
                 for (t, x) in total.iter_mut().zip(w) {
                     *t += x;
                 }
-                return Deflected { wrench: total, status: e.status, punctures, stiffness_n_per_mm: k * qlv.tick_gain() };
+                let filter = if rate { filter_terms(qlv, &elastic, &w) } else { FilterTerms::NONE };
+                return Deflected {
+                    wrench: total,
+                    status: e.status,
+                    punctures,
+                    stiffness_n_per_mm: k * qlv.effective_stiffness_ratio(),
+                    filter,
+                };
             }
             let w = elastic;
             let axial_n = dot([w[0], w[1], w[2]], a);
@@ -471,7 +538,7 @@ impl Insertion {
             punctures = punctures.saturating_add(1);
         }
         self.qlv_state.reset();
-        Deflected { wrench: self.preload, status: Status::OK, punctures, stiffness_n_per_mm: 0.0 }
+        Deflected { wrench: self.preload, status: Status::OK, punctures, stiffness_n_per_mm: 0.0, filter: FilterTerms::NONE }
     }
 
     /// The cutting force of the last punctured layer (N; 0 before the first puncture):
