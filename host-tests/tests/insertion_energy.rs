@@ -105,6 +105,12 @@ fn trajectory(rng: &mut ChaCha8Rng, deepest_mm: f64) -> Vec<Move> {
     moves
 }
 
+/// Whether the hand goes below the surface (the others only dissipate in the device's
+/// damping, or not even that: the report's worst case is over these).
+fn enters(moves: &[Move]) -> bool {
+    moves.iter().any(|m| m.to_mm > 0.0)
+}
+
 /// The hand's depth at time `t` along the chain of moves (the last one's end after it).
 fn depth_at(moves: &[Move], mut t: f64) -> f64 {
     for m in moves {
@@ -209,9 +215,11 @@ fn no_closed_cycle_delivers_energy(stack: &Stack<'_>, trajectories: usize) {
             let (e, p) = energy(stack, &moves);
             punctured += usize::from(p > 0);
             assert!(e <= BOUND_NMM, "{}: trajectory {n} delivered {e:e} N·mm to the hand: {moves:?}", stack.name);
-            worst = worst.max(e);
+            if enters(&moves) {
+                worst = worst.max(e);
+            }
         }
-        println!("{}: {trajectories} trajectories ({punctured} with a puncture), most energy to the hand {worst:e} N·mm", stack.name);
+        println!("{}: {trajectories} trajectories ({punctured} with a puncture), most energy to the hand of those entering the tissue {worst:e} N·mm", stack.name);
         assert!(punctured > trajectories / 4, "{}: only {punctured} trajectories punctured: the test must cross punctures", stack.name);
     }
 }
@@ -259,10 +267,12 @@ fn the_guarded_loop_delivers_no_energy(stack: &Stack<'_>, loop_trajectories: usi
             limited += usize::from(was_limited);
             punctured += usize::from(p > 0);
             assert!(e <= BOUND_NMM, "{}: trajectory {n} through the loop delivered {e:e} N·mm to the hand: {moves:?}", stack.name);
-            worst = worst.max(e);
+            if enters(&moves) {
+                worst = worst.max(e);
+            }
         }
         println!(
-            "{}: {loop_trajectories} trajectories through the guarded loop ({limited} stiffness-limited, {punctured} punctured), most energy to the hand {worst:e} N·mm",
+            "{}: {loop_trajectories} trajectories through the guarded loop ({limited} stiffness-limited, {punctured} punctured), most energy to the hand of those entering the tissue {worst:e} N·mm",
             stack.name
         );
         assert!(limited > loop_trajectories / 4, "{}: the guard acted in only {limited} trajectories", stack.name);
