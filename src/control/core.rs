@@ -123,7 +123,9 @@ impl<const N: usize> LoopCore<N> {
     /// With an insertion, each tick with a valid pose steps it once
     /// ([`Insertion::step`], or [`Insertion::step_with_stiffness`] with the passivity
     /// guard on: the guard then limits the elastic part of the force, of the deflected
-    /// boundary's stiffness `|dF/dδ|`, and passes friction and cutting as they are:
+    /// boundary's stiffness `|dF/dδ|` (times the viscoelastic filter's `rho`, whose part
+    /// of the force the guard then renders with its own filter of the guarded
+    /// deflection), and passes friction and cutting as they are:
     /// [`Passivity`]'s module). A stale or missing pose
     /// does not step it (its velocity filter then sees the whole motion since the last
     /// valid pose in one tick, smoothed by its time constant). A tick that punctures a

@@ -28,6 +28,40 @@
 //!   (with the deflected boundary's stiffness as `K`) and `D` is added back unchanged.
 //!   Scaled into the offset, a friction reversal would keep pushing the needle out
 //!   after a withdrawal starts. The block surrogate has no `D`: its force is guarded whole.
+//! - **with the viscoelastic filter** (feature `viscoelastic`, a deflected layer with
+//!   Prony terms): the insertion's force is `F = P + E + V(E) + D`, `E` the boundary's
+//!   elastic deflection force (a function of the path, stiffness `K`), `V(E)` the
+//!   quasi-linear filter's part (a function of time too: at a fixed position it relaxes),
+//!   `P` the preload and the track's hold. The guard limits first and filters after: the
+//!   rule above runs on the elastic part `F - D - V` (the insertion names `V` and `E`:
+//!   `GuardTerms`), at the stiffness `rho K` (`rho`:
+//!   [`QlvCoefficients::effective_stiffness_ratio`](crate::viscoelastic::QlvCoefficients::effective_stiffness_ratio),
+//!   the filter's worst-case stiffness ratio in a sampled loop, Colgate's general
+//!   condition at the Nyquist frequency: `1 + sum 2 b_i / (1 + a_i)`), and the guard's own
+//!   filter, the same coefficients, runs on the guarded deflection force `E'` (its
+//!   change each tick is `s` times `E`'s, `s = k_g / (rho K)` when limited, else 1); the
+//!   command is `E'`'s guarded elastic part `+ V(E') + D`.
+//!
+//!   Why it is passive: the guarded elastic part is a function of the path again (the
+//!   offset integrates `(1 - s) dE` along it; it no longer integrates the relaxing `V`,
+//!   which made the old rule's offset depend on time: issue 39, energy delivered to the
+//!   hand with `g = 3, 3, 3`, `tau = 1 ms, 10 ms, 0.1 s`, `docs/insertion.md`); a
+//!   quasi-linear filter with every `g_i >= 0` on a path function is a generalised
+//!   Maxwell body (springs `g_i K'` in series with dampers `g_i K' tau_i` beside the
+//!   spring `K'`), which only dissipates in continuous time; sampled, Colgate's condition
+//!   `b > T / (2 (1 - cos wT)) Re[(1 - e^{-iwT}) H(e^{iwT})]` for the filter's
+//!   `H = K' (1 + sum b_i (1 - z^-1) / (1 - a_i z^-1))` is `b > K' rho(wT) T / 2`, largest
+//!   at the Nyquist frequency, so `rho K' <= k_g` keeps the loop at `GUARD_FRACTION` of
+//!   the bound at every frequency (a term of `tau_i` near `T` is charged as the damper it
+//!   acts as, `2 g_i K tau_i / T`; the old tick gain `1 + sum b_i` was 8.74 for the set
+//!   above, `rho` 9.77). The guard's filter rests (nothing stored, last `E` zero) in every
+//!   tick without a deflected boundary with terms, exactly when the insertion's filter
+//!   rests, and starts without history after a puncture or a fault (relaxed at the first
+//!   `E` it sees). Where the limit has not acted since a boundary's first contact it
+//!   renders the insertion's own force (within f32 rounding); a layer without terms, the block surrogate and the build without the
+//!   feature take the rule above bit for bit (the feature's state is zero-sized without
+//!   it). Measured: `host-tests/tests/insertion_energy.rs` (random closed cycles and
+//!   Colgate's ratio at `wT` from `0.2 pi` to `pi`).
 use super::ConfigError;
 use crate::insertion::GuardTerms;
 

@@ -237,8 +237,11 @@ pub struct Insertion {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct GuardTerms {
     /// The stiffness along the path of the boundary being deflected, N/mm: `|dF/dδ|` of
-    /// its three forces (the rate of [`deflection`]); 0 when no boundary is deflected
-    /// (approach, or in the track short of the next boundary) and for an error.
+    /// its three forces (the rate of [`deflection`]) times the layer's viscoelastic
+    /// filter's effective stiffness ratio `rho` (1 without Prony terms:
+    /// `viscoelastic::QlvCoefficients::effective_stiffness_ratio`); 0 when no boundary
+    /// is deflected (approach, or in the track short of the next boundary) and for an
+    /// error.
     pub stiffness_n_per_mm: f32,
     /// The force of shaft friction and cutting in the wrench, N (block frame): it only
     /// takes energy out, so a guard leaves it as it is and limits the rest (the
