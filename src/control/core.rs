@@ -253,16 +253,19 @@ impl<const N: usize> LoopCore<N> {
     /// (the insertion's friction and cutting; zero for the block surrogate).
     fn evaluate(&mut self, pose: &Pose) -> (Wrench, Status, Option<(Passivity, GuardTerms)>) {
         if let Some(ins) = self.insertion.as_mut() {
-            let (e, terms) = match self.passivity {
-                Some(_) => ins.step_with_stiffness(pose),
-                None => (ins.step(pose), GuardTerms::NONE),
+            let (e, guarded) = match self.passivity {
+                Some(p) => {
+                    let (e, terms) = ins.step_with_stiffness(pose);
+                    (e, Some((p, terms)))
+                }
+                None => (ins.step(pose), None),
             };
             self.insertion_last = Some(e);
             if e.punctures > 0 {
                 // nothing the guard stored while the boundary deflected is given back
                 self.guard.reset();
             }
-            return (e.wrench, e.status, self.passivity.map(|p| (p, terms)));
+            return (e.wrench, e.status, guarded);
         }
         match self.passivity {
             Some(p) => {

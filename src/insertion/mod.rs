@@ -229,6 +229,10 @@ pub struct Insertion {
     qlv: [QlvCoefficients; MAX_LAYERS],
     /// The viscoelastic filter of the deflected boundary's wrench.
     qlv_state: QlvState,
+    /// The filter's share for a guard of the last [`Insertion::step_with_stiffness`]
+    /// (zero-sized without the `viscoelastic` feature; written only by that call, so
+    /// `step` carries none of it).
+    guard_share: FilterTerms,
 }
 
 /// What a passivity guard needs of an insertion tick beside its wrench
@@ -300,7 +304,6 @@ struct Deflected {
     status: Status,
     punctures: u8,
     stiffness_n_per_mm: f32,
-    filter: FilterTerms,
 }
 
 /// The guard's share of the deflected boundary's filter ([`FilterTerms`]): the
@@ -382,6 +385,7 @@ impl Insertion {
             velocity_mm_per_s: 0.0,
             qlv,
             qlv_state: QlvState::REST,
+            guard_share: FilterTerms::NONE,
         })
     }
 
@@ -434,16 +438,23 @@ impl Insertion {
     /// stiffness and the dissipative part of the force. The control loop's guard takes
     /// them ([`LoopCore::set_insertion`](crate::control::LoopCore::set_insertion)).
     pub fn step_with_stiffness(&mut self, pose: &Pose) -> (InsertionEvaluation, GuardTerms) {
-        self.tick(pose, true)
+        let (e, stiffness_n_per_mm, dissipative_n) = self.tick(pose, true);
+        (e, GuardTerms { stiffness_n_per_mm, dissipative_n, filter: self.guard_share })
     }
 
     // Never inlined: LLVM 22 (rustc 1.95) crashed in register allocation on x86-64 with
     // the grown state inlined into a large caller (host-tests/tests/insertion_fixed.rs).
     #[inline(never)]
-    fn tick(&mut self, pose: &Pose, rate: bool) -> (InsertionEvaluation, GuardTerms) {
+    /// The tick's evaluation, and (with `rate`; else 0) the deflected boundary's
+    /// stiffness and the dissipative force of [`GuardTerms`], whose filter share it
+    /// leaves in `guard_share` (with `rate` only).
+    fn tick(&mut self, pose: &Pose, rate: bool) -> (InsertionEvaluation, f32, [f32; 3]) {
+        if rate {
+            self.guard_share = FilterTerms::NONE;
+        }
         let finite = [pose.x_mm, pose.z_mm, pose.theta_x_deg, pose.theta_z_deg, pose.depth_mm].into_iter().all(f32::is_finite);
         if !finite {
-            return (self.evaluation(Wrench::ZERO, Status::ERROR, Phase::Approach, 0), GuardTerms::NONE);
+            return (self.evaluation(Wrench::ZERO, Status::ERROR, Phase::Approach, 0), 0.0, [0.0; 3]);
         }
         let depth = pose.depth_mm;
         let step_mm = self.last_depth_mm.map_or(0.0, |last| depth - last);
@@ -453,16 +464,16 @@ impl Insertion {
         let v = if self.velocity_mm_per_s * step_mm > 0.0 { self.velocity_mm_per_s } else { 0.0 };
         if depth <= 0.0 {
             self.end_path();
-            return (self.evaluation(Wrench::ZERO, Status::OK, Phase::Approach, 0), GuardTerms::NONE);
+            return (self.evaluation(Wrench::ZERO, Status::OK, Phase::Approach, 0), 0.0, [0.0; 3]);
         }
         let a = axis(pose.theta_x_deg, pose.theta_z_deg);
         let entry: Vec3 = [pose.x_mm, 0.0, pose.z_mm];
         let bounds = self.boundaries(a[1]);
-        let Deflected { wrench: mut w, status, punctures, stiffness_n_per_mm, filter } = self.deflect(pose, a, entry, &bounds, rate);
+        let Deflected { wrench: mut w, status, punctures, stiffness_n_per_mm } = self.deflect(pose, a, entry, &bounds, rate);
         let (phase, axial_n) = self.shaft(pose, a, entry, v, &bounds, &mut w);
         let wrench = Wrench::from_array(w);
-        let terms = GuardTerms { stiffness_n_per_mm, dissipative_n: [axial_n * a[0], axial_n * a[1], axial_n * a[2]], filter };
-        (self.evaluation(wrench, status, phase, punctures), terms)
+        let dissipative_n = [axial_n * a[0], axial_n * a[1], axial_n * a[2]];
+        (self.evaluation(wrench, status, phase, punctures), stiffness_n_per_mm, dissipative_n)
     }
 
     fn evaluation(&self, wrench: Wrench, status: Status, phase: Phase, punctures: u8) -> InsertionEvaluation {
@@ -516,14 +527,10 @@ impl Insertion {
                 for (t, x) in total.iter_mut().zip(w) {
                     *t += x;
                 }
-                let filter = if rate { filter_terms(qlv, &elastic, &w) } else { FilterTerms::NONE };
-                return Deflected {
-                    wrench: total,
-                    status: e.status,
-                    punctures,
-                    stiffness_n_per_mm: k * qlv.effective_stiffness_ratio(),
-                    filter,
-                };
+                if rate {
+                    self.guard_share = filter_terms(qlv, &elastic, &w);
+                }
+                return Deflected { wrench: total, status: e.status, punctures, stiffness_n_per_mm: k * qlv.effective_stiffness_ratio() };
             }
             let w = elastic;
             let axial_n = dot([w[0], w[1], w[2]], a);
@@ -541,7 +548,7 @@ impl Insertion {
             punctures = punctures.saturating_add(1);
         }
         self.qlv_state.reset();
-        Deflected { wrench: self.preload, status: Status::OK, punctures, stiffness_n_per_mm: 0.0, filter: FilterTerms::NONE }
+        Deflected { wrench: self.preload, status: Status::OK, punctures, stiffness_n_per_mm: 0.0 }
     }
 
     /// The cutting force of the last punctured layer (N; 0 before the first puncture):
