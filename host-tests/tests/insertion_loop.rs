@@ -191,7 +191,10 @@ fn without_prony_terms_the_guarded_loop_gives_the_rules_bits_as_before() {
             assert!(limited > 100, "{}: the guard limited only {limited} ticks", stack.name);
         }
     }
-    // the block surrogate: the whole force guarded, its stiffness |dF/d depth|
+    // the block surrogate: the whole force guarded, its stiffness |dF/d depth|; a device
+    // of 0.001 N·s/m (k_g = 0.001 N/mm), below the block's stiffness over the motion
+    let guard = Passivity { damping_n_s_per_mm: 0.000001, period_s: 0.001 };
+    let k_g = guard.guard_stiffness_n_per_mm();
     let mut l = core();
     l.set_passivity(Some(guard)).expect("guard");
     let (mut rule, mut limited) = (RuleBefore::default(), 0);
