@@ -133,11 +133,10 @@ impl Guard {
         let d = terms.dissipative_n;
         // no dissipative part (the block surrogate): the whole force, bits unchanged
         if d == [0.0; 3] {
-            let (g, limited, _) = self.apply_elastic(p, f_n, terms.stiffness_n_per_mm);
-            return (g, limited);
+            return self.apply_elastic(p, f_n, terms.stiffness_n_per_mm);
         }
         let elastic = [f_n[0] - d[0], f_n[1] - d[1], f_n[2] - d[2]];
-        let (g, limited, _) = self.apply_elastic(p, elastic, terms.stiffness_n_per_mm);
+        let (g, limited) = self.apply_elastic(p, elastic, terms.stiffness_n_per_mm);
         ([g[0] + d[0], g[1] + d[1], g[2] + d[2]], limited)
     }
 
@@ -150,27 +149,29 @@ impl Guard {
     fn apply_filtered(&mut self, p: &Passivity, f_n: [f32; 3], terms: &GuardTerms) -> ([f32; 3], bool) {
         let (d, v) = (terms.dissipative_n, terms.filter.viscous_n);
         let elastic = [f_n[0] - d[0] - v[0], f_n[1] - d[1] - v[1], f_n[2] - d[2] - v[2]];
-        let (g, limited, scale) = self.apply_elastic(p, elastic, terms.stiffness_n_per_mm);
+        // the scale the rule gives this tick's change (below), before it records the force
+        let k_g = p.guard_stiffness_n_per_mm();
+        let k = terms.stiffness_n_per_mm;
+        // `k > k_g > 0` (validated), so the division is by a positive, finite number
+        let scale = self.last_model_n.map(|_| if k > k_g { k_g / k } else { 1.0 });
+        let (g, limited) = self.apply_elastic(p, elastic, k);
         let h = self.filter.step(&terms.filter.coefficients, terms.filter.deflection_n, scale);
         ([g[0] + h[0] + d[0], g[1] + h[1] + d[1], g[2] + h[2] + d[2]], limited)
     }
 
-    /// The rule on an elastic force `f_n` of stiffness `k_n_per_mm`; the guarded force,
-    /// whether the stiffness was limited, and the scale the force's change of this
-    /// tick entered the command with (`k_g / k` when limited, else 1; `None` without a
-    /// last force: the first tick after a reset follows the model).
-    fn apply_elastic(&mut self, p: &Passivity, f_n: [f32; 3], k_n_per_mm: f32) -> ([f32; 3], bool, Option<f32>) {
+    /// The rule on an elastic force `f_n` of stiffness `k_n_per_mm`: its change since the
+    /// last tick enters the command times `k_g / k` when limited, else whole (the
+    /// filter's scale in [`apply_filtered`](Self::apply_filtered)); nothing without a
+    /// last force (the first tick after a reset follows the model).
+    fn apply_elastic(&mut self, p: &Passivity, f_n: [f32; 3], k_n_per_mm: f32) -> ([f32; 3], bool) {
         let k_g = p.guard_stiffness_n_per_mm();
         // `k > k_g > 0` (validated), so the division is by a positive, finite number.
         let limited = k_n_per_mm > k_g;
-        let mut scale = self.last_model_n.map(|_| 1.0);
         if let (Some(last), true) = (self.last_model_n, limited) {
-            let pass = k_g / k_n_per_mm;
-            let keep = 1.0 - pass;
+            let keep = 1.0 - k_g / k_n_per_mm;
             for ((o, f), l) in self.offset_n.iter_mut().zip(f_n).zip(last) {
                 *o += keep * (f - l);
             }
-            scale = Some(pass);
         }
         if f_n == [0.0; 3] {
             self.offset_n = [0.0; 3];
@@ -178,7 +179,7 @@ impl Guard {
         self.last_model_n = Some(f_n);
         let [o0, o1, o2] = self.offset_n;
         let [f0, f1, f2] = f_n;
-        ([f0 - o0, f1 - o1, f2 - o2], limited, scale)
+        ([f0 - o0, f1 - o1, f2 - o2], limited)
     }
 }
 
