@@ -65,6 +65,7 @@ mod pose;
 mod status;
 mod stiffness;
 pub mod telemetry;
+mod unsolved;
 pub mod viscoelastic;
 mod wrench;
 

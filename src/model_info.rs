@@ -28,3 +28,12 @@ pub const TABLES_RS: &str = include_str!(concat!(env!("OUT_DIR"), "/tables_f32.r
 /// The generated Rust source of the coupled form's cross terms compiled into this build
 /// (for audits and the regeneration test).
 pub const CROSS_RS: &str = include_str!(concat!(env!("OUT_DIR"), "/cross_f32.rs"));
+
+/// Balls of the compiled-in unsolved region (every failed pose of the set's FE campaign
+/// and its mirror images, `unsolved.toml`); 0: the set has no region and no pose is
+/// flagged [`Status::FE_UNSOLVED`](crate::Status::FE_UNSOLVED).
+pub const UNSOLVED_BALLS: usize = crate::unsolved::tables::COUNT;
+
+/// The generated Rust source of the unsolved region compiled into this build (for audits
+/// and the regeneration test).
+pub const UNSOLVED_RS: &str = include_str!(concat!(env!("OUT_DIR"), "/unsolved.rs"));

@@ -220,12 +220,14 @@ impl PronyTerms {
 pub struct QlvCoefficients {
     a: [f32; MAX_TERMS],
     b: [f32; MAX_TERMS],
+    /// `rho = 1 + sum 2 b_i / (1 + a_i)`: [`effective_stiffness_ratio`](Self::effective_stiffness_ratio).
+    rho: f32,
     count: u8,
 }
 
 impl QlvCoefficients {
     /// No terms: the filter passes its input.
-    pub const NONE: Self = Self { a: [0.0; MAX_TERMS], b: [0.0; MAX_TERMS], count: 0 };
+    pub const NONE: Self = Self { a: [0.0; MAX_TERMS], b: [0.0; MAX_TERMS], rho: 1.0, count: 0 };
 
     /// `a_i = exp(-dt / tau_i)`, `b_i = g_i (1 - a_i) / (dt / tau_i)` for the tick period
     /// `tick_s` (`1 - a_i` as `-expm1(-dt / tau_i)`: no cancellation for `tau_i >> dt`).
@@ -247,6 +249,8 @@ impl QlvCoefficients {
                 *b = 0.0; // x = +inf: the term relaxes within the tick
             }
         }
+        // 0 <= a_i <= 1, so 1 + a_i >= 1: no division by zero; unused terms add 0
+        out.rho = 1.0 + 2.0 * out.b[0] / (1.0 + out.a[0]) + 2.0 * out.b[1] / (1.0 + out.a[1]) + 2.0 * out.b[2] / (1.0 + out.a[2]);
         Ok(out)
     }
 
@@ -261,6 +265,51 @@ impl QlvCoefficients {
     #[must_use]
     pub fn tick_gain(&self) -> f32 {
         1.0 + self.b[0] + self.b[1] + self.b[2]
+    }
+
+    /// `rho`, the filter's worst-case stiffness ratio in a sampled loop (1 without
+    /// terms): an elastic force of stiffness `K` passed through the filter is, for
+    /// Colgate's passivity condition of a zero-order-hold loop at the filter's tick `T`,
+    /// the same as a spring of stiffness `rho K`.
+    ///
+    /// Colgate and Schenkel's general condition for a virtual environment `H(z)`
+    /// (force per position) on a device of damping `b` is
+    /// `b > T / (2 (1 - cos wT)) Re[(1 - e^{-iwT}) H(e^{iwT})]` for every `w` in
+    /// `(0, pi/T]`. Per unit stiffness the filter is
+    /// `H(z) = 1 + sum_i b_i (1 - z^-1) / (1 - a_i z^-1)`, and with `c = cos wT`
+    ///
+    /// ```text
+    /// Re[(1 - e^{-iwT}) H] / (1 - c) = 1 + sum_i 2 b_i (a_i - c) / (1 + a_i² - 2 a_i c)
+    /// ```
+    ///
+    /// Each term's derivative by `c` is `2 b_i (a_i² - 1) / (1 + a_i² - 2 a_i c)² <= 0`
+    /// (`0 <= a_i < 1`), so every term, and their sum, is largest at `c = -1` (the
+    /// Nyquist frequency): `rho = 1 + sum_i 2 b_i / (1 + a_i)`, exact, not a bound. With
+    /// `x_i = T / tau_i` it is `1 + sum_i g_i tanh(x_i / 2) / (x_i / 2)`: `g_i` for
+    /// `tau_i >> T` (the instantaneous stiffness), `2 g_i tau_i / T` for `tau_i << T`
+    /// (the term is then a damper `g_i K tau_i`, which Colgate's condition charges as
+    /// `2 g_i K tau_i / T`), never above `1 + sum g_i`. Computed once, in
+    /// [`new`](Self::new) (f32).
+    #[must_use]
+    pub fn effective_stiffness_ratio(&self) -> f32 {
+        self.rho
+    }
+
+    /// One tick of the three force components' terms driven by input increments
+    /// `d` (not inputs): `h_i <- a_i h_i + b_i d`; the filter's viscous part
+    /// `sum_i h_i` of each component out. For a passivity guard that feeds the filter
+    /// the guarded increments of an elastic force (`control::passivity`).
+    #[cfg(feature = "viscoelastic")]
+    #[inline]
+    pub(crate) fn step_increments(&self, h: &mut [[f32; MAX_TERMS]; 3], d: [f32; 3]) -> [f32; 3] {
+        let mut out = [0.0; 3];
+        for ((o, [h0, h1, h2]), d) in out.iter_mut().zip(h.iter_mut()).zip(d) {
+            *h0 = self.a[0] * *h0 + self.b[0] * d;
+            *h1 = self.a[1] * *h1 + self.b[1] * d;
+            *h2 = self.a[2] * *h2 + self.b[2] * d;
+            *o = *h0 + *h1 + *h2;
+        }
+        out
     }
 
     /// One component: `h_i <- a_i h_i + b_i d`, the output `elastic + sum h_i`.

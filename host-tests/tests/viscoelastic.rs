@@ -214,3 +214,74 @@ fn the_fixed_point_filter_matches_the_closed_form() {
     assert_eq!(fx::QlvCoefficients::new(&bad, 1000), None);
     assert_eq!(fx::QlvCoefficients::new(&fixed_terms, 0), None);
 }
+
+/// Colgate's ratio `Re[(1 - e^{-iθ}) H(e^{iθ})] / (1 - cos θ)` at `θ = wT` of the
+/// filter's transfer function per unit stiffness, `H(z) = 1 + sum b_i (1 - z^-1) /
+/// (1 - a_i z^-1)` (the recursion `h_i <- a_i h_i + b_i (u_k - u_{k-1})`), in f64 complex
+/// arithmetic from `g`, `tau` and the tick (not from the library's closed form).
+fn colgate_ratio(terms: &PronyTerms, tick_s: f64, theta: f64) -> f64 {
+    let mul = |(a, b): (f64, f64), (c, d): (f64, f64)| (a * c - b * d, a * d + b * c);
+    let div = |x: (f64, f64), (c, d): (f64, f64)| {
+        let n = c * c + d * d;
+        let (re, im) = mul(x, (c, -d));
+        (re / n, im / n)
+    };
+    let z_inv = (theta.cos(), -theta.sin()); // e^{-iθ}
+    let one_minus = |k: f64| (1.0 - k * z_inv.0, -k * z_inv.1);
+    let mut h = (1.0, 0.0);
+    for t in terms.as_slice() {
+        let x = tick_s / f64::from(t.tau_s);
+        let (a, b) = ((-x).exp(), f64::from(t.g) * -(-x).exp_m1() / x);
+        let term = div(one_minus(1.0), one_minus(a));
+        h = (h.0 + b * term.0, h.1 + b * term.1);
+    }
+    mul(one_minus(1.0), h).0 / (1.0 - theta.cos())
+}
+
+/// `QlvCoefficients::effective_stiffness_ratio` (the closed form `1 + sum 2 b_i / (1 +
+/// a_i)`, f32) against the largest of Colgate's ratio over a sweep of 100,000
+/// frequencies in `(0, pi/T]` (f64), for time constants far below, at and far above the
+/// tick and the energy test's sets: within 2e-6 relative (f32 round-off of `a_i`, `b_i`
+/// and the sum, each below 1e-7 relative, a few of them). And the bounds the docs state:
+/// at least the tick gain `1 + sum b_i`, at most `1 + sum g_i`; exactly 1 without terms.
+#[test]
+fn the_effective_stiffness_ratio_is_the_largest_colgate_ratio_over_frequency() {
+    let t = |g: f32, tau_s: f32| PronyTerm { g, tau_s };
+    let sets: [(&str, &[PronyTerm]); 9] = [
+        ("none", &[]),
+        ("tau << T", &[t(3.0, 1e-5)]),
+        ("tau = T / 5", &[t(2.0, 2e-4)]),
+        ("tau = T", &[t(3.0, 0.001)]),
+        ("tau = 3 T", &[t(1.0, 0.003)]),
+        ("tau >> T", &[t(3.0, 100.0)]),
+        ("mixed", &[t(3.0, 1e-5), t(3.0, 0.001), t(3.0, 100.0)]),
+        ("moderate (insertion_energy)", &[t(0.8, 0.05), t(0.5, 1.0), t(0.3, 20.0)]),
+        ("extreme (insertion_energy)", &[t(3.0, 0.001), t(3.0, 0.01), t(3.0, 0.1)]),
+    ];
+    const N: usize = 100_000;
+    let tick = f64::from(TICK_S);
+    for (name, set) in sets {
+        let terms = PronyTerms::new(set).expect("valid terms");
+        let c = QlvCoefficients::new(&terms, TICK_S).expect("coefficients");
+        let rho = f64::from(c.effective_stiffness_ratio());
+        let (mut max, mut at) = (f64::NEG_INFINITY, 0.0);
+        for j in 1..=N {
+            let theta = std::f64::consts::PI * j as f64 / N as f64;
+            let r = colgate_ratio(&terms, tick, theta);
+            if r > max {
+                (max, at) = (r, theta);
+            }
+        }
+        println!(
+            "{name}: rho {rho:.6}, swept max {max:.6} at wT = {at:.4}, tick gain {:.6}, 1 + sum g {:.6}",
+            c.tick_gain(),
+            terms.instantaneous_ratio()
+        );
+        assert!((rho - max).abs() <= 2e-6 * max, "{name}: rho {rho} against the swept maximum {max}");
+        assert!(rho >= f64::from(c.tick_gain()) * (1.0 - 1e-6), "{name}: rho {rho} below the tick gain {}", c.tick_gain());
+        assert!(rho <= f64::from(terms.instantaneous_ratio()) * (1.0 + 1e-6), "{name}: rho {rho} above 1 + sum g");
+        if set.is_empty() {
+            assert_eq!(c.effective_stiffness_ratio(), 1.0, "no terms: exactly 1");
+        }
+    }
+}

@@ -62,8 +62,8 @@ pub fn wrench_and_stiffness(pose: &Pose) -> StiffnessEvaluation {
 /// computed (measured stack, M0: 704 B with all three sets of accumulators live).
 #[inline(never)]
 fn wrench_and_depth_rates(pose: &Pose, e: &mut StiffnessEvaluation) {
-    let at = &Inputs::of(pose);
-    let a = accumulators(at);
+    let at = &mut Inputs::of(pose);
+    let a = accumulators(at, pose);
     let w = output(&a, at.u);
     let mut by_depth = [0_i32; COMPONENT_COUNT];
     for (((r, ac), &g), &rs) in by_depth.iter_mut().zip(a.iter()).zip(FRAC_BITS.iter()).zip(RATE_SHIFTS.iter()) {

@@ -7,7 +7,7 @@
 //! the compiler drops them: the wrench and the three force rates are its bits exactly
 //! (host-tests/tests/depth_rate.rs compares them on the golden poses).
 use crate::float::cross::{add_cross, add_cross_rates, COUPLED, CROSS_SCALES};
-use crate::float::eval::{clamp_to_domain, ONE_THIRD};
+use crate::float::eval::{clamp_to_domain, unsolved_flag, ONE_THIRD};
 use crate::float::eval_stiffness::{component, At, Column};
 use crate::float::tables::FITTED;
 use crate::{Evaluation, Pose, Status, Wrench};
@@ -25,8 +25,10 @@ pub fn wrench_and_depth_rate(pose: &Pose) -> (Evaluation, [f32; 3]) {
     let Some((clamped, status)) = clamp_to_domain(pose) else {
         return error(Status::ERROR);
     };
+    let Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, .. } = clamped;
+    let status = status | unsolved_flag([x, z, tx, tz], clamped.depth_mm);
     let at = At::of(&clamped);
-    let (Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, .. }, u) = (clamped, at.u);
+    let u = at.u;
     let columns = [
         column::<0, true>(&at),
         column::<1, true>(&at),

@@ -358,7 +358,9 @@ pub(crate) fn clamp_to_domain(pose: &Pose) -> Option<(Pose, Status)> {
 ///    `w_c = w_c ± D_c(t, u)`, minus when the sweep value is negative and the component
 ///    is odd under that sweep's mirror;
 /// 5. coupled form only ([`model_info::COUPLED`](crate::model_info::COUPLED)): the cross
-///    terms, `w_c = w_c + m * P(u)` per term with `m` a product of the normalised inputs.
+///    terms, `w_c = w_c + m * P(u)` per term with `m` a product of the normalised inputs;
+/// 6. [`Status::FE_UNSOLVED`] when the clamped pose lies in the set's unsolved region
+///    (where its FE campaign could not solve; the wrench is still the model's).
 ///
 /// The wrench is that of the clamped pose; forces in N, moments in N·mm about the
 /// needle's reference point (see [`Wrench`]).
@@ -386,6 +388,7 @@ pub fn wrench(pose: &Pose) -> Evaluation {
     };
     let Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, depth_mm: d } = clamped;
 
+    let status = status | unsolved_flag([x, z, tx, tz], d);
     let u = d * ONE_THIRD - 1.0;
     let mut w = superpose([x, z, tx, tz], u);
     if COUPLED {
@@ -393,4 +396,16 @@ pub fn wrench(pose: &Pose) -> Evaluation {
         add_cross([x * rx, z * rz, tx * rtx, tz * rtz], u, &mut w);
     }
     Evaluation { wrench: Wrench::from_array(w), status }
+}
+
+/// Step 7 of the contract: [`Status::FE_UNSOLVED`] when the clamped pose, `v` its x, z,
+/// theta_x, theta_z and `d` its depth, lies in the set's unsolved region
+/// (`crate::unsolved`), else [`Status::OK`]. The wrench is not changed.
+#[inline(always)]
+pub(crate) fn unsolved_flag(v: [f32; 4], d: f32) -> Status {
+    if crate::unsolved::in_region_f32(v, d) {
+        Status::FE_UNSOLVED
+    } else {
+        Status::OK
+    }
 }

@@ -1,7 +1,7 @@
 //! The wrench and its stiffness in f32: the evaluation algorithm of `coeffs/README.md`
 //! ("Stiffness") bit for bit, sharing the wrench's operations.
 use crate::float::cross::{add_cross, add_cross_rates, COUPLED, CROSS_SCALES};
-use crate::float::eval::{clamp_to_domain, skip_sweep, sweep_t, BASELINE_STARTS, ODD, ONE_THIRD, STARTS, SWEEP_SCALES};
+use crate::float::eval::{clamp_to_domain, skip_sweep, sweep_t, unsolved_flag, BASELINE_STARTS, ODD, ONE_THIRD, STARTS, SWEEP_SCALES};
 use crate::float::horner::{horner_from, horner_with_rate_from, MatrixStarts, Start};
 use crate::float::tables::{BASELINE, DEVIATION, FITTED};
 use crate::stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
@@ -53,8 +53,9 @@ pub fn wrench_and_stiffness(pose: &Pose) -> StiffnessEvaluation {
     let Some((clamped, status)) = clamp_to_domain(pose) else {
         return error(Status::ERROR);
     };
-    let at = At::of(&clamped);
     let Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, .. } = clamped;
+    let status = status | unsolved_flag([x, z, tx, tz], clamped.depth_mm);
+    let at = At::of(&clamped);
     let [sx, sz, _, _] = SWEEP_SCALES;
     let u = at.u;
     // Component by component (the contract's order within each component: baseline,

@@ -33,9 +33,9 @@ impl QlvCoefficients {
         }
     }
 
-    /// `1`: the identity's output changes as its input.
+    /// `1`: the identity renders its input's stiffness.
     #[must_use]
-    pub fn tick_gain(&self) -> f32 {
+    pub fn effective_stiffness_ratio(&self) -> f32 {
         1.0
     }
 }

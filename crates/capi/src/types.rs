@@ -230,6 +230,9 @@ pub const NEEDLE_STATUS_SAT_THETA_X: u8 = 0x04;
 pub const NEEDLE_STATUS_SAT_THETA_Z: u8 = 0x08;
 /// Status bit: depth clamped to the domain.
 pub const NEEDLE_STATUS_SAT_DEPTH: u8 = 0x10;
+/// Status bit: the (clamped) pose lies in the region where the set's FE campaign could
+/// not solve; the wrench is still the model's (an extrapolation), not zeroed.
+pub const NEEDLE_STATUS_FE_UNSOLVED: u8 = 0x20;
 /// Status bit: the build has no fitted model (the wrench is zero).
 pub const NEEDLE_STATUS_NO_MODEL: u8 = 0x40;
 /// Status bit: no wrench could be computed (NaN input, NULL pose, no model).

@@ -1,6 +1,6 @@
 //! `needle fe run --visco` and `needle fe verify --qlv` end to end on FEBio, on the smoke
 //! mesh (CI's budget: about a minute; the elastic centre and the three ramp-and-hold runs
-//! took 47 s on one shared core, 2026-11-27, every run within the bounds there): the centre's ramp-and-hold runs land in fe/visco/
+//! took 47 s on one shared core, every run within the bounds there): the centre's ramp-and-hold runs land in fe/visco/
 //! with a time column and their manifest, are resumed, and the QLV check compares them
 //! with the library's filter into verify.toml and the figure. They need `febio4`
 //! (`.ci/install-febio`); without it they fail, they are not skipped. The bounds are

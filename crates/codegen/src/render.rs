@@ -126,14 +126,23 @@ pub fn render_rust(model: &Model) -> String {
 }
 
 /// The C header `needle_coeffs.h`: the same tables as `static const float`, the domain,
-/// the normalisation constants and the status bits.
+/// the normalisation constants and the status bits (a set without an unsolved region:
+/// [`render_c_header_with`] adds the region's part).
 pub fn render_c_header(model: &Model) -> String {
+    render_c_header_with(model, &crate::unsolved::render_c(&crate::unsolved::Region::default()))
+}
+
+/// [`render_c_header`] with `unsolved` (the region's part, `unsolved::render_c`) before
+/// the end of the header.
+pub fn render_c_header_with(model: &Model, unsolved: &str) -> String {
     let mut s = String::new();
     let w = &mut s;
     render_c_preamble(w, model);
     render_c_constants(w);
     render_c_tables(w, model);
     let _ = write!(w, "{}", crate::render_cross::render_c_cross(model));
+    let _ = writeln!(w);
+    let _ = write!(w, "{unsolved}");
     let _ = writeln!(w);
     let _ = writeln!(w, "#endif /* NEEDLE_COEFFS_H */");
     s
@@ -158,7 +167,8 @@ fn render_c_preamble(w: &mut String, model: &Model) {
     let _ = writeln!(w, " *     r_i = h(NEEDLE_DEVIATION[k][c][i], t); D_kc = h(r, u);");
     let _ = writeln!(w, " *  5. w_c = B_c, then for k = 0..3: w_c -= D_kc if v_k < 0 and NEEDLE_ODD[k][c],");
     let _ = writeln!(w, " *     else w_c += D_kc;");
-    let _ = writeln!(w, " *  6. coupled form only: the cross terms (NEEDLE_CROSS_* below).");
+    let _ = writeln!(w, " *  6. coupled form only: the cross terms (NEEDLE_CROSS_* below);");
+    let _ = writeln!(w, " *  7. the status bit NEEDLE_STATUS_FE_UNSOLVED (NEEDLE_UNSOLVED_* below).");
     let _ = writeln!(w, " */");
     let _ = writeln!(w, "#ifndef NEEDLE_COEFFS_H");
     let _ = writeln!(w, "#define NEEDLE_COEFFS_H");

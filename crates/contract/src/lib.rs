@@ -140,6 +140,12 @@ pub const MAX_TISSUE_LAYERS: usize = 8;
 /// Format version of a tissue stack file.
 pub const TISSUE_FORMAT: i64 = 1;
 
+/// Format version of a set's unsolved region (`unsolved.toml`).
+pub const UNSOLVED_FORMAT: i64 = 1;
+/// Most balls (mirror images included) an unsolved region may have: the library's
+/// prefilter holds one bit per ball in a `u64`.
+pub const UNSOLVED_MAX_BALLS: usize = 64;
+
 /// Most Prony terms of a tissue layer's relaxation function (the quasi-linear
 /// viscoelastic filter holds this many per wrench component).
 pub const MAX_PRONY_TERMS: usize = 3;
@@ -204,6 +210,11 @@ pub mod status {
     pub const SAT_THETA_Z: u8 = 0x08;
     /// depth was clamped.
     pub const SAT_DEPTH: u8 = 0x10;
+    /// The (clamped) pose lies in the region where the set's FE campaign could not solve
+    /// (`unsolved.toml`, coeffs/README.md "The unsolved region"): the wrench is still the
+    /// model's, an extrapolation from the runs that solved. Like the saturation bits it
+    /// does not zero the wrench.
+    pub const FE_UNSOLVED: u8 = 0x20;
     /// The build has no fitted model (always with [`ERROR`]).
     pub const NO_MODEL: u8 = 0x40;
     /// No wrench: an input was NaN or infinite, or there is no model.
@@ -211,13 +222,14 @@ pub mod status {
     /// The five saturation bits.
     pub const SATURATION: u8 = SAT_X | SAT_Z | SAT_THETA_X | SAT_THETA_Z | SAT_DEPTH;
     /// Every bit with its name, `OK` first, then in bit order.
-    pub const NAMES: [(&str, u8); 8] = [
+    pub const NAMES: [(&str, u8); 9] = [
         ("OK", OK),
         ("SAT_X", SAT_X),
         ("SAT_Z", SAT_Z),
         ("SAT_THETA_X", SAT_THETA_X),
         ("SAT_THETA_Z", SAT_THETA_Z),
         ("SAT_DEPTH", SAT_DEPTH),
+        ("FE_UNSOLVED", FE_UNSOLVED),
         ("NO_MODEL", NO_MODEL),
         ("ERROR", ERROR),
     ];

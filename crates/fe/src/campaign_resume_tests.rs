@@ -161,3 +161,69 @@ fn another_runs_record_or_force_starts_afresh() {
     let (ran, ..) = run(&opts(d.path(), "x+04", 3), None, None);
     assert_eq!(ran, [0, 1, 2, 3]);
 }
+
+/// The FEBio backend with its solver given (`prepare` would look for the real one).
+struct Given(crate::febio::FebioBackend);
+
+impl crate::backend::Backend for Given {
+    fn prepare(&mut self) -> Result<String> {
+        Ok("4.11.0".into())
+    }
+    fn engine(&self) -> &'static str {
+        self.0.engine()
+    }
+    fn attempts(&self) -> u32 {
+        self.0.attempts()
+    }
+    fn first_increment_in(&self, work_dir: &Path, attempt: u32, full_block: bool) -> f64 {
+        self.0.first_increment_in(work_dir, attempt, full_block)
+    }
+    fn describe_attempt(&self, work_dir: &Path, attempt: u32, full_block: bool, depth_mm: f64, steps: u32) -> String {
+        self.0.describe_attempt(work_dir, attempt, full_block, depth_mm, steps)
+    }
+    fn solve(&self, job: &crate::backend::Job<'_>) -> crate::febio::running::tests::Solve {
+        self.0.solve(job)
+    }
+    fn steps_done(&self, work_dir: &Path) -> u32 {
+        self.0.steps_done(work_dir)
+    }
+}
+
+/// The campaign and FEBio together: a campaign killed in the first FEBio process of
+/// `centre` (its work folder as the fake left it: `progress.toml`, `running.toml`, the
+/// dump) resumes the pose with one restart, and writes the uninterrupted run's CSV with
+/// "resumed after an interruption at 3 mm" in the manifest.
+#[test]
+fn a_killed_campaign_resumes_its_febio_pose_from_the_dump() {
+    use crate::febio::running::tests::{backend_with, calls, dump_bytes, killed};
+    let d = set_dir();
+    let k = killed(d.path());
+    std::fs::write(&k.dump, dump_bytes(3.0, true)).expect("fixture");
+    let mut backend = Given(backend_with(&k.exe));
+    let o = crate::campaign::RunOptions { jobs: 1, ..opts(d.path(), "centre", 4) };
+    let fe = d.path().join("fe");
+    let r = run_with(&o, &mut backend).expect("the run that was not killed");
+    assert_eq!(r.done(), 1, "{}", r.table());
+    let whole = std::fs::read(fe.join("centre.csv")).expect("csv");
+    assert_eq!(calls(&k), ["-i", "-r"], "the first process gave up at 3.2 mm and was continued");
+    let rec = crate::resume::read(&k.snap).expect("readable").expect("the campaign's record in the killed folder");
+    assert_eq!((rec.attempt, rec.failures.len()), (0, 0));
+
+    // the killed campaign's state: no result yet, the work folder as the kill left it
+    for f in ["centre.csv", MANIFEST] {
+        std::fs::remove_file(fe.join(f)).expect("remove");
+    }
+    let work = fe.join(".work/centre");
+    std::fs::create_dir_all(&work).expect("mkdir");
+    for e in std::fs::read_dir(&k.snap).expect("snapshot").flatten() {
+        std::fs::copy(e.path(), work.join(e.file_name())).expect("copy");
+    }
+    let r = run_with(&o, &mut backend).expect("the rerun");
+    assert_eq!(r.done(), 1, "{}", r.table());
+    assert_eq!(calls(&k), ["-r"], "resumed from the dump, not from depth 0");
+    assert_eq!(std::fs::read(fe.join("centre.csv")).expect("csv"), whole, "the uninterrupted run's result");
+    let m = read_manifest(&fe.join(MANIFEST)).expect("manifest");
+    let e = &m.pose["centre"];
+    assert!(e.solver_settings.ends_with("; resumed after an interruption at 3 mm"), "{}", e.solver_settings);
+    assert_eq!(e.retry, None, "attempt 1 solved");
+}

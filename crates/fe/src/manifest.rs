@@ -203,7 +203,7 @@ pub fn rfc3339_utc(t: SystemTime) -> String {
     let secs = t.duration_since(SystemTime::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0);
     let days = (secs / 86_400) as i64;
     let rem = secs % 86_400;
-    // civil_from_days (H. Hinnant): days since 1970-01-01 -> proleptic Gregorian date
+    // civil_from_days (H. Hinnant): days since the Unix epoch -> proleptic Gregorian date
     let z = days + 719_468;
     let era = z.div_euclid(146_097);
     let doe = z.rem_euclid(146_097);

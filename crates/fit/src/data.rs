@@ -393,6 +393,10 @@ pub fn load_training_runs(set_dir: &Path) -> Result<(Campaign, Vec<Run>, Vec<Unu
     Ok((campaign, runs, unusable))
 }
 
+/// How [`Unusable::why`] starts for a pose that failed every attempt (it has a partial
+/// record).
+pub const FAILED_PREFIX: &str = "no result;";
+
 /// Why a pose has no result when the campaign kept a record of it (issue 42, item 4:
 /// `<set>/fe/<pose>.partial.toml`, written when every attempt failed): the depth reached
 /// and its attempts by class; `None` without a record of the current spec.
@@ -404,7 +408,7 @@ fn failed_record(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Option
         return None;
     }
     Some(format!(
-        "no result; its furthest failed attempt reached {} of {} mm; {}",
+        "{FAILED_PREFIX} its furthest failed attempt reached {} of {} mm; {}",
         r.reached_depth_mm,
         r.depth_mm,
         failures::summary(&failures::failures_from_record(&r.failure))

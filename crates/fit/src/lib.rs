@@ -29,6 +29,7 @@ pub mod model;
 pub mod model_file;
 pub mod model_file_error;
 pub mod poly;
+pub mod unsolved;
 pub mod validate;
 
 use anyhow::Result;
@@ -63,6 +64,10 @@ pub struct FitOutput {
     pub golden_stiffness_fixed_csv: String,
     /// The text of `depth-extension.toml`, when the set has a deep centre run.
     pub depth_extension_toml: Option<String>,
+    /// The unsolved region, from the set's FE records.
+    pub unsolved: unsolved::Region,
+    /// The text of `unsolved.toml`.
+    pub unsolved_toml: String,
 }
 
 impl FitOutput {
@@ -74,6 +79,7 @@ impl FitOutput {
             (GOLDEN_FIXED_FILE, &self.golden_fixed_csv),
             (GOLDEN_STIFFNESS_FILE, &self.golden_stiffness_csv),
             (GOLDEN_STIFFNESS_FIXED_FILE, &self.golden_stiffness_fixed_csv),
+            (unsolved::FILE, &self.unsolved_toml),
         ];
         if let Some(text) = &self.depth_extension_toml {
             files.push((depth_extension::FILE, text));
@@ -105,10 +111,12 @@ pub fn fit_set(set_dir: &Path) -> Result<FitOutput> {
             .map(|r| format!("{} (replaced by {})", r.pose, data.campaign.replacement_of(&r.pose).unwrap_or_default())),
     );
     let model_toml = model_file::to_toml(&model, &left_out);
-    let tables = eval::float32::Tables32::from_model(&model);
+    let region = unsolved::region(set_dir)?;
+    let unsolved_toml = unsolved::to_toml(&model.set, &region);
+    let tables = eval::float32::Tables32::from_model(&model).with_unsolved(region.entries());
     let golden_csv = golden::float32::to_csv(&tables);
     let golden_stiffness_csv = golden::stiffness_float32::to_csv(&tables);
-    let fixed = fixed_formats::TablesFixed::from_model(&model)?;
+    let fixed = fixed_formats::TablesFixed::from_model(&model)?.with_unsolved(region.entries());
     let golden_fixed_csv = golden::fixed::to_csv(&fixed)?;
     let golden_stiffness_fixed_csv = golden::stiffness_fixed::to_csv(&fixed)?;
     let depth_extension_toml = depth_extension::fit(set_dir)?.map(|e| depth_extension::to_toml(&e));
@@ -120,6 +128,8 @@ pub fn fit_set(set_dir: &Path) -> Result<FitOutput> {
         golden_stiffness_csv,
         golden_stiffness_fixed_csv,
         depth_extension_toml,
+        unsolved: region,
+        unsolved_toml,
     })
 }
 

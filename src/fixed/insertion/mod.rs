@@ -34,6 +34,7 @@ pub use stack::{
     STIFFNESS_SCALE_MAX, TOTAL_THICKNESS_MAX_MM, VISCOUS_MAX_Q16,
 };
 
+use super::arith::sat_mul;
 use super::depth_extension::saturate_i32;
 #[cfg(not(feature = "viscoelastic"))]
 use super::viscoelastic::identity::{QlvCoefficients, QlvState};
@@ -304,8 +305,8 @@ impl<'a> Insertion<'a> {
             }
             let e = self.surrogate(pose, entry, depth - q);
             let [fx, fy, fz, mx, my, mz] = e.wrench.to_array().map(i64::from);
-            let f = [fx, fy, fz].map(|c| c.saturating_mul(gf));
-            let moments = [mx, my, mz].map(|c| c.saturating_mul(gm));
+            let f = [fx, fy, fz].map(|c| sat_mul(c, gf));
+            let moments = [mx, my, mz].map(|c| sat_mul(c, gm));
             let [vfx, vfy, vfz, vmx, vmy, vmz] = self.qlv_state.step(qlv, [f[0], f[1], f[2], moments[0], moments[1], moments[2]]);
             let [px, py, pz, pmx, pmy, pmz] = self.preload_q16;
             if dot([vfx, vfy, vfz], a).saturating_add(self.carried_cutting_q16()) < layer.puncture_force_q16 {

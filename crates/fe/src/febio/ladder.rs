@@ -23,7 +23,7 @@
 //!   [`failed_at_first_contact`]), a later fresh attempt with whole load steps takes time
 //!   steps of at most `first_contact_step_fraction` of a load step until then, whole
 //!   steps after. Not on a first attempt: the cap makes the auto stepper climb back to
-//!   whole steps slowly (measured 2026-11-27: the needle8 centre took 46 time steps and
+//!   whole steps slowly (measured: the needle8 centre took 46 time steps and
 //!   50 s instead of 35 and 24 s, Fy within 0.17 % of peak; CI's smoke runs 23-24 time
 //!   steps instead of 10, and z+02 on the smoke mesh then failed its first attempt).
 //!

@@ -278,14 +278,14 @@ pub(crate) mod tests {
     /// at 3.2 mm. A restart (`-r`) reads `pose-from.dmp`: one holding `UNREADABLE` fails
     /// as FEBio does on a dump it cannot read; else it prints FEBio's restart line and logs
     /// 4.5 and 6 mm. Every call's arguments go to `calls`.
-    struct Killed {
-        exe: PathBuf,
+    pub(crate) struct Killed {
+        pub(crate) exe: PathBuf,
         calls: PathBuf,
-        dump: PathBuf,
-        snap: PathBuf,
+        pub(crate) dump: PathBuf,
+        pub(crate) snap: PathBuf,
     }
 
-    fn killed(dir: &Path) -> Killed {
+    pub(crate) fn killed(dir: &Path) -> Killed {
         use std::os::unix::fs::PermissionsExt;
         let k =
             Killed { exe: dir.join("fake-febio4"), calls: dir.join("calls.txt"), dump: dir.join("fixture.dmp"), snap: dir.join("snap") };
@@ -321,13 +321,18 @@ pub(crate) mod tests {
     }
 
     /// The calls of the fake since the last look: `-r` (a restart) or `-i` (from depth 0).
-    fn calls(k: &Killed) -> Vec<&'static str> {
+    /// The FEBio backend running `exe` with one thread (its fields are the module's).
+    pub(crate) fn backend_with(exe: &Path) -> super::super::FebioBackend {
+        super::super::FebioBackend { exe: Some(exe.to_path_buf()), threads: 1 }
+    }
+
+    pub(crate) fn calls(k: &Killed) -> Vec<&'static str> {
         let text = std::fs::read_to_string(&k.calls).unwrap_or_default();
         let _ = std::fs::remove_file(&k.calls);
         text.lines().map(|l| if l.contains(" -r ") { "-r" } else { "-i" }).collect()
     }
 
-    type Solve = std::result::Result<crate::backend::Solved, crate::backend::SolveFailure>;
+    pub(crate) type Solve = std::result::Result<crate::backend::Solved, crate::backend::SolveFailure>;
 
     /// Kill a campaign in attempt 1 of `centre` (the first FEBio process, at 3 mm) with
     /// `fixture` as the dump it left, and solve the attempt again in the killed folder.
@@ -411,73 +416,5 @@ pub(crate) mod tests {
         let f = again.expect_err("the fake's restarts all fail on this dump");
         assert_eq!(calls(&k), ["-r", "-i", "-r"], "the restart fails, then from depth 0: {}", f.message);
         assert!(f.message.contains("after 2 of 4 steps"), "{}", f.message);
-    }
-
-    /// The FEBio backend with its solver given (`prepare` would look for the real one).
-    struct Given(super::super::FebioBackend);
-
-    impl crate::backend::Backend for Given {
-        fn prepare(&mut self) -> Result<String> {
-            Ok("4.11.0".into())
-        }
-        fn engine(&self) -> &'static str {
-            self.0.engine()
-        }
-        fn attempts(&self) -> u32 {
-            self.0.attempts()
-        }
-        fn first_increment_in(&self, work_dir: &Path, attempt: u32, full_block: bool) -> f64 {
-            self.0.first_increment_in(work_dir, attempt, full_block)
-        }
-        fn describe_attempt(&self, work_dir: &Path, attempt: u32, full_block: bool, depth_mm: f64, steps: u32) -> String {
-            self.0.describe_attempt(work_dir, attempt, full_block, depth_mm, steps)
-        }
-        fn solve(&self, job: &crate::backend::Job<'_>) -> Solve {
-            self.0.solve(job)
-        }
-        fn steps_done(&self, work_dir: &Path) -> u32 {
-            self.0.steps_done(work_dir)
-        }
-    }
-
-    /// The campaign and FEBio together: a campaign killed in the first FEBio process of
-    /// `centre` (its work folder as the fake left it: `progress.toml`, `running.toml`, the
-    /// dump) resumes the pose with one restart, and writes the uninterrupted run's CSV with
-    /// "resumed after an interruption at 3 mm" in the manifest.
-    #[test]
-    fn a_killed_campaign_resumes_its_febio_pose_from_the_dump() {
-        use crate::campaign::run_with;
-        use crate::campaign::tests::{opts, set_dir};
-        use crate::manifest::{read_manifest, MANIFEST};
-        let d = set_dir();
-        let k = killed(d.path());
-        std::fs::write(&k.dump, dump_bytes(3.0, true)).expect("fixture");
-        let mut backend = Given(super::super::FebioBackend { exe: Some(k.exe.clone()), threads: 1 });
-        let o = crate::campaign::RunOptions { jobs: 1, ..opts(d.path(), "centre", 4) };
-        let fe = d.path().join("fe");
-        let r = run_with(&o, &mut backend).expect("the run that was not killed");
-        assert_eq!(r.done(), 1, "{}", r.table());
-        let whole = std::fs::read(fe.join("centre.csv")).expect("csv");
-        assert_eq!(calls(&k), ["-i", "-r"], "the first process gave up at 3.2 mm and was continued");
-        let rec = crate::resume::read(&k.snap).expect("readable").expect("the campaign's record in the killed folder");
-        assert_eq!((rec.attempt, rec.failures.len()), (0, 0));
-
-        // the killed campaign's state: no result yet, the work folder as the kill left it
-        for f in ["centre.csv", MANIFEST] {
-            std::fs::remove_file(fe.join(f)).expect("remove");
-        }
-        let work = fe.join(".work/centre");
-        std::fs::create_dir_all(&work).expect("mkdir");
-        for e in std::fs::read_dir(&k.snap).expect("snapshot").flatten() {
-            std::fs::copy(e.path(), work.join(e.file_name())).expect("copy");
-        }
-        let r = run_with(&o, &mut backend).expect("the rerun");
-        assert_eq!(r.done(), 1, "{}", r.table());
-        assert_eq!(calls(&k), ["-r"], "resumed from the dump, not from depth 0");
-        assert_eq!(std::fs::read(fe.join("centre.csv")).expect("csv"), whole, "the uninterrupted run's result");
-        let m = read_manifest(&fe.join(MANIFEST)).expect("manifest");
-        let e = &m.pose["centre"];
-        assert!(e.solver_settings.ends_with("; resumed after an interruption at 3 mm"), "{}", e.solver_settings);
-        assert_eq!(e.retry, None, "attempt 1 solved");
     }
 }

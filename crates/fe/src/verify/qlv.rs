@@ -207,7 +207,7 @@ fn read_partial(plan: &crate::campaign::Plan, run: &str) -> Option<Vec<Row>> {
     // timed since the record keeps the times; earlier ones have the depth only
     let mut rows = crate::results::parse_timed_csv(&text, &csv).map(|(_, r)| r).or_else(|_| crate::results::parse_csv(&text, &csv)).ok()?;
     // a continuation that failed at once logs its start must point with a zero reaction
-    // (x+04_1mm-s and centre_10mm-s, 2026-11-27: an exact zero wrench at 6 mm after
+    // (x+04_1mm-s and centre_10mm-s: an exact zero wrench at 6 mm after
     // 0.083 N): not a state of the tissue, left out
     while rows.len() > 1 && rows.last().is_some_and(|r| r.depth_mm > 0.0 && r.wrench.iter().all(|v| *v == 0.0)) {
         rows.pop();

@@ -8,7 +8,9 @@
 //! there). Products are floored with `div_euclid`, not shifts.
 
 use crate::contract::COMPONENT_COUNT;
-use crate::contract::{Sweep, NCOEF, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z};
+use crate::contract::{
+    Sweep, NCOEF, STATUS_FE_UNSOLVED, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z,
+};
 use crate::fixed_formats::{TablesFixed, LIMIT};
 use std::fmt;
 
@@ -154,6 +156,10 @@ fn accumulate(t: &TablesFixed, pose: [i32; 5]) -> Result<Accumulated, Overflow> 
                 a[c][i] = check(a[c][i].checked_add(shifted), || format!("A[{c}][{i}] after cross {e:?}"))?;
             }
         }
+    }
+    // 7. the unsolved region (on the clamped pose)
+    if crate::unsolved::inside_fixed(&t.unsolved, n, d) {
+        status |= STATUS_FE_UNSOLVED;
     }
     Ok(Accumulated { v, u, tk, n, status, a })
 }

@@ -4,7 +4,9 @@
 //! or `-` (Rust never fuses them), each rounded to nearest even on its own.
 
 use crate::contract::COMPONENT_COUNT;
-use crate::contract::{NCOEF, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z};
+use crate::contract::{
+    NCOEF, STATUS_ERROR, STATUS_FE_UNSOLVED, STATUS_SAT_DEPTH, STATUS_SAT_THETA_X, STATUS_SAT_THETA_Z, STATUS_SAT_X, STATUS_SAT_Z,
+};
 use crate::model::Model;
 use needle_contract::{DEPTH_MAX_MM, HALF_RANGES};
 
@@ -33,6 +35,8 @@ pub struct Tables32 {
     /// `(xi, zeta, alpha, beta)` and the depth polynomial (`p[i]` multiplies `u^i`).
     /// Empty for the paper form.
     pub cross: [Vec<([u8; 4], Vec<f32>)>; COMPONENT_COUNT],
+    /// The set's unsolved region (`unsolved.toml`; empty: no pose is flagged).
+    pub unsolved: Vec<crate::unsolved::Entry>,
 }
 
 impl Tables32 {
@@ -42,7 +46,12 @@ impl Tables32 {
             Some(k) => k.terms.terms[c].iter().map(|(e, p)| (*e, p.iter().map(|v| *v as f32).collect())).collect(),
             None => Vec::new(),
         });
-        let mut t = Tables32 { baseline: [[0.0; NCOEF]; COMPONENT_COUNT], rows: [[[[0.0; NCOEF]; NCOEF]; COMPONENT_COUNT]; 4], cross };
+        let mut t = Tables32 {
+            baseline: [[0.0; NCOEF]; COMPONENT_COUNT],
+            rows: [[[[0.0; NCOEF]; NCOEF]; COMPONENT_COUNT]; 4],
+            cross,
+            unsolved: Vec::new(),
+        };
         for (dst, src) in t.baseline.iter_mut().zip(&model.baseline) {
             for (d, s) in dst.iter_mut().zip(&src.coeffs) {
                 *d = *s as f32;
@@ -58,6 +67,13 @@ impl Tables32 {
             }
         }
         t
+    }
+
+    /// The same tables with the unsolved region `entries` (`FE_UNSOLVED` in the status).
+    #[must_use]
+    pub fn with_unsolved(mut self, entries: Vec<crate::unsolved::Entry>) -> Self {
+        self.unsolved = entries;
+        self
     }
 }
 
@@ -150,6 +166,10 @@ pub fn eval(t: &Tables32, pose: [f32; 5]) -> ([f32; COMPONENT_COUNT], u8) {
         for (e, p) in terms {
             *wc += monomial32(*e, &n) * horner_n32(p, u);
         }
+    }
+    // 7. the unsolved region (on the clamped pose)
+    if crate::unsolved::inside_f32(&t.unsolved, n, dc) {
+        status |= STATUS_FE_UNSOLVED;
     }
     (w, status)
 }

@@ -5,7 +5,8 @@
 //! The pose list is fixed in code: a 5^5 grid over the domain, 1,000 ChaCha8 random poses
 //! from [`GOLDEN_FIXED_SEED`], every input on, one unit inside and one unit outside its
 //! bounds, the corners and just outside them, inputs far outside (up to `i32::MIN` and
-//! `i32::MAX`), zeros, and inputs on both sides of the normalisation's rounding points.
+//! `i32::MAX`), zeros, inputs on both sides of the normalisation's rounding points, and
+//! poses in and around the set's unsolved region.
 
 use crate::contract::COMPONENT_COUNT;
 use crate::eval::fixed::{eval, DEPTH_DIVISOR, DEPTH_MAX_Q16, DIVISORS, HALF_RANGE_Q16, ONE};
@@ -42,8 +43,10 @@ fn with(i: usize, v: i64) -> [i32; 5] {
     p
 }
 
-/// Every golden pose `[x, z, theta_x, theta_z, depth]` in Q16.16, in file order.
-pub fn poses() -> Vec<[i32; 5]> {
+/// Every golden pose `[x, z, theta_x, theta_z, depth]` in Q16.16, in file order, for a
+/// set whose unsolved region has the balls `unsolved` (section 8: poses in and around
+/// each ball, [`crate::unsolved::golden_poses_fixed`]).
+pub fn poses(unsolved: &[crate::unsolved::Entry]) -> Vec<[i32; 5]> {
     let (min, max) = bounds();
     let mut out = Vec::with_capacity(4600);
     // 1. grid 5^5 with the edges (the bounds are multiples of 4)
@@ -114,6 +117,8 @@ pub fn poses() -> Vec<[i32; 5]> {
     }
     // 7. the benchmark's typical pose (3, -2, 5, -7, 4.5)
     out.push([3 * ONE, -2 * ONE, 5 * ONE, -7 * ONE, 9 * ONE / 2].map(|v| v as i32));
+    // 8. in and around the unsolved region
+    out.extend(crate::unsolved::golden_poses_fixed(unsolved));
     out
 }
 
@@ -122,7 +127,7 @@ pub fn poses() -> Vec<[i32; 5]> {
 /// # Errors
 /// An intermediate of a pose leaves the contract's range (the tables are wrong).
 pub fn to_csv(t: &TablesFixed) -> Result<String> {
-    let poses = poses();
+    let poses = poses(&t.unsolved);
     let mut s = String::with_capacity(96 * (poses.len() + 1));
     s.push_str(&header());
     s.push('\n');

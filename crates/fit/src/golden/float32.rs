@@ -5,7 +5,9 @@
 //! ChaCha8 random poses from [`GOLDEN_SEED`], the domain's bounds (on, one ulp inside, one
 //! ulp outside) and corners, out-of-domain values on each input and on all together,
 //! negative zeros, NaNs (quiet, with payload, negative, signalling), infinities and
-//! subnormals in each input.
+//! subnormals in each input, and poses in and around the set's unsolved region (its
+//! balls' centres, depths either side of their thresholds, offsets of half and twice the
+//! radius).
 
 use crate::contract::COMPONENT_COUNT;
 use crate::eval::float32::{eval, Tables32};
@@ -67,8 +69,10 @@ fn with(i: usize, v: f32) -> [f32; 5] {
     p
 }
 
-/// Every golden pose `[x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm]`, in file order.
-pub fn poses() -> Vec<[f32; 5]> {
+/// Every golden pose `[x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm]`, in file order,
+/// for a set whose unsolved region has the balls `unsolved` (section 8: poses in and
+/// around each ball, [`crate::unsolved::golden_poses_f32`]).
+pub fn poses(unsolved: &[crate::unsolved::Entry]) -> Vec<[f32; 5]> {
     let mut out = Vec::with_capacity(4500);
     // 1. grid 5 x 5 x 5 x 5 x 5 with the edges
     let lin = |i: usize| -> [f32; 5] {
@@ -144,12 +148,14 @@ pub fn poses() -> Vec<[f32; 5]> {
         }
     }
     out.push([f32::from_bits(1); 5]);
+    // 8. in and around the unsolved region
+    out.extend(crate::unsolved::golden_poses_f32(unsolved));
     out
 }
 
 /// The text of golden-f32.csv for the f32 tables `t`.
 pub fn to_csv(t: &Tables32) -> String {
-    let poses = poses();
+    let poses = poses(&t.unsolved);
     let mut s = String::with_capacity(128 * (poses.len() + 1));
     s.push_str(&header());
     s.push('\n');

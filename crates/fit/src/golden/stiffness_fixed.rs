@@ -23,7 +23,7 @@ pub fn header() -> String {
 /// # Errors
 /// An intermediate of a pose leaves the contract's range (the tables are wrong).
 pub fn to_csv(t: &TablesFixed) -> Result<String> {
-    let poses = poses();
+    let poses = poses(&t.unsolved);
     let mut s = String::with_capacity(160 * (poses.len() + 1));
     s.push_str(&header());
     s.push('\n');

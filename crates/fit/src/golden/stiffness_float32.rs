@@ -39,7 +39,7 @@ pub fn header() -> String {
 
 /// The text of golden-stiffness-f32.csv for the f32 tables `t`.
 pub fn to_csv(t: &Tables32) -> String {
-    let poses = poses();
+    let poses = poses(&t.unsolved);
     let mut s = String::with_capacity(256 * (poses.len() + 1));
     s.push_str(&header());
     s.push('\n');
