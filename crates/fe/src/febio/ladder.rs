@@ -9,8 +9,8 @@
 //!   attempt's last converged must point (its FEBio dump, kept as [`FURTHEST_DUMP`]) with
 //!   the retry's settings: a first time step of [`RETRY_FIRST_INCREMENT`] of a load step
 //!   (every time step of that load step at most that: the restart input caps the
-//!   must-point curve there, `restart.rs`; before 2026-11-27 FEBio took the dump's own
-//!   step, and the settings lines of the continuations before then overstate their first
+//!   must-point curve there, `restart.rs`; before that fix FEBio took the dump's own
+//!   step, and the settings lines of the continuations before it overstate their first
 //!   step) and the retry tolerances (`retry_dtol`, `retry_rtol`: FEBio's restart input can set
 //!   the Newton solver's parameters). In the failed logs "max nr of reformations" is the
 //!   displacement norm stalling while the residual and energy norms have converged (a
