@@ -7,7 +7,9 @@
 //! the same line is one line long, a declaration without a body (`;`) is not counted.
 //! Tests aside: a file stops at its first `#[cfg(test)]` at the start of a line, and
 //! files named `*_tests.rs` (test modules kept in their own file) are skipped.
-use std::path::{Path, PathBuf};
+mod source_walk;
+
+use source_walk::{rust_files, workspace};
 
 /// The longest a function may be, lines.
 const MAX_LINES: usize = 80;
@@ -67,18 +69,6 @@ fn fn_name(t: &str) -> Option<String> {
     (!name.is_empty()).then_some(name)
 }
 
-fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else { return };
-    for e in entries.flatten() {
-        let p = e.path();
-        if p.is_dir() {
-            rust_files(&p, out);
-        } else if p.extension().is_some_and(|x| x == "rs") && !p.to_string_lossy().ends_with("_tests.rs") {
-            out.push(p);
-        }
-    }
-}
-
 #[test]
 fn the_measure_counts_bodies_and_skips_declarations_and_tests() {
     let text = "fn one() -> u8 { 1 }\n\
@@ -92,14 +82,14 @@ fn the_measure_counts_bodies_and_skips_declarations_and_tests() {
 
 #[test]
 fn no_function_is_over_80_lines() {
-    let ws = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let mut files = Vec::new();
-    rust_files(&ws.join("src"), &mut files);
+    let ws = workspace();
+    // test modules kept in their own file
+    let tests_file = |p: &std::path::Path| p.to_string_lossy().ends_with("_tests.rs");
+    let mut files = rust_files(&ws.join("src"), &tests_file);
     let Ok(crates) = std::fs::read_dir(ws.join("crates")) else { panic!("{}: cannot list", ws.join("crates").display()) };
     for c in crates.flatten() {
-        rust_files(&c.path().join("src"), &mut files);
+        files.extend(rust_files(&c.path().join("src"), &tests_file));
     }
-    files.sort();
     assert!(files.len() > 100, "found {} source files: the walk is wrong", files.len());
     let mut long = Vec::new();
     for f in &files {

@@ -4,7 +4,9 @@
 //! measured figures to the set's README. A date is `YYYY-MM-DD` not followed by `T` (an
 //! RFC 3339 timestamp in a format example is not history). Test modules aside (a file
 //! stops at its first `#[cfg(test)]` at the start of a line).
-use std::path::{Path, PathBuf};
+mod source_walk;
+
+use source_walk::{rust_files, workspace};
 
 /// The dates in `text` (`YYYY-MM-DD` with a plausible month and day, not followed by `T`).
 fn dates(text: &str) -> Vec<String> {
@@ -37,18 +39,6 @@ fn comments(text: &str) -> Vec<(usize, &str)> {
         .collect()
 }
 
-fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else { return };
-    for e in entries.flatten() {
-        let p = e.path();
-        if p.is_dir() {
-            rust_files(&p, out);
-        } else if p.extension().is_some_and(|x| x == "rs") {
-            out.push(p);
-        }
-    }
-}
-
 #[test]
 fn the_detector_finds_dates_and_leaves_timestamps() {
     assert_eq!(dates("measured 2026-11-27: 46 steps"), vec!["2026-11-27"]);
@@ -59,7 +49,7 @@ fn the_detector_finds_dates_and_leaves_timestamps() {
 
 #[test]
 fn specs_and_code_comments_carry_no_dates() {
-    let ws = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let ws = workspace();
     let mut found = Vec::new();
     for doc in ["coeffs/README.md", "docs/architecture.md"] {
         let text = std::fs::read_to_string(ws.join(doc)).unwrap_or_else(|e| panic!("{doc}: {e}"));
@@ -69,13 +59,9 @@ fn specs_and_code_comments_carry_no_dates() {
             }
         }
     }
-    let mut files = Vec::new();
-    for dir in ["src", "crates", "host-tests", "examples"] {
-        rust_files(&ws.join(dir), &mut files);
-    }
     // this file's own examples are dates on purpose
-    files.retain(|f| !f.components().any(|c| c.as_os_str() == "target") && !f.ends_with("host-tests/tests/no_dates.rs"));
-    files.sort();
+    let this = |p: &std::path::Path| p.ends_with("host-tests/tests/no_dates.rs");
+    let files: Vec<_> = ["src", "crates", "host-tests", "examples"].iter().flat_map(|d| rust_files(&ws.join(d), &this)).collect();
     assert!(files.len() > 100, "found {} source files: the walk is wrong", files.len());
     for f in &files {
         let text = std::fs::read_to_string(f).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
