@@ -237,9 +237,10 @@ fn the_loop_with_the_guard_delivers_no_energy_either() {
     }
 }
 
-fn the_guarded_loop_delivers_no_energy(stack: &Stack<'_>, loop_trajectories: usize) {
-    use needle_haptics::control::{ChannelMap, LoopConfig, LoopCore, LoopFlags, OverLimit, Passivity};
-    const WEAK_DAMPING_N_S_PER_MM: f64 = 0.0001;
+/// The guarded loops' configuration: one channel on Fy, limits far above the forces, and
+/// the passivity guard for a device of damping `damping_n_s_per_mm` at the test's period.
+fn guarded_loop_setup(damping_n_s_per_mm: f64) -> (needle_haptics::control::LoopConfig<1>, needle_haptics::control::Passivity) {
+    use needle_haptics::control::{ChannelMap, LoopConfig, OverLimit, Passivity};
     let config = LoopConfig {
         channels: [ChannelMap { gains_per_n: [0.0, 0.01, 0.0], direction_inverted: false }],
         force_limit_n: 100.0,
@@ -247,7 +248,13 @@ fn the_guarded_loop_delivers_no_energy(stack: &Stack<'_>, loop_trajectories: usi
         over_limit: OverLimit::Saturate,
         ramp_step_n: 0.01,
     };
-    let guard = Passivity { damping_n_s_per_mm: WEAK_DAMPING_N_S_PER_MM as f32, period_s: PERIOD_S as f32 };
+    (config, Passivity { damping_n_s_per_mm: damping_n_s_per_mm as f32, period_s: PERIOD_S as f32 })
+}
+
+fn the_guarded_loop_delivers_no_energy(stack: &Stack<'_>, loop_trajectories: usize) {
+    use needle_haptics::control::{LoopCore, LoopFlags};
+    const WEAK_DAMPING_N_S_PER_MM: f64 = 0.0001;
+    let (config, guard) = guarded_loop_setup(WEAK_DAMPING_N_S_PER_MM);
     {
         // one generator per stack: a stack added does not change another's trajectories
         let mut rng = ChaCha8Rng::seed_from_u64(20261127);
@@ -298,17 +305,10 @@ fn the_guarded_loop_delivers_no_energy(stack: &Stack<'_>, loop_trajectories: usi
 /// 8.74, so a guard bounding by the tick gain gives 0.559 and fails).
 #[test]
 fn the_guarded_loop_renders_at_half_colgates_bound_at_every_frequency() {
-    use needle_haptics::control::{ChannelMap, LoopConfig, LoopCore, LoopFlags, OverLimit, Passivity, GUARD_FRACTION};
+    use needle_haptics::control::{LoopCore, LoopFlags, GUARD_FRACTION};
     const WEAK_DAMPING_N_S_PER_MM: f64 = 0.0001;
     const AMPLITUDE_MM: f64 = 0.02;
-    let config = LoopConfig {
-        channels: [ChannelMap { gains_per_n: [0.0, 0.01, 0.0], direction_inverted: false }],
-        force_limit_n: 100.0,
-        force_limit_max_n: 100.0,
-        over_limit: OverLimit::Saturate,
-        ramp_step_n: 0.01,
-    };
-    let guard = Passivity { damping_n_s_per_mm: WEAK_DAMPING_N_S_PER_MM as f32, period_s: PERIOD_S as f32 };
+    let (config, guard) = guarded_loop_setup(WEAK_DAMPING_N_S_PER_MM);
     let elastic = ("elastic", PronyTerms::NONE);
     for stack in &stacks::ALL {
         for (label, terms) in [elastic, test_terms()[0], test_terms()[1]] {
