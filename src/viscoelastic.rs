@@ -369,11 +369,15 @@ impl Qlv {
 pub struct QlvState {
     /// Per component `[last input, h_0, h_1, h_2]`.
     state: [[f32; 1 + MAX_TERMS]; COMPONENT_COUNT],
+    /// Whether a step with terms ran since the last reset (when not, every value is
+    /// still zero and [`reset`](Self::reset) has nothing to clear: a stack without
+    /// terms pays no 24 stores a tick).
+    stored: bool,
 }
 
 impl QlvState {
     /// At rest.
-    pub const REST: Self = Self { state: [[0.0; 1 + MAX_TERMS]; COMPONENT_COUNT] };
+    pub const REST: Self = Self { state: [[0.0; 1 + MAX_TERMS]; COMPONENT_COUNT], stored: false };
 
     /// One tick of every component with `coefficients`: the elastic wrench in, the
     /// viscoelastic wrench out. Without terms the input is returned and the state left
@@ -388,6 +392,7 @@ impl QlvState {
 
     /// The six components in place.
     fn filter(&mut self, coefficients: &QlvCoefficients, w: &mut [f32; COMPONENT_COUNT]) {
+        self.stored = true;
         for (o, s) in w.iter_mut().zip(self.state.iter_mut()) {
             *o = coefficients.step_one(s, *o);
         }
@@ -395,7 +400,9 @@ impl QlvState {
 
     /// Back to rest.
     pub fn reset(&mut self) {
-        *self = Self::REST;
+        if self.stored {
+            *self = Self::REST;
+        }
     }
 }
 

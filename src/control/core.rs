@@ -196,7 +196,8 @@ impl<const N: usize> LoopCore<N> {
                     let f = [wrench.fx_n, wrench.fy_n, wrench.fz_n];
                     let f = match stiffness {
                         Some((p, terms)) => {
-                            let (guarded, limited) = self.guard.apply(&p, f, &terms);
+                            let filter = self.insertion.as_ref().and_then(Insertion::guard_filter);
+                            let (guarded, limited) = self.guard.apply(&p, f, &terms, filter);
                             if limited {
                                 s.flags |= LoopFlags::STIFFNESS_LIMITED;
                             }

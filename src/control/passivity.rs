@@ -34,7 +34,7 @@
 //!   quasi-linear filter's part (a function of time too: at a fixed position it relaxes),
 //!   `P` the preload and the track's hold. The guard limits first and filters after: the
 //!   rule above runs on the elastic part `F - D - V` (the insertion names `V` and `E`:
-//!   `GuardTerms`), at the stiffness `rho K` (`rho`:
+//!   `Insertion::guard_filter`, beside the layer's coefficients), at the stiffness `rho K` (`rho`:
 //!   [`QlvCoefficients::effective_stiffness_ratio`](crate::viscoelastic::QlvCoefficients::effective_stiffness_ratio),
 //!   the filter's worst-case stiffness ratio in a sampled loop, Colgate's general
 //!   condition at the Nyquist frequency: `1 + sum 2 b_i / (1 + a_i)`), and the guard's own
@@ -63,7 +63,11 @@
 //!   it). Measured: `host-tests/tests/insertion_energy.rs` (random closed cycles and
 //!   Colgate's ratio at `wT` from `0.2 pi` to `pi`).
 use super::ConfigError;
-use crate::insertion::GuardTerms;
+#[cfg(feature = "viscoelastic")]
+use crate::insertion::FilterTerms;
+use crate::insertion::{FilterShare, GuardTerms};
+#[cfg(feature = "viscoelastic")]
+use crate::viscoelastic::QlvCoefficients;
 
 /// The fraction of Colgate's bound `2 b / T` the guard renders at most.
 pub const GUARD_FRACTION: f32 = 0.5;
@@ -123,12 +127,15 @@ impl Guard {
     }
 
     /// The guarded force for the model force `f_n` with its stiffness and dissipative
-    /// part `terms` (the module's rule), and whether the stiffness was limited.
-    pub(crate) fn apply(&mut self, p: &Passivity, f_n: [f32; 3], terms: &GuardTerms) -> ([f32; 3], bool) {
+    /// part `terms` (the module's rule; `filter` the deflected boundary's viscoelastic
+    /// filter, [`Insertion::guard_filter`](crate::insertion::Insertion::guard_filter)),
+    /// and whether the stiffness was limited.
+    pub(crate) fn apply(&mut self, p: &Passivity, f_n: [f32; 3], terms: &GuardTerms, filter: FilterShare<'_>) -> ([f32; 3], bool) {
         #[cfg(feature = "viscoelastic")]
-        if terms.filter.coefficients.is_active() {
-            return self.apply_filtered(p, f_n, terms);
+        if let Some((c, share)) = filter {
+            return self.apply_filtered(p, f_n, terms, c, share);
         }
+        let _ = filter;
         self.filter.rest();
         let d = terms.dissipative_n;
         // no dissipative part (the block surrogate): the whole force, bits unchanged
@@ -146,8 +153,15 @@ impl Guard {
     /// the guarded deflection force (its increments `s dE`, `s` the rule's scale), then
     /// `D` unchanged.
     #[cfg(feature = "viscoelastic")]
-    fn apply_filtered(&mut self, p: &Passivity, f_n: [f32; 3], terms: &GuardTerms) -> ([f32; 3], bool) {
-        let (d, v) = (terms.dissipative_n, terms.filter.viscous_n);
+    fn apply_filtered(
+        &mut self,
+        p: &Passivity,
+        f_n: [f32; 3],
+        terms: &GuardTerms,
+        c: &QlvCoefficients,
+        share: &FilterTerms,
+    ) -> ([f32; 3], bool) {
+        let (d, v) = (terms.dissipative_n, share.viscous_n);
         let elastic = [f_n[0] - d[0] - v[0], f_n[1] - d[1] - v[1], f_n[2] - d[2] - v[2]];
         // the scale the rule gives this tick's change (below), before it records the force
         let k_g = p.guard_stiffness_n_per_mm();
@@ -155,7 +169,7 @@ impl Guard {
         // `k > k_g > 0` (validated), so the division is by a positive, finite number
         let scale = self.last_model_n.map(|_| if k > k_g { k_g / k } else { 1.0 });
         let (g, limited) = self.apply_elastic(p, elastic, k);
-        let h = self.filter.step(&terms.filter.coefficients, terms.filter.deflection_n, scale);
+        let h = self.filter.step(c, share.deflection_n, scale);
         ([g[0] + h[0] + d[0], g[1] + h[1] + d[1], g[2] + h[2] + d[2]], limited)
     }
 
@@ -195,6 +209,9 @@ impl Guard {
 struct GuardFilter {
     last_deflection_n: Option<[f32; 3]>,
     h_n: [[f32; crate::viscoelastic::MAX_TERMS]; 3],
+    /// Set by [`rest`](Self::rest), cleared by [`step`](Self::step): a filter at rest
+    /// is not written again (a tick without terms pays no 13 stores).
+    at_rest: bool,
 }
 
 #[cfg(feature = "viscoelastic")]
@@ -203,7 +220,9 @@ impl GuardFilter {
     /// stored, the last deflection force 0 (the next boundary's first force enters
     /// whole, as in the insertion's filter).
     fn rest(&mut self) {
-        *self = Self { last_deflection_n: Some([0.0; 3]), ..Self::default() };
+        if !self.at_rest {
+            *self = Self { last_deflection_n: Some([0.0; 3]), h_n: [[0.0; crate::viscoelastic::MAX_TERMS]; 3], at_rest: true };
+        }
     }
 
     /// One tick: the deflection force `e_n` whose change since the last tick enters the
@@ -216,6 +235,7 @@ impl GuardFilter {
             _ => [0.0; 3],
         };
         self.last_deflection_n = Some(e_n);
+        self.at_rest = false;
         c.step_increments(&mut self.h_n, d)
     }
 }

@@ -251,27 +251,28 @@ pub struct GuardTerms {
     /// takes energy out, so a guard leaves it as it is and limits the rest (the
     /// boundary's deflection, the preload and the track's hold: the elastic part).
     pub dissipative_n: [f32; 3],
-    /// The viscoelastic filter's share (zero-sized without the `viscoelastic` feature).
-    pub(crate) filter: FilterTerms,
 }
 
 impl GuardTerms {
     /// No stiffness, no dissipative force.
-    pub const NONE: Self = Self { stiffness_n_per_mm: 0.0, dissipative_n: [0.0; 3], filter: FilterTerms::NONE };
+    pub const NONE: Self = Self { stiffness_n_per_mm: 0.0, dissipative_n: [0.0; 3] };
 }
 
-/// What a guard needs of the deflected boundary's viscoelastic filter: the filter's
-/// coefficients (`NONE` when no boundary with Prony terms is deflected: the insertion's
-/// filter is then at rest), the unfiltered elastic deflection force `E` and the
-/// filter's part `V` of the wrench's forces (filtered minus `E`). The guard renders
-/// `F - D - V` (the elastic part, a function of the path) through its rule and adds
-/// its own filter run on the guarded `E` (`control::passivity`).
+/// What a guard needs of the deflected boundary's viscoelastic filter: the deflected
+/// layer whose coefficients it uses ([`Insertion::filter_coefficients`]; none when no
+/// boundary with Prony terms is deflected: the insertion's filter is then at rest), the
+/// unfiltered elastic deflection force `E` and the filter's part `V` of the wrench's
+/// forces (filtered minus `E`). The guard renders `F - D - V` (the elastic part, a
+/// function of the path) through its rule and adds its own filter run on the guarded `E`
+/// (`control::passivity`). The insertion keeps it and the guard reads it
+/// ([`Insertion::guard_filter`]): nothing of the filter is copied through the loop's
+/// calls in a tick without one.
 #[cfg(feature = "viscoelastic")]
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub(crate) struct FilterTerms {
-    /// The deflected layer's per-tick coefficients.
-    pub(crate) coefficients: QlvCoefficients,
+    /// The deflected layer with Prony terms, [`FilterTerms::NO_LAYER`] for none.
+    layer: u8,
     /// The boundary's deflection force before the filter, N (block frame).
     pub(crate) deflection_n: [f32; 3],
     /// The filter's part of the wrench's forces, N: the filtered deflection force
@@ -281,9 +282,20 @@ pub(crate) struct FilterTerms {
 
 #[cfg(feature = "viscoelastic")]
 impl FilterTerms {
+    /// No deflected layer with terms.
+    const NO_LAYER: u8 = u8::MAX;
     /// No filter in this tick.
-    pub(crate) const NONE: Self = Self { coefficients: QlvCoefficients::NONE, deflection_n: [0.0; 3], viscous_n: [0.0; 3] };
+    pub(crate) const NONE: Self = Self { layer: Self::NO_LAYER, deflection_n: [0.0; 3], viscous_n: [0.0; 3] };
+
+    /// No filter in this tick (the forces are not read without a layer).
+    fn clear(&mut self) {
+        self.layer = Self::NO_LAYER;
+    }
 }
+
+/// The deflected boundary's filter as a guard reads it ([`Insertion::guard_filter`]):
+/// the layer's coefficients and [`FilterTerms`]; `None` without one.
+pub(crate) type FilterShare<'a> = Option<(&'a QlvCoefficients, &'a FilterTerms)>;
 
 /// Without the `viscoelastic` feature there is no filter: nothing.
 #[cfg(not(feature = "viscoelastic"))]
@@ -295,6 +307,9 @@ pub(crate) struct FilterTerms;
 impl FilterTerms {
     /// Nothing.
     pub(crate) const NONE: Self = Self;
+
+    /// Nothing to clear.
+    fn clear(&mut self) {}
 }
 
 /// What [`Insertion::deflect`] found: the wrench so far (preload included), the
@@ -306,21 +321,23 @@ struct Deflected {
     stiffness_n_per_mm: f32,
 }
 
-/// The guard's share of the deflected boundary's filter ([`FilterTerms`]): the
-/// coefficients, the elastic deflection force and the filtered minus the elastic one.
+/// The guard's share of the deflected boundary's filter ([`FilterTerms`]): layer `j`
+/// (whose coefficients have terms), the elastic deflection force and the filtered minus
+/// the elastic one.
 #[cfg(feature = "viscoelastic")]
-fn filter_terms(qlv: &QlvCoefficients, elastic: &[f32; 6], filtered: &[f32; 6]) -> FilterTerms {
-    if !qlv.is_active() {
-        return FilterTerms::NONE;
-    }
+fn filter_terms(j: usize, elastic: &[f32; 6], filtered: &[f32; 6]) -> FilterTerms {
+    let layer = match u8::try_from(j) {
+        Ok(layer) if layer != FilterTerms::NO_LAYER => layer,
+        _ => return FilterTerms::NONE,
+    };
     let [ex, ey, ez, ..] = *elastic;
     let [fx, fy, fz, ..] = *filtered;
-    FilterTerms { coefficients: *qlv, deflection_n: [ex, ey, ez], viscous_n: [fx - ex, fy - ey, fz - ez] }
+    FilterTerms { layer, deflection_n: [ex, ey, ez], viscous_n: [fx - ex, fy - ey, fz - ez] }
 }
 
 /// Without the filter: nothing.
 #[cfg(not(feature = "viscoelastic"))]
-fn filter_terms(_qlv: &QlvCoefficients, _elastic: &[f32; 6], _filtered: &[f32; 6]) -> FilterTerms {
+fn filter_terms(_j: usize, _elastic: &[f32; 6], _filtered: &[f32; 6]) -> FilterTerms {
     FilterTerms
 }
 
@@ -439,7 +456,19 @@ impl Insertion {
     /// them ([`LoopCore::set_insertion`](crate::control::LoopCore::set_insertion)).
     pub fn step_with_stiffness(&mut self, pose: &Pose) -> (InsertionEvaluation, GuardTerms) {
         let (e, stiffness_n_per_mm, dissipative_n) = self.tick(pose, true);
-        (e, GuardTerms { stiffness_n_per_mm, dissipative_n, filter: self.guard_share })
+        (e, GuardTerms { stiffness_n_per_mm, dissipative_n })
+    }
+
+    /// The deflected boundary's filter of the last
+    /// [`step_with_stiffness`](Self::step_with_stiffness) for a guard: its coefficients
+    /// and the forces of [`FilterTerms`]; `None` when no boundary with Prony terms was
+    /// deflected (always without the `viscoelastic` feature).
+    pub(crate) fn guard_filter(&self) -> FilterShare<'_> {
+        #[cfg(feature = "viscoelastic")]
+        if let Some(c) = self.qlv.get(usize::from(self.guard_share.layer)) {
+            return Some((c, &self.guard_share));
+        }
+        None
     }
 
     // Never inlined: LLVM 22 (rustc 1.95) crashed in register allocation on x86-64 with
@@ -450,7 +479,7 @@ impl Insertion {
     /// leaves in `guard_share` (with `rate` only).
     fn tick(&mut self, pose: &Pose, rate: bool) -> (InsertionEvaluation, f32, [f32; 3]) {
         if rate {
-            self.guard_share = FilterTerms::NONE;
+            self.guard_share.clear();
         }
         let finite = [pose.x_mm, pose.z_mm, pose.theta_x_deg, pose.theta_z_deg, pose.depth_mm].into_iter().all(f32::is_finite);
         if !finite {
@@ -527,8 +556,8 @@ impl Insertion {
                 for (t, x) in total.iter_mut().zip(w) {
                     *t += x;
                 }
-                if rate {
-                    self.guard_share = filter_terms(qlv, &elastic, &w);
+                if rate && qlv.is_active() {
+                    self.guard_share = filter_terms(self.punctured, &elastic, &w);
                 }
                 return Deflected { wrench: total, status: e.status, punctures, stiffness_n_per_mm: k * qlv.effective_stiffness_ratio() };
             }

@@ -21,6 +21,12 @@ impl QlvCoefficients {
     /// No terms.
     pub const NONE: Self = Self;
 
+    /// Whether there are terms: never.
+    #[must_use]
+    pub const fn is_active(&self) -> bool {
+        false
+    }
+
     /// The identity for terms without any term.
     ///
     /// # Errors
