@@ -9,7 +9,9 @@
 //!   ladder's record of a failed attempt and its dump;
 //! - [`Setup::failure`] or [`Setup::solved`]: what the campaign gets.
 
-use super::{feb, interrupted_run, keep_failed_attempt, ladder, logs, pick_steps, remove_if_exists, restart, running, segment_results, settings_line};
+use super::{
+    feb, interrupted_run, keep_failed_attempt, ladder, logs, pick_steps, remove_if_exists, restart, running, segment_results, settings_line,
+};
 use super::{FebioBackend, JOB, REACTION_SIGN};
 use crate::backend::{Job, SolveFailure, Solved};
 use crate::process::{self, ExitKind, LOG_TAIL_LINES};

@@ -252,7 +252,11 @@ pub fn settings_line(s: &crate::spec::FebioSettings, friction: f64, threads: usi
 /// partial records at 6 mm, `fe/visco/`), and `pick_steps`, where the last record of a
 /// time wins, took it over the earlier segment's converged one. `end` is the loading's
 /// final time (the tolerance's scale, as in `pick_steps`).
-fn segment_results<'a>(before: &[logs::RigidRecord], current: &'a [logs::RigidRecord], end: f64) -> impl Iterator<Item = logs::RigidRecord> + 'a {
+fn segment_results<'a>(
+    before: &[logs::RigidRecord],
+    current: &'a [logs::RigidRecord],
+    end: f64,
+) -> impl Iterator<Item = logs::RigidRecord> + 'a {
     let start = before.iter().map(|r| r.time).fold(f64::NEG_INFINITY, f64::max);
     current.iter().filter(move |r| r.time > start + 1e-6 * end).copied()
 }
