@@ -190,6 +190,37 @@ done:
   return result;
 }
 
+/* The passivity guard through the C API: a device of 1e-6 N*s/mm at 1 kHz lets the guard
+   render at most 0.001 N/mm (half of Colgate's 2 b / T), below the block model's stiffness
+   along the insertion, so every tick that pushes the needle in is limited and the
+   commanded fy falls behind the model's; NULL turns the guard off (the command is the
+   model's force again); a zero damping and a NULL loop are refused. Returns the failures. */
+static int check_passivity(const needle_loop_config_t *cfg) {
+  int failures = 0;
+  needle_loop_t g;
+  if (needle_loop_init(&g, cfg) != NEEDLE_OK) return 1;
+  needle_passivity_t bad = {0.0f, 0.001f};
+  failures += needle_loop_set_passivity(&g, &bad) != NEEDLE_E_CONFIG;
+  needle_passivity_t weak = {1e-6f, 0.001f};
+  failures += needle_loop_set_passivity(NULL, &weak) != NEEDLE_E_NULL;
+  failures += needle_loop_set_passivity(&g, &weak) != NEEDLE_OK;
+  int limited = 0;
+  needle_tick_t t;
+  for (int k = 0; k < 20; k++) {
+    needle_pose_t p = {1.0f, -0.5f, 2.0f, -3.0f, 2.0f + 0.1f * (float)k};
+    if (needle_loop_tick(&g, &p, NEEDLE_POSE_FRESH, MAX_DUTY, &t) != NEEDLE_OK) return failures + 1;
+    limited += (t.flags & NEEDLE_LOOP_STIFFNESS_LIMITED) != 0;
+  }
+  int behind = t.force_cmd_n[1] < t.wrench.fy_n;
+  printf("capi-passivity limited=%d/20 fy_cmd=%.9g fy_model=%.9g\n", limited, (double)t.force_cmd_n[1], (double)t.wrench.fy_n);
+  failures += limited != 20 || !behind;
+  failures += needle_loop_set_passivity(&g, NULL) != NEEDLE_OK;
+  needle_pose_t p = {1.0f, -0.5f, 2.0f, -3.0f, 4.1f};
+  if (needle_loop_tick(&g, &p, NEEDLE_POSE_FRESH, MAX_DUTY, &t) != NEEDLE_OK) return failures + 1;
+  failures += (t.flags & NEEDLE_LOOP_STIFFNESS_LIMITED) != 0 || bits_of(t.force_cmd_n[1]) != bits_of(t.wrench.fy_n);
+  return failures;
+}
+
 int main(int argc, char **argv) {
   if (argc < 2) {
     printf("usage: capi_golden <golden-f32.csv>\n");
@@ -321,6 +352,7 @@ int main(int argc, char **argv) {
     }
   }
   if (needle_loop_set_force_limit_n(&loop, 30.0f) != NEEDLE_E_CONFIG) command_failures++;
+  command_failures += check_passivity(&cfg);
   if (needle_loop_tick(NULL, NULL, NEEDLE_POSE_MISSING, MAX_DUTY, NULL) != NEEDLE_E_NULL) command_failures++;
   /* The names C users print: error codes, status bits, loop flags. */
   if (strcmp(needle_strerror(NEEDLE_E_NULL), "NULL pointer argument") != 0) command_failures++;

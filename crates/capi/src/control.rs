@@ -1,4 +1,5 @@
-//! The control loop: `needle_loop_init`, `needle_loop_tick`, `needle_loop_set_force_limit_n`.
+//! The control loop: `needle_loop_init`, `needle_loop_tick`, `needle_loop_set_force_limit_n`,
+//! `needle_loop_set_passivity`.
 //!
 //! The C loop is `needle_haptics::control::LoopCore<3>` kept in the opaque storage of a
 //! [`needle_loop_t`]: C reads the pose itself, passes it to the tick, and applies the
@@ -6,7 +7,7 @@
 use crate::eval::{pose_in, pose_out, wrench_out_of};
 use crate::types::*;
 use core::mem::{align_of, size_of};
-use needle_haptics::control::{ChannelMap, LoopConfig, LoopCore, OverLimit, PoseFault};
+use needle_haptics::control::{ChannelMap, LoopConfig, LoopCore, OverLimit, Passivity, PoseFault};
 
 type Core = LoopCore<NEEDLE_CHANNELS>;
 
@@ -142,6 +143,29 @@ pub unsafe extern "C" fn needle_loop_set_force_limit_n(l: *mut needle_loop_t, li
         Ok(c) => c.set_force_limit_n(limit_n).map_or(NEEDLE_E_CONFIG, |()| NEEDLE_OK),
         Err(e) => e,
     }
+}
+
+/// Turns the loop's passivity guard on with `*passivity`, or off for NULL
+/// (`needle_haptics::control::LoopCore::set_passivity`): while on, a tick whose model
+/// stiffness along the insertion is above half of Colgate's bound `2 b / T` renders it at
+/// that stiffness and sets `NEEDLE_LOOP_STIFFNESS_LIMITED`. Either way the guard starts
+/// without history.
+///
+/// Returns `NEEDLE_OK`, `NEEDLE_E_NULL` (a NULL loop), `NEEDLE_E_UNINIT`, or
+/// `NEEDLE_E_CONFIG` (a damping or period not finite and > 0; the guard is then unchanged).
+///
+/// # Safety
+/// `l` is NULL or valid and aligned; `passivity` is NULL or a valid pointer.
+#[no_mangle]
+pub unsafe extern "C" fn needle_loop_set_passivity(l: *mut needle_loop_t, passivity: *const needle_passivity_t) -> i32 {
+    // SAFETY: the caller's contract.
+    let core = match unsafe { core_mut(l) } {
+        Ok(c) => c,
+        Err(e) => return e,
+    };
+    // SAFETY: the caller's contract: NULL or valid.
+    let p = unsafe { passivity.as_ref() }.map(|p| Passivity { damping_n_s_per_mm: p.damping_n_s_per_mm, period_s: p.period_s });
+    core.set_passivity(p).map_or(NEEDLE_E_CONFIG, |()| NEEDLE_OK)
 }
 
 /// The loop in `l` (for the command module).

@@ -183,6 +183,18 @@ pub struct needle_loop_config_t {
     pub ramp_step_n: f32,
 }
 
+/// The passivity guard of the C loop (see `needle_haptics::control::Passivity`): the
+/// device's physical damping along the insertion and the loop's period; the guard keeps
+/// the rendered stiffness at half of Colgate's bound `2 b / T`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default)]
+pub struct needle_passivity_t {
+    /// Physical damping of the device along the insertion, N·s/mm (finite, > 0).
+    pub damping_n_s_per_mm: f32,
+    /// The loop's period, s (finite, > 0; 0.001 at 1 kHz).
+    pub period_s: f32,
+}
+
 /// What one tick of the C loop read, computed and commands.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default)]

@@ -28,6 +28,8 @@ fn header_declares_the_api() {
         "needle_loop_init(",
         "needle_loop_tick(",
         "needle_loop_set_force_limit_n(",
+        "needle_loop_set_passivity(",
+        "} needle_passivity_t;",
         "needle_loop_command(",
         "needle_insertion_init(",
         "needle_insertion_step(",

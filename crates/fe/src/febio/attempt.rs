@@ -9,7 +9,9 @@
 //!   ladder's record of a failed attempt and its dump;
 //! - [`Setup::failure`] or [`Setup::solved`]: what the campaign gets.
 
-use super::{feb, interrupted_run, keep_failed_attempt, ladder, logs, pick_steps, remove_if_exists, restart, running, settings_line};
+use super::{
+    feb, interrupted_run, keep_failed_attempt, ladder, logs, pick_steps, remove_if_exists, restart, running, segment_results, settings_line,
+};
 use super::{FebioBackend, JOB, REACTION_SIGN};
 use crate::backend::{Job, SolveFailure, Solved};
 use crate::process::{self, ExitKind, LOG_TAIL_LINES};
@@ -320,7 +322,7 @@ impl<'j, 'a> Setup<'j, 'a> {
                 .with_context(|| format!("{}", self.rb_path().display()));
             let mut all = p.segments.clone();
             if let Ok(r) = &records {
-                all.extend_from_slice(r);
+                all.extend(segment_results(&p.segments, r, loading.time_at(job.steps)));
             }
             let at_steps = pick_steps(&all, loading, job.steps);
             let done_steps = at_steps.iter().take_while(|w| w.is_some()).count();

@@ -243,6 +243,24 @@ pub fn settings_line(s: &crate::spec::FebioSettings, friction: f64, threads: usi
     )
 }
 
+/// The records of a segment that are its results: `current`, the records FEBio logged in
+/// the segment, without those at or before the segment's start when it is a restart
+/// (`before` holds the earlier segments' records; the restart goes on from the dump of
+/// the last must point logged there, the latest of them). A restart's record at its own
+/// start is a re-output of the dump's state, not a solution: FEBio 4.11 logged it with
+/// an all-zero wrench when the continuation failed at once (the ramp-and-hold runs'
+/// partial records at 6 mm, `fe/visco/`), and `pick_steps`, where the last record of a
+/// time wins, took it over the earlier segment's converged one. `end` is the loading's
+/// final time (the tolerance's scale, as in `pick_steps`).
+fn segment_results<'a>(
+    before: &[logs::RigidRecord],
+    current: &'a [logs::RigidRecord],
+    end: f64,
+) -> impl Iterator<Item = logs::RigidRecord> + 'a {
+    let start = before.iter().map(|r| r.time).fold(f64::NEG_INFINITY, f64::max);
+    current.iter().filter(move |r| r.time > start + 1e-6 * end).copied()
+}
+
 /// The record at each must point t_k = depth * k / steps, k = 1..=steps (None where the
 /// log has none; FEBio logs must points only, but a retried step may log twice: the last
 /// record at a time wins).
@@ -470,6 +488,25 @@ mod tests {
         assert!(!work.join(ladder::FURTHEST_DUMP).exists(), "the kept dump goes once the pose solves");
         // a new campaign's first attempt starts from depth 0 whatever the folder holds
         assert_eq!(backend.first_increment_in(&work, 0, false), 1.0);
+    }
+
+    #[test]
+    fn a_restart_does_not_replace_the_must_point_it_starts_from() {
+        let r = |t: f64, v: f64| logs::RigidRecord { time: t, values: [v; COMPONENT_COUNT] };
+        let loading = crate::spec::Loading { depth_mm: 9.0, steps: 3, ramp_hold: None };
+        // segment 1 converged at 3 and 6; the restart from 6 logs 6 again (zeros) and 9
+        let before = [r(3.0, 1.0), r(6.0, 2.0)];
+        let restart = [r(6.0, 0.0), r(9.0, 3.0)];
+        let mut all = before.to_vec();
+        all.extend(segment_results(&before, &restart, 9.0));
+        let want = vec![Some([1.0; COMPONENT_COUNT]), Some([2.0; COMPONENT_COUNT]), Some([3.0; COMPONENT_COUNT])];
+        assert_eq!(pick_steps(&all, &loading, 3), want);
+        // without the filter the restart's zeros would win (what the partial records had)
+        let mut raw = before.to_vec();
+        raw.extend_from_slice(&restart);
+        assert_eq!(pick_steps(&raw, &loading, 3).get(1), Some(&Some([0.0; COMPONENT_COUNT])));
+        // the first segment keeps all its records
+        assert_eq!(segment_results(&[], &restart, 9.0).count(), 2);
     }
 
     #[test]
