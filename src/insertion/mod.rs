@@ -259,7 +259,7 @@ impl GuardTerms {
 }
 
 /// What a guard needs of the deflected boundary's viscoelastic filter: the deflected
-/// layer whose coefficients it uses ([`Insertion::filter_coefficients`]; none when no
+/// layer whose coefficients it uses (read with them by [`Insertion::guard_filter`]; none when no
 /// boundary with Prony terms is deflected: the insertion's filter is then at rest), the
 /// unfiltered elastic deflection force `E` and the filter's part `V` of the wrench's
 /// forces (filtered minus `E`). The guard renders `F - D - V` (the elastic part, a
