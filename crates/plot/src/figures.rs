@@ -271,7 +271,8 @@ pub fn figures(set_dir: &Path, model: &Model) -> Result<Vec<Figure>> {
     let table2: Vec<&Run> = validation.iter().filter(|r| r.pose.role == Role::Table2).collect();
     let held: Vec<&Run> = validation.iter().filter(|r| r.pose.role.is_validation()).collect();
     // The model curves' scales: the centre run's peak |Fy|, times the lever arm for moments.
-    let scales = needle_contract::error_scales(needle_fe::results::peak_fy_n(data.centre.rows.iter()), campaign.needle.reference_from_tip_mm);
+    let scales =
+        needle_contract::error_scales(needle_fe::results::peak_fy_n(data.centre.rows.iter()), campaign.needle.reference_from_tip_mm);
     let mut out = vec![
         Figure {
             file: "fig4-centre.svg",
