@@ -54,7 +54,9 @@ fn broken<T: Copy + PartialEq + std::fmt::Debug + std::ops::Neg<Output = T>>(k: 
 
 #[test]
 fn odd_components_flip_and_even_ones_stay_bit_for_bit() {
-    assert!(model_info::FITTED, "the library was built without a fitted model ({})", model_info::SET_DIR);
+    if !model_info::FITTED {
+        panic!("the library was built without a fitted model ({}): run `needle fit`", model_info::SET_DIR);
+    }
     let poses = grid();
     let mut failures = Vec::new();
     let (mut bad_f32, mut bad_fixed) = (0usize, 0usize);

@@ -598,7 +598,8 @@ impl Checker<'_> {
         row32: &[f32; TERMS],
     ) -> Result<(), CodegenError> {
         let [p0, p1, p2, p3, p4] = *row32;
-        let f32_at_zero = (((p4 * -1.0 + p3) * -1.0 + p2) * -1.0 + p1) * -1.0 + p0;
+        let t = -1.0_f32;
+        let f32_at_zero = (((p4 * t + p3) * t + p2) * t + p1) * t + p0;
         if f32_at_zero != 0.0 {
             return Err(self.err(
                 span,

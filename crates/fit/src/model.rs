@@ -163,11 +163,12 @@ pub fn shift(rows: &mut [[f64; NCOEF]; NCOEF]) {
 /// `t = -1` (coeffs/README.md, step 4) before its last addition of `p0`.
 pub fn f32_row_tail_at_minus_one(row: &[f64; NCOEF]) -> f32 {
     let p = row.map(|v| v as f32);
+    let t = -1.0f32;
     let mut acc = p[4];
     for j in (1..NCOEF - 1).rev() {
-        acc = acc * -1.0f32 + p[j];
+        acc = acc * t + p[j];
     }
-    acc * -1.0f32
+    acc * t
 }
 
 /// The deviation matrix `rows` of sweep `k`, component `c`, with its residuals: (`base`
