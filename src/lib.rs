@@ -29,8 +29,9 @@
 //!
 //! where `B_c` is the quartic in depth of the centred vertical needle, `D_kc` the
 //! deviation of sweep k's fitted model from its value at `v_k = 0` (a 5x5 polynomial,
-//! zero at `t = -1`), and `s_kc = -1` when `v_k < 0` and component c is odd under that
-//! sweep's mirror, else `+1`. The exact f32 operation order is the contract in
+//! exactly `+0.0` at `t = -1` in f32 and 0 in fixed point, by the fitter's construction),
+//! and `s_kc = -1` when `v_k < 0` and component c is odd under that sweep's mirror, else
+//! `+1`: every odd component changes sign under its mirror bit for bit. The exact f32 operation order is the contract in
 //! `coeffs/README.md`; [`wrench`] follows it bit for bit.
 //!
 //! A set fitted in the coupled form (`form = "coupled"` in its `model.toml`,

@@ -233,12 +233,42 @@ fn other_contract_violations_name_the_line() {
         let v = f32::from_bits(u32::from_str_radix(&first[3..11], 16).unwrap()) + 1.0;
         format!("  [\"{:#010x}\", {rest}", v.to_bits())
     });
-    expect_error(&bad, l, &["matrix z/fz_n", "rows[0]", "t = -1"]);
+    expect_error(&bad, l, &["matrix z/fz_n", "rows_f32[0]", "t = -1", "in f32"]);
     // 25 matrices: the extra one is named.
     let extra = text[text.rfind("[[matrix]]").unwrap()..].to_string();
     let bad = format!("{text}\n{extra}");
     let l = line_starting(&bad, "[[matrix]]", 24);
     expect_error(&bad, l, &["25 [[matrix]] entries", "exactly 24"]);
+}
+
+/// The first value of row `l` (1-based line of `[f64, ...]`) and of its `rows_f32` line
+/// `l32`, replaced by `f(value as f32)` in both (so the hex stays the nearest f32).
+fn edit_row_constant(text: &str, l: usize, l32: usize, f: impl Fn(f32) -> f32) -> String {
+    let row = text.lines().nth(l - 1).unwrap();
+    let (first, rest) = row.trim().trim_start_matches('[').split_once(", ").unwrap();
+    let v = f(first.parse::<f64>().unwrap() as f32);
+    let bad = edit_line(text, l, |_| format!("  [{:?}, {rest}", f64::from(v)));
+    edit_line(&bad, l32, |row| {
+        let (_, rest) = row.trim().trim_start_matches('[').split_once(", ").unwrap();
+        format!("  [\"{:#010x}\", {rest}", v.to_bits())
+    })
+}
+
+#[test]
+fn a_deviation_row_not_exactly_zero_at_sweep_zero_in_f32_names_the_line() {
+    let text = valid_model();
+    let (l, l32) = (matrix_line(&text, 8, "rows =") + 2, matrix_line(&text, 8, "rows_f32 =") + 2);
+    // One f32 step off in the constant: within 2^-21 of the row's size in f64 (the f64
+    // tolerance), but the f32 Horner at t = -1 is no longer exactly 0.
+    let bad = edit_row_constant(&text, l, l32, |v| f32::from_bits(v.to_bits() + 1));
+    let e = expect_error(&bad, l, &["matrix z/fz_n", "rows_f32[1]", "t = -1", "in f32, not 0"]);
+    assert!(!e.message.contains("in f64"), "{e}");
+    // The unchanged row is accepted: the error is that one step.
+    assert!(parse_model_str(&edit_row_constant(&text, l, l32, |v| v), Path::new("m.toml")).is_ok());
+    // Exactly 0 in f32 (1e-46 rounds to +0.0) but not within 2^-21 of 0 in f64.
+    let bad = edit_line(&text, l, |_| "  [0.0, 1e-46, 0.0, 0.0, 0.0],".into());
+    let bad = edit_line(&bad, l32, |_| format!("  [{}],", ["\"0x00000000\""; 5].join(", ")));
+    expect_error(&bad, l, &["matrix z/fz_n", "rows[1]", "t = -1", "in f64", "2^-21"]);
 }
 
 #[test]

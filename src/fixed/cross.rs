@@ -8,6 +8,18 @@ use super::arith::mul_q15;
 
 include!(concat!(env!("OUT_DIR"), "/cross_fixed.rs"));
 
+/// `a - term` when `negative`, else `a + term` (wrapping; the generator's bounds keep it
+/// from wrapping): a cross term's magnitude added with its monomial's sign.
+#[allow(dead_code)]
+#[inline(always)]
+fn add_signed(a: i32, term: i32, negative: bool) -> i32 {
+    if negative {
+        a.wrapping_sub(term)
+    } else {
+        a.wrapping_add(term)
+    }
+}
+
 /// `N = sign(v) * ((|v| + d / 2) / d)`: a clamped Q16.16 input to the cross terms' signed
 /// Q15 input `v / V` (`d = 2 V`, one of the generated [`CROSS_DIVISORS`]), its magnitude
 /// rounded to nearest.

@@ -26,8 +26,10 @@ use needle_contract::TERMS;
 ///    negative and c is odd under that sweep's mirror), with `h` a Horner whose products
 ///    are `floor(a * w / 2^15)`;
 /// 4. coupled form only: `N_k = sign(v_k) * ((|v_k| + V_k) / (2 V_k))` (Q15) and per cross
-///    term `A_i += (P[i] * M >> 15) >> shift` with `M` the Q15 monomial (generated code);
-/// 5. `W = h(A, U)`, and the result `(W + 2^(G-1)) >> G` in µN or µN·mm
+///    term `A_i ±= (P[i] * M >> 15) >> shift` with `M` the Q15 monomial of the `|N_k|`
+///    and the sign of the product of the `N_k` (generated code);
+/// 5. in sign and magnitude, `s = -1` when the first nonzero `A_i` is negative, else
+///    `+1`: `W = h(s A, U)`, and the result `s ((W + 2^(G-1)) >> G)` in µN or µN·mm
 ///    ([`tables::FRAC_BITS`](super::tables::FRAC_BITS) = G);
 /// 6. [`Status::FE_UNSOLVED`] when the clamped pose lies in the set's unsolved region
 ///    (integer comparisons on the `N_k` and the depth; the wrench is not changed).
@@ -163,13 +165,31 @@ pub(super) fn accumulators(at: &mut Inputs, pose: &Pose) -> [[i32; TERMS]; COMPO
     a
 }
 
-/// Step 7: `W = h(A, U)` per component, rounded half up to whole µN or µN·mm.
+/// Step 7, in sign and magnitude: with `s = -1` when the first nonzero of `A_0 .. A_4`
+/// is negative (else `+1`), `W = h(s A, U)` per component, rounded half up to whole µN or
+/// µN·mm, times `s`. So `A` and `-A` (a mirror of the pose, for a component odd under
+/// it) give exactly opposite outputs, although every floor rounds towards minus
+/// infinity.
 #[inline(always)]
 pub(super) fn output(a: &[[i32; TERMS]; COMPONENT_COUNT], u: i32) -> [i32; COMPONENT_COUNT] {
     let mut w = [0_i32; COMPONENT_COUNT];
     for ((wc, ac), &g) in w.iter_mut().zip(a.iter()).zip(FRAC_BITS.iter()) {
-        let acc = horner(ac, u);
-        *wc = acc.wrapping_add(1_i32.wrapping_shl(g) >> 1).wrapping_shr(g);
+        let negative = first_nonzero_is_negative(ac);
+        let p = if negative { ac.map(i32::wrapping_neg) } else { *ac };
+        let acc = horner(&p, u);
+        let out = acc.wrapping_add(1_i32.wrapping_shl(g) >> 1).wrapping_shr(g);
+        *wc = if negative { out.wrapping_neg() } else { out };
     }
     w
+}
+
+/// Whether the first nonzero of `a` (from `a[0]`) is negative; `false` when all are 0.
+#[inline(always)]
+fn first_nonzero_is_negative(a: &[i32; TERMS]) -> bool {
+    for &v in a {
+        if v != 0 {
+            return v < 0;
+        }
+    }
+    false
 }

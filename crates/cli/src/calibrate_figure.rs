@@ -37,12 +37,14 @@ pub fn svg(c: &Calibration, name: &str, reference: &str) -> anyhow::Result<Strin
                 data: c.replay.punctures.clone(),
             },
         ],
+        y_min_span: 0.0,
     };
     let residual = Panel {
         title: format!("residual: {reference} - model"),
         x_label: "needle position, mm".into(),
         y_label: "residual, N".into(),
         series: vec![Series { label: "residual".into(), colour: grey, style: Style::Points, data: residuals }],
+        y_min_span: 0.0,
     };
     render(&format!("needle calibrate: {name}"), &[force, residual], 1, (900, 420))
 }

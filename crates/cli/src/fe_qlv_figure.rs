@@ -46,7 +46,7 @@ pub fn svg(cases: &[QlvCase]) -> anyhow::Result<String> {
             }
         }
         for (title, series) in [(format!("{pose}: ramp to 6 mm, 30 s hold"), full), (format!("{pose}: first {ZOOM_S} s"), zoom)] {
-            panels.push(Panel { title, x_label: "time, s".into(), y_label: "Fy, N".into(), series });
+            panels.push(Panel { title, x_label: "time, s".into(), y_label: "Fy, N".into(), series, y_min_span: 0.0 });
         }
     }
     render("FEBio uncoupled viscoelastic (points) against the library's QLV filter on the elastic run (lines)", &panels, 2, (640, 400))

@@ -57,8 +57,9 @@ pub struct FixedRow {
     pub bound: i64,
 }
 
-/// One cross term of the coupled form in fixed point: `A_i += (P[i] * M >> 15) >> shift`
-/// with `M` the Q15 monomial of `exponents`.
+/// One cross term of the coupled form in fixed point: `A_i ±= (P[i] * M >> 15) >> shift`
+/// with `M` the Q15 monomial of `exponents` over the inputs' magnitudes and the sign of
+/// the monomial (coeffs/README.md, "The coupled form").
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FixedCross {
     /// Exponents of `(xi, zeta, alpha, beta)`.
@@ -111,11 +112,24 @@ pub struct FixedTables {
     pub components: [FixedComponent; COMPONENT_COUNT],
 }
 
-/// The largest `f` in `0..=MAX_FRAC_BITS` whose quantised row fits: `sum_j |q(c_j, f)| <= LIMIT`.
+/// The row in Q(`f`): `P_j = q(c_j, f)` for j = 1..=4 and `P_0 = -sum_{j>=1} (-1)^j P_j`
+/// (coeffs/README.md, "Fixed-point evaluation", row format), so that the row is exactly 0
+/// at `T = -32768` (sweep value 0), where `m(a, T) = -a`: `P0 - P1 + P2 - P3 + P4 = 0`.
+/// `c_0` is not used. In i128: no overflow for any f64.
+#[must_use]
+pub fn quantize_row(c: &[f64; TERMS], f: u32) -> [i128; TERMS] {
+    let mut q = c.map(|v| i128::from(quantize(v, f)));
+    let [_, p1, p2, p3, p4] = q;
+    q[0] = p1 - p2 + p3 - p4;
+    q
+}
+
+/// The largest `f` in `0..=MAX_FRAC_BITS` whose row ([`quantize_row`]) fits:
+/// `sum_j |P_j| <= LIMIT`.
 fn choose_row(c: &[f64; TERMS]) -> Option<FixedRow> {
     (0..=MAX_FRAC_BITS).rev().find_map(|f| {
-        let q = c.map(|v| quantize(v, f));
-        let bound = q.iter().map(|v| i128::from(*v).abs()).sum::<i128>();
+        let q = quantize_row(c, f);
+        let bound = q.iter().map(|v| v.abs()).sum::<i128>();
         (bound <= i128::from(LIMIT)).then(|| FixedRow { coeffs: q.map(|v| v as i32), frac_bits: f, bound: bound as i64 })
     })
 }

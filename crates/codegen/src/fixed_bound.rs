@@ -11,7 +11,9 @@
 //!   floors per row polynomial (`4 * 2^-f`), one per alignment shift that is not zero
 //!   (`2^-G`), four in the Horner in u (`4 * 2^-G`);
 //! - *coefficients*: `sum |P * 2^-f - c * 10^6|` over every coefficient (each multiplies a
-//!   product of powers of `|u|, |t|` <= 1), plus the rounding of `c * 10^6` in f64;
+//!   product of powers of `|u|, |t|` <= 1), plus the rounding of `c * 10^6` in f64; a
+//!   row's constant `c` is the f64 evaluation's, `-sum_{j>=1} (-1)^j c_j` ([`f64_row`]),
+//!   and its `P0` the same sum of the row's integers;
 //! - *inputs*: the model's slope times the rounding of the inputs:
 //!   `2^-16 * (sup|dw/du| + sum_k sup|dD_k/dt|)`, each `sup` over `[-1, 1]^2` bounded by
 //!   the maximum on a 257 x 257 grid plus (half the grid step) x (a coefficient-sum bound
@@ -72,6 +74,16 @@ fn pow2(e: i32) -> f64 {
     2f64.powi(e)
 }
 
+/// A deviation row as the f64 evaluation sees it (coeffs/README.md, "The model"): its
+/// terms `j >= 1` in the basis `t^j - (-1)^j`, that is with the constant
+/// `-sum_{j>=1} (-1)^j rows[i][j]` in place of `rows[i][0]` (which holds the f32 tables'
+/// constant). The fixed-point row's `P0` is derived the same way from its other integers,
+/// so the quantisation error of `P0` is at most that of the others.
+fn f64_row(row: &[f64; 5]) -> [f64; 5] {
+    let [_, c1, c2, c3, c4] = *row;
+    [c1 - c2 + c3 - c4, c1, c2, c3, c4]
+}
+
 /// The error bound of component `c` with the tables `comp`.
 pub(crate) fn error_bound(model: &Model, c: usize, comp: &FixedComponent) -> ErrorBound {
     let g = comp.frac_bits;
@@ -91,7 +103,8 @@ pub(crate) fn error_bound(model: &Model, c: usize, comp: &FixedComponent) -> Err
     let mut slope_t = 0.0;
     for m in model.matrices.iter().filter(|m| m.component == c) {
         let k = m.sweep;
-        for (i, row) in m.rows.iter().enumerate() {
+        let rows = m.rows.map(|r| f64_row(&r));
+        for (i, row) in rows.iter().enumerate() {
             let fr = &comp.rows[k][i];
             arithmetic += 4.0 * pow2(-(fr.frac_bits as i32));
             if comp.shifts[k][i] > 0 {
@@ -101,7 +114,7 @@ pub(crate) fn error_bound(model: &Model, c: usize, comp: &FixedComponent) -> Err
                 coefficients += coef_err(fr.coeffs[j], fr.frac_bits, *v);
             }
         }
-        let poly: Poly2 = m.rows.iter().map(|r| r.to_vec()).collect();
+        let poly: Poly2 = rows.iter().map(|r| r.to_vec()).collect();
         slope_u += sup_abs(&derivative(&poly, true));
         slope_t += sup_abs(&derivative(&poly, false));
     }

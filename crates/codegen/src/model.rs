@@ -565,17 +565,7 @@ impl Checker<'_> {
             raw.rows.get_ref().iter().zip(raw.rows_f32.get_ref()).zip(rows.iter_mut().zip(rows_f32.iter_mut())).enumerate()
         {
             let (row, row32) = self.poly(r, b, &format!("{label}: rows[{i}]"), &format!("{label}: rows_f32[{i}]"))?;
-            // A deviation is zero at t = -1 (sweep value 0), in f64 up to rounding.
-            let at_zero: f64 = row.iter().zip([1.0, -1.0, 1.0, -1.0, 1.0]).map(|(a, s)| a * s).sum();
-            let scale: f64 = row.iter().map(|a| a.abs()).sum();
-            if at_zero.abs() > 1e-9 * scale {
-                return Err(self.err(
-                    r.span(),
-                    format!(
-                        "{label}: rows[{i}] at t = -1 is {at_zero:e}, not 0: a deviation vanishes at sweep value 0 (rows[i][0] -= sum_j rows[i][j] * (-1)^j)"
-                    ),
-                ));
-            }
+            self.zero_at_sweep_zero(r.span(), &label, i, &row, &row32)?;
             *o = row;
             *o32 = row32;
         }
@@ -591,6 +581,51 @@ impl Checker<'_> {
         })
     }
 }
+
+impl Checker<'_> {
+    /// A deviation row vanishes at `t = -1` (sweep value 0; coeffs/README.md, "The
+    /// model"): exactly in the contract's f32 Horner (step 4, `h(rows_f32[i], -1)` is a
+    /// zero), and in f64 within the f32 rounding that made it exact there: the fitter
+    /// writes `rows[i][0] = -q`, `q` the f32 Horner of the other coefficients' nearest f32,
+    /// which is within `7 * 2^-24 * sum_j |rows[i][j]|` (four roundings of a coefficient,
+    /// three of a sum) of the f64 alternating sum; `2^-21` is 8 such units.
+    fn zero_at_sweep_zero(
+        &self,
+        span: Range<usize>,
+        label: &str,
+        i: usize,
+        row: &[f64; TERMS],
+        row32: &[f32; TERMS],
+    ) -> Result<(), CodegenError> {
+        let [p0, p1, p2, p3, p4] = *row32;
+        let t = -1.0_f32;
+        let f32_at_zero = (((p4 * t + p3) * t + p2) * t + p1) * t + p0;
+        if f32_at_zero != 0.0 {
+            return Err(self.err(
+                span,
+                format!(
+                    "{label}: rows_f32[{i}] at t = -1 is {f32_at_zero:e} in f32, not 0: a deviation vanishes at sweep value 0 exactly in the f32 evaluation (rows[i][0] = -(((p4*(-1) + p3)*(-1) + p2)*(-1) + p1)*(-1), each operation rounded in f32)"
+                ),
+            ));
+        }
+        let at_zero: f64 = row.iter().zip([1.0, -1.0, 1.0, -1.0, 1.0]).map(|(a, s)| a * s).sum();
+        let scale: f64 = row.iter().map(|a| a.abs()).sum();
+        if at_zero.abs() > ZERO_AT_SWEEP_ZERO_F64 * scale {
+            return Err(self.err(
+                span,
+                format!(
+                    "{label}: rows[{i}] at t = -1 is {at_zero:e} in f64, over 2^-21 * sum_j |rows[{i}][j]| = {:e}: a deviation vanishes at sweep value 0 (rows[i][0] -= sum_j rows[i][j] * (-1)^j, then made exact in f32)",
+                    ZERO_AT_SWEEP_ZERO_F64 * scale
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The f64 tolerance of a deviation row at `t = -1`, relative to `sum_j |rows[i][j]|`:
+/// `2^-21`, the f32 rounding of the row's exact zero in f32 (`Checker::zero_at_sweep_zero`).
+pub const ZERO_AT_SWEEP_ZERO_F64: f64 = 1.0 / (1u32 << 21) as f64;
 
 /// Parses `0x` and exactly 8 lower-case hex digits.
 pub fn parse_bits(text: &str) -> Option<u32> {

@@ -224,9 +224,11 @@ pub fn render_c_cross(model: &Model) -> String {
 }
 
 /// The Rust source of `cross_fixed.rs`: the coupled form's cross terms in fixed point as
-/// straight-line integer code, `A_i = A_i + ((P[i] * M >> 15) >> shift)` per term and
-/// coefficient (wrapping operations that the generator's bounds keep from wrapping),
-/// `M` the Q15 monomial multiplied left to right with `mul_q15`.
+/// straight-line integer code in sign and magnitude, `A_i = A_i ± ((P[i] * M >> 15) >>
+/// shift)` per term and coefficient (wrapping operations that the generator's bounds keep
+/// from wrapping), `M` the Q15 monomial of the magnitudes `|N_k|` multiplied left to right
+/// with `mul_q15`, the sign that of the product of the `N_k` (`add_signed`): a mirror that
+/// flips the monomial's sign flips the term exactly.
 pub fn render_rust_cross_fixed(model: &Model, t: &FixedTables) -> String {
     let mut s = String::new();
     let w = &mut s;
@@ -245,7 +247,8 @@ pub fn render_rust_cross_fixed(model: &Model, t: &FixedTables) -> String {
     if !any {
         let _ = writeln!(w, "    let _ = (n, a);");
     } else {
-        let _ = writeln!(w, "    let [xi, zeta, alpha, beta] = n;");
+        let _ = writeln!(w, "    let [xi_neg, zeta_neg, alpha_neg, beta_neg] = n.map(|v| v < 0);");
+        let _ = writeln!(w, "    let [xi, zeta, alpha, beta] = n.map(i32::wrapping_abs);");
         let _ = writeln!(w, "    let [a0, a1, a2, a3, a4, a5] = a;");
         for (c, comp) in t.components.iter().enumerate() {
             if comp.cross.is_empty() {
@@ -256,11 +259,20 @@ pub fn render_rust_cross_fixed(model: &Model, t: &FixedTables) -> String {
             for x in &comp.cross {
                 let _ = writeln!(w, "    // exponents {:?}, Q{}, shift {}, model.toml line {}", x.exponents, x.frac_bits, x.shift, x.line);
                 let _ = writeln!(w, "    let m = {};", monomial_q15(x.exponents));
+                let sign = negative_sign(x.exponents);
                 for (i, p) in x.coeffs.iter().enumerate() {
                     if *p == 0 {
                         continue;
                     }
-                    let _ = writeln!(w, "    *a{c}_{i} = a{c}_{i}.wrapping_add(mul_q15({p}, m) >> {});", x.shift);
+                    let term = format!("mul_q15({p}, m) >> {}", x.shift);
+                    match &sign {
+                        Some(neg) => {
+                            let _ = writeln!(w, "    *a{c}_{i} = add_signed(*a{c}_{i}, {term}, {neg});");
+                        }
+                        None => {
+                            let _ = writeln!(w, "    *a{c}_{i} = a{c}_{i}.wrapping_add({term});");
+                        }
+                    }
                 }
             }
         }
@@ -268,6 +280,13 @@ pub fn render_rust_cross_fixed(model: &Model, t: &FixedTables) -> String {
     let _ = writeln!(w, "}}");
     render_rust_cross_rates_fixed(w, t);
     s
+}
+
+/// Whether the term's monomial is negative, as code: the `^` of the signs (`xi_neg`, ...)
+/// of the inputs of odd exponent; `None` when every exponent is even (never negative).
+fn negative_sign(e: [u8; 4]) -> Option<String> {
+    let odd: Vec<String> = e.iter().zip(INPUTS).filter(|(k, _)| *k % 2 == 1).map(|(_, name)| format!("{name}_neg")).collect();
+    (!odd.is_empty()).then(|| odd.join(" ^ "))
 }
 
 /// `M` reduced by one factor of input `k` (`e_k * M / n_k` without the `e_k`), as Q15

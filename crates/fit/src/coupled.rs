@@ -18,9 +18,10 @@
 //! Here every coefficient is one linear least-squares problem per component (Householder
 //! QR, [`lstsq`]) over every depth of every fitted run; a deviation is written in the
 //! basis `t^j - (-1)^j` (j >= 1), so it is zero at `t = -1` (sweep value 0) and the
-//! paper's shift gives `rows[i][0]` ([`super::model::shift`]). The block's mirror
-//! symmetries stay exact: a component has a baseline or a deviation only where its
-//! parities allow one ([`allowed`]), and cross monomials only of its parities.
+//! paper's shift gives `rows[i][0]` ([`super::model::shift`]: exactly zero there in the
+//! f32 evaluation too). The block's mirror symmetries stay exact: a component has a
+//! baseline or a deviation only where its parities allow one ([`allowed`]), and cross
+//! monomials only of its parities.
 //!
 //! **The size per component** ([`select`]): k-fold cross-validation over the sweep and
 //! training runs (the centre run, the baseline's anchor, is fitted in every fold): the

@@ -57,19 +57,29 @@ pub fn quantise(c: f64, f: u32) -> i64 {
     (micro * 2f64.powi(f as i32)).round() as i64
 }
 
-/// Largest `f` whose quantised row has `sum |P_j| <= 2^30` (the sum grows with `f`, so this
-/// searches upwards and keeps the last that fits), with the row and its sum.
-fn row_format(row: &[f64; NCOEF]) -> Option<(u32, [i64; NCOEF], i64)> {
-    let mut best = None;
-    for f in 0..=MAX_FRAC {
-        let q = row.map(|c| quantise(c, f));
-        let sum = q.iter().try_fold(0i64, |s, v| s.checked_add(v.checked_abs()?));
-        match sum {
-            Some(s) if s <= LIMIT => best = Some((f, q, s)),
-            _ => break,
-        }
+/// The row in Q(`f`): `P_j = q(row[j], f)` for j = 1..=4 and
+/// `P_0 = -sum_{j>=1} (-1)^j P_j`, so that `h(P, -1) = P0 - P1 + P2 - P3 + P4 = 0` exactly
+/// (the fixed-point contract's row at sweep value 0: `m(a, -32768) = -a`); `row[0]` is
+/// not used. With `sum |P_j|`; `None` when an integer leaves the i64 range.
+pub fn quantise_row(row: &[f64; NCOEF], f: u32) -> Option<([i64; NCOEF], i64)> {
+    let mut q = row.map(|c| quantise(c, f));
+    let mut at_minus_one = 0i64;
+    for (j, v) in q.iter().enumerate().skip(1) {
+        at_minus_one = if j % 2 == 0 { at_minus_one.checked_add(*v)? } else { at_minus_one.checked_sub(*v)? };
     }
-    best
+    q[0] = at_minus_one.checked_neg()?;
+    let sum = q.iter().try_fold(0i64, |s, v| s.checked_add(v.checked_abs()?))?;
+    Some((q, sum))
+}
+
+/// Largest `f` in `0..=MAX_FRAC` whose row ([`quantise_row`]) has `sum |P_j| <= 2^30`,
+/// with the row and its sum. Every `f` is tried: the largest that fits is kept (past the
+/// limit the sum at least doubles less 8 per bit, so none above a failing `f` fits).
+fn row_format(row: &[f64; NCOEF]) -> Option<(u32, [i64; NCOEF], i64)> {
+    (0..=MAX_FRAC).rev().find_map(|f| match quantise_row(row, f) {
+        Some((q, s)) if s <= LIMIT => Some((f, q, s)),
+        _ => None,
+    })
 }
 
 impl TablesFixed {
@@ -173,10 +183,19 @@ mod tests {
     #[test]
     fn row_format_keeps_the_largest_fitting_format() {
         // 1 N = 10^6 uN: 2^30 / 10^6 = 1073.7, so f = 10 (1024 * 10^6 <= 2^30 < 2048 * 10^6)
-        let only = |c0: f64| std::array::from_fn(|i| if i == 0 { c0 } else { 0.0 });
+        // with P0 = P1 (row zero at t = -1): 2 * 512 * 10^6 <= 2^30 at f = 9
+        let only = |c1: f64| std::array::from_fn(|i| if i == 1 { c1 } else { 0.0 });
         let (f, q, s) = row_format(&only(1.0)).unwrap();
-        assert_eq!((f, q[0], s), (10, 1_024_000_000, 1_024_000_000));
+        assert_eq!((f, q[0], q[1], s), (9, 512_000_000, 512_000_000, 1_024_000_000));
         assert_eq!(row_format(&[0.0; NCOEF]).unwrap().0, MAX_FRAC);
-        assert!(row_format(&only(2000.0)).is_none());
+        assert!(row_format(&only(1000.0)).is_none());
+    }
+
+    #[test]
+    fn a_quantised_row_is_zero_at_t_minus_one() {
+        // rows[i][0] is ignored: P0 comes from the others.
+        let (q, s) = quantise_row(&[123.0, 1.25e-3, -2.5e-4, 7.0e-5, 3.0e-6], 20).unwrap();
+        assert_eq!(q[0] - q[1] + q[2] - q[3] + q[4], 0);
+        assert_eq!(s, q.iter().map(|v| v.abs()).sum::<i64>());
     }
 }

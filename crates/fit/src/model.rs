@@ -21,7 +21,7 @@ pub struct Baseline {
     pub residual_max: f64,
 }
 
-/// One deviation matrix `D_kc(t, u)` (zero at t = -1 in f64).
+/// One deviation matrix `D_kc(t, u)` (zero at t = -1: [`shift`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Deviation {
     /// `rows[i][j]` multiplies `u^i * t^j`; unit of the component.
@@ -126,8 +126,22 @@ pub fn fit_deviation(k: Sweep, c: usize, points: &[SweepPoint], base: &[f64; NCO
     Ok(deviation_of(c, points, base, rows, k))
 }
 
-/// The deviation shift: `rows[i][0] -= sum_j rows[i][j] * (-1)^j` (j = 0..=4 in that
-/// order), so that `D(-1, u) = 0`; a zero of either sign is then written `+0.0`.
+/// The deviation shift (coeffs/README.md, "The model"), so that `D(-1, u) = 0` (sweep
+/// value 0) exactly in the contract's f32 evaluation, for every `u`:
+///
+/// 1. in f64, `rows[i][0] -= sum_j rows[i][j] * (-1)^j` (j = 0..=4 in that order);
+/// 2. then `rows[i][0] = -q` with `q` the f32 Horner of the row's other coefficients (their
+///    nearest f32) at `t = -1` up to and including the last product,
+///    `(((p4*(-1) + p3)*(-1) + p2)*(-1) + p1)*(-1)` ([`f32_row_tail_at_minus_one`]), as
+///    step 4 of the f32 evaluation computes it: then `q + p0 = +0.0` in f32, every
+///    `r_i(-1)` is `+0.0` and so is `D(-1, u)`. The f64 value is that f32 exactly, so
+///    the f64 evaluators and the f32 tables hold the same constant; in f64 the row is
+///    then zero at `t = -1` only up to the f32 rounding of its coefficients (step 1 left
+///    it within f64 rounding of zero, step 2 moves `rows[i][0]` by less than
+///    `2^-21 * sum_j |rows[i][j]|`, the bound `needle-codegen` checks). The fixed-point
+///    tables do not use `rows[i][0]`: their `P0` is derived from the other integers.
+///
+/// A zero of either sign is then written `+0.0`.
 pub fn shift(rows: &mut [[f64; NCOEF]; NCOEF]) {
     for row in rows.iter_mut() {
         let mut s = 0.0f64;
@@ -140,7 +154,21 @@ pub fn shift(rows: &mut [[f64; NCOEF]; NCOEF]) {
         for v in row.iter_mut() {
             *v = no_neg_zero(*v);
         }
+        row[0] = no_neg_zero(f64::from(-f32_row_tail_at_minus_one(row)));
     }
+}
+
+/// `(((p4*(-1) + p3)*(-1) + p2)*(-1) + p1)*(-1)` in f32 with `p_j` the nearest f32 of
+/// `row[j]`, every operation rounded on its own: the contract's f32 Horner of the row at
+/// `t = -1` (coeffs/README.md, step 4) before its last addition of `p0`.
+pub fn f32_row_tail_at_minus_one(row: &[f64; NCOEF]) -> f32 {
+    let p = row.map(|v| v as f32);
+    let t = -1.0f32;
+    let mut acc = p[4];
+    for j in (1..NCOEF - 1).rev() {
+        acc = acc * t + p[j];
+    }
+    acc * t
 }
 
 /// The deviation matrix `rows` of sweep `k`, component `c`, with its residuals: (`base`

@@ -6,7 +6,7 @@
 //! Model curves are the f64 evaluation of the set's `model.toml`
 //! ([`needle_fit::eval::float64`]), FE points its current runs.
 
-use super::panel::{Panel, Series, Style, COMPONENT_COLOURS};
+use super::panel::{Panel, Series, Style, COMPONENT_COLOURS, MIN_SPAN_OF_SCALE};
 use anyhow::Result;
 use needle_fe::spec::Role;
 use needle_fit::contract::{unit, Sweep, COMPONENTS, DEPTH_MAX_MM};
@@ -31,8 +31,10 @@ fn axis_name(c: usize) -> String {
     format!("{} ({})", COMPONENTS[c], unit(c))
 }
 
-/// Fig 4: the six components against depth at the centred pose.
-fn fig4(model: &Model, centre: &Run) -> Vec<Panel> {
+/// Fig 4: the six components against depth at the centred pose; each panel spans at
+/// least [`MIN_SPAN_OF_SCALE`] of its component's scale `scales[c]` (the odd components
+/// are exactly 0 there: a flat line, not round-off autoscaled into a curve).
+fn fig4(model: &Model, centre: &Run, scales: [f64; 6]) -> Vec<Panel> {
     (0..6)
         .map(|c| Panel {
             title: format!("{}: centred vertical needle", COMPONENTS[c]),
@@ -52,12 +54,14 @@ fn fig4(model: &Model, centre: &Run) -> Vec<Panel> {
                     data: centre.rows.iter().map(|r| (r.depth_mm, r.wrench[c])).collect(),
                 },
             ],
+            y_min_span: MIN_SPAN_OF_SCALE * scales[c],
         })
         .collect()
 }
 
-/// Figs 6 and 7: components `comps` at full depth against each swept input.
-fn sweeps(model: &Model, sweep_runs: &[Vec<&Run>; 4], comps: [usize; 3]) -> Vec<Panel> {
+/// Figs 6 and 7: components `comps` (of one unit) at full depth against each swept input;
+/// each panel spans at least [`MIN_SPAN_OF_SCALE`] of their scale.
+fn sweeps(model: &Model, sweep_runs: &[Vec<&Run>; 4], comps: [usize; 3], scales: [f64; 6]) -> Vec<Panel> {
     Sweep::ALL
         .iter()
         .map(|&k| {
@@ -96,6 +100,7 @@ fn sweeps(model: &Model, sweep_runs: &[Vec<&Run>; 4], comps: [usize; 3]) -> Vec<
                 x_label: format!("{} ({})", k.name(), k.unit()),
                 y_label: format!("{} ({unit})", if needle_contract::is_force(comps[0]) { "force" } else { "moment about the hub" }),
                 series,
+                y_min_span: MIN_SPAN_OF_SCALE * scales[comps[0]],
             }
         })
         .collect()
@@ -125,6 +130,7 @@ fn fig8(model: &Model, table2: &[&Run]) -> Vec<Panel> {
                         data: r.rows.iter().map(|x| (x.depth_mm, x.fy_n())).collect(),
                     },
                 ],
+                y_min_span: 0.0,
             }
         })
         .collect()
@@ -168,6 +174,7 @@ fn parity(model: &Model, held: &[&Run], lever_arm_mm: f64) -> Vec<Panel> {
                 x_label: format!("FE ({u})"),
                 y_label: format!("model ({u})"),
                 series,
+                y_min_span: 0.0,
             }
         })
         .collect()
@@ -204,6 +211,7 @@ fn verification(verify: &toml::Table) -> Vec<Panel> {
                     data: vec![(1.0, f1), (0.5, f2), (0.0, fh)],
                 },
             ],
+            y_min_span: 0.0,
         });
     }
     if let Some(levels) = verify.get("mesh").and_then(|m| m.get("levels")).and_then(|l| l.as_array()) {
@@ -223,6 +231,7 @@ fn verification(verify: &toml::Table) -> Vec<Panel> {
             x_label: "fine element size h (mm)".into(),
             y_label: axis_name(1),
             series,
+            y_min_span: 0.0,
         });
     }
     panels
@@ -261,23 +270,26 @@ pub fn figures(set_dir: &Path, model: &Model) -> Result<Vec<Figure>> {
     }
     let table2: Vec<&Run> = validation.iter().filter(|r| r.pose.role == Role::Table2).collect();
     let held: Vec<&Run> = validation.iter().filter(|r| r.pose.role.is_validation()).collect();
+    // The model curves' scales: the centre run's peak |Fy|, times the lever arm for moments.
+    let scales =
+        needle_contract::error_scales(needle_fe::results::peak_fy_n(data.centre.rows.iter()), campaign.needle.reference_from_tip_mm);
     let mut out = vec![
         Figure {
             file: "fig4-centre.svg",
             caption: format!("Set {set}: the six wrench components against depth, centred vertical needle (cf. the paper's Fig 4)"),
-            panels: fig4(model, &data.centre),
+            panels: fig4(model, &data.centre, scales),
             cols: 3,
         },
         Figure {
             file: "fig6-forces.svg",
             caption: format!("Set {set}: forces at full depth against position and tilt (cf. Fig 6)"),
-            panels: sweeps(model, &sweep_runs, [0, 1, 2]),
+            panels: sweeps(model, &sweep_runs, [0, 1, 2], scales),
             cols: 2,
         },
         Figure {
             file: "fig7-moments.svg",
             caption: format!("Set {set}: moments about the hub at full depth against position and tilt (cf. Fig 7)"),
-            panels: sweeps(model, &sweep_runs, [3, 4, 5]),
+            panels: sweeps(model, &sweep_runs, [3, 4, 5], scales),
             cols: 2,
         },
         Figure {

@@ -52,14 +52,29 @@ pub struct Panel {
     pub y_label: String,
     /// The series, drawn in order.
     pub series: Vec<Series>,
+    /// The y axis spans at least this much (in the panel's unit; 0: autoscale to the
+    /// data): a component that is 0, or round-off, over the whole panel is drawn as a
+    /// flat line on the component's scale, never autoscaled into a curve.
+    pub y_min_span: f64,
 }
 
-fn range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
+/// The share of a component's scale (`needle_contract::error_scales`) that a panel of
+/// model curves spans at least ([`Panel::y_min_span`]): 1 %.
+pub const MIN_SPAN_OF_SCALE: f64 = 0.01;
+
+/// The axis range of `values`, padded by 6 % of their span, and at least `min_span` wide
+/// (centred on the values' midpoint).
+fn range(values: impl Iterator<Item = f64>, min_span: f64) -> std::ops::Range<f64> {
     let (lo, hi) = values.filter(|v| v.is_finite()).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
     if !lo.is_finite() {
         return 0.0..1.0;
     }
     let span = hi - lo;
+    if min_span > 0.0 && span < min_span {
+        let mid = 0.5 * (lo + hi);
+        let half = 0.5 * min_span * 1.12;
+        return (mid - half)..(mid + half);
+    }
     let pad = if span > 0.0 { 0.06 * span } else { lo.abs().max(1e-6) * 0.1 };
     (lo - pad)..(hi + pad)
 }
@@ -92,8 +107,8 @@ pub fn render(caption: &str, panels: &[Panel], cols: usize, panel_px: (u32, u32)
 }
 
 fn draw_panel(p: &Panel, area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>) -> Result<()> {
-    let xs = range(p.series.iter().flat_map(|s| s.data.iter().map(|d| d.0)));
-    let ys = range(p.series.iter().flat_map(|s| s.data.iter().map(|d| d.1)));
+    let xs = range(p.series.iter().flat_map(|s| s.data.iter().map(|d| d.0)), 0.0);
+    let ys = range(p.series.iter().flat_map(|s| s.data.iter().map(|d| d.1)), p.y_min_span);
     let mut chart = ChartBuilder::on(area)
         .caption(&p.title, ("sans-serif", 15))
         .margin(8)

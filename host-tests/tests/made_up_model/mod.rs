@@ -170,7 +170,8 @@ pub fn signed_zeros_text() -> String {
                 (1, 0..=2) => [r0, r0, -0.0, 0.0, 0.0],
                 (1, 3) => [-0.0, 0.0, 0.0, 0.0, 0.0],
                 (2, 0..=3) => [-r0, -0.0, r0, 0.0, 0.0],
-                (3, 0..=2) => [r1 - r2, r1, r2, 0.0, 0.0],
+                // the constant that makes the f32 row exactly 0 at t = -1 (the fitter's rule)
+                (3, 0..=2) => [f64::from(-needle_fit::model::f32_row_tail_at_minus_one(&[0.0, r1, r2, 0.0, 0.0])), r1, r2, 0.0, 0.0],
                 _ => [0.0; 5],
             }
         };

@@ -146,14 +146,19 @@ fn accumulate(t: &TablesFixed, pose: [i32; 5]) -> Result<Accumulated, Overflow> 
             q
         }
     });
+    // Sign and magnitude: the monomial of the |N_k|, its sign the product of the signs of
+    // the factors, applied to each floored term (a mirror flips a term exactly).
+    let magnitudes = n.map(i64::abs);
     for (c, terms) in t.cross.iter().enumerate() {
         for (e, p, f) in terms {
             let what = || format!("cross {c} {e:?}");
-            let m = monomial(factors(e, n), 0, &what)?;
+            let m = monomial(factors(e, magnitudes), 0, &what)?;
+            let negative = factors(e, n).filter(|nk| *nk < 0).count() % 2 == 1;
             for (i, pi) in p.iter().enumerate() {
                 let prod = step(*pi, m, 0, &what)?;
                 let shifted = prod.div_euclid(1i64 << (f - t.acc_frac[c]));
-                a[c][i] = check(a[c][i].checked_add(shifted), || format!("A[{c}][{i}] after cross {e:?}"))?;
+                let sum = if negative { a[c][i].checked_sub(shifted) } else { a[c][i].checked_add(shifted) };
+                a[c][i] = check(sum, || format!("A[{c}][{i}] after cross {e:?}"))?;
             }
         }
     }
@@ -174,14 +179,18 @@ pub fn eval(t: &TablesFixed, pose: [i32; 5]) -> Result<([i32; COMPONENT_COUNT], 
     Ok((output(t, &acc)?, acc.status))
 }
 
-/// Step 7: `W = h(A, U)` per component, rounded half up to whole µN or µN·mm.
+/// Step 7, in sign and magnitude: `s = -1` when the first nonzero of `A_0 .. A_4` is
+/// negative, else `+1`; `W = h(s A, U)` per component, rounded half up to whole µN or
+/// µN·mm, times `s`. `A` and `-A` give exactly opposite outputs.
 fn output(t: &TablesFixed, acc: &Accumulated) -> Result<[i32; COMPONENT_COUNT], Overflow> {
     let mut w = [0i32; COMPONENT_COUNT];
     for (c, wc) in w.iter_mut().enumerate() {
-        let h = horner(&acc.a[c], acc.u, &|| format!("Horner in u of component {c}"))?;
+        let negative = acc.a[c].iter().find(|v| **v != 0).is_some_and(|v| *v < 0);
+        let s = if negative { -1 } else { 1 };
+        let h = horner(&acc.a[c].map(|v| s * v), acc.u, &|| format!("Horner in u of component {c}"))?;
         let g = t.acc_frac[c];
         let half = (1i64 << g) / 2;
-        let out = (h + half).div_euclid(1i64 << g);
+        let out = s * (h + half).div_euclid(1i64 << g);
         *wc = i32::try_from(out).map_err(|_| Overflow { what: format!("output {c}"), value: Some(out) })?;
     }
     Ok(w)

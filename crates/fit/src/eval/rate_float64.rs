@@ -31,7 +31,7 @@ pub fn eval_rates(model: &Model, pose: Pose64) -> ([[f64; COMPONENT_COUNT]; 3], 
             let vk = v[k.index()];
             let rows = &model.matrices[k.index()][c].rows;
             let t = k.t_of(vk);
-            let r: [f64; NCOEF] = std::array::from_fn(|i| horner(&rows[i], t));
+            let r: [f64; NCOEF] = crate::poly::deviation_rows(rows, t);
             let mirror = if vk < 0.0 && k.is_odd(c) { -1.0 } else { 1.0 };
             a += mirror * horner_rate(&r, u);
             if let Some(j) = [Sweep::X, Sweep::Z].iter().position(|s| *s == k) {
