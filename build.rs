@@ -2,8 +2,10 @@
 //!
 //! - Selects the coefficient set: the folder named by `NEEDLE_COEFFS` (relative paths
 //!   are relative to this crate's root), default `coeffs/default`.
-//! - Validates `<set>/model.toml` with `needle-codegen` and writes `$OUT_DIR/tables_f32.rs`
-//!   (included by `src/tables.rs`) and `$OUT_DIR/needle_coeffs.h` (`model_info::C_HEADER`).
+//! - Validates `<set>/model.toml` (and `<set>/unsolved.toml`, the region where the FE
+//!   could not solve, when present) with `needle-codegen` and writes
+//!   `$OUT_DIR/tables_f32.rs` (included by `src/tables.rs`), `$OUT_DIR/unsolved.rs`
+//!   (`src/unsolved.rs`) and `$OUT_DIR/needle_coeffs.h` (`model_info::C_HEADER`).
 //! - A bad model fails the build with `cargo::error=<path>:<line>: <what is wrong>` and a
 //!   non-zero exit, never a panic.
 //! - A set without `model.toml` (a new set before `needle fit` has run) builds an
@@ -40,6 +42,8 @@ fn run() -> Result<(), String> {
     // itself is watched only while it has no model: its fe/ data changes during an FE
     // campaign, and the generated code depends on model.toml alone.
     println!("cargo::rerun-if-changed={}", model_path.display());
+    // The unsolved region beside it (read by `generate` when present).
+    println!("cargo::rerun-if-changed={}", set_dir.join(needle_codegen::unsolved::FILE).display());
 
     if !set_dir.is_dir() {
         println!("cargo::rerun-if-changed={}", set_dir.display());

@@ -29,6 +29,10 @@
 //!   inside, from a state advanced there at 3 mm/s): evaluator `insertion`
 //!   ([`needle_haptics::insertion::Insertion::step`]) and `fixed-insertion`
 //!   ([`needle_haptics::fixed::insertion::Insertion::step`], the same poses in Q16.16).
+//!   With the viscoelastic filter: `insertion+qlv` and `fixed-insertion+qlv`, the same
+//!   stacks and cases with three Prony terms on every layer ([`QLV_TERMS`]: cost inputs,
+//!   not a tissue's values; the filter's work does not depend on them), so every tick
+//!   filters all six components through three terms.
 //! - **Stack**: the 4 KiB below the caller's stack pointer is painted with a pattern,
 //!   one evaluation runs, and the deepest overwritten word gives the bytes used.
 //!
@@ -36,7 +40,7 @@
 //!
 //! ```text
 //! needle-bench target=<triple> calls=<CALLS> calibration_instructions=<n> calibration_ticks=<n> deterministic=<yes|no>
-//! needle-bench pose=<name> evaluator=<f32|f32+k|fixed|fixed+k|insertion|fixed-insertion> instructions_per_wrench=<n.n> stack_bytes=<n> status=0x<ss>
+//! needle-bench pose=<name> evaluator=<f32|f32+k|fixed|fixed+k|insertion|fixed-insertion|insertion+qlv|fixed-insertion+qlv> instructions_per_wrench=<n.n> stack_bytes=<n> status=0x<ss>
 //! ...
 //! needle-bench end
 //! ```
@@ -54,10 +58,32 @@ mod firmware {
     use cortex_m::peripheral::SYST;
     use needle_haptics::fixed::insertion::Insertion as FixedInsertion;
     use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, InsertionEvaluation};
+    #[cfg(feature = "viscoelastic")]
+    use needle_haptics::insertion::{Layer, MAX_LAYERS};
+    #[cfg(feature = "viscoelastic")]
+    use needle_haptics::viscoelastic::{PronyTerm, PronyTerms};
     use needle_haptics::{fixed, wrench, wrench_and_stiffness, Pose};
 
     /// Evaluations per timed loop.
     const CALLS: u32 = 256;
+
+    /// Three Prony terms for the `+qlv` rows (built with the `viscoelastic` feature, as
+    /// `needle firmware bench` does) (weights and time constants of the
+    /// host-tests' filter tests: cost inputs, the step's work is the same for any).
+    #[cfg(feature = "viscoelastic")]
+    const QLV_TERMS: [PronyTerm; 3] =
+        [PronyTerm { g: 0.8, tau_s: 0.05 }, PronyTerm { g: 0.5, tau_s: 1.0 }, PronyTerm { g: 0.3, tau_s: 20.0 }];
+
+    /// `stack`'s layers with [`QLV_TERMS`] on each (the first `count` used).
+    #[cfg(feature = "viscoelastic")]
+    fn with_qlv(stack: &needle_haptics::insertion::Stack<'_>) -> Option<([Layer; MAX_LAYERS], usize)> {
+        let terms = PronyTerms::from_array(QLV_TERMS, 3)?;
+        let mut layers = [*stack.layers.first()?; MAX_LAYERS];
+        for (slot, l) in layers.iter_mut().zip(stack.layers) {
+            *slot = Layer { prony: terms, ..*l };
+        }
+        Some((layers, stack.layers.len()))
+    }
     /// Bytes of stack painted below the caller's stack pointer.
     const STACK_WINDOW: usize = 4096;
     const PAINT: u32 = 0xa5c3_5a3c;
@@ -303,18 +329,42 @@ mod firmware {
         for stack in &stacks::ALL {
             let total: f32 = stack.layers.iter().map(|l| l.thickness_mm).sum();
             let cases = [("surface", Pose::new(3.0, -2.0, 5.0, -7.0, 4.5)), ("deep", Pose::new(3.0, -2.0, 5.0, -7.0, total + 2.0))];
+            #[cfg(feature = "viscoelastic")]
+            let Some((qlv_layers, count)) = with_qlv(stack) else {
+                continue;
+            };
+            #[cfg(feature = "viscoelastic")]
+            let qlv = needle_haptics::insertion::Stack { layers: qlv_layers.get(..count).unwrap_or(&[]), ..*stack };
             for (name, pose) in cases {
                 let Some(ins) = advanced(stack, &pose) else { continue };
                 bench_insertion(&mut out, &cal, &ins, &pose, (stack.name, name, "insertion"));
+                #[cfg(feature = "viscoelastic")]
+                {
+                    let Some(ins) = advanced(&qlv, &pose) else { continue };
+                    bench_insertion(&mut out, &cal, &ins, &pose, (stack.name, name, "insertion+qlv"));
+                }
             }
         }
         // The fixed-point insertion, the same cases in Q16.16.
         for stack in &fixed::insertion::stacks::ALL {
             let total: i32 = stack.layers().iter().map(|l| l.thickness_q16 as i32).sum();
             let tilted = |depth| fixed::Pose::new(3 * ONE, -2 * ONE, 5 * ONE, -7 * ONE, depth);
+            #[cfg(feature = "viscoelastic")]
+            let mut qlv = *stack;
+            #[cfg(feature = "viscoelastic")]
+            if let Some(t) = PronyTerms::from_array(QLV_TERMS, 3) {
+                for l in &mut qlv.layers {
+                    l.prony = fixed::viscoelastic::PronyTerms::from_f32(&t);
+                }
+            }
             for (name, pose) in [("surface", tilted(9 * ONE / 2)), ("deep", tilted(total + 2 * ONE))] {
                 let Some(ins) = advanced_fixed(stack, &pose) else { continue };
                 bench_insertion(&mut out, &cal, &ins, &pose, (stack.name, name, "fixed-insertion"));
+                #[cfg(feature = "viscoelastic")]
+                {
+                    let Some(ins) = advanced_fixed(&qlv, &pose) else { continue };
+                    bench_insertion(&mut out, &cal, &ins, &pose, (stack.name, name, "fixed-insertion+qlv"));
+                }
             }
         }
         out.str("needle-bench end\n");

@@ -11,10 +11,12 @@ use core::fmt;
 /// | [`SAT_THETA_X`](Self::SAT_THETA_X) | `0x04` | `theta_x_deg` was outside `±15` and was clamped |
 /// | [`SAT_THETA_Z`](Self::SAT_THETA_Z) | `0x08` | `theta_z_deg` was outside `±15` and was clamped |
 /// | [`SAT_DEPTH`](Self::SAT_DEPTH) | `0x10` | `depth_mm` was outside `0..=6` and was clamped |
+/// | [`FE_UNSOLVED`](Self::FE_UNSOLVED) | `0x20` | the (clamped) pose lies in the region where the set's FE campaign could not solve: the wrench is the model's extrapolation |
 /// | [`NO_MODEL`](Self::NO_MODEL) | `0x40` | the library was built without a fitted model (always with `ERROR`) |
 /// | [`ERROR`](Self::ERROR) | `0x80` | no wrench: an input was NaN or infinite, or `NO_MODEL`; the wrench is zero |
 ///
-/// A saturated evaluation is still a valid wrench (of the clamped pose).
+/// A saturated evaluation is still a valid wrench (of the clamped pose), and so is one
+/// flagged [`FE_UNSOLVED`](Self::FE_UNSOLVED): neither zeroes the wrench.
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct Status(u8);
 
@@ -31,6 +33,11 @@ impl Status {
     pub const SAT_THETA_Z: Self = Self(needle_contract::status::SAT_THETA_Z);
     /// `depth_mm` was clamped to `0..=DEPTH_MAX_MM`.
     pub const SAT_DEPTH: Self = Self(needle_contract::status::SAT_DEPTH);
+    /// The pose (after clamping) lies in the set's unsolved region: near a pose whose FE
+    /// run failed every attempt, deeper than that run reached (`coeffs/README.md`, "The
+    /// unsolved region"; the set's `unsolved.toml`). The wrench is still computed: it is
+    /// the model's extrapolation from the runs that solved, with no FE result to back it.
+    pub const FE_UNSOLVED: Self = Self(needle_contract::status::FE_UNSOLVED);
     /// The library has no fitted model (its set had no `model.toml` at build time).
     /// Always reported together with [`ERROR`](Self::ERROR).
     pub const NO_MODEL: Self = Self(needle_contract::status::NO_MODEL);
@@ -41,12 +48,13 @@ impl Status {
     pub const SATURATION: Self = Self(needle_contract::status::SATURATION);
 
     /// Every flag with its name, in bit order (for printing).
-    pub const FLAGS: [(Self, &'static str); 7] = [
+    pub const FLAGS: [(Self, &'static str); 8] = [
         (Self::SAT_X, "SAT_X"),
         (Self::SAT_Z, "SAT_Z"),
         (Self::SAT_THETA_X, "SAT_THETA_X"),
         (Self::SAT_THETA_Z, "SAT_THETA_Z"),
         (Self::SAT_DEPTH, "SAT_DEPTH"),
+        (Self::FE_UNSOLVED, "FE_UNSOLVED"),
         (Self::NO_MODEL, "NO_MODEL"),
         (Self::ERROR, "ERROR"),
     ];
@@ -63,6 +71,13 @@ impl Status {
     #[must_use]
     pub const fn is_error(self) -> bool {
         self.0 & Self::ERROR.0 != 0
+    }
+
+    /// `true` when the pose lies in the set's unsolved region ([`FE_UNSOLVED`](Self::FE_UNSOLVED)).
+    #[inline]
+    #[must_use]
+    pub const fn fe_unsolved(self) -> bool {
+        self.0 & Self::FE_UNSOLVED.0 != 0
     }
 
     /// `true` when at least one input was clamped to the domain (any `SAT_*` flag).

@@ -9,8 +9,8 @@
  *
  * poses: single, n x 5, one pose per row: x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm
  * (the block frame of docs/architecture.md, section 3). wrench: single n x 6, fx_n, fy_n,
- * fz_n (N), mx_nmm, my_nmm, mz_nmm (N*mm about the hub); status: uint8 n x 1 (saturation
- * bits); stiffness: single n x 18, d wrench/d depth_mm, then d/d x_mm, then d/d z_mm
+ * fz_n (N), mx_nmm, my_nmm, mz_nmm (N*mm about the hub); status: uint8 n x 1 (the
+ * library's bits, NEEDLE_STATUS_* of needle.h: saturation, FE_UNSOLVED, ERROR); stiffness: single n x 18, d wrench/d depth_mm, then d/d x_mm, then d/d z_mm
  * (six components each). The insertion steps every row once from a fresh state
  * (default 1 kHz, 5 ms velocity filter); phase uint16, punctures uint8, velocity single
  * (mm/s), n x 1 each. The library's bits: no conversion happens anywhere.

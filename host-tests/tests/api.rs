@@ -48,9 +48,12 @@ fn status_flags() {
     let e = Status::NO_MODEL | Status::ERROR;
     assert_eq!(e.bits(), 0xc0);
     assert!(e.is_error() && !e.saturated());
-    assert_eq!(format!("{}", Status::from_bits(0x21)), "SAT_X | 0x20");
+    assert_eq!(format!("{}", Status::from_bits(0x21)), "SAT_X | FE_UNSOLVED");
+    let u = Status::FE_UNSOLVED;
+    assert_eq!(u.bits(), 0x20);
+    assert!(u.fe_unsolved() && !u.is_ok() && !u.is_error() && !u.saturated(), "a flag beside the wrench, not an error");
     let all: u8 = Status::FLAGS.iter().fold(0, |a, (f, _)| a | f.bits());
-    assert_eq!(all, 0xdf);
+    assert_eq!(all, 0xff);
 }
 
 #[test]

@@ -39,6 +39,12 @@ fn compiled_tables_match_a_fresh_generation() {
         "the library's tables_fixed.rs differs from a fresh generation from {}",
         model_info::SET_DIR
     );
+    assert!(
+        g.rust_unsolved == model_info::UNSOLVED_RS,
+        "the library's unsolved.rs differs from a fresh generation from {}",
+        model_info::SET_DIR
+    );
+    assert_eq!(g.unsolved.balls.len(), model_info::UNSOLVED_BALLS);
     assert_eq!(g.model.set, model_info::SET);
     assert_eq!(g.model.fe_sha256, model_info::FE_SHA256);
     // The numbers the evaluator uses, against the model file's f32 bits.

@@ -7,9 +7,9 @@
 //! the paper part is unchanged. Not a fitted model: nothing here goes under coeffs/.
 mod made_up_model;
 
-use needle_fit::eval_f32::{eval as eval32, Tables32};
-use needle_fit::eval_f64::{eval as eval64, eval_paper};
-use needle_fit::eval_fixed::eval as eval_fixed;
+use needle_fit::eval::fixed::eval as eval_fixed;
+use needle_fit::eval::float32::{eval as eval32, Tables32};
+use needle_fit::eval::float64::{eval as eval64, eval_paper};
 use needle_fit::fixed_formats::TablesFixed;
 use needle_fit::model_file::parse;
 use std::path::Path;

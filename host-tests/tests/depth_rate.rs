@@ -3,7 +3,7 @@
 //! the three force rates by depth bit for bit; past 6 mm `extended_wrench_and_depth_rate`
 //! has `extended_wrench`'s bits and its rate is the derivative of the fitter's f64 law.
 use needle_fit::depth_extension::{fit, ratio};
-use needle_fit::golden_stiffness::parse_csv;
+use needle_fit::golden::stiffness_float32::parse_csv;
 use needle_fit::GOLDEN_STIFFNESS_FILE;
 use needle_haptics::depth_extension::extended_wrench_and_depth_rate;
 use needle_haptics::{extended_wrench, model_info, wrench, wrench_and_depth_rate, wrench_and_stiffness, Pose};

@@ -2,7 +2,7 @@
 //! stored in tests/data/ccx/ (see its README for the decks that produced it).
 
 use needle_fe::ccx;
-use needle_fe::dat::{parse_rf, StepRf};
+use needle_fe::ccx::dat::{parse_rf, StepRf};
 use std::path::PathBuf;
 
 fn data(name: &str) -> String {

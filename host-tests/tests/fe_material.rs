@@ -9,7 +9,7 @@ fn repo() -> PathBuf {
 }
 
 fn tissue(mu: &[f64], alpha: &[f64]) -> Tissue {
-    Tissue { mu_n_per_mm2: mu.to_vec(), alpha: alpha.to_vec(), bulk_to_shear: 100.0, stretch_min: 0.4, stretch_max: 2.5 }
+    Tissue { mu_n_per_mm2: mu.to_vec(), alpha: alpha.to_vec(), bulk_to_shear: 100.0, stretch_min: 0.4, stretch_max: 2.5, prony: None }
 }
 
 /// Spacing of the log-spaced stretch grid of the check, as a ratio.

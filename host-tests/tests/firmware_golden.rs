@@ -9,7 +9,7 @@
 //! Nothing skips: a missing QEMU, rustup target, model.toml or golden file fails with a
 //! message that says what to install or run.
 use needle_firmware_host::{self as firmware, golden, golden_fixed, golden_stiffness};
-use needle_fit::{eval_f32::Tables32, fixed_formats::TablesFixed, model_file};
+use needle_fit::{eval::float32::Tables32, fixed_formats::TablesFixed, model_file};
 use std::path::Path;
 
 mod made_up_model;
@@ -97,7 +97,7 @@ fn golden_bits_of_signed_zero_coefficients_on_cortex_m4f_and_m0() {
 /// A set folder at `set` with the model file `text` and the four golden files written
 /// by the fitter's own implementations.
 fn write_made_up_set(set: &Path, text: String) {
-    use needle_fit::{golden as g32, golden_fixed as gfixed, golden_stiffness as gs32, golden_stiffness_fixed as gsfixed};
+    use needle_fit::golden::{fixed as gfixed, float32 as g32, stiffness_fixed as gsfixed, stiffness_float32 as gs32};
     std::fs::create_dir(set).expect("set folder");
     let model = model_file::parse(&text, &set.join("model.toml")).unwrap_or_else(|e| panic!("{e:#}"));
     let t32 = Tables32::from_model(&model);
@@ -168,7 +168,7 @@ fn fixed_comparison_catches_one_bit() {
 /// section are all caught.
 #[test]
 fn stiffness_comparison_catches_one_bit_and_a_differing_wrench() {
-    let h = needle_fit::golden_stiffness::header();
+    let h = needle_fit::golden::stiffness_float32::header();
     let inputs = "0x00000000,0x00000000,0x00000000,0x00000000,0x40400000";
     let rates: Vec<String> = (0..18).map(|i| format!("0x3c{i:06x}")).collect();
     let row = format!("{inputs},0x00,{}", rates.join(","));
@@ -196,7 +196,7 @@ fn stiffness_comparison_catches_one_bit_and_a_differing_wrench() {
 /// wrench the firmware found differing, a missing or truncated section are all caught.
 #[test]
 fn fixed_stiffness_comparison_catches_one_unit_and_a_differing_wrench() {
-    let h = needle_fit::golden_stiffness_fixed::header();
+    let h = needle_fit::golden::stiffness_fixed::header();
     let inputs = "0,0,0,0,196608";
     let rates: Vec<String> = (0..18).map(|i| format!("{}", 1000 * i - 7000)).collect();
     let row = format!("{inputs},0x00,{}", rates.join(","));

@@ -7,6 +7,7 @@
 //! same check does find them in the f32 evaluator).
 //!
 //! Nothing skips: a missing rustup target, QEMU or fitted model fails with a message.
+use needle_firmware_host::build::Features;
 use needle_firmware_host::{self as firmware, build, float_check, qemu, size, CORES};
 use std::time::Duration;
 
@@ -90,7 +91,7 @@ fn fixed_point_evaluator_has_no_floating_point_on_any_core() {
         );
         // The same check on the f32 evaluator does see floating point (soft float on the
         // M0 and M3, FPU instructions on the M4F): it can fail.
-        let f32_use = float_check::analyse_elf(&elfs[0], "needle_haptics::model_f32::wrench").unwrap_or_else(|e| panic!("{e:#}"));
+        let f32_use = float_check::analyse_elf(&elfs[0], "needle_haptics::float::eval::wrench").unwrap_or_else(|e| panic!("{e:#}"));
         if core.name == "m4f" {
             assert!(!f32_use.fpu_instructions.is_empty(), "{}: no FPU instruction found in {}", core.core, f32_use.function);
         } else {
@@ -115,47 +116,45 @@ fn fixed_point_evaluator_has_no_floating_point_on_any_core() {
 /// Issue 41's flash budget for the whole insertion: the model, its depth extension, the
 /// insertion model with its guard stiffness and every compiled-in stack, in the
 /// `no_panic_insertion` image (library code + `.rodata` + compiler runtime, the same
-/// accounting as `needle firmware size`), <= 24 KiB on every core.
+/// accounting as `needle firmware size`), <= 24 KiB on every core, for the elastic build
+/// (the viscoelastic filter is the `viscoelastic` feature: its build is measured beside
+/// it and must hold more, or the filter is not in it).
 #[test]
 fn insertion_flash_within_24_kib_on_every_core() {
-    let set = firmware::fitted_set(&firmware::compiled_set()).unwrap_or_else(|e| panic!("{e:#}"));
-    for core in &CORES {
-        let elfs = build::build_examples(core, &["no_panic", "no_panic_insertion"], &set).unwrap_or_else(|e| panic!("{e:#}"));
-        let model = size::measure(core, &elfs[0], "f32").unwrap_or_else(|e| panic!("{e:#}"));
-        let report = size::measure(core, &elfs[1], "insertion").unwrap_or_else(|e| panic!("{e:#}"));
-        println!(
-            "{} ({}): model + insertion flash {} (model alone {}), static RAM {} B",
-            core.core,
-            core.target,
-            size::bytes(report.model_flash()),
-            size::bytes(model.model_flash()),
-            report.static_ram()
-        );
-        assert!(report.model_flash() > model.model_flash(), "{}: the insertion image holds more than the model", core.core);
-        assert!(report.model_flash() <= 24 * 1024, "{}: model + insertion flash {} B > 24 KiB", core.core, report.model_flash());
-    }
+    insertion_flash_within_24_kib(["no_panic", "no_panic_insertion"], ["f32", "insertion", "insertion+qlv"]);
 }
 
 /// The same budget for the fixed-point insertion: the fixed-point model, its depth
 /// extension, `fixed::insertion` and every stack in integers (`no_panic_fixed_insertion`).
 #[test]
 fn fixed_point_insertion_flash_within_24_kib_on_every_core() {
+    insertion_flash_within_24_kib(["no_panic_fixed", "no_panic_fixed_insertion"], ["fixed", "fixed-insertion", "fixed-insertion+qlv"]);
+}
+
+fn insertion_flash_within_24_kib([model_example, insertion_example]: [&str; 2], [model_name, elastic_name, qlv_name]: [&'static str; 3]) {
     let set = firmware::fitted_set(&firmware::compiled_set()).unwrap_or_else(|e| panic!("{e:#}"));
     for core in &CORES {
-        let elfs = build::build_examples(core, &["no_panic_fixed", "no_panic_fixed_insertion"], &set).unwrap_or_else(|e| panic!("{e:#}"));
-        let model = size::measure(core, &elfs[0], "fixed").unwrap_or_else(|e| panic!("{e:#}"));
-        let report = size::measure(core, &elfs[1], "fixed-insertion").unwrap_or_else(|e| panic!("{e:#}"));
+        let elfs = build::build_examples_with(core, &[model_example, insertion_example], &set, Features::Elastic)
+            .unwrap_or_else(|e| panic!("{e:#}"));
+        let model = size::measure(core, &elfs[0], model_name).unwrap_or_else(|e| panic!("{e:#}"));
+        let report = size::measure(core, &elfs[1], elastic_name).unwrap_or_else(|e| panic!("{e:#}"));
+        let qlv_elf = build::build_examples(core, &[insertion_example], &set).unwrap_or_else(|e| panic!("{e:#}")).remove(0);
+        let qlv = size::measure(core, &qlv_elf, qlv_name).unwrap_or_else(|e| panic!("{e:#}"));
         println!(
-            "{} ({}): fixed-point model + insertion flash {} (fixed-point model and stiffness {}), static RAM {} B",
+            "{} ({}): {elastic_name} model + insertion flash {} (model alone {}), static RAM {} B; with the viscoelastic filter {} (+{} B)",
             core.core,
             core.target,
             size::bytes(report.model_flash()),
             size::bytes(model.model_flash()),
-            report.static_ram()
+            report.static_ram(),
+            size::bytes(qlv.model_flash()),
+            qlv.model_flash().saturating_sub(report.model_flash())
         );
+        assert!(report.model_flash() > model.model_flash(), "{}: the insertion image holds more than the model", core.core);
+        assert!(qlv.model_flash() > report.model_flash(), "{}: the viscoelastic build holds the filter", core.core);
         assert!(
             report.model_flash() <= 24 * 1024,
-            "{}: fixed-point model + insertion flash {} B > 24 KiB",
+            "{}: {elastic_name} model + insertion flash {} B > 24 KiB",
             core.core,
             report.model_flash()
         );

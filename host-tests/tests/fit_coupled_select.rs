@@ -9,7 +9,7 @@ use needle_fe::spec::{PoseSpec, Role};
 use needle_fit::contract::COMPONENTS;
 use needle_fit::coupled::{scales, select_and_fit};
 use needle_fit::data::{load_paper_data, Run};
-use needle_fit::eval_f64::{eval, eval_paper};
+use needle_fit::eval::float64::{eval, eval_paper};
 use std::path::Path;
 
 fn pose_of(p: &PoseSpec, depth_mm: f64) -> [f64; 5] {

@@ -5,9 +5,9 @@
 mod fit_synthetic;
 
 use needle_fit::contract::{Sweep, STATUS_ERROR, STATUS_SAT_DEPTH, STATUS_SAT_THETA_Z, STATUS_SAT_X};
-use needle_fit::eval_f32::{eval as eval32, Tables32};
-use needle_fit::eval_f64::eval as eval64;
-use needle_fit::golden;
+use needle_fit::eval::float32::{eval as eval32, Tables32};
+use needle_fit::eval::float64::eval as eval64;
+use needle_fit::golden::float32 as golden;
 use needle_fit::model::Model;
 use needle_fit::model_file;
 use rand::{Rng, SeedableRng};

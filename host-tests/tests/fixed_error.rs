@@ -3,7 +3,7 @@
 //! dense grid over the domain and on proptest-random poses. The bounds meet the goal of
 //! issue 5: <= 0.1 % of peak |Fy| (moments: of peak |Fy| x the lever arm).
 use needle_cli::fixed_error::{self, ErrorStats, GOAL_PCT};
-use needle_fit::eval_f64;
+use needle_fit::eval::float64 as eval_f64;
 use needle_haptics::{fixed, model_info};
 use proptest::prelude::*;
 use std::path::Path;

@@ -1,5 +1,5 @@
 //! No intermediate of the fixed-point evaluation overflows, checked with checked
-//! arithmetic: the fitter's independent implementation (`fit::eval_fixed`, i64 with checked
+//! arithmetic: the fitter's independent implementation (`fit::eval::fixed`, i64 with checked
 //! operations, every intermediate held to the contract's |v| <= 2^30) runs on a dense grid
 //! and on proptest-random poses over all of i32, and the library (wrapping i32, which
 //! would give a different result had anything wrapped) must give the same integers.
@@ -7,7 +7,7 @@
 //! Also: the fitter's choice of formats equals the tables compiled into the library, and
 //! the checker does catch an overflow when the formats are one bit too ambitious.
 use needle_contract::{COMPONENT_COUNT, TERMS};
-use needle_fit::eval_fixed::eval;
+use needle_fit::eval::fixed::eval;
 use needle_fit::fixed_formats::TablesFixed;
 use needle_fit::model_file;
 use needle_haptics::fixed::{self, tables};
@@ -23,7 +23,9 @@ fn fitter_tables() -> &'static TablesFixed {
             panic!("no fitted model compiled in: run `needle fit`");
         }
         let model = model_file::read(&Path::new(model_info::SET_DIR).join("model.toml")).unwrap_or_else(|e| panic!("{e:#}"));
-        TablesFixed::from_model(&model).unwrap_or_else(|e| panic!("{e:#}"))
+        // the set's unsolved region too: the library flags FE_UNSOLVED in the status
+        let region = needle_fit::unsolved::region(Path::new(model_info::SET_DIR)).unwrap_or_else(|e| panic!("{e:#}"));
+        TablesFixed::from_model(&model).unwrap_or_else(|e| panic!("{e:#}")).with_unsolved(region.entries())
     })
 }
 

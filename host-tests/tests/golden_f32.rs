@@ -51,7 +51,7 @@ fn library_matches_golden_vectors_bit_for_bit() {
         )
     });
     let mut lines = text.lines();
-    assert_eq!(lines.next(), Some(needle_fit::golden::header().as_str()), "{}:1: unexpected header", path.display());
+    assert_eq!(lines.next(), Some(needle_fit::golden::float32::header().as_str()), "{}:1: unexpected header", path.display());
 
     let mut rows = 0usize;
     let mut mismatches = Vec::new();

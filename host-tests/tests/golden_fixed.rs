@@ -2,7 +2,7 @@
 //! own, independent implementation of the fixed-point contract (coeffs/README.md): every
 //! row, every integer, exactly. The golden file is `<set>/golden-fixed.csv` of the set
 //! compiled into the library. A missing file is a failure, never a skip.
-use needle_fit::golden_fixed::parse_csv;
+use needle_fit::golden::fixed::parse_csv;
 use needle_haptics::{fixed, model_info};
 use std::path::Path;
 

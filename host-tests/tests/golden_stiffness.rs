@@ -4,7 +4,7 @@
 //! `wrench_and_stiffness` has the bits of `wrench` at every golden pose.
 //!
 //! A missing file is a failure, never a skip: `needle fit` writes it with model.toml.
-use needle_fit::golden_stiffness::{parse_csv, rate_columns};
+use needle_fit::golden::stiffness_float32::{parse_csv, rate_columns};
 use needle_fit::GOLDEN_STIFFNESS_FILE;
 use needle_haptics::{model_info, wrench, wrench_and_stiffness, Pose};
 use std::path::Path;

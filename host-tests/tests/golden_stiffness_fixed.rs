@@ -4,8 +4,8 @@
 //! and the wrench of `fixed::wrench_and_stiffness` is `fixed::wrench`'s at every pose.
 //!
 //! A missing file is a failure, never a skip: `needle fit` writes it with model.toml.
-use needle_fit::golden_stiffness::rate_columns;
-use needle_fit::golden_stiffness_fixed::parse_csv;
+use needle_fit::golden::stiffness_fixed::parse_csv;
+use needle_fit::golden::stiffness_float32::rate_columns;
 use needle_fit::GOLDEN_STIFFNESS_FIXED_FILE;
 use needle_haptics::{fixed, model_info};
 use std::path::Path;
@@ -57,7 +57,7 @@ fn library_fixed_stiffness_matches_golden_vectors_exactly() {
     );
 }
 
-/// The fixed-point rates approximate the f64 model's exact derivatives (eval_rate_f64,
+/// The fixed-point rates approximate the f64 model's exact derivatives (eval::rate_float64,
 /// itself checked against central differences in stiffness_f64.rs) at every golden pose
 /// inside the domain (x, z != 0: at 0 the rates are one-sided by rule): within
 /// `1e-4 * max|rate| + 3 µN/mm` per rate and component. Why that tolerance: the contract
@@ -70,9 +70,9 @@ fn fixed_rates_follow_the_f64_derivatives() {
     let path = Path::new(model_info::SET_DIR).join("model.toml");
     let model = needle_fit::model_file::read(&path).unwrap_or_else(|e| panic!("{e:#}"));
     let mut rows = Vec::new();
-    for p in needle_fit::golden_fixed::poses() {
+    for p in needle_fit::golden::fixed::poses(&[]) {
         let exact = p.map(|v| f64::from(v) / 65536.0);
-        let (want, status) = needle_fit::eval_rate_f64::eval_rates(&model, exact);
+        let (want, status) = needle_fit::eval::rate_float64::eval_rates(&model, exact);
         if status != 0 || exact[0] == 0.0 || exact[1] == 0.0 {
             continue;
         }

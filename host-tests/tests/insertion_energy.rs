@@ -26,7 +26,8 @@
 //! 7e-5 N·mm in the worst case, but only its non-cancelling part accumulates: the
 //! dissipation of friction and puncture over any path is orders above it, so the
 //! assertion is `E <= 1e-6 N·mm`.
-use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, Stack};
+use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, Layer, Stack};
+use needle_haptics::viscoelastic::{PronyTerm, PronyTerms};
 use needle_haptics::Pose;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -104,6 +105,12 @@ fn trajectory(rng: &mut ChaCha8Rng, deepest_mm: f64) -> Vec<Move> {
     moves
 }
 
+/// Whether the hand goes below the surface (the others only dissipate in the device's
+/// damping, or not even that: the report's worst case is over these).
+fn enters(moves: &[Move]) -> bool {
+    moves.iter().any(|m| m.to_mm > 0.0)
+}
+
 /// The hand's depth at time `t` along the chain of moves (the last one's end after it).
 fn depth_at(moves: &[Move], mut t: f64) -> f64 {
     for m in moves {
@@ -155,19 +162,65 @@ fn energy_of(moves: &[Move], damping_n_s_per_mm: f64, mut render: impl FnMut(Pos
 fn no_closed_cycle_delivers_energy_to_the_hand() {
     assert!(!stacks::ALL.is_empty(), "the default set ships tissue stacks");
     for stack in &stacks::ALL {
+        no_closed_cycle_delivers_energy(stack, TRAJECTORIES);
+    }
+}
+
+/// Prony terms for the filter-on runs: inputs that exercise the filter, not a tissue's
+/// values (the shipped stacks have none: `coeffs/default/tissue/`). `moderate`: weights
+/// of the order a soft tissue relaxes by over three decades of time constants;
+/// `extreme`: the largest sum the format allows (9) with time constants of the
+/// trajectories' own time scales (1 ms to 0.1 s), where the filter acts most.
+fn test_terms() -> [(&'static str, PronyTerms); 2] {
+    let t = |g: f32, tau_s: f32| PronyTerm { g, tau_s };
+    [
+        ("moderate", PronyTerms::new(&[t(0.8, 0.05), t(0.5, 1.0), t(0.3, 20.0)]).expect("valid terms")),
+        ("extreme", PronyTerms::new(&[t(3.0, 0.001), t(3.0, 0.01), t(3.0, 0.1)]).expect("valid terms")),
+    ]
+}
+
+/// `stack`'s layers with `terms` on every layer.
+fn with_terms(stack: &Stack<'_>, terms: PronyTerms) -> Vec<Layer> {
+    stack.layers.iter().map(|l| Layer { prony: terms, ..*l }).collect()
+}
+
+/// The passivity test of the insertion model with the viscoelastic filter on every layer
+/// of every shipped stack (a third of the trajectories each, both sets of terms), and the
+/// guarded loop's (100 trajectories each, both sets). The extreme set through the guarded
+/// loop failed before the guard filtered after limiting (issue 39: 18.5 N·mm delivered on
+/// an epidural trajectory; the old rule reinstated on this insertion as a mutation
+/// delivers 0.034 N·mm on epidural trajectory 21): the guard's offset then integrated the
+/// relaxing viscous force, which is not a function of the path.
+#[test]
+fn with_the_viscoelastic_filter_no_closed_cycle_delivers_energy() {
+    for stack in &stacks::ALL {
+        for (label, terms) in test_terms() {
+            let layers = with_terms(stack, terms);
+            let name = format!("{} with {label} Prony terms", stack.name);
+            let filtered = Stack { name: &name, layers: &layers, ..*stack };
+            no_closed_cycle_delivers_energy(&filtered, TRAJECTORIES / 3);
+            the_guarded_loop_delivers_no_energy(&filtered, 100);
+        }
+    }
+}
+
+fn no_closed_cycle_delivers_energy(stack: &Stack<'_>, trajectories: usize) {
+    {
         // one generator per stack: a stack added does not change another's trajectories
         let mut rng = ChaCha8Rng::seed_from_u64(20261126);
         let deepest: f64 = stack.layers.iter().map(|l| f64::from(l.thickness_mm)).sum::<f64>() + 5.0;
         let (mut worst, mut punctured) = (f64::NEG_INFINITY, 0);
-        for n in 0..TRAJECTORIES {
+        for n in 0..trajectories {
             let moves = trajectory(&mut rng, deepest);
             let (e, p) = energy(stack, &moves);
             punctured += usize::from(p > 0);
             assert!(e <= BOUND_NMM, "{}: trajectory {n} delivered {e:e} N·mm to the hand: {moves:?}", stack.name);
-            worst = worst.max(e);
+            if enters(&moves) {
+                worst = worst.max(e);
+            }
         }
-        println!("{}: {TRAJECTORIES} trajectories ({punctured} with a puncture), most energy to the hand {worst:e} N·mm", stack.name);
-        assert!(punctured > TRAJECTORIES / 4, "{}: only {punctured} trajectories punctured: the test must cross punctures", stack.name);
+        println!("{}: {trajectories} trajectories ({punctured} with a puncture), most energy to the hand of those entering the tissue {worst:e} N·mm", stack.name);
+        assert!(punctured > trajectories / 4, "{}: only {punctured} trajectories punctured: the test must cross punctures", stack.name);
     }
 }
 
@@ -179,9 +232,15 @@ fn no_closed_cycle_delivers_energy_to_the_hand() {
 /// deflects, and a puncture clears it (the force drops; nothing stored is given back).
 #[test]
 fn the_loop_with_the_guard_delivers_no_energy_either() {
-    use needle_haptics::control::{ChannelMap, LoopConfig, LoopCore, LoopFlags, OverLimit, Passivity};
-    const WEAK_DAMPING_N_S_PER_MM: f64 = 0.0001;
-    const LOOP_TRAJECTORIES: usize = 300;
+    for stack in &stacks::ALL {
+        the_guarded_loop_delivers_no_energy(stack, 300);
+    }
+}
+
+/// The guarded loops' configuration: one channel on Fy, limits far above the forces, and
+/// the passivity guard for a device of damping `damping_n_s_per_mm` at the test's period.
+fn guarded_loop_setup(damping_n_s_per_mm: f64) -> (needle_haptics::control::LoopConfig<1>, needle_haptics::control::Passivity) {
+    use needle_haptics::control::{ChannelMap, LoopConfig, OverLimit, Passivity};
     let config = LoopConfig {
         channels: [ChannelMap { gains_per_n: [0.0, 0.01, 0.0], direction_inverted: false }],
         force_limit_n: 100.0,
@@ -189,13 +248,19 @@ fn the_loop_with_the_guard_delivers_no_energy_either() {
         over_limit: OverLimit::Saturate,
         ramp_step_n: 0.01,
     };
-    let guard = Passivity { damping_n_s_per_mm: WEAK_DAMPING_N_S_PER_MM as f32, period_s: PERIOD_S as f32 };
-    for stack in &stacks::ALL {
+    (config, Passivity { damping_n_s_per_mm: damping_n_s_per_mm as f32, period_s: PERIOD_S as f32 })
+}
+
+fn the_guarded_loop_delivers_no_energy(stack: &Stack<'_>, loop_trajectories: usize) {
+    use needle_haptics::control::{LoopCore, LoopFlags};
+    const WEAK_DAMPING_N_S_PER_MM: f64 = 0.0001;
+    let (config, guard) = guarded_loop_setup(WEAK_DAMPING_N_S_PER_MM);
+    {
         // one generator per stack: a stack added does not change another's trajectories
         let mut rng = ChaCha8Rng::seed_from_u64(20261127);
         let deepest: f64 = stack.layers.iter().map(|l| f64::from(l.thickness_mm)).sum::<f64>() + 5.0;
         let (mut worst, mut limited, mut punctured) = (f64::NEG_INFINITY, 0, 0);
-        for n in 0..LOOP_TRAJECTORIES {
+        for n in 0..loop_trajectories {
             let moves = trajectory(&mut rng, deepest);
             let mut core = LoopCore::new(config).expect("config");
             core.set_passivity(Some(guard)).expect("guard");
@@ -209,13 +274,97 @@ fn the_loop_with_the_guard_delivers_no_energy_either() {
             limited += usize::from(was_limited);
             punctured += usize::from(p > 0);
             assert!(e <= BOUND_NMM, "{}: trajectory {n} through the loop delivered {e:e} N·mm to the hand: {moves:?}", stack.name);
-            worst = worst.max(e);
+            if enters(&moves) {
+                worst = worst.max(e);
+            }
         }
         println!(
-            "{}: {LOOP_TRAJECTORIES} trajectories through the guarded loop ({limited} stiffness-limited, {punctured} punctured), most energy to the hand {worst:e} N·mm",
+            "{}: {loop_trajectories} trajectories through the guarded loop ({limited} stiffness-limited, {punctured} punctured), most energy to the hand of those entering the tissue {worst:e} N·mm",
             stack.name
         );
-        assert!(limited > LOOP_TRAJECTORIES / 4, "{}: the guard acted in only {limited} trajectories", stack.name);
-        assert!(punctured > LOOP_TRAJECTORIES / 4, "{}: only {punctured} trajectories punctured", stack.name);
+        assert!(limited > loop_trajectories / 4, "{}: the guard acted in only {limited} trajectories", stack.name);
+        assert!(punctured > loop_trajectories / 4, "{}: only {punctured} trajectories punctured", stack.name);
+    }
+}
+
+/// Colgate's ratio measured through the guarded loop: the hand holds the needle on a
+/// deflected boundary (the first layer of every stack, four times as stiff, its puncture
+/// force raised so that it holds) and oscillates it by the samples `d_k = d0 + A sin(θ k + π/4)` (the phase:
+/// not zero at every sample of the Nyquist frequency), θ = wT from a
+/// fifth of the Nyquist frequency to it. The energy the loop's zero-order hold gives the
+/// hand over whole periods, `W = -Σ F_k (d_{k+1} - d_k)`, over the device damping's
+/// discrete budget `(b / T) Σ (d_{k+1} - d_k)²` is `r = K_eff T / (2 b)` for a rendered
+/// spring of stiffness `K_eff` (`-Σ K d_k Δd_k = (K / 2) Σ Δd_k²` over a closed cycle):
+/// Colgate's condition is `r < 1` at every frequency, and the guard renders at
+/// `GUARD_FRACTION` of the bound, so `r <= 0.5`. With the viscoelastic filter `K_eff`
+/// is `rho(θ) K`; the guard bounds it by the largest `rho`, at the Nyquist frequency,
+/// so there `r` reaches 0.5: the assertion is `r <= 0.5 (1 + 1%)` (1%: the surrogate's
+/// stiffness changes over the oscillation's 2A = 0.04 mm, the guard scales each tick's
+/// change by the stiffness at its end), and `r >= 0.45` at the Nyquist frequency for
+/// terms whose `rho` exceeds the tick gain `1 + sum b_i` (the extreme set: 9.77 against
+/// 8.74, so a guard bounding by the tick gain gives 0.559 and fails).
+#[test]
+fn the_guarded_loop_renders_at_half_colgates_bound_at_every_frequency() {
+    use needle_haptics::control::{LoopCore, LoopFlags, GUARD_FRACTION};
+    const WEAK_DAMPING_N_S_PER_MM: f64 = 0.0001;
+    const AMPLITUDE_MM: f64 = 0.02;
+    let (config, guard) = guarded_loop_setup(WEAK_DAMPING_N_S_PER_MM);
+    let elastic = ("elastic", PronyTerms::NONE);
+    for stack in &stacks::ALL {
+        for (label, terms) in [elastic, test_terms()[0], test_terms()[1]] {
+            // four times as stiff: the guard acts over the whole oscillation in either stack
+            let first = stack.layers[0];
+            let layer = Layer { prony: terms, puncture_force_n: 1.0e3, stiffness_scale: 4.0 * first.stiffness_scale, ..first };
+            let layers = [layer];
+            let one = Stack { layers: &layers, ..*stack };
+            let mut worst = 0.0f64;
+            // θ = π p / q: a period is 2q / p ticks, so 2q ticks are whole periods
+            for (p, q) in [(1usize, 5usize), (1, 2), (4, 5), (9, 10), (19, 20), (1, 1)] {
+                let fraction = p as f64 / q as f64;
+                let theta = std::f64::consts::PI * fraction;
+                let d0 = 0.5 * f64::from(layer.thickness_mm).min(6.0);
+                let mut core = LoopCore::new(config).expect("config");
+                core.set_passivity(Some(guard)).expect("guard");
+                core.set_insertion(Some(Insertion::new(&one, InsertionConfig::DEFAULT_1KHZ).expect("stack")));
+                // in at 5 mm/s from 1 mm above, then 2 s held (the filter relaxes; what
+                // still relaxes drifts linearly over the oscillation, which gives no net work
+                // over whole periods of a sine about d0)
+                let ramp_ticks = ((d0 + 1.0) / 5.0 / PERIOD_S) as usize;
+                let hold_ticks = 2000;
+                let depth = |k: usize| -> f64 {
+                    if k < ramp_ticks {
+                        -1.0 + (d0 + 1.0) * k as f64 / ramp_ticks as f64
+                    } else if k < ramp_ticks + hold_ticks {
+                        d0
+                    } else {
+                        d0 + AMPLITUDE_MM * (theta * (k - ramp_ticks - hold_ticks) as f64 + std::f64::consts::FRAC_PI_4).sin()
+                    }
+                };
+                // the oscillation: 200 ticks or more of warm-up, then 1,000 or more measured,
+                // each a whole number of periods
+                let whole = |ticks: usize| ticks.div_ceil(2 * q) * 2 * q;
+                let start = ramp_ticks + hold_ticks + whole(200);
+                let end = start + whole(1000);
+                let (mut work, mut budget, mut limited) = (0.0f64, 0.0f64, true);
+                for k in 0..end {
+                    let s = core.step(Ok(Pose { depth_mm: depth(k) as f32, ..Pose::default() }));
+                    if k >= start {
+                        let step = f64::from(depth(k + 1) as f32) - f64::from(depth(k) as f32);
+                        work -= f64::from(s.force_cmd_n[1]) * step;
+                        budget += WEAK_DAMPING_N_S_PER_MM / PERIOD_S * step * step;
+                        limited &= s.flags.contains(LoopFlags::STIFFNESS_LIMITED);
+                        assert_eq!(core.insertion_evaluation().map(|e| e.punctures), Some(0), "{}: the boundary holds", stack.name);
+                    }
+                }
+                let r = work / budget;
+                println!("{} {label}: wT = {fraction:.2} pi, energy to the hand over the damping's budget {r:.4}", stack.name);
+                assert!(limited, "{} {label}: the guard must act in every tick of the oscillation", stack.name);
+                assert!(r <= f64::from(GUARD_FRACTION) * 1.01, "{} {label}: wT = {fraction} pi: r = {r}", stack.name);
+                worst = worst.max(r);
+            }
+            if label == "extreme" {
+                assert!(worst >= 0.45, "{} {label}: the largest r {worst} is not near the guard's 0.5", stack.name);
+            }
+        }
     }
 }

@@ -130,3 +130,82 @@ fn a_puncture_clears_the_guards_offset() {
         assert!(limited > 100 && punctures >= 1, "{}: {limited} limited ticks, {punctures} punctures", stack.name);
     }
 }
+
+/// The guard's rule as it was before the viscoelastic filter had its own share
+/// (issue 39), written again here in f32 with the same operations: the reference the
+/// loop must give bit for bit for everything without Prony terms.
+#[derive(Default)]
+struct RuleBefore {
+    offset_n: [f32; 3],
+    last_n: Option<[f32; 3]>,
+}
+
+impl RuleBefore {
+    fn apply(&mut self, k_g: f32, f: [f32; 3], k: f32, d: [f32; 3]) -> [f32; 3] {
+        if d == [0.0; 3] {
+            return self.elastic(k_g, f, k);
+        }
+        let g = self.elastic(k_g, [f[0] - d[0], f[1] - d[1], f[2] - d[2]], k);
+        [g[0] + d[0], g[1] + d[1], g[2] + d[2]]
+    }
+
+    fn elastic(&mut self, k_g: f32, f: [f32; 3], k: f32) -> [f32; 3] {
+        if let (Some(last), true) = (self.last_n, k > k_g) {
+            let keep = 1.0 - k_g / k;
+            for ((o, f), l) in self.offset_n.iter_mut().zip(f).zip(last) {
+                *o += keep * (f - l);
+            }
+        }
+        if f == [0.0; 3] {
+            self.offset_n = [0.0; 3];
+        }
+        self.last_n = Some(f);
+        [f[0] - self.offset_n[0], f[1] - self.offset_n[1], f[2] - self.offset_n[2]]
+    }
+}
+
+/// The elastic insertion (every shipped stack, every golden path) and the block
+/// surrogate through the guarded loop give the bits of the rule before issue 39's change
+/// (`RuleBefore`, driven by a copy of the insertion's `step_with_stiffness` and by
+/// `wrench_and_depth_rate`), with the guard limiting (a weak device).
+#[test]
+fn without_prony_terms_the_guarded_loop_gives_the_rules_bits_as_before() {
+    let guard = Passivity { damping_n_s_per_mm: 0.00005, period_s: 0.001 };
+    let k_g = guard.guard_stiffness_n_per_mm();
+    for stack in &stacks::ALL {
+        for path in PATHS {
+            let mut l = core();
+            l.set_passivity(Some(guard)).expect("guard");
+            l.set_insertion(Some(new(stack)));
+            let (mut model, mut rule, mut limited) = (new(stack), RuleBefore::default(), 0);
+            for_each_tick(path, depth_scale(stack), |tick, p| {
+                let s = l.step(Ok(pose_of(p)));
+                let (e, terms) = model.step_with_stiffness(&pose_of(p));
+                if e.punctures > 0 {
+                    rule = RuleBefore::default();
+                }
+                let want = rule.apply(k_g, [e.wrench.fx_n, e.wrench.fy_n, e.wrench.fz_n], terms.stiffness_n_per_mm, terms.dissipative_n);
+                limited += usize::from(s.flags.contains(LoopFlags::STIFFNESS_LIMITED));
+                assert_eq!(s.force_cmd_n.map(f32::to_bits), want.map(f32::to_bits), "{} tick {tick}", stack.name);
+            });
+            assert!(limited > 100, "{}: the guard limited only {limited} ticks", stack.name);
+        }
+    }
+    // the block surrogate: the whole force guarded, its stiffness |dF/d depth|; a device
+    // of 0.001 N·s/m (k_g = 0.001 N/mm), below the block's stiffness over the motion
+    let guard = Passivity { damping_n_s_per_mm: 0.000001, period_s: 0.001 };
+    let k_g = guard.guard_stiffness_n_per_mm();
+    let mut l = core();
+    l.set_passivity(Some(guard)).expect("guard");
+    let (mut rule, mut limited) = (RuleBefore::default(), 0);
+    for k in 0..6000 {
+        let t = k as f32 * 0.001;
+        let pose = Pose { x_mm: 2.0, z_mm: -1.0, theta_x_deg: 3.0, theta_z_deg: -2.0, depth_mm: 3.0 + 2.5 * (1.3 * t).sin() };
+        let s = l.step(Ok(pose));
+        let (e, [dx, dy, dz]) = needle_haptics::wrench_and_depth_rate(&pose);
+        let want = rule.apply(k_g, [e.wrench.fx_n, e.wrench.fy_n, e.wrench.fz_n], (dx * dx + dy * dy + dz * dz).sqrt(), [0.0; 3]);
+        limited += usize::from(s.flags.contains(LoopFlags::STIFFNESS_LIMITED));
+        assert_eq!(s.force_cmd_n.map(f32::to_bits), want.map(f32::to_bits), "block surrogate tick {k}");
+    }
+    assert!(limited > 100, "block surrogate: the guard limited only {limited} ticks");
+}

@@ -1,14 +1,14 @@
-//! The f64 stiffness (`fit::eval_rate_f64`) against central differences of the f64 model,
-//! and the f32 stiffness (`fit::eval_rate_f32`, which writes the golden file) against the
+//! The f64 stiffness (`fit::eval::rate_float64`) against central differences of the f64 model,
+//! and the f32 stiffness (`fit::eval::rate_float32`, which writes the golden file) against the
 //! f64 stiffness, on the shipped paper model and on a coupled model with made-up cross
 //! terms (`made_up_model`), at 400 poses inside the domain.
 mod made_up_model;
 
 use needle_contract::COMPONENT_COUNT;
-use needle_fit::eval_f32::Tables32;
-use needle_fit::eval_f64::eval;
-use needle_fit::eval_rate_f32::eval_rates as rates32;
-use needle_fit::eval_rate_f64::eval_rates as rates64;
+use needle_fit::eval::float32::Tables32;
+use needle_fit::eval::float64::eval;
+use needle_fit::eval::rate_float32::eval_rates as rates32;
+use needle_fit::eval::rate_float64::eval_rates as rates64;
 use needle_fit::model::Model;
 use needle_fit::model_file::{parse, read};
 use rand::{Rng, SeedableRng};

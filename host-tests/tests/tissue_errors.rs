@@ -114,3 +114,80 @@ fn every_shipped_stack_is_read_and_named_after_its_file() {
         assert_eq!(parse_stack(path).expect("readable"), *stack);
     }
 }
+
+/// GOOD with `lines` added after the second layer's `source` (its last line).
+fn with_prony(lines: &str) -> String {
+    format!("{GOOD}{lines}\n")
+}
+
+/// The 1-based line of the first line of `text` that starts with `start`.
+fn line_in(text: &str, start: &str) -> usize {
+    text.lines().position(|l| l.starts_with(start)).map(|i| i + 1).expect("line in text")
+}
+
+#[test]
+fn prony_terms_are_read_in_the_long_term_normalisation() {
+    let text =
+        with_prony("prony = [{ g = 0.8, tau_s = 0.05 }, { g = 0.5, tau_s = 1.0 }, { g = 0.3, tau_s = 20.0 }]\nprony_source = \"test\"");
+    let s = parse_stack_str(&text, Path::new("two.toml")).expect("good prony terms");
+    let p: Vec<(f64, f64)> = s.layers[1].prony.iter().map(|t| (t.g, t.tau_s)).collect();
+    assert_eq!(p, [(0.8, 0.05), (0.5, 1.0), (0.3, 20.0)]);
+    assert!(s.layers[0].prony.is_empty(), "a layer without terms is elastic");
+    // written back (needle calibrate's to_toml) and read again: the same stack
+    let again = parse_stack_str(&s.to_toml("round trip"), Path::new("two.toml")).expect("round trip");
+    assert_eq!(again, s);
+    // the sum at its bound (9) is allowed
+    let text = with_prony("prony = [{ g = 5.0, tau_s = 1.0 }, { g = 4.0, tau_s = 2.0 }]\nprony_source = \"test\"");
+    parse_stack_str(&text, Path::new("two.toml")).expect("sum 9");
+}
+
+#[test]
+fn bad_prony_terms_are_refused_at_their_line() {
+    let cases = [
+        ("prony = [{ g = -0.1, tau_s = 1.0 }]", "prony g = -0.1: must be finite and >= 0"),
+        ("prony = [{ g = 0.5, tau_s = 0.0 }]", "prony tau_s = 0: must be finite and > 0"),
+        ("prony = [{ g = 0.5, tau_s = -2.0 }]", "prony tau_s = -2: must be finite and > 0"),
+        ("prony = [{ g = nan, tau_s = 1.0 }]", "prony g = NaN: must be finite and >= 0"),
+        ("prony = [{ g = 0.5, tau_s = inf }]", "prony tau_s = inf: must be finite and > 0"),
+        ("prony = [{ g = 5.0, tau_s = 1.0 }, { g = 4.5, tau_s = 2.0 }]", "prony: sum of g = 9.5: must be <= 9"),
+        (
+            "prony = [{ g = 0.1, tau_s = 1.0 }, { g = 0.1, tau_s = 2.0 }, { g = 0.1, tau_s = 3.0 }, { g = 0.1, tau_s = 4.0 }]",
+            "4 prony terms: a layer has at most 3",
+        ),
+    ];
+    for (line, message) in cases {
+        let text = with_prony(&format!("{line}\nprony_source = \"test\""));
+        let e = parse_stack_str(&text, Path::new("bad.toml")).expect_err(&format!("{line} must be refused"));
+        assert_eq!(e.line, Some(line_in(&text, "prony =")), "{line}: {e}");
+        assert!(e.message.starts_with(message), "{line}: {e}");
+        assert!(e.to_string().starts_with("bad.toml:"), "{e}");
+    }
+    // terms without their citation
+    let text = with_prony("prony = [{ g = 0.5, tau_s = 1.0 }]");
+    let e = parse_stack_str(&text, Path::new("bad.toml")).expect_err("terms need a source");
+    assert_eq!(e.line, Some(line_in(&text, "prony =")), "{e}");
+    assert!(e.message.contains("prony_source"), "{e}");
+    // an unknown key in a term
+    let text = with_prony("prony = [{ g = 0.5, tau = 1.0 }]\nprony_source = \"test\"");
+    let e = parse_stack_str(&text, Path::new("bad.toml")).expect_err("unknown key");
+    assert!(e.message.contains("tau"), "{e}");
+}
+
+/// The build's entry point (`build.rs` calls `needle_codegen::generate_tissue`) refuses a
+/// set whose tissue file has bad Prony terms, naming the file and the line.
+#[test]
+fn the_build_refuses_bad_prony_terms_with_file_and_line() {
+    let dir = std::env::temp_dir().join(format!("needle-prony-build-{}", std::process::id()));
+    let tissue = dir.join("tissue");
+    std::fs::create_dir_all(&tissue).expect("temp set");
+    let text = with_prony("prony = [{ g = 0.5, tau_s = 1.0 }, { g = -0.2, tau_s = 5.0 }]\nprony_source = \"test\"");
+    let path = tissue.join("two.toml");
+    std::fs::write(&path, &text).expect("write");
+    let out = dir.join("out");
+    std::fs::create_dir_all(&out).expect("out dir");
+    let e = needle_codegen::generate_tissue(&dir, &out).expect_err("bad prony terms");
+    let shown = e.to_string();
+    assert!(shown.starts_with(&format!("{}:{}:", path.display(), line_in(&text, "prony ="))), "{shown}");
+    assert!(shown.contains("prony g = -0.2"), "{shown}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -123,7 +123,9 @@ impl<const N: usize> LoopCore<N> {
     /// With an insertion, each tick with a valid pose steps it once
     /// ([`Insertion::step`], or [`Insertion::step_with_stiffness`] with the passivity
     /// guard on: the guard then limits the elastic part of the force, of the deflected
-    /// boundary's stiffness `|dF/dδ|`, and passes friction and cutting as they are:
+    /// boundary's stiffness `|dF/dδ|` (times the viscoelastic filter's `rho`, whose part
+    /// of the force the guard then renders with its own filter of the guarded
+    /// deflection), and passes friction and cutting as they are:
     /// [`Passivity`]'s module). A stale or missing pose
     /// does not step it (its velocity filter then sees the whole motion since the last
     /// valid pose in one tick, smoothed by its time constant). A tick that punctures a
@@ -251,16 +253,19 @@ impl<const N: usize> LoopCore<N> {
     /// (the insertion's friction and cutting; zero for the block surrogate).
     fn evaluate(&mut self, pose: &Pose) -> (Wrench, Status, Option<(Passivity, GuardTerms)>) {
         if let Some(ins) = self.insertion.as_mut() {
-            let (e, terms) = match self.passivity {
-                Some(_) => ins.step_with_stiffness(pose),
-                None => (ins.step(pose), GuardTerms::NONE),
+            let (e, guarded) = match self.passivity {
+                Some(p) => {
+                    let (e, terms) = ins.step_with_stiffness(pose);
+                    (e, Some((p, terms)))
+                }
+                None => (ins.step(pose), None),
             };
             self.insertion_last = Some(e);
             if e.punctures > 0 {
                 // nothing the guard stored while the boundary deflected is given back
                 self.guard.reset();
             }
-            return (e.wrench, e.status, self.passivity.map(|p| (p, terms)));
+            return (e.wrench, e.status, guarded);
         }
         match self.passivity {
             Some(p) => {
@@ -268,7 +273,7 @@ impl<const N: usize> LoopCore<N> {
                 // rates by x and z the guard does not use
                 let (e, [dfx, dfy, dfz]) = crate::wrench_and_depth_rate(pose);
                 let k2 = dfx * dfx + dfy * dfy + dfz * dfz;
-                (e.wrench, e.status, Some((p, GuardTerms { stiffness_n_per_mm: libm::sqrtf(k2), dissipative_n: [0.0; 3] })))
+                (e.wrench, e.status, Some((p, GuardTerms { stiffness_n_per_mm: libm::sqrtf(k2), ..GuardTerms::NONE })))
             }
             None => {
                 let e = crate::wrench(pose);

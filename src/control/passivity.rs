@@ -28,6 +28,40 @@
 //!   (with the deflected boundary's stiffness as `K`) and `D` is added back unchanged.
 //!   Scaled into the offset, a friction reversal would keep pushing the needle out
 //!   after a withdrawal starts. The block surrogate has no `D`: its force is guarded whole.
+//! - **with the viscoelastic filter** (feature `viscoelastic`, a deflected layer with
+//!   Prony terms): the insertion's force is `F = P + E + V(E) + D`, `E` the boundary's
+//!   elastic deflection force (a function of the path, stiffness `K`), `V(E)` the
+//!   quasi-linear filter's part (a function of time too: at a fixed position it relaxes),
+//!   `P` the preload and the track's hold. The guard limits first and filters after: the
+//!   rule above runs on the elastic part `F - D - V` (the insertion names `V` and `E`:
+//!   `GuardTerms`), at the stiffness `rho K` (`rho`:
+//!   [`QlvCoefficients::effective_stiffness_ratio`](crate::viscoelastic::QlvCoefficients::effective_stiffness_ratio),
+//!   the filter's worst-case stiffness ratio in a sampled loop, Colgate's general
+//!   condition at the Nyquist frequency: `1 + sum 2 b_i / (1 + a_i)`), and the guard's own
+//!   filter, the same coefficients, runs on the guarded deflection force `E'` (its
+//!   change each tick is `s` times `E`'s, `s = k_g / (rho K)` when limited, else 1); the
+//!   command is `E'`'s guarded elastic part `+ V(E') + D`.
+//!
+//!   Why it is passive: the guarded elastic part is a function of the path again (the
+//!   offset integrates `(1 - s) dE` along it; it no longer integrates the relaxing `V`,
+//!   which made the old rule's offset depend on time: issue 39, energy delivered to the
+//!   hand with `g = 3, 3, 3`, `tau = 1 ms, 10 ms, 0.1 s`, `docs/insertion.md`); a
+//!   quasi-linear filter with every `g_i >= 0` on a path function is a generalised
+//!   Maxwell body (springs `g_i K'` in series with dampers `g_i K' tau_i` beside the
+//!   spring `K'`), which only dissipates in continuous time; sampled, Colgate's condition
+//!   `b > T / (2 (1 - cos wT)) Re[(1 - e^{-iwT}) H(e^{iwT})]` for the filter's
+//!   `H = K' (1 + sum b_i (1 - z^-1) / (1 - a_i z^-1))` is `b > K' rho(wT) T / 2`, largest
+//!   at the Nyquist frequency, so `rho K' <= k_g` keeps the loop at `GUARD_FRACTION` of
+//!   the bound at every frequency (a term of `tau_i` near `T` is charged as the damper it
+//!   acts as, `2 g_i K tau_i / T`; the old tick gain `1 + sum b_i` was 8.74 for the set
+//!   above, `rho` 9.77). The guard's filter rests (nothing stored, last `E` zero) in every
+//!   tick without a deflected boundary with terms, exactly when the insertion's filter
+//!   rests, and starts without history after a puncture or a fault (relaxed at the first
+//!   `E` it sees). Where the limit has not acted since a boundary's first contact it
+//!   renders the insertion's own force (within f32 rounding); a layer without terms, the block surrogate and the build without the
+//!   feature take the rule above bit for bit (the feature's state is zero-sized without
+//!   it). Measured: `host-tests/tests/insertion_energy.rs` (random closed cycles and
+//!   Colgate's ratio at `wT` from `0.2 pi` to `pi`).
 use super::ConfigError;
 use crate::insertion::GuardTerms;
 
@@ -72,12 +106,14 @@ impl Passivity {
     }
 }
 
-/// The guard's state: the offset between model and command, and the last model force.
+/// The guard's state: the offset between model and command, the last model force, and
+/// (with the `viscoelastic` feature) the guard's own filter of the guarded deflection.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub(crate) struct Guard {
     offset_n: [f32; 3],
     last_model_n: Option<[f32; 3]>,
+    filter: GuardFilter,
 }
 
 impl Guard {
@@ -89,6 +125,11 @@ impl Guard {
     /// The guarded force for the model force `f_n` with its stiffness and dissipative
     /// part `terms` (the module's rule), and whether the stiffness was limited.
     pub(crate) fn apply(&mut self, p: &Passivity, f_n: [f32; 3], terms: &GuardTerms) -> ([f32; 3], bool) {
+        #[cfg(feature = "viscoelastic")]
+        if terms.filter.coefficients.is_active() {
+            return self.apply_filtered(p, f_n, terms);
+        }
+        self.filter.rest();
         let d = terms.dissipative_n;
         // no dissipative part (the block surrogate): the whole force, bits unchanged
         if d == [0.0; 3] {
@@ -99,7 +140,29 @@ impl Guard {
         ([g[0] + d[0], g[1] + d[1], g[2] + d[2]], limited)
     }
 
-    /// The rule on an elastic force `f_n` of stiffness `k_n_per_mm`.
+    /// The rule with the deflected boundary's viscoelastic filter: the elastic part
+    /// `F - D - V` through [`apply_elastic`](Self::apply_elastic) at the effective
+    /// stiffness `rho K` (`terms.stiffness_n_per_mm`), then the guard's own filter run on
+    /// the guarded deflection force (its increments `s dE`, `s` the rule's scale), then
+    /// `D` unchanged.
+    #[cfg(feature = "viscoelastic")]
+    fn apply_filtered(&mut self, p: &Passivity, f_n: [f32; 3], terms: &GuardTerms) -> ([f32; 3], bool) {
+        let (d, v) = (terms.dissipative_n, terms.filter.viscous_n);
+        let elastic = [f_n[0] - d[0] - v[0], f_n[1] - d[1] - v[1], f_n[2] - d[2] - v[2]];
+        // the scale the rule gives this tick's change (below), before it records the force
+        let k_g = p.guard_stiffness_n_per_mm();
+        let k = terms.stiffness_n_per_mm;
+        // `k > k_g > 0` (validated), so the division is by a positive, finite number
+        let scale = self.last_model_n.map(|_| if k > k_g { k_g / k } else { 1.0 });
+        let (g, limited) = self.apply_elastic(p, elastic, k);
+        let h = self.filter.step(&terms.filter.coefficients, terms.filter.deflection_n, scale);
+        ([g[0] + h[0] + d[0], g[1] + h[1] + d[1], g[2] + h[2] + d[2]], limited)
+    }
+
+    /// The rule on an elastic force `f_n` of stiffness `k_n_per_mm`: its change since the
+    /// last tick enters the command times `k_g / k` when limited, else whole (the
+    /// filter's scale in [`apply_filtered`](Self::apply_filtered)); nothing without a
+    /// last force (the first tick after a reset follows the model).
     fn apply_elastic(&mut self, p: &Passivity, f_n: [f32; 3], k_n_per_mm: f32) -> ([f32; 3], bool) {
         let k_g = p.guard_stiffness_n_per_mm();
         // `k > k_g > 0` (validated), so the division is by a positive, finite number.
@@ -118,4 +181,54 @@ impl Guard {
         let [f0, f1, f2] = f_n;
         ([f0 - o0, f1 - o1, f2 - o2], limited)
     }
+}
+
+/// The guard's own viscoelastic filter of the guarded deflection force: the last
+/// deflection force `E` it saw and the terms' state `h_i` per force component. At rest
+/// (nothing stored, last `E` 0) whenever the tick has no filter (no boundary with
+/// Prony terms deflected: the insertion's filter is at rest too); without history
+/// (nothing stored, no last `E`: it starts relaxed at the next `E`) after a puncture
+/// and after a fault.
+#[cfg(feature = "viscoelastic")]
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct GuardFilter {
+    last_deflection_n: Option<[f32; 3]>,
+    h_n: [[f32; crate::viscoelastic::MAX_TERMS]; 3],
+}
+
+#[cfg(feature = "viscoelastic")]
+impl GuardFilter {
+    /// At rest as the insertion's filter is without a deflected boundary: nothing
+    /// stored, the last deflection force 0 (the next boundary's first force enters
+    /// whole, as in the insertion's filter).
+    fn rest(&mut self) {
+        *self = Self { last_deflection_n: Some([0.0; 3]), ..Self::default() };
+    }
+
+    /// One tick: the deflection force `e_n` whose change since the last tick enters the
+    /// filter times `scale` (the guard's rule; with `scale` `None`, the first tick after
+    /// a reset, or no last force: nothing enters, the filter starts relaxed at `E`);
+    /// the filter's viscous force out.
+    fn step(&mut self, c: &crate::viscoelastic::QlvCoefficients, e_n: [f32; 3], scale: Option<f32>) -> [f32; 3] {
+        let d = match (self.last_deflection_n, scale) {
+            (Some(l), Some(s)) => [s * (e_n[0] - l[0]), s * (e_n[1] - l[1]), s * (e_n[2] - l[2])],
+            _ => [0.0; 3],
+        };
+        self.last_deflection_n = Some(e_n);
+        c.step_increments(&mut self.h_n, d)
+    }
+}
+
+/// Without the `viscoelastic` feature: no filter, nothing stored.
+#[cfg(not(feature = "viscoelastic"))]
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct GuardFilter;
+
+#[cfg(not(feature = "viscoelastic"))]
+impl GuardFilter {
+    /// Nothing to reset.
+    #[inline]
+    fn rest(&mut self) {}
 }

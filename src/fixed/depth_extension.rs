@@ -14,6 +14,7 @@
 //! Against the f32 law the integer one differs by the fixed-point model's error bound at
 //! 6 mm times `R` plus the rounding of `R` (below 2^-28 relative): the accuracy test in
 //! `host-tests/tests/insertion_fixed.rs` bounds the whole insertion.
+use super::arith::sat_mul;
 use super::{wrench, Evaluation, Pose, Wrench};
 use crate::depth_extension::tables as f32_tables;
 use crate::Status;
@@ -47,7 +48,7 @@ const COEFFS_Q30: [i64; 4] = {
 /// `floor(a b / 2^30)`.
 #[inline(always)]
 fn mul_q30(a: i64, b: i64) -> i64 {
-    a.saturating_mul(b) >> 30
+    sat_mul(a, b) >> 30
 }
 
 /// `R(v)` in Q30 for `v` in Q30 (`0 <= v <= 2^30`).
@@ -70,9 +71,9 @@ pub fn extended_wrench(pose: &Pose) -> Evaluation {
         return at6;
     }
     // depth - 6 mm in Q16 times 1/mm in Q30, over 2^16: v in Q30
-    let v = (i64::from(depth) - i64::from(MODEL_DEPTH_MAX_Q16)).saturating_mul(INV_SPAN_Q30) >> 16;
+    let v = sat_mul(i64::from(depth) - i64::from(MODEL_DEPTH_MAX_Q16), INV_SPAN_Q30) >> 16;
     let r = ratio_q30(v);
-    let w = at6.wrench.to_array().map(|c| saturate_i32(i64::from(c).saturating_mul(r).saturating_add(1 << 29) >> 30));
+    let w = at6.wrench.to_array().map(|c| saturate_i32(sat_mul(i64::from(c), r).saturating_add(1 << 29) >> 30));
     let status = if clamped { at6.status | Status::SAT_DEPTH } else { at6.status };
     Evaluation { wrench: Wrench::from_array(w), status }
 }

@@ -5,7 +5,7 @@ use super::tables::{
     BASELINE, DEPTH_DIVISOR, DEPTH_MAX_MM_Q16, FRAC_BITS, ODD, ROWS, SHIFTS, SWEEP_DIVISORS, THETA_MAX_DEG_Q16, X_MAX_MM_Q16, Z_MAX_MM_Q16,
 };
 use super::{Evaluation, Pose, Wrench};
-use crate::tables::FITTED;
+use crate::float::tables::FITTED;
 use crate::Status;
 use needle_contract::COMPONENT_COUNT;
 use needle_contract::TERMS;
@@ -28,7 +28,9 @@ use needle_contract::TERMS;
 /// 4. coupled form only: `N_k = sign(v_k) * ((|v_k| + V_k) / (2 V_k))` (Q15) and per cross
 ///    term `A_i += (P[i] * M >> 15) >> shift` with `M` the Q15 monomial (generated code);
 /// 5. `W = h(A, U)`, and the result `(W + 2^(G-1)) >> G` in µN or µN·mm
-///    ([`tables::FRAC_BITS`](super::tables::FRAC_BITS) = G).
+///    ([`tables::FRAC_BITS`](super::tables::FRAC_BITS) = G);
+/// 6. [`Status::FE_UNSOLVED`] when the clamped pose lies in the set's unsolved region
+///    (integer comparisons on the `N_k` and the depth; the wrench is not changed).
 ///
 /// No intermediate can overflow: the code generator bounds every one of them over the
 /// whole domain and chose the formats so that all stay within ±2^30. The result differs
@@ -49,8 +51,8 @@ pub fn wrench(pose: &Pose) -> Evaluation {
     if !FITTED {
         return Evaluation { wrench: Wrench::ZERO, status: Status::NO_MODEL | Status::ERROR };
     }
-    let at = Inputs::of(pose);
-    let a = accumulators(&at);
+    let mut at = Inputs::of(pose);
+    let a = accumulators(&mut at, pose);
     Evaluation { wrench: Wrench::from_array(output(&a, at.u)), status: at.status }
 }
 
@@ -64,7 +66,7 @@ pub(super) struct Inputs {
     pub negative: [bool; 4],
     /// `U` (Q15).
     pub u: i32,
-    /// The saturation flags.
+    /// The saturation flags ([`accumulators`] adds [`Status::FE_UNSOLVED`]).
     pub status: Status,
 }
 
@@ -133,10 +135,19 @@ pub(super) const ROW_STARTS: [[[u8; TERMS]; 4]; COMPONENT_COUNT] = {
 /// any order, and so the clamped inputs and `N_k` are dead before the sweeps' rows are
 /// computed (measured with a coupled model, `needle firmware bench`: the fixed-point
 /// stiffness's stack 524 -> 492 B on the M4F, 520 -> 504 B on the M0).
+///
+/// Step 7 here too, on the same `N_k`: [`Status::FE_UNSOLVED`] into `at.status` when the
+/// clamped pose lies in the set's unsolved region (`pose` gives the depth, clamped again
+/// here rather than kept in [`Inputs`]: the stack).
 #[inline(always)]
-pub(super) fn accumulators(at: &Inputs) -> [[i32; TERMS]; COMPONENT_COUNT] {
+pub(super) fn accumulators(at: &mut Inputs, pose: &Pose) -> [[i32; TERMS]; COMPONENT_COUNT] {
     let mut a = BASELINE;
-    add_cross(at.cross_inputs(), &mut a);
+    let n = at.cross_inputs();
+    add_cross(n, &mut a);
+    let (d, _) = clamp(pose.depth_mm_q16, 0, DEPTH_MAX_MM_Q16);
+    if crate::unsolved::in_region_fixed(n, d) {
+        at.status |= Status::FE_UNSOLVED;
+    }
     let tables = ROWS.iter().zip(SHIFTS.iter()).zip(ODD.iter()).zip(ROW_STARTS.iter());
     for (ac, (((rows, shifts), odd), starts)) in a.iter_mut().zip(tables) {
         for (((((rows_k, shifts_k), &tk), &neg), &o), starts_k) in

@@ -6,7 +6,7 @@ use super::eval::{accumulators, output, Inputs};
 use super::stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
 use super::tables::{FRAC_BITS, ODD, RATE_ROWS, RATE_SHIFTS, SHIFTS};
 use super::{Pose, Wrench};
-use crate::tables::FITTED;
+use crate::float::tables::FITTED;
 use crate::Status;
 use needle_contract::COMPONENT_COUNT;
 use needle_contract::{DEGREE, TERMS};
@@ -62,8 +62,8 @@ pub fn wrench_and_stiffness(pose: &Pose) -> StiffnessEvaluation {
 /// computed (measured stack, M0: 704 B with all three sets of accumulators live).
 #[inline(never)]
 fn wrench_and_depth_rates(pose: &Pose, e: &mut StiffnessEvaluation) {
-    let at = &Inputs::of(pose);
-    let a = accumulators(at);
+    let at = &mut Inputs::of(pose);
+    let a = accumulators(at, pose);
     let w = output(&a, at.u);
     let mut by_depth = [0_i32; COMPONENT_COUNT];
     for (((r, ac), &g), &rs) in by_depth.iter_mut().zip(a.iter()).zip(FRAC_BITS.iter()).zip(RATE_SHIFTS.iter()) {

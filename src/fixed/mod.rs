@@ -36,6 +36,7 @@ pub mod insertion;
 mod pose;
 mod stiffness;
 pub mod tables;
+pub mod viscoelastic;
 mod wrench;
 
 pub use depth_extension::{extended_wrench, DEPTH_MAX_MM_Q16 as EXTENDED_DEPTH_MAX_MM_Q16};

@@ -15,7 +15,18 @@
 //!   the stack's by geometric similarity: with `λ = needle_diameter_mm /
 //!   FE_NEEDLE_DIAMETER_MM`, the surrogate is evaluated at `x/λ, z/λ, δ/λ` (tilts
 //!   unchanged) and its forces are scaled by `s λ²`, its moments by `s λ³` (the hub at
-//!   `λ` times the FE needle's). Elastic: withdrawing gives the same force back.
+//!   `λ` times the FE needle's). Elastic for a layer without Prony terms: withdrawing
+//!   gives the same force back. With terms ([`Layer::prony`]) each of the six components
+//!   passes the layer's quasi-linear viscoelastic filter
+//!   ([`viscoelastic`](crate::viscoelastic), the state in the insertion): faster
+//!   indentation gives more force, a held needle feels it relax to the elastic one;
+//!   withdrawing, the filter keeps running (the force falls below the elastic one). The
+//!   puncture threshold compares the filtered axial force.
+//! - *viscous force released*: a puncture resets the filter (the boundary's stored
+//!   viscous force goes with its axial force; the lateral preload kept is the elastic
+//!   one), and so does the tip leaving the boundary (moving above it, or the path
+//!   ending): no stored force is pushed into the hand, and the next boundary starts
+//!   from rest.
 //! - *puncture*: when the deflection's axial force (along the needle, pushing it back)
 //!   plus the cutting force carried from the layer above (see below) reaches the layer's
 //!   `puncture_force_n`, the boundary is punctured in that tick: its axial force is gone
@@ -52,6 +63,10 @@ mod track;
 pub use stack::{stacks, Karnopp, Layer, Stack, FE_NEEDLE_DIAMETER_MM, HUB_FROM_TIP_MM, MAX_LAYERS};
 
 use crate::depth_extension::extended_wrench_and_depth_rate;
+#[cfg(not(feature = "viscoelastic"))]
+use crate::viscoelastic::identity::{QlvCoefficients, QlvState};
+#[cfg(feature = "viscoelastic")]
+use crate::viscoelastic::{QlvCoefficients, QlvState};
 use crate::{extended_wrench, Pose, Status, Wrench};
 use track::{axis, dot, Track, Vec3};
 
@@ -87,6 +102,9 @@ pub enum InsertionError {
     /// [`Insertion::set_scales`] got a count other than the stack's layers, or a scale
     /// that is not finite and > 0.
     Scales,
+    /// A layer has Prony terms and the library was built without its `viscoelastic`
+    /// feature.
+    NeedsViscoelastic,
 }
 
 impl core::fmt::Display for InsertionError {
@@ -96,6 +114,7 @@ impl core::fmt::Display for InsertionError {
             Self::Value => "tissue stack: a value out of range (thickness, scale, puncture force, stick band > 0; the rest >= 0)",
             Self::Config => "insertion config: period_s must be finite and > 0, velocity_time_constant_s finite and >= 0",
             Self::Scales => "stiffness scales: one per layer, each finite and > 0",
+            Self::NeedsViscoelastic => "tissue stack: a layer has Prony terms; build needle-haptics with its `viscoelastic` feature",
         })
     }
 }
@@ -206,6 +225,14 @@ pub struct Insertion {
     preload: [f32; 6],
     last_depth_mm: Option<f32>,
     velocity_mm_per_s: f32,
+    /// Per layer the relaxation's per-tick coefficients (computed once, in `new`).
+    qlv: [QlvCoefficients; MAX_LAYERS],
+    /// The viscoelastic filter of the deflected boundary's wrench.
+    qlv_state: QlvState,
+    /// The filter's share for a guard of the last [`Insertion::step_with_stiffness`]
+    /// (zero-sized without the `viscoelastic` feature; written only by that call, so
+    /// `step` carries none of it).
+    guard_share: FilterTerms,
 }
 
 /// What a passivity guard needs of an insertion tick beside its wrench
@@ -214,18 +241,60 @@ pub struct Insertion {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct GuardTerms {
     /// The stiffness along the path of the boundary being deflected, N/mm: `|dF/dδ|` of
-    /// its three forces (the rate of [`deflection`]); 0 when no boundary is deflected
-    /// (approach, or in the track short of the next boundary) and for an error.
+    /// its three forces (the rate of [`deflection`]) times the layer's viscoelastic
+    /// filter's effective stiffness ratio `rho` (1 without Prony terms:
+    /// `viscoelastic::QlvCoefficients::effective_stiffness_ratio`); 0 when no boundary
+    /// is deflected (approach, or in the track short of the next boundary) and for an
+    /// error.
     pub stiffness_n_per_mm: f32,
     /// The force of shaft friction and cutting in the wrench, N (block frame): it only
     /// takes energy out, so a guard leaves it as it is and limits the rest (the
     /// boundary's deflection, the preload and the track's hold: the elastic part).
     pub dissipative_n: [f32; 3],
+    /// The viscoelastic filter's share (zero-sized without the `viscoelastic` feature).
+    pub(crate) filter: FilterTerms,
 }
 
 impl GuardTerms {
     /// No stiffness, no dissipative force.
-    pub const NONE: Self = Self { stiffness_n_per_mm: 0.0, dissipative_n: [0.0; 3] };
+    pub const NONE: Self = Self { stiffness_n_per_mm: 0.0, dissipative_n: [0.0; 3], filter: FilterTerms::NONE };
+}
+
+/// What a guard needs of the deflected boundary's viscoelastic filter: the filter's
+/// coefficients (`NONE` when no boundary with Prony terms is deflected: the insertion's
+/// filter is then at rest), the unfiltered elastic deflection force `E` and the
+/// filter's part `V` of the wrench's forces (filtered minus `E`). The guard renders
+/// `F - D - V` (the elastic part, a function of the path) through its rule and adds
+/// its own filter run on the guarded `E` (`control::passivity`).
+#[cfg(feature = "viscoelastic")]
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub(crate) struct FilterTerms {
+    /// The deflected layer's per-tick coefficients.
+    pub(crate) coefficients: QlvCoefficients,
+    /// The boundary's deflection force before the filter, N (block frame).
+    pub(crate) deflection_n: [f32; 3],
+    /// The filter's part of the wrench's forces, N: the filtered deflection force
+    /// minus `deflection_n`.
+    pub(crate) viscous_n: [f32; 3],
+}
+
+#[cfg(feature = "viscoelastic")]
+impl FilterTerms {
+    /// No filter in this tick.
+    pub(crate) const NONE: Self = Self { coefficients: QlvCoefficients::NONE, deflection_n: [0.0; 3], viscous_n: [0.0; 3] };
+}
+
+/// Without the `viscoelastic` feature there is no filter: nothing.
+#[cfg(not(feature = "viscoelastic"))]
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub(crate) struct FilterTerms;
+
+#[cfg(not(feature = "viscoelastic"))]
+impl FilterTerms {
+    /// Nothing.
+    pub(crate) const NONE: Self = Self;
 }
 
 /// What [`Insertion::deflect`] found: the wrench so far (preload included), the
@@ -235,6 +304,24 @@ struct Deflected {
     status: Status,
     punctures: u8,
     stiffness_n_per_mm: f32,
+}
+
+/// The guard's share of the deflected boundary's filter ([`FilterTerms`]): the
+/// coefficients, the elastic deflection force and the filtered minus the elastic one.
+#[cfg(feature = "viscoelastic")]
+fn filter_terms(qlv: &QlvCoefficients, elastic: &[f32; 6], filtered: &[f32; 6]) -> FilterTerms {
+    if !qlv.is_active() {
+        return FilterTerms::NONE;
+    }
+    let [ex, ey, ez, ..] = *elastic;
+    let [fx, fy, fz, ..] = *filtered;
+    FilterTerms { coefficients: *qlv, deflection_n: [ex, ey, ez], viscous_n: [fx - ex, fy - ey, fz - ez] }
+}
+
+/// Without the filter: nothing.
+#[cfg(not(feature = "viscoelastic"))]
+fn filter_terms(_qlv: &QlvCoefficients, _elastic: &[f32; 6], _filtered: &[f32; 6]) -> FilterTerms {
+    FilterTerms
 }
 
 fn positive(v: f32) -> bool {
@@ -272,6 +359,15 @@ impl Insertion {
         if !positive(config.period_s) || !non_negative(config.velocity_time_constant_s) {
             return Err(InsertionError::Config);
         }
+        if cfg!(not(feature = "viscoelastic")) && stack.layers.iter().any(|l| !l.prony.as_slice().is_empty()) {
+            return Err(InsertionError::NeedsViscoelastic);
+        }
+        let mut qlv = [QlvCoefficients::NONE; MAX_LAYERS];
+        for (k, l) in qlv.iter_mut().zip(stack.layers) {
+            // a run-time stack's terms are checked like the file's (`PronyTerms::new`)
+            let terms = crate::viscoelastic::PronyTerms::new(l.prony.as_slice()).map_err(|_| InsertionError::Value)?;
+            *k = QlvCoefficients::new(&terms, config.period_s).map_err(|_| InsertionError::Config)?;
+        }
         let mut layers = [stack.layers.first().copied().ok_or(InsertionError::LayerCount)?; MAX_LAYERS];
         for (slot, l) in layers.iter_mut().zip(stack.layers) {
             *slot = *l;
@@ -287,6 +383,9 @@ impl Insertion {
             preload: [0.0; 6],
             last_depth_mm: None,
             velocity_mm_per_s: 0.0,
+            qlv,
+            qlv_state: QlvState::REST,
+            guard_share: FilterTerms::NONE,
         })
     }
 
@@ -324,6 +423,7 @@ impl Insertion {
         self.track_end_mm = 0.0;
         self.track = None;
         self.preload = [0.0; 6];
+        self.qlv_state.reset();
     }
 
     /// One tick: the pose (entry point on the top surface, tilts, `depth_mm` of the tip
@@ -338,13 +438,23 @@ impl Insertion {
     /// stiffness and the dissipative part of the force. The control loop's guard takes
     /// them ([`LoopCore::set_insertion`](crate::control::LoopCore::set_insertion)).
     pub fn step_with_stiffness(&mut self, pose: &Pose) -> (InsertionEvaluation, GuardTerms) {
-        self.tick(pose, true)
+        let (e, stiffness_n_per_mm, dissipative_n) = self.tick(pose, true);
+        (e, GuardTerms { stiffness_n_per_mm, dissipative_n, filter: self.guard_share })
     }
 
-    fn tick(&mut self, pose: &Pose, rate: bool) -> (InsertionEvaluation, GuardTerms) {
+    // Never inlined: LLVM 22 (rustc 1.95) crashed in register allocation on x86-64 with
+    // the grown state inlined into a large caller (host-tests/tests/insertion_fixed.rs).
+    #[inline(never)]
+    /// The tick's evaluation, and (with `rate`; else 0) the deflected boundary's
+    /// stiffness and the dissipative force of [`GuardTerms`], whose filter share it
+    /// leaves in `guard_share` (with `rate` only).
+    fn tick(&mut self, pose: &Pose, rate: bool) -> (InsertionEvaluation, f32, [f32; 3]) {
+        if rate {
+            self.guard_share = FilterTerms::NONE;
+        }
         let finite = [pose.x_mm, pose.z_mm, pose.theta_x_deg, pose.theta_z_deg, pose.depth_mm].into_iter().all(f32::is_finite);
         if !finite {
-            return (self.evaluation(Wrench::ZERO, Status::ERROR, Phase::Approach, 0), GuardTerms::NONE);
+            return (self.evaluation(Wrench::ZERO, Status::ERROR, Phase::Approach, 0), 0.0, [0.0; 3]);
         }
         let depth = pose.depth_mm;
         let step_mm = self.last_depth_mm.map_or(0.0, |last| depth - last);
@@ -354,7 +464,7 @@ impl Insertion {
         let v = if self.velocity_mm_per_s * step_mm > 0.0 { self.velocity_mm_per_s } else { 0.0 };
         if depth <= 0.0 {
             self.end_path();
-            return (self.evaluation(Wrench::ZERO, Status::OK, Phase::Approach, 0), GuardTerms::NONE);
+            return (self.evaluation(Wrench::ZERO, Status::OK, Phase::Approach, 0), 0.0, [0.0; 3]);
         }
         let a = axis(pose.theta_x_deg, pose.theta_z_deg);
         let entry: Vec3 = [pose.x_mm, 0.0, pose.z_mm];
@@ -362,8 +472,8 @@ impl Insertion {
         let Deflected { wrench: mut w, status, punctures, stiffness_n_per_mm } = self.deflect(pose, a, entry, &bounds, rate);
         let (phase, axial_n) = self.shaft(pose, a, entry, v, &bounds, &mut w);
         let wrench = Wrench::from_array(w);
-        let terms = GuardTerms { stiffness_n_per_mm, dissipative_n: [axial_n * a[0], axial_n * a[1], axial_n * a[2]] };
-        (self.evaluation(wrench, status, phase, punctures), terms)
+        let dissipative_n = [axial_n * a[0], axial_n * a[1], axial_n * a[2]];
+        (self.evaluation(wrench, status, phase, punctures), stiffness_n_per_mm, dissipative_n)
     }
 
     fn evaluation(&self, wrench: Wrench, status: Status, phase: Phase, punctures: u8) -> InsertionEvaluation {
@@ -392,6 +502,14 @@ impl Insertion {
     }
 
     /// The deflection of the first intact boundary, with the punctures it causes.
+    ///
+    /// The boundary's wrench passes the layer's viscoelastic filter (the `viscoelastic`
+    /// module; its stiffness times the filter's effective stiffness ratio `rho`,
+    /// [`QlvCoefficients::effective_stiffness_ratio`], and with `rate` the filter's
+    /// share for a guard: [`GuardTerms`]). A puncture
+    /// releases the boundary's stored viscous force (the filter is reset: the lateral
+    /// part kept as preload is the elastic one), as does the tip leaving the boundary
+    /// (no deflected boundary in this tick): nothing stored is pushed into the hand.
     fn deflect(&mut self, pose: &Pose, a: Vec3, entry: Vec3, bounds: &[f32; MAX_LAYERS + 1], rate: bool) -> Deflected {
         let mut punctures = 0u8;
         while self.punctured < self.count {
@@ -399,17 +517,24 @@ impl Insertion {
             if pose.depth_mm <= q {
                 break;
             }
-            let Some(layer) = self.layers.get(self.punctured).copied() else { break };
+            let (Some(layer), Some(qlv)) = (self.layers.get(self.punctured).copied(), self.qlv.get(self.punctured)) else { break };
             let (e, k) = deflection_at(pose, pose.depth_mm - q, layer.stiffness_scale, self.similarity, rate);
-            let w = e.wrench.to_array();
+            let elastic = e.wrench.to_array();
+            let w = self.qlv_state.step(qlv, elastic);
             let axial_n = dot([w[0], w[1], w[2]], a);
             if axial_n + self.carried_cutting_n() < layer.puncture_force_n {
                 let mut total = self.preload;
                 for (t, x) in total.iter_mut().zip(w) {
                     *t += x;
                 }
-                return Deflected { wrench: total, status: e.status, punctures, stiffness_n_per_mm: k };
+                if rate {
+                    self.guard_share = filter_terms(qlv, &elastic, &w);
+                }
+                return Deflected { wrench: total, status: e.status, punctures, stiffness_n_per_mm: k * qlv.effective_stiffness_ratio() };
             }
+            let w = elastic;
+            let axial_n = dot([w[0], w[1], w[2]], a);
+            self.qlv_state.reset();
             // puncture: the axial force goes, the lateral force and the moments stay
             if self.track.is_none() {
                 self.track = Some(Track { entry_mm: entry, axis: a });
@@ -422,6 +547,7 @@ impl Insertion {
             self.track_end_mm = pose.depth_mm;
             punctures = punctures.saturating_add(1);
         }
+        self.qlv_state.reset();
         Deflected { wrench: self.preload, status: Status::OK, punctures, stiffness_n_per_mm: 0.0 }
     }
 

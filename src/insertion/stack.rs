@@ -2,6 +2,8 @@
 //! compiled in from the set's `tissue/*.toml` (format: `coeffs/README.md`, "Tissue
 //! stacks") into [`stacks`].
 
+use crate::viscoelastic::{PronyTerm, PronyTerms};
+
 /// Shaft friction per mm of shaft in a layer: Karnopp's static and Coulomb levels, a
 /// viscous term and the stick band (Okamura, Simone and O'Leary 2004, modified: inside
 /// the band the force rises linearly from zero, so it never acts on a needle at rest).
@@ -55,6 +57,10 @@ pub struct Layer {
     pub friction: Karnopp,
     /// Lateral stiffness of the cut track per mm of shaft in the layer, N/mm per mm.
     pub track_stiffness_n_per_mm2: f32,
+    /// The relaxation function of the layer's boundary deflection (quasi-linear
+    /// viscoelasticity, [`viscoelastic`](crate::viscoelastic)); [`PronyTerms::NONE`]:
+    /// elastic.
+    pub prony: PronyTerms,
 }
 
 /// A stack of layers and the needle its values belong to.
@@ -75,10 +81,33 @@ pub const MAX_LAYERS: usize = needle_contract::MAX_TISSUE_LAYERS;
 /// The stacks of the compiled-in set, generated from its `tissue/*.toml`, and the FE
 /// needle they are scaled from.
 pub mod stacks {
-    #![allow(clippy::unreadable_literal, clippy::excessive_precision)]
-    #[allow(unused_imports)] // a set without tissue files uses neither
-    use super::{Karnopp, Layer, Stack};
+    // `panic!` only in constant evaluation (a refused Prony set is a compile error)
+    #![allow(clippy::unreadable_literal, clippy::excessive_precision, clippy::panic)]
+    #[allow(unused_imports)] // a set without tissue files uses none
+    use super::{Karnopp, Layer, PronyTerm, PronyTerms, Stack};
     include!(concat!(env!("OUT_DIR"), "/tissue_stacks.rs"));
+
+    /// Whether no layer of `stacks` has a Prony term.
+    #[cfg(not(feature = "viscoelastic"))]
+    #[allow(clippy::indexing_slicing)] // const evaluation only: out of range is a compile error
+    const fn elastic(stacks: &[Stack<'static>]) -> bool {
+        let mut i = 0;
+        while i < stacks.len() {
+            let layers = stacks[i].layers;
+            let mut j = 0;
+            while j < layers.len() {
+                if layers[j].prony.as_array().1 > 0 {
+                    return false;
+                }
+                j += 1;
+            }
+            i += 1;
+        }
+        true
+    }
+
+    #[cfg(not(feature = "viscoelastic"))]
+    const _: () = assert!(elastic(&ALL), "a tissue file of the set has Prony terms: build needle-haptics with its `viscoelastic` feature");
 }
 
 pub use stacks::{FE_NEEDLE_DIAMETER_MM, HUB_FROM_TIP_MM};

@@ -76,6 +76,8 @@ pub fn calibrate_published(opts: &ModelOptions<'_>) -> Result<Calibration> {
             stick_band_mm_per_s: STICK_BAND_MM_PER_S,
             track_stiffness_n_per_mm2: WINKLER_E_PER_MU * f.scale * opts.fe_shear_modulus_n_per_mm2,
             source: cited,
+            prony: Vec::new(),
+            prony_source: None,
         });
     }
     let stack = file::Stack {

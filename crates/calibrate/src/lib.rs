@@ -32,6 +32,7 @@ pub mod replay;
 use anyhow::{bail, Result};
 use needle_codegen::tissue as file;
 use needle_haptics::insertion::{self, Karnopp};
+use needle_haptics::viscoelastic::{PronyTerm, PronyTerms};
 use needle_haptics::Pose;
 use std::path::Path;
 
@@ -187,6 +188,8 @@ fn to_file(opts: &Options<'_>, fit: &fit::Fit) -> file::Stack {
                 stick_band_mm_per_s: STICK_BAND_MM_PER_S,
                 track_stiffness_n_per_mm2: WINKLER_E_PER_MU * l.scale * opts.fe_shear_modulus_n_per_mm2,
                 source: source.clone(),
+                prony: Vec::new(),
+                prony_source: None,
             }
         })
         .collect();
@@ -214,5 +217,8 @@ pub fn to_layer(l: &file::Layer) -> insertion::Layer {
             stick_band_mm_per_s: l.stick_band_mm_per_s as f32,
         },
         track_stiffness_n_per_mm2: l.track_stiffness_n_per_mm2 as f32,
+        // the parser checked the terms with the library's rules (on the f32 weights)
+        prony: PronyTerms::new(&l.prony.iter().map(|t| PronyTerm { g: t.g as f32, tau_s: t.tau_s as f32 }).collect::<Vec<_>>())
+            .unwrap_or(PronyTerms::NONE),
     }
 }

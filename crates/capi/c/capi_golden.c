@@ -325,6 +325,7 @@ int main(int argc, char **argv) {
   /* The names C users print: error codes, status bits, loop flags. */
   if (strcmp(needle_strerror(NEEDLE_E_NULL), "NULL pointer argument") != 0) command_failures++;
   if (strcmp(needle_status_name(NEEDLE_STATUS_SAT_DEPTH), "SAT_DEPTH") != 0) command_failures++;
+  if (strcmp(needle_status_name(NEEDLE_STATUS_FE_UNSOLVED), "FE_UNSOLVED") != 0) command_failures++;
   if (needle_status_name(NEEDLE_STATUS_SAT_X | NEEDLE_STATUS_SAT_Z) != NULL) command_failures++;
   if (strcmp(needle_loop_flag_name(NEEDLE_LOOP_RAMPING), "RAMPING") != 0) command_failures++;
   {

@@ -29,6 +29,7 @@ pub extern "C" fn needle_status_name(bit: u8) -> *const c_char {
         crate::types::NEEDLE_STATUS_SAT_THETA_X => Some(c"SAT_THETA_X"),
         crate::types::NEEDLE_STATUS_SAT_THETA_Z => Some(c"SAT_THETA_Z"),
         crate::types::NEEDLE_STATUS_SAT_DEPTH => Some(c"SAT_DEPTH"),
+        crate::types::NEEDLE_STATUS_FE_UNSOLVED => Some(c"FE_UNSOLVED"),
         crate::types::NEEDLE_STATUS_NO_MODEL => Some(c"NO_MODEL"),
         crate::types::NEEDLE_STATUS_ERROR => Some(c"ERROR"),
         _ => None,
@@ -118,7 +119,7 @@ mod tests {
         for (flag, lib_name) in Status::FLAGS {
             assert_eq!(name(needle_status_name(flag.bits())).as_deref(), Some(lib_name), "status bit {:#04x}", flag.bits());
         }
-        assert_eq!(Status::FLAGS.len(), 7, "a new Status flag needs its NEEDLE_STATUS_ constant and name");
+        assert_eq!(Status::FLAGS.len(), 8, "a new Status flag needs its NEEDLE_STATUS_ constant and name");
         for (flag, lib_name) in LoopFlags::FLAGS {
             assert_eq!(name(needle_loop_flag_name(flag.bits())).as_deref(), Some(lib_name), "loop flag {:#06x}", flag.bits());
         }
@@ -127,7 +128,7 @@ mod tests {
         assert_eq!(name(needle_loop_flag_name(0x0400)), None, "unknown flag");
         assert_eq!(name(needle_strerror(crate::types::NEEDLE_E_NULL)).as_deref(), Some("NULL pointer argument"));
         assert_eq!(name(needle_strerror(-99)).as_deref(), Some("unknown needle error code"));
-        for (status, want) in [(0u8, "OK"), (0x11, "SAT_X | SAT_DEPTH"), (0xa0, "ERROR | 0x20")] {
+        for (status, want) in [(0u8, "OK"), (0x11, "SAT_X | SAT_DEPTH"), (0x30, "SAT_DEPTH | FE_UNSOLVED")] {
             let mut buf = [0x55 as c_char; 32];
             // SAFETY: 32 writable bytes
             let n = unsafe { needle_status_str(status, buf.as_mut_ptr(), buf.len()) };

@@ -3,17 +3,17 @@
 /// Motor channels of the C loop.
 pub const NEEDLE_CHANNELS: usize = 3;
 /// 64-bit words of opaque storage in a [`needle_loop_t`].
-pub const NEEDLE_LOOP_STORAGE_WORDS: usize = 96;
+pub const NEEDLE_LOOP_STORAGE_WORDS: usize = 176;
 /// [`needle_loop_t::magic`] of an initialised loop.
 pub const NEEDLE_LOOP_MAGIC: u32 = 0x4e4c_4f50;
 
 /// 64-bit words of opaque storage in a [`needle_insertion_t`].
-pub const NEEDLE_INSERTION_STORAGE_WORDS: usize = 64;
+pub const NEEDLE_INSERTION_STORAGE_WORDS: usize = 128;
 /// [`needle_insertion_t::magic`] of an initialised insertion.
 pub const NEEDLE_INSERTION_MAGIC: u32 = 0x4e49_4e53;
 
 /// 64-bit words of opaque storage in a [`needle_fixed_insertion_t`].
-pub const NEEDLE_FIXED_INSERTION_STORAGE_WORDS: usize = 48;
+pub const NEEDLE_FIXED_INSERTION_STORAGE_WORDS: usize = 112;
 /// [`needle_fixed_insertion_t::magic`] of an initialised fixed-point insertion.
 pub const NEEDLE_FIXED_INSERTION_MAGIC: u32 = 0x4e46_494e;
 
@@ -230,6 +230,9 @@ pub const NEEDLE_STATUS_SAT_THETA_X: u8 = 0x04;
 pub const NEEDLE_STATUS_SAT_THETA_Z: u8 = 0x08;
 /// Status bit: depth clamped to the domain.
 pub const NEEDLE_STATUS_SAT_DEPTH: u8 = 0x10;
+/// Status bit: the (clamped) pose lies in the region where the set's FE campaign could
+/// not solve; the wrench is still the model's (an extrapolation), not zeroed.
+pub const NEEDLE_STATUS_FE_UNSOLVED: u8 = 0x20;
 /// Status bit: the build has no fitted model (the wrench is zero).
 pub const NEEDLE_STATUS_NO_MODEL: u8 = 0x40;
 /// Status bit: no wrench could be computed (NaN input, NULL pose, no model).

@@ -2,7 +2,7 @@
 use clap::{Args, Subcommand};
 use needle_fe::campaign::{self, RunOptions};
 use needle_fe::launcher::slurm::{self, SlurmOptions};
-use needle_fe::launcher::Launched;
+use needle_fe::manifest::Launched;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
@@ -10,11 +10,14 @@ use std::time::Duration;
 /// `needle fe` subcommands.
 #[derive(Subcommand)]
 pub enum FeCommand {
-    /// Solve the set's FE campaign, one solver job per pose; resumable.
+    /// Solve the set's FE campaign, one solver job per pose; resumable, an interrupted pose where it was.
     #[command(after_help = "Each pose's result goes to <set>/fe/<pose>.csv (depth in mm, forces in N, moments in N*mm \
 about the needle hub) and its record to <set>/fe/manifest.toml. Poses whose result matches the current spec are \
-skipped; a failed attempt is retried on the engine's retry ladder (docs/usage.md). Exit status 1 when a run failed \
-(the others are kept), 2 on an error before any run.")]
+skipped; a failed attempt is retried on the engine's retry ladder (docs/usage.md). A run killed in the middle of a \
+pose (Ctrl-C, kill -9, the end of a session) resumes it on the rerun at the attempt it was in \
+(<out>/.work/<pose>/progress.toml): FEBio goes on from the attempt's last dump (its last must point), ccx reruns the \
+attempt from its start; --force, another spec or a pose whose attempts all failed start afresh. Exit status 1 when a \
+run failed (the others are kept), 2 on an error before any run.")]
     Run(RunArgs),
     /// Verify the FE setup: flat punch, mesh study, mirror runs, smoothness, scaling law.
     #[command(after_help = "Without --punch, --mesh, --mirror, --smooth or --scaling all five run (the mesh study's \
@@ -69,12 +72,17 @@ pub struct SpecArgs {
     /// The runs of campaign.toml's [deep] section (to deep.depth_mm on deep.mesh), into <set>/fe/deep/.
     #[arg(long)]
     pub deep: bool,
+    /// The viscoelastic ramp-and-hold runs of campaign.toml's [viscoelastic] section (each
+    /// pose at each speed, --steps must points on the ramp), into <set>/fe/visco/.
+    #[arg(long, conflicts_with = "deep")]
+    pub visco: bool,
 }
 
 /// How each pose is solved (shared by `fe run` and the array tasks' `fe run-one`).
 #[derive(Args, Debug)]
 pub struct SolveArgs {
-    /// Rerun the selected poses even when their results are up to date.
+    /// Rerun the selected poses even when their results are up to date; an interrupted
+    /// pose starts afresh instead of resuming.
     #[arg(long)]
     pub force: bool,
     /// Keep the work folder (<out>/.work/<pose>: solver input and logs) of successful
@@ -205,8 +213,22 @@ pub struct VerifyArgs {
     /// Load steps of the scaling check's runs and of the s = 1 runs (default: loading.steps).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=10_000))]
     pub scaling_steps: Option<u32>,
-    /// Solve none of the scaling and mesh-study runs: compare the results already there
-    /// and name the missing ones.
+    /// Compare the viscoelastic ramp-and-hold runs ([viscoelastic], fe/visco/) with the
+    /// library's QLV filter on the elastic runs (goal RMS 3%, must 5%, largest 6% of peak |Fy|).
+    #[arg(long)]
+    pub qlv: bool,
+    /// Poses of the QLV check, comma-separated exact names (default: viscoelastic.poses).
+    #[arg(long, value_name = "NAME,...", value_delimiter = ',')]
+    pub qlv_poses: Vec<String>,
+    /// Mesh level of the QLV check's runs, viscoelastic and elastic (default: viscoelastic.mesh).
+    #[arg(long, value_name = "LEVEL")]
+    pub qlv_mesh: Option<String>,
+    /// Must points on the ramp of the QLV check's runs and load steps of the elastic ones
+    /// (default: loading.steps).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=10_000))]
+    pub qlv_steps: Option<u32>,
+    /// Solve none of the scaling, mesh-study and QLV runs: compare the results already
+    /// there and name the missing ones.
     #[arg(long)]
     pub no_solve: bool,
     /// Coarsen the flat-punch mesh by this factor (1 = the verification mesh; the goal
@@ -254,6 +276,9 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
         RunOptions { jobs, threads: a.threads.map(|t| t as usize).unwrap_or((cores / jobs).max(1)), ..spec_options(a.spec)? },
         &a.solve,
     );
+    if a.launcher == LauncherArg::Slurm && opts.visco {
+        anyhow::bail!("--visco runs locally only (--launcher local): each speed is its own campaign run");
+    }
     if a.launcher == LauncherArg::Slurm {
         let slurm = SlurmOptions {
             partition: a.partition,
@@ -268,12 +293,38 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     needle_fe::process::stop_jobs_on_termination()?;
-    let report = campaign::run(&opts)?;
-    print!("{}", report.table());
-    if needle_fe::process::interrupted() {
-        return Ok(ExitCode::from(needle_fe::process::EXIT_INTERRUPTED));
+    let mut failed = 0;
+    for opts in visco_variants(opts)? {
+        let report = campaign::run(&opts)?;
+        print!("{}", report.table());
+        if needle_fe::process::interrupted() {
+            return Ok(ExitCode::from(needle_fe::process::EXIT_INTERRUPTED));
+        }
+        failed += report.failed();
     }
-    Ok(if report.failed() > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS })
+    Ok(if failed > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+/// `opts` as it is, or with `visco`: once per speed of `[viscoelastic]`, in order.
+fn visco_variants(opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
+    if !opts.visco {
+        return Ok(vec![opts]);
+    }
+    let (c, path) = needle_fe::spec::load(&opts.set_dir)?;
+    let v = c.viscoelastic.clone().ok_or_else(|| anyhow::anyhow!("{}: --visco: the spec has no [viscoelastic] section", path.display()))?;
+    // the speeds with a run that --only selects (a speed without one is no error)
+    let selects = |speed: f64| -> bool {
+        let (_, runs) = needle_fe::visco::apply(&c, &v, speed, c.loading.steps);
+        needle_fe::spec::select(&runs, opts.only.as_deref()).is_ok_and(|r| !r.is_empty())
+    };
+    let speeds: Vec<f64> = v.speeds_mm_per_s.iter().copied().filter(|&s| selects(s)).collect();
+    if speeds.is_empty() {
+        anyhow::bail!(
+            "--visco --only {:?}: matches no run (names: <pose>_<speed>mm-s, e.g. centre_10mm-s)",
+            opts.only.as_deref().unwrap_or("")
+        );
+    }
+    Ok(speeds.into_iter().map(|s| RunOptions { visco_speed_mm_per_s: Some(s), ..opts.clone() }).collect())
 }
 
 /// What `needle fe run --launcher slurm` prints.
@@ -303,7 +354,13 @@ fn submit_summary(r: &slurm::SubmitReport) -> String {
 }
 
 fn run_status(a: StatusArgs) -> anyhow::Result<ExitCode> {
-    let plan = campaign::plan(&spec_options(a.spec)?)?;
+    let variants = visco_variants(spec_options(a.spec)?)?;
+    for extra in variants.iter().skip(1) {
+        let plan = campaign::plan(extra)?;
+        print!("{}", needle_fe::launcher::status::status(&plan)?.table());
+    }
+    let Some(first) = variants.first() else { return Ok(ExitCode::SUCCESS) };
+    let plan = campaign::plan(first)?;
     let r = needle_fe::launcher::status::status(&plan)?;
     print!("{}", r.table());
     print!("{}", needle_fe::launcher::status::attempts_by_class(&plan));
@@ -330,6 +387,7 @@ fn spec_options(spec: SpecArgs) -> anyhow::Result<RunOptions> {
         steps: spec.steps,
         out_dir: spec.out,
         deep: spec.deep,
+        visco: spec.visco,
         ..RunOptions::new(spec.set)
     })
 }
@@ -353,6 +411,28 @@ fn run_one(a: RunOneArgs) -> anyhow::Result<ExitCode> {
 fn run_verify(a: VerifyArgs) -> anyhow::Result<ExitCode> {
     if !(a.punch_mesh_scale.is_finite() && a.punch_mesh_scale >= 1.0) {
         anyhow::bail!("--punch-mesh-scale {}: must be a number >= 1", a.punch_mesh_scale);
+    }
+    if a.qlv && !(a.punch || a.mesh || a.mirror || a.smooth || a.scaling) {
+        // the QLV check alone (it is not part of the default five: its runs are the
+        // viscoelastic campaign's, `needle fe run --visco`)
+        needle_fe::process::stop_jobs_on_termination()?;
+        let threads = a.threads.map(|t| t as usize).unwrap_or(1);
+        let opts = needle_fe::verify::qlv::QlvOptions {
+            set_dir: a.set.clone(),
+            steps: a.qlv_steps,
+            mesh: a.qlv_mesh.clone(),
+            poses: a.qlv_poses.clone(),
+            threads,
+            solve: !a.no_solve,
+        };
+        let ok = crate::fe_qlv::check(&opts)?;
+        if !ok {
+            eprintln!("needle fe verify --qlv: a run missed its bound or has no comparison");
+        }
+        return Ok(if ok { ExitCode::SUCCESS } else { ExitCode::from(1) });
+    }
+    if a.qlv {
+        anyhow::bail!("--qlv runs alone (not with --punch, --mesh, --mirror, --smooth, --scaling)");
     }
     let all = !(a.punch || a.mesh || a.mirror || a.smooth || a.scaling);
     let threads = a.threads.map(|t| t as usize).unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));

@@ -83,12 +83,25 @@ fn size_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
     banner("needle firmware size", &set)?;
     println!("model form: {} (its goals below)", goals.form);
     println!(
-        "release profile; f32: `no_panic` example ELF, fixed: `no_panic_fixed`, insertion: `no_panic_insertion` (model, depth extension, insertion, stacks, loop); text/data/bss from size -B, tables = .rodata, symbols from nm -S -C\n"
+        "release profile; f32: `no_panic` example ELF, fixed: `no_panic_fixed`, insertion: `no_panic_insertion` (model, depth extension, insertion, stacks, loop), fixed-insertion: `no_panic_fixed_insertion`, built without optional features; +qlv: the same with the `viscoelastic` feature; text/data/bss from size -B, tables = .rodata, symbols from nm -S -C\n"
     );
     print!("{}", size::table(&reports));
     println!();
     for r in &reports {
-        let limit = if r.evaluator == "insertion" { INSERTION_FLASH_BYTES } else { goals.model_flash_bytes };
+        if let Some(elastic) = r.evaluator.strip_suffix("+qlv") {
+            let base = reports.iter().find(|b| b.core.core == r.core.core && b.evaluator == elastic);
+            let extra = base.map_or_else(|| "?".to_string(), |b| size::bytes(r.model_flash().saturating_sub(b.model_flash())));
+            println!(
+                "{} {}: model flash {} (the viscoelastic filter: {extra} over `{elastic}`; no flash goal); static RAM {} B == 0: {}",
+                r.core.core,
+                r.evaluator,
+                size::bytes(r.model_flash()),
+                r.static_ram(),
+                goal(r.static_ram() == 0)
+            );
+            continue;
+        }
+        let limit = if r.evaluator.ends_with("insertion") { INSERTION_FLASH_BYTES } else { goals.model_flash_bytes };
         println!(
             "goals {} {}: model flash {} <= {} KiB: {}; static RAM {} B == 0: {}",
             r.core.core,
@@ -103,7 +116,8 @@ fn size_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Flash of the model with the whole insertion (issue 41): the `insertion` row.
+/// Flash of the model with the whole insertion (issue 41): the `insertion` and
+/// `fixed-insertion` rows (the elastic build: the viscoelastic filter is a feature).
 const INSERTION_FLASH_BYTES: u64 = 24 * 1024;
 
 /// Stack of one insertion step (issue 41), beside the evaluators' 512 B.
@@ -111,6 +125,9 @@ const INSERTION_STACK_BYTES: u64 = 1024;
 
 /// Instructions of one fixed-point insertion step on the Cortex-M0 (issue 41).
 const INSERTION_FIXED_M0_INSTRUCTIONS: f64 = 20_000.0;
+/// Extra instructions of the viscoelastic filter per f32 insertion step on the
+/// Cortex-M4F, three Prony terms on all six components (issue 39).
+const QLV_M4F_EXTRA_INSTRUCTIONS: f64 = 120.0;
 
 /// The firmware goals of a model form: f32 instructions per wrench on the M4F, fixed-point
 /// instructions on the M0, model flash (paper form: issues 4 and 5; coupled form: issue 16).
@@ -154,7 +171,7 @@ fn bench_cmd(a: &FirmwareArgs) -> anyhow::Result<ExitCode> {
 fn print_core_goals(f: &bench::CoreFigures, goals: &Goals) {
     let Some(t) = f.pose("typical", "f32") else { return };
     // the evaluators' stack goal (512 B); the insertion step has its own (issue 41: 1 KiB)
-    let is_insertion = |e: &str| e == "insertion" || e == "fixed-insertion";
+    let is_insertion = |e: &str| e.starts_with("insertion") || e.starts_with("fixed-insertion");
     let max_stack = f.poses.iter().filter(|p| !is_insertion(&p.evaluator)).map(|p| p.stack_bytes).max().unwrap_or(0);
     let insertion_stack = f.poses.iter().filter(|p| is_insertion(&p.evaluator)).map(|p| p.stack_bytes).max();
     let instr_goal = if f.core.name == "m4f" {
@@ -218,6 +235,30 @@ fn print_insertion_goals(f: &bench::CoreFigures, insertion_stack: Option<u64>) {
         let ratio = insertion_f32.map(|t| format!(", {:.2}x the f32 insertion's speed", t / worst)).unwrap_or_default();
         println!(
             "fixed-point insertion {}: {worst:.1} instructions per step (most of every stack's surface and deep tick){ratio}{m0_goal}",
+            f.core.core
+        );
+    }
+    print_filter_cost(f);
+}
+
+/// The viscoelastic filter's cost: the most, over every stack's surface and deep tick, of
+/// the step with three Prony terms on every layer (`+qlv`) less the step without.
+fn print_filter_cost(f: &bench::CoreFigures) {
+    for (plain, filtered) in [("insertion", "insertion+qlv"), ("fixed-insertion", "fixed-insertion+qlv")] {
+        let extra = f
+            .poses
+            .iter()
+            .filter(|p| p.evaluator == filtered)
+            .filter_map(|q| f.pose(&q.pose, plain).map(|p| q.instructions - p.instructions))
+            .reduce(f64::max);
+        let Some(extra) = extra else { continue };
+        let m4f_goal = if f.core.name == "m4f" && plain == "insertion" {
+            format!("; <= {QLV_M4F_EXTRA_INSTRUCTIONS} on the M4F: {}", goal(extra <= QLV_M4F_EXTRA_INSTRUCTIONS))
+        } else {
+            String::new()
+        };
+        println!(
+            "viscoelastic filter {} ({plain}): {extra:.1} extra instructions per step at most (3 Prony terms, 6 components){m4f_goal}",
             f.core.core
         );
     }

@@ -94,6 +94,7 @@ pub fn fit(a: FitArgs) -> Result<ExitCode> {
     let coupled = fit::coupled_report::measure(&a.set)
         .with_context(|| format!("needle fit --set {}: measuring the coupled form", a.set.display()))?;
     print!("{}", fit::coupled_report::to_table(&coupled));
+    print!("{}", fit::unsolved::summary(&out.unsolved));
     for (path, text) in &files {
         if path.extension().is_some_and(|e| e == "csv") {
             println!("wrote {} ({} poses)", path.display(), text.lines().count().saturating_sub(1));

@@ -1,6 +1,6 @@
 //! The fixed-point evaluator's error against the f64 evaluation of the same model,
 //! measured: the library's [`needle_haptics::fixed::wrench`] against the fitter's
-//! [`needle_fit::eval_f64`] on the f64 coefficients of the set's `model.toml`, at the same
+//! [`needle_fit::eval::float64`] on the f64 coefficients of the set's `model.toml`, at the same
 //! Q16.16 poses (exact in f64), beside the bound the code generator derived
 //! ([`needle_haptics::fixed::tables::ERROR_BOUND_MICRO`]).
 //!
@@ -11,7 +11,7 @@
 use anyhow::{Context, Result};
 use needle_contract::COMPONENT_COUNT;
 use needle_fit::contract::{unit, COMPONENTS};
-use needle_fit::{eval_f64, model::Model, model_file, MODEL_FILE};
+use needle_fit::{eval::float64 as eval_f64, model::Model, model_file, MODEL_FILE};
 use needle_haptics::fixed::{self, tables::ERROR_BOUND_MICRO};
 use std::fmt::Write as _;
 use std::path::Path;

@@ -57,7 +57,8 @@ pub struct HeaderArgs {
 }
 
 /// Checks that the set folder `dir` is the one compiled into the library: same
-/// `fe_sha256` and the same f32 coefficient bits as its `model.toml`.
+/// `fe_sha256` and the same f32 coefficient bits as its `model.toml`, and the same
+/// unsolved region (`unsolved.toml`, or none).
 ///
 /// # Errors
 /// The library has no fitted model, `dir` has no valid model.toml, or it is another set
@@ -100,6 +101,20 @@ pub fn check_compiled_set(dir: &Path) -> anyhow::Result<()> {
         .all(|(a, b)| same_bits(a, b));
     if !(base_same && dev_same) {
         bail!("{} has other coefficients than the compiled-in model (same FE data, refitted?): {built}; {rebuild}", model_path.display());
+    }
+    // the unsolved region beside it (FE_UNSOLVED): the compiled-in one, or none for both
+    let region_path = dir.join(needle_codegen::unsolved::FILE);
+    let region = if region_path.is_file() {
+        needle_codegen::unsolved::parse(&region_path).map_err(anyhow::Error::new)?
+    } else {
+        needle_codegen::unsolved::Region::default()
+    };
+    if needle_codegen::unsolved::render(&region) != model_info::UNSOLVED_RS {
+        bail!(
+            "{} is another unsolved region than the compiled-in one ({} balls compiled in; refitted after new FE records?): {built}; {rebuild}",
+            region_path.display(),
+            model_info::UNSOLVED_BALLS
+        );
     }
     Ok(())
 }
@@ -176,6 +191,7 @@ pub fn eval_json(pose: &Pose, e: &Evaluation) -> serde_json::Value {
             "flags": status_names(e.status),
             "ok": e.status.is_ok(),
             "saturated": e.status.saturated(),
+            "fe_unsolved": e.status.fe_unsolved(),
             "error": e.status.is_error(),
         },
     })
@@ -227,7 +243,12 @@ pub fn eval(a: EvalArgs) -> anyhow::Result<ExitCode> {
         } else {
             "in the domain"
         };
-        println!("status  = {:#04x} ({}): {meaning}", e.status.bits(), e.status);
+        let unsolved = if e.status.fe_unsolved() {
+            "; FE_UNSOLVED: the pose lies where the set's FE campaign could not solve (unsolved.toml), the wrench is the model's extrapolation"
+        } else {
+            ""
+        };
+        println!("status  = {:#04x} ({}): {meaning}{unsolved}", e.status.bits(), e.status);
     }
     Ok(if e.status.is_error() { ExitCode::from(1) } else { ExitCode::SUCCESS })
 }

@@ -138,12 +138,14 @@ async fn explorer_page_shows_what_needle_eval_computes() {
     let shots = workspace_root().join("target/explore");
     std::fs::create_dir_all(&shots).expect("screenshot folder");
 
-    // a pose inside the domain, an FE run's of the set (x+04: its FE points overlaid), and
-    // one whose x is beyond the domain (clamped, SAT_X)
-    let cases: [(&str, [(&str, &str); 5]); 3] = [
+    // a pose inside the domain, an FE run's of the set (x+04: its FE points overlaid), one
+    // whose x is beyond the domain (clamped, SAT_X), and tx+15's, which the FE could not
+    // solve (FE_UNSOLVED: the note shows)
+    let cases: [(&str, [(&str, &str); 5]); 4] = [
         ("inside", [("x_mm", "2"), ("z_mm", "1"), ("theta_x_deg", "3"), ("theta_z_deg", "-4.5"), ("depth_mm", "5")]),
         ("fe-run", [("x_mm", "4"), ("z_mm", "0"), ("theta_x_deg", "0"), ("theta_z_deg", "0"), ("depth_mm", "4.2")]),
         ("saturated", [("x_mm", "14"), ("z_mm", "-3"), ("theta_x_deg", "-7"), ("theta_z_deg", "11"), ("depth_mm", "2.5")]),
+        ("unsolved", [("x_mm", "0"), ("z_mm", "0"), ("theta_x_deg", "15"), ("theta_z_deg", "0"), ("depth_mm", "4")]),
     ];
     for (case, pose) in &cases {
         for (name, v) in pose {
@@ -157,11 +159,14 @@ async fn explorer_page_shows_what_needle_eval_computes() {
         assert_eq!(command, format!("needle eval --set coeffs/default {}", args.join(" ")), "{case}: copy-as-command text");
         let note = c.find(Locator::Id("fe-note")).await.expect("FE note").text().await.expect("text");
         assert_eq!(note.contains("FE run x+04"), *case == "fe-run", "{case}: FE overlay note {note:?}");
+        let unsolved = c.find(Locator::Id("unsolved-note")).await.expect("unsolved note").is_displayed().await.expect("displayed");
+        assert_eq!(unsolved, want_status & 0x20 != 0, "{case}: the FE_UNSOLVED note shows exactly when the status has it");
         let png = c.screenshot().await.expect("screenshot");
         std::fs::write(shots.join(format!("explorer-{case}.png")), png).expect("save screenshot");
         println!("{case}: page = needle eval at {pose:?}: status {want_status:#04x}, bits {want_bits:?}");
     }
     assert_eq!(needle_eval(&cases[2].1).1 & 0x01, 0x01, "the saturated case must raise SAT_X");
+    assert_eq!(needle_eval(&cases[3].1).1, 0x20, "the unsolved case must raise FE_UNSOLVED alone");
 
     // the depth slider: End moves it to the domain's end, the number field follows, and
     // the numbers equal needle eval at depth 6 mm

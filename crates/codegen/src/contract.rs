@@ -8,7 +8,7 @@ pub use needle_contract::{
 };
 
 /// Status bits of the evaluation (name, value), as in the library's `Status`.
-pub const STATUS_BITS: [(&str, u8); 8] = needle_contract::status::NAMES;
+pub const STATUS_BITS: [(&str, u8); 9] = needle_contract::status::NAMES;
 
 /// `"fx_n .. mz_nmm"`: the first and the last component's names, for messages and
 /// generated comments.

@@ -204,99 +204,126 @@ fn rate_bounds(
 /// the matrix (or baseline), its line in `model_path` and the bound that is exceeded.
 pub fn fixed_formats(model: &Model, model_path: &Path) -> Result<FixedTables, CodegenError> {
     let at = |line: usize, message: String| CodegenError { path: model_path.to_path_buf(), line: (line > 0).then_some(line), message };
-    let zero_row = FixedRow { coeffs: [0; TERMS], frac_bits: 0, bound: 0 };
     let mut components = Vec::with_capacity(COMPONENT_COUNT);
     for (c, base) in model.baseline.iter().enumerate() {
-        let mut rows = [[zero_row; TERMS]; 4];
-        for m in model.matrices.iter().filter(|m| m.component == c) {
-            for (i, row) in m.rows.iter().enumerate() {
-                rows[m.sweep][i] = choose_row(row).ok_or_else(|| {
-                    let sum: f64 = row.iter().map(|v| v.abs()).sum();
-                    at(
-                        m.line,
-                        format!(
-                            "matrix {}/{}: row u^{i} does not fit the fixed-point evaluator: sum_j |rows[{i}][j]| = {sum:e} {}, which is {:.0} micro-units even with 0 fractional bits; every integer intermediate is limited to 2^30 = {LIMIT} micro-units (1073.7 N or N*mm)",
-                            SWEEPS[m.sweep],
-                            COMPONENTS[c],
-                            crate::contract::UNITS[c],
-                            sum * OUTPUT_SCALE
-                        ),
-                    )
-                })?;
-            }
-        }
-        let mut cross = Vec::new();
-        for t in model.cross.iter().filter(|t| t.component == c) {
-            let (frac_bits, coeffs) = choose_cross(&t.coeffs).ok_or_else(|| {
-                at(
-                    t.line,
-                    format!(
-                        "cross {} {:?}: a coefficient does not fit the fixed-point evaluator: |coeffs| up to {:e} {}, over 2^30 = {LIMIT} micro-units even with 0 fractional bits",
-                        COMPONENTS[c],
-                        t.exponents,
-                        t.coeffs.iter().map(|v| v.abs()).fold(0.0, f64::max),
-                        crate::contract::UNITS[c]
-                    ),
-                )
-            })?;
-            cross.push(FixedCross { exponents: t.exponents, coeffs, frac_bits, shift: 0, line: t.line });
-        }
-        let max_g = rows.iter().flatten().map(|r| r.frac_bits).chain(cross.iter().map(|x| x.frac_bits)).min().unwrap_or(MAX_FRAC_BITS);
-        let chosen = (0..=max_g).rev().find_map(|g| {
-            let (a, total, baseline) = component_bounds(&rows, &cross, &base.coeffs, g);
-            (total <= LIMIT).then_some((g, a, total, baseline))
-        });
-        let Some((g, a_bounds, horner_bound, baseline)) = chosen else {
-            let (_, total, _) = component_bounds(&rows, &cross, &base.coeffs, 0);
-            return Err(at(
-                base.line,
-                format!(
-                    "baseline {0}: component {0} does not fit the fixed-point evaluator: the baseline plus the four deviations (matrices x/{0} .. theta_z/{0}) and its cross terms can reach {total} micro-units ({1}) in the domain even with 0 fractional bits, over the limit 2^30 = {LIMIT} of every integer intermediate",
-                    COMPONENTS[c],
-                    crate::contract::UNITS[c]
-                ),
-            ));
-        };
-        let shifts = rows.map(|r| r.map(|row| row.frac_bits - g));
-        for x in &mut cross {
-            x.shift = x.frac_bits - g;
-        }
-        let rate_shift = g.min(MAX_RATE_SHIFT);
-        let [rows_x, rows_z, _, _] = &rows;
-        let rate_of = |rows: &[FixedRow; TERMS]| -> Option<[[i32; DEGREE]; TERMS]> {
-            let r: Vec<[i32; DEGREE]> = rows.iter().map(|row| rate_row(&row.coeffs, rate_shift)).collect::<Option<_>>()?;
-            r.try_into().ok()
-        };
-        let rate_rows = rate_of(rows_x).zip(rate_of(rows_z)).map(|(x, z)| [x, z]);
-        let rate_bounds = rate_rows.map(|rr| rate_bounds(&a_bounds, rate_shift, &rr, &shifts, &cross));
-        let (Some(rate_rows), Some(rate_bounds)) = (rate_rows, rate_bounds.filter(|b| b.iter().all(|v| *v <= LIMIT))) else {
-            return Err(at(
-                base.line,
-                format!(
-                    "baseline {0}: component {0} does not fit the fixed-point stiffness: with accumulator format Q{g} and coefficient shift {rate_shift}, a rate row or a Horner bound of its rates by depth, x, z {rate_bounds:?} exceeds the limit 2^30 = {LIMIT} micro-units ({1})",
-                    COMPONENTS[c],
-                    crate::contract::UNITS[c]
-                ),
-            ));
-        };
-        let comp = FixedComponent {
-            rows,
-            shifts,
-            baseline: baseline.map(|v| v as i32),
-            frac_bits: g,
-            a_bounds,
-            horner_bound,
-            error_bound: ErrorBound::default(),
-            cross,
-            rate_shift,
-            rate_rows,
-            rate_bounds,
-        };
-        components.push(comp);
+        let rows = fixed_rows(model, c, &at)?;
+        let cross = fixed_cross(model, c, &at)?;
+        components.push(fixed_component(c, rows, cross, base, &at)?);
     }
     let components: [FixedComponent; COMPONENT_COUNT] =
         components.try_into().map_err(|_| at(0, format!("the model does not have {COMPONENT_COUNT} components")))?;
     Ok(FixedTables { components })
+}
+
+/// `CodegenError` at a line of model.toml (0: the file).
+type At<'p> = dyn Fn(usize, String) -> CodegenError + 'p;
+
+/// Component `c`'s row polynomials `[sweep][i]`, each in its own format.
+fn fixed_rows(model: &Model, c: usize, at: &At<'_>) -> Result<[[FixedRow; TERMS]; 4], CodegenError> {
+    let zero_row = FixedRow { coeffs: [0; TERMS], frac_bits: 0, bound: 0 };
+    let mut rows = [[zero_row; TERMS]; 4];
+    for m in model.matrices.iter().filter(|m| m.component == c) {
+        for (i, row) in m.rows.iter().enumerate() {
+            rows[m.sweep][i] = choose_row(row).ok_or_else(|| {
+                let sum: f64 = row.iter().map(|v| v.abs()).sum();
+                at(
+                    m.line,
+                    format!(
+                        "matrix {}/{}: row u^{i} does not fit the fixed-point evaluator: sum_j |rows[{i}][j]| = {sum:e} {}, which is {:.0} micro-units even with 0 fractional bits; every integer intermediate is limited to 2^30 = {LIMIT} micro-units (1073.7 N or N*mm)",
+                        SWEEPS[m.sweep],
+                        COMPONENTS[c],
+                        crate::contract::UNITS[c],
+                        sum * OUTPUT_SCALE
+                    ),
+                )
+            })?;
+        }
+    }
+    Ok(rows)
+}
+
+/// Component `c`'s cross terms, each in its own format (shift set by [`fixed_component`]).
+fn fixed_cross(model: &Model, c: usize, at: &At<'_>) -> Result<Vec<FixedCross>, CodegenError> {
+    let mut cross = Vec::new();
+    for t in model.cross.iter().filter(|t| t.component == c) {
+        let (frac_bits, coeffs) = choose_cross(&t.coeffs).ok_or_else(|| {
+            at(
+                t.line,
+                format!(
+                    "cross {} {:?}: a coefficient does not fit the fixed-point evaluator: |coeffs| up to {:e} {}, over 2^30 = {LIMIT} micro-units even with 0 fractional bits",
+                    COMPONENTS[c],
+                    t.exponents,
+                    t.coeffs.iter().map(|v| v.abs()).fold(0.0, f64::max),
+                    crate::contract::UNITS[c]
+                ),
+            )
+        })?;
+        cross.push(FixedCross { exponents: t.exponents, coeffs, frac_bits, shift: 0, line: t.line });
+    }
+    Ok(cross)
+}
+
+/// Component `c` with the largest accumulator format its bounds allow, the alignment
+/// shifts and the stiffness's rate rows.
+fn fixed_component(
+    c: usize,
+    rows: [[FixedRow; TERMS]; 4],
+    mut cross: Vec<FixedCross>,
+    base: &crate::model::Baseline,
+    at: &At<'_>,
+) -> Result<FixedComponent, CodegenError> {
+    let max_g = rows.iter().flatten().map(|r| r.frac_bits).chain(cross.iter().map(|x| x.frac_bits)).min().unwrap_or(MAX_FRAC_BITS);
+    let chosen = (0..=max_g).rev().find_map(|g| {
+        let (a, total, baseline) = component_bounds(&rows, &cross, &base.coeffs, g);
+        (total <= LIMIT).then_some((g, a, total, baseline))
+    });
+    let Some((g, a_bounds, horner_bound, baseline)) = chosen else {
+        let (_, total, _) = component_bounds(&rows, &cross, &base.coeffs, 0);
+        return Err(at(
+            base.line,
+            format!(
+                "baseline {0}: component {0} does not fit the fixed-point evaluator: the baseline plus the four deviations (matrices x/{0} .. theta_z/{0}) and its cross terms can reach {total} micro-units ({1}) in the domain even with 0 fractional bits, over the limit 2^30 = {LIMIT} of every integer intermediate",
+                COMPONENTS[c],
+                crate::contract::UNITS[c]
+            ),
+        ));
+    };
+    let shifts = rows.map(|r| r.map(|row| row.frac_bits - g));
+    for x in &mut cross {
+        x.shift = x.frac_bits - g;
+    }
+    let rate_shift = g.min(MAX_RATE_SHIFT);
+    let [rows_x, rows_z, _, _] = &rows;
+    let rate_of = |rows: &[FixedRow; TERMS]| -> Option<[[i32; DEGREE]; TERMS]> {
+        let r: Vec<[i32; DEGREE]> = rows.iter().map(|row| rate_row(&row.coeffs, rate_shift)).collect::<Option<_>>()?;
+        r.try_into().ok()
+    };
+    let rate_rows = rate_of(rows_x).zip(rate_of(rows_z)).map(|(x, z)| [x, z]);
+    let rate_bounds = rate_rows.map(|rr| rate_bounds(&a_bounds, rate_shift, &rr, &shifts, &cross));
+    let (Some(rate_rows), Some(rate_bounds)) = (rate_rows, rate_bounds.filter(|b| b.iter().all(|v| *v <= LIMIT))) else {
+        return Err(at(
+            base.line,
+            format!(
+                "baseline {0}: component {0} does not fit the fixed-point stiffness: with accumulator format Q{g} and coefficient shift {rate_shift}, a rate row or a Horner bound of its rates by depth, x, z {rate_bounds:?} exceeds the limit 2^30 = {LIMIT} micro-units ({1})",
+                COMPONENTS[c],
+                crate::contract::UNITS[c]
+            ),
+        ));
+    };
+    let comp = FixedComponent {
+        rows,
+        shifts,
+        baseline: baseline.map(|v| v as i32),
+        frac_bits: g,
+        a_bounds,
+        horner_bound,
+        error_bound: ErrorBound::default(),
+        cross,
+        rate_shift,
+        rate_rows,
+        rate_bounds,
+    };
+    Ok(comp)
 }
 
 /// The error bound of one component, term by term, in micro-units (µN or µN·mm).

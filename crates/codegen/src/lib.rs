@@ -13,7 +13,9 @@
 //!   (`cross_fixed.rs`) the same in fixed point;
 //! - [`RUST_FIXED_TABLES_FILE`] (`tables_fixed.rs`): the fixed-point tables ([`fixed`]):
 //!   Q formats chosen from the coefficients so that no integer intermediate can overflow,
-//!   the integer coefficients, and the derived error bound against f64.
+//!   the integer coefficients, and the derived error bound against f64;
+//! - [`unsolved::RUST_FILE`] (`unsolved.rs`): the set's unsolved region (`unsolved.toml`
+//!   beside `model.toml`, optional), see [`unsolved`].
 //!
 //! Every refusal is a [`CodegenError`] naming the file and the line (`path:line: what is
 //! wrong`). It is a library, so the checks are testable without running cargo.
@@ -31,6 +33,7 @@ mod render;
 mod render_cross;
 mod render_fixed;
 pub mod tissue;
+pub mod unsolved;
 
 pub use error::{line_of, CodegenError};
 pub use fixed::FixedTables;
@@ -73,23 +76,31 @@ pub struct Generated {
     pub rust_cross: String,
     /// Text of `cross_fixed.rs`.
     pub rust_cross_fixed: String,
+    /// The unsolved region (empty without `unsolved.toml`).
+    pub unsolved: unsolved::Region,
+    /// Text of `unsolved.rs`.
+    pub rust_unsolved: String,
     /// Where `tables_f32.rs` was written.
     pub rust_path: PathBuf,
     /// Where `needle_coeffs.h` was written.
     pub c_header_path: PathBuf,
 }
 
-/// Validates the model at `model_path` and writes [`RUST_TABLES_FILE`],
-/// [`C_HEADER_FILE`] and [`RUST_FIXED_TABLES_FILE`] into `out_dir` (which must exist). A
-/// file whose contents would not change is not rewritten.
+/// Validates the model at `model_path` and the unsolved region beside it
+/// ([`unsolved::FILE`], when present) and writes [`RUST_TABLES_FILE`], [`C_HEADER_FILE`],
+/// [`RUST_FIXED_TABLES_FILE`], the cross terms and [`unsolved::RUST_FILE`] into `out_dir`
+/// (which must exist). A file whose contents would not change is not rewritten.
 ///
 /// # Errors
 /// The model file is unreadable, is not valid TOML or departs from the contract (the
 /// error has its line), a matrix or component does not fit the fixed-point evaluator
-/// ([`fixed_tables`]), or an output file cannot be written.
+/// ([`fixed_tables`]), the unsolved region is refused ([`unsolved::parse`]), or an output
+/// file cannot be written.
 pub fn generate(model_path: &Path, out_dir: &Path) -> Result<Generated, CodegenError> {
     let model = parse_model(model_path)?;
-    write_all(model, model_path, out_dir)
+    let region_path = model_path.with_file_name(unsolved::FILE);
+    let region = if region_path.is_file() { unsolved::parse(&region_path)? } else { unsolved::Region::default() };
+    write_all(model, region, model_path, out_dir)
 }
 
 /// Writes the placeholder tables of a set that has no `model.toml` yet: every table is
@@ -99,13 +110,14 @@ pub fn generate(model_path: &Path, out_dir: &Path) -> Result<Generated, CodegenE
 /// # Errors
 /// An output file cannot be written.
 pub fn generate_unfitted(set: &str, out_dir: &Path) -> Result<Generated, CodegenError> {
-    write_all(Model::unfitted(set), Path::new(MODEL_FILE), out_dir)
+    write_all(Model::unfitted(set), unsolved::Region::default(), Path::new(MODEL_FILE), out_dir)
 }
 
-fn write_all(model: Model, model_path: &Path, out_dir: &Path) -> Result<Generated, CodegenError> {
+fn write_all(model: Model, region: unsolved::Region, model_path: &Path, out_dir: &Path) -> Result<Generated, CodegenError> {
     let fixed = fixed_tables(&model, model_path)?;
     let rust = render_rust(&model);
-    let c_header = render_c_header(&model);
+    let c_header = render::render_c_header_with(&model, &unsolved::render_c(&region));
+    let rust_unsolved = unsolved::render(&region);
     let rust_fixed = render_rust_fixed(&model, &fixed);
     let rust_cross = render_rust_cross(&model);
     let rust_cross_fixed = render_rust_cross_fixed(&model, &fixed);
@@ -116,7 +128,20 @@ fn write_all(model: Model, model_path: &Path, out_dir: &Path) -> Result<Generate
     write_if_changed(&out_dir.join(RUST_FIXED_TABLES_FILE), &rust_fixed)?;
     write_if_changed(&out_dir.join(RUST_CROSS_FILE), &rust_cross)?;
     write_if_changed(&out_dir.join(RUST_CROSS_FIXED_FILE), &rust_cross_fixed)?;
-    Ok(Generated { model, rust, c_header, fixed, rust_fixed, rust_cross, rust_cross_fixed, rust_path, c_header_path })
+    write_if_changed(&out_dir.join(unsolved::RUST_FILE), &rust_unsolved)?;
+    Ok(Generated {
+        model,
+        rust,
+        c_header,
+        fixed,
+        rust_fixed,
+        rust_cross,
+        rust_cross_fixed,
+        unsolved: region,
+        rust_unsolved,
+        rust_path,
+        c_header_path,
+    })
 }
 
 /// Checks the set's depth extension (`<set>/depth-extension.toml`, optional) and tissue

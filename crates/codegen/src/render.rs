@@ -126,10 +126,31 @@ pub fn render_rust(model: &Model) -> String {
 }
 
 /// The C header `needle_coeffs.h`: the same tables as `static const float`, the domain,
-/// the normalisation constants and the status bits.
+/// the normalisation constants and the status bits (a set without an unsolved region:
+/// [`render_c_header_with`] adds the region's part).
 pub fn render_c_header(model: &Model) -> String {
+    render_c_header_with(model, &crate::unsolved::render_c(&crate::unsolved::Region::default()))
+}
+
+/// [`render_c_header`] with `unsolved` (the region's part, `unsolved::render_c`) before
+/// the end of the header.
+pub fn render_c_header_with(model: &Model, unsolved: &str) -> String {
     let mut s = String::new();
     let w = &mut s;
+    render_c_preamble(w, model);
+    render_c_constants(w);
+    render_c_tables(w, model);
+    let _ = write!(w, "{}", crate::render_cross::render_c_cross(model));
+    let _ = writeln!(w);
+    let _ = write!(w, "{unsolved}");
+    let _ = writeln!(w);
+    let _ = writeln!(w, "#endif /* NEEDLE_COEFFS_H */");
+    s
+}
+
+/// The header's comment (the model, the evaluation algorithm), its guard, includes and
+/// the model's identity.
+fn render_c_preamble(w: &mut String, model: &Model) {
     let _ = writeln!(w, "/*");
     for line in header_lines(model, " *").lines() {
         let _ = writeln!(w, "{line}");
@@ -146,7 +167,8 @@ pub fn render_c_header(model: &Model) -> String {
     let _ = writeln!(w, " *     r_i = h(NEEDLE_DEVIATION[k][c][i], t); D_kc = h(r, u);");
     let _ = writeln!(w, " *  5. w_c = B_c, then for k = 0..3: w_c -= D_kc if v_k < 0 and NEEDLE_ODD[k][c],");
     let _ = writeln!(w, " *     else w_c += D_kc;");
-    let _ = writeln!(w, " *  6. coupled form only: the cross terms (NEEDLE_CROSS_* below).");
+    let _ = writeln!(w, " *  6. coupled form only: the cross terms (NEEDLE_CROSS_* below);");
+    let _ = writeln!(w, " *  7. the status bit NEEDLE_STATUS_FE_UNSOLVED (NEEDLE_UNSOLVED_* below).");
     let _ = writeln!(w, " */");
     let _ = writeln!(w, "#ifndef NEEDLE_COEFFS_H");
     let _ = writeln!(w, "#define NEEDLE_COEFFS_H");
@@ -159,6 +181,11 @@ pub fn render_c_header(model: &Model) -> String {
     let _ = writeln!(w, "#define NEEDLE_COEFFS_SET \"{}\"", model.set);
     let _ = writeln!(w, "#define NEEDLE_COEFFS_FE_SHA256 \"{}\"", model.fe_sha256);
     let _ = writeln!(w);
+}
+
+/// The domain, the normalisation constants, the status bits, the indices and the odd
+/// components.
+fn render_c_constants(w: &mut String) {
     let _ = writeln!(w, "/* Domain: |x|, |z| <= 12 mm, |theta_x|, |theta_z| <= 15 deg, 0 <= depth <= 6 mm. */");
     for (name, v) in [
         ("NEEDLE_X_MAX_MM", HALF_RANGES[0]),
@@ -199,6 +226,10 @@ pub fn render_c_header(model: &Model) -> String {
     }
     let _ = writeln!(w, "}};");
     let _ = writeln!(w);
+}
+
+/// The baselines and the deviation matrices.
+fn render_c_tables(w: &mut String, model: &Model) {
     let _ = writeln!(w, "/* Baselines B_c(u), [component][i]: coefficient of u^i; {DEPTH_DOMAIN}. */");
     let _ = writeln!(w, "static const float NEEDLE_BASELINE[6][{TERMS}] = {{");
     for b in &model.baseline {
@@ -245,8 +276,4 @@ pub fn render_c_header(model: &Model) -> String {
     }
     let _ = writeln!(w, "}};");
     let _ = writeln!(w);
-    let _ = write!(w, "{}", crate::render_cross::render_c_cross(model));
-    let _ = writeln!(w);
-    let _ = writeln!(w, "#endif /* NEEDLE_COEFFS_H */");
-    s
 }

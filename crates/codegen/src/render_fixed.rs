@@ -34,6 +34,15 @@ pub fn render_rust_fixed(model: &Model, t: &FixedTables) -> String {
     let _ = writeln!(w, "// and micro-newton millimetres (uN*mm).");
     let _ = writeln!(w);
 
+    render_domain(w);
+    render_formats(w, t);
+    render_tables(w, t);
+    render_rate_tables(w, t);
+    s
+}
+
+/// The domain in Q16.16, the input divisors and the odd components.
+fn render_domain(w: &mut String) {
     let q16 = |v: f64| (v * f64::from(1u32 << POSE_FRAC_BITS)) as i64;
     let domain = [
         ("X_MAX_MM_Q16", HALF_RANGES[0], "`|x_mm_q16| <= X_MAX_MM_Q16` (12 mm in Q16.16); beyond it the input saturates."),
@@ -59,6 +68,10 @@ pub fn render_rust_fixed(model: &Model, t: &FixedTables) -> String {
     }
     let _ = writeln!(w, "];");
     let _ = writeln!(w);
+}
+
+/// Each component's accumulator format and its error bound against f64.
+fn render_formats(w: &mut String, t: &FixedTables) {
     let _ = writeln!(w, "/// Fractional bits `G` of each component's accumulator (`A_i`, the Horner in `u`), contract");
     let _ = writeln!(w, "/// component order; the result is `(W + ((1 << G) >> 1)) >> G` micro-units.");
     let g: Vec<String> = t.components.iter().map(|c| c.frac_bits.to_string()).collect();
@@ -87,6 +100,10 @@ pub fn render_rust_fixed(model: &Model, t: &FixedTables) -> String {
     let _ = writeln!(w, "];");
 
     let _ = writeln!(w);
+}
+
+/// The baselines, the row polynomials and their alignment shifts.
+fn render_tables(w: &mut String, t: &FixedTables) {
     let _ = writeln!(w, "/// Baseline coefficients `[component][i]` (multiplies `u^i`), in each component's Q(G).");
     let _ = writeln!(w, "pub const BASELINE: [[i32; {TERMS}]; {COMPONENT_COUNT}] = [");
     for (c, comp) in t.components.iter().enumerate() {
@@ -131,9 +148,6 @@ pub fn render_rust_fixed(model: &Model, t: &FixedTables) -> String {
         let _ = writeln!(w, "    [{}], // {}", rows.join(", "), COMPONENTS[c]);
     }
     let _ = writeln!(w, "];");
-
-    render_rate_tables(w, t);
-    s
 }
 
 /// The fixed-point stiffness's tables (coeffs/README.md, "Fixed-point stiffness").

@@ -12,7 +12,7 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
-pub use needle_contract::{MAX_TISSUE_LAYERS as MAX_LAYERS, TISSUE_FORMAT};
+pub use needle_contract::{MAX_PRONY_TERMS, MAX_TISSUE_LAYERS as MAX_LAYERS, PRONY_G_SUM_MAX, TISSUE_FORMAT};
 /// The folder of a set that holds its tissue stacks.
 pub const TISSUE_DIR: &str = "tissue";
 /// File name of the generated stacks in the output folder.
@@ -46,6 +46,24 @@ pub struct Layer {
     pub track_stiffness_n_per_mm2: f64,
     /// Where the values come from (a citation, or the `needle calibrate` run).
     pub source: String,
+    /// The relaxation function's Prony terms (0 to [`MAX_PRONY_TERMS`]; none: elastic), in
+    /// the long-term normalisation `G(t) = 1 + sum g_i exp(-t / tau_i)`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub prony: Vec<PronyTerm>,
+    /// Where the Prony terms come from (a citation; required with terms), or why the
+    /// layer has none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub prony_source: Option<String>,
+}
+
+/// One Prony term of a layer's relaxation function (long-term normalisation).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PronyTerm {
+    /// Weight relative to the long-term response (>= 0).
+    pub g: f64,
+    /// Time constant, s (> 0).
+    pub tau_s: f64,
 }
 
 /// A stack as read from its file.
@@ -91,6 +109,15 @@ struct RawLayer {
     stick_band_mm_per_s: Spanned<f64>,
     track_stiffness_n_per_mm2: Spanned<f64>,
     source: String,
+    prony: Option<Spanned<Vec<Spanned<RawProny>>>>,
+    prony_source: Option<Spanned<String>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawProny {
+    g: Spanned<f64>,
+    tau_s: Spanned<f64>,
 }
 
 /// What a value must be.
@@ -151,7 +178,22 @@ pub fn parse_stack_str(text: &str, path: &Path) -> Result<Stack, CodegenError> {
 
 fn layer(l: RawLayer, err: &dyn Fn(Range<usize>, String) -> CodegenError) -> Result<Layer, CodegenError> {
     use Bound::{NonNegative, Positive};
+    let (prony, prony_span) = match l.prony {
+        None => (Vec::new(), l.thickness_mm.span()),
+        Some(p) => {
+            let span = p.span();
+            (prony(p, err)?, span)
+        }
+    };
+    if !prony.is_empty() && l.prony_source.as_ref().is_none_or(|s| s.get_ref().trim().is_empty()) {
+        return Err(err(
+            prony_span,
+            format!("layer {:?}: prony terms need prony_source = \"the published measurement they come from\"", l.name),
+        ));
+    }
     Ok(Layer {
+        prony,
+        prony_source: l.prony_source.map(Spanned::into_inner),
         thickness_mm: check(&l.thickness_mm, "thickness_mm", Positive, err)?,
         stiffness_scale: check(&l.stiffness_scale, "stiffness_scale", Positive, err)?,
         puncture_force_n: check(&l.puncture_force_n, "puncture_force_n", Positive, err)?,
@@ -164,6 +206,35 @@ fn layer(l: RawLayer, err: &dyn Fn(Range<usize>, String) -> CodegenError) -> Res
         name: l.name,
         source: l.source,
     })
+}
+
+/// The Prony terms: at most [`MAX_PRONY_TERMS`], each `g >= 0` and `tau_s > 0`, the sum
+/// of `g` at most [`PRONY_G_SUM_MAX`] (the checks of the library's `PronyTerms::new`).
+fn prony(p: Spanned<Vec<Spanned<RawProny>>>, err: &dyn Fn(Range<usize>, String) -> CodegenError) -> Result<Vec<PronyTerm>, CodegenError> {
+    let span = p.span();
+    let terms = p.into_inner();
+    if terms.len() > MAX_PRONY_TERMS {
+        return Err(err(span, format!("{} prony terms: a layer has at most {MAX_PRONY_TERMS}", terms.len())));
+    }
+    let mut out = Vec::with_capacity(terms.len());
+    for t in terms {
+        let t = t.into_inner();
+        let g = check(&t.g, "prony g", Bound::NonNegative, err)?;
+        let tau_s = check(&t.tau_s, "prony tau_s", Bound::Positive, err)?;
+        out.push(PronyTerm { g, tau_s });
+    }
+    // the library checks the sum of the f32 weights: so does the build
+    #[allow(clippy::cast_possible_truncation)]
+    let sum: f64 = out.iter().map(|t| f64::from(t.g as f32)).sum();
+    if sum > PRONY_G_SUM_MAX {
+        return Err(err(
+            span,
+            format!(
+                "prony: sum of g = {sum}: must be <= {PRONY_G_SUM_MAX} (long-term normalisation; instantaneous at most 10 times long-term)"
+            ),
+        ));
+    }
+    Ok(out)
 }
 
 /// The value, if it is finite, within f32's range and inside `bound`.
@@ -296,7 +367,7 @@ pub fn render_rust_stacks(stacks: &[(PathBuf, Stack)], needle: Option<FeNeedle>)
         out.push_str(&format!("    name: {:?},\n    needle_diameter_mm: {},\n    layers: &[\n", s.name, lit(s.needle_diameter_mm)));
         for l in &s.layers {
             out.push_str(&format!(
-                "        Layer {{ thickness_mm: {}, stiffness_scale: {}, puncture_force_n: {}, cutting_force_n: {}, friction: Karnopp {{ static_n_per_mm: {}, coulomb_n_per_mm: {}, viscous_n_s_per_mm2: {}, stick_band_mm_per_s: {} }}, track_stiffness_n_per_mm2: {} }}, // {}\n",
+                "        Layer {{ thickness_mm: {}, stiffness_scale: {}, puncture_force_n: {}, cutting_force_n: {}, friction: Karnopp {{ static_n_per_mm: {}, coulomb_n_per_mm: {}, viscous_n_s_per_mm2: {}, stick_band_mm_per_s: {} }}, track_stiffness_n_per_mm2: {}, prony: {} }}, // {}\n",
                 lit(l.thickness_mm),
                 lit(l.stiffness_scale),
                 lit(l.puncture_force_n),
@@ -306,6 +377,7 @@ pub fn render_rust_stacks(stacks: &[(PathBuf, Stack)], needle: Option<FeNeedle>)
                 lit(l.friction_viscous_n_s_per_mm2),
                 lit(l.stick_band_mm_per_s),
                 lit(l.track_stiffness_n_per_mm2),
+                render_prony(&l.prony),
                 l.name.replace('\n', " ")
             ));
         }
@@ -318,6 +390,22 @@ pub fn render_rust_stacks(stacks: &[(PathBuf, Stack)], needle: Option<FeNeedle>)
         names.join(", ")
     ));
     out
+}
+
+/// A layer's terms as a `PronyTerms` constant expression (checked again at compile time
+/// by the library's `PronyTerms::from_array`, which this build's checks match: a
+/// refusal there is a compile error, never a run-time path).
+fn render_prony(terms: &[PronyTerm]) -> String {
+    if terms.is_empty() {
+        return "PronyTerms::NONE".to_string();
+    }
+    let mut items: Vec<String> = terms.iter().map(|t| format!("PronyTerm {{ g: {}, tau_s: {} }}", lit(t.g), lit(t.tau_s))).collect();
+    items.resize(MAX_PRONY_TERMS, "PronyTerm { g: 0.0, tau_s: 0.0 }".to_string());
+    format!(
+        "match PronyTerms::from_array([{}], {}) {{ Some(p) => p, None => panic!(\"prony terms refused by PronyTerms::from_array\") }}",
+        items.join(", "),
+        terms.len()
+    )
 }
 
 /// The f32 nearest to `v` (the format checks f32's range), as an exact literal.

@@ -140,6 +140,40 @@ pub const MAX_TISSUE_LAYERS: usize = 8;
 /// Format version of a tissue stack file.
 pub const TISSUE_FORMAT: i64 = 1;
 
+/// Format version of a set's unsolved region (`unsolved.toml`).
+pub const UNSOLVED_FORMAT: i64 = 1;
+/// Most balls (mirror images included) an unsolved region may have: the library's
+/// prefilter holds one bit per ball in a `u64`.
+pub const UNSOLVED_MAX_BALLS: usize = 64;
+
+/// Most Prony terms of a tissue layer's relaxation function (the quasi-linear
+/// viscoelastic filter holds this many per wrench component).
+pub const MAX_PRONY_TERMS: usize = 3;
+/// Largest sum of a layer's Prony weights `g_i` in the long-term normalisation
+/// (`G(t) = 1 + sum g_i exp(-t / tau_i)` relative to the elastic, long-term response):
+/// the instantaneous response is at most 10 times the long-term one (an Abaqus-style
+/// normalised sum of at most 0.9, [`prony_long_term_from_instantaneous`]).
+pub const PRONY_G_SUM_MAX: f64 = 9.0;
+
+/// The Prony weights in the long-term normalisation (FEBio's, the tissue files' and the
+/// library's: `G(t) / G_inf = 1 + sum g_i exp(-t / tau_i)`) from the weights normalised by
+/// the instantaneous response (Abaqus-style: `G(t) / G_0 = 1 - sum g'_i (1 - exp(-t /
+/// tau_i))`, `sum g'_i < 1`): `g_i = g'_i / (1 - sum g'_j)`, the time constants unchanged.
+/// `None` when a weight is not finite and >= 0 or their sum is not below 1 (no long-term
+/// response).
+#[must_use]
+pub fn prony_long_term_from_instantaneous<const N: usize>(g_instantaneous: [f64; N]) -> Option<[f64; N]> {
+    if !g_instantaneous.iter().all(|g| g.is_finite() && *g >= 0.0) {
+        return None;
+    }
+    let long_term = 1.0 - g_instantaneous.iter().sum::<f64>();
+    // the weights are finite (checked): so is their sum
+    if long_term <= 0.0 {
+        return None;
+    }
+    Some(g_instantaneous.map(|g| g / long_term))
+}
+
 /// Half-range `V_k` of each sweep (mm, mm, deg, deg): the domain is `|v| <= V_k`.
 pub const HALF_RANGES: [f64; 4] = [XZ_MAX_MM, XZ_MAX_MM, THETA_MAX_DEG, THETA_MAX_DEG];
 
@@ -176,6 +210,11 @@ pub mod status {
     pub const SAT_THETA_Z: u8 = 0x08;
     /// depth was clamped.
     pub const SAT_DEPTH: u8 = 0x10;
+    /// The (clamped) pose lies in the region where the set's FE campaign could not solve
+    /// (`unsolved.toml`, coeffs/README.md "The unsolved region"): the wrench is still the
+    /// model's, an extrapolation from the runs that solved. Like the saturation bits it
+    /// does not zero the wrench.
+    pub const FE_UNSOLVED: u8 = 0x20;
     /// The build has no fitted model (always with [`ERROR`]).
     pub const NO_MODEL: u8 = 0x40;
     /// No wrench: an input was NaN or infinite, or there is no model.
@@ -183,13 +222,14 @@ pub mod status {
     /// The five saturation bits.
     pub const SATURATION: u8 = SAT_X | SAT_Z | SAT_THETA_X | SAT_THETA_Z | SAT_DEPTH;
     /// Every bit with its name, `OK` first, then in bit order.
-    pub const NAMES: [(&str, u8); 8] = [
+    pub const NAMES: [(&str, u8); 9] = [
         ("OK", OK),
         ("SAT_X", SAT_X),
         ("SAT_Z", SAT_Z),
         ("SAT_THETA_X", SAT_THETA_X),
         ("SAT_THETA_Z", SAT_THETA_Z),
         ("SAT_DEPTH", SAT_DEPTH),
+        ("FE_UNSOLVED", FE_UNSOLVED),
         ("NO_MODEL", NO_MODEL),
         ("ERROR", ERROR),
     ];

@@ -2,7 +2,7 @@
 
 use anyhow::{Context, Result};
 use needle_fe::spec;
-use needle_fit::data::{read_run, run_path};
+use needle_fit::data::{run_path, FeRuns};
 use serde_json::{json, Value};
 use std::path::Path;
 
@@ -18,13 +18,14 @@ use std::path::Path;
 /// spec's depth grid (the message names the file).
 pub fn set_json(set_dir: &Path) -> Result<Value> {
     let (c, _) = spec::load(set_dir)?;
-    let manifest = needle_fe::manifest::read_manifest(&set_dir.join("fe").join(needle_fe::manifest::MANIFEST))?;
+    let fe = FeRuns::open(set_dir, &c)?;
+    let manifest = fe.manifest();
     let mut runs = Vec::new();
     for pose in c.poses() {
         if !run_path(set_dir, &pose).is_file() || !manifest.pose.contains_key(&pose.name) {
             continue;
         }
-        let run = read_run(set_dir, &c, &pose).with_context(|| format!("FE run {} of the explorer", pose.name))?;
+        let run = fe.read(&pose).with_context(|| format!("FE run {} of the explorer", pose.name))?;
         runs.push(json!({
             "name": pose.name,
             "role": serde_json::to_value(pose.role)?,

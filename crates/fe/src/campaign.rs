@@ -11,7 +11,15 @@
 //! - `manifest.toml.lock`: the lock ([`lock_manifest`]) under which every process
 //!   (this one's jobs, SLURM array tasks, another `needle fe run`) rewrites the manifest.
 //! - `.work/<pose>/`: the solver's input and files of a run; removed when the run
-//!   succeeds (unless `keep_work`), kept for debugging when it fails.
+//!   succeeds (unless `keep_work`), kept for debugging when it fails. Its
+//!   `progress.toml` ([`resume`]) records the attempt running, the finished attempts'
+//!   failures and the furthest must points: a run killed in the middle of a pose (a
+//!   session's end) resumes on the rerun at the attempt it was in, which the engine
+//!   continues from its last dump (FEBio) or reruns from its start (ccx), with
+//!   `<pose>: resuming attempt K of N (interrupted at X mm)` on stderr. Another run's
+//!   record (spec hash, engine and version, mesh, steps), an unreadable one, one whose
+//!   attempts all failed, or `--force`: the folder is cleared and attempt 1 starts, with
+//!   the reason on stderr.
 //!
 //! A pose is up to date, and skipped, when its CSV exists with `steps + 1` rows and its
 //! manifest entry has the spec hash of the current run ([`Campaign::run_hash`] of the
@@ -26,7 +34,7 @@
 //! A run that fails (solver error, no convergence, timeout) or stalls (no output for
 //! [`RunOptions::stall`]: ccx 2.20 was seen spinning without output at the start of a
 //! step, deterministically, e.g. theta_z = 15 degrees at 5.4 mm) is rerun with every load
-//! step starting at [`deck::RETRY_FIRST_INCREMENT`] of the step instead of the whole step,
+//! step starting at [`RETRY_FIRST_INCREMENT`](crate::backend::RETRY_FIRST_INCREMENT) of the step instead of the whole step,
 //! up to the engine's [`Backend::attempts`] in all (ccx: one retry; FEBio: four, decided
 //! by its ladder, `febio/ladder.rs`: a retry may continue the furthest attempt from its
 //! last converged must point). The manifest entry records it (`first_increment`,
@@ -37,15 +45,15 @@
 //! `progress` the display.
 
 use crate::backend::{Backend, Job, SolveFailure, Solved};
-use crate::deck;
 use crate::engines::backend_for;
-use crate::launcher::Launched;
-use crate::manifest::{manifest_text, read_manifest, rfc3339_utc, Manifest, ManifestEntry, MANIFEST};
+use crate::manifest::{manifest_text, read_manifest, rfc3339_utc, Launched, Manifest, ManifestEntry, MANIFEST};
+use crate::mesh_summary;
 use crate::partial;
 use crate::process;
 use crate::progress::Progress;
 use crate::report::{PoseReport, Report, Status};
 use crate::results::{self, Row};
+use crate::resume;
 use crate::spec::{self, Campaign, Engine, MeshLevel, PoseSpec};
 use anyhow::{bail, Context, Result};
 use needle_contract::COMPONENT_COUNT;
@@ -92,6 +100,13 @@ pub struct RunOptions {
     /// `needle fe verify --scaling`. Part of the run hash through the tissue; needs `out_dir`
     /// (scaled runs never go into `<set>/fe/`).
     pub tissue_scale: Option<f64>,
+    /// The ramp-and-hold runs of `[viscoelastic]` at this speed, mm/s (`crate::visco`):
+    /// its poses, mesh and Prony series, `--steps` must points on the ramp, output in
+    /// `<set>/fe/visco/` unless `out_dir`.
+    pub visco_speed_mm_per_s: Option<f64>,
+    /// Every speed of `[viscoelastic]` is meant (the CLI's `--visco`: one run of the
+    /// campaign per speed, each with `visco_speed_mm_per_s`); not read by [`run`].
+    pub visco: bool,
 }
 
 impl RunOptions {
@@ -113,6 +128,8 @@ impl RunOptions {
             launcher: Launched::Local,
             deep: false,
             tissue_scale: None,
+            visco_speed_mm_per_s: None,
+            visco: false,
         }
     }
 }
@@ -149,6 +166,8 @@ struct Ctx<'a> {
     solver_version: String,
     manifest_lock: Mutex<()>,
     keep_work: bool,
+    /// `--force`: a pose's progress record is not resumed.
+    force: bool,
     launcher: &'a Launched,
 }
 
@@ -223,7 +242,10 @@ pub fn plan(opts: &RunOptions) -> Result<Plan> {
         // a CSV whose content is not what the campaign wrote is not up to date
         let rows = entry
             .and_then(|e| std::fs::read_to_string(&csv).ok().filter(|text| e.content_matches(text.as_bytes())))
-            .and_then(|text| results::parse_csv(&text, &csv).ok())
+            .and_then(|text| match campaign.loading.ramp_hold {
+                Some(_) => results::parse_timed_csv(&text, &csv).ok().map(|(_, rows)| rows),
+                None => results::parse_csv(&text, &csv).ok(),
+            })
             .filter(|r| r.len() == steps as usize + 1);
         let mut report = PoseReport {
             pose: pose.name.clone(),
@@ -274,6 +296,18 @@ fn apply_variant(opts: &RunOptions, campaign: &mut Campaign, spec_path: &Path) -
         }
         campaign.loading.steps = s;
     }
+    if let Some(speed) = opts.visco_speed_mm_per_s {
+        let v = campaign
+            .viscoelastic
+            .clone()
+            .with_context(|| format!("{}: --visco: the spec has no [viscoelastic] section", spec_path.display()))?;
+        if opts.deep {
+            bail!("--visco and --deep: the ramp-and-hold runs go to loading.depth_mm only");
+        }
+        let (run, poses) = crate::visco::apply(campaign, &v, speed, campaign.loading.steps);
+        *campaign = run;
+        return Ok(Variant { mesh: v.mesh, poses: Some(poses), out_dir: opts.set_dir.join("fe").join(crate::visco::VISCO_DIR) });
+    }
     if let Some(s) = opts.tissue_scale {
         if !(s.is_finite() && s > 0.0) || opts.out_dir.is_none() {
             bail!("tissue scale {s}: must be finite and > 0, with its own output folder (never <set>/fe)");
@@ -323,6 +357,7 @@ pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> 
             solver_version,
             manifest_lock: Mutex::new(()),
             keep_work: opts.keep_work,
+            force: opts.force,
             launcher: &opts.launcher,
         };
         let earlier_walls_s = manifest.wall_times_s(ctx.campaign.solver.engine.name(), &mesh_name, steps);
@@ -369,7 +404,7 @@ fn run_workers(
 ) {
     let queue: Mutex<VecDeque<usize>> = Mutex::new((0..to_run.len()).collect());
     let (tx, rx) = mpsc::channel::<Event>();
-    let runs = to_run.iter().map(|(_, p)| (p.name.clone(), deck::model_name(p.symmetry()).to_string())).collect();
+    let runs = to_run.iter().map(|(_, p)| (p.name.clone(), mesh_summary::model_name(p.symmetry()).to_string())).collect();
     let mut progress = Progress::new(runs, ctx.steps, jobs, earlier_walls_s);
     std::thread::scope(|s| {
         for _ in 0..jobs {
@@ -438,18 +473,18 @@ fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
     let start = Instant::now();
     let wd = work_dir(ctx.out_dir, &pose.name);
     let fail = |message: String, log_tail: String| failed_report(pose, ctx, message, log_tail);
-    let prepared = (|| -> Result<()> {
-        if wd.exists() {
-            std::fs::remove_dir_all(&wd).with_context(|| format!("{}: cannot clear", wd.display()))?;
-        }
-        std::fs::create_dir_all(&wd).with_context(|| format!("{}: cannot create", wd.display()))?;
-        // The earlier result and its entry stay until the new ones replace them: a failed
-        // or interrupted rerun (`--force`) costs nothing (module docs).
-        Ok(())
-    })();
-    if let Err(e) = prepared {
-        return fail(format!("{e:#}"), String::new());
-    }
+    let run = resume::Identity {
+        spec_hash: ctx.campaign.run_hash(pose, ctx.mesh_name),
+        engine: ctx.backend.engine().to_string(),
+        engine_version: ctx.solver_version.clone(),
+        mesh: ctx.mesh_name.to_string(),
+        steps: ctx.steps,
+    };
+    let attempts = ctx.backend.attempts().max(1);
+    let from = match starting_point(ctx, pose, &wd, &run, attempts) {
+        Ok(from) => from,
+        Err(e) => return fail(format!("{e:#}"), String::new()),
+    };
     let job = Job {
         campaign: ctx.campaign,
         pose,
@@ -477,8 +512,18 @@ fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
             Err(e) => format!(" (the partial record could not be written: {e:#})"),
         }
     };
-    let solved = match solve_with_retry(ctx.backend, &job, &mut keep) {
-        Ok(s) => s,
+    // a record that cannot be written costs the resumability only, not the run
+    let mut record = |at: &resume::Start| {
+        if let Err(e) = resume::write(&wd, &run, attempts, at) {
+            eprintln!("{}: {e:#} (an interruption would restart this pose from attempt 1)", pose.name);
+        }
+    };
+    let solved = match solve_with_retry(ctx.backend, &job, from, &mut keep, &mut record) {
+        // solved: nothing to resume, even if its results cannot be written below
+        Ok(s) => {
+            resume::remove(&wd);
+            s
+        }
         Err(f) => {
             let kept = if f.reached.is_empty() { String::new() } else { keep(&f.reached, &f.message) };
             return fail(format!("{}{kept}", f.message), f.log_tail);
@@ -505,24 +550,62 @@ fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
     }
 }
 
-/// Solve `job`; when that fails, again with [`deck::RETRY_FIRST_INCREMENT`], up to the
-/// backend's [`Backend::attempts`] (module docs). The failures so far go into the
-/// result's `retry` (or the final failure's message). `keep` gets the must points of
+/// Where `pose` starts: an interrupted run of the same pose resumes at its attempt
+/// ([`resume`]); anything else starts afresh in an empty work folder `wd`. The earlier
+/// result and its entry stay until the new ones replace them: a failed or interrupted
+/// rerun (`--force`) costs nothing (module docs).
+///
+/// # Errors
+/// The work folder cannot be cleared or made.
+fn starting_point(ctx: &Ctx<'_>, pose: &PoseSpec, wd: &Path, run: &resume::Identity, attempts: u32) -> Result<resume::Start> {
+    let decision = if wd.exists() { resume::decide(wd, run, attempts, ctx.force) } else { resume::Decision::Fresh(None) };
+    match decision {
+        resume::Decision::Resume(start) => {
+            let reached = ctx.backend.steps_done(wd);
+            eprintln!(
+                "{}: resuming attempt {} of {attempts} (interrupted at {} mm)",
+                pose.name,
+                start.attempt + 1,
+                ctx.campaign.loading.depth_at(reached.min(ctx.steps))
+            );
+            Ok(start)
+        }
+        resume::Decision::Fresh(why) => {
+            if let Some(why) = why {
+                eprintln!("{}: starting afresh: {why}", pose.name);
+            }
+            if wd.exists() {
+                std::fs::remove_dir_all(wd).with_context(|| format!("{}: cannot clear", wd.display()))?;
+            }
+            std::fs::create_dir_all(wd).with_context(|| format!("{}: cannot create", wd.display()))?;
+            Ok(resume::Start::default())
+        }
+    }
+}
+
+/// Solve `job`; when that fails, again with [`RETRY_FIRST_INCREMENT`](crate::backend::RETRY_FIRST_INCREMENT), up to the
+/// backend's [`Backend::attempts`] (module docs), starting at `start` (attempt 0 with no
+/// failures, or where an interrupted run was: [`resume`]). The failures so far go into
+/// the result's `retry` (or the final failure's message). `keep` gets the must points of
 /// each failed attempt that reached further than the ones before, with the failures so
-/// far (the final failure carries the furthest in `reached`).
+/// far (the final failure carries the furthest in `reached`). `record` gets where the
+/// pose stands at the start of each attempt and after each failed one (the attempt to
+/// run next; `attempts` once all failed).
 pub(crate) fn solve_with_retry(
     backend: &dyn Backend,
     job: &Job<'_>,
+    start: resume::Start,
     keep: &mut dyn FnMut(&[[f64; COMPONENT_COUNT]], &str) -> String,
+    record: &mut dyn FnMut(&resume::Start),
 ) -> std::result::Result<Solved, SolveFailure> {
-    let mut failures: Vec<String> = Vec::new();
-    let mut furthest: Vec<[f64; COMPONENT_COUNT]> = Vec::new();
+    let resume::Start { attempt: first, mut failures, mut furthest } = start;
     let attempts = backend.attempts().max(1);
     let sym = job.pose.symmetry();
     let full_block = !sym.plane_x && !sym.plane_z;
-    for attempt in 0..attempts {
+    for attempt in first..attempts {
         let r = backend.first_increment_in(job.work_dir, attempt, full_block);
         let this = Job { first_increment: r, attempt, ..*job };
+        record(&resume::Start { attempt, failures: failures.clone(), furthest: furthest.clone() });
         match backend.solve(&this) {
             Ok(s) => return Ok(Solved { retry: (!failures.is_empty()).then(|| failures.join("; ")), ..s }),
             Err(f) => {
@@ -533,6 +616,10 @@ pub(crate) fn solve_with_retry(
                     if attempt + 1 < attempts {
                         let _ = keep(&furthest, &failures.join("; "));
                     }
+                }
+                // an interrupted attempt (Ctrl-C) is not finished: a rerun runs it again
+                if !process::interrupted() {
+                    record(&resume::Start { attempt: attempt + 1, failures: failures.clone(), furthest: furthest.clone() });
                 }
                 if attempt + 1 == attempts || process::interrupted() {
                     return Err(SolveFailure { message: failures.join("; "), log_tail: f.log_tail, reached: furthest });
@@ -575,7 +662,10 @@ fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Res
         rows.push(Row { depth_mm: ctx.campaign.loading.depth_at(k), wrench: *w });
     }
     let csv = ctx.out_dir.join(format!("{}.csv", pose.name));
-    let text = results::to_csv(&rows);
+    let text = match ctx.campaign.loading.ramp_hold {
+        Some(_) => results::to_timed_csv(&(0..=ctx.steps).map(|k| ctx.campaign.loading.time_at(k)).collect::<Vec<_>>(), &rows),
+        None => results::to_csv(&rows),
+    };
     results::write_atomic(&csv, text.as_bytes())?;
     let entry = ManifestEntry {
         spec_hash: ctx.campaign.run_hash(pose, ctx.mesh_name),
@@ -609,6 +699,7 @@ fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Res
         batch_job: ctx.launcher.batch_job(),
         replaces: ctx.campaign.replaced_by(&pose.name).map(|r| r.pose.clone()),
         replaced_because: ctx.campaign.replaced_by(&pose.name).map(|r| replaced_because(ctx.out_dir, r)),
+        viscoelastic: crate::visco::describe(ctx.campaign),
     };
     update_manifest(ctx, |m| {
         m.pose.insert(pose.name.clone(), entry);
@@ -632,9 +723,13 @@ fn update_manifest(ctx: &Ctx<'_>, f: impl FnOnce(&mut Manifest)) -> Result<()> {
 }
 
 #[cfg(test)]
+#[path = "campaign_resume_tests.rs"]
+mod resume_tests;
+
+#[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::deck::MeshSummary;
+    use crate::mesh_summary::MeshSummary;
     use crate::spec::Role;
     use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -664,12 +759,17 @@ pub(crate) mod tests {
             self.solves.fetch_add(1, Ordering::SeqCst);
             assert!(job.work_dir.is_dir(), "work dir exists");
             if job.first_increment == 1.0 {
-                assert_eq!(std::fs::read_dir(job.work_dir).map(|d| d.count()).unwrap_or(9), 0, "work dir is empty");
+                let others = std::fs::read_dir(job.work_dir)
+                    .map(|d| d.flatten().filter(|e| e.file_name() != resume::RECORD_FILE).count())
+                    .unwrap_or(9);
+                assert_eq!(others, 0, "work dir is empty but for the progress record");
             }
-            std::fs::write(job.work_dir.join("pose.log"), "fake log\n").map_err(anyhow::Error::from)?;
+            // a panic leaves the folder as a killed run does: only the progress record, so
+            // that the rerun's resumed first attempt finds it empty too
             if self.panic_on.as_deref() == Some(job.pose.name.as_str()) {
                 panic!("fake panic");
             }
+            std::fs::write(job.work_dir.join("pose.log"), "fake log\n").map_err(anyhow::Error::from)?;
             if self.fail.as_deref() == Some(job.pose.name.as_str()) {
                 return Err(SolveFailure { message: "fake exit code 201".into(), log_tail: "*ERROR fake".into(), reached: Vec::new() });
             }
@@ -910,7 +1010,7 @@ pub(crate) mod tests {
         let m = read_manifest(&d.path().join("fe").join(MANIFEST)).expect("manifest");
         let (x2, x4) = (&m.pose["x+02"], &m.pose["x+04"]);
         assert_eq!((x2.first_increment, x2.retry.as_deref()), (None, None));
-        assert_eq!((x4.first_increment, x4.retry.as_deref()), (Some(deck::RETRY_FIRST_INCREMENT), Some("fake stall")));
+        assert_eq!((x4.first_increment, x4.retry.as_deref()), (Some(crate::backend::RETRY_FIRST_INCREMENT), Some("fake stall")));
         let text = std::fs::read_to_string(d.path().join("fe").join(MANIFEST)).expect("manifest text");
         assert_eq!(text.matches("first_increment = 0.25").count(), 1, "{text}");
         assert_eq!(text.matches("retry = \"fake stall\"").count(), 1, "{text}");

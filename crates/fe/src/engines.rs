@@ -1,6 +1,7 @@
 //! Which [`Backend`] solves a run: the one place that knows every engine.
 
-use crate::backend::{Backend, CcxBackend};
+use crate::backend::Backend;
+use crate::ccx::CcxBackend;
 use crate::febio::FebioBackend;
 use crate::spec::Engine;
 

@@ -1,13 +1,11 @@
-//! The FE campaign: spec, material check, mesh and deck writer, the ccx runner and
-//! result parser, the reduction of nodal reactions to the needle wrench, and the campaign
-//! driver (backend, manifest, report, progress).
+//! The FE campaign: spec, material check, mesh, the engines behind the `Backend` trait
+//! (`ccx/`: deck writer, runner, result parser, reduction of nodal reactions to the needle
+//! wrench; `febio/`), and the campaign driver (manifest, report, progress, launchers).
 #![forbid(unsafe_code)]
 
 pub mod backend;
 pub mod campaign;
 pub mod ccx;
-pub mod dat;
-pub mod deck;
 pub mod deep;
 pub mod engines;
 pub mod febio;
@@ -15,14 +13,17 @@ pub mod launcher;
 pub mod manifest;
 pub mod material;
 pub mod mesh;
+pub mod mesh_summary;
 pub mod partial;
 pub mod process;
 mod progress;
 pub mod report;
 pub mod results;
+pub mod resume;
 pub mod spec;
 pub mod verify;
 pub mod versions;
+pub mod visco;
 pub mod wrench;
 
 /// The workspace root (this crate is `crates/fe`), for the unit tests' `coeffs/default`.

@@ -1,6 +1,7 @@
 //! `fe/manifest.toml`: how each `fe/<pose>.csv` was made (spec hash, solver, mesh,
 //! increments, wall time), read to skip up-to-date poses and rewritten atomically by the
-//! campaign after each pose.
+//! campaign after each pose; and how the process that solved a run was launched
+//! ([`Launched`], its `launcher` and `batch_job`).
 
 use crate::spec::{Campaign, PoseSpec, Role};
 use anyhow::{Context, Result};
@@ -45,7 +46,7 @@ pub struct ManifestEntry {
     pub mesh: String,
     /// SHA-256 of the CSV as the campaign wrote it ([`results::content_sha256`](crate::results::content_sha256)):
     /// the fitter, validator, plots and explorer refuse a CSV whose content differs
-    /// (`fit::data::read_run`). An entry without it is not trusted: `needle fe run`
+    /// (`fit::data::FeRuns::read`). An entry without it is not trusted: `needle fe run`
     /// solves its pose again and the fitter refuses its CSV (a hash taken later would
     /// vouch for whatever file is there then).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -110,6 +111,10 @@ pub struct ManifestEntry {
     /// attempt from its `.partial.toml` when there is one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub replaced_because: Option<String>,
+    /// A viscoelastic ramp-and-hold run (`crate::visco`): its Prony series and time
+    /// course, one line with units.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub viscoelastic: Option<String>,
 }
 
 impl Manifest {
@@ -198,7 +203,7 @@ pub fn rfc3339_utc(t: SystemTime) -> String {
     let secs = t.duration_since(SystemTime::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0);
     let days = (secs / 86_400) as i64;
     let rem = secs % 86_400;
-    // civil_from_days (H. Hinnant): days since 1970-01-01 -> proleptic Gregorian date
+    // civil_from_days (H. Hinnant): days since the Unix epoch -> proleptic Gregorian date
     let z = days + 719_468;
     let era = z.div_euclid(146_097);
     let doe = z.rem_euclid(146_097);
@@ -209,6 +214,47 @@ pub fn rfc3339_utc(t: SystemTime) -> String {
     let month = if mp < 10 { mp + 3 } else { mp - 9 };
     let year = yoe + era * 400 + i64::from(month <= 2);
     format!("{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z", rem / 3_600, rem % 3_600 / 60, rem % 60)
+}
+
+/// How the process that solved a pose was started; recorded in its manifest entry
+/// (`launcher`, `batch_job`).
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub enum Launched {
+    /// `needle fe run` on this machine.
+    #[default]
+    Local,
+    /// A SLURM array task; `job` is `<array job id>_<task id>`.
+    Slurm {
+        /// `SLURM_ARRAY_JOB_ID_SLURM_ARRAY_TASK_ID`, e.g. `1234_5`.
+        job: String,
+    },
+}
+
+impl Launched {
+    /// `"local"` or `"slurm"`: the manifest's `launcher`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Launched::Local => "local",
+            Launched::Slurm { .. } => "slurm",
+        }
+    }
+
+    /// The manifest's `batch_job`: the SLURM array task, none for a local run.
+    pub fn batch_job(&self) -> Option<String> {
+        match self {
+            Launched::Local => None,
+            Launched::Slurm { job } => Some(job.clone()),
+        }
+    }
+
+    /// The launcher of this process: a SLURM array task when `SLURM_ARRAY_JOB_ID` and
+    /// `SLURM_ARRAY_TASK_ID` are set, else local.
+    pub fn from_env() -> Self {
+        match (std::env::var("SLURM_ARRAY_JOB_ID"), std::env::var("SLURM_ARRAY_TASK_ID")) {
+            (Ok(j), Ok(t)) if !j.is_empty() && !t.is_empty() => Launched::Slurm { job: format!("{j}_{t}") },
+            _ => Launched::Local,
+        }
+    }
 }
 
 #[cfg(test)]

@@ -88,6 +88,55 @@ pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<Row>> {
     Ok(rows)
 }
 
+/// The CSV text of a ramp-and-hold result (`crate::visco`): a `time_s` column (s) before
+/// the columns of [`to_csv`], one time per row.
+pub fn to_timed_csv(times_s: &[f64], rows: &[Row]) -> String {
+    let plain = to_csv(rows);
+    let mut s = String::with_capacity(plain.len() + 24 * (rows.len() + 1));
+    for (i, line) in plain.lines().enumerate() {
+        match i.checked_sub(1).map(|k| times_s.get(k)) {
+            None => s.push_str(crate::visco::TIME_COLUMN),
+            Some(t) => s.push_str(&format!("{}", t.copied().unwrap_or(f64::NAN))),
+        }
+        s.push(',');
+        s.push_str(line);
+        s.push('\n');
+    }
+    s
+}
+
+/// Parse a ramp-and-hold result ([`to_timed_csv`]): the times, s, and the rows.
+///
+/// # Errors
+/// As [`parse_csv`], or a row without its time (messages with `path:line`).
+pub fn parse_timed_csv(text: &str, path: &Path) -> Result<(Vec<f64>, Vec<Row>)> {
+    let mut times = Vec::new();
+    let mut plain = String::with_capacity(text.len());
+    for (i, line) in text.lines().enumerate() {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let Some((t, rest)) = line.split_once(',') else {
+            bail!("{}:{}: no {} column: {line:?}", path.display(), i + 1, crate::visco::TIME_COLUMN);
+        };
+        if i == 0 {
+            if t.trim() != crate::visco::TIME_COLUMN {
+                bail!("{}:1: first column {t:?}, expected {:?}", path.display(), crate::visco::TIME_COLUMN);
+            }
+        } else {
+            let v: f64 = t.trim().parse().with_context(|| format!("{}:{}: time {t:?} s is not a number", path.display(), i + 1))?;
+            if !v.is_finite() {
+                bail!("{}:{}: time {t:?} s is not finite", path.display(), i + 1);
+            }
+            times.push(v);
+        }
+        plain.push_str(rest);
+        plain.push('\n');
+    }
+    let rows = parse_csv(&plain, path)?;
+    Ok((times, rows))
+}
+
 /// SHA-256 of a result file's bytes, 64 hex digits: the manifest's `csv_sha256`.
 #[must_use]
 pub fn content_sha256(bytes: &[u8]) -> String {

@@ -90,22 +90,63 @@ pub fn run_cargo_in(mut cmd: Command, dir: &Path, what: &str) -> anyhow::Result<
     bail!("cargo build of {what} failed ({}):\n{}{hint}", out.status, tail.join("\n"))
 }
 
-/// Builds the firmware `examples` for `core` (release profile, the crate's default
-/// features) with the coefficient set `set`, and returns their ELF paths in order.
+/// The library features of a firmware example build.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Features {
+    /// The product's: `viscoelastic` (the filter inside both insertions). Every
+    /// check (no panic, goldens, bench) runs on this build.
+    Viscoelastic,
+    /// None of the optional features: the elastic insertions, the build the flash
+    /// budget of the insertion holds for (issue 41). Its own target folder
+    /// (`firmware-elastic/` beside [`target_dir`]), so the two builds do not replace
+    /// each other's files.
+    Elastic,
+}
+
+impl Features {
+    /// The target folder of this build.
+    #[must_use]
+    pub fn target_dir(self) -> PathBuf {
+        match self {
+            Self::Viscoelastic => target_dir(),
+            Self::Elastic => target_dir().with_file_name("firmware-elastic"),
+        }
+    }
+
+    fn cargo_args(self) -> &'static [&'static str] {
+        match self {
+            Self::Viscoelastic => &["--features", "viscoelastic"],
+            Self::Elastic => &[],
+        }
+    }
+}
+
+/// Builds the firmware `examples` for `core` (release profile, [`Features::Viscoelastic`])
+/// with the coefficient set `set`, and returns their ELF paths in order.
 ///
 /// # Errors
 /// The target is not installed, or the build fails (the error holds cargo's output).
 pub fn build_examples(core: &Core, examples: &[&str], set: &Path) -> anyhow::Result<Vec<PathBuf>> {
+    build_examples_with(core, examples, set, Features::Viscoelastic)
+}
+
+/// [`build_examples`] with the library's `features`.
+///
+/// # Errors
+/// As [`build_examples`].
+pub fn build_examples_with(core: &Core, examples: &[&str], set: &Path, features: Features) -> anyhow::Result<Vec<PathBuf>> {
     check_target(core.target)?;
     let mut cmd = nested_cargo();
-    cmd.args(["build", "--release", "-p", "needle-haptics", "--target", core.target, "--target-dir"])
-        .arg(target_dir())
+    cmd.args(["build", "--release", "-p", "needle-haptics", "--target", core.target])
+        .args(features.cargo_args())
+        .arg("--target-dir")
+        .arg(features.target_dir())
         .env("NEEDLE_COEFFS", set);
     for e in examples {
         cmd.args(["--example", e]);
     }
-    run_cargo(cmd, &format!("examples {} for {} ({})", examples.join(", "), core.core, core.target))?;
-    let dir = examples_dir(core);
+    run_cargo(cmd, &format!("examples {} for {} ({}, {features:?})", examples.join(", "), core.core, core.target))?;
+    let dir = features.target_dir().join(core.target).join("release").join("examples");
     examples
         .iter()
         .map(|e| {

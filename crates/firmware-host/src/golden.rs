@@ -11,7 +11,7 @@ use std::path::Path;
 use std::time::Duration;
 
 /// The golden file's header line (the fitter's, from the contract's columns).
-pub use needle_fit::golden::header;
+pub use needle_fit::golden::float32::header;
 
 use needle_contract::GOLDEN_COLUMNS as COLUMNS;
 

@@ -4,7 +4,7 @@
 //! `fixed::wrench_and_stiffness` wrench is not `fixed::wrench`'s must be 0).
 use super::comparison::{Comparison, Section};
 
-pub use needle_fit::golden_fixed::header;
+pub use needle_fit::golden::fixed::header;
 
 /// The differing integer fields of one row (after the five inputs), named by `header`.
 fn integer_diffs(header: &str, want: &[&str], got: &[&str]) -> Vec<String> {
@@ -38,7 +38,7 @@ pub fn compare(output: &str, csv: &str) -> anyhow::Result<Comparison> {
 /// firmware found a wrench that differs from `fixed::wrench`'s; differing rates are
 /// [`Comparison::mismatches`].
 pub fn compare_stiffness(output: &str, csv: &str) -> anyhow::Result<Comparison> {
-    let header = needle_fit::golden_stiffness_fixed::header();
+    let header = needle_fit::golden::stiffness_fixed::header();
     let section = Section {
         file: needle_fit::GOLDEN_STIFFNESS_FIXED_FILE,
         tag: "needle-golden-stiffness-fixed",

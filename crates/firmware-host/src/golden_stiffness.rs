@@ -4,7 +4,7 @@
 //! not `wrench`'s must be 0.
 use super::comparison::{same_f32, Comparison, Section};
 use anyhow::bail;
-use needle_fit::golden_stiffness::{header, rate_columns};
+use needle_fit::golden::stiffness_float32::{header, rate_columns};
 
 /// Compares the stiffness section of the `golden` firmware's stdout `output` (after its
 /// `needle-golden-stiffness rows=N` line) with the text `csv` of golden-stiffness-f32.csv.

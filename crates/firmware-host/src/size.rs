@@ -15,7 +15,7 @@
 //! - *static RAM*: `.data` + `.bss` of the whole image.
 //!
 //! Model flash = evaluator code + tables + compiler runtime.
-use super::{build, qemu::find_on_path, Core};
+use super::{build, build::Features, qemu::find_on_path, Core};
 use anyhow::{bail, Context};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -195,10 +195,19 @@ pub fn measure(core: &Core, elf: &Path, evaluator: &'static str) -> anyhow::Resu
     })
 }
 
-/// The evaluators and the firmware example that holds each alone (`insertion`: the f32
-/// model, its depth extension, the insertion model with the guard's stiffness, every
-/// compiled-in tissue stack and a control loop rendering it).
-pub const EVALUATORS: [(&str, &str); 3] = [("f32", "no_panic"), ("fixed", "no_panic_fixed"), ("insertion", "no_panic_insertion")];
+/// The evaluators, the firmware example that holds each alone and the library features
+/// it is built with (`insertion`: the f32 model, its depth extension, the insertion model
+/// with the guard's stiffness, every compiled-in tissue stack and a control loop rendering
+/// it; `fixed-insertion` the same in integers; `+qlv`: the same image with the
+/// viscoelastic filter, [`Features::Viscoelastic`]).
+pub const EVALUATORS: [(&str, &str, Features); 6] = [
+    ("f32", "no_panic", Features::Viscoelastic),
+    ("fixed", "no_panic_fixed", Features::Viscoelastic),
+    ("insertion", "no_panic_insertion", Features::Elastic),
+    ("fixed-insertion", "no_panic_fixed_insertion", Features::Elastic),
+    ("insertion+qlv", "no_panic_insertion", Features::Viscoelastic),
+    ("fixed-insertion+qlv", "no_panic_fixed_insertion", Features::Viscoelastic),
+];
 
 /// Builds the [`EVALUATORS`]' examples for `core` with the set `set` and measures each
 /// (in that order).
@@ -206,9 +215,18 @@ pub const EVALUATORS: [(&str, &str); 3] = [("f32", "no_panic"), ("fixed", "no_pa
 /// # Errors
 /// Build failed or binutils missing.
 pub fn run(core: &Core, set: &Path) -> anyhow::Result<Vec<SizeReport>> {
-    let names: Vec<&str> = EVALUATORS.iter().map(|(_, e)| *e).collect();
-    let elfs = build::build_examples(core, &names, set)?;
-    EVALUATORS.iter().zip(&elfs).map(|((which, _), elf)| measure(core, elf, which)).collect()
+    let mut out = Vec::with_capacity(EVALUATORS.len());
+    for features in [Features::Viscoelastic, Features::Elastic] {
+        let chosen: Vec<_> = EVALUATORS.iter().filter(|(_, _, f)| *f == features).collect();
+        let names: Vec<&str> = chosen.iter().map(|(_, e, _)| *e).collect();
+        let elfs = build::build_examples_with(core, &names, set, features)?;
+        for ((which, _, _), elf) in chosen.iter().zip(&elfs) {
+            out.push(measure(core, elf, which)?);
+        }
+    }
+    let order = |r: &SizeReport| EVALUATORS.iter().position(|(w, _, _)| *w == r.evaluator);
+    out.sort_by_key(order);
+    Ok(out)
 }
 
 /// `1234 B (1.21 KiB)`.

@@ -32,10 +32,10 @@
 use super::contract::{u_of, Pose64, Sweep, COMPONENTS, DEGREE, DEPTH_MAX_MM, NCOEF};
 use super::cross_terms::{mono, monomials, normalised, poly, CrossForm, CrossTerms, Exponents};
 use super::data::{FitData, Run};
-use super::eval_f64::{eval_paper, paper_component};
 use super::lsq::lstsq;
 use super::model::{baseline_of, deviation_of, shift, Coupled, Model};
 use crate::contract::COMPONENT_COUNT;
+use crate::eval::float64::{eval_paper, paper_component};
 use anyhow::{bail, Context, Result};
 use nalgebra::{DMatrix, DVector};
 

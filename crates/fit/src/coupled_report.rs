@@ -9,10 +9,10 @@
 
 use super::coupled::{self, Selection};
 use super::data::{load_paper_data, load_training_runs, load_validation_runs, Run};
-use super::eval_f64::{eval, eval_paper, Pose64};
 use super::model::{fit as fit_paper, Model};
 use super::validate::TABLE2_MIN_DEPTH_MM;
 use crate::contract::COMPONENT_COUNT;
+use crate::eval::float64::{eval, eval_paper, Pose64};
 use anyhow::Result;
 use needle_fe::spec::Role;
 use serde::Serialize;
@@ -351,7 +351,7 @@ mod tests {
         model.cross =
             Some(Coupled { terms: terms.clone(), training_runs: 1, cv_rms_pct: [0.0; COMPONENT_COUNT], scale: [1.0; COMPONENT_COUNT] });
         let paper = paper_held_out(&[&run], 60.0, &model);
-        let coupled = held_out(&[&run], 60.0, |p| crate::eval_f64::eval_with_cross(&model, &terms, p).0);
+        let coupled = held_out(&[&run], 60.0, |p| crate::eval::float64::eval_with_cross(&model, &terms, p).0);
         assert_eq!(paper.lhs_worst_rms_pct, 0.0, "the paper row must not include the cross terms");
         assert!(coupled.lhs_worst_rms_pct > 1.0, "the cross term shows in the coupled row: {}", coupled.lhs_worst_rms_pct);
     }

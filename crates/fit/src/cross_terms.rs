@@ -108,8 +108,8 @@ pub fn cross_value(t: &CrossTerms, pose: Pose64) -> [f64; COMPONENT_COUNT] {
 
 #[cfg(test)]
 mod tests {
-    use super::super::contract::COMPONENTS;
     use super::*;
+    use crate::contract::COMPONENTS;
 
     /// Every monomial flips exactly like its component under both mirrors.
     #[test]

@@ -79,27 +79,58 @@ pub fn run_path(set_dir: &Path, pose: &PoseSpec) -> PathBuf {
     set_dir.join("fe").join(format!("{}.csv", pose.name))
 }
 
-/// Read one run and check its depth grid against the spec's loading (steps + 1 rows at
-/// `depth_at(k)`, to 1e-9 mm).
-///
-/// # Errors
-/// The file cannot be read or parsed, or its depths are not the spec's.
-pub fn read_run(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Result<Run> {
-    let path = run_path(set_dir, pose);
-    let text = std::fs::read_to_string(&path).with_context(|| format!("{}: cannot read", path.display()))?;
-    check_content(set_dir, pose, &path, text.as_bytes())?;
-    let rows = parse_csv(&text, &path)?;
-    let steps = campaign.loading.steps;
-    if rows.len() != steps as usize + 1 {
-        bail!("{}: {} depth rows, expected loading.steps + 1 = {} (an unfinished or failed run?)", path.display(), rows.len(), steps + 1);
+/// A set's FE results as the fitter reads them: the spec's loading and the manifest, the
+/// manifest read once ([`FeRuns::open`]) and every run checked against that copy (issue 37:
+/// the manifest used to be parsed again for each run).
+pub struct FeRuns<'a> {
+    set_dir: &'a Path,
+    campaign: &'a Campaign,
+    manifest: Manifest,
+}
+
+impl<'a> FeRuns<'a> {
+    /// The runs of `set_dir` with the spec `campaign`: reads `<set>/fe/manifest.toml`.
+    ///
+    /// # Errors
+    /// The manifest exists but is not a valid one.
+    pub fn open(set_dir: &'a Path, campaign: &'a Campaign) -> Result<Self> {
+        Ok(Self { set_dir, campaign, manifest: read_set_manifest(set_dir)? })
     }
-    for (k, r) in (0u32..).zip(&rows) {
-        let want = campaign.loading.depth_at(k);
-        if (r.depth_mm - want).abs() > 1e-9 {
-            bail!("{}:{}: depth_mm = {}, expected {want}", path.display(), k + 2, r.depth_mm);
+
+    /// The set's manifest, as read by [`open`](Self::open).
+    pub fn manifest(&self) -> &Manifest {
+        &self.manifest
+    }
+
+    /// Read one run, check its content against the manifest ([`check_content`]) and its
+    /// depth grid against the spec's loading (steps + 1 rows at `depth_at(k)`, to 1e-9 mm).
+    ///
+    /// # Errors
+    /// The file cannot be read or parsed, its content is not what the campaign wrote, or
+    /// its depths are not the spec's.
+    pub fn read(&self, pose: &PoseSpec) -> Result<Run> {
+        let path = run_path(self.set_dir, pose);
+        let text = std::fs::read_to_string(&path).with_context(|| format!("{}: cannot read", path.display()))?;
+        check_content(&self.manifest, pose, &path, text.as_bytes())?;
+        let rows = parse_csv(&text, &path)?;
+        let loading = &self.campaign.loading;
+        let steps = loading.steps;
+        if rows.len() != steps as usize + 1 {
+            bail!(
+                "{}: {} depth rows, expected loading.steps + 1 = {} (an unfinished or failed run?)",
+                path.display(),
+                rows.len(),
+                steps + 1
+            );
         }
+        for (k, r) in (0u32..).zip(&rows) {
+            let want = loading.depth_at(k);
+            if (r.depth_mm - want).abs() > 1e-9 {
+                bail!("{}:{}: depth_mm = {}, expected {want}", path.display(), k + 2, r.depth_mm);
+            }
+        }
+        Ok(Run { pose: pose.clone(), file_name: format!("{}.csv", pose.name), rows })
     }
-    Ok(Run { pose: pose.clone(), file_name: format!("{}.csv", pose.name), rows })
 }
 
 /// A run's CSV must be the bytes the campaign wrote: when its manifest entry records a
@@ -109,9 +140,8 @@ pub fn read_run(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Result<
 /// gives both hashes.
 ///
 /// # Errors
-/// The manifest cannot be read, or `bytes` (the file at `path`) differ from the recorded hash.
-fn check_content(set_dir: &Path, pose: &PoseSpec, path: &Path, bytes: &[u8]) -> Result<()> {
-    let manifest = read_set_manifest(set_dir)?;
+/// `bytes` (the file at `path`) differ from the hash `manifest` records, or it records none.
+fn check_content(manifest: &Manifest, pose: &PoseSpec, path: &Path, bytes: &[u8]) -> Result<()> {
     let Some(entry) = manifest.pose.get(&pose.name) else { return Ok(()) };
     let Some(want) = entry.csv_sha256.as_ref() else {
         bail!(
@@ -202,6 +232,21 @@ fn load_fit_data_in(set_dir: &Path, form: Option<ModelForm>) -> Result<FitData> 
         );
     }
     let fitted = fitted_poses(&campaign);
+    let (centre, sweeps, train) = {
+        let runs = FeRuns::open(set_dir, &campaign)?;
+        check_fitted_runs_current(&runs, &fitted)?;
+        let centre = centre_run(&runs, &spec_path, &fitted)?;
+        let sweeps = sweep_points(&runs, &spec_path, &fitted, &centre)?;
+        let train = fitted.iter().filter(|p| p.role == Role::Train).map(|p| runs.read(p)).collect::<Result<Vec<_>>>()?;
+        (centre, sweeps, train)
+    };
+    let fe_sha256 = fitted_fe_sha256(set_dir, &fitted)?;
+    Ok(FitData { campaign, centre, sweeps, train, fe_sha256 })
+}
+
+/// Every fitted pose has a result and it is current (the manifest's record of the spec).
+fn check_fitted_runs_current(runs: &FeRuns<'_>, fitted: &[PoseSpec]) -> Result<()> {
+    let (set_dir, campaign) = (runs.set_dir, runs.campaign);
     let missing: Vec<&str> = fitted.iter().filter(|p| !run_path(set_dir, p).is_file()).map(|p| p.name.as_str()).collect();
     if !missing.is_empty() {
         bail!(
@@ -213,10 +258,8 @@ fn load_fit_data_in(set_dir: &Path, form: Option<ModelForm>) -> Result<FitData> 
             set_dir.display()
         );
     }
-
-    let manifest = read_set_manifest(set_dir)?;
     let stale: Vec<String> =
-        fitted.iter().filter_map(|p| stale_reason(&manifest, &campaign, p).map(|why| format!("{}: {why}", p.name))).collect();
+        fitted.iter().filter_map(|p| stale_reason(runs.manifest(), campaign, p).map(|why| format!("{}: {why}", p.name))).collect();
     if !stale.is_empty() {
         bail!(
             "{} of the {} fitted FE runs in {} are stale:\n  {}\n(run `needle fe run --set {}`: it solves exactly the poses whose result is not current)",
@@ -227,7 +270,11 @@ fn load_fit_data_in(set_dir: &Path, form: Option<ModelForm>) -> Result<FitData> 
             set_dir.display()
         );
     }
+    Ok(())
+}
 
+/// The run of the one pose with role centre, at x = z = theta_x = theta_z = 0.
+fn centre_run(runs: &FeRuns<'_>, spec_path: &Path, fitted: &[PoseSpec]) -> Result<Run> {
     let centres: Vec<&PoseSpec> = fitted.iter().filter(|p| p.role == Role::Centre).collect();
     let centre_pose = match centres.as_slice() {
         [one] => (*one).clone(),
@@ -236,13 +283,18 @@ fn load_fit_data_in(set_dir: &Path, form: Option<ModelForm>) -> Result<FitData> 
     if centre_pose.x_mm != 0.0 || centre_pose.z_mm != 0.0 || centre_pose.theta_x_deg != 0.0 || centre_pose.theta_z_deg != 0.0 {
         bail!("{}: pose {:?} (role centre) is not at x = z = theta_x = theta_z = 0", spec_path.display(), centre_pose.name);
     }
-    let centre = read_run(set_dir, &campaign, &centre_pose)?;
+    runs.read(&centre_pose)
+}
 
+/// Each sweep's points (the centre run at 0 first), sorted by the swept value: every
+/// sweep pose varies only its own input, within (0, half range], and each sweep has at
+/// least [`NCOEF`] distinct values.
+fn sweep_points(runs: &FeRuns<'_>, spec_path: &Path, fitted: &[PoseSpec], centre: &Run) -> Result<[Vec<SweepPoint>; 4]> {
     let mut sweeps: [Vec<SweepPoint>; 4] = Default::default();
     for k in Sweep::ALL {
         sweeps[k.index()].push(SweepPoint { value: 0.0, run: centre.clone() });
     }
-    for pose in &fitted {
+    for pose in fitted {
         let Some(k) = sweep_of(pose.role) else { continue };
         let (v, others) = sweep_value(pose, k);
         if others != 0.0 {
@@ -262,7 +314,7 @@ fn load_fit_data_in(set_dir: &Path, form: Option<ModelForm>) -> Result<FitData> 
                 k.half_range()
             );
         }
-        let run = read_run(set_dir, &campaign, pose)?;
+        let run = runs.read(pose)?;
         sweeps[k.index()].push(SweepPoint { value: v, run });
     }
     for k in Sweep::ALL {
@@ -279,10 +331,7 @@ fn load_fit_data_in(set_dir: &Path, form: Option<ModelForm>) -> Result<FitData> 
             );
         }
     }
-
-    let train = fitted.iter().filter(|p| p.role == Role::Train).map(|p| read_run(set_dir, &campaign, p)).collect::<Result<Vec<_>>>()?;
-    let fe_sha256 = fitted_fe_sha256(set_dir, &fitted)?;
-    Ok(FitData { campaign, centre, sweeps, train, fe_sha256 })
+    Ok(sweeps)
 }
 
 /// `fe_sha256` of the runs of `poses` in `set_dir` (their `<pose>.csv` files).
@@ -344,6 +393,10 @@ pub fn load_training_runs(set_dir: &Path) -> Result<(Campaign, Vec<Run>, Vec<Unu
     Ok((campaign, runs, unusable))
 }
 
+/// How [`Unusable::why`] starts for a pose that failed every attempt (it has a partial
+/// record).
+pub const FAILED_PREFIX: &str = "no result;";
+
 /// Why a pose has no result when the campaign kept a record of it (issue 42, item 4:
 /// `<set>/fe/<pose>.partial.toml`, written when every attempt failed): the depth reached
 /// and its attempts by class; `None` without a record of the current spec.
@@ -355,7 +408,7 @@ fn failed_record(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Option
         return None;
     }
     Some(format!(
-        "no result; its furthest failed attempt reached {} of {} mm; {}",
+        "{FAILED_PREFIX} its furthest failed attempt reached {} of {} mm; {}",
         r.reached_depth_mm,
         r.depth_mm,
         failures::summary(&failures::failures_from_record(&r.failure))
@@ -364,7 +417,7 @@ fn failed_record(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Option
 
 fn load_runs_where(set_dir: &Path, keep: impl Fn(Role) -> bool) -> Result<(Campaign, Vec<Run>, Vec<Unusable>)> {
     let (campaign, _) = spec::load(set_dir)?;
-    let manifest = read_set_manifest(set_dir)?;
+    let fe = FeRuns::open(set_dir, &campaign)?;
     let mut runs = Vec::new();
     let mut unusable = Vec::new();
     for pose in campaign.poses() {
@@ -374,10 +427,10 @@ fn load_runs_where(set_dir: &Path, keep: impl Fn(Role) -> bool) -> Result<(Campa
         if !run_path(set_dir, &pose).is_file() {
             let why = failed_record(set_dir, &campaign, &pose).unwrap_or_else(|| "no result file".into());
             unusable.push(Unusable { pose, why });
-        } else if let Some(why) = stale_reason(&manifest, &campaign, &pose) {
+        } else if let Some(why) = stale_reason(fe.manifest(), &campaign, &pose) {
             unusable.push(Unusable { pose, why });
         } else {
-            runs.push(read_run(set_dir, &campaign, &pose)?);
+            runs.push(fe.read(&pose)?);
         }
     }
     Ok((campaign, runs, unusable))

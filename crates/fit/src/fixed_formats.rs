@@ -28,6 +28,8 @@ pub struct TablesFixed {
     /// coefficients (`[i]` goes to `A_i`) and their fractional bits `F` (empty for the
     /// paper form).
     pub cross: [Vec<CrossTermFixed>; COMPONENT_COUNT],
+    /// The set's unsolved region (`unsolved.toml`; empty: no pose is flagged).
+    pub unsolved: Vec<crate::unsolved::Entry>,
 }
 
 /// One cross term in fixed point: exponents of (x, z, theta_x, theta_z), integer
@@ -71,6 +73,13 @@ fn row_format(row: &[f64; NCOEF]) -> Option<(u32, [i64; NCOEF], i64)> {
 }
 
 impl TablesFixed {
+    /// The same tables with the unsolved region `entries` (`FE_UNSOLVED` in the status).
+    #[must_use]
+    pub fn with_unsolved(mut self, entries: Vec<crate::unsolved::Entry>) -> Self {
+        self.unsolved = entries;
+        self
+    }
+
     /// Quantise `model` and choose its formats.
     ///
     /// # Errors
@@ -83,6 +92,7 @@ impl TablesFixed {
             baseline: [[0; NCOEF]; COMPONENT_COUNT],
             acc_frac: [0; COMPONENT_COUNT],
             cross: Default::default(),
+            unsolved: Vec::new(),
         };
         if let Some(k) = &model.cross {
             for (c, terms) in k.terms.terms.iter().enumerate() {

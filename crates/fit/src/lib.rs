@@ -5,10 +5,11 @@
 //!
 //! Pipeline: [`data::load_fit_data`] reads the centre and sweep runs, [`model::fit`] fits
 //! the paper model by least squares ([`lsq`]) in normalised variables,
-//! [`model_file::to_toml`] writes it, [`golden::to_csv`] evaluates it with this crate's
-//! own f32 implementation of the contract ([`eval_f32`]), [`golden_fixed::to_csv`] with its
-//! own fixed-point implementation ([`fixed_formats`], [`eval_fixed`]). [`validate`] compares the
-//! model ([`eval_f64`], [`eval_f32`]) with the validation runs, and [`error_trend`] tells
+//! [`model_file::to_toml`] writes it, [`golden::float32::to_csv`] evaluates it with this
+//! crate's own f32 implementation of the contract ([`eval::float32`]),
+//! [`golden::fixed::to_csv`] with its own fixed-point implementation ([`fixed_formats`],
+//! [`eval::fixed`]). [`validate`] compares the model ([`eval::float64`],
+//! [`eval::float32`]) with the validation runs, and [`error_trend`] tells
 //! whether its errors follow the tilt or the offset.
 #![forbid(unsafe_code)]
 
@@ -20,20 +21,15 @@ pub mod data;
 pub mod depth_extension;
 pub mod depth_floor;
 pub mod error_trend;
-pub mod eval_f32;
-pub mod eval_f64;
-pub mod eval_fixed;
-pub mod eval_rate_f32;
-pub mod eval_rate_f64;
+pub mod eval;
 pub mod fixed_formats;
 pub mod golden;
-pub mod golden_fixed;
-pub mod golden_stiffness;
-pub mod golden_stiffness_fixed;
 pub mod lsq;
 pub mod model;
 pub mod model_file;
+pub mod model_file_error;
 pub mod poly;
+pub mod unsolved;
 pub mod validate;
 
 use anyhow::Result;
@@ -68,6 +64,10 @@ pub struct FitOutput {
     pub golden_stiffness_fixed_csv: String,
     /// The text of `depth-extension.toml`, when the set has a deep centre run.
     pub depth_extension_toml: Option<String>,
+    /// The unsolved region, from the set's FE records.
+    pub unsolved: unsolved::Region,
+    /// The text of `unsolved.toml`.
+    pub unsolved_toml: String,
 }
 
 impl FitOutput {
@@ -79,6 +79,7 @@ impl FitOutput {
             (GOLDEN_FIXED_FILE, &self.golden_fixed_csv),
             (GOLDEN_STIFFNESS_FILE, &self.golden_stiffness_csv),
             (GOLDEN_STIFFNESS_FIXED_FILE, &self.golden_stiffness_fixed_csv),
+            (unsolved::FILE, &self.unsolved_toml),
         ];
         if let Some(text) = &self.depth_extension_toml {
             files.push((depth_extension::FILE, text));
@@ -110,12 +111,14 @@ pub fn fit_set(set_dir: &Path) -> Result<FitOutput> {
             .map(|r| format!("{} (replaced by {})", r.pose, data.campaign.replacement_of(&r.pose).unwrap_or_default())),
     );
     let model_toml = model_file::to_toml(&model, &left_out);
-    let tables = eval_f32::Tables32::from_model(&model);
-    let golden_csv = golden::to_csv(&tables);
-    let golden_stiffness_csv = golden_stiffness::to_csv(&tables);
-    let fixed = fixed_formats::TablesFixed::from_model(&model)?;
-    let golden_fixed_csv = golden_fixed::to_csv(&fixed)?;
-    let golden_stiffness_fixed_csv = golden_stiffness_fixed::to_csv(&fixed)?;
+    let region = unsolved::region(set_dir)?;
+    let unsolved_toml = unsolved::to_toml(&model.set, &region);
+    let tables = eval::float32::Tables32::from_model(&model).with_unsolved(region.entries());
+    let golden_csv = golden::float32::to_csv(&tables);
+    let golden_stiffness_csv = golden::stiffness_float32::to_csv(&tables);
+    let fixed = fixed_formats::TablesFixed::from_model(&model)?.with_unsolved(region.entries());
+    let golden_fixed_csv = golden::fixed::to_csv(&fixed)?;
+    let golden_stiffness_fixed_csv = golden::stiffness_fixed::to_csv(&fixed)?;
     let depth_extension_toml = depth_extension::fit(set_dir)?.map(|e| depth_extension::to_toml(&e));
     Ok(FitOutput {
         model,
@@ -125,6 +128,8 @@ pub fn fit_set(set_dir: &Path) -> Result<FitOutput> {
         golden_stiffness_csv,
         golden_stiffness_fixed_csv,
         depth_extension_toml,
+        unsolved: region,
+        unsolved_toml,
     })
 }
 

@@ -7,7 +7,7 @@ use super::coupled::FOLDS;
 use super::cross_terms::{monomials, CrossForm, CrossTerms, Exponents, CANDIDATES};
 use super::model::{Baseline, Coupled, Deviation, Model};
 use crate::contract::COMPONENT_COUNT;
-use anyhow::{bail, Result};
+use crate::model_file_error::ModelFileError;
 use needle_fe::spec::ModelForm;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -141,8 +141,8 @@ fn write_coupled(s: &mut String, c: &Coupled) {
 /// # Errors
 /// As [`needle_codegen::parse_model_str`]; a coupled form that is not one of the
 /// fitter's [`CANDIDATES`] or whose `[[cross]]` entries are not its monomials in order.
-pub fn parse(text: &str, path: &Path) -> Result<Model> {
-    let m = needle_codegen::parse_model_str(text, path).map_err(|e| anyhow::anyhow!("{e}"))?;
+pub fn parse(text: &str, path: &Path) -> Result<Model, ModelFileError> {
+    let m = needle_codegen::parse_model_str(text, path)?;
     let mut baseline = [Baseline::default(); COMPONENT_COUNT];
     for (dst, b) in baseline.iter_mut().zip(&m.baseline) {
         *dst = Baseline { coeffs: b.coeffs, residual_rms: b.residual_rms, residual_max: b.residual_max };
@@ -160,14 +160,10 @@ pub fn parse(text: &str, path: &Path) -> Result<Model> {
 
 /// The coupled form as the fitter holds it: the form one of [`CANDIDATES`], every
 /// monomial of it per component in the fitter's order ([`monomials`]).
-fn coupled(c: &needle_codegen::Coupled, cross: &[needle_codegen::Cross], p: &str) -> Result<Coupled> {
+fn coupled(c: &needle_codegen::Coupled, cross: &[needle_codegen::Cross], p: &str) -> Result<Coupled, ModelFileError> {
     let form = CrossForm { max_degree: c.max_degree, depth_degree: c.depth_degree };
     if !CANDIDATES.contains(&form) {
-        bail!(
-            "{p}: [coupled] max_degree = {}, depth_degree = {}: not one of the forms the fitter chooses from",
-            c.max_degree,
-            c.depth_degree
-        );
+        return Err(ModelFileError::UnknownForm { path: p.to_string(), max_degree: c.max_degree, depth_degree: c.depth_degree });
     }
     let mut terms: [Vec<(Exponents, Vec<f64>)>; COMPONENT_COUNT] = Default::default();
     let mut entries = cross.iter();
@@ -175,23 +171,35 @@ fn coupled(c: &needle_codegen::Coupled, cross: &[needle_codegen::Cross], p: &str
         for e in monomials(comp, form.max_degree) {
             match entries.next() {
                 Some(x) if x.component == comp && x.exponents == e => out.push((e, x.coeffs.clone())),
-                Some(x) => bail!(
-                    "{p}:{}: [[cross]] {} with exponents {:?}: expected {} with exponents {e:?} here (per component, monomials in the fitter's order)",
-                    x.line,
-                    COMPONENTS[x.component],
-                    x.exponents,
-                    COMPONENTS[comp]
-                ),
-                None => bail!(
-                    "{p}: {} [[cross]] entries; {} {e:?} is missing (per component, monomials in the fitter's order)",
-                    cross.len(),
-                    COMPONENTS[comp]
-                ),
+                Some(x) => {
+                    return Err(ModelFileError::CrossTerms {
+                        at: format!("{p}:{}", x.line),
+                        message: format!(
+                            "[[cross]] {} with exponents {:?}: expected {} with exponents {e:?} here (per component, monomials in the fitter's order)",
+                            COMPONENTS[x.component],
+                            x.exponents,
+                            COMPONENTS[comp]
+                        ),
+                    })
+                }
+                None => {
+                    return Err(ModelFileError::CrossTerms {
+                        at: p.to_string(),
+                        message: format!(
+                            "{} [[cross]] entries; {} {e:?} is missing (per component, monomials in the fitter's order)",
+                            cross.len(),
+                            COMPONENTS[comp]
+                        ),
+                    })
+                }
             }
         }
     }
     if let Some(x) = entries.next() {
-        bail!("{p}:{}: [[cross]] {} {:?}: more entries than the form has", x.line, COMPONENTS[x.component], x.exponents);
+        return Err(ModelFileError::CrossTerms {
+            at: format!("{p}:{}", x.line),
+            message: format!("[[cross]] {} {:?}: more entries than the form has", COMPONENTS[x.component], x.exponents),
+        });
     }
     Ok(Coupled { terms: CrossTerms { form, terms }, training_runs: c.training_runs, cv_rms_pct: c.cv_rms_pct, scale: c.scale })
 }
@@ -200,8 +208,46 @@ fn coupled(c: &needle_codegen::Coupled, cross: &[needle_codegen::Cross], p: &str
 ///
 /// # Errors
 /// The file cannot be read, or as [`parse`].
-pub fn read(path: &Path) -> Result<Model> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| anyhow::anyhow!("{}: cannot read the model ({e}); run `needle fit` first", path.display()))?;
+pub fn read(path: &Path) -> Result<Model, ModelFileError> {
+    let text = std::fs::read_to_string(path).map_err(|error| ModelFileError::Read { path: path.to_path_buf(), error })?;
     parse(&text, path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{parse, read};
+    use crate::model_file_error::ModelFileError;
+    use std::path::Path;
+
+    fn committed() -> String {
+        std::fs::read_to_string(crate::workspace_root().join("coeffs/default/model.toml")).expect("coeffs/default/model.toml")
+    }
+
+    /// Each kind of refusal is its own variant; the messages start with the file.
+    #[test]
+    fn refusals_are_told_apart_by_their_variant() {
+        let p = Path::new("model.toml");
+        let text = committed();
+        assert!(parse(&text, p).is_ok(), "the committed model is read");
+        let r = read(Path::new("/nonexistent/model.toml"));
+        assert!(matches!(&r, Err(ModelFileError::Read { .. })), "{r:?}");
+        let r = parse("format = \n", p);
+        assert!(matches!(&r, Err(ModelFileError::Invalid(e)) if e.line == Some(1)), "{r:?}");
+        let form = text.replacen("\nmax_degree = 2\n", "\nmax_degree = 9\n", 1);
+        assert_ne!(form, text, "the test's edit did not apply");
+        // the generator bounds the form to the fitter's candidates already: its refusal
+        let r = parse(&form, p);
+        assert!(matches!(&r, Err(ModelFileError::Invalid(e)) if e.line.is_some()), "{r:?}");
+        let swapped = text.replacen("exponents = [1, 0, 0, 1]", "exponents = [0, 9, 9, 0]", 1).replacen(
+            "exponents = [0, 1, 1, 0]",
+            "exponents = [1, 0, 0, 1]",
+            1,
+        );
+        let swapped = swapped.replacen("exponents = [0, 9, 9, 0]", "exponents = [0, 1, 1, 0]", 1);
+        assert_ne!(swapped, text, "the test's edit did not apply");
+        let r = parse(&swapped, p);
+        assert!(matches!(&r, Err(ModelFileError::CrossTerms { at, .. }) if at.starts_with("model.toml:")), "{r:?}");
+        let msg = r.err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(msg.starts_with("model.toml:"), "file:line first: {msg}");
+    }
 }

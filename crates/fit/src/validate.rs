@@ -32,11 +32,11 @@ use super::contract::{unit, COMPONENTS};
 use super::data::{fitted_fe_sha256, fitted_poses, load_paper_data, load_validation_runs, run_path, Run};
 use super::depth_floor::{depth_floor, DepthFloor};
 use super::error_trend::{trend, ErrorTrend};
-use super::eval_f32::{eval as eval32, Tables32};
-use super::eval_f64::{eval as eval64, eval_paper};
 use super::model::{rms_max, Model};
 use super::model_file;
 use crate::contract::{COMPONENT_COUNT, DEGREE};
+use crate::eval::float32::{eval as eval32, Tables32};
+use crate::eval::float64::{eval as eval64, eval_paper};
 use anyhow::Result;
 use needle_fe::spec::Role;
 use serde::Serialize;
@@ -157,6 +157,10 @@ pub struct Report {
     /// Validation poses without a usable result, as `name (role, why)`: no result file, or
     /// a stale one (solved from another spec, see `data::stale_reason`).
     pub missing: Vec<String>,
+    /// The held-out poses (table2, lhs) without a result, each with whether the FE could
+    /// not solve it (a partial record: every attempt failed) and whether the model's
+    /// unsolved region (`unsolved.toml`) holds its pose; every one counts as missed.
+    pub unsolved: Vec<UnsolvedRun>,
     /// Largest |f32 - f64| model difference at the validation points, in % of the run's
     /// peak |Fy| scale.
     pub f32_vs_f64_max_pct: f64,
@@ -171,6 +175,25 @@ pub struct Report {
     pub error_trend: Option<ErrorTrend>,
     /// The depth degree of the runs' floors (the contract's, 4, unless asked otherwise).
     pub floor_degree: usize,
+}
+
+/// A held-out run without a result.
+#[derive(Debug, Clone, Serialize)]
+pub struct UnsolvedRun {
+    /// Pose name.
+    pub name: String,
+    /// `table2` or `lhs`.
+    pub role: String,
+    /// `[x_mm, z_mm, theta_x_deg, theta_z_deg]`.
+    pub pose: [f64; 4],
+    /// Every attempt failed: the campaign kept a partial record (`fe/<pose>.partial.toml`).
+    pub failed_every_attempt: bool,
+    /// Why there is no result: the depth reached and the failures by class, or `no
+    /// result file`, or why the result is stale.
+    pub why: String,
+    /// The shallowest depth (0, 0.3, ..., 6 mm) at which the model flags the pose
+    /// `FE_UNSOLVED` (its unsolved region holds it), `None` when it never does.
+    pub flagged_from_mm: Option<f64>,
 }
 
 fn role_name(r: Role) -> &'static str {
@@ -308,6 +331,27 @@ pub fn validate_with(set_dir: &Path, floor_degree: usize) -> Result<Report> {
     };
     let table2_goal_met = goal(Role::Table2);
     let lhs_goal_met = goal(Role::Lhs);
+    let flag_tables = Tables32::from_model(&model).with_unsolved(read_region(set_dir)?);
+    let unsolved = missing
+        .iter()
+        .filter(|u| u.pose.role.is_validation())
+        .map(|u| {
+            let p = &u.pose;
+            let at = [p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg];
+            let flagged_from_mm = (0..=20).map(|k| 0.3 * f64::from(k)).find(|&d| {
+                let pose = [at[0] as f32, at[1] as f32, at[2] as f32, at[3] as f32, d as f32];
+                eval32(&flag_tables, pose).1 & crate::contract::STATUS_FE_UNSOLVED != 0
+            });
+            UnsolvedRun {
+                name: p.name.clone(),
+                role: role_name(p.role).to_string(),
+                pose: at,
+                failed_every_attempt: u.why.starts_with(super::data::FAILED_PREFIX),
+                why: u.why.clone(),
+                flagged_from_mm,
+            }
+        })
+        .collect();
     let judged: Vec<&RunReport> = reports.iter().filter(|r| r.goal_met.is_some()).collect();
     let error_trend =
         trend(&judged.iter().map(|r| r.pose).collect::<Vec<_>>(), &judged.iter().map(|r| r.worst_rms_pct).collect::<Vec<_>>());
@@ -318,6 +362,7 @@ pub fn validate_with(set_dir: &Path, floor_degree: usize) -> Result<Report> {
         goals: Goals::of(&model),
         runs: reports,
         missing: missing.iter().map(|u| format!("{} ({}, {})", u.pose.name, role_name(u.pose.role), u.why)).collect(),
+        unsolved,
         f32_vs_f64_max_pct: diff,
         table2_goal_met,
         lhs_goal_met,
@@ -325,6 +370,22 @@ pub fn validate_with(set_dir: &Path, floor_degree: usize) -> Result<Report> {
         error_trend,
         floor_degree,
     })
+}
+
+/// The balls of the set's unsolved region (`unsolved.toml`; none without the file).
+///
+/// # Errors
+/// The file is refused by the generator (with its line).
+fn read_region(set_dir: &Path) -> Result<Vec<crate::unsolved::Entry>> {
+    let path = set_dir.join(crate::unsolved::FILE);
+    if !path.is_file() {
+        return Ok(Vec::new());
+    }
+    let r = needle_codegen::unsolved::parse(&path)?;
+    Ok(r.balls
+        .iter()
+        .map(|b| crate::unsolved::Entry { centre_q15: b.centre_q15, radius_q15: b.radius_q15, depth_q16: b.depth_q16 })
+        .collect())
 }
 
 fn pass(b: bool) -> &'static str {
@@ -440,6 +501,7 @@ fn write_goals(s: &mut String, r: &Report) {
     if !r.missing.is_empty() {
         let _ = writeln!(s, "missing or stale FE runs (goal cannot be met): {}", r.missing.join(", "));
     }
+    write_unsolved(s, r);
     let g = &r.goals;
     let _ = writeln!(s, "goals of the {} form:", g.form);
     let _ = writeln!(
@@ -466,6 +528,31 @@ fn write_goals(s: &mut String, r: &Report) {
             "goal (reported, not the exit code): every component's RMS <= {stretch} % on table2 and lhs: {} (worst {w:.3} % over {} runs)",
             pass(w <= stretch),
             all.len()
+        );
+    }
+}
+
+/// The held-out runs without a result, beside the goals: those the FE could not solve
+/// (every attempt failed) and those not solved (yet), each with where the model's
+/// unsolved region flags its pose; all count as missed.
+fn write_unsolved(s: &mut String, r: &Report) {
+    let line = |u: &UnsolvedRun| {
+        let flag = match u.flagged_from_mm {
+            Some(d) => format!("FE_UNSOLVED from {d:.1} mm"),
+            None => "not in the unsolved region".to_string(),
+        };
+        format!("{} ({}; {flag})", u.name, u.role)
+    };
+    let failed: Vec<String> = r.unsolved.iter().filter(|u| u.failed_every_attempt).map(line).collect();
+    let open: Vec<String> = r.unsolved.iter().filter(|u| !u.failed_every_attempt).map(line).collect();
+    if !failed.is_empty() {
+        let _ = writeln!(s, "held-out runs the FE cannot solve (every attempt failed; counted as missed): {}", failed.join(", "));
+    }
+    if !open.is_empty() {
+        let _ = writeln!(
+            s,
+            "held-out runs without a result and no record of a failure (not solved yet; counted as missed): {}",
+            open.join(", ")
         );
     }
 }
@@ -524,5 +611,73 @@ fn worst(r: &Report, role: &str, f: fn(&RunReport) -> f64) -> String {
         "no runs".to_string()
     } else {
         format!("worst {:.3} % over {} runs", v.iter().copied().fold(0.0, f64::max), v.len())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::unsolved::{inside_f32, normalised, solved_inside, to_toml, FILE};
+    use needle_fe::spec;
+
+    /// A copy of the default set's spec, FE runs and model in a temporary folder.
+    fn temp_set(tag: &str) -> std::path::PathBuf {
+        let root = crate::workspace_root().join("coeffs/default");
+        let dir = std::env::temp_dir().join(format!("needle-fit-unsolved-{tag}-{}", std::process::id()));
+        let fe = dir.join("fe");
+        std::fs::create_dir_all(&fe).expect("temp set");
+        for f in ["campaign.toml", "model.toml"] {
+            std::fs::copy(root.join(f), dir.join(f)).expect("copy");
+        }
+        for e in std::fs::read_dir(root.join("fe")).expect("fe").flatten() {
+            let p = e.path();
+            if p.is_file() {
+                std::fs::copy(&p, fe.join(e.file_name())).expect("copy a run");
+            }
+        }
+        dir
+    }
+
+    /// Issue 42, item 4: a held-out pose that failed every attempt joins the region from
+    /// its partial record (deeper than it reached), `needle validate` names it beside the
+    /// goals as a run the FE cannot solve, and no solved run lies in any ball.
+    #[test]
+    fn a_partial_record_joins_the_region_and_validate_names_it() {
+        let dir = temp_set("record");
+        let (campaign, _) = spec::load(&dir).expect("spec");
+        let pose = campaign.poses().into_iter().find(|p| p.name == "t2-b").expect("t2-b");
+        let failed = needle_fe::partial::Failed {
+            campaign: &campaign,
+            pose: &pose,
+            mesh: &campaign.campaign.mesh,
+            engine: ("febio", "4.11.0"),
+            failure:
+                "febio4 exit code 1 after 6 of 20 steps (t = 1.95 mm): Max nr of reformations reached. (failed to converge at time : 1.95)",
+        };
+        let reached: Vec<[f64; 6]> = (1..=6).map(|k| [0.0, 0.001 * f64::from(k), 0.0, 0.0, 0.0, 0.0]).collect();
+        needle_fe::partial::write(&dir.join("fe"), &failed, &reached).expect("partial record");
+        let r = crate::unsolved::region(&dir).expect("region");
+        let t2b = r.failed.iter().find(|f| f.pose == "t2-b").expect("t2-b is in the region").clone();
+        assert_eq!((t2b.source.as_str(), t2b.reached_depth_mm, t2b.depth_q16), ("fe/t2-b.partial.toml", Some(1.8), 117_965));
+        assert!(t2b.cause.contains("max reformations"), "{}", t2b.cause);
+        assert!(r.failed.iter().all(|f| f.pose != "lhs-04"), "no record, not fitted without: not in the region");
+        assert!(solved_inside(&r).is_empty(), "a ball reaches half way to the nearest solved run: {:?}", solved_inside(&r));
+        let entries = r.entries();
+        let n = normalised(t2b.at).map(|v| v as f32);
+        assert!(!inside_f32(&entries, n, 1.8) && inside_f32(&entries, n, 2.1), "deeper than it reached only");
+        // the model carries it once `needle fit` writes unsolved.toml; validate then says so
+        std::fs::write(dir.join(FILE), to_toml("default", &r)).expect("unsolved.toml");
+        let report = validate(&dir).expect("validate");
+        let table = to_table(&report);
+        let _ = std::fs::remove_dir_all(&dir);
+        let u = report.unsolved.iter().find(|u| u.name == "t2-b").expect("t2-b reported");
+        assert!(u.failed_every_attempt && u.flagged_from_mm == Some(2.1), "{u:?}");
+        assert!(
+            table.contains(
+                "held-out runs the FE cannot solve (every attempt failed; counted as missed): t2-b (table2; FE_UNSOLVED from 2.1 mm)"
+            ),
+            "{table}"
+        );
+        assert!(!report.table2_goal_met, "an unsolved held-out run still counts as missed");
     }
 }

@@ -4,14 +4,14 @@
 //! the FE verification (flat punch, mesh study) when `fe/verify.toml` exists.
 //!
 //! Model curves are the f64 evaluation of the set's `model.toml`
-//! ([`needle_fit::eval_f64`]), FE points its current runs.
+//! ([`needle_fit::eval::float64`]), FE points its current runs.
 
 use super::panel::{Panel, Series, Style, COMPONENT_COLOURS};
 use anyhow::Result;
 use needle_fe::spec::Role;
 use needle_fit::contract::{unit, Sweep, COMPONENTS, DEPTH_MAX_MM};
 use needle_fit::data::{load_fit_data, load_validation_runs, Run};
-use needle_fit::eval_f64::eval;
+use needle_fit::eval::float64::eval;
 use needle_fit::model::Model;
 use plotters::style::RGBColor;
 use std::path::Path;

@@ -31,7 +31,8 @@ static OUT: [AtomicU32; COMPONENT_COUNT] = [const { AtomicU32::new(0) }; COMPONE
 /// Evaluates the wrench at `x_mm`, `z_mm` (entry point), `theta_x_deg`, `theta_z_deg`
 /// (tilt) and `depth_mm`, exactly as the firmware's `needle_haptics::wrench`; stores it
 /// at [`needle_out`] and returns the status bits (`Status`: saturation flags 0x1f,
-/// `NO_MODEL` 0x40, `ERROR` 0x80).
+/// `FE_UNSOLVED` 0x20 (the pose lies where the set's FE could not solve; the wrench is
+/// still the model's), `NO_MODEL` 0x40, `ERROR` 0x80).
 #[no_mangle]
 pub extern "C" fn needle_eval(x_mm: f32, z_mm: f32, theta_x_deg: f32, theta_z_deg: f32, depth_mm: f32) -> u32 {
     let e = wrench(&Pose::new(x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm));

@@ -22,7 +22,7 @@ pub fn golden_rows() -> Vec<GoldenRow> {
     let path = Path::new(model_info::SET_DIR).join("golden-f32.csv");
     let text = std::fs::read_to_string(&path)
         .unwrap_or_else(|e| panic!("{}: {e}: run `needle fit --set {}`", path.display(), model_info::SET_DIR));
-    let rows = needle_fit::golden::parse_csv(&text, &path).unwrap_or_else(|e| panic!("{e:#}"));
+    let rows = needle_fit::golden::float32::parse_csv(&text, &path).unwrap_or_else(|e| panic!("{e:#}"));
     rows.into_iter()
         .enumerate()
         .map(|(i, r)| {

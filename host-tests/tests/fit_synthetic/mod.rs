@@ -95,6 +95,7 @@ fn synthetic_entry(campaign: &spec::Campaign, pose: &PoseSpec) -> ManifestEntry 
         batch_job: None,
         replaces: None,
         replaced_because: None,
+        viscoelastic: None,
     }
 }
 

@@ -8,13 +8,15 @@
 //! friction level) saturate, so an absurd stack gives a saturated wrench, never a
 //! wrapped one.
 
+use crate::fixed::arith::sat_mul;
+
 /// A vector of the block frame (mm in Q16 for points, Q30 for directions).
 pub(super) type Vec3 = [i64; 3];
 
 /// `floor(a b / 2^s)`, saturating.
 #[inline(always)]
 pub(super) fn mul_shr(a: i64, b: i64, s: u32) -> i64 {
-    a.saturating_mul(b) >> s
+    sat_mul(a, b) >> s
 }
 
 /// `x a / 2^30` for a direction component `a` (Q30, `|a| <= 2^30`) and any `x` below

@@ -34,7 +34,12 @@ pub use stack::{
     STIFFNESS_SCALE_MAX, TOTAL_THICKNESS_MAX_MM, VISCOUS_MAX_Q16,
 };
 
+use super::arith::sat_mul;
 use super::depth_extension::saturate_i32;
+#[cfg(not(feature = "viscoelastic"))]
+use super::viscoelastic::identity::{QlvCoefficients, QlvState};
+#[cfg(feature = "viscoelastic")]
+use super::viscoelastic::{QlvCoefficients, QlvState};
 use super::{extended_wrench, Pose, Wrench};
 use crate::insertion::{InsertionError, Phase};
 use crate::Status;
@@ -89,6 +94,10 @@ pub struct Insertion<'a> {
     preload_q16: [i64; 6],
     last_depth_q16: Option<i64>,
     velocity_q16: i64,
+    /// Per layer the relaxation's per-tick coefficients (computed once, in `new`).
+    qlv: [QlvCoefficients; MAX_LAYERS],
+    /// The viscoelastic filter of the deflected boundary's wrench (µN Q16).
+    qlv_state: QlvState,
 }
 
 /// What [`Insertion::deflect`] found.
@@ -131,6 +140,17 @@ impl<'a> Insertion<'a> {
         if !stack.layers().iter().all(|l| layer_ok(l) && l.stiffness_scale_q16 <= max_scale) || stack.inv_similarity_q30 <= 0 {
             return Err(InsertionError::Value);
         }
+        #[cfg_attr(not(feature = "viscoelastic"), allow(unused_mut))]
+        let mut qlv = [QlvCoefficients::NONE; MAX_LAYERS];
+        #[cfg(feature = "viscoelastic")]
+        for (k, l) in qlv.iter_mut().zip(stack.layers()) {
+            // terms out of the integer ranges (or a zero period: `Config` below)
+            *k = QlvCoefficients::new(&l.prony, config.period_us).ok_or(if config.period_us == 0 {
+                InsertionError::Config
+            } else {
+                InsertionError::Value
+            })?;
+        }
         let mut scales_q16 = [0; MAX_LAYERS];
         for (s, l) in scales_q16.iter_mut().zip(stack.layers()) {
             // <= 2^30 (checked above)
@@ -152,6 +172,8 @@ impl<'a> Insertion<'a> {
             preload_q16: [0; 6],
             last_depth_q16: None,
             velocity_q16: 0,
+            qlv,
+            qlv_state: QlvState::REST,
         };
         insertion.update_gains();
         Ok(insertion)
@@ -206,6 +228,7 @@ impl<'a> Insertion<'a> {
         self.track_end_q16 = 0;
         self.track = None;
         self.preload_q16 = [0; 6];
+        self.qlv_state.reset();
     }
 
     /// One tick: the pose in, the wrench out (the f32 model's
@@ -263,13 +286,18 @@ impl<'a> Insertion<'a> {
         q
     }
 
-    /// The deflection of the first intact boundary, with the punctures it causes.
+    /// The deflection of the first intact boundary, with the punctures it causes; the
+    /// boundary's wrench through the layer's viscoelastic filter, reset at a puncture and
+    /// when no boundary is deflected (the f32 model's rules).
     fn deflect(&mut self, pose: &Pose, depth: i64, a: Vec3, entry: Vec3, bounds: &[i64; MAX_LAYERS + 1]) -> Deflected {
         let mut punctures = 0u8;
         while self.punctured < self.stack.count {
-            let (Some(&q), Some(layer), Some(&[gf, gm])) =
-                (bounds.get(self.punctured), self.stack.layers.get(self.punctured), self.gains_q16.get(self.punctured))
-            else {
+            let (Some(&q), Some(layer), Some(&[gf, gm]), Some(qlv)) = (
+                bounds.get(self.punctured),
+                self.stack.layers.get(self.punctured),
+                self.gains_q16.get(self.punctured),
+                self.qlv.get(self.punctured),
+            ) else {
                 break;
             };
             if depth <= q {
@@ -277,16 +305,19 @@ impl<'a> Insertion<'a> {
             }
             let e = self.surrogate(pose, entry, depth - q);
             let [fx, fy, fz, mx, my, mz] = e.wrench.to_array().map(i64::from);
-            let f = [fx, fy, fz].map(|c| c.saturating_mul(gf));
-            let moments = [mx, my, mz].map(|c| c.saturating_mul(gm));
-            let axial = dot(f, a);
-            let [ax, ay, az] = a;
+            let f = [fx, fy, fz].map(|c| sat_mul(c, gf));
+            let moments = [mx, my, mz].map(|c| sat_mul(c, gm));
+            let [vfx, vfy, vfz, vmx, vmy, vmz] = self.qlv_state.step(qlv, [f[0], f[1], f[2], moments[0], moments[1], moments[2]]);
             let [px, py, pz, pmx, pmy, pmz] = self.preload_q16;
-            if axial.saturating_add(self.carried_cutting_q16()) < layer.puncture_force_q16 {
+            if dot([vfx, vfy, vfz], a).saturating_add(self.carried_cutting_q16()) < layer.puncture_force_q16 {
                 let sum = |p: i64, x: i64| p.saturating_add(x);
-                let total = [sum(px, f[0]), sum(py, f[1]), sum(pz, f[2]), sum(pmx, moments[0]), sum(pmy, moments[1]), sum(pmz, moments[2])];
+                let total = [sum(px, vfx), sum(py, vfy), sum(pz, vfz), sum(pmx, vmx), sum(pmy, vmy), sum(pmz, vmz)];
                 return Deflected { wrench_q16: total, status: e.status, punctures };
             }
+            // the stored viscous force is released; the elastic lateral part stays
+            self.qlv_state.reset();
+            let axial = dot(f, a);
+            let [ax, ay, az] = a;
             // puncture: the axial force goes, the lateral force and the moments stay
             if self.track.is_none() {
                 self.track = Some(Track { entry_q16: entry, axis_q30: a });
@@ -299,6 +330,7 @@ impl<'a> Insertion<'a> {
             self.track_end_q16 = depth;
             punctures = punctures.saturating_add(1);
         }
+        self.qlv_state.reset();
         Deflected { wrench_q16: self.preload_q16, status: Status::OK, punctures }
     }
 

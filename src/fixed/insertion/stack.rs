@@ -12,7 +12,10 @@
 //! | puncture and cutting force | µN × 2^16 |
 //! | friction levels | µN per mm of shaft × 2^16; the stick band's slope and the viscous term µN/mm per mm/s × 2^16 |
 //! | track stiffness | µN/mm per mm of shaft × 2^8 |
+//! | Prony terms | `g` × 2^16, `tau` µs ([`PronyTerms::from_f32`]) |
 use crate::fixed::depth_extension::round_i64;
+#[cfg(feature = "viscoelastic")]
+use crate::fixed::viscoelastic::PronyTerms;
 use crate::insertion as f32_insertion;
 
 /// Most layers a stack has.
@@ -82,6 +85,10 @@ pub struct Layer {
     pub friction: Karnopp,
     /// Lateral stiffness of the track, µN/mm per mm of shaft, Q8.
     pub track_stiffness_q8: i64,
+    /// The boundary's relaxation function ([`crate::fixed::viscoelastic`]); only with
+    /// the `viscoelastic` feature (an elastic build's layers carry none: flash).
+    #[cfg(feature = "viscoelastic")]
+    pub prony: PronyTerms,
 }
 
 /// A stack in integers: the layers and the needle's similarity to the FE needle.
@@ -176,6 +183,8 @@ impl Layer {
                 stick_band_q16: q16(l.friction.stick_band_mm_per_s),
             },
             track_stiffness_q8: round_i64(l.track_stiffness_n_per_mm2 as f64 * MICRO * 256.0),
+            #[cfg(feature = "viscoelastic")]
+            prony: PronyTerms::from_f32(&l.prony),
         }
     }
 }
@@ -188,14 +197,16 @@ const EMPTY_LAYER: Layer = Layer {
     cutting_per_speed_q16: 0,
     friction: Karnopp { static_per_speed_q16: 0, coulomb_q16: 0, viscous_q16: 0, stick_band_q16: 0 },
     track_stiffness_q8: 0,
+    #[cfg(feature = "viscoelastic")]
+    prony: PronyTerms::NONE,
 };
 
 impl Stack {
     /// The stack in integers; `count` 0 (which [`Insertion::new`](super::Insertion::new)
     /// refuses) for a stack with no layer or more than [`MAX_LAYERS`], a needle diameter
     /// whose `λ` is not within `1/SIMILARITY_MAX ..= SIMILARITY_MAX`, a stiffness scale
-    /// above [`STIFFNESS_SCALE_MAX`] or a total thickness above
-    /// [`TOTAL_THICKNESS_MAX_MM`]. The other checks (positive thickness, scale, ...) are
+    /// above [`STIFFNESS_SCALE_MAX`], a total thickness above [`TOTAL_THICKNESS_MAX_MM`]
+    /// or, without the `viscoelastic` feature, a layer with Prony terms. The other checks (positive thickness, scale, ...) are
     /// `Insertion::new`'s. `const`: the compiled-in stacks are converted at compile time.
     #[must_use]
     pub const fn from_f32(s: &f32_insertion::Stack<'static>) -> Self {
@@ -213,6 +224,10 @@ impl Stack {
             let [slot, free @ ..] = slots else { return refused };
             let scale = l.stiffness_scale as f64;
             if scale.is_nan() || scale > STIFFNESS_SCALE_MAX {
+                return refused;
+            }
+            // an elastic build's layers carry no terms: a layer with terms is refused
+            if cfg!(not(feature = "viscoelastic")) && l.prony.as_array().1 > 0 {
                 return refused;
             }
             total += l.thickness_mm as f64;

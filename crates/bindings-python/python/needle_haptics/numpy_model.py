@@ -27,7 +27,9 @@ SWEEPS = ("x", "z", "theta_x", "theta_z")
 HALF_RANGES = (12.0, 12.0, 15.0, 15.0)  # V_k, mm or degrees
 DEPTH_MAX_MM = 6.0
 SAT_BITS = (0x01, 0x02, 0x04, 0x08, 0x10)
+FE_UNSOLVED = 0x20
 ERROR = 0x80
+CROSS_SCALES = (1.0 / 12.0, 1.0 / 12.0, 1.0 / 15.0, 1.0 / 15.0)  # their nearest float32
 
 
 def _f32(hex_words: list[str]) -> npt.NDArray[np.float32]:
@@ -50,6 +52,9 @@ class NumpyModel:
     baseline: list[list[np.float32]]  # [c][i]
     deviation: list[list[tuple[bool, list[list[np.float32]]]]]  # [k][c] = (odd, rows[i][j])
     cross: list[tuple[int, list[int], list[np.float32]]]  # (c, exponents, coeffs)
+    # the unsolved region (unsolved.toml beside model.toml): per ball, the centre C / 2^15,
+    # the float32 nearest R^2 / 2^30 and the depth threshold Dq / 2^16 mm
+    unsolved: list[tuple[list[np.float32], np.float32, np.float32]]
 
     @staticmethod
     def load(set_dir: Optional[str] = None) -> "NumpyModel":
@@ -65,7 +70,18 @@ class NumpyModel:
             rows = [list(_f32(r)) for r in d["rows_f32"]]
             deviation[SWEEPS.index(d["sweep"])][index[d["component"]]] = (bool(d["odd"]), rows)
         cross = [(index[t["component"]], list(t["exponents"]), list(_f32(t["coeffs_f32"]))) for t in m.get("cross", [])]
-        return NumpyModel(baseline, deviation, cross)
+        unsolved: list[tuple[list[np.float32], np.float32, np.float32]] = []
+        region_path = os.path.join(set_dir or SET_DIR, "unsolved.toml")
+        if os.path.exists(region_path):
+            with open(region_path, "rb") as f:
+                region = tomllib.load(f)
+            for failed in region.get("failed", []):
+                r = int(failed["radius_q15"])
+                for c in failed["centres_q15"]:
+                    unsolved.append(
+                        ([F32(v / 32768.0) for v in c], F32((r * r) / 2.0**30), F32(int(failed["depth_q16"]) / 65536.0))
+                    )
+        return NumpyModel(baseline, deviation, cross, unsolved)
 
     def wrench(self, poses: npt.NDArray[np.float32]) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint8]]:
         """(wrench (n, 6) float32, status (n,) uint8) at every row of `poses` (n, 5) float32;
@@ -101,15 +117,19 @@ class NumpyModel:
                     acc = acc * u + ri
                 w = np.where(neg[k] & odd, w - acc, w + acc)
             out[:, c] = w
+        ns = [clamped[k] * F32(CROSS_SCALES[k]) for k in range(4)]
         if self.cross:
-            scales = [F32(1.0 / 12.0), F32(1.0 / 12.0), F32(1.0 / 15.0), F32(1.0 / 15.0)]
-            ns = [clamped[k] * scales[k] for k in range(4)]
             for c, exponents, coeffs in self.cross:
                 factors = [ns[k] for k, e in enumerate(exponents) for _ in range(e)]
                 m = factors[0]
                 for f in factors[1:]:
                     m = m * f
                 out[:, c] = out[:, c] + m * _horner(coeffs, u)
+        # the unsolved region (FE_UNSOLVED): on the clamped pose; the wrench is not changed
+        for centre, r2, depth in self.unsolved:
+            q = [ns[k] - centre[k] for k in range(4)]
+            s = ((q[0] * q[0] + q[1] * q[1]) + q[2] * q[2]) + q[3] * q[3]
+            status |= np.where((clamped[4] > depth) & (s < r2), np.uint8(FE_UNSOLVED), np.uint8(0))
         out[bad] = 0.0
         status[bad] = ERROR
         return out, status

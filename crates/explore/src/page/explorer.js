@@ -2,7 +2,7 @@
 // components, their status, the force-depth curve of the pose with the set's FE points
 // when the pose is one of its runs, and side views of needle and block.
 // Served by `needle explore` (crates/explore); no network, no framework.
-import { load, COMPONENTS, statusNames } from "./needle-wasm.mjs";
+import { load, COMPONENTS, FE_UNSOLVED, statusNames } from "./needle-wasm.mjs";
 
 // a component's unit from its name: "_n" newtons, "_nmm" newton millimetres
 const UNITS = Object.fromEntries(COMPONENTS.map((c) => [c, c.endsWith("_nmm") ? "N·mm" : "N"]));
@@ -93,7 +93,8 @@ function update() {
   const st = $("status");
   st.textContent = `${statusNames(e.status)} (0x${e.status.toString(16).padStart(2, "0")})`;
   st.dataset.bits = String(e.status);
-  st.className = e.status & 0x80 ? "error" : e.status & 0x1f ? "saturated" : "";
+  st.className = e.status & 0x80 ? "error" : e.status & 0x1f ? "saturated" : e.status & FE_UNSOLVED ? "unsolved" : "";
+  $("unsolved-note").hidden = !(e.status & FE_UNSOLVED);
   const args = INPUTS.map((i) => `${i.flag} ${pose[i.name]}`).join(" ");
   $("command").textContent = `needle eval --set ${set.set_arg} ${args}`;
   const pts = curve();
@@ -144,13 +145,24 @@ function drawPlot(pts, run) {
   g.strokeStyle = "#1f5fbf"; g.lineWidth = 2; g.beginPath();
   pts.forEach((p, i) => (i ? g.lineTo : g.moveTo).call(g, X(p.depth), Y(p.wrench[k])));
   g.stroke();
+  // the depths where the pose is in the unsolved region (FE_UNSOLVED): drawn over, dashed
+  g.strokeStyle = "#e67e22"; g.lineWidth = 4; g.setLineDash([6, 4]); g.beginPath();
+  pts.forEach((p, i) => {
+    const prev = pts[i - 1];
+    if (prev && p.status & FE_UNSOLVED && prev.status & FE_UNSOLVED) {
+      g.moveTo(X(prev.depth), Y(prev.wrench[k])); g.lineTo(X(p.depth), Y(p.wrench[k]));
+    }
+  });
+  g.stroke(); g.setLineDash([]);
+  const unsolved = pts.some((p) => p.status & FE_UNSOLVED);
   g.fillStyle = "#c0392b";
   for (const [dep, v] of fe) { g.beginPath(); g.arc(X(dep), Y(v), 3.5, 0, 2 * Math.PI); g.fill(); }
   g.strokeStyle = "#aaa"; g.lineWidth = 1; g.setLineDash([4, 4]);
   g.beginPath(); g.moveTo(X(pose.depth_mm), T); g.lineTo(X(pose.depth_mm), H - B); g.stroke(); g.setLineDash([]);
-  $("fe-note").textContent = run
+  $("fe-note").textContent = (run
     ? `line: model; dots: FE run ${run.name} (${run.role}) of the set at this pose`
-    : "line: model (no FE run of the set at this pose: set a run's pose to overlay its points)";
+    : "line: model (no FE run of the set at this pose: set a run's pose to overlay its points)") +
+    (unsolved ? "; dashed orange: FE_UNSOLVED, where the FE could not solve (the model extrapolates)" : "");
 }
 
 // two views of block (grey) and needle (dark): left looking along -z (x right, y up),

@@ -15,8 +15,12 @@ export const COMPONENTS = ["fx_n", "fy_n", "fz_n", "mx_nmm", "my_nmm", "mz_nmm"]
 
 export const STATUS_FLAGS = [
   [0x01, "SAT_X"], [0x02, "SAT_Z"], [0x04, "SAT_THETA_X"], [0x08, "SAT_THETA_Z"],
-  [0x10, "SAT_DEPTH"], [0x40, "NO_MODEL"], [0x80, "ERROR"],
+  [0x10, "SAT_DEPTH"], [0x20, "FE_UNSOLVED"], [0x40, "NO_MODEL"], [0x80, "ERROR"],
 ];
+
+// FE_UNSOLVED: the pose lies where the set's FE campaign could not solve (its
+// unsolved.toml); the wrench is still the model's (an extrapolation), not zeroed.
+export const FE_UNSOLVED = 0x20;
 
 export function statusNames(status) {
   const names = STATUS_FLAGS.filter(([bit]) => status & bit).map(([, name]) => name);

@@ -18,11 +18,15 @@
 //!   of quarter and half models fixed in their normal direction;
 //! - time: t runs from 0 to the insertion depth in mm (t = depth), one must point per
 //!   load step with automatic time stepping between; the log file records the rigid
-//!   body's reaction force and moment at the must points only.
+//!   body's reaction force and moment at the must points only;
+//! - a viscoelastic ramp-and-hold run (`loading.ramp_hold`, `tissue.prony`: `crate::visco`)
+//!   wraps the Ogden in `uncoupled viscoelastic` (the Prony terms act on the deviatoric
+//!   stress; the bulk modulus stays the Ogden's) and its time is seconds: the feed curve
+//!   ramps to the depth at the set speed and holds, the must points are the run's.
 
-use crate::deck::{model_name, MeshSummary};
 use crate::mesh::{self, NeedleMesh, TissueMesh, FACES};
-use crate::spec::{Campaign, FebioSettings, MeshLevel, PoseSpec, Symmetry};
+use crate::mesh_summary::{model_name, MeshSummary};
+use crate::spec::{Campaign, FebioSettings, Loading, MeshLevel, PoseSpec, Symmetry};
 use anyhow::{bail, Result};
 use std::fmt::Write;
 
@@ -136,7 +140,7 @@ pub fn write_with_symmetry(
     let _ = writeln!(w, r#"<?xml version="1.0" encoding="ISO-8859-1"?>"#);
     let _ = writeln!(
         w,
-        "<!-- needle-haptics FEBio input (generator v{}), set {:?}, pose {:?}: x = {} mm, z = {} mm, theta_x = {} deg, theta_z = {} deg; insertion {} mm in {} load steps; model: {}; tissue mesh: {}. Units: mm, N, N/mm^2, s (time t = depth in mm). -->",
+        "<!-- needle-haptics FEBio input (generator v{}), set {:?}, pose {:?}: x = {} mm, z = {} mm, theta_x = {} deg, theta_z = {} deg; insertion {} mm in {} load steps; model: {}; tissue mesh: {}. Units: mm, N, N/mm^2, s ({}). -->",
         super::GENERATOR_VERSION,
         c.set.name,
         pose.name,
@@ -147,11 +151,15 @@ pub fn write_with_symmetry(
         depth,
         steps,
         model_name(sym),
-        t.info
+        t.info,
+        match &c.loading.ramp_hold {
+            Some(r) => format!("time in s: ramp at {} mm/s, then a {} s hold", r.speed_mm_per_s, r.hold_s),
+            None => "time t = depth in mm".to_string(),
+        }
     );
     let _ = writeln!(w, r#"<febio_spec version="4.0">"#);
     let _ = writeln!(w, r#"  <Module type="solid"/>"#);
-    write_control(&mut w, s, depth, steps, stepping);
+    write_control(&mut w, s, &c.loading, steps, stepping);
     write_material(&mut w, c, hub);
     let needle0 = t.nodes.len();
     let needle_el0 = t.elements.len();
@@ -163,7 +171,7 @@ pub fn write_with_symmetry(
     write_boundary(&mut w, &t);
     write_rigid(&mut w, n.axis);
     write_contact(&mut w, c);
-    write_load_data(&mut w, depth, steps, stepping.first_contact);
+    write_load_data(&mut w, &c.loading, steps, stepping.first_contact);
     let _ = writeln!(w, "  <Output>");
     let _ = writeln!(w, "    <logfile>");
     let _ =
@@ -174,16 +182,24 @@ pub fn write_with_symmetry(
     Ok(Feb { text: w, summary: MeshSummary::of(&t, &n, sym), steps, symmetry: sym })
 }
 
-fn write_control(w: &mut String, s: &FebioSettings, depth: f64, steps: u32, stepping: &Stepping) {
-    let dt = depth / f64::from(steps);
+fn write_control(w: &mut String, s: &FebioSettings, loading: &Loading, steps: u32, stepping: &Stepping) {
     let dt_fraction = stepping.first_step();
     // FEBio ends at time_steps * step_size: keep that the insertion depth when the first
     // step is a fraction of a load step (the automatic stepper then grows it to dt)
-    let time_steps = (f64::from(steps) / dt_fraction).round().max(1.0) as u64;
+    let (time_steps, step_size, dt) = if loading.ramp_hold.is_some() {
+        // uneven must points: the first step a fraction of the first one, the end exact
+        let end = loading.time_at(steps);
+        let n = (end / (loading.step_time(1) * dt_fraction)).ceil().max(1.0);
+        let shortest = (1..=steps).map(|k| loading.step_time(k)).fold(f64::INFINITY, f64::min);
+        (n as u64, end / n, shortest)
+    } else {
+        let dt = loading.depth_mm / f64::from(steps);
+        ((f64::from(steps) / dt_fraction).round().max(1.0) as u64, dt * dt_fraction, dt)
+    };
     let _ = writeln!(w, "  <Control>");
     let _ = writeln!(w, "    <analysis>STATIC</analysis>");
     let _ = writeln!(w, "    <time_steps>{time_steps}</time_steps>");
-    let _ = writeln!(w, "    <step_size>{}</step_size>", num(dt * dt_fraction));
+    let _ = writeln!(w, "    <step_size>{}</step_size>", num(step_size));
     let _ = writeln!(w, "    <plot_zero_state>0</plot_zero_state>");
     let _ = writeln!(w, "    <plot_level>PLOT_NEVER</plot_level>");
     let _ = writeln!(w, "    <output_level>OUTPUT_MUST_POINTS</output_level>");
@@ -206,7 +222,9 @@ fn write_control(w: &mut String, s: &FebioSettings, depth: f64, steps: u32, step
     let _ = writeln!(w, "      <max_refs>{}</max_refs>", s.max_refs);
     let _ = writeln!(w, "      <reform_each_time_step>1</reform_each_time_step>");
     let _ = writeln!(w, "      <diverge_reform>1</diverge_reform>");
-    let _ = writeln!(w, "      <min_residual>1e-20</min_residual>");
+    // FEBio compares the squared norm; a ramp-and-hold run sets its floor (`crate::visco`)
+    let min_residual = loading.ramp_hold.as_ref().map_or(1e-20, |r| r.min_residual_n * r.min_residual_n);
+    let _ = writeln!(w, "      <min_residual>{}</min_residual>", num(min_residual));
     // the campaign's retry converges on energy and residual with `retry_dtol` /
     // `retry_rtol` (FebioSettings docs)
     let (dtol, rtol) = if stepping.retry_tolerances { (s.retry_dtol, s.retry_rtol) } else { (s.dtol, s.rtol) };
@@ -231,12 +249,32 @@ fn write_material(w: &mut String, c: &Campaign, hub: [f64; 3]) {
         t.bulk_to_shear,
         num(t.k0_n_per_mm2())
     );
-    let _ = writeln!(w, r#"    <material id="1" name="tissue" type="Ogden">"#);
-    let _ = writeln!(w, "      <density>1e-9</density>");
-    let _ = writeln!(w, "      <k>{}</k>", num(t.k0_n_per_mm2()));
+    // the Ogden, alone or as the elastic part of the viscoelastic wrapper (FEBio adds the
+    // child's k to the wrapper's, which is left at 0: the volumetric part stays elastic)
+    let ind = if let Some(p) = &t.prony {
+        let _ = writeln!(
+            w,
+            "    <!-- uncoupled viscoelastic, FEBio's normalisation: g0 = 1 (the Ogden is the long-term response); tau_i in s -->"
+        );
+        let _ = writeln!(w, r#"    <material id="1" name="tissue" type="uncoupled viscoelastic">"#);
+        let _ = writeln!(w, "      <g0>1</g0>");
+        for (i, (g, tau)) in p.g.iter().zip(&p.tau_s).enumerate() {
+            let _ = writeln!(w, "      <g{}>{}</g{}>\n      <t{}>{}</t{}>", i + 1, num(*g), i + 1, i + 1, num(*tau), i + 1);
+        }
+        let _ = writeln!(w, r#"      <elastic type="Ogden">"#);
+        "  "
+    } else {
+        let _ = writeln!(w, r#"    <material id="1" name="tissue" type="Ogden">"#);
+        ""
+    };
+    let _ = writeln!(w, "{ind}      <density>1e-9</density>");
+    let _ = writeln!(w, "{ind}      <k>{}</k>", num(t.k0_n_per_mm2()));
     for (i, (mu, a)) in t.mu_n_per_mm2.iter().zip(&t.alpha).enumerate() {
-        let _ = writeln!(w, "      <c{}>{}</c{}>", i + 1, num(2.0 * mu), i + 1);
-        let _ = writeln!(w, "      <m{}>{}</m{}>", i + 1, num(*a), i + 1);
+        let _ = writeln!(w, "{ind}      <c{}>{}</c{}>", i + 1, num(2.0 * mu), i + 1);
+        let _ = writeln!(w, "{ind}      <m{}>{}</m{}>", i + 1, num(*a), i + 1);
+    }
+    if t.prony.is_some() {
+        let _ = writeln!(w, "      </elastic>");
     }
     let _ = writeln!(w, "    </material>");
     let _ = writeln!(w, "    <!-- rigid needle; centre of mass at the hub: the reaction moment is about the hub -->");
@@ -368,32 +406,113 @@ fn write_contact(w: &mut String, c: &Campaign) {
     let _ = writeln!(w, "  </Contact>");
 }
 
-/// The must points and, as the load curve's values, the largest time step up to each
-/// (FEBio's `dtmax` curve: between must points k-1 and k it is point k's value); within
-/// the first-contact depth the cap of [`FirstContact`].
-fn write_load_data(w: &mut String, depth: f64, steps: u32, first_contact: Option<FirstContact>) {
-    let dt = depth / f64::from(steps);
-    let _ = writeln!(w, "  <LoadData>");
-    let _ = writeln!(w, r#"    <load_controller id="1" name="feed_mm" type="loadcurve">"#);
-    let _ = writeln!(w, "      <interpolate>LINEAR</interpolate>\n      <extend>EXTRAPOLATE</extend>");
-    let _ = writeln!(w, "      <points>\n        <pt>0,0</pt>\n        <pt>{},{}</pt>\n      </points>", num(depth), num(depth));
-    let _ = writeln!(w, "    </load_controller>");
-    let _ = writeln!(w, "    <!-- must points: the end of every load step; value: the largest time step -->");
-    let _ = writeln!(w, r#"    <load_controller id="2" name="must_points" type="loadcurve">"#);
+/// The load controller (1-based id) of the must points, which is also the time stepper's
+/// `dtmax` curve (`<dtmax lc="2">`); a restart redefines it (`restart.rs`).
+pub const MUST_POINT_LC: u32 = 2;
+
+/// One point of the must-point curve: a must point and the largest time step up to it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MustPoint {
+    /// The solver's time of the must point (the end of a load step): mm of depth, or s of
+    /// a ramp-and-hold run.
+    pub time: f64,
+    /// The largest time step of the load step that ends here, in the same unit.
+    pub dtmax: f64,
+}
+
+/// The must points 1..=`steps` of `loading` and, as the load curve's values, the largest
+/// time step up to each: the load step itself, or within the first-contact depth
+/// ([`FirstContact`]) that fraction of it. FEBio reads the curve with STEP interpolation
+/// (`PointCurve::value`): at a time in (t(k-1), t(k)) it is point k's value; at a must
+/// point t(k) itself it is point k+1's (the first point after the time), except at the
+/// first and the last must point, whose own values FEBio returns at their times.
+pub fn must_points(loading: &Loading, steps: u32, first_contact: Option<FirstContact>) -> Vec<MustPoint> {
+    let depth = loading.depth_mm;
+    (1..=steps)
+        .map(|k| {
+            let dt = loading.step_time(k);
+            // the step ending at t starts within the first-contact depth
+            let capped = first_contact.filter(|fc| loading.depth_at(k - 1) < fc.depth_mm - 1e-9 * depth);
+            MustPoint { time: loading.time_at(k), dtmax: capped.map_or(dt, |fc| dt * fc.step_fraction) }
+        })
+        .collect()
+}
+
+/// The `<load_controller>` element of the must-point curve ([`MUST_POINT_LC`]), indented
+/// for `<LoadData>`: the `.feb` writes it, a restart redefines it with the same text but
+/// for the values (`restart.rs`).
+pub fn must_point_controller(points: &[MustPoint]) -> String {
+    let mut w = String::new();
+    let _ = writeln!(w, r#"    <load_controller id="{MUST_POINT_LC}" name="must_points" type="loadcurve">"#);
     let _ = writeln!(w, "      <interpolate>STEP</interpolate>\n      <extend>CONSTANT</extend>\n      <points>");
-    for k in 1..=steps {
-        let t = depth * f64::from(k) / f64::from(steps);
-        // the step ending at t starts within the first-contact depth
-        let capped = first_contact.filter(|fc| t - dt < fc.depth_mm - 1e-9 * depth);
-        let dtmax = capped.map_or(dt, |fc| dt * fc.step_fraction);
-        let _ = writeln!(w, "        <pt>{},{}</pt>", num(t), num(dtmax));
+    for p in points {
+        let _ = writeln!(w, "        <pt>{},{}</pt>", num(p.time), num(p.dtmax));
     }
     let _ = writeln!(w, "      </points>\n    </load_controller>");
+    w
+}
+
+/// The feed curve (load controller 1) and the must points ([`must_points`], load
+/// controller [`MUST_POINT_LC`]).
+fn write_load_data(w: &mut String, loading: &Loading, steps: u32, first_contact: Option<FirstContact>) {
+    let depth = loading.depth_mm;
+    let _ = writeln!(w, "  <LoadData>");
+    let _ = writeln!(w, r#"    <load_controller id="1" name="feed_mm" type="loadcurve">"#);
+    match &loading.ramp_hold {
+        Some(r) => {
+            // time in s: the ramp at the speed, then the hold
+            let ramp = r.ramp_s(depth);
+            let _ = writeln!(w, "      <interpolate>LINEAR</interpolate>\n      <extend>CONSTANT</extend>");
+            let _ = writeln!(
+                w,
+                "      <points>\n        <pt>0,0</pt>\n        <pt>{},{}</pt>\n        <pt>{},{}</pt>\n      </points>",
+                num(ramp),
+                num(depth),
+                num(ramp + r.hold_s),
+                num(depth)
+            );
+        }
+        None => {
+            let _ = writeln!(w, "      <interpolate>LINEAR</interpolate>\n      <extend>EXTRAPOLATE</extend>");
+            let _ = writeln!(w, "      <points>\n        <pt>0,0</pt>\n        <pt>{},{}</pt>\n      </points>", num(depth), num(depth));
+        }
+    }
+    let _ = writeln!(w, "    </load_controller>");
+    let _ = writeln!(w, "    <!-- must points: the end of every load step; value: the largest time step -->");
+    w.push_str(&must_point_controller(&must_points(loading, steps, first_contact)));
     let _ = writeln!(w, "  </LoadData>");
 }
 
 /// A number as FEBio reads it: Rust's shortest round-trip form.
-fn num(v: f64) -> String {
+pub(super) fn num(v: f64) -> String {
     let v = if v == 0.0 { 0.0 } else { v };
     format!("{v:?}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    fn shipped() -> String {
+        std::fs::read_to_string(crate::workspace_root().join("coeffs/default/campaign.toml")).expect("campaign.toml")
+    }
+
+    #[test]
+    fn the_feb_wraps_the_ogden_and_runs_in_seconds() {
+        let c = crate::spec::parse(&shipped(), Path::new("campaign.toml")).expect("the shipped spec");
+        let v = c.viscoelastic.clone().expect("[viscoelastic]");
+        let (run, poses) = crate::visco::apply(&c, &v, 1.0, 4);
+        let pose = poses.first().expect("a pose");
+        let mesh = run.mesh_level("smoke").expect("smoke").clone();
+        let feb = write(&run, pose, &mesh, run.loading.steps, 1.0).expect("feb");
+        let t = &feb.text;
+        assert!(t.contains(r#"type="uncoupled viscoelastic""#) && t.contains(r#"<elastic type="Ogden">"#), "wrapped");
+        assert!(t.contains("<g1>0.6</g1>") && t.contains("<t2>5.0</t2>"), "the Prony terms");
+        // the feed: 6 mm at 1 mm/s, then held to 36 s; the last must point at 36 s
+        assert!(t.contains("<pt>6.0,6.0</pt>") && t.contains("<pt>36.0,6.0</pt>"), "feed curve");
+        assert!(t.contains("<pt>1.5,1.5</pt>") && t.contains("<pt>36.0,"), "must points");
+        let elastic = write(&c, pose, &mesh, 4, 1.0).expect("feb");
+        assert!(!elastic.text.contains("viscoelastic"), "an elastic run stays elastic");
+    }
 }

@@ -8,7 +8,10 @@
 //!   after a fresh attempt that reached a must point *continues* from the furthest
 //!   attempt's last converged must point (its FEBio dump, kept as [`FURTHEST_DUMP`]) with
 //!   the retry's settings: a first time step of [`RETRY_FIRST_INCREMENT`] of a load step
-//!   and the retry tolerances (`retry_dtol`, `retry_rtol`: FEBio's restart input can set
+//!   (every time step of that load step at most that: the restart input caps the
+//!   must-point curve there, `restart.rs`; before that fix FEBio took the dump's own
+//!   step, and the settings lines of the continuations before it overstate their first
+//!   step) and the retry tolerances (`retry_dtol`, `retry_rtol`: FEBio's restart input can set
 //!   the Newton solver's parameters). In the failed logs "max nr of reformations" is the
 //!   displacement norm stalling while the residual and energy norms have converged (a
 //!   contact node chattering), which is what the retry tolerances judge differently.
@@ -20,7 +23,7 @@
 //!   [`failed_at_first_contact`]), a later fresh attempt with whole load steps takes time
 //!   steps of at most `first_contact_step_fraction` of a load step until then, whole
 //!   steps after. Not on a first attempt: the cap makes the auto stepper climb back to
-//!   whole steps slowly (measured 2026-11-27: the needle8 centre took 46 time steps and
+//!   whole steps slowly (measured: the needle8 centre took 46 time steps and
 //!   50 s instead of 35 and 24 s, Fy within 0.17 % of peak; CI's smoke runs 23-24 time
 //!   steps instead of 10, and z+02 on the smoke mesh then failed its first attempt).
 //!
@@ -34,7 +37,7 @@
 //! ([`STATE_FILE`], beside the dump), so that each attempt decides from what is on disk.
 
 use super::logs::RigidRecord;
-use crate::deck::RETRY_FIRST_INCREMENT;
+use crate::backend::RETRY_FIRST_INCREMENT;
 use anyhow::{Context, Result};
 use needle_contract::COMPONENT_COUNT;
 use serde::{Deserialize, Serialize};
@@ -190,9 +193,9 @@ pub struct Furthest {
 }
 
 impl Furthest {
-    /// The records as the rigid-body log's, at t = depth of each must point.
-    pub fn rigid_records(&self, depth_mm: f64, steps: u32) -> Vec<RigidRecord> {
-        (1u32..).zip(&self.records).map(|(k, v)| RigidRecord { time: depth_at(depth_mm, steps, k), values: *v }).collect()
+    /// The records as the rigid-body log's, at the solver's time of each must point.
+    pub fn rigid_records(&self, loading: &crate::spec::Loading) -> Vec<RigidRecord> {
+        (1u32..).zip(&self.records).map(|(k, v)| RigidRecord { time: loading.time_at(k), values: *v }).collect()
     }
 }
 
@@ -220,7 +223,8 @@ impl State {
         }
     }
 
-    /// Write [`STATE_FILE`] in `work_dir`.
+    /// Write [`STATE_FILE`] in `work_dir` atomically (a campaign killed while writing it
+    /// leaves the earlier state, which its resumed attempt reads: `crate::resume`).
     ///
     /// # Errors
     /// It cannot be written.
@@ -230,7 +234,7 @@ impl State {
             "# the FEBio retry ladder's state of this pose (fe/febio/ladder.rs); removed with the work folder\n{}",
             toml::to_string(self).context("cannot serialise the ladder's state")?
         );
-        std::fs::write(&p, text).with_context(|| format!("{}: cannot write", p.display()))
+        crate::results::write_atomic(&p, text.as_bytes())
     }
 
     /// Whether a failed attempt that reached `steps` must points is further than the kept
@@ -245,6 +249,16 @@ impl State {
 /// A later fresh attempt with whole steps then takes the first-contact steps.
 pub fn failed_at_first_contact(state: &State, first_contact_steps: u32) -> bool {
     state.tried.iter().any(|t| matches!(t.plan, Plan::Fresh(_)) && t.reached_steps < first_contact_steps)
+}
+
+/// Whether attempt `attempt`, a fresh one with whole load steps, ran with the first-contact
+/// steps: an attempt before it failed at first contact ([`failed_at_first_contact`] of the
+/// attempts before it, as when it was decided). Its dump carries that must-point curve,
+/// which a continuation of it redefines (`restart.rs`); a spec whose first-contact
+/// settings changed since is read as it is now.
+pub fn had_first_contact_steps(state: &State, attempt: u32, first_contact_steps: u32) -> bool {
+    let before = State { tried: state.tried.iter().filter(|t| t.attempt < attempt).cloned().collect(), furthest: None };
+    failed_at_first_contact(&before, first_contact_steps)
 }
 
 /// The load steps (of `steps` to `depth_mm`) that start within `first_contact_depth_mm`.
@@ -366,6 +380,11 @@ mod tests {
         assert!(!failed_at_first_contact(&at(2), 2), "past 0.6 mm: another class");
         let cont = State { tried: vec![tried(2, Plan::Continue { from_attempt: 1, from_steps: 1, contact: a[0] }, 1)], furthest: None };
         assert!(!failed_at_first_contact(&cont, 2), "a continuation starts past the surface");
+        // the attempts before attempt 2 failed at first contact: it had the steps, attempt 1 not
+        let mut s = at(0);
+        s.tried.push(tried(2, Plan::Fresh(fresh_order(false)[1]), 7));
+        assert!(had_first_contact_steps(&s, 2, 2) && !had_first_contact_steps(&s, 1, 2));
+        assert!(!had_first_contact_steps(&s, 2, 0), "off");
     }
 
     #[test]
@@ -379,7 +398,11 @@ mod tests {
         };
         s.write(d.path()).expect("write");
         assert_eq!(State::read(d.path()).expect("read"), s);
-        let r = s.furthest.as_ref().map(|f| f.rigid_records(6.0, 20)).unwrap_or_default();
+        let r = s
+            .furthest
+            .as_ref()
+            .map(|f| f.rigid_records(&crate::spec::Loading { depth_mm: 6.0, steps: 20, ramp_hold: None }))
+            .unwrap_or_default();
         assert_eq!(r.iter().map(|r| r.time).collect::<Vec<_>>(), [0.3, 0.6]);
         std::fs::write(d.path().join(STATE_FILE), "tried = 3").expect("write");
         assert!(State::read(d.path()).is_err(), "a corrupt state is an error, not a fresh ladder");

@@ -5,7 +5,7 @@ use anyhow::{bail, Context, Result};
 use needle_contract::COMPONENT_COUNT;
 
 /// One record of the rigid-body log: the time and the six values of one body.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RigidRecord {
     /// Time t of the record (t = depth in mm in the campaign's inputs).
     pub time: f64,

@@ -2,20 +2,26 @@
 //! and reading the rigid needle's reaction back ([`logs`]), behind the campaign's
 //! [`Backend`] trait.
 //!
+//! Each FEBio process of an attempt is recorded in `running.toml` ([`running`]), so that
+//! an attempt a killed campaign left running goes on from its last dump (`pose.dmp`, at
+//! its last must point) when the campaign resumes the pose (`crate::resume`); nothing at
+//! the start of an attempt removes that dump before the decision.
+//!
 //! `febio4` is found, in order: `$FEBIO` (must be an executable; a bad path is an
 //! error, not a silent fallback), the build of `.ci/install-febio` in the cache folder
 //! (`$NEEDLE_CACHE`, default `~/.cache/needle-haptics`, `febio-4.11/bin/febio4`), a
 //! `febio4` on `PATH`.
 
+mod attempt;
 pub mod failures;
 pub mod feb;
 pub mod ladder;
 pub mod logs;
 pub mod restart;
+pub mod running;
 
 use crate::backend::{Backend, Job, SolveFailure, Solved};
-use crate::process::{self, ExitKind, LOG_TAIL_LINES};
-use crate::wrench::expand_mirrors;
+use crate::process;
 use anyhow::{bail, Context, Result};
 use needle_contract::COMPONENT_COUNT;
 use std::path::{Path, PathBuf};
@@ -169,259 +175,24 @@ impl Backend for FebioBackend {
         if attempt < 2 {
             1.0
         } else {
-            crate::deck::RETRY_FIRST_INCREMENT
+            crate::backend::RETRY_FIRST_INCREMENT
         }
     }
 
+    /// One attempt as the ladder plans it (the trait's docs above). An attempt that a
+    /// killed campaign left running (`running.toml`, `pose.dmp`: `running.rs`) goes on
+    /// from its dump; when FEBio cannot read that dump the attempt is run again from its
+    /// start, and the settings line says so.
     fn solve(&self, job: &Job<'_>) -> std::result::Result<Solved, SolveFailure> {
-        let exe = self.exe.as_deref().context("FebioBackend::solve before prepare")?;
-        // the ladder's state: what the earlier attempts at this pose did (none on the first)
-        let mut state = if job.attempt == 0 {
-            remove_if_exists(&job.work_dir.join(ladder::STATE_FILE))?;
-            remove_if_exists(&job.work_dir.join(ladder::FURTHEST_DUMP))?;
-            ladder::State::default()
-        } else {
-            ladder::State::read(job.work_dir)?
-        };
-        let symmetry = job.pose.symmetry();
-        let mut plan = ladder::next(&state, !symmetry.plane_x && !symmetry.plane_z);
-        let resume = match plan {
-            ladder::Plan::Continue { .. } => match &state.furthest {
-                Some(f) if job.work_dir.join(ladder::FURTHEST_DUMP).is_file() => Some(f.clone()),
-                // the dump is gone (a folder cleared by hand): the fresh ladder
-                _ => {
-                    state.furthest = None;
-                    plan = ladder::next(&state, !symmetry.plane_x && !symmetry.plane_z);
-                    None
-                }
-            },
-            ladder::Plan::Fresh(_) => None,
-        };
-        let contact = plan.contact();
-        let changed;
-        let campaign = if contact.seg_up == ladder::SegUp::Spec && !contact.softer {
-            job.campaign
-        } else {
-            let mut c = job.campaign.clone();
-            let s = &mut c.solver.febio;
-            if contact.seg_up == ladder::SegUp::Retry {
-                s.seg_up = s.retry_seg_up;
+        let mut unreadable = None;
+        let r = self.solve_attempt(job, true, &mut unreadable, None);
+        match unreadable {
+            Some(why) => {
+                eprintln!("{}: attempt {}: {why}; the attempt starts again from its start", job.pose.name, job.attempt + 1);
+                self.solve_attempt(job, false, &mut None, Some(why))
             }
-            if contact.softer {
-                s.penalty *= s.last_attempt_penalty_scale;
-            }
-            changed = c;
-            &changed
-        };
-        let fs = &campaign.solver.febio;
-        let contact_steps = ladder::first_contact_steps(fs.first_contact_depth_mm, job.campaign.loading.depth_mm, job.steps);
-        let first_contact = (!plan.retry_tolerances() && ladder::failed_at_first_contact(&state, contact_steps))
-            .then_some(feb::FirstContact { depth_mm: fs.first_contact_depth_mm, step_fraction: fs.first_contact_step_fraction });
-        let stepping =
-            feb::Stepping { first_step_fraction: plan.first_increment(), retry_tolerances: plan.retry_tolerances(), first_contact };
-        // a continuation writes the model too: the record of its contact, kept with its logs
-        let feb = feb::write_stepped(campaign, job.pose, job.mesh, job.steps, &stepping).context("writing the FEBio input")?;
-        let input = job.work_dir.join(format!("{JOB}.feb"));
-        std::fs::write(&input, &feb.text).with_context(|| format!("{}: cannot write", input.display()))?;
-        let rb_path = job.work_dir.join(feb::RIGID_LOG);
-        let log_path = job.work_dir.join(format!("{JOB}.log"));
-        let out_path = job.work_dir.join("febio.out");
-        // files of an earlier attempt in this folder would be taken for this one's
-        for n in 0..=restart::MAX_CONTINUATIONS {
-            remove_if_exists(&restart::segment_log(job.work_dir, n))?;
-            remove_if_exists(&job.work_dir.join(restart::segment_solver_log_name(n)))?;
+            None => r,
         }
-        for f in [rb_path.clone(), log_path.clone(), job.work_dir.join(restart::DUMP), job.work_dir.join(restart::DUMP_FROM)] {
-            remove_if_exists(&f)?;
-        }
-        let depth = job.campaign.loading.depth_mm;
-        let step_mm = depth / f64::from(job.steps.max(1));
-        let dtmin = step_mm * fs.dtmin_fraction * restart::CONTINUE_DTMIN_SCALE;
-        // a continuation's restarts set the retry tolerances: the dump carries the run's own
-        let tolerances = plan.retry_tolerances().then_some(restart::Tolerances { dtol: fs.retry_dtol, rtol: fs.retry_rtol });
-        let started = std::time::Instant::now();
-        let mut segments: Vec<logs::RigidRecord> = Vec::new();
-        let mut cont = restart::Continuations::default();
-        let mut restarting = false;
-        if let Some(f) = &resume {
-            let from = job.work_dir.join(restart::DUMP_FROM);
-            let dump = job.work_dir.join(ladder::FURTHEST_DUMP);
-            std::fs::copy(&dump, &from).with_context(|| format!("{}: cannot copy to {}", dump.display(), from.display()))?;
-            let restart_in = job.work_dir.join(restart::RESTART_INPUT);
-            std::fs::write(&restart_in, restart::restart_input(step_mm * plan.first_increment(), dtmin, tolerances))
-                .with_context(|| format!("{}: cannot write", restart_in.display()))?;
-            segments = f.rigid_records(depth, job.steps);
-            eprintln!("{}: attempt {}: {}", job.pose.name, job.attempt + 1, plan.describe(depth, job.steps));
-            restarting = true;
-        }
-        let mut totals = logs::RunLog::default();
-        let (done, run, log_tail, at_steps, done_steps) = loop {
-            let mut cmd = Command::new(exe);
-            cmd.arg("-nosplash");
-            if restarting {
-                cmd.arg("-r").arg(restart::RESTART_INPUT).arg("-noappend").arg("-p").arg(format!("{JOB}.xplt"));
-            } else {
-                cmd.arg("-i").arg(format!("{JOB}.feb")).arg("-p").arg(format!("{JOB}.xplt"));
-            }
-            cmd.arg("-o")
-                .arg(format!("{JOB}.log"))
-                .arg("-dump=3")
-                .arg(restart::DUMP)
-                .env("OMP_NUM_THREADS", self.threads.to_string())
-                .env("MKL_NUM_THREADS", self.threads.to_string());
-            let timeout = job.timeout.map(|t| t.saturating_sub(started.elapsed()));
-            let done = process::run(cmd, job.work_dir, &out_path, &[log_path.clone(), rb_path.clone()], timeout, job.stall)?;
-            let log_text = std::fs::read_to_string(&log_path).unwrap_or_default();
-            let run = logs::parse_run_log(if log_text.is_empty() { &done.log_text } else { &log_text });
-            totals.time_steps += run.time_steps;
-            totals.iterations += run.iterations;
-            totals.retries += run.retries;
-            let tail_src = if log_text.trim().is_empty() { &done.log_text } else { &log_text };
-            let log_tail = process::tail(tail_src, LOG_TAIL_LINES);
-            let records = std::fs::read_to_string(&rb_path)
-                .map_err(anyhow::Error::from)
-                .and_then(|t| logs::parse_rigid_log(&t))
-                .with_context(|| format!("{}", rb_path.display()));
-            let mut all = segments.clone();
-            if let Ok(r) = &records {
-                all.extend_from_slice(r);
-            }
-            let at_steps = pick_steps(&all, depth, job.steps);
-            let done_steps = at_steps.iter().take_while(|w| w.is_some()).count();
-            let solved = done.exit == ExitKind::Code(0) && run.normal_termination && done_steps >= job.steps as usize;
-            // continue from the last must point when the solver gave up (not on a
-            // timeout, stall or stop) and a dump of a converged must point exists; the
-            // must point a continuation of another attempt started from counts as one
-            let last_mm = done_steps as f64 * step_mm;
-            let mut tried_from = cont.clone();
-            if let Some(f) = &resume {
-                tried_from.from_mm.insert(0, ladder::depth_at(depth, job.steps, f.steps));
-            }
-            let next = (!solved && matches!(done.exit, ExitKind::Code(_)) && done_steps > 0 && !process::interrupted())
-                .then(|| tried_from.next_fraction(last_mm))
-                .flatten()
-                .filter(|_| job.work_dir.join(restart::DUMP).is_file());
-            let Some(fraction) = next else {
-                break (done, run, log_tail, at_steps, done_steps);
-            };
-            let n = cont.from_mm.len() as u32;
-            eprintln!(
-                "{}: febio4 stopped at t = {} mm ({}); continuing from the must point at {last_mm} mm with a first time step of {} mm",
-                job.pose.name,
-                run.last_time,
-                run.cause.as_deref().unwrap_or("no stated cause"),
-                step_mm * fraction
-            );
-            for (from, to) in
-                [(&rb_path, restart::segment_log(job.work_dir, n)), (&log_path, job.work_dir.join(restart::segment_solver_log_name(n)))]
-            {
-                if from.exists() {
-                    std::fs::rename(from, &to).with_context(|| format!("{}: cannot keep as {}", from.display(), to.display()))?;
-                }
-            }
-            segments = all;
-            let from = job.work_dir.join(restart::DUMP_FROM);
-            std::fs::copy(job.work_dir.join(restart::DUMP), &from).with_context(|| format!("{}: cannot write", from.display()))?;
-            let input = job.work_dir.join(restart::RESTART_INPUT);
-            std::fs::write(&input, restart::restart_input(step_mm * fraction, dtmin, tolerances))
-                .with_context(|| format!("{}: cannot write", input.display()))?;
-            cont.from_mm.push(last_mm);
-            restarting = true;
-        };
-        let line = {
-            let mut line = settings_line(fs, campaign.contact.friction, self.threads, plan.retry_tolerances());
-            if let Some(fc) = first_contact {
-                line.push_str(&format!("; time steps <= {} of a load step to {} mm (first contact)", fc.step_fraction, fc.depth_mm));
-            }
-            if let Some(f) = &resume {
-                line.push_str(&format!(
-                    "; continued attempt {}'s last converged must point ({} mm; to there: {})",
-                    f.attempt,
-                    ladder::depth_at(depth, job.steps, f.steps),
-                    f.settings
-                ));
-            }
-            let continued = cont.describe();
-            if !continued.is_empty() {
-                line.push_str(&format!("; {continued}"));
-            }
-            line
-        };
-        let failed = done.exit != ExitKind::Code(0) || !run.normal_termination || done_steps < job.steps as usize;
-        if failed && !process::interrupted() {
-            // keep the furthest attempt's dump for the ladder's next attempt
-            let steps = done_steps as u32;
-            let dump = job.work_dir.join(restart::DUMP);
-            let mut kept_dump = false;
-            if state.is_further(steps) && dump.is_file() {
-                let furthest = job.work_dir.join(ladder::FURTHEST_DUMP);
-                std::fs::rename(&dump, &furthest).with_context(|| format!("{}: cannot keep as {}", dump.display(), furthest.display()))?;
-                let records = at_steps.iter().take(done_steps).map_while(|v| *v).collect();
-                state.furthest = Some(ladder::Furthest { attempt: job.attempt + 1, steps, records, settings: line.clone() });
-                kept_dump = true;
-            }
-            state.tried.push(ladder::Tried { attempt: job.attempt + 1, plan, reached_steps: steps });
-            state.write(job.work_dir)?;
-            if kept_dump {
-                eprintln!(
-                    "{}: attempt {}'s dump at {} mm kept for the next attempt",
-                    job.pose.name,
-                    job.attempt + 1,
-                    ladder::depth_at(depth, job.steps, steps)
-                );
-            }
-        }
-        // the dumps are large (tens of MB) and only needed while the run goes on
-        for f in [restart::DUMP, restart::DUMP_FROM] {
-            let _ = std::fs::remove_file(job.work_dir.join(f));
-        }
-        if failed {
-            let how = match done.exit {
-                ExitKind::Code(0) if run.error_termination => "ended with ERROR TERMINATION".to_string(),
-                ExitKind::Code(0) => "exited 0".to_string(),
-                e => e.to_string(),
-            };
-            let kept = keep_failed_attempt(job);
-            let continued = cont.describe();
-            let resumed = resume
-                .as_ref()
-                .map(|f| format!(", continuing attempt {} from {} mm", f.attempt, ladder::depth_at(depth, job.steps, f.steps)));
-            return Err(SolveFailure {
-                message: format!(
-                    "febio4 {how} after {done_steps} of {} steps (t = {} mm), {} time steps, {} retries, {:.1} s{}{}{}{kept}",
-                    job.steps,
-                    run.last_time,
-                    totals.time_steps,
-                    totals.retries,
-                    started.elapsed().as_secs_f64(),
-                    resumed.unwrap_or_default(),
-                    if continued.is_empty() { String::new() } else { format!(", {continued}") },
-                    run.cause.as_deref().map(|c| format!(": {c}")).unwrap_or_default(),
-                ),
-                log_tail,
-                reached: at_steps.iter().map_while(|v| v.map(|v| expand_mirrors(v.map(|x| REACTION_SIGN * x), feb.symmetry))).collect(),
-            });
-        }
-        let _ = std::fs::remove_file(job.work_dir.join(ladder::FURTHEST_DUMP));
-        let run = logs::RunLog { time_steps: totals.time_steps, iterations: totals.iterations, ..run };
-        let wrenches = at_steps
-            .into_iter()
-            .map(|v| {
-                let v = v.unwrap_or([f64::NAN; COMPONENT_COUNT]);
-                expand_mirrors(v.map(|x| REACTION_SIGN * x), feb.symmetry)
-            })
-            .collect();
-        Ok(Solved {
-            wrenches,
-            summary: feb.summary,
-            increments: run.time_steps,
-            iterations: run.iterations,
-            first_increment: plan.first_increment(),
-            retry: None,
-            element: "hex8, three-field (u-p-J) for the uncoupled Ogden tissue; rigid-body needle".into(),
-            peak_rss_mib: done.peak_rss_mib,
-            settings: line,
-        })
     }
 
     fn first_increment_in(&self, work_dir: &Path, attempt: u32, full_block: bool) -> f64 {
@@ -435,7 +206,7 @@ impl Backend for FebioBackend {
     /// Must points logged so far, over the continued segments' logs too.
     fn steps_done(&self, work_dir: &Path) -> u32 {
         let count = |p: PathBuf| std::fs::read_to_string(p).ok().and_then(|t| logs::parse_rigid_log(&t).ok()).map(|r| r.len() as u32);
-        let segments: u32 = (0..restart::MAX_CONTINUATIONS).map_while(|n| count(restart::segment_log(work_dir, n))).sum();
+        let segments: u32 = (0..restart::MAX_SEGMENTS).map_while(|n| count(restart::segment_log(work_dir, n))).sum();
         segments + count(work_dir.join(feb::RIGID_LOG)).unwrap_or(0)
     }
 }
@@ -475,13 +246,27 @@ pub fn settings_line(s: &crate::spec::FebioSettings, friction: f64, threads: usi
 /// The record at each must point t_k = depth * k / steps, k = 1..=steps (None where the
 /// log has none; FEBio logs must points only, but a retried step may log twice: the last
 /// record at a time wins).
-fn pick_steps(records: &[logs::RigidRecord], depth: f64, steps: u32) -> Vec<Option<[f64; COMPONENT_COUNT]>> {
+fn pick_steps(records: &[logs::RigidRecord], loading: &crate::spec::Loading, steps: u32) -> Vec<Option<[f64; COMPONENT_COUNT]>> {
+    let end = loading.time_at(steps);
     (1..=steps)
         .map(|k| {
-            let t = depth * f64::from(k) / f64::from(steps);
-            records.iter().rev().find(|r| (r.time - t).abs() <= 1e-6 * depth).map(|r| r.values)
+            let t = loading.time_at(k);
+            records.iter().rev().find(|r| (r.time - t).abs() <= 1e-6 * end).map(|r| r.values)
         })
         .collect()
+}
+
+/// The record of the attempt `job` as a killed campaign left it running, when its dump
+/// is there too (`running.rs`); an unreadable record is reported and not resumed.
+fn interrupted_run(job: &Job<'_>) -> Option<running::Running> {
+    let r = match running::read(job.work_dir) {
+        Ok(r) => r?,
+        Err(e) => {
+            eprintln!("{}: {e:#}; the attempt starts from its start", job.pose.name);
+            return None;
+        }
+    };
+    (r.attempt == job.attempt && job.work_dir.join(restart::DUMP).is_file()).then_some(r)
 }
 
 fn remove_if_exists(p: &Path) -> Result<()> {
@@ -504,7 +289,7 @@ fn keep_failed_attempt(job: &Job<'_>) -> String {
         ("febio.out".to_string(), "out".to_string()),
         (feb::RIGID_LOG.to_string(), "rb.txt".to_string()),
     ];
-    for n in 0..restart::MAX_CONTINUATIONS {
+    for n in 0..restart::MAX_SEGMENTS {
         files.push((restart::segment_solver_log_name(n), format!("log-{n}")));
         files.push((restart::segment_log_name(n), format!("rb-{n}.txt")));
     }
@@ -670,7 +455,7 @@ mod tests {
         let state = ladder::State::read(&work).expect("state");
         assert_eq!(state.furthest.as_ref().map(|f| (f.attempt, f.steps)), Some((1, 2)));
         assert!(work.join(ladder::FURTHEST_DUMP).is_file() && !work.join(restart::DUMP).exists());
-        assert_eq!(backend.first_increment_in(&work, 1, false), crate::deck::RETRY_FIRST_INCREMENT);
+        assert_eq!(backend.first_increment_in(&work, 1, false), crate::backend::RETRY_FIRST_INCREMENT);
         assert!(backend
             .describe_attempt(&work, 1, false, 6.0, 4)
             .starts_with("continuing attempt 1 from its last converged must point (3 mm"));
@@ -679,9 +464,9 @@ mod tests {
         assert_eq!(fy, vec![-4.0, -8.0, -12.0, -16.0], "attempt 1's must points, then the continuation's");
         assert!(s.settings.contains("continued attempt 1's last converged must point (3 mm; to there: "), "{}", s.settings);
         assert!(s.settings.contains(&format!("dtol {} etol", c.solver.febio.retry_dtol)), "the retry tolerances: {}", s.settings);
-        assert_eq!(s.first_increment, crate::deck::RETRY_FIRST_INCREMENT);
+        assert_eq!(s.first_increment, crate::backend::RETRY_FIRST_INCREMENT);
         let restart = std::fs::read_to_string(work.join(restart::RESTART_INPUT)).expect("restart input");
-        assert!(restart.contains(&format!("<step_size>{:e}</step_size>", 1.5 * crate::deck::RETRY_FIRST_INCREMENT)), "{restart}");
+        assert!(restart.contains(&format!("<step_size>{:e}</step_size>", 1.5 * crate::backend::RETRY_FIRST_INCREMENT)), "{restart}");
         assert!(!work.join(ladder::FURTHEST_DUMP).exists(), "the kept dump goes once the pose solves");
         // a new campaign's first attempt starts from depth 0 whatever the folder holds
         assert_eq!(backend.first_increment_in(&work, 0, false), 1.0);
@@ -691,8 +476,9 @@ mod tests {
     fn must_points_are_picked_by_time() {
         let r = |t: f64, v: f64| logs::RigidRecord { time: t, values: [v; COMPONENT_COUNT] };
         let recs = [r(3.0, 1.0), r(3.0, 2.0), r(6.0, 3.0)];
-        let got = pick_steps(&recs, 6.0, 2);
+        let loading = crate::spec::Loading { depth_mm: 6.0, steps: 2, ramp_hold: None };
+        let got = pick_steps(&recs, &loading, 2);
         assert_eq!(got, vec![Some([2.0; COMPONENT_COUNT]), Some([3.0; COMPONENT_COUNT])]);
-        assert_eq!(pick_steps(&recs[..1], 6.0, 2), vec![Some([1.0; COMPONENT_COUNT]), None]);
+        assert_eq!(pick_steps(&recs[..1], &loading, 2), vec![Some([1.0; COMPONENT_COUNT]), None]);
     }
 }

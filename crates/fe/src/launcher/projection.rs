@@ -5,7 +5,7 @@
 //! neither queue waiting nor the slower cores a cluster may have.
 
 use crate::campaign::Plan;
-use crate::deck;
+use crate::mesh_summary;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
@@ -79,7 +79,7 @@ pub fn table(plan: &Plan, nodes: &[usize], tasks_per_node: usize) -> String {
         if let Some(e) = plan.manifest.pose.get(&p.name).filter(measured) {
             walls.push(e.wall_s);
             own += 1;
-        } else if let Some(&m) = kind_median.get(&deck::model_name(p.symmetry()).to_string()) {
+        } else if let Some(&m) = kind_median.get(&mesh_summary::model_name(p.symmetry()).to_string()) {
             walls.push(m);
             estimated += 1;
         } else {

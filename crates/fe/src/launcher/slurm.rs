@@ -211,27 +211,9 @@ pub fn submit(opts: &RunOptions, slurm: &SlurmOptions) -> Result<SubmitReport> {
     };
     let plan = campaign::plan(opts)?;
     let earlier = read_submissions(&plan.out_dir)?;
-    let queued = queue_states(&earlier)?;
-    let latest = earlier.latest_tasks();
     let mut report =
         SubmitReport { selected: plan.selected.len(), up_to_date: Vec::new(), in_queue: Vec::new(), submission: None, resources: None };
-    let to_run = plan.to_run_names();
-    for p in &plan.selected {
-        if !to_run.contains(&p.name) {
-            report.up_to_date.push(p.name.clone());
-        }
-    }
-    let mut poses = Vec::new();
-    for name in to_run {
-        let active = latest
-            .get(&name)
-            .and_then(|(job, task)| queued.get(&format!("{job}_{task}")).map(|s| (format!("{job}_{task}"), s.clone())))
-            .filter(|(_, s)| s.is_active());
-        match active {
-            Some((task, state)) => report.in_queue.push((name, task, state.state)),
-            None => poses.push(name),
-        }
-    }
+    let poses = sort_poses(&plan, &earlier, &mut report)?;
     if poses.is_empty() {
         return Ok(report);
     }
@@ -239,24 +221,7 @@ pub fn submit(opts: &RunOptions, slurm: &SlurmOptions) -> Result<SubmitReport> {
     let res = Resources::defaults(&plan, attempts, slurm);
     let out_abs = absolute(&plan.out_dir)?;
     let slurm_dir = out_abs.join(SLURM_DIR);
-    let mut args = vec![
-        "--parsable".to_string(),
-        format!("--job-name=needle-fe-{}", set_name(&opts.set_dir)),
-        format!("--array=0-{}", poses.len() - 1),
-        format!("--output={}/%A_%a.out", slurm_dir.display()),
-        format!("--chdir={}", absolute(Path::new("."))?.display()),
-        format!("--cpus-per-task={}", res.cpus_per_task),
-    ];
-    if let Some(t) = &res.time {
-        args.push(format!("--time={t}"));
-    }
-    if let Some(m) = &res.mem {
-        args.push(format!("--mem={m}"));
-    }
-    if let Some(p) = &slurm.partition {
-        args.push(format!("--partition={p}"));
-    }
-    args.extend(slurm.extra.iter().cloned());
+    let args = sbatch_args(opts, slurm, &res, poses.len(), &slurm_dir)?;
     let script = batch_script(opts, &plan, &needle, &poses)?;
 
     // .slurm/ must exist before the tasks start (their output goes there); what this
@@ -284,6 +249,55 @@ pub fn submit(opts: &RunOptions, slurm: &SlurmOptions) -> Result<SubmitReport> {
     report.submission = Some(sub);
     report.resources = Some(res);
     Ok(report)
+}
+
+/// The poses of `plan` to submit: those to run that have no active task of an earlier
+/// submission; the others go into `report` (up to date, or in the queue with their task).
+fn sort_poses(plan: &campaign::Plan, earlier: &Submissions, report: &mut SubmitReport) -> Result<Vec<String>> {
+    let queued = queue_states(earlier)?;
+    let latest = earlier.latest_tasks();
+    let to_run = plan.to_run_names();
+    for p in &plan.selected {
+        if !to_run.contains(&p.name) {
+            report.up_to_date.push(p.name.clone());
+        }
+    }
+    let mut poses = Vec::new();
+    for name in to_run {
+        let active = latest
+            .get(&name)
+            .and_then(|(job, task)| queued.get(&format!("{job}_{task}")).map(|s| (format!("{job}_{task}"), s.clone())))
+            .filter(|(_, s)| s.is_active());
+        match active {
+            Some((task, state)) => report.in_queue.push((name, task, state.state)),
+            None => poses.push(name),
+        }
+    }
+    Ok(poses)
+}
+
+/// sbatch's arguments for an array of `tasks` (>= 1) tasks writing their output to
+/// `slurm_dir`.
+fn sbatch_args(opts: &RunOptions, slurm: &SlurmOptions, res: &Resources, tasks: usize, slurm_dir: &Path) -> Result<Vec<String>> {
+    let mut args = vec![
+        "--parsable".to_string(),
+        format!("--job-name=needle-fe-{}", set_name(&opts.set_dir)),
+        format!("--array=0-{}", tasks.saturating_sub(1)),
+        format!("--output={}/%A_%a.out", slurm_dir.display()),
+        format!("--chdir={}", absolute(Path::new("."))?.display()),
+        format!("--cpus-per-task={}", res.cpus_per_task),
+    ];
+    if let Some(t) = &res.time {
+        args.push(format!("--time={t}"));
+    }
+    if let Some(m) = &res.mem {
+        args.push(format!("--mem={m}"));
+    }
+    if let Some(p) = &slurm.partition {
+        args.push(format!("--partition={p}"));
+    }
+    args.extend(slurm.extra.iter().cloned());
+    Ok(args)
 }
 
 const UNCHANGED: &str = "Nothing was submitted; no file of the set changed.";

@@ -13,11 +13,15 @@
 //!    solver accepted off the equilibrium path shows as such a point.
 //! 5. **Scaling law** ([`scaling`]): the centre and a half-model pose with every Ogden
 //!    mu_i scaled by 0.5 and 2 against s times the committed run (goal 0.5 % of peak |Fy|).
+//! 6. **Viscoelastic ramp and hold** ([`qlv`]): the `[viscoelastic]` runs against the
+//!    library's QLV filter on the elastic run (run by the CLI, `needle fe verify --qlv`;
+//!    goal RMS 3 %, must 5 %, largest 6 % of peak |Fy|), written with [`write_tables`].
 
 pub mod mesh_check;
 mod mirror;
 pub mod punch;
 pub mod punch_febio;
+pub mod qlv;
 pub mod runs;
 pub mod scaling;
 pub mod shape;
@@ -121,61 +125,16 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
             crate::spec::Engine::Febio => punch_febio::punch(&c, &work, opts)?,
             crate::spec::Engine::Ccx => punch::punch(&c, &work, opts)?,
         };
-        println!(
-            "flat punch a = {} mm, delta = {} mm, nu = {:.4}, {}: F(block) = {:.5e} N, F(2x block) = {:.5e} N, \
-             F(half-space, extrapolated) = {:.5e} N, Sneddon {:.5e} N: error {:+.2}% (goal within {}%); {} {:.0} s + {:.0} s",
-            p.radius_mm,
-            p.delta_mm,
-            p.nu,
-            p.check.element,
-            p.check.force_block_n,
-            p.check.force_block_2x_n,
-            p.check.force_half_space_n,
-            p.force_sneddon_n,
-            p.check.error_percent,
-            p.goal_percent,
-            p.solver,
-            p.check.wall_s[0],
-            p.check.wall_s[1]
-        );
-        if let Some(r) = &p.campaign_element {
-            println!(
-                "  campaign element {}: F(block) = {:.5e} N, F(2x block) = {:.5e} N, F(half-space) = {:.5e} N: {:+.2}% \
-                 (no goal: volumetric locking of the fully integrated C3D8 at K0/mu0 = {}); ccx {:.0} s + {:.0} s",
-                r.element,
-                r.force_block_n,
-                r.force_block_2x_n,
-                r.force_half_space_n,
-                r.error_percent,
-                p.bulk_to_shear,
-                r.wall_s[0],
-                r.wall_s[1]
-            );
-        }
+        print_punch(&p);
         ok &= p.check.error_percent.abs() <= p.goal_percent;
         report.punch = Some(p);
     }
     if let Some(o) = &opts.mesh {
         let m = mesh_check::mesh_convergence(&c, o)?;
-        println!(
-            "mesh study, centre Fy({} mm): {} vs {} {}; {}{}",
-            m.depth_mm,
-            m.committed,
-            m.refined,
-            m.difference_percent
-                .map(|d| format!("{d:+.2}% (absolute level: reported, not judged)"))
-                .unwrap_or_else(|| "no comparison".into()),
-            m.asymptotic,
-            m.ratio_of_changes.map(|r| format!(" (ratio of successive changes {r:.3})")).unwrap_or_default()
-        );
-        if let (Some(f), Some(p), Some(d)) = (m.richardson_fy_n, m.richardson_order, m.committed_vs_richardson_percent) {
-            println!("  Richardson estimate of the converged Fy: {f:.5e} N (observed order {p:.2}); committed level {d:+.2}% from it");
-        }
+        print_mesh_study(&m);
         ok &= m.ok();
         report.mesh = Some(m);
     }
-    let path = opts.set_dir.join("fe").join("verify.toml");
-    let mut old: toml::Table = std::fs::read_to_string(&path).ok().and_then(|t| t.parse().ok()).unwrap_or_default();
     let mut new: toml::Table = toml::Table::try_from(&report).context("cannot serialise the verify report")?;
     // only the checks that ran replace their part of an earlier verify.toml
     if !opts.mirror {
@@ -184,11 +143,86 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
     if !opts.smooth {
         new.remove("smooth");
     }
+    write_tables(&opts.set_dir, new)?;
+    Ok((report, ok))
+}
+
+/// The flat-punch check's lines: the block, twice the block, the half-space extrapolated
+/// against Sneddon, and the campaign element's (no goal) when it ran.
+fn print_punch(p: &PunchReport) {
+    println!(
+        "flat punch a = {} mm, delta = {} mm, nu = {:.4}, {}: F(block) = {:.5e} N, F(2x block) = {:.5e} N, \
+         F(half-space, extrapolated) = {:.5e} N, Sneddon {:.5e} N: error {:+.2}% (goal within {}%); {} {:.0} s + {:.0} s",
+        p.radius_mm,
+        p.delta_mm,
+        p.nu,
+        p.check.element,
+        p.check.force_block_n,
+        p.check.force_block_2x_n,
+        p.check.force_half_space_n,
+        p.force_sneddon_n,
+        p.check.error_percent,
+        p.goal_percent,
+        p.solver,
+        p.check.wall_s[0],
+        p.check.wall_s[1]
+    );
+    if let Some(r) = &p.campaign_element {
+        println!(
+            "  campaign element {}: F(block) = {:.5e} N, F(2x block) = {:.5e} N, F(half-space) = {:.5e} N: {:+.2}% \
+             (no goal: volumetric locking of the fully integrated C3D8 at K0/mu0 = {}); ccx {:.0} s + {:.0} s",
+            r.element,
+            r.force_block_n,
+            r.force_block_2x_n,
+            r.force_half_space_n,
+            r.error_percent,
+            p.bulk_to_shear,
+            r.wall_s[0],
+            r.wall_s[1]
+        );
+    }
+}
+
+/// The mesh study's lines: the committed and refined centre Fy, and Richardson's estimate
+/// when three levels are in the asymptotic range.
+fn print_mesh_study(m: &MeshReport) {
+    println!(
+        "mesh study, centre Fy({} mm): {} vs {} {}; {}{}",
+        m.depth_mm,
+        m.committed,
+        m.refined,
+        m.difference_percent.map(|d| format!("{d:+.2}% (absolute level: reported, not judged)")).unwrap_or_else(|| "no comparison".into()),
+        m.asymptotic,
+        m.ratio_of_changes.map(|r| format!(" (ratio of successive changes {r:.3})")).unwrap_or_default()
+    );
+    if let (Some(f), Some(p), Some(d)) = (m.richardson_fy_n, m.richardson_order, m.committed_vs_richardson_percent) {
+        println!("  Richardson estimate of the converged Fy: {f:.5e} N (observed order {p:.2}); committed level {d:+.2}% from it");
+    }
+}
+
+/// Replace the table `name` of `<set>/fe/verify.toml` with `value` ([`write_tables`]).
+///
+/// # Errors
+/// `value` does not serialise as TOML, or the file cannot be written.
+pub fn write_table(set_dir: &std::path::Path, name: &str, value: &impl Serialize) -> Result<()> {
+    let mut t = toml::Table::new();
+    t.insert(name.to_string(), toml::Value::try_from(value).with_context(|| format!("cannot serialise verify.toml's [{name}]"))?);
+    write_tables(set_dir, t)
+}
+
+/// Replace the tables of `new` in `<set>/fe/verify.toml` (atomically), keeping the
+/// others: a check that did not run keeps its table from the last run that did.
+///
+/// # Errors
+/// The file cannot be written.
+pub fn write_tables(set_dir: &std::path::Path, new: toml::Table) -> Result<()> {
+    let path = set_dir.join("fe").join("verify.toml");
+    let mut old: toml::Table = std::fs::read_to_string(&path).ok().and_then(|t| t.parse().ok()).unwrap_or_default();
     for (k, v) in new {
         old.insert(k, v);
     }
     let text = format!("# written by `needle fe verify`; do not edit\n{}", toml::to_string(&old)?);
     results::write_atomic(&path, text.as_bytes())?;
     println!("wrote {}", path.display());
-    Ok((report, ok))
+    Ok(())
 }

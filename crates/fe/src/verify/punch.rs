@@ -58,8 +58,7 @@
 //! takes about a minute and is the CI test (tests/fe_verify_punch.rs).
 
 use super::VerifyOptions;
-use crate::ccx;
-use crate::dat;
+use crate::ccx::{self, dat};
 use crate::mesh::{self, P3};
 use crate::spec::{self, Campaign, PoseSpec, Role, Symmetry};
 use anyhow::{bail, Context, Result};

@@ -55,11 +55,23 @@ pub fn read_current(opts: &RunOptions) -> Result<PoseRows> {
         let entry = plan.manifest.pose.get(&pose.name).filter(|_| !plan.to_run.contains(&i));
         let r = match entry {
             None => Err(format!("{}: no current result (mesh {}, {} steps)", csv.display(), plan.mesh_name, plan.steps)),
-            Some(e) => results::read_csv(&csv).map(|rows| Run { rows, entry: e.clone() }).map_err(|e| format!("{e:#}")),
+            Some(e) => read_rows(&csv, plan.campaign.loading.ramp_hold.is_some())
+                .map(|rows| Run { rows, entry: e.clone() })
+                .map_err(|e| format!("{e:#}")),
         };
         out.insert(pose.name.clone(), r);
     }
     Ok(out)
+}
+
+/// A result's rows: an elastic run's, or a ramp-and-hold run's without its time column
+/// (`timed`; the times are the loading's must points).
+fn read_rows(csv: &std::path::Path, timed: bool) -> Result<Vec<Row>> {
+    if !timed {
+        return results::read_csv(csv);
+    }
+    let text = std::fs::read_to_string(csv).map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", csv.display()))?;
+    Ok(results::parse_timed_csv(&text, csv)?.1)
 }
 
 /// The depths of `a` and `b` agree row by row (the same must points).

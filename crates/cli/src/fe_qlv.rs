@@ -1,0 +1,48 @@
+//! `needle fe verify --qlv`: the library's QLV filter (`needle_haptics::viscoelastic`,
+//! f32, one tick of `InsertionConfig::DEFAULT_1KHZ`) run on the elastic FE wrench along
+//! each ramp-and-hold run's depth-time path, against FEBio's viscoelastic solution
+//! (`needle_fe::verify::qlv`: pairing, scores, bounds). The filter is the firmware's own
+//! code; this module only feeds it and samples its output at the FE's must points.
+
+use needle_fe::verify::qlv::{self, QlvCase, QlvOptions, QlvRun};
+
+/// Run the check: solve (when `opts.solve`) and read the runs, filter, score, print each
+/// run's line, write `[[qlv]]` of `<set>/fe/verify.toml`. Returns whether every run is
+/// within the bounds (a missing run is a miss).
+///
+/// # Errors
+/// As [`qlv::cases`], or verify.toml cannot be written.
+pub fn check(opts: &QlvOptions) -> anyhow::Result<bool> {
+    let (c, _) = needle_fe::spec::load(&opts.set_dir)?;
+    let mut runs: Vec<QlvRun> = Vec::new();
+    let mut missing: Vec<String> = Vec::new();
+    let mut compared: Vec<QlvCase> = Vec::new();
+    for case in qlv::cases(opts)? {
+        match case {
+            Ok(case) => {
+                let r = qlv::score(
+                    &case,
+                    &crate::qlv_filtered::filtered(&case)?,
+                    crate::qlv_filtered::tick_s(),
+                    c.needle.reference_from_tip_mm,
+                )?;
+                println!("{r}");
+                runs.push(r);
+                compared.push(case);
+            }
+            Err((run, why)) => {
+                println!("qlv {run}: no comparison: {why}");
+                missing.push(format!("{run}: {why}"));
+            }
+        }
+    }
+    let report = qlv::report(runs, missing);
+    needle_fe::verify::write_table(&opts.set_dir, "qlv", &report)?;
+    if !compared.is_empty() {
+        let svg = crate::fe_qlv_figure::svg(&compared)?;
+        let path = opts.set_dir.join("figures").join(crate::fe_qlv_figure::FILE);
+        needle_fe::results::write_atomic(&path, svg.as_bytes())?;
+        println!("wrote {}", path.display());
+    }
+    Ok(report.ok())
+}

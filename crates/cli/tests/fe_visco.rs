@@ -1,0 +1,59 @@
+//! `needle fe run --visco` and `needle fe verify --qlv` end to end on FEBio, on the smoke
+//! mesh (CI's budget: about a minute; the elastic centre and the three ramp-and-hold runs
+//! took 47 s on one shared core, every run within the bounds there): the centre's ramp-and-hold runs land in fe/visco/
+//! with a time column and their manifest, are resumed, and the QLV check compares them
+//! with the library's filter into verify.toml and the figure. They need `febio4`
+//! (`.ci/install-febio`); without it they fail, they are not skipped. The bounds are
+//! judged on the campaign's runs (host-tests/tests/fe_qlv_bounds.rs), not on this mesh.
+
+mod fe_common;
+
+use fe_common::{default_set, show};
+use needle_fe::manifest::{read_manifest, MANIFEST};
+use std::ffi::OsStr;
+use std::path::Path;
+use std::process::Output;
+
+/// Must points on the ramp (1.2 mm each; the smoke mesh finds the contact at this step).
+const RAMP_STEPS: &str = "5";
+
+/// `needle <args> --set <set>`.
+fn needle(args: &[&str], set: &Path) -> Output {
+    let mut all: Vec<&OsStr> = args.iter().map(OsStr::new).collect();
+    all.extend([OsStr::new("--set"), set.as_os_str()]);
+    fe_common::needle(&all, &[])
+}
+
+#[test]
+fn centre_ramp_and_hold_on_the_smoke_mesh_against_the_filter() {
+    let (_d, set) = default_set();
+    let (c, _) = needle_fe::spec::load(&set).expect("spec");
+    let v = c.viscoelastic.clone().expect("[viscoelastic]");
+    let args = ["fe", "verify", "--qlv", "--qlv-poses", "centre", "--qlv-mesh", "smoke", "--qlv-steps", RAMP_STEPS, "--threads", "1"];
+    let o = needle(&args, &set);
+    let out = String::from_utf8_lossy(&o.stdout).to_string();
+    // solved and compared (the exit status judges the bounds, which are the campaign's)
+    assert!(o.status.code().is_some_and(|c| c <= 1) && out.contains("qlv centre_10mm-s"), "{}", show(&o));
+    let m = read_manifest(&set.join("fe/visco").join(MANIFEST)).expect("visco manifest");
+    for &speed in &v.speeds_mm_per_s {
+        let run = needle_fe::visco::run_name("centre", speed);
+        let text = std::fs::read_to_string(set.join(format!("fe/visco/{run}.csv"))).expect("visco csv");
+        let (times, rows) = needle_fe::results::parse_timed_csv(&text, Path::new(&run)).expect("timed csv");
+        let steps = 5 + v.hold_steps as usize;
+        assert_eq!((times.len(), rows.len()), (steps + 1, steps + 1), "{run}");
+        let end = c.loading.depth_mm / speed + v.hold_s;
+        assert!((times[steps] - end).abs() < 1e-9 * end, "{run}: ends at {} s, not {end} s", times[steps]);
+        // the hold relaxes: Fy at the hold's end below Fy at the ramp's end
+        let (ramp_end, hold_end) = (rows[5].fy_n(), rows[steps].fy_n());
+        assert!(ramp_end > 0.0 && hold_end < ramp_end, "{run}: Fy {ramp_end} N at the ramp's end, {hold_end} N at the hold's");
+        let e = &m.pose[&run];
+        assert!(e.viscoelastic.as_deref().is_some_and(|l| l.contains(&format!("at {speed} mm/s"))), "{run}: {:?}", e.viscoelastic);
+    }
+    let verify = std::fs::read_to_string(set.join("fe/verify.toml")).expect("verify.toml");
+    assert_eq!(verify.matches("[[qlv.runs]]").count(), v.speeds_mm_per_s.len(), "{verify}");
+    assert!(set.join("figures").join("qlv-ramp-hold.svg").is_file(), "the figure");
+    // resumed, not solved again
+    let again = needle(&["fe", "run", "--visco", "--only", "centre_*", "--mesh", "smoke", "--steps", RAMP_STEPS, "--threads", "1"], &set);
+    let out = String::from_utf8_lossy(&again.stdout);
+    assert!(again.status.success() && out.matches("up to date").count() >= v.speeds_mm_per_s.len(), "{}", show(&again));
+}

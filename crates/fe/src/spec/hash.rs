@@ -1,0 +1,50 @@
+//! The run hash: everything that determines the result of one run, hashed.
+
+use super::{Block, Campaign, Contact, Engine, Loading, MeshLevel, Needle, PoseSpec, Solver, Tissue};
+use serde::Serialize;
+use sha2::{Digest, Sha256};
+
+impl Campaign {
+    /// Hash of everything that determines the result of one run: the whole spec except
+    /// the pose list and description, plus this pose and the mesh level. Hex SHA-256.
+    pub fn run_hash(&self, pose: &PoseSpec, mesh_name: &str) -> String {
+        #[derive(Serialize)]
+        struct Key<'a> {
+            tissue: &'a Tissue,
+            needle: &'a Needle,
+            block: &'a Block,
+            contact: &'a Contact,
+            loading: &'a Loading,
+            mesh_name: &'a str,
+            mesh: Option<&'a MeshLevel>,
+            pose: &'a PoseSpec,
+            generator: u32,
+            #[serde(skip_serializing_if = "Option::is_none")]
+            solver: Option<&'a Solver>,
+        }
+        let key = Key {
+            tissue: &self.tissue,
+            needle: &self.needle,
+            block: &self.block,
+            contact: &self.contact,
+            loading: &self.loading,
+            mesh_name,
+            mesh: self.mesh.get(mesh_name),
+            pose,
+            generator: match self.solver.engine {
+                Engine::Ccx => crate::versions::CCX_DECK,
+                Engine::Febio => crate::versions::FEBIO_INPUT,
+            },
+            solver: (self.solver.engine != Engine::Ccx).then_some(&self.solver),
+        };
+        // plain data with string keys: serialising cannot fail; if it ever did, an empty
+        // key would give every run the same hash, so fail loudly instead
+        let json = serde_json::to_string(&key).unwrap_or_else(|e| panic!("the spec hash key does not serialise: {e}"));
+        hex(&Sha256::digest(json.as_bytes()))
+    }
+}
+
+/// Lower-case hex of a byte string.
+pub fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}

@@ -1,0 +1,58 @@
+//! `[mesh.<level>]`: the named mesh levels.
+
+use super::error::{SpecError, SpecResult};
+use super::positive;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// `[mesh.<level>]`: the O-grid tissue mesh and the needle facets.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshLevel {
+    /// Half side of the fine core square around the needle path, mm.
+    pub core_half_mm: f64,
+    /// Elements along each side of the core square (even).
+    pub core_elements: u32,
+    /// Size of the first ring and of the fine layers, mm.
+    pub fine_size_mm: f64,
+    /// Depth of the fine layers under the surface, mm.
+    pub fine_depth_mm: f64,
+    /// Geometric growth ratio of rings and layers.
+    pub growth: f64,
+    /// Needle facets per quarter circumference.
+    pub needle_facets_per_quarter: u32,
+    /// Needle layer length near the tip, mm.
+    pub needle_axial_mm: f64,
+}
+
+impl MeshLevel {
+    /// Check the level `name`; messages start with the spec's `path`.
+    ///
+    /// # Errors
+    /// An odd or too small element count, fewer than 2 facets per quarter, a size not
+    /// finite and > 0, a growth below 1.
+    pub fn validate(&self, path: &Path, name: &str) -> SpecResult<()> {
+        let p = path.display();
+        if self.core_elements < 2 || !self.core_elements.is_multiple_of(2) {
+            let field = format!("mesh.{name}.core_elements");
+            return Err(SpecError::range(&p, &field, format!("{field} = {}: must be even and >= 2", self.core_elements)));
+        }
+        if self.needle_facets_per_quarter < 2 {
+            let field = format!("mesh.{name}.needle_facets_per_quarter");
+            return Err(SpecError::range(&p, &field, format!("{field} = {}: must be >= 2", self.needle_facets_per_quarter)));
+        }
+        for (f, v) in [
+            ("core_half_mm", self.core_half_mm),
+            ("fine_size_mm", self.fine_size_mm),
+            ("fine_depth_mm", self.fine_depth_mm),
+            ("needle_axial_mm", self.needle_axial_mm),
+        ] {
+            positive(path, &format!("mesh.{name}.{f}"), v)?;
+        }
+        if !(self.growth.is_finite() && self.growth >= 1.0) {
+            let field = format!("mesh.{name}.growth");
+            return Err(SpecError::range(&p, &field, format!("{field} = {}: must be >= 1", self.growth)));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,129 @@
+//! Viscoelastic ramp-and-hold runs (issue 39, item 3): the set's FE tissue (the uncoupled
+//! Ogden of `[tissue]`) wrapped in FEBio's `uncoupled viscoelastic` material with the
+//! Prony series of `[viscoelastic]`, fed at each of `speeds_mm_per_s` to
+//! `loading.depth_mm` in `loading.steps` must points (at the elastic runs' depths), then
+//! held for `hold_s`. `needle fe run --visco` solves them through the campaign's own
+//! machinery (resume, retry ladder, atomic CSV and manifest) into
+//! `<set>/fe/visco/<pose>_<speed>mm-s.csv` (with a `time_s` column) and
+//! `<set>/fe/visco/manifest.toml`.
+//!
+//! A run's spec is the campaign's with the Prony series in `tissue.prony` and the time
+//! course in `loading.ramp_hold` ([`apply`]), so its hash never equals an elastic run's.
+//! FEBio's time is then seconds; the must points are [`RampHold::time_s`].
+//! `needle fe verify --qlv` compares these runs with the library's filter.
+
+pub use crate::spec::visco::{run_name, Prony, RampHold, ViscoSettings, MAX_PRONY_TERMS};
+
+use crate::spec::{Campaign, PoseSpec};
+
+/// Sub-folder of `<set>/fe/` holding the ramp-and-hold runs and their manifest.
+pub const VISCO_DIR: &str = "visco";
+
+/// Header of a ramp-and-hold result: the time, s, before the FE result's columns.
+pub const TIME_COLUMN: &str = "time_s";
+
+/// The campaign as the runs at `speed_mm_per_s` see it (`ramp_steps` must points on the
+/// ramp), and their poses (renamed by [`run_name`]).
+pub fn apply(c: &Campaign, v: &ViscoSettings, speed_mm_per_s: f64, ramp_steps: u32) -> (Campaign, Vec<PoseSpec>) {
+    let mut run = c.clone();
+    run.tissue.prony = Some(Prony { g: v.g.clone(), tau_s: v.tau_s.clone() });
+    run.loading.steps = ramp_steps + v.hold_steps;
+    run.loading.ramp_hold = Some(RampHold {
+        speed_mm_per_s,
+        ramp_steps,
+        hold_s: v.hold_s,
+        hold_steps: v.hold_steps,
+        hold_first_s: v.hold_first_s,
+        min_residual_n: v.min_residual_n,
+    });
+    let every = c.poses();
+    let poses = v
+        .poses
+        .iter()
+        .filter_map(|n| every.iter().find(|p| &p.name == n))
+        .map(|p| PoseSpec { name: run_name(&p.name, speed_mm_per_s), ..p.clone() })
+        .collect();
+    (run, poses)
+}
+
+/// The manifest's line of a ramp-and-hold run (`None`: not one): its Prony series and
+/// time course, with units.
+pub fn describe(c: &Campaign) -> Option<String> {
+    let (p, r) = (c.tissue.prony.as_ref()?, c.loading.ramp_hold.as_ref()?);
+    let terms: Vec<String> = p.g.iter().zip(&p.tau_s).map(|(g, t)| format!("g {g} tau {t} s")).collect();
+    Some(format!(
+        "uncoupled viscoelastic (FEBio normalisation, g0 = 1) {}; ramp to {} mm at {} mm/s ({} s, {} must points), hold {} s ({} must points from {} s); Newton's residual floor {} N",
+        terms.join(", "),
+        c.loading.depth_mm,
+        r.speed_mm_per_s,
+        r.ramp_s(c.loading.depth_mm),
+        r.ramp_steps,
+        r.hold_s,
+        r.hold_steps,
+        r.hold_first_s,
+        r.min_residual_n
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::deep::key_line;
+    use std::path::Path;
+
+    fn shipped() -> String {
+        std::fs::read_to_string(crate::workspace_root().join("coeffs/default/campaign.toml")).expect("campaign.toml")
+    }
+
+    fn error_of(text: &str) -> String {
+        crate::spec::parse(text, Path::new("campaign.toml")).err().map(|e| e.to_string()).unwrap_or_default()
+    }
+
+    #[test]
+    fn the_shipped_section_makes_runs_that_never_pass_for_elastic_ones() {
+        let c = crate::spec::parse(&shipped(), Path::new("campaign.toml")).expect("the shipped spec");
+        let v = c.viscoelastic.clone().expect("coeffs/default has [viscoelastic]");
+        assert_eq!(v.poses.first().map(String::as_str), Some("centre"), "the quarter model first");
+        let (run, poses) = apply(&c, &v, 10.0, c.loading.steps);
+        assert_eq!(run.loading.steps, c.loading.steps + v.hold_steps);
+        assert_eq!(poses.first().map(|p| p.name.as_str()), Some("centre_10mm-s"));
+        let centre = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");
+        assert_ne!(run.run_hash(&centre, &v.mesh), c.run_hash(&centre, &v.mesh));
+        // the ramp's must points are the elastic run's depths; the last is the hold's end
+        assert_eq!(run.loading.depth_at(c.loading.steps), c.loading.depth_mm);
+        assert_eq!(run.loading.time_at(run.loading.steps), c.loading.depth_mm / 10.0 + v.hold_s);
+        let text = describe(&run).expect("a ramp-and-hold run");
+        assert!(text.contains("at 10 mm/s (0.6 s") && text.contains("tau 0.5 s"), "{text}");
+        assert_eq!(run_name("x+04", 1.5), "x+04_1p5mm-s");
+    }
+
+    #[test]
+    fn bad_sections_are_refused_with_file_line_and_field() {
+        let text = shipped();
+        let line = |key: &str| key_line(&text, "viscoelastic", key);
+        // the section's own line replaced (`mesh = ...` is in [campaign] too)
+        let with = |key: &str, bad: &str| -> String {
+            let n = line(key);
+            text.lines().enumerate().map(|(i, l)| if i + 1 == n { format!("{bad}\n") } else { format!("{l}\n") }).collect()
+        };
+        let cases = [
+            ("g", "g = [-0.1, 0.4]", "every g_i must be finite and >= 0"),
+            ("g", "g = [0.1, 0.1, 0.1, 0.1]", "must be 1 ..= 3"),
+            ("g", "g = [5.0, 4.5]", "sums to 9.5: must be <= 9"),
+            ("tau_s", "tau_s = [0.0, 5.0]", "must be finite and > 0 s"),
+            ("tau_s", "tau_s = [1.0]", "one tau_s per g"),
+            ("speeds_mm_per_s", "speeds_mm_per_s = [1.0, 1.0]", "listed twice"),
+            ("speeds_mm_per_s", "speeds_mm_per_s = [0.0]", "must be finite and > 0"),
+            ("hold_s", "hold_s = -1.0", "must be finite and > 0"),
+            ("hold_first_s", "hold_first_s = 40.0", "must be in (0, hold_s"),
+            ("mesh", "mesh = \"nope\"", "no [mesh.nope] level"),
+            ("poses", "poses = [\"centre\", \"nope\"]", "not a pose of this campaign"),
+        ];
+        for (key, bad, want) in cases {
+            let msg = error_of(&with(key, bad));
+            assert!(msg.starts_with(&format!("campaign.toml:{}: viscoelastic.", line(key))) && msg.contains(want), "{key}: {msg}");
+        }
+        let msg = error_of(&text.replacen("stretch_max = 2.5\n", "stretch_max = 2.5\nprony = { g = [0.1], tau_s = [1.0] }\n", 1));
+        assert!(msg.contains("tissue.prony: set by [viscoelastic]"), "{msg}");
+    }
+}

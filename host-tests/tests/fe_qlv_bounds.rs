@@ -1,0 +1,49 @@
+//! The shipped set's viscoelastic verification (`needle fe verify --qlv`, issue 39): every
+//! ramp-and-hold run of `[viscoelastic]` (each pose at each speed) that FEBio solved, in
+//! whole or in part, is in `coeffs/default/fe/verify.toml` `[qlv]` and within the bounds:
+//! RMS <= 5 % (must) and largest <= 6 % of peak |Fy|, every component, over what it
+//! solved; at least one run is solved through its whole hold. The numbers are FEBio's and
+//! the library's filter's, written by the tool (never typed in).
+//!
+//! Why not every run: on the campaign's `needle8` mesh FEBio inverts elements in the hold
+//! of most ramp-and-hold runs (issue 39's closing notes: centre 1 mm/s solved; the others
+//! stop between 1.4 s and 16 s into the run). Until that is solved the unsolved runs are
+//! listed by this test, not failed; the issue stays open on them.
+
+use needle_fe::verify::qlv::{QLV_MAX_PERCENT, QLV_MUST_RMS_PERCENT};
+use needle_fe::visco::run_name;
+use std::path::Path;
+
+#[test]
+fn every_ramp_and_hold_run_is_within_the_bounds() {
+    let set = Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default");
+    let (c, _) = needle_fe::spec::load(&set).expect("the shipped spec");
+    let v = c.viscoelastic.expect("coeffs/default has [viscoelastic]");
+    let path = set.join("fe/verify.toml");
+    let text = std::fs::read_to_string(&path).expect("fe/verify.toml");
+    let t: toml::Table = text.parse().expect("verify.toml is TOML");
+    let qlv = t.get("qlv").and_then(toml::Value::as_table).unwrap_or_else(|| panic!("{}: no [qlv]", path.display()));
+    if let Some(missing) = qlv.get("missing").and_then(toml::Value::as_array) {
+        println!("not solved by FEBio (no comparison): {missing:?}");
+    }
+    let runs = qlv.get("runs").and_then(toml::Value::as_array).unwrap_or_else(|| panic!("{}: no [[qlv.runs]]", path.display()));
+    let num = |r: &toml::Value, k: &str| r.get(k).and_then(toml::Value::as_float).unwrap_or(f64::NAN);
+    let mut whole = 0;
+    for pose in &v.poses {
+        for &speed in &v.speeds_mm_per_s {
+            let name = run_name(pose, speed);
+            let Some(r) = runs.iter().find(|r| r.get("run").and_then(toml::Value::as_str) == Some(name.as_str())) else {
+                println!("{name}: no comparison (not solved)");
+                continue;
+            };
+            if r.get("partial").and_then(toml::Value::as_bool) == Some(false) {
+                whole += 1;
+            }
+            let (rms, max) = (num(r, "worst_rms_percent"), num(r, "worst_max_percent"));
+            assert!(rms <= QLV_MUST_RMS_PERCENT, "{name}: RMS {rms} % of peak |Fy| > {QLV_MUST_RMS_PERCENT} %");
+            assert!(max <= QLV_MAX_PERCENT, "{name}: largest error {max} % of peak |Fy| > {QLV_MAX_PERCENT} %");
+            assert!(num(r, "peak_fy_n") > 0.0, "{name}: no force measured");
+        }
+    }
+    assert!(whole >= 1, "{}: no ramp-and-hold run solved through its hold", path.display());
+}
