@@ -196,6 +196,8 @@ pub struct Plan {
     pub to_run: Vec<usize>,
     /// The selected poses, in campaign order (same order as `reports`).
     pub selected: Vec<PoseSpec>,
+    /// Every pose of the run variant, selected or not.
+    pub all: Vec<PoseSpec>,
 }
 
 impl Plan {
@@ -265,7 +267,7 @@ pub fn plan(opts: &RunOptions) -> Result<Plan> {
         }
         reports.push(report);
     }
-    Ok(Plan { campaign, spec_path, mesh_name, steps, out_dir, manifest, reports, to_run, selected })
+    Ok(Plan { campaign, spec_path, mesh_name, steps, out_dir, manifest, reports, to_run, selected, all })
 }
 
 /// What a run variant (`--deep`, a tissue scale) changes besides the spec it rewrites.
@@ -323,14 +325,23 @@ fn apply_variant(opts: &RunOptions, campaign: &mut Campaign, spec_path: &Path) -
 /// As [`run`].
 pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> {
     let start = Instant::now();
-    let Plan { campaign, mesh_name, steps, out_dir, mut reports, to_run, selected, .. } = plan(opts)?;
+    let Plan { campaign, mesh_name, steps, out_dir, mut reports, to_run, selected, all, .. } = plan(opts)?;
     let mesh = campaign.mesh_level(&mesh_name)?.clone();
     std::fs::create_dir_all(&out_dir).with_context(|| format!("{}: cannot create", out_dir.display()))?;
     let manifest_path = out_dir.join(MANIFEST);
     let manifest = {
         let _lock = lock_manifest(&out_dir)?;
         // read again under the lock: another process may have written it since the plan
-        read_manifest(&manifest_path)?
+        let mut m = read_manifest(&manifest_path)?;
+        let recorded = m.record_first_attempts(&campaign, &all, &mesh_name);
+        if recorded > 0 {
+            results::write_atomic(&manifest_path, manifest_text(&m)?.as_bytes())?;
+            eprintln!(
+                "recorded the first attempt's hash of {recorded} run(s) solved by their first attempt in {}",
+                manifest_path.display()
+            );
+        }
+        m
     };
     let to_run: Vec<(usize, &PoseSpec)> = to_run.iter().filter_map(|&i| selected.get(i).map(|p| (i, p))).collect();
     let skipped = reports.len() - to_run.len();
@@ -669,6 +680,7 @@ fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Res
     results::write_atomic(&csv, text.as_bytes())?;
     let entry = ManifestEntry {
         spec_hash: ctx.campaign.run_hash(pose, ctx.mesh_name),
+        first_attempt_hash: s.retry.is_none().then(|| ctx.campaign.first_attempt_hash(pose, ctx.mesh_name)),
         engine: ctx.backend.engine().to_string(),
         engine_version: ctx.solver_version.clone(),
         element: s.element.clone(),
@@ -1014,6 +1026,42 @@ pub(crate) mod tests {
         let text = std::fs::read_to_string(d.path().join("fe").join(MANIFEST)).expect("manifest text");
         assert_eq!(text.matches("first_increment = 0.25").count(), 1, "{text}");
         assert_eq!(text.matches("retry = \"fake stall\"").count(), 1, "{text}");
+    }
+
+    /// Issue 42: a run its first attempt solved stays current when only settings of the
+    /// retry ladder's later attempts change (`retry_dtol`); a run a retry solved is solved
+    /// again; an entry from before the first attempt's hash gets it on the next run.
+    #[test]
+    fn a_change_of_the_later_attempts_settings_reruns_only_the_runs_they_solved() {
+        let d = set_dir();
+        let mut fake = Fake { fail_first: Some("x+04".into()), ..Fake::default() };
+        let r = run_with(&opts(d.path(), "x+0[24]", 2), &mut fake).expect("run");
+        assert_eq!((r.done(), r.failed()), (2, 0), "{}", r.table());
+        let path = d.path().join("fe").join(MANIFEST);
+        let m = read_manifest(&path).expect("manifest");
+        let first = m.pose["x+02"].first_attempt_hash.clone();
+        assert!(first.is_some() && m.pose["x+04"].first_attempt_hash.is_none(), "{m:?}");
+        // an entry written before the hash existed gets it from the next run
+        let mut old = m.clone();
+        if let Some(e) = old.pose.get_mut("x+02") {
+            e.first_attempt_hash = None;
+        }
+        std::fs::write(&path, manifest_text(&old).expect("text")).expect("write");
+        let r = run_with(&opts(d.path(), "x+04", 2), &mut Fake::default()).expect("run");
+        assert_eq!(r.up_to_date(), 1, "{}", r.table());
+        assert_eq!(read_manifest(&path).expect("manifest").pose["x+02"].first_attempt_hash, first);
+        // the retry's displacement tolerance changes: x+04 (solved by the retry) is stale
+        let spec_path = d.path().join("campaign.toml");
+        let text = std::fs::read_to_string(&spec_path).expect("spec");
+        assert!(text.contains("[solver.febio]\n") && !text.contains("\nretry_dtol"), "the default set's [solver.febio]");
+        std::fs::write(&spec_path, text.replacen("[solver.febio]\n", "[solver.febio]\nretry_dtol = 0.0005\n", 1)).expect("write");
+        let mut fake = Fake::default();
+        let r = run_with(&opts(d.path(), "x+0[24]", 2), &mut fake).expect("run");
+        assert_eq!((r.done(), r.up_to_date()), (1, 1), "{}", r.table());
+        assert_eq!(fake.solves.load(Ordering::SeqCst), 1, "x+04 only");
+        let m = read_manifest(&path).expect("manifest");
+        assert_eq!(m.pose["x+02"].first_attempt_hash, first, "x+02 kept");
+        assert!(m.pose["x+04"].first_attempt_hash.is_some(), "x+04 solved again, by its first attempt now");
     }
 
     /// `--deep`: the [deep] poses only, to the deep depth, into fe/deep/ with its own

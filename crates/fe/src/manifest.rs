@@ -28,6 +28,13 @@ pub struct Manifest {
 pub struct ManifestEntry {
     /// [`Campaign::run_hash`](crate::spec::Campaign::run_hash) of the spec (with the steps actually run), pose and mesh.
     pub spec_hash: String,
+    /// For a run its first attempt solved (no `retry`):
+    /// [`Campaign::first_attempt_hash`](crate::spec::Campaign::first_attempt_hash) of the
+    /// same spec. The run stays current while that hash does, when only settings of the
+    /// retry ladder's later attempts change. None for a run a later attempt solved, and
+    /// in entries from before it was recorded (until [`Manifest::record_first_attempts`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub first_attempt_hash: Option<String>,
     /// The engine that solved it: "ccx" or "febio" (entries written before there were
     /// two engines have none: ccx).
     #[serde(default = "ccx")]
@@ -119,8 +126,11 @@ pub struct ManifestEntry {
 
 impl Manifest {
     /// The entry of `pose` when it says the pose's result came from the spec `campaign`
-    /// as it is now, on mesh level `mesh_name` (its spec hash is
-    /// [`Campaign::run_hash`](crate::spec::Campaign::run_hash)); otherwise why not.
+    /// as it is now, on mesh level `mesh_name`: its spec hash is
+    /// [`Campaign::run_hash`](crate::spec::Campaign::run_hash), or its first attempt
+    /// solved it and its `first_attempt_hash` is
+    /// [`Campaign::first_attempt_hash`](crate::spec::Campaign::first_attempt_hash) (the
+    /// spec changed only where later attempts would have differed); otherwise why not.
     /// The one test of "current" shared by the campaign's skipping and by the fitter's
     /// and validator's refusal of stale runs.
     ///
@@ -131,13 +141,31 @@ impl Manifest {
         let short = |h: &str| h.get(..12).unwrap_or(h).to_string();
         match self.pose.get(&pose.name) {
             None => Err(format!("no entry in fe/{MANIFEST}")),
-            Some(e) if e.spec_hash != want => Err(format!(
+            Some(e) if e.spec_hash == want => Ok(e),
+            Some(e) if e.first_attempt_hash.as_deref() == Some(campaign.first_attempt_hash(pose, mesh_name).as_str()) => Ok(e),
+            Some(e) => Err(format!(
                 "solved from another spec (spec_hash {} in fe/{MANIFEST}, {} for the current campaign.toml)",
                 short(&e.spec_hash),
                 short(&want)
             )),
-            Some(e) => Ok(e),
         }
+    }
+
+    /// Record the first attempt's hash in every entry of `poses` that is current by its
+    /// spec hash on `mesh_name`, was solved by its first attempt (no `retry`) and has none
+    /// yet (entries written before the hash existed). Returns how many entries changed.
+    /// Only a current entry gets it: the hash is of the spec that solved the run.
+    pub fn record_first_attempts(&mut self, campaign: &Campaign, poses: &[PoseSpec], mesh_name: &str) -> usize {
+        let mut changed = 0;
+        for pose in poses {
+            if let Some(e) = self.pose.get_mut(&pose.name) {
+                if e.retry.is_none() && e.first_attempt_hash.is_none() && e.spec_hash == campaign.run_hash(pose, mesh_name) {
+                    e.first_attempt_hash = Some(campaign.first_attempt_hash(pose, mesh_name));
+                    changed += 1;
+                }
+            }
+        }
+        changed
     }
 }
 

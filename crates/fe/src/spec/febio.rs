@@ -269,4 +269,32 @@ mod tests {
         other.solver.febio.retry_rtol *= 2.0;
         assert_ne!(other.run_hash(&centre, "needle8"), h, "a tolerance is part of the problem's hash");
     }
+
+    /// The first attempt's hash leaves out what only the ladder's later attempts use (the
+    /// retry tolerances, the last attempt's penalty) and keeps what the first attempt
+    /// uses; it is never a run hash.
+    #[test]
+    fn the_first_attempts_hash_leaves_out_only_the_later_attempts_settings() {
+        let set = crate::workspace_root().join("coeffs/default");
+        let Ok((c, _)) = crate::spec::load(&set) else { panic!("cannot load {}", set.display()) };
+        let centre = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");
+        let (run, first) = (c.run_hash(&centre, "needle8"), c.first_attempt_hash(&centre, "needle8"));
+        assert_ne!(run, first);
+        let mut later = c.clone();
+        later.solver.febio.retry_dtol = 0.001;
+        later.solver.febio.retry_rtol *= 2.0;
+        later.solver.febio.last_attempt_penalty_scale = 0.5;
+        assert_ne!(later.run_hash(&centre, "needle8"), run, "the run hash holds every tolerance");
+        assert_eq!(later.first_attempt_hash(&centre, "needle8"), first);
+        for change in [
+            |f: &mut FebioSettings| f.dtol *= 2.0,
+            |f: &mut FebioSettings| f.rtol *= 2.0,
+            |f: &mut FebioSettings| f.retry_seg_up += 1,
+            |f: &mut FebioSettings| f.penalty *= 2.0,
+        ] {
+            let mut first_rung = c.clone();
+            change(&mut first_rung.solver.febio);
+            assert_ne!(first_rung.first_attempt_hash(&centre, "needle8"), first, "{:?}", first_rung.solver.febio);
+        }
+    }
 }

@@ -8,6 +8,26 @@ impl Campaign {
     /// Hash of everything that determines the result of one run: the whole spec except
     /// the pose list and description, plus this pose and the mesh level. Hex SHA-256.
     pub fn run_hash(&self, pose: &PoseSpec, mesh_name: &str) -> String {
+        self.hash_with(pose, mesh_name, &self.solver, None)
+    }
+
+    /// Hash of everything that determines a run solved by its first attempt: as
+    /// [`run_hash`](Self::run_hash), without the settings only later attempts of the
+    /// FEBio retry ladder use (`retry_dtol`, `retry_rtol`: the continuations and the
+    /// quarter-step attempts; `last_attempt_penalty_scale`: the fifth attempt), and marked
+    /// so that it never equals a `run_hash`. A run whose first attempt solved it is
+    /// reproduced by the spec as long as this hash stays the same, whatever the ladder's
+    /// later rungs become (the manifest's `first_attempt_hash`,
+    /// [`Manifest::current_entry`](crate::manifest::Manifest::current_entry)).
+    pub fn first_attempt_hash(&self, pose: &PoseSpec, mesh_name: &str) -> String {
+        let mut solver = self.solver.clone();
+        solver.febio.retry_dtol = 0.0;
+        solver.febio.retry_rtol = 0.0;
+        solver.febio.last_attempt_penalty_scale = 0.0;
+        self.hash_with(pose, mesh_name, &solver, Some("first attempt"))
+    }
+
+    fn hash_with(&self, pose: &PoseSpec, mesh_name: &str, solver: &Solver, scope: Option<&str>) -> String {
         #[derive(Serialize)]
         struct Key<'a> {
             tissue: &'a Tissue,
@@ -21,6 +41,8 @@ impl Campaign {
             generator: u32,
             #[serde(skip_serializing_if = "Option::is_none")]
             solver: Option<&'a Solver>,
+            #[serde(skip_serializing_if = "Option::is_none")]
+            scope: Option<&'a str>,
         }
         let key = Key {
             tissue: &self.tissue,
@@ -35,7 +57,8 @@ impl Campaign {
                 Engine::Ccx => crate::versions::CCX_DECK,
                 Engine::Febio => crate::versions::FEBIO_INPUT,
             },
-            solver: (self.solver.engine != Engine::Ccx).then_some(&self.solver),
+            solver: (solver.engine != Engine::Ccx).then_some(solver),
+            scope,
         };
         // plain data with string keys: serialising cannot fail; if it ever did, an empty
         // key would give every run the same hash, so fail loudly instead
