@@ -65,6 +65,7 @@ pub fn make_set(dir: &Path, skip: &[&str]) {
 fn synthetic_entry(campaign: &spec::Campaign, pose: &PoseSpec) -> ManifestEntry {
     ManifestEntry {
         spec_hash: campaign.run_hash(pose, &campaign.campaign.mesh),
+        first_attempt_hash: None,
         engine: "none".into(),
         engine_version: "none (synthetic wrench)".into(),
         element: String::new(),
