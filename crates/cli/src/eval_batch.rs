@@ -54,8 +54,9 @@ pub fn pose_columns(header: &csv::StringRecord, path: &Path) -> Result<[usize; 5
     Ok(idx)
 }
 
-/// One row's pose from the fields at `idx` (`field(i)` gives field `i`, trimmed), or the
-/// row's problems pushed to `bad` as `FILE:LINE: column NAME: ...`.
+/// One row's pose from the fields at `idx` (`field(i)` gives field `i`; ASCII white
+/// space around a number is ignored), or the row's problems pushed to `bad` as
+/// `FILE:LINE: column NAME: ...` (the field echoed trimmed).
 pub fn parse_row<'a>(
     field: impl Fn(usize) -> Option<&'a [u8]>,
     len: usize,
@@ -68,10 +69,10 @@ pub fn parse_row<'a>(
     let mut ok = true;
     for ((slot, &i), name) in v.iter_mut().zip(idx).zip(POSE_COLUMNS) {
         match field(i) {
-            Some(bytes) => match std::str::from_utf8(bytes).ok().and_then(|t| t.parse::<f32>().ok()) {
+            Some(bytes) => match std::str::from_utf8(bytes.trim_ascii()).ok().and_then(|t| t.parse::<f32>().ok()) {
                 Some(x) => *slot = x,
                 None => {
-                    let t = String::from_utf8_lossy(bytes);
+                    let t = String::from_utf8_lossy(bytes.trim_ascii());
                     bad.push(format!("{}:{line}: column {name}: {} is not a number", path.display(), echo(&t)));
                     ok = false;
                 }

@@ -9,6 +9,15 @@
 
 /// Appends `v` to `out` as `format!("{v:?}")` would.
 pub fn push_f32(out: &mut String, v: f32, ryu: &mut ryu::Buffer) {
+    // the common case: ryu writes `{:?}`'s text itself. ryu's layout is plain for a
+    // shortest decimal in [1e-6, 1e13) (`pretty::format32`), `{:?}`'s for a value in
+    // [1e-4, 1e16): both plain in [1e-4, 1e12) (the upper bound kept a decade below
+    // ryu's so that a value whose shortest decimal rounds up to 1e13 stays out), with the
+    // same digits unless the value can tie
+    if (1e-4..1e12).contains(&v.abs()) && !may_tie(v) {
+        out.push_str(ryu.format_finite(v));
+        return;
+    }
     if !v.is_finite() {
         use std::fmt::Write as _;
         let _ = write!(out, "{v:?}");
@@ -153,6 +162,15 @@ impl Text {
         }
         self.push(itoa.get(k..).unwrap_or(&[]));
     }
+}
+
+/// Whether `|v| = m 2^e` (`m` odd) has an exact decimal expansion short enough to tie
+/// (`-14 <= e <= 33`, see [`tie_rounded_up`]); false for most values, cheaply.
+fn may_tie(v: f32) -> bool {
+    let bits = v.abs().to_bits();
+    let (biased, frac) = ((bits >> 23) as i32, bits & 0x7f_ffff);
+    let (m, e) = if biased == 0 { (frac, -149) } else { (frac | 0x80_0000, biased - 150) };
+    m != 0 && (-14..=33).contains(&(e + m.trailing_zeros() as i32))
 }
 
 /// When `|v|` lies exactly halfway between `digits` and `digits + 1` (in the last

@@ -225,3 +225,31 @@ fn bad_rows_in_several_slices_are_listed_in_line_order() {
     let at: Vec<usize> = bad.iter().map(|i| err.find(&format!("{}:{}: column z_mm", file.display(), i + 2)).expect("listed")).collect();
     assert!(at.windows(2).all(|w| w[0] < w[1]), "in line order: {err}");
 }
+
+/// White space around a field or a header name is not part of it (the batch path trims
+/// each field itself, the CSV reader only the header): a padded file gives the rows of
+/// the plain one, byte for byte, and a bad padded field is echoed without its padding.
+#[test]
+fn padded_fields_read_as_the_numbers_they_hold() {
+    let d = tempfile::tempdir().expect("tempdir");
+    let set = default_set();
+    let run = |name: &str, text: &str| {
+        let file = d.path().join(name);
+        std::fs::write(&file, text).expect("write");
+        let out = d.path().join(format!("{name}.out"));
+        let o = needle(&["eval", "--set", &set.to_string_lossy(), "--poses", &file.to_string_lossy(), "--out", &out.to_string_lossy()]);
+        (o, std::fs::read(&out).ok(), file)
+    };
+    let (o, plain, _) = run("plain.csv", "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n2,1,3,0,5\n-1.5,0.25,-4,7,2\n");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (o, padded, _) =
+        run("padded.csv", " x_mm ,\tz_mm,theta_x_deg , theta_z_deg,depth_mm\n 2 ,1\t, 3,0 ,  5\n\t-1.5,  0.25 ,-4 ,7,2 \n");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(plain.is_some());
+    assert_eq!(padded, plain, "padded fields give the plain file's rows");
+    let (o, written, file) = run("bad.csv", "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n2, 1 x ,3,0,5\n");
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains(&format!("{}:2: column z_mm: \"1 x\" is not a number", file.display())), "{err}");
+    assert!(written.is_none(), "nothing written");
+}
