@@ -19,6 +19,7 @@ pub mod process;
 mod progress;
 pub mod report;
 pub mod results;
+pub mod results_error;
 pub mod resume;
 pub mod spec;
 pub mod verify;

@@ -7,7 +7,7 @@ use crate::spec::{Campaign, PoseSpec, Role};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::SystemTime;
 
 /// Name of the manifest file in the output folder.
@@ -197,22 +197,43 @@ fn ccx() -> String {
     "ccx".into()
 }
 
+/// Why a manifest was refused.
+#[derive(Debug, thiserror::Error)]
+pub enum ManifestError {
+    /// The file exists but cannot be read.
+    #[error("{}: cannot read", path.display())]
+    Read {
+        /// The manifest's path.
+        path: PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// Not TOML, or not a manifest's tables and keys.
+    #[error("{}:{line}: not a valid manifest ({message}); it is written by `needle fe run` only: delete it to rerun every pose", path.display())]
+    Invalid {
+        /// The manifest's path.
+        path: PathBuf,
+        /// 1-based line of the error (0: unknown).
+        line: usize,
+        /// The TOML reader's words.
+        message: String,
+    },
+}
+
 /// Read a manifest; a missing file is an empty manifest.
 ///
 /// # Errors
-/// The file exists but cannot be read or is not a valid manifest.
-pub fn read_manifest(path: &Path) -> Result<Manifest> {
+/// [`ManifestError`]: the file exists but cannot be read or is not a valid manifest.
+pub fn read_manifest(path: &Path) -> std::result::Result<Manifest, ManifestError> {
     let text = match std::fs::read_to_string(path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Manifest::default()),
-        Err(e) => return Err(e).with_context(|| format!("{}: cannot read", path.display())),
+        Err(source) => return Err(ManifestError::Read { path: path.into(), source }),
     };
     toml::from_str(&text).map_err(|e| {
-        anyhow::anyhow!(
-            "{}: not a valid manifest ({}); it is written by `needle fe run` only: delete it to rerun every pose",
-            path.display(),
-            e.message()
-        )
+        let line = e.span().and_then(|s| text.get(..s.start)).map_or(0, |t| t.matches('\n').count() + 1);
+        ManifestError::Invalid { path: path.into(), line, message: e.message().to_string() }
     })
 }
 
@@ -298,5 +319,24 @@ mod tests {
         assert_eq!(at(951_782_400 + 3_600 + 61), "2000-02-29T01:01:01Z");
         assert_eq!(at(4_107_542_400), "2100-03-01T00:00:00Z");
         assert_eq!(at(1_735_689_599), "2024-12-31T23:59:59Z");
+    }
+
+    /// A missing manifest is an empty one; a folder in its place cannot be read; a broken
+    /// one is refused with the line of the fault.
+    #[test]
+    fn each_bad_manifest_is_its_own_error() {
+        let d = tempfile::tempdir().expect("tempdir");
+        let path = d.path().join(MANIFEST);
+        assert!(read_manifest(&path).expect("missing: empty").pose.is_empty());
+        std::fs::create_dir(&path).expect("a folder in its place");
+        assert!(matches!(read_manifest(&path), Err(ManifestError::Read { .. })));
+        std::fs::remove_dir(&path).expect("remove the folder");
+        std::fs::write(&path, "# a comment\n\n[pose.x]\nengine = 3\n").expect("write");
+        match read_manifest(&path) {
+            Err(e @ ManifestError::Invalid { line: 4, .. }) => {
+                assert!(e.to_string().contains("manifest.toml:4: not a valid manifest"), "{e}")
+            }
+            other => panic!("a wrong type on line 4 must be Invalid at line 4: {other:?}"),
+        }
     }
 }

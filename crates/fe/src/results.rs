@@ -1,6 +1,7 @@
 //! FE result files `fe/<pose>.csv`: one row per depth, the reaction wrench on the needle.
 //! Format: coeffs/README.md, "FE result files".
 
+pub use crate::results_error::CsvError;
 use anyhow::{bail, Context, Result};
 use needle_contract::COMPONENT_COUNT;
 use std::io::Write;
@@ -54,16 +55,18 @@ pub fn to_csv(rows: &[Row]) -> String {
 /// Parse the CSV text of a result; `path` is only used in messages.
 ///
 /// # Errors
-/// Wrong header, a row without one field per column of `FE_COLUMNS` (7), a field that is not a finite number: the
-/// message has `path:line` and the offending value.
-pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<Row>> {
+/// [`CsvError`]: no header or another one, a row without one field per column of
+/// `FE_COLUMNS` (7), a field that is not a finite number; the message has `path:line` and
+/// the offending value (cut after [`MAX_ECHO_CHARS`](crate::results_error::MAX_ECHO_CHARS)
+/// characters).
+pub fn parse_csv(text: &str, path: &Path) -> std::result::Result<Vec<Row>, CsvError> {
     const FIELDS: usize = needle_contract::FE_COLUMNS.len();
     let mut lines = text.lines().enumerate();
     let header = header();
     match lines.next() {
         Some((_, h)) if h.trim() == header => {}
-        Some((_, h)) => bail!("{}:1: header is {h:?}, expected {header:?}", path.display()),
-        None => bail!("{}:1: empty file, expected the header {header:?}", path.display()),
+        Some((_, h)) => return Err(CsvError::Header { path: path.into(), found: h.into(), expected: header }),
+        None => return Err(CsvError::Empty { path: path.into(), expected: header }),
     }
     let mut rows = Vec::new();
     for (i, line) in lines {
@@ -73,15 +76,20 @@ pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<Row>> {
         }
         let fields: Vec<&str> = line.split(',').collect();
         if fields.len() != FIELDS {
-            bail!("{}:{n}: {} fields, expected {FIELDS}: {line:?}", path.display(), fields.len());
+            return Err(CsvError::FieldCount { path: path.into(), line: n, found: fields.len(), expected: FIELDS, text: line.into() });
         }
         let mut v = [0.0f64; FIELDS];
-        for (k, f) in fields.iter().enumerate() {
-            let x: f64 = f.trim().parse().with_context(|| format!("{}:{n}: field {} = {f:?} is not a number", path.display(), k + 1))?;
+        for (k, (slot, f)) in v.iter_mut().zip(&fields).enumerate() {
+            let at = |text: &str| (path.to_path_buf(), n, k + 1, text.to_string());
+            let x: f64 = f.trim().parse().map_err(|_| {
+                let (path, line, field, text) = at(f);
+                CsvError::NotANumber { path, line, field, text }
+            })?;
             if !x.is_finite() {
-                bail!("{}:{n}: field {} = {f:?} is not finite", path.display(), k + 1);
+                let (path, line, field, text) = at(f);
+                return Err(CsvError::NotFinite { path, line, field, text });
             }
-            v[k] = x;
+            *slot = x;
         }
         rows.push(Row { depth_mm: v[0], wrench: std::array::from_fn(|c| v[1 + c]) });
     }
@@ -150,7 +158,7 @@ pub fn content_sha256(bytes: &[u8]) -> String {
 /// As [`parse_csv`], or the file cannot be read.
 pub fn read_csv(path: &Path) -> Result<Vec<Row>> {
     let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
-    parse_csv(&text, path)
+    Ok(parse_csv(&text, path)?)
 }
 
 /// Write `bytes` to `path` atomically: a temporary file in the same folder, flushed and
@@ -308,6 +316,26 @@ pub fn remove_stale_temporaries(path: &Path) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Each kind of bad result file is its own [`CsvError`], at its line and field; a
+    /// huge bad field is cut in the message.
+    #[test]
+    fn each_bad_result_file_is_its_own_error() {
+        let p = Path::new("fe/x+02.csv");
+        let h = header();
+        let ok = format!("{h}\n0,0,0,0,0,0,0\n0.3,1e-3,2,3,4,5,6\n");
+        assert_eq!(parse_csv(&ok, p).expect("a good file").len(), 2);
+        assert!(matches!(parse_csv("", p), Err(CsvError::Empty { .. })));
+        assert!(matches!(parse_csv("depth_mm,fy_n\n", p), Err(CsvError::Header { .. })));
+        let rows = |row: &str| parse_csv(&format!("{h}\n0,0,0,0,0,0,0\n{row}\n"), p);
+        assert!(matches!(rows("0.3,1,2"), Err(CsvError::FieldCount { line: 3, found: 3, expected: 7, .. })));
+        assert!(matches!(rows("0.3,1,x,3,4,5,6"), Err(CsvError::NotANumber { line: 3, field: 3, .. })));
+        assert!(matches!(rows("0.3,1,2,inf,4,5,6"), Err(CsvError::NotFinite { line: 3, field: 4, .. })));
+        let huge = "9".repeat(1 << 20) + "x";
+        let e = rows(&format!("0.3,{huge},2,3,4,5,6")).expect_err("not a number");
+        assert!(matches!(e, CsvError::NotANumber { field: 2, .. }));
+        assert!(e.to_string().len() < 300, "the field is cut: {} bytes of message", e.to_string().len());
+    }
 
     /// A failure while writing the second file (its folder cannot be made: a file is in
     /// the way) leaves the first file's old content and no temporary of either.

@@ -2,6 +2,7 @@
 //! validation runs, read from `<set>/fe/<pose>.csv` as the campaign spec names them.
 
 use super::contract::{Sweep, DEPTH_MAX_MM, NCOEF};
+pub use super::run_error::RunError;
 use anyhow::{bail, Context, Result};
 use needle_fe::manifest::{read_manifest, Manifest, MANIFEST};
 use needle_fe::results::{parse_csv, Row};
@@ -116,17 +117,12 @@ impl<'a> FeRuns<'a> {
         let loading = &self.campaign.loading;
         let steps = loading.steps;
         if rows.len() != steps as usize + 1 {
-            bail!(
-                "{}: {} depth rows, expected loading.steps + 1 = {} (an unfinished or failed run?)",
-                path.display(),
-                rows.len(),
-                steps + 1
-            );
+            return Err(RunError::DepthRows { path, found: rows.len(), expected: steps as usize + 1 }.into());
         }
         for (k, r) in (0u32..).zip(&rows) {
             let want = loading.depth_at(k);
             if (r.depth_mm - want).abs() > 1e-9 {
-                bail!("{}:{}: depth_mm = {}, expected {want}", path.display(), k + 2, r.depth_mm);
+                return Err(RunError::Depth { path, line: k as usize + 2, found_mm: r.depth_mm, expected_mm: want }.into());
             }
         }
         Ok(Run { pose: pose.clone(), file_name: format!("{}.csv", pose.name), rows })
@@ -141,25 +137,14 @@ impl<'a> FeRuns<'a> {
 ///
 /// # Errors
 /// `bytes` (the file at `path`) differ from the hash `manifest` records, or it records none.
-fn check_content(manifest: &Manifest, pose: &PoseSpec, path: &Path, bytes: &[u8]) -> Result<()> {
+fn check_content(manifest: &Manifest, pose: &PoseSpec, path: &Path, bytes: &[u8]) -> std::result::Result<(), RunError> {
     let Some(entry) = manifest.pose.get(&pose.name) else { return Ok(()) };
     let Some(want) = entry.csv_sha256.as_ref() else {
-        bail!(
-            "{}: fe/manifest.toml records no csv_sha256 for {}, so nothing vouches for the file's content: rerun the pose with `needle fe run --force --only {}`",
-            path.display(),
-            pose.name,
-            pose.name
-        );
+        return Err(RunError::NoHash { path: path.into(), pose: pose.name.clone() });
     };
     if !entry.content_matches(bytes) {
-        let have = needle_fe::results::content_sha256(bytes);
-        bail!(
-            "{}: content changed since the FE run wrote it (sha256 {} now, {} in fe/manifest.toml): restore it (git checkout) or rerun the pose with `needle fe run --force --only {}`",
-            path.display(),
-            have.get(..16).unwrap_or(&have),
-            want.get(..16).unwrap_or(want),
-            pose.name
-        );
+        let now = needle_fe::results::content_sha256(bytes);
+        return Err(RunError::ContentChanged { path: path.into(), pose: pose.name.clone(), now, recorded: want.clone() });
     }
     Ok(())
 }
@@ -168,7 +153,7 @@ fn check_content(manifest: &Manifest, pose: &PoseSpec, path: &Path, bytes: &[u8]
 ///
 /// # Errors
 /// The file exists but is not a valid manifest.
-pub fn read_set_manifest(set_dir: &Path) -> Result<Manifest> {
+pub fn read_set_manifest(set_dir: &Path) -> std::result::Result<Manifest, needle_fe::manifest::ManifestError> {
     read_manifest(&set_dir.join("fe").join(MANIFEST))
 }
 
@@ -247,28 +232,14 @@ fn load_fit_data_in(set_dir: &Path, form: Option<ModelForm>) -> Result<FitData> 
 /// Every fitted pose has a result and it is current (the manifest's record of the spec).
 fn check_fitted_runs_current(runs: &FeRuns<'_>, fitted: &[PoseSpec]) -> Result<()> {
     let (set_dir, campaign) = (runs.set_dir, runs.campaign);
-    let missing: Vec<&str> = fitted.iter().filter(|p| !run_path(set_dir, p).is_file()).map(|p| p.name.as_str()).collect();
+    let missing: Vec<String> = fitted.iter().filter(|p| !run_path(set_dir, p).is_file()).map(|p| p.name.clone()).collect();
     if !missing.is_empty() {
-        bail!(
-            "{} of the {} fitted FE runs are missing from {}: {}\n(run `needle fe run --set {}` to finish the campaign; the fit needs the centre run, every sweep run and, for [fit] form = \"coupled\", every training run, less those listed in campaign.fit_without)",
-            missing.len(),
-            fitted.len(),
-            set_dir.join("fe").display(),
-            missing.join(", "),
-            set_dir.display()
-        );
+        return Err(RunError::Missing { set_dir: set_dir.into(), fitted: fitted.len(), poses: missing }.into());
     }
-    let stale: Vec<String> =
-        fitted.iter().filter_map(|p| stale_reason(runs.manifest(), campaign, p).map(|why| format!("{}: {why}", p.name))).collect();
+    let stale: Vec<(String, String)> =
+        fitted.iter().filter_map(|p| stale_reason(runs.manifest(), campaign, p).map(|why| (p.name.clone(), why))).collect();
     if !stale.is_empty() {
-        bail!(
-            "{} of the {} fitted FE runs in {} are stale:\n  {}\n(run `needle fe run --set {}`: it solves exactly the poses whose result is not current)",
-            stale.len(),
-            fitted.len(),
-            set_dir.join("fe").display(),
-            stale.join("\n  "),
-            set_dir.display()
-        );
+        return Err(RunError::Stale { set_dir: set_dir.into(), fitted: fitted.len(), runs: stale }.into());
     }
     Ok(())
 }

@@ -29,6 +29,7 @@ pub mod model;
 pub mod model_file;
 pub mod model_file_error;
 pub mod poly;
+pub mod run_error;
 pub mod unsolved;
 pub mod validate;
 
