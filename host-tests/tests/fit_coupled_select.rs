@@ -20,8 +20,8 @@ fn pose_of(p: &PoseSpec, depth_mm: f64) -> [f64; 5] {
 fn each_component_chooses_its_own_size_and_the_cross_term_is_recovered() {
     // The paper form of the default set, fitted here on its sweeps (the set may ship
     // either form): its deviations are degree 4 in the swept value.
-    let set = Path::new(needle_haptics::model_info::SET_DIR);
-    let mut data = load_paper_data(set).unwrap_or_else(|e| panic!("{e:#}"));
+    let set = needle_fe::set_folder::SetFolder::open(Path::new(needle_haptics::model_info::SET_DIR)).unwrap_or_else(|e| panic!("{e:#}"));
+    let mut data = load_paper_data(&set).unwrap_or_else(|e| panic!("{e:#}"));
     let paper = needle_fit::model::fit(&data).unwrap_or_else(|e| panic!("{e:#}"));
     // The centre and sweep runs become the paper model's own values.
     let exact = |run: &mut Run| {

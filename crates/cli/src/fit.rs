@@ -2,6 +2,7 @@
 use anyhow::{Context, Result};
 use clap::Args;
 use needle_fe::results::write_all_atomic;
+use needle_fe::set_folder::SetFolder;
 use needle_fit::{self as fit, validate as val};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -79,7 +80,8 @@ fn check_file(path: &Path, want: &str) -> Result<bool> {
 /// A fitted run is missing (every missing pose is named) or malformed, the spec is
 /// invalid, a fit is rank deficient, or a file cannot be written.
 pub fn fit(a: FitArgs) -> Result<ExitCode> {
-    let out = fit::fit_set(&a.set).with_context(|| format!("needle fit --set {}", a.set.display()))?;
+    let set = SetFolder::open(&a.set).with_context(|| format!("needle fit --set {}", a.set.display()))?;
+    let out = fit::fit_set_in(&set).with_context(|| format!("needle fit --set {}", a.set.display()))?;
     let files: Vec<(PathBuf, &str)> = out.files().iter().map(|(name, text)| (a.set.join(name), *text)).collect();
     if a.check {
         let mut same = true;
@@ -91,7 +93,7 @@ pub fn fit(a: FitArgs) -> Result<ExitCode> {
     let writes: Vec<(&Path, &[u8])> = files.iter().map(|(path, text)| (path.as_path(), text.as_bytes())).collect();
     write_all_atomic(&writes)?;
     print!("{}", fit::summary(&out.model));
-    let coupled = fit::coupled_report::measure(&a.set)
+    let coupled = fit::coupled_report::measure_in(&set)
         .with_context(|| format!("needle fit --set {}: measuring the coupled form", a.set.display()))?;
     print!("{}", fit::coupled_report::to_table(&coupled));
     print!("{}", fit::unsolved::summary(&out.unsolved));
@@ -112,7 +114,9 @@ pub fn fit(a: FitArgs) -> Result<ExitCode> {
 /// model.toml or the spec is missing or malformed, or a validation run is malformed.
 pub fn validate(a: ValidateArgs) -> Result<ExitCode> {
     let floor_degree = a.floor_degree.map_or(needle_contract::DEGREE, usize::from);
-    let report = val::validate_with(&a.set, floor_degree).with_context(|| format!("needle validate --set {}", a.set.display()))?;
+    let report = SetFolder::open(&a.set)
+        .and_then(|set| val::validate_in(&set, floor_degree))
+        .with_context(|| format!("needle validate --set {}", a.set.display()))?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {

@@ -1,10 +1,9 @@
 //! `/set.json` of the explorer: what the page needs besides the evaluator.
 
 use anyhow::{Context, Result};
-use needle_fe::spec;
+use needle_fe::set_folder::SetFolder;
 use needle_fit::data::{run_path, FeRuns};
 use serde_json::{json, Value};
-use std::path::Path;
 
 /// The set's name, the folder as given on the command line (for "copy as command"), the
 /// needle and block dimensions (mm, degrees: the side view), and every solved FE run of
@@ -14,11 +13,11 @@ use std::path::Path;
 /// leaves it out too).
 ///
 /// # Errors
-/// `campaign.toml` cannot be read, or a run file exists but is not a complete run of the
+/// A run file exists but is not a complete run of the
 /// spec's depth grid (the message names the file).
-pub fn set_json(set_dir: &Path) -> Result<Value> {
-    let (c, _) = spec::load(set_dir)?;
-    let fe = FeRuns::open(set_dir, &c)?;
+pub fn set_json(set: &SetFolder) -> Result<Value> {
+    let (c, set_dir) = (set.campaign(), set.dir());
+    let fe = FeRuns::new(set, c);
     let manifest = fe.manifest();
     let mut runs = Vec::new();
     for pose in c.poses() {

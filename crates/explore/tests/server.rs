@@ -68,7 +68,8 @@ fn set_json_leaves_out_a_run_without_a_manifest_entry() {
     let mut m = needle_fe::manifest::read_manifest(&path).expect("manifest");
     m.pose.retain(|name, _| name == "centre");
     std::fs::write(&path, needle_fe::manifest::manifest_text(&m).expect("text")).expect("write");
-    let v = needle_explore::set_json::set_json(&set).expect("set.json");
+    let opened = needle_fe::set_folder::SetFolder::open(&set).expect("open the set");
+    let v = needle_explore::set_json::set_json(&opened).expect("set.json");
     let names: Vec<&str> = v["runs"].as_array().expect("runs").iter().filter_map(|r| r["name"].as_str()).collect();
     assert_eq!(names, ["centre"], "x+04.csv has no manifest entry: not served");
 }

@@ -14,6 +14,7 @@ use super::validate::TABLE2_MIN_DEPTH_MM;
 use crate::contract::COMPONENT_COUNT;
 use crate::eval::float64::{eval, eval_paper, Pose64};
 use anyhow::Result;
+use needle_fe::set_folder::SetFolder;
 use needle_fe::spec::Role;
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -150,10 +151,18 @@ pub fn paper_held_out(runs: &[&Run], lever_arm_mm: f64, model: &Model) -> HeldOu
 /// # Errors
 /// The spec, the manifest or a run cannot be read; the paper form cannot be fitted.
 pub fn measure(set_dir: &Path) -> Result<CoupledReport> {
-    let data = load_paper_data(set_dir)?;
+    measure_in(&SetFolder::open(set_dir)?)
+}
+
+/// [`measure`] of an opened set.
+///
+/// # Errors
+/// As [`measure`].
+pub fn measure_in(set: &SetFolder) -> Result<CoupledReport> {
+    let data = load_paper_data(set)?;
     let paper = fit_paper(&data)?;
-    let (campaign, train, unusable) = load_training_runs(set_dir)?;
-    let (_, validation, _) = load_validation_runs(set_dir)?;
+    let (campaign, train, unusable) = load_training_runs(set)?;
+    let (_, validation, _) = load_validation_runs(set)?;
     let lever = campaign.needle.reference_from_tip_mm;
     let held: Vec<&Run> = validation.iter().filter(|r| r.pose.role.is_validation()).collect();
     let train_refs: Vec<&Run> = train.iter().collect();

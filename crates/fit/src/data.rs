@@ -4,9 +4,10 @@
 use super::contract::{Sweep, DEPTH_MAX_MM, NCOEF};
 pub use super::run_error::RunError;
 use anyhow::{bail, Context, Result};
-use needle_fe::manifest::{read_manifest, Manifest, MANIFEST};
+use needle_fe::manifest::Manifest;
 use needle_fe::results::{parse_csv, Row};
-use needle_fe::spec::{self, hex, Campaign, ModelForm, PoseSpec, Role};
+use needle_fe::set_folder::SetFolder;
+use needle_fe::spec::{hex, Campaign, ModelForm, PoseSpec, Role};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
@@ -84,23 +85,20 @@ pub fn run_path(set_dir: &Path, pose: &PoseSpec) -> PathBuf {
 /// manifest read once ([`FeRuns::open`]) and every run checked against that copy (issue 37:
 /// the manifest used to be parsed again for each run).
 pub struct FeRuns<'a> {
-    set_dir: &'a Path,
+    set: &'a SetFolder,
     campaign: &'a Campaign,
-    manifest: Manifest,
 }
 
 impl<'a> FeRuns<'a> {
-    /// The runs of `set_dir` with the spec `campaign`: reads `<set>/fe/manifest.toml`.
-    ///
-    /// # Errors
-    /// The manifest exists but is not a valid one.
-    pub fn open(set_dir: &'a Path, campaign: &'a Campaign) -> Result<Self> {
-        Ok(Self { set_dir, campaign, manifest: read_set_manifest(set_dir)? })
+    /// The runs of `set` read with the spec `campaign` (the set's, or a copy with
+    /// another `[fit] form`), checked against the manifest `set` was opened with.
+    pub fn new(set: &'a SetFolder, campaign: &'a Campaign) -> Self {
+        Self { set, campaign }
     }
 
-    /// The set's manifest, as read by [`open`](Self::open).
+    /// The set's manifest, as read when the set was opened.
     pub fn manifest(&self) -> &Manifest {
-        &self.manifest
+        self.set.manifest()
     }
 
     /// Read one run, check its content against the manifest ([`check_content`]) and its
@@ -110,9 +108,9 @@ impl<'a> FeRuns<'a> {
     /// The file cannot be read or parsed, its content is not what the campaign wrote, or
     /// its depths are not the spec's.
     pub fn read(&self, pose: &PoseSpec) -> Result<Run> {
-        let path = run_path(self.set_dir, pose);
+        let path = self.set.run_path(pose);
         let text = std::fs::read_to_string(&path).with_context(|| format!("{}: cannot read", path.display()))?;
-        check_content(&self.manifest, pose, &path, text.as_bytes())?;
+        check_content(self.set.manifest(), pose, &path, text.as_bytes())?;
         let rows = parse_csv(&text, &path)?;
         let loading = &self.campaign.loading;
         let steps = loading.steps;
@@ -149,14 +147,6 @@ fn check_content(manifest: &Manifest, pose: &PoseSpec, path: &Path, bytes: &[u8]
     Ok(())
 }
 
-/// The manifest of a set's FE runs (`<set>/fe/manifest.toml`; none is an empty one).
-///
-/// # Errors
-/// The file exists but is not a valid manifest.
-pub fn read_set_manifest(set_dir: &Path) -> std::result::Result<Manifest, needle_fe::manifest::ManifestError> {
-    read_manifest(&set_dir.join("fe").join(MANIFEST))
-}
-
 /// Why the present result of `pose` cannot be used with the current spec, or `None` when
 /// it is current on the spec's committed mesh level ([`Manifest::current_entry`]). A
 /// result solved before `campaign.toml` changed (tissue, contact, mesh, loading...) is
@@ -190,8 +180,8 @@ pub fn fitted_poses(campaign: &Campaign) -> Vec<PoseSpec> {
 /// the wrong depths; a sweep pose has another input nonzero or a negative value; there is
 /// not exactly one centre pose; a sweep has fewer than 5 distinct values (centre
 /// included) or a value outside its half-range.
-pub fn load_fit_data(set_dir: &Path) -> Result<FitData> {
-    load_fit_data_in(set_dir, None)
+pub fn load_fit_data(set: &SetFolder) -> Result<FitData> {
+    load_fit_data_in(set, None)
 }
 
 /// [`load_fit_data`] as if the set's `[fit] form` were `"paper"`: the centre and sweep
@@ -200,12 +190,12 @@ pub fn load_fit_data(set_dir: &Path) -> Result<FitData> {
 ///
 /// # Errors
 /// As [`load_fit_data`], for the centre and sweep runs.
-pub fn load_paper_data(set_dir: &Path) -> Result<FitData> {
-    load_fit_data_in(set_dir, Some(ModelForm::Paper))
+pub fn load_paper_data(set: &SetFolder) -> Result<FitData> {
+    load_fit_data_in(set, Some(ModelForm::Paper))
 }
 
-fn load_fit_data_in(set_dir: &Path, form: Option<ModelForm>) -> Result<FitData> {
-    let (mut campaign, spec_path) = spec::load(set_dir)?;
+fn load_fit_data_in(set: &SetFolder, form: Option<ModelForm>) -> Result<FitData> {
+    let (mut campaign, spec_path) = (set.campaign().clone(), set.spec_path());
     if let Some(f) = form {
         campaign.fit.form = f;
     }
@@ -218,20 +208,20 @@ fn load_fit_data_in(set_dir: &Path, form: Option<ModelForm>) -> Result<FitData> 
     }
     let fitted = fitted_poses(&campaign);
     let (centre, sweeps, train) = {
-        let runs = FeRuns::open(set_dir, &campaign)?;
+        let runs = FeRuns::new(set, &campaign);
         check_fitted_runs_current(&runs, &fitted)?;
-        let centre = centre_run(&runs, &spec_path, &fitted)?;
-        let sweeps = sweep_points(&runs, &spec_path, &fitted, &centre)?;
+        let centre = centre_run(&runs, spec_path, &fitted)?;
+        let sweeps = sweep_points(&runs, spec_path, &fitted, &centre)?;
         let train = fitted.iter().filter(|p| p.role == Role::Train).map(|p| runs.read(p)).collect::<Result<Vec<_>>>()?;
         (centre, sweeps, train)
     };
-    let fe_sha256 = fitted_fe_sha256(set_dir, &fitted)?;
+    let fe_sha256 = fitted_fe_sha256(set.dir(), &fitted)?;
     Ok(FitData { campaign, centre, sweeps, train, fe_sha256 })
 }
 
 /// Every fitted pose has a result and it is current (the manifest's record of the spec).
 fn check_fitted_runs_current(runs: &FeRuns<'_>, fitted: &[PoseSpec]) -> Result<()> {
-    let (set_dir, campaign) = (runs.set_dir, runs.campaign);
+    let (set_dir, campaign) = (runs.set.dir(), runs.campaign);
     let missing: Vec<String> = fitted.iter().filter(|p| !run_path(set_dir, p).is_file()).map(|p| p.name.clone()).collect();
     if !missing.is_empty() {
         return Err(RunError::Missing { set_dir: set_dir.into(), fitted: fitted.len(), poses: missing }.into());
@@ -347,8 +337,8 @@ pub struct Unusable {
 /// # Errors
 /// The spec or the manifest cannot be loaded, or a present run cannot be read or has the
 /// wrong depths.
-pub fn load_validation_runs(set_dir: &Path) -> Result<(Campaign, Vec<Run>, Vec<Unusable>)> {
-    load_runs_where(set_dir, |r| r.is_validation() || r == Role::Mirror)
+pub fn load_validation_runs(set: &SetFolder) -> Result<(Campaign, Vec<Run>, Vec<Unusable>)> {
+    load_runs_where(set, |r| r.is_validation() || r == Role::Mirror)
 }
 
 /// The training runs of a set (role train, in spec order: `train-01`, ...) and those that
@@ -357,8 +347,8 @@ pub fn load_validation_runs(set_dir: &Path) -> Result<(Campaign, Vec<Run>, Vec<U
 ///
 /// # Errors
 /// As [`load_validation_runs`].
-pub fn load_training_runs(set_dir: &Path) -> Result<(Campaign, Vec<Run>, Vec<Unusable>)> {
-    let (campaign, mut runs, mut unusable) = load_runs_where(set_dir, |r| r == Role::Train)?;
+pub fn load_training_runs(set: &SetFolder) -> Result<(Campaign, Vec<Run>, Vec<Unusable>)> {
+    let (campaign, mut runs, mut unusable) = load_runs_where(set, |r| r == Role::Train)?;
     runs.retain(|r| !campaign.is_replaced(&r.pose.name));
     unusable.retain(|u| !campaign.is_replaced(&u.pose.name));
     Ok((campaign, runs, unusable))
@@ -386,9 +376,9 @@ fn failed_record(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Option
     ))
 }
 
-fn load_runs_where(set_dir: &Path, keep: impl Fn(Role) -> bool) -> Result<(Campaign, Vec<Run>, Vec<Unusable>)> {
-    let (campaign, _) = spec::load(set_dir)?;
-    let fe = FeRuns::open(set_dir, &campaign)?;
+fn load_runs_where(set: &SetFolder, keep: impl Fn(Role) -> bool) -> Result<(Campaign, Vec<Run>, Vec<Unusable>)> {
+    let (campaign, set_dir) = (set.campaign().clone(), set.dir());
+    let fe = FeRuns::new(set, &campaign);
     let mut runs = Vec::new();
     let mut unusable = Vec::new();
     for pose in campaign.poses() {
@@ -410,6 +400,7 @@ fn load_runs_where(set_dir: &Path, keep: impl Fn(Role) -> bool) -> Result<(Campa
 #[cfg(test)]
 mod tests {
     use super::*;
+    use needle_fe::spec;
 
     /// Issue 42, item 4: a validation run that cannot be solved says how far its furthest
     /// attempt got and why, from the campaign's partial record (of the current spec only).
@@ -432,7 +423,7 @@ mod tests {
         };
         let reached: Vec<[f64; 6]> = (1..=6).map(|k| [0.0, 0.001 * f64::from(k), 0.0, 0.0, 0.0, 0.0]).collect();
         needle_fe::partial::write(&fe, &failed, &reached).expect("partial record");
-        let (_, _, unusable) = load_validation_runs(&dir).expect("load");
+        let (_, _, unusable) = load_validation_runs(&SetFolder::open(&dir).expect("open")).expect("load");
         let why = |name: &str| unusable.iter().find(|u| u.pose.name == name).map(|u| u.why.clone()).unwrap_or_default();
         let t2b = why("t2-b");
         let _ = std::fs::remove_dir_all(&dir);

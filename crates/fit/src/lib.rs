@@ -34,6 +34,7 @@ pub mod unsolved;
 pub mod validate;
 
 use anyhow::Result;
+use needle_fe::set_folder::SetFolder;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -96,7 +97,16 @@ impl FitOutput {
 /// As [`data::load_fit_data`] (missing or malformed runs, bad spec) and [`model::fit`]
 /// (rank-deficient fits); a model too large for the fixed-point evaluator.
 pub fn fit_set(set_dir: &Path) -> Result<FitOutput> {
-    let data = data::load_fit_data(set_dir)?;
+    fit_set_in(&SetFolder::open(set_dir)?)
+}
+
+/// [`fit_set`] of an opened set.
+///
+/// # Errors
+/// As [`fit_set`].
+pub fn fit_set_in(set: &SetFolder) -> Result<FitOutput> {
+    let set_dir = set.dir();
+    let data = data::load_fit_data(set)?;
     let mut model = model::fit(&data)?;
     if data.campaign.fit.form == needle_fe::spec::ModelForm::Coupled {
         model = coupled::fit_coupled(&data, &model, data.campaign.needle.reference_from_tip_mm)?;
@@ -112,7 +122,7 @@ pub fn fit_set(set_dir: &Path) -> Result<FitOutput> {
             .map(|r| format!("{} (replaced by {})", r.pose, data.campaign.replacement_of(&r.pose).unwrap_or_default())),
     );
     let model_toml = model_file::to_toml(&model, &left_out);
-    let region = unsolved::region(set_dir)?;
+    let region = unsolved::region_in(set)?;
     let unsolved_toml = unsolved::to_toml(&model.set, &region);
     let tables = eval::float32::Tables32::from_model(&model).with_unsolved(region.entries());
     let golden_csv = golden::float32::to_csv(&tables);

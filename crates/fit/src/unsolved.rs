@@ -14,10 +14,11 @@
 //! mirror images, over the depths beyond the depth its furthest attempt reached (every
 //! depth when no record says how far it got). No solved run lies in the region: a ball
 //! reaches at most half way to the nearest one.
-use crate::data::{read_set_manifest, run_path, stale_reason};
+use crate::data::{run_path, stale_reason};
 use anyhow::{bail, Result};
 use needle_contract::{DEPTH_MAX_MM, HALF_RANGES};
-use needle_fe::spec::{self, Campaign, PoseSpec};
+use needle_fe::set_folder::SetFolder;
+use needle_fe::spec::{Campaign, PoseSpec};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -135,11 +136,18 @@ fn partial_record(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Optio
 /// The spec or the manifest cannot be read; no run of the set is solved while a pose
 /// failed (no radius); more than [`MAX_ENTRIES`] balls.
 pub fn region(set_dir: &Path) -> Result<Region> {
-    let (campaign, _) = spec::load(set_dir)?;
-    let manifest = read_set_manifest(set_dir)?;
+    region_in(&SetFolder::open(set_dir)?)
+}
+
+/// [`region`] of an opened set.
+///
+/// # Errors
+/// As [`region`].
+pub fn region_in(set: &SetFolder) -> Result<Region> {
+    let (campaign, manifest, set_dir) = (set.campaign(), set.manifest(), set.dir());
     let poses = campaign.poses();
     let mut solved_points: Vec<(String, [f64; 4])> = Vec::new();
-    for p in poses.iter().filter(|p| solved(set_dir, &manifest, &campaign, p)) {
+    for p in poses.iter().filter(|p| solved(set_dir, manifest, campaign, p)) {
         let n = normalised([p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg]);
         for (i, image) in mirror_images(n).into_iter().enumerate() {
             let name = match i {
@@ -153,10 +161,10 @@ pub fn region(set_dir: &Path) -> Result<Region> {
     }
     let mut failed = Vec::new();
     for p in &poses {
-        if solved(set_dir, &manifest, &campaign, p) {
+        if solved(set_dir, manifest, campaign, p) {
             continue;
         }
-        let record = partial_record(set_dir, &campaign, p);
+        let record = partial_record(set_dir, campaign, p);
         let source = if campaign.campaign.fit_without.contains(&p.name) {
             "campaign.fit_without".to_string()
         } else if campaign.is_replaced(&p.name) {

@@ -38,6 +38,7 @@ use crate::contract::{COMPONENT_COUNT, DEGREE};
 use crate::eval::float32::{eval as eval32, Tables32};
 use crate::eval::float64::{eval as eval64, eval_paper};
 use anyhow::Result;
+use needle_fe::set_folder::SetFolder;
 use needle_fe::spec::Role;
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -295,15 +296,24 @@ pub fn validate(set_dir: &Path) -> Result<Report> {
     validate_with(set_dir, DEGREE)
 }
 
+/// [`validate_in`] of the set folder `set_dir`, opened once.
+///
+/// # Errors
+/// As [`validate`].
+pub fn validate_with(set_dir: &Path, floor_degree: usize) -> Result<Report> {
+    validate_in(&SetFolder::open(set_dir)?, floor_degree)
+}
+
 /// [`validate`] with each run's floor computed for models of depth degree `floor_degree`
 /// (the contract's is [`DEGREE`]; the goals and errors do not depend on it).
 ///
 /// # Errors
 /// As [`validate`].
-pub fn validate_with(set_dir: &Path, floor_degree: usize) -> Result<Report> {
-    let model = model_file::read(&set_dir.join(super::MODEL_FILE))?;
+pub fn validate_in(set: &SetFolder, floor_degree: usize) -> Result<Report> {
+    let set_dir = set.dir();
+    let model = model_file::read(&set.file(super::MODEL_FILE))?;
     let tables = Tables32::from_model(&model);
-    let (campaign, runs, missing) = load_validation_runs(set_dir)?;
+    let (campaign, runs, missing) = load_validation_runs(set)?;
     let lever = campaign.needle.reference_from_tip_mm;
 
     let fitted = fitted_poses(&campaign);
@@ -315,7 +325,7 @@ pub fn validate_with(set_dir: &Path, floor_degree: usize) -> Result<Report> {
     // missing or stale there is nothing to compare with, and the coupled model is still
     // validated (its goals then fail on the missing runs, not here).
     let paper = match model.cross {
-        Some(_) => load_paper_data(set_dir).and_then(|d| super::model::fit(&d)).ok(),
+        Some(_) => load_paper_data(set).and_then(|d| super::model::fit(&d)).ok(),
         None => None,
     };
     let mut reports = Vec::new();

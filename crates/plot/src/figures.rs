@@ -8,13 +8,13 @@
 
 use super::panel::{Panel, Series, Style, COMPONENT_COLOURS, MIN_SPAN_OF_SCALE};
 use anyhow::Result;
+use needle_fe::set_folder::SetFolder;
 use needle_fe::spec::Role;
 use needle_fit::contract::{unit, Sweep, COMPONENTS, DEPTH_MAX_MM};
 use needle_fit::data::{load_fit_data, load_validation_runs, Run};
 use needle_fit::eval::float64::eval;
 use needle_fit::model::Model;
 use plotters::style::RGBColor;
-use std::path::Path;
 
 const GREY: RGBColor = RGBColor(90, 90, 90);
 
@@ -249,13 +249,14 @@ pub struct Figure {
     pub cols: usize,
 }
 
-/// Every figure of the set in `set_dir` with model `model`.
+/// Every figure of the set `set` with model `model`.
 ///
 /// # Errors
 /// The set's runs cannot be loaded (missing or stale fitted runs, malformed files).
-pub fn figures(set_dir: &Path, model: &Model) -> Result<Vec<Figure>> {
-    let data = load_fit_data(set_dir)?;
-    let (campaign, validation, _) = load_validation_runs(set_dir)?;
+pub fn figures(set: &SetFolder, model: &Model) -> Result<Vec<Figure>> {
+    let data = load_fit_data(set)?;
+    let (campaign, validation, _) = load_validation_runs(set)?;
+    let fe_dir = set.fe_dir();
     let set = &campaign.set.name;
     let mut sweep_runs: [Vec<&Run>; 4] = Default::default();
     for k in Sweep::ALL {
@@ -305,7 +306,7 @@ pub fn figures(set_dir: &Path, model: &Model) -> Result<Vec<Figure>> {
             cols: 2,
         },
     ];
-    let verify_path = set_dir.join("fe").join("verify.toml");
+    let verify_path = fe_dir.join("verify.toml");
     if let Ok(text) = std::fs::read_to_string(&verify_path) {
         let t: toml::Table = text.parse().map_err(|e| anyhow::anyhow!("{}: {e}", verify_path.display()))?;
         let panels = verification(&t);

@@ -7,20 +7,20 @@ pub mod figures;
 pub mod panel;
 
 use anyhow::{Context, Result};
+use needle_fe::set_folder::SetFolder;
 use needle_fit::{model_file, MODEL_FILE};
-use std::path::Path;
 
 /// Width and height of one panel, pixels.
 pub const PANEL_PX: (u32, u32) = (520, 360);
 
-/// Render every figure of the set in `set_dir`: (file name, SVG text).
+/// Render every figure of the set `set`: (file name, SVG text).
 ///
 /// # Errors
 /// model.toml or the set's runs cannot be read; a chart cannot be laid out.
-pub fn render_set(set_dir: &Path) -> Result<Vec<(&'static str, String)>> {
-    let model = model_file::read(&set_dir.join(MODEL_FILE))?;
+pub fn render_set(set: &SetFolder) -> Result<Vec<(&'static str, String)>> {
+    let model = model_file::read(&set.file(MODEL_FILE))?;
     let mut out = Vec::new();
-    for f in figures::figures(set_dir, &model)? {
+    for f in figures::figures(set, &model)? {
         let svg = panel::render(&f.caption, &f.panels, f.cols, PANEL_PX).with_context(|| f.file.to_string())?;
         out.push((f.file, svg));
     }
