@@ -148,9 +148,11 @@ pub const DEFAULT_STALL: Duration = Duration::from_secs(600);
 /// ccx is missing, the manifest is corrupt or the output folder cannot be written.
 /// Failed solves are not errors: they are in the [`Report`].
 pub fn run(opts: &RunOptions) -> Result<Report> {
-    let (campaign, _) = spec::load(&opts.set_dir)?;
-    let engine = opts.solver.unwrap_or(campaign.solver.engine);
-    run_with(opts, backend_for(engine, opts.threads).as_mut())
+    // the spec is read once, by the plan; its engine (with `opts.solver` applied) picks
+    // the backend
+    let plan = plan(opts)?;
+    let engine = plan.campaign.solver.engine;
+    run_planned(opts, plan, backend_for(engine, opts.threads).as_mut())
 }
 
 /// Everything shared by the workers.
@@ -324,8 +326,13 @@ fn apply_variant(opts: &RunOptions, campaign: &mut Campaign, spec_path: &Path) -
 /// # Errors
 /// As [`run`].
 pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> {
+    run_planned(opts, plan(opts)?, backend)
+}
+
+/// [`run_with`] of a plan already made for `opts`.
+fn run_planned(opts: &RunOptions, plan: Plan, backend: &mut dyn Backend) -> Result<Report> {
     let start = Instant::now();
-    let Plan { campaign, mesh_name, steps, out_dir, mut reports, to_run, selected, all, .. } = plan(opts)?;
+    let Plan { campaign, mesh_name, steps, out_dir, mut reports, to_run, selected, all, .. } = plan;
     let mesh = campaign.mesh_level(&mesh_name)?.clone();
     std::fs::create_dir_all(&out_dir).with_context(|| format!("{}: cannot create", out_dir.display()))?;
     let manifest_path = out_dir.join(MANIFEST);
