@@ -30,10 +30,7 @@ pub const MAX_ECHO_CHARS: usize = 40;
 /// `text` as a message shows it: quoted, cut after [`MAX_ECHO_CHARS`] characters with
 /// its length in bytes.
 fn echo(text: &str) -> String {
-    match text.char_indices().nth(MAX_ECHO_CHARS) {
-        Some((cut, _)) => format!("{:?}... ({} bytes)", &text[..cut], text.len()),
-        None => format!("{text:?}"),
-    }
+    needle_fe::results_error::echo_cut(text, MAX_ECHO_CHARS)
 }
 
 /// The pose columns' indices in `header` (in [`POSE_COLUMNS`] order).

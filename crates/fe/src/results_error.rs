@@ -7,12 +7,18 @@ use std::path::PathBuf;
 /// Most characters of a bad line or field echoed in a message.
 pub const MAX_ECHO_CHARS: usize = 80;
 
-/// `text` cut after [`MAX_ECHO_CHARS`] characters (its length in bytes given then).
-pub fn echo(text: &str) -> String {
-    match text.char_indices().nth(MAX_ECHO_CHARS) {
+/// `text` as a message shows it: quoted, cut after `max_chars` characters with its
+/// length in bytes then.
+pub fn echo_cut(text: &str, max_chars: usize) -> String {
+    match text.char_indices().nth(max_chars) {
         Some((cut, _)) => format!("{:?}... ({} bytes)", text.get(..cut).unwrap_or(""), text.len()),
         None => format!("{text:?}"),
     }
+}
+
+/// [`echo_cut`] after [`MAX_ECHO_CHARS`] characters.
+fn echo(text: &str) -> String {
+    echo_cut(text, MAX_ECHO_CHARS)
 }
 
 /// Why an FE result file was refused. `line` is 1-based; `field` the 1-based column.
