@@ -33,7 +33,7 @@ impl SetFolder {
     /// but cannot be read or is not a valid one ([`crate::manifest::ManifestError`]).
     pub fn open(dir: &Path) -> Result<Self> {
         let (campaign, spec_path) = spec::load(dir)?;
-        let manifest = read_manifest(&dir.join("fe").join(MANIFEST))?;
+        let manifest = read_manifest(&fe_dir(dir).join(MANIFEST))?;
         Ok(Self { dir: dir.to_path_buf(), spec_path, campaign, manifest })
     }
 
@@ -59,16 +59,26 @@ impl SetFolder {
 
     /// The folder of the FE runs, `<set>/fe`.
     pub fn fe_dir(&self) -> PathBuf {
-        self.dir.join("fe")
+        fe_dir(&self.dir)
     }
 
     /// The result file of `pose`, `<set>/fe/<pose>.csv`.
     pub fn run_path(&self, pose: &PoseSpec) -> PathBuf {
-        self.fe_dir().join(format!("{}.csv", pose.name))
+        run_path(&self.dir, pose)
     }
 
     /// A file of the set by its name, e.g. `model.toml`.
     pub fn file(&self, name: &str) -> PathBuf {
         self.dir.join(name)
     }
+}
+
+/// The folder of the FE runs of the set folder `set_dir`, `<set>/fe`.
+pub fn fe_dir(set_dir: &Path) -> PathBuf {
+    set_dir.join("fe")
+}
+
+/// The result file of `pose` in the set folder `set_dir`, `<set>/fe/<pose>.csv`.
+pub fn run_path(set_dir: &Path, pose: &PoseSpec) -> PathBuf {
+    fe_dir(set_dir).join(format!("{}.csv", pose.name))
 }

@@ -76,10 +76,7 @@ fn sweep_value(pose: &PoseSpec, k: Sweep) -> (f64, f64) {
     (v, others)
 }
 
-/// Path of a pose's result file.
-pub fn run_path(set_dir: &Path, pose: &PoseSpec) -> PathBuf {
-    set_dir.join("fe").join(format!("{}.csv", pose.name))
-}
+pub use needle_fe::set_folder::run_path;
 
 /// A set's FE results as the fitter reads them: the spec's loading and the manifest, the
 /// manifest read once ([`FeRuns::open`]) and every run checked against that copy (issue 37:
