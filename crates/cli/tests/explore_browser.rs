@@ -78,16 +78,20 @@ fn needle_eval(pose: &[(&str, &str); 5]) -> (Vec<String>, u32) {
     (bits, status)
 }
 
-/// The punctures of the page's insertion script (explorer.js `playInsertion`: depths in
-/// f64 steps of speed * 1 ms from -1 mm to 5 mm past the first stack's layers and back,
-/// each passed to the module as f32) through the library's insertion model.
-fn host_punctures(speed_mm_per_s: f64) -> u32 {
-    use needle_haptics::insertion::{stacks, Insertion, InsertionConfig};
-    let stack = stacks::ALL.first().expect("a shipped stack");
-    let deepest: f64 = stack.layers.iter().map(|l| f64::from(l.thickness_mm)).sum::<f64>() + 5.0;
-    let step = speed_mm_per_s * 0.001;
+/// The page's insertion script (explorer.js `script`): depths in f64 steps of
+/// `step` from -1 mm, to `stop` (when given) then `hold_ticks` ticks at the last depth
+/// reached, on to `deepest`, back to -1 mm.
+fn script(step: f64, deepest: f64, stop: Option<f64>, hold_ticks: usize) -> Vec<f64> {
     let mut depths = Vec::new();
     let mut d = -1.0;
+    if let Some(stop) = stop {
+        while d < stop {
+            depths.push(d);
+            d += step;
+        }
+        let held = depths.last().copied().unwrap_or(-1.0);
+        depths.extend(std::iter::repeat(held).take(hold_ticks));
+    }
     while d < deepest {
         depths.push(d);
         d += step;
@@ -97,8 +101,34 @@ fn host_punctures(speed_mm_per_s: f64) -> u32 {
         depths.push(d);
         d -= step;
     }
-    let mut ins = Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ).expect("stack");
-    depths.iter().map(|&d| u32::from(ins.step(&needle_haptics::Pose { depth_mm: d as f32, ..Default::default() }).punctures)).sum()
+    depths
+}
+
+/// What the page's insertion player computes (explorer.js `playInsertion`, the centred
+/// vertical needle through the first shipped stack with `prony` on every layer, stopped
+/// at 80 % of the unstopped insertion's first puncture depth for `hold_ticks` ticks),
+/// through the library: the punctures, and Fy (N) when the needle stops and at the end
+/// of the hold.
+fn host_insertion(speed_mm_per_s: f64, hold_ticks: usize, prony: &[needle_haptics::viscoelastic::PronyTerm]) -> (u32, f32, f32) {
+    use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, Stack};
+    use needle_haptics::viscoelastic::PronyTerms;
+    let stack = stacks::ALL.first().expect("a shipped stack");
+    let terms = PronyTerms::new(prony).expect("terms in range");
+    let layers: Vec<_> = stack.layers.iter().map(|l| needle_haptics::insertion::Layer { prony: terms, ..*l }).collect();
+    let with = Stack { layers: &layers, ..*stack };
+    let deepest: f64 = stack.layers.iter().map(|l| f64::from(l.thickness_mm)).sum::<f64>() + 5.0;
+    let step = speed_mm_per_s * 0.001;
+    let run = |depths: &[f64]| {
+        let mut ins = Insertion::new(&with, InsertionConfig::DEFAULT_1KHZ).expect("stack");
+        depths.iter().map(|&d| ins.step(&needle_haptics::Pose { depth_mm: d as f32, ..Default::default() })).collect::<Vec<_>>()
+    };
+    let dry = script(step, deepest, None, 0);
+    let first = run(&dry).iter().position(|e| e.punctures > 0).expect("the unstopped insertion punctures");
+    let depths = script(step, deepest, Some(0.8 * dry[first]), hold_ticks);
+    let ticks = run(&depths);
+    let stopped = depths.windows(2).position(|w| w[0] == w[1]).expect("a hold");
+    let punctures = ticks.iter().map(|e| u32::from(e.punctures)).sum();
+    (punctures, ticks[stopped].wrench.fy_n, ticks[stopped + hold_ticks].wrench.fy_n)
 }
 
 async fn set_field(c: &fantoccini::Client, name: &str, value: &str) {
@@ -187,26 +217,39 @@ async fn explorer_page_shows_what_needle_eval_computes() {
     assert_eq!((bits, status), (want_bits, want_status), "slider case at {pose:?}");
 
     // the insertion player: the centred vertical needle in and out of the first stack at
-    // 3 mm/s; the punctures the page counts are the host library's for the same ticks
+    // 3 mm/s, stopped for 3 s (the page's defaults) with the Prony terms the page starts
+    // with (the campaign's [viscoelastic]); the punctures and the Fy the page shows before
+    // and after the hold are the host library's for the same ticks, and the force relaxes
     for (name, v) in [("x_mm", "0"), ("z_mm", "0"), ("theta_x_deg", "0"), ("theta_z_deg", "0")] {
         set_field(&c, name, v).await;
     }
+    let prony_text = c.find(Locator::Id("prony")).await.expect("Prony field").prop("value").await.expect("prop").expect("a value");
+    let (spec, _) = needle_fe::spec::load(&workspace_root().join("coeffs/default")).expect("campaign.toml");
+    let visco = spec.viscoelastic.expect("the default set has [viscoelastic]");
+    let want_text = visco.g.iter().zip(&visco.tau_s).map(|(g, t)| format!("{g}:{t}")).collect::<Vec<_>>().join(", ");
+    assert_eq!(prony_text, want_text, "the page's Prony terms are the campaign's [viscoelastic]");
+    #[allow(clippy::cast_possible_truncation)] // the page passes the terms to the module as f32
+    let prony: Vec<_> = visco.g.iter().zip(&visco.tau_s).map(|(&g, &tau_s)| needle_haptics::viscoelastic::PronyTerm { g: g as f32, tau_s: tau_s as f32 }).collect();
     c.find(Locator::Id("play")).await.expect("play button").click().await.expect("click play");
-    let shown_punctures: u32 = c
+    let body = c
         .wait()
         .at_most(Duration::from_secs(30))
         .for_element(Locator::Css("body[data-insertion-punctures]"))
         .await
-        .expect("the insertion ran")
-        .attr("data-insertion-punctures")
-        .await
-        .expect("attr")
-        .expect("punctures")
-        .parse()
-        .expect("a count");
+        .expect("the insertion ran");
+    let attr = |name: &'static str| {
+        let body = body.clone();
+        async move { body.attr(name).await.expect("attr").unwrap_or_else(|| panic!("{name} set")) }
+    };
+    let shown_punctures: u32 = attr("data-insertion-punctures").await.parse().expect("a count");
+    let fy_start: f64 = attr("data-hold-fy-start").await.parse().expect("a number");
+    let fy_end: f64 = attr("data-hold-fy-end").await.parse().expect("a number");
     let png = c.screenshot().await.expect("screenshot");
     std::fs::write(shots.join("explorer-insertion.png"), png).expect("save screenshot");
-    assert_eq!(shown_punctures, host_punctures(3.0), "the page's insertion punctures differ from the library's");
+    let (punctures, want_start, want_end) = host_insertion(3.0, 3000, &prony);
+    assert_eq!(shown_punctures, punctures, "the page's insertion punctures differ from the library's");
     assert!(shown_punctures > 0, "the insertion crosses at least one puncture");
+    assert_eq!((fy_start, fy_end), (f64::from(want_start), f64::from(want_end)), "the page's Fy before and after the hold differ from the library's");
+    assert!(want_end < 0.9 * want_start, "the force relaxes while the needle is still: Fy {want_start} -> {want_end} N");
     c.close().await.expect("close the browser");
 }

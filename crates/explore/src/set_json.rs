@@ -10,7 +10,8 @@ use serde_json::{json, Value};
 /// the set (`fe/<pose>.csv`): pose, role, depths (mm) and the six wrench components (N,
 /// N*mm) per depth. Poses not solved yet are left out, and so is a CSV without an entry
 /// in `fe/manifest.toml` (no FE run of the campaign vouches for it: `needle validate`
-/// leaves it out too).
+/// leaves it out too). `viscoelastic`: the Prony terms of the campaign's FE verification
+/// (`[viscoelastic]`: `g`, `tau_s`), or null; the insertion player starts with them.
 ///
 /// # Errors
 /// A run file exists but is not a complete run of the
@@ -46,5 +47,6 @@ pub fn set_json(set: &SetFolder) -> Result<Value> {
         },
         "block": { "size_x_mm": c.block.size_x_mm, "size_z_mm": c.block.size_z_mm, "depth_mm": c.block.depth_mm },
         "runs": runs,
+        "viscoelastic": c.viscoelastic.as_ref().map(|v| json!({ "g": v.g, "tau_s": v.tau_s })),
     }))
 }

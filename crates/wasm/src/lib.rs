@@ -11,7 +11,8 @@
 //!   the buffer of [`needle_component_count`] words at [`needle_out`];
 //! - [`needle_domain`] the model's domain, [`needle_coupled`] its form;
 //! - the insertion model through the compiled-in tissue stacks: [`needle_stack_count`],
-//!   [`needle_insertion_start`] (one path at a time) and [`needle_insertion_step`], whose
+//!   [`needle_insertion_start`] (one path at a time; [`needle_insertion_start_prony`]
+//!   with Prony terms tried on every layer) and [`needle_insertion_step`], whose
 //!   wrench is left at [`needle_out`] as [`needle_eval`]'s is; the fixed-point insertion
 //!   the same way ([`needle_fixed_insertion_start`], [`needle_fixed_insertion_step`]:
 //!   Q16.16 poses, the wrench in µN and µN·mm as `i32` bits).
@@ -128,6 +129,48 @@ pub extern "C" fn needle_stack_thickness_mm(stack: u32, layer: u32) -> f32 {
 pub extern "C" fn needle_insertion_start(stack: u32, period_s: f32, velocity_time_constant_s: f32) -> i32 {
     let Some(s) = stacks::ALL.get(stack as usize) else { return -1 };
     match Insertion::new(s, InsertionConfig { period_s, velocity_time_constant_s }) {
+        Ok(i) => {
+            *PATH.0.borrow_mut() = Some(i);
+            0
+        }
+        Err(_) => -2,
+    }
+}
+
+/// Starts a needle path as [`needle_insertion_start`] does, with the Prony terms
+/// `(g0, tau0_s)`, `(g1, tau1_s)`, `(g2, tau2_s)` (the first `count`, 0 ..= 3; the
+/// library's normalisation: the layer's elastic response is the long-term one) on every
+/// layer of stack `stack` in place of its own: the explorer's relaxation view, where a
+/// user tries terms on a compiled-in stack. Returns 0, -1 for an unknown stack, -2 for a
+/// period or time constant out of range, -3 for terms the tissue files would refuse
+/// (`PronyTerms::new`: g >= 0, tau > 0 s, sum of g <= 9).
+#[no_mangle]
+#[allow(clippy::too_many_arguments)] // numbers only: the module has no allocator or bindings
+pub extern "C" fn needle_insertion_start_prony(
+    stack: u32,
+    period_s: f32,
+    velocity_time_constant_s: f32,
+    count: u32,
+    g0: f32,
+    tau0_s: f32,
+    g1: f32,
+    tau1_s: f32,
+    g2: f32,
+    tau2_s: f32,
+) -> i32 {
+    use needle_haptics::insertion::{Layer, Stack, MAX_LAYERS};
+    use needle_haptics::viscoelastic::{PronyTerm, PronyTerms};
+    let Some(s) = stacks::ALL.get(stack as usize) else { return -1 };
+    let all = [PronyTerm { g: g0, tau_s: tau0_s }, PronyTerm { g: g1, tau_s: tau1_s }, PronyTerm { g: g2, tau_s: tau2_s }];
+    let Some(chosen) = all.get(..count as usize) else { return -3 };
+    let Ok(terms) = PronyTerms::new(chosen) else { return -3 };
+    let Some(first) = s.layers.first() else { return -1 };
+    let mut layers: [Layer; MAX_LAYERS] = [*first; MAX_LAYERS];
+    for (slot, l) in layers.iter_mut().zip(s.layers) {
+        *slot = Layer { prony: terms, ..*l };
+    }
+    let with = Stack { layers: layers.get(..s.layers.len()).unwrap_or(&[]), ..*s };
+    match Insertion::new(&with, InsertionConfig { period_s, velocity_time_constant_s }) {
         Ok(i) => {
             *PATH.0.borrow_mut() = Some(i);
             0

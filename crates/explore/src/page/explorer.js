@@ -196,7 +196,35 @@ update();
 document.body.dataset.ready = "yes";
 
 // The insertion player: the firmware's insertion model (wasm) through a compiled-in
-// stack, at 1 kHz, in at the chosen speed to 5 mm past the layers and back out.
+// stack, at 1 kHz: in at the chosen speed, stopped for a while on the way (to show the
+// viscoelastic relaxation: the needle still, the force falling), on to 5 mm past the
+// layers and back out. Depths are f64 steps of speed * 1 ms from -1 mm, passed as f32
+// (crates/cli/tests/explore_browser.rs replays the same script through the library).
+
+// "g:tau_s, g:tau_s" -> [{ g, tau_s }], [] for an empty field; null for text that is not
+// numbers (the module refuses out-of-range terms itself)
+function parseProny(text) {
+  if (!text.trim()) return [];
+  const terms = text.split(",").map((t) => t.split(":").map(Number));
+  if (terms.some((t) => t.length !== 2 || !t.every(Number.isFinite))) return null;
+  return terms.map(([g, tau_s]) => ({ g, tau_s }));
+}
+
+// the script's depths: in to `stop_mm` (or to the end when null), held for `hold_ticks`
+// ticks at the last depth reached, on to `deepest`, back out to -1 mm
+function script(step, deepest, stop_mm, hold_ticks) {
+  const depths = [];
+  let dep = -1;
+  if (stop_mm !== null) {
+    for (; dep < stop_mm; dep += step) depths.push(dep);
+    const held = depths.length ? depths[depths.length - 1] : -1;
+    for (let i = 0; i < hold_ticks; i++) depths.push(held);
+  }
+  for (; dep < deepest; dep += step) depths.push(dep);
+  for (dep = deepest; dep > -1; dep -= step) depths.push(dep);
+  return depths;
+}
+
 function playInsertion() {
   const s = Number($("stack").value);
   const stack = model.stacks[s];
@@ -205,46 +233,71 @@ function playInsertion() {
   const deepest = total + 5;
   const speed = Math.max(0.1, Number($("speed").value) || 3);
   const step = speed * 0.001;
-  const poses = [];
+  const prony = parseProny($("prony").value);
+  if (prony === null) { $("insertion-summary").textContent = "Prony terms: write g:tau_s pairs, e.g. 0.6:0.5, 0.4:5"; return; }
+  const terms = prony.length ? prony : null;
   const at = (depth_mm) => ({ ...pose, depth_mm });
-  for (let dep = -1; dep < deepest; dep += step) poses.push(at(dep));
-  for (let dep = deepest; dep > -1; dep -= step) poses.push(at(dep));
-  const ticks = model.insert(s, poses);
+  let ticks;
+  let stop = $("stop").value.trim() === "" ? null : Number($("stop").value);
+  const hold_ticks = Math.max(0, Math.round(1000 * (Number($("hold").value) || 0)));
+  try {
+    if (stop === null) {
+      // stop at 80 % of the depth of the first puncture of the same insertion unstopped
+      const dry = model.insert(s, script(step, deepest, null, 0).map(at), terms);
+      const first = dry.findIndex((t) => t.punctures > 0);
+      stop = first > 0 ? 0.8 * dry[first].depth_mm : null;
+    }
+    ticks = model.insert(s, script(step, deepest, stop, hold_ticks).map(at), terms);
+  } catch (err) {
+    $("insertion-summary").textContent = String(err.message);
+    return;
+  }
   const punctures = ticks.filter((t) => t.punctures > 0);
-  $("insertion-summary").textContent = `${ticks.length} ticks, ${punctures.length} puncture(s), largest Fy ${Math.max(...ticks.map((t) => t.fy_n)).toPrecision(3)} N`;
+  const holdStart = stop === null ? -1 : ticks.findIndex((t, i) => i > 0 && t.depth_mm === ticks[i - 1].depth_mm);
+  const held = holdStart > 0 && hold_ticks > 0 ? [ticks[holdStart - 1], ticks[holdStart + hold_ticks - 1]] : null;
+  const relax = held
+    ? `; stopped at ${held[0].depth_mm.toFixed(2)} mm for ${(hold_ticks / 1000).toFixed(1)} s: Fy ${held[0].fy_n.toPrecision(3)} -> ${held[1].fy_n.toPrecision(3)} N` +
+      (held[0].fy_n !== 0 ? ` (${(100 * (held[1].fy_n / held[0].fy_n - 1)).toFixed(1)} %)` : "")
+    : "";
+  $("insertion-summary").textContent = `${ticks.length} ticks, ${punctures.length} puncture(s), largest Fy ${Math.max(...ticks.map((t) => t.fy_n)).toPrecision(3)} N${relax}`;
+  if (held) {
+    document.body.dataset.holdFyStart = String(held[0].fy_n);
+    document.body.dataset.holdFyEnd = String(held[1].fy_n);
+  }
   document.body.dataset.insertionPunctures = String(punctures.reduce((a, t) => a + t.punctures, 0));
   const canvas = $("insertion");
   const g = canvas.getContext("2d");
   const W = canvas.width, H = canvas.height, L = 60, R = 15, T = 15, B = 40;
   const fy = ticks.map((t) => t.fy_n);
+  const end_s = ticks.length / 1000;
   let lo = Math.min(0, ...fy), hi = Math.max(0, ...fy);
   if (hi - lo < 1e-12) { hi += 1; lo -= 1; }
-  const X = (v) => L + ((W - L - R) * (v + 1)) / (deepest + 1);
+  const X = (t_s) => L + ((W - L - R) * t_s) / end_s;
   const Y = (v) => T + ((H - T - B) * (hi - v)) / (hi - lo);
   g.clearRect(0, 0, W, H);
+  if (held) {
+    g.fillStyle = "#eef3fb";
+    g.fillRect(X(holdStart / 1000), T, X((holdStart + hold_ticks) / 1000) - X(holdStart / 1000), H - T - B);
+  }
   g.strokeStyle = "#888"; g.fillStyle = "#222"; g.font = "12px sans-serif"; g.lineWidth = 1;
   g.beginPath(); g.moveTo(L, T); g.lineTo(L, H - B); g.lineTo(W - R, H - B); g.stroke();
   for (let i = 0; i <= 4; i++) {
     const v = lo + ((hi - lo) * i) / 4;
     g.fillText(tick(v), L - 6 - g.measureText(tick(v)).width, Y(v) + 4);
-    const dep = -1 + ((deepest + 1) * i) / 4;
-    g.fillText(dep.toFixed(0), X(dep) - 8, H - B + 16);
+    const t_s = (end_s * i) / 4;
+    g.fillText(t_s.toFixed(1), X(t_s) - 8, H - B + 16);
   }
-  g.fillText("needle depth (mm)", W / 2 - 50, H - 6);
-  g.setLineDash([4, 4]); g.strokeStyle = "#aaa";
-  let boundary = 0;
-  for (const t of stack.thickness_mm) {
-    g.beginPath(); g.moveTo(X(boundary), T); g.lineTo(X(boundary), H - B); g.stroke();
-    boundary += t;
-  }
-  g.setLineDash([]);
+  g.fillText("time (s)", W / 2 - 20, H - 6);
   g.strokeStyle = "#1f5fbf"; g.lineWidth = 1.5; g.beginPath();
-  ticks.forEach((t, i) => (i ? g.lineTo : g.moveTo).call(g, X(t.depth_mm), Y(t.fy_n)));
+  ticks.forEach((t, i) => (i ? g.lineTo : g.moveTo).call(g, X(i / 1000), Y(t.fy_n)));
   g.stroke();
   g.fillStyle = "#c0392b";
   ticks.forEach((t, i) => {
-    if (t.punctures > 0 && i > 0) { g.beginPath(); g.arc(X(ticks[i - 1].depth_mm), Y(ticks[i - 1].fy_n), 4, 0, 2 * Math.PI); g.fill(); }
+    if (t.punctures > 0 && i > 0) { g.beginPath(); g.arc(X((i - 1) / 1000), Y(ticks[i - 1].fy_n), 4, 0, 2 * Math.PI); g.fill(); }
   });
+}
+if (set.viscoelastic) {
+  $("prony").value = set.viscoelastic.g.map((g, i) => `${g}:${set.viscoelastic.tau_s[i]}`).join(", ");
 }
 model.stacks.forEach((st, i) => {
   const o = document.createElement("option");

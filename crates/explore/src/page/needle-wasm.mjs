@@ -49,9 +49,16 @@ export async function load(bytes) {
     form,
     stacks,
     // a scripted insertion through stack `s` at 1 kHz: returns per tick the depth, fy and
-    // the punctures (the firmware's own insertion model)
-    insert(s, poses) {
-      if (e.needle_insertion_start(s, 0.001, 0.005) !== 0) throw new Error(`stack ${s}: cannot start`);
+    // the punctures (the firmware's own insertion model). `prony`: null for the stack's own
+    // terms, or up to 3 { g, tau_s } tried on every layer (needle_insertion_start_prony)
+    insert(s, poses, prony = null) {
+      const t = prony ?? [];
+      const term = (i) => [t[i]?.g ?? 0, t[i]?.tau_s ?? 0];
+      const started = prony === null
+        ? e.needle_insertion_start(s, 0.001, 0.005)
+        : e.needle_insertion_start_prony(s, 0.001, 0.005, t.length, ...term(0), ...term(1), ...term(2));
+      if (started === -3) throw new Error("Prony terms refused: at most 3, each g >= 0 and tau_s > 0 s, sum of g <= 9");
+      if (started !== 0) throw new Error(`stack ${s}: cannot start`);
       return poses.map((p) => {
         const r = e.needle_insertion_step(p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg, p.depth_mm) >>> 0;
         const w = new Float32Array(Uint32Array.from(new Uint32Array(e.memory.buffer, e.needle_out(), COMPONENTS.length)).buffer);
