@@ -1,5 +1,7 @@
-//! `needle eval --poses FILE.csv --insertion STACK`: a scripted insertion through one of
-//! the compiled-in tissue stacks, one wrench row per tick.
+//! `needle eval --poses FILE.csv --insertion STACK [--prony G:TAU_S,...]`: a scripted
+//! insertion through one of the compiled-in tissue stacks, one wrench row per tick; with
+//! `--prony`, those terms on every layer (the viscoelastic filter: the force relaxes
+//! while the needle is still).
 //!
 //! Input: the pose file of [`super::eval_batch`] with one more column, `time_s`, equally
 //! spaced (the tick period; within 1e-6 s); rows in time order. Each row is one tick of
@@ -31,6 +33,24 @@ pub fn stack(name: &str) -> Result<&'static needle_haptics::insertion::Stack<'st
         let names: Vec<&str> = stacks::ALL.iter().map(|s| s.name).collect();
         format!("--insertion {name:?}: no such tissue stack in the compiled-in set (it has: {})", names.join(", "))
     })
+}
+
+/// The Prony terms of `--prony`: "g:tau_s" pairs, comma-separated, checked as a tissue
+/// file's are (`PronyTerms::new`).
+///
+/// # Errors
+/// A pair that is not two numbers, or terms out of range (the message says which).
+pub fn parse_prony(text: &str) -> Result<needle_haptics::viscoelastic::PronyTerms> {
+    use needle_haptics::viscoelastic::{PronyTerm, PronyTerms};
+    let mut terms = Vec::new();
+    for pair in text.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        let parsed = pair.split_once(':').and_then(|(g, tau)| Some((g.trim().parse::<f32>().ok()?, tau.trim().parse::<f32>().ok()?)));
+        let Some((g, tau_s)) = parsed else {
+            bail!("--prony {text:?}: {pair:?} is not g:tau_s (two numbers, e.g. 0.6:0.5)");
+        };
+        terms.push(PronyTerm { g, tau_s });
+    }
+    PronyTerms::new(&terms).map_err(|e| anyhow::anyhow!("--prony {text:?}: {e}"))
 }
 
 /// The time column of `text`, checked: numbers, equally spaced, increasing; the period.
@@ -108,12 +128,17 @@ pub fn to_csv(times: &[f64], poses: &[Pose], evals: &[InsertionEvaluation]) -> S
     s
 }
 
-/// `needle eval --poses FILE --insertion STACK [--out F]`.
+/// `needle eval --poses FILE --insertion STACK [--prony G:TAU_S,...] [--out F]`.
 ///
 /// # Errors
-/// As [`parse_poses`], [`parse_times`], [`stack`]; the output cannot be written.
-pub fn eval_script(file: &Path, stack_name: &str, out: Option<&Path>) -> Result<()> {
-    let stack = stack(stack_name)?;
+/// As [`parse_poses`], [`parse_times`], [`stack`], [`parse_prony`]; the output cannot be
+/// written.
+pub fn eval_script(file: &Path, stack_name: &str, prony: Option<&str>, out: Option<&Path>) -> Result<()> {
+    let compiled = stack(stack_name)?;
+    let terms = prony.map(parse_prony).transpose()?;
+    let layers: Vec<needle_haptics::insertion::Layer> =
+        compiled.layers.iter().map(|l| needle_haptics::insertion::Layer { prony: terms.unwrap_or(l.prony), ..*l }).collect();
+    let stack = &needle_haptics::insertion::Stack { layers: &layers, ..*compiled };
     let text = std::fs::read_to_string(file).with_context(|| format!("{}: cannot read", file.display()))?;
     let (times, period) = parse_times(&text, file)?;
     let poses = parse_poses(&text, file)?;

@@ -39,6 +39,12 @@ pub struct EvalArgs {
     /// liver): the file needs a time_s column, one row per tick; one wrench row per tick.
     #[arg(long, value_name = "STACK", requires = "poses", conflicts_with = "json")]
     pub insertion: Option<String>,
+    /// With --insertion: these Prony terms on every layer of the stack in place of its
+    /// own, "g:tau_s" pairs comma-separated (e.g. "0.6:0.5, 0.4:5"; at most 3, g >= 0,
+    /// tau_s > 0 s, the long-term normalisation of coeffs/README.md): the scripted
+    /// insertion with the viscoelastic filter (a shipped stack has no terms).
+    #[arg(long, value_name = "G:TAU_S,...", requires = "insertion", allow_hyphen_values = true)]
+    pub prony: Option<String>,
     /// With --poses: write the rows to this file instead of standard output.
     #[arg(long, value_name = "FILE", requires = "poses")]
     pub out: Option<PathBuf>,
@@ -211,7 +217,7 @@ pub fn eval(a: EvalArgs) -> anyhow::Result<ExitCode> {
         );
     }
     if let (Some(file), Some(stack)) = (&a.poses, &a.insertion) {
-        super::eval_insertion::eval_script(file, stack, a.out.as_deref())?;
+        super::eval_insertion::eval_script(file, stack, a.prony.as_deref(), a.out.as_deref())?;
         return Ok(ExitCode::SUCCESS);
     }
     if let Some(file) = &a.poses {

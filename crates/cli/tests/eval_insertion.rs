@@ -77,3 +77,64 @@ fn bad_scripts_are_refused_with_their_line() {
     let out = needle(&["eval", "--set", &set(), "--poses", file.to_str().expect("path"), "--insertion", "no_such"]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("no such tissue stack"), "{}", String::from_utf8_lossy(&out.stderr));
 }
+
+/// In at 5 mm/s to 3 mm (the liver's first boundary deflected, not punctured), held 2 s.
+fn stop_script() -> (String, Vec<Pose>) {
+    let mut text = String::from("time_s,x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n");
+    let mut poses = Vec::new();
+    for k in 0..3000u32 {
+        let t = f64::from(k) * 0.001;
+        let d = (-1.0 + 0.005 * f64::from(k)).min(3.0);
+        let p = Pose { x_mm: 0.0, z_mm: 0.0, theta_x_deg: 0.0, theta_z_deg: 0.0, depth_mm: d as f32 };
+        text.push_str(&format!("{t},{:?},{:?},{:?},{:?},{:?}\n", p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg, p.depth_mm));
+        poses.push(p);
+    }
+    (text, poses)
+}
+
+#[test]
+fn prony_terms_make_the_scripted_insertion_relax_as_the_library_does() {
+    use needle_haptics::insertion::{Layer, Stack};
+    use needle_haptics::viscoelastic::{PronyTerm, PronyTerms};
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (text, poses) = stop_script();
+    let file = dir.path().join("stop.csv");
+    std::fs::write(&file, text).expect("script");
+    let out = needle(&["eval", "--set", &set(), "--poses", file.to_str().expect("path"), "--insertion", "liver", "--prony", "0.6:0.5, 0.4:5"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let fy: Vec<f32> = stdout.lines().skip(1).map(|r| r.split(',').nth(7).expect("fy").parse().expect("fy")).collect();
+    let terms = PronyTerms::new(&[PronyTerm { g: 0.6, tau_s: 0.5 }, PronyTerm { g: 0.4, tau_s: 5.0 }]).expect("terms");
+    let liver = stacks::ALL.iter().find(|s| s.name == "liver").expect("liver");
+    let layers: Vec<Layer> = liver.layers.iter().map(|l| Layer { prony: terms, ..*l }).collect();
+    let mut ins = Insertion::new(&Stack { layers: &layers, ..*liver }, InsertionConfig::DEFAULT_1KHZ).expect("stack");
+    let want: Vec<f32> = poses.iter().map(|p| ins.step(p).wrench.fy_n).collect();
+    assert_eq!(fy.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), want.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
+    // the needle stops at tick 800 (3 mm): the force relaxes over the 2.2 s that follow
+    let (stopped, end) = (fy[800], fy[2999]);
+    assert!(end < 0.8 * stopped, "Fy {stopped} N at the stop, {end} N 2.2 s later: the filter relaxes");
+    // without terms the same script holds its force
+    let out = needle(&["eval", "--set", &set(), "--poses", file.to_str().expect("path"), "--insertion", "liver"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let elastic: Vec<f32> = stdout.lines().skip(1).map(|r| r.split(',').nth(7).expect("fy").parse().expect("fy")).collect();
+    assert_eq!(elastic[801].to_bits(), elastic[2999].to_bits(), "elastic: no relaxation");
+}
+
+#[test]
+fn bad_prony_terms_are_refused() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (text, _) = stop_script();
+    let file = dir.path().join("stop.csv");
+    std::fs::write(&file, text).expect("script");
+    for (terms, want) in [
+        ("0.6", "is not g:tau_s"),
+        ("-0.1:1", "must be finite and >= 0"),
+        ("0.5:0", "must be finite and > 0 s"),
+        ("5:1, 5:2", "must be <= 9"),
+        ("0.1:1, 0.1:1, 0.1:1, 0.1:1", "at most 3"),
+    ] {
+        let out = needle(&["eval", "--set", &set(), "--poses", file.to_str().expect("path"), "--insertion", "liver", "--prony", terms]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && err.contains(want), "--prony {terms:?}: {err}");
+    }
+}

@@ -90,7 +90,7 @@ fn script(step: f64, deepest: f64, stop: Option<f64>, hold_ticks: usize) -> Vec<
             d += step;
         }
         let held = depths.last().copied().unwrap_or(-1.0);
-        depths.extend(std::iter::repeat(held).take(hold_ticks));
+        depths.extend(std::iter::repeat_n(held, hold_ticks));
     }
     while d < deepest {
         depths.push(d);
