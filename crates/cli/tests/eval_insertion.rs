@@ -100,7 +100,8 @@ fn prony_terms_make_the_scripted_insertion_relax_as_the_library_does() {
     let (text, poses) = stop_script();
     let file = dir.path().join("stop.csv");
     std::fs::write(&file, text).expect("script");
-    let out = needle(&["eval", "--set", &set(), "--poses", file.to_str().expect("path"), "--insertion", "liver", "--prony", "0.6:0.5, 0.4:5"]);
+    let out =
+        needle(&["eval", "--set", &set(), "--poses", file.to_str().expect("path"), "--insertion", "liver", "--prony", "0.6:0.5, 0.4:5"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let stdout = String::from_utf8_lossy(&out.stdout);
     let fy: Vec<f32> = stdout.lines().skip(1).map(|r| r.split(',').nth(7).expect("fy").parse().expect("fy")).collect();

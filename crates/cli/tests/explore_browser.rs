@@ -229,7 +229,12 @@ async fn explorer_page_shows_what_needle_eval_computes() {
     let want_text = visco.g.iter().zip(&visco.tau_s).map(|(g, t)| format!("{g}:{t}")).collect::<Vec<_>>().join(", ");
     assert_eq!(prony_text, want_text, "the page's Prony terms are the campaign's [viscoelastic]");
     #[allow(clippy::cast_possible_truncation)] // the page passes the terms to the module as f32
-    let prony: Vec<_> = visco.g.iter().zip(&visco.tau_s).map(|(&g, &tau_s)| needle_haptics::viscoelastic::PronyTerm { g: g as f32, tau_s: tau_s as f32 }).collect();
+    let prony: Vec<_> = visco
+        .g
+        .iter()
+        .zip(&visco.tau_s)
+        .map(|(&g, &tau_s)| needle_haptics::viscoelastic::PronyTerm { g: g as f32, tau_s: tau_s as f32 })
+        .collect();
     c.find(Locator::Id("play")).await.expect("play button").click().await.expect("click play");
     let body = c
         .wait()
@@ -249,7 +254,11 @@ async fn explorer_page_shows_what_needle_eval_computes() {
     let (punctures, want_start, want_end) = host_insertion(3.0, 3000, &prony);
     assert_eq!(shown_punctures, punctures, "the page's insertion punctures differ from the library's");
     assert!(shown_punctures > 0, "the insertion crosses at least one puncture");
-    assert_eq!((fy_start, fy_end), (f64::from(want_start), f64::from(want_end)), "the page's Fy before and after the hold differ from the library's");
+    assert_eq!(
+        (fy_start, fy_end),
+        (f64::from(want_start), f64::from(want_end)),
+        "the page's Fy before and after the hold differ from the library's"
+    );
     assert!(want_end < 0.9 * want_start, "the force relaxes while the needle is still: Fy {want_start} -> {want_end} N");
     c.close().await.expect("close the browser");
 }
