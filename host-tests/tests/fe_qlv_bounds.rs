@@ -5,14 +5,19 @@
 //! solved; at least one run is solved through its whole hold. The numbers are FEBio's and
 //! the library's filter's, written by the tool (never typed in).
 //!
-//! Why not every run: on the campaign's `needle8` mesh FEBio inverts elements in the hold
-//! of most ramp-and-hold runs (issue 39's closing notes: centre 1 mm/s solved; the others
-//! stop between 1.4 s and 16 s into the run). Until that is solved the unsolved runs are
-//! listed by this test, not failed; the issue stays open on them.
+//! Why not every run: with friction (the campaign's 0.5) FEBio inverts elements in the hold
+//! of the z+04 runs at every speed (2026-11-28, the current retry ladder: stopped at 19.0,
+//! 4.9 and 7.7 s); the same run without friction solved (z+04 at 1 mm/s, 179 s, in a copy
+//! of the set). Until that is solved the unsolved runs are listed by this test, not
+//! failed; the issue stays open on them. The centre and x+04 runs are solved through the
+//! hold at every speed and must stay so ([`WHOLE_POSES`]).
 
 use needle_fe::verify::qlv::{QLV_MAX_PERCENT, QLV_MUST_RMS_PERCENT};
 use needle_fe::visco::run_name;
 use std::path::Path;
+
+/// Poses whose ramp-and-hold runs are solved through the hold at every speed.
+const WHOLE_POSES: [&str; 2] = ["centre", "x+04"];
 
 #[test]
 fn every_ramp_and_hold_run_is_within_the_bounds() {
@@ -33,10 +38,13 @@ fn every_ramp_and_hold_run_is_within_the_bounds() {
         for &speed in &v.speeds_mm_per_s {
             let name = run_name(pose, speed);
             let Some(r) = runs.iter().find(|r| r.get("run").and_then(toml::Value::as_str) == Some(name.as_str())) else {
+                assert!(!WHOLE_POSES.contains(&pose.as_str()), "{name}: no comparison, but it was solved through its hold");
                 println!("{name}: no comparison (not solved)");
                 continue;
             };
-            if r.get("partial").and_then(toml::Value::as_bool) == Some(false) {
+            let is_whole = r.get("partial").and_then(toml::Value::as_bool) == Some(false);
+            assert!(is_whole || !WHOLE_POSES.contains(&pose.as_str()), "{name}: only partly solved, but it was solved through its hold");
+            if is_whole {
                 whole += 1;
             }
             let (rms, max) = (num(r, "worst_rms_percent"), num(r, "worst_max_percent"));
@@ -45,5 +53,9 @@ fn every_ramp_and_hold_run_is_within_the_bounds() {
             assert!(num(r, "peak_fy_n") > 0.0, "{name}: no force measured");
         }
     }
-    assert!(whole >= 1, "{}: no ramp-and-hold run solved through its hold", path.display());
+    assert!(
+        whole >= WHOLE_POSES.len() * v.speeds_mm_per_s.len(),
+        "{}: {whole} ramp-and-hold runs solved through their hold",
+        path.display()
+    );
 }
