@@ -13,18 +13,26 @@ fn set() -> String {
     format!("{}/../../coeffs/default", env!("CARGO_MANIFEST_DIR"))
 }
 
-/// A script in and out of the stack at 10 mm/s, 1 kHz.
-fn script() -> (String, Vec<Pose>) {
+/// The script file of `poses`, one tick of 1 ms each, and the poses.
+fn script_of(poses: Vec<Pose>) -> (String, Vec<Pose>) {
     let mut text = String::from("time_s,x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n");
-    let mut poses = Vec::new();
-    for k in 0..8000u32 {
+    for (k, p) in (0u32..).zip(&poses) {
         let t = f64::from(k) * 0.001;
-        let d = if k < 4000 { -1.0 + 0.01 * f64::from(k) } else { 39.0 - 0.01 * f64::from(k - 4000) };
-        let p = Pose { x_mm: 1.0, z_mm: -0.5, theta_x_deg: 2.0, theta_z_deg: -1.0, depth_mm: d as f32 };
         text.push_str(&format!("{t},{:?},{:?},{:?},{:?},{:?}\n", p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg, p.depth_mm));
-        poses.push(p);
     }
     (text, poses)
+}
+
+/// A script in and out of the stack at 10 mm/s, 1 kHz.
+fn script() -> (String, Vec<Pose>) {
+    script_of(
+        (0..8000u32)
+            .map(|k| {
+                let d = if k < 4000 { -1.0 + 0.01 * f64::from(k) } else { 39.0 - 0.01 * f64::from(k - 4000) };
+                Pose { x_mm: 1.0, z_mm: -0.5, theta_x_deg: 2.0, theta_z_deg: -1.0, depth_mm: d as f32 }
+            })
+            .collect(),
+    )
 }
 
 #[test]
@@ -80,16 +88,7 @@ fn bad_scripts_are_refused_with_their_line() {
 
 /// In at 5 mm/s to 3 mm (the liver's first boundary deflected, not punctured), held 2 s.
 fn stop_script() -> (String, Vec<Pose>) {
-    let mut text = String::from("time_s,x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n");
-    let mut poses = Vec::new();
-    for k in 0..3000u32 {
-        let t = f64::from(k) * 0.001;
-        let d = (-1.0 + 0.005 * f64::from(k)).min(3.0);
-        let p = Pose { x_mm: 0.0, z_mm: 0.0, theta_x_deg: 0.0, theta_z_deg: 0.0, depth_mm: d as f32 };
-        text.push_str(&format!("{t},{:?},{:?},{:?},{:?},{:?}\n", p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg, p.depth_mm));
-        poses.push(p);
-    }
-    (text, poses)
+    script_of((0..3000u32).map(|k| Pose { depth_mm: (-1.0 + 0.005 * f64::from(k)).min(3.0) as f32, ..Pose::default() }).collect())
 }
 
 #[test]
