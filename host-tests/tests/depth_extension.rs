@@ -58,3 +58,23 @@ fn the_extended_centre_follows_the_deep_fe_run() {
     // held-out run (coeffs/README.md), kept here for the deeper range
     assert!(worst <= 3.0, "extended centre Fy off the deep FE run by {worst:.3} % of peak |Fy|");
 }
+
+/// The law's largest error past 6 mm against a deep half-model run, % of the run's peak
+/// |Fy|: the model's own largest-error goal on held-out runs (3 %, `needle validate`), so
+/// that past 6 mm the law costs no more than the fit does within it.
+const LAW_MAX_PCT: f64 = 3.0;
+
+#[test]
+fn the_law_holds_on_the_deep_half_model_runs() {
+    let e = fit(&set()).expect("fit").expect("a deep centre run");
+    let folder = needle_fe::set_folder::SetFolder::open(&set()).expect("the shipped set");
+    let checks = needle_fit::depth_extension::law_checks(&folder, &e).expect("the deep runs");
+    println!("{}", needle_fit::depth_extension::law_summary(&checks));
+    assert!(checks.iter().any(|c| c.pose == "x+04"), "the set ships the deep x+04 run");
+    for c in &checks {
+        assert!(c.depth_mm >= e.depth_max_mm - 1e-9, "{}: reaches {} mm of {}", c.pose, c.depth_mm, e.depth_max_mm);
+        for (k, v) in c.worst_pct.iter().enumerate() {
+            assert!(*v <= LAW_MAX_PCT, "{} component {k}: the law is {v} % of peak |Fy| off the FE past 6 mm", c.pose);
+        }
+    }
+}

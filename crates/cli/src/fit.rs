@@ -97,6 +97,7 @@ pub fn fit(a: FitArgs) -> Result<ExitCode> {
         .with_context(|| format!("needle fit --set {}: measuring the coupled form", a.set.display()))?;
     print!("{}", fit::coupled_report::to_table(&coupled));
     print!("{}", fit::unsolved::summary(&out.unsolved));
+    print!("{}", fit::depth_extension::law_summary(&out.depth_law));
     for (path, text) in &files {
         if path.extension().is_some_and(|e| e == "csv") {
             println!("wrote {} ({} poses)", path.display(), text.lines().count().saturating_sub(1));

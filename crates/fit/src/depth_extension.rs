@@ -105,6 +105,64 @@ pub fn to_toml(e: &DepthExtension) -> String {
     s
 }
 
+/// The law against one deep run other than the centre's ([`law_checks`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LawCheck {
+    /// The pose's name (`fe/deep/<pose>.csv`).
+    pub pose: String,
+    /// Deepest depth of the run, mm.
+    pub depth_mm: f64,
+    /// [`law_check`]'s figures per component, % of the run's peak |Fy| (moments: times
+    /// the lever arm).
+    pub worst_pct: [f64; 6],
+}
+
+/// The law against every deep run of the set's `[deep]` poses other than the centre
+/// whose `fe/deep/<pose>.csv` exists, in the spec's order; moments over the needle's
+/// hub lever arm (`needle.reference_from_tip_mm`).
+///
+/// # Errors
+/// A run that exists but is unreadable or malformed, or has no row at 6 mm.
+pub fn law_checks(set: &needle_fe::set_folder::SetFolder, e: &DepthExtension) -> Result<Vec<LawCheck>> {
+    let c = set.campaign();
+    let Some(deep) = &c.deep else { return Ok(Vec::new()) };
+    let mut out = Vec::new();
+    for pose in deep.poses.iter().filter(|p| format!("{p}.csv") != CENTRE_RUN) {
+        let path = set.dir().join("fe").join(DEEP_DIR).join(format!("{pose}.csv"));
+        if !path.is_file() {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).with_context(|| format!("{}: cannot read", path.display()))?;
+        let rows = parse_csv(&text, &path)?;
+        let worst_pct = law_check(e, &rows, c.needle.reference_from_tip_mm)
+            .with_context(|| format!("{}: no row at {DEPTH_MAX_MM} mm", path.display()))?;
+        let depth_mm = rows.iter().map(|r| r.depth_mm).fold(0.0, f64::max);
+        out.push(LawCheck { pose: pose.clone(), depth_mm, worst_pct });
+    }
+    Ok(out)
+}
+
+/// The lines `needle fit` prints for [`law_checks`].
+#[must_use]
+pub fn law_summary(checks: &[LawCheck]) -> String {
+    let mut s = String::new();
+    if checks.is_empty() {
+        let _ = writeln!(s, "depth extension law: no deep run besides the centre's to check it against");
+        return s;
+    }
+    let _ = writeln!(
+        s,
+        "depth extension law w(pose, d) = w(pose, 6 mm) R(d) against the deep runs (largest |FE - law| past 6 mm, % of the run's peak |Fy|; moments x lever arm):"
+    );
+    let _ = writeln!(s, "pose      to mm       fx      fy      fz      mx      my      mz   worst");
+    for c in checks {
+        let worst = c.worst_pct.iter().copied().fold(0.0, f64::max);
+        let cells: Vec<String> = c.worst_pct.iter().map(|v| format!("{v:7.3}")).collect();
+        let _ = writeln!(s, "{:<8} {:6.2} {} {worst:7.3}", c.pose, c.depth_mm, cells.join(" "));
+    }
+    s
+}
+
 /// The law against a deep half-model run: the largest |w_FE(d) - w_FE(6) R(d)| past 6 mm
 /// per component, % of the run's peak |Fy| (moments: of peak |Fy| times `lever_mm`).
 #[must_use]

@@ -66,6 +66,9 @@ pub struct FitOutput {
     pub golden_stiffness_fixed_csv: String,
     /// The text of `depth-extension.toml`, when the set has a deep centre run.
     pub depth_extension_toml: Option<String>,
+    /// The extension's law against the set's other deep runs (none without the
+    /// extension).
+    pub depth_law: Vec<depth_extension::LawCheck>,
     /// The unsolved region, from the set's FE records.
     pub unsolved: unsolved::Region,
     /// The text of `unsolved.toml`.
@@ -130,7 +133,12 @@ pub fn fit_set_in(set: &SetFolder) -> Result<FitOutput> {
     let fixed = fixed_formats::TablesFixed::from_model(&model)?.with_unsolved(region.entries());
     let golden_fixed_csv = golden::fixed::to_csv(&fixed)?;
     let golden_stiffness_fixed_csv = golden::stiffness_fixed::to_csv(&fixed)?;
-    let depth_extension_toml = depth_extension::fit(set_dir)?.map(|e| depth_extension::to_toml(&e));
+    let extension = depth_extension::fit(set_dir)?;
+    let depth_law = match &extension {
+        Some(e) => depth_extension::law_checks(set, e)?,
+        None => Vec::new(),
+    };
+    let depth_extension_toml = extension.as_ref().map(depth_extension::to_toml);
     Ok(FitOutput {
         model,
         model_toml,
@@ -139,6 +147,7 @@ pub fn fit_set_in(set: &SetFolder) -> Result<FitOutput> {
         golden_stiffness_csv,
         golden_stiffness_fixed_csv,
         depth_extension_toml,
+        depth_law,
         unsolved: region,
         unsolved_toml,
     })
