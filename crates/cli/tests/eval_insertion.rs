@@ -23,6 +23,21 @@ fn script_of(poses: Vec<Pose>) -> (String, Vec<Pose>) {
     (text, poses)
 }
 
+/// `needle eval --poses <dir>/<name> --insertion liver` plus `extra`, the script written first.
+fn eval_liver(dir: &std::path::Path, name: &str, text: &str, extra: &[&str]) -> std::process::Output {
+    let file = dir.join(name);
+    std::fs::write(&file, text).expect("script");
+    let set = set();
+    let mut args = vec!["eval", "--set", &set, "--poses", file.to_str().expect("path"), "--insertion", "liver"];
+    args.extend_from_slice(extra);
+    needle(&args)
+}
+
+/// The fy_n column of an insertion's output rows.
+fn fy_column(out: &std::process::Output) -> Vec<f32> {
+    String::from_utf8_lossy(&out.stdout).lines().skip(1).map(|r| r.split(',').nth(7).expect("fy").parse().expect("fy")).collect()
+}
+
 /// A script in and out of the stack at 10 mm/s, 1 kHz.
 fn script() -> (String, Vec<Pose>) {
     script_of(
@@ -39,9 +54,7 @@ fn script() -> (String, Vec<Pose>) {
 fn a_scripted_insertion_gives_the_librarys_ticks() {
     let dir = tempfile::tempdir().expect("temp dir");
     let (text, poses) = script();
-    let file = dir.path().join("script.csv");
-    std::fs::write(&file, text).expect("script");
-    let out = needle(&["eval", "--set", &set(), "--poses", file.to_str().expect("path"), "--insertion", "liver"]);
+    let out = eval_liver(dir.path(), "script.csv", &text, &[]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let stdout = String::from_utf8_lossy(&out.stdout);
     let rows: Vec<&str> = stdout.lines().skip(1).collect();
@@ -97,13 +110,9 @@ fn prony_terms_make_the_scripted_insertion_relax_as_the_library_does() {
     use needle_haptics::viscoelastic::{PronyTerm, PronyTerms};
     let dir = tempfile::tempdir().expect("temp dir");
     let (text, poses) = stop_script();
-    let file = dir.path().join("stop.csv");
-    std::fs::write(&file, text).expect("script");
-    let out =
-        needle(&["eval", "--set", &set(), "--poses", file.to_str().expect("path"), "--insertion", "liver", "--prony", "0.6:0.5, 0.4:5"]);
+    let out = eval_liver(dir.path(), "stop.csv", &text, &["--prony", "0.6:0.5, 0.4:5"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let fy: Vec<f32> = stdout.lines().skip(1).map(|r| r.split(',').nth(7).expect("fy").parse().expect("fy")).collect();
+    let fy = fy_column(&out);
     let terms = PronyTerms::new(&[PronyTerm { g: 0.6, tau_s: 0.5 }, PronyTerm { g: 0.4, tau_s: 5.0 }]).expect("terms");
     let liver = stacks::ALL.iter().find(|s| s.name == "liver").expect("liver");
     let layers: Vec<Layer> = liver.layers.iter().map(|l| Layer { prony: terms, ..*l }).collect();
@@ -114,9 +123,7 @@ fn prony_terms_make_the_scripted_insertion_relax_as_the_library_does() {
     let (stopped, end) = (fy[800], fy[2999]);
     assert!(end < 0.8 * stopped, "Fy {stopped} N at the stop, {end} N 2.2 s later: the filter relaxes");
     // without terms the same script holds its force
-    let out = needle(&["eval", "--set", &set(), "--poses", file.to_str().expect("path"), "--insertion", "liver"]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let elastic: Vec<f32> = stdout.lines().skip(1).map(|r| r.split(',').nth(7).expect("fy").parse().expect("fy")).collect();
+    let elastic = fy_column(&eval_liver(dir.path(), "stop.csv", &text, &[]));
     assert_eq!(elastic[801].to_bits(), elastic[2999].to_bits(), "elastic: no relaxation");
 }
 
@@ -124,8 +131,6 @@ fn prony_terms_make_the_scripted_insertion_relax_as_the_library_does() {
 fn bad_prony_terms_are_refused() {
     let dir = tempfile::tempdir().expect("temp dir");
     let (text, _) = stop_script();
-    let file = dir.path().join("stop.csv");
-    std::fs::write(&file, text).expect("script");
     for (terms, want) in [
         ("0.6", "is not g:tau_s"),
         ("-0.1:1", "must be finite and >= 0"),
@@ -133,7 +138,7 @@ fn bad_prony_terms_are_refused() {
         ("5:1, 5:2", "must be <= 9"),
         ("0.1:1, 0.1:1, 0.1:1, 0.1:1", "at most 3"),
     ] {
-        let out = needle(&["eval", "--set", &set(), "--poses", file.to_str().expect("path"), "--insertion", "liver", "--prony", terms]);
+        let out = eval_liver(dir.path(), "stop.csv", &text, &["--prony", terms]);
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success() && err.contains(want), "--prony {terms:?}: {err}");
     }
