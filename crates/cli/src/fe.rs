@@ -305,26 +305,39 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
     Ok(if failed > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS })
 }
 
-/// `opts` as it is, or with `visco`: once per speed of `[viscoelastic]`, in order.
+/// `opts` as it is, or with `visco`: once per speed of `[viscoelastic]`, in order; with
+/// `[viscoelastic] frictionless` then the frictionless elastic companions and once per
+/// speed frictionless. Variants whose runs `--only` does not select are left out.
 fn visco_variants(opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
+    use needle_fe::visco::Friction;
     if !opts.visco {
         return Ok(vec![opts]);
     }
     let (c, path) = needle_fe::spec::load(&opts.set_dir)?;
     let v = c.viscoelastic.clone().ok_or_else(|| anyhow::anyhow!("{}: --visco: the spec has no [viscoelastic] section", path.display()))?;
-    // the speeds with a run that --only selects (a speed without one is no error)
-    let selects = |speed: f64| -> bool {
-        let (_, runs) = needle_fe::visco::apply(&c, &v, speed, c.loading.steps);
-        needle_fe::spec::select(&runs, opts.only.as_deref()).is_ok_and(|r| !r.is_empty())
-    };
-    let speeds: Vec<f64> = v.speeds_mm_per_s.iter().copied().filter(|&s| selects(s)).collect();
-    if speeds.is_empty() {
+    let selects = |runs: &[needle_fe::spec::PoseSpec]| needle_fe::spec::select(runs, opts.only.as_deref()).is_ok_and(|r| !r.is_empty());
+    let mut out = Vec::new();
+    for friction in Friction::cases(&v) {
+        let frictionless = friction == Friction::None;
+        if let Some((_, runs)) = needle_fe::visco::apply_frictionless_elastic(&c, &v).filter(|_| frictionless) {
+            if selects(&runs) {
+                out.push(RunOptions { visco_frictionless: true, ..opts.clone() });
+            }
+        }
+        for &speed in &v.speeds_mm_per_s {
+            let (_, runs) = needle_fe::visco::apply(&c, &v, speed, c.loading.steps, friction);
+            if selects(&runs) {
+                out.push(RunOptions { visco_speed_mm_per_s: Some(speed), visco_frictionless: frictionless, ..opts.clone() });
+            }
+        }
+    }
+    if out.is_empty() {
         anyhow::bail!(
-            "--visco --only {:?}: matches no run (names: <pose>_<speed>mm-s, e.g. centre_10mm-s)",
+            "--visco --only {:?}: matches no run (names: <pose>_<speed>mm-s, e.g. centre_10mm-s; frictionless: centre_10mm-s_mu0 and the elastic centre_mu0)",
             opts.only.as_deref().unwrap_or("")
         );
     }
-    Ok(speeds.into_iter().map(|s| RunOptions { visco_speed_mm_per_s: Some(s), ..opts.clone() }).collect())
+    Ok(out)
 }
 
 /// What `needle fe run --launcher slurm` prints.

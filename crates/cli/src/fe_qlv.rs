@@ -37,6 +37,7 @@ pub fn check(opts: &QlvOptions) -> anyhow::Result<bool> {
         }
     }
     let report = qlv::report(runs, missing);
+    report.summary().iter().for_each(|l| println!("{l}"));
     needle_fe::verify::write_table(&opts.set_dir, "qlv", &report)?;
     if !compared.is_empty() {
         let svg = crate::fe_qlv_figure::svg(&compared)?;

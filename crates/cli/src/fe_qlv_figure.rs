@@ -1,7 +1,7 @@
-//! The figure of `needle fe verify --qlv`: per pose, the axial force Fy against time of
-//! the FEBio ramp-and-hold runs (points: must points) and the library's QLV filter on
-//! the elastic run (lines), one colour per speed; beside it the first seconds (the
-//! ramps and the early hold).
+//! The figure of `needle fe verify --qlv`: per pose and friction, the axial force Fy
+//! against time of the FEBio ramp-and-hold runs (points: must points) and the library's
+//! QLV filter on the elastic run (lines), one colour per speed; beside it the first
+//! seconds (the ramps and the early hold).
 use needle_contract::FY;
 use needle_fe::verify::qlv::QlvCase;
 use needle_plot::panel::{render, Panel, Series, Style, COMPONENT_COLOURS};
@@ -20,17 +20,17 @@ const ZOOM_S: f64 = 8.0;
 /// # Errors
 /// The filter refuses a case's Prony series, or a chart cannot be laid out.
 pub fn svg(cases: &[QlvCase]) -> anyhow::Result<String> {
-    let mut poses: Vec<&str> = Vec::new();
+    let mut groups: Vec<(&str, f64)> = Vec::new();
     for c in cases {
-        if !poses.contains(&c.pose.as_str()) {
-            poses.push(&c.pose);
+        if !groups.contains(&(c.pose.as_str(), c.friction)) {
+            groups.push((&c.pose, c.friction));
         }
     }
     let mut panels = Vec::new();
-    for pose in poses {
+    for (pose, friction) in groups {
         let mut full = Vec::new();
         let mut zoom = Vec::new();
-        for (i, c) in cases.iter().filter(|c| c.pose == pose).enumerate() {
+        for (i, c) in cases.iter().filter(|c| c.pose == pose && c.friction == friction).enumerate() {
             let colour = COMPONENT_COLOURS[i % COMPONENT_COLOURS.len()];
             let speed = c.loading.ramp_hold.as_ref().map_or(0.0, |r| r.speed_mm_per_s);
             let times = c.times_s();
@@ -45,6 +45,7 @@ pub fn svg(cases: &[QlvCase]) -> anyhow::Result<String> {
                 set.push(Series { label: format!("{speed} mm/s FEBio"), colour, style: Style::Points, data: f });
             }
         }
+        let pose = format!("{pose}, friction {friction}");
         for (title, series) in [(format!("{pose}: ramp to 6 mm, 30 s hold"), full), (format!("{pose}: first {ZOOM_S} s"), zoom)] {
             panels.push(Panel { title, x_label: "time, s".into(), y_label: "Fy, N".into(), series, y_min_span: 0.0 });
         }

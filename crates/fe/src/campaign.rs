@@ -104,6 +104,10 @@ pub struct RunOptions {
     /// its poses, mesh and Prony series, `--steps` must points on the ramp, output in
     /// `<set>/fe/visco/` unless `out_dir`.
     pub visco_speed_mm_per_s: Option<f64>,
+    /// The ramp-and-hold runs (with `visco_speed_mm_per_s`) are the frictionless ones of
+    /// `[viscoelastic] frictionless` (`<run>_mu0`); without a speed, their elastic
+    /// companions (`<pose>_mu0`, friction 0, in `<set>/fe/visco/`).
+    pub visco_frictionless: bool,
     /// Every speed of `[viscoelastic]` is meant (the CLI's `--visco`: one run of the
     /// campaign per speed, each with `visco_speed_mm_per_s`); not read by [`run`].
     pub visco: bool,
@@ -129,6 +133,7 @@ impl RunOptions {
             deep: false,
             tissue_scale: None,
             visco_speed_mm_per_s: None,
+            visco_frictionless: false,
             visco: false,
         }
     }
@@ -308,7 +313,21 @@ fn apply_variant(opts: &RunOptions, campaign: &mut Campaign, spec_path: &Path) -
         if opts.deep {
             bail!("--visco and --deep: the ramp-and-hold runs go to loading.depth_mm only");
         }
-        let (run, poses) = crate::visco::apply(campaign, &v, speed, campaign.loading.steps);
+        let friction = if opts.visco_frictionless { crate::visco::Friction::None } else { crate::visco::Friction::Campaign };
+        let (run, poses) = crate::visco::apply(campaign, &v, speed, campaign.loading.steps, friction);
+        *campaign = run;
+        return Ok(Variant { mesh: v.mesh, poses: Some(poses), out_dir: opts.set_dir.join("fe").join(crate::visco::VISCO_DIR) });
+    }
+    if opts.visco_frictionless {
+        let v = campaign
+            .viscoelastic
+            .clone()
+            .with_context(|| format!("{}: --visco: the spec has no [viscoelastic] section", spec_path.display()))?;
+        if opts.deep {
+            bail!("--visco and --deep: the ramp-and-hold runs go to loading.depth_mm only");
+        }
+        let (run, poses) = crate::visco::apply_frictionless_elastic(campaign, &v)
+            .with_context(|| format!("{}: the frictionless elastic companions: [viscoelastic] frictionless is not set", spec_path.display()))?;
         *campaign = run;
         return Ok(Variant { mesh: v.mesh, poses: Some(poses), out_dir: opts.set_dir.join("fe").join(crate::visco::VISCO_DIR) });
     }

@@ -369,7 +369,7 @@ fn failed_record(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Option
         "{FAILED_PREFIX} its furthest failed attempt reached {} of {} mm; {}",
         r.reached_depth_mm,
         r.depth_mm,
-        failures::summary(&failures::failures_from_record(&r.failure))
+        failures::summary(&failures::failures_from_record(&r.failure), "mm")
     ))
 }
 

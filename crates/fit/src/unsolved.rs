@@ -127,7 +127,7 @@ fn partial_record(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Optio
     if r.spec_hash != campaign.run_hash(pose, &campaign.campaign.mesh) {
         return None;
     }
-    Some((r.reached_depth_mm, failures::summary(&failures::failures_from_record(&r.failure))))
+    Some((r.reached_depth_mm, failures::summary(&failures::failures_from_record(&r.failure), "mm")))
 }
 
 /// The region of the set in `set_dir`, from its records (module docs).

@@ -15,7 +15,8 @@ pub struct AttemptFailure {
     /// The class: `negative jacobian`, `max reformations`, `diverged`, `stopped` (no
     /// error in the log: killed on a stall, timeout or Ctrl-C) or `other`.
     pub class: &'static str,
-    /// Depth where it failed, mm (time t = depth): FEBio's "failed to converge at time",
+    /// Where it failed in the solver's time (depth in mm; s of a ramp-and-hold run,
+    /// `Loading::time_unit`): FEBio's "failed to converge at time",
     /// else the last converged time.
     pub depth_mm: f64,
     /// FEBio's own words, when it gave any.
@@ -87,8 +88,9 @@ pub fn failures_from_record(failure: &str) -> Vec<AttemptFailure> {
 }
 
 /// One line: `5 failed attempt(s), furthest 5.22 mm: negative jacobian x3 (0.6, 0.86, 2.69 mm), max reformations x2 (...)`;
-/// empty when there are none.
-pub fn summary(failures: &[AttemptFailure]) -> String {
+/// empty when there are none. `unit`: of the solver's time, `Loading::time_unit` (mm of
+/// depth, s of a ramp-and-hold run).
+pub fn summary(failures: &[AttemptFailure], unit: &str) -> String {
     if failures.is_empty() {
         return String::new();
     }
@@ -100,10 +102,10 @@ pub fn summary(failures: &[AttemptFailure]) -> String {
     let classes: Vec<String> = by_class
         .iter()
         .map(|(c, d)| {
-            format!("{c} x{} ({} mm)", d.len(), d.iter().map(|v| format!("{}", (v * 100.0).round() / 100.0)).collect::<Vec<_>>().join(", "))
+            format!("{c} x{} ({} {unit})", d.len(), d.iter().map(|v| format!("{}", (v * 100.0).round() / 100.0)).collect::<Vec<_>>().join(", "))
         })
         .collect();
-    format!("{} failed attempt(s), furthest {:.2} mm: {}", failures.len(), furthest, classes.join("; "))
+    format!("{} failed attempt(s), furthest {:.2} {unit}: {}", failures.len(), furthest, classes.join("; "))
 }
 
 #[cfg(test)]
@@ -122,12 +124,13 @@ mod tests {
         let f = read_failures(d.path());
         let got: Vec<(u32, &str, f64)> = f.iter().map(|f| (f.attempt, f.class, f.depth_mm)).collect();
         assert_eq!(got, [(1, "negative jacobian", 0.863), (2, "max reformations", 5.22), (4, "stopped", 1.5)]);
-        let s = summary(&f);
+        let s = summary(&f, "mm");
         assert_eq!(
             s,
             "3 failed attempt(s), furthest 5.22 mm: max reformations x1 (5.22 mm); negative jacobian x1 (0.86 mm); stopped x1 (1.5 mm)"
         );
-        assert_eq!(summary(&[]), "");
+        assert_eq!(summary(&[], "mm"), "");
+        assert!(summary(&f, "s").starts_with("3 failed attempt(s), furthest 5.22 s: max reformations x1 (5.22 s)"));
     }
 
     #[test]

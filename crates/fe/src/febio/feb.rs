@@ -502,7 +502,7 @@ mod tests {
     fn the_feb_wraps_the_ogden_and_runs_in_seconds() {
         let c = crate::spec::parse(&shipped(), Path::new("campaign.toml")).expect("the shipped spec");
         let v = c.viscoelastic.clone().expect("[viscoelastic]");
-        let (run, poses) = crate::visco::apply(&c, &v, 1.0, 4);
+        let (run, poses) = crate::visco::apply(&c, &v, 1.0, 4, crate::visco::Friction::Campaign);
         let pose = poses.first().expect("a pose");
         let mesh = run.mesh_level("smoke").expect("smoke").clone();
         let feb = write(&run, pose, &mesh, run.loading.steps, 1.0).expect("feb");

@@ -102,7 +102,7 @@ pub fn status(plan: &Plan) -> Result<StatusReport> {
         let task = latest.get(&pose.name).map(|(job, t)| format!("{job}_{t}"));
         let (state, cause) = match (&task, done) {
             (_, true) => ("done".to_string(), String::new()),
-            (None, false) => ("not submitted".to_string(), local_failures(&plan.out_dir, &pose.name)),
+            (None, false) => ("not submitted".to_string(), local_failures(&plan.out_dir, &pose.name, plan.campaign.loading.time_unit())),
             (Some(t), false) => match queue.get(t) {
                 Some(q) => (q.state.to_lowercase(), reason(q)),
                 None if queue_error.is_some() => ("unknown".to_string(), String::new()),
@@ -118,17 +118,17 @@ pub fn status(plan: &Plan) -> Result<StatusReport> {
 /// ([`febio::failures`](crate::febio::failures)); empty when there are none.
 /// Without logs, the attempts of its `.partial.toml` record (the logs' folder is gone
 /// when the campaign ran elsewhere or the work folder was cleaned).
-fn local_failures(out_dir: &Path, pose: &str) -> String {
+fn local_failures(out_dir: &Path, pose: &str, unit: &str) -> String {
     use crate::febio::failures;
     let f = failures::read_failures(&out_dir.join(".work").join(pose));
     if !f.is_empty() {
-        return failures::summary(&f);
+        return failures::summary(&f, unit);
     }
     let (_, record) = crate::partial::paths(out_dir, pose);
     let Some(r) = std::fs::read_to_string(&record).ok().and_then(|t| toml::from_str::<crate::partial::PartialRecord>(&t).ok()) else {
         return String::new();
     };
-    format!("{} (record {})", failures::summary(&failures::failures_from_record(&r.failure)), r.date)
+    format!("{} (record {})", failures::summary(&failures::failures_from_record(&r.failure), unit), r.date)
 }
 
 /// The failed attempts of the selected poses by attempt and class (issue 42, item 2:
@@ -169,12 +169,14 @@ pub fn attempts_by_class(plan: &Plan) -> String {
     for f in &failed {
         by.entry((f.attempt, f.class)).or_default().push(f.depth_mm);
     }
-    let _ = writeln!(s, "failed attempts by class ({} in all; depth where each stopped, min / median / max mm):", failed.len());
+    let unit = plan.campaign.loading.time_unit();
+    let what = if unit == "s" { "time" } else { "depth" };
+    let _ = writeln!(s, "failed attempts by class ({} in all; {what} where each stopped, min / median / max {unit}):", failed.len());
     for ((attempt, class), d) in &mut by {
         d.sort_by(f64::total_cmp);
         let median = d.get(d.len() / 2).copied().unwrap_or(f64::NAN);
         let (lo, hi) = (d.first().copied().unwrap_or(f64::NAN), d.last().copied().unwrap_or(f64::NAN));
-        let _ = writeln!(s, "  attempt {attempt}: {class:<17} x{:<3} {lo:.2} / {median:.2} / {hi:.2} mm", d.len());
+        let _ = writeln!(s, "  attempt {attempt}: {class:<17} x{:<3} {lo:.2} / {median:.2} / {hi:.2} {unit}", d.len());
     }
     let on: Vec<String> = solved_on.iter().map(|(a, n)| format!("attempt {a}: {n}")).collect();
     let _ = writeln!(s, "solved runs by the attempt that solved them: {}", on.join(", "));

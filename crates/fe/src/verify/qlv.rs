@@ -18,7 +18,7 @@ use super::runs::{read_current, solve_and_read, PoseRows};
 use crate::campaign::RunOptions;
 use crate::results::{peak_fy_n, Row};
 use crate::spec::{self, Loading};
-use crate::visco::{run_name, Prony};
+use crate::visco::{run_name, Friction, Prony};
 use anyhow::{Context, Result};
 use needle_contract::{error_scales, COMPONENTS, COMPONENT_COUNT, FY};
 use serde::Serialize;
@@ -65,6 +65,10 @@ pub struct QlvCase {
     pub fe: Vec<Row>,
     /// The elastic FE run of the pose, one row per depth.
     pub elastic: Vec<Row>,
+    /// Coulomb friction of both runs: the campaign's `contact.friction`, or 0 for the
+    /// frictionless runs of `[viscoelastic] frictionless` (their elastic run is the
+    /// frictionless companion `fe/visco/<pose>_mu0.csv`).
+    pub friction: f64,
     /// The viscoelastic run failed every attempt: `fe` is its partial record (the must
     /// points of its furthest attempt, `fe/visco/<run>.partial.csv`), compared as far as
     /// it goes and reported as such; a miss of the check.
@@ -98,8 +102,9 @@ pub fn elastic_at_depth(rows: &[Row], depth_mm: f64) -> [f64; COMPONENT_COUNT] {
     std::array::from_fn(|c| a.wrench[c] + f * (b.wrench[c] - a.wrench[c]))
 }
 
-/// Each run of `[viscoelastic]` (pose by speed, in the spec's order) with its elastic
-/// run, solved first when `opts.solve`, or why it is missing.
+/// Each run of `[viscoelastic]` (the campaign's friction, then frictionless when asked;
+/// pose by speed in the spec's order) with its elastic run, solved first when
+/// `opts.solve`, or why it is missing.
 ///
 /// # Errors
 /// The spec has no `[viscoelastic]`, or as [`crate::campaign::run`].
@@ -119,40 +124,38 @@ pub fn cases(opts: &QlvOptions) -> Result<Vec<std::result::Result<QlvCase, (Stri
     if let Some(p) = poses.iter().find(|p| !v.poses.contains(p)) {
         anyhow::bail!("{}: --qlv-poses {p:?}: not in viscoelastic.poses ({})", path.display(), v.poses.join(", "));
     }
-    let elastic = read(&RunOptions { only: Some(poses.join(",")), ..base.clone() })?;
     let mut out = Vec::new();
-    for &speed in &v.speeds_mm_per_s {
-        let only = poses.iter().map(|p| run_name(p, speed)).collect::<Vec<_>>().join(",");
-        let o = RunOptions { visco_speed_mm_per_s: Some(speed), only: Some(only), ..base.clone() };
-        let visco = read(&o)?;
-        let plan = crate::campaign::plan(&o)?;
-        for pose in &poses {
-            let run = run_name(pose, speed);
-            let fe = visco.get(&run).cloned().unwrap_or_else(|| Err("not selected".into()));
-            let partial = fe.as_ref().err().and_then(|_| read_partial(&plan, &run));
-            let el = elastic.get(pose).cloned().unwrap_or_else(|| Err("not selected".into()));
-            out.push(match (fe, el) {
-                (Ok(fe), Ok(el)) => Ok(QlvCase {
+    for friction in Friction::cases(&v) {
+        let frictionless = friction == Friction::None;
+        let only = poses.iter().map(|p| friction.name(p)).collect::<Vec<_>>().join(",");
+        let elastic = read(&RunOptions { only: Some(only), visco_frictionless: frictionless, ..base.clone() })?;
+        for &speed in &v.speeds_mm_per_s {
+            let only = poses.iter().map(|p| friction.name(&run_name(p, speed))).collect::<Vec<_>>().join(",");
+            let o = RunOptions { visco_speed_mm_per_s: Some(speed), visco_frictionless: frictionless, only: Some(only), ..base.clone() };
+            let visco = read(&o)?;
+            let plan = crate::campaign::plan(&o)?;
+            for pose in &poses {
+                let run = friction.name(&run_name(pose, speed));
+                let fe = visco.get(&run).cloned().unwrap_or_else(|| Err("not selected".into()));
+                let partial = fe.as_ref().err().and_then(|_| read_partial(&plan, &run));
+                let el = elastic.get(&friction.name(pose)).cloned().unwrap_or_else(|| Err("not selected".into()));
+                let case = |fe: Vec<Row>, elastic: Vec<Row>, partial: bool| QlvCase {
                     pose: pose.clone(),
-                    run,
+                    run: run.clone(),
                     loading: plan.campaign.loading.clone(),
                     prony: plan.campaign.tissue.prony.clone().unwrap_or(Prony { g: Vec::new(), tau_s: Vec::new() }),
-                    fe: fe.rows,
-                    elastic: el.rows,
-                    partial: false,
-                }),
-                (Err(_), Ok(el)) if partial.is_some() => Ok(QlvCase {
-                    pose: pose.clone(),
-                    run,
-                    loading: plan.campaign.loading.clone(),
-                    prony: plan.campaign.tissue.prony.clone().unwrap_or(Prony { g: Vec::new(), tau_s: Vec::new() }),
-                    fe: partial.unwrap_or_default(),
-                    elastic: el.rows,
-                    partial: true,
-                }),
-                (Err(why), _) => Err((run, why)),
-                (_, Err(why)) => Err((run, format!("the elastic run of {pose}: {why}"))),
-            });
+                    friction: plan.campaign.contact.friction,
+                    fe,
+                    elastic,
+                    partial,
+                };
+                out.push(match (fe, el) {
+                    (Ok(fe), Ok(el)) => Ok(case(fe.rows, el.rows, false)),
+                    (Err(_), Ok(el)) if partial.is_some() => Ok(case(partial.unwrap_or_default(), el.rows, true)),
+                    (Err(why), _) => Err((run.clone(), why)),
+                    (_, Err(why)) => Err((run.clone(), format!("the elastic run {}: {why}", friction.name(pose)))),
+                });
+            }
         }
     }
     Ok(out)
@@ -176,6 +179,31 @@ pub struct QlvReport {
 }
 
 impl QlvReport {
+    /// One line per friction case: runs whole and within the bounds, of those compared.
+    pub fn summary(&self) -> Vec<String> {
+        let mut frictions: Vec<f64> = Vec::new();
+        for r in &self.runs {
+            if !frictions.contains(&r.friction) {
+                frictions.push(r.friction);
+            }
+        }
+        frictions
+            .iter()
+            .map(|f| {
+                let of: Vec<&QlvRun> = self.runs.iter().filter(|r| r.friction == *f).collect();
+                let whole = of.iter().filter(|r| !r.partial).count();
+                let ok = of.iter().filter(|r| r.ok()).count();
+                let worst = |g: fn(&QlvRun) -> f64| of.iter().filter(|r| !r.partial).map(|r| g(r)).fold(0.0, f64::max);
+                format!(
+                    "qlv friction {f}: {whole} of {} runs solved whole, {ok} within the bounds; worst RMS {:.2}%, largest {:.2}% of peak |Fy| over the whole runs",
+                    of.len(),
+                    worst(|r| r.worst_rms_percent),
+                    worst(|r| r.worst_max_percent)
+                )
+            })
+            .collect()
+    }
+
     /// Every run of the spec compared and within the bounds.
     pub fn ok(&self) -> bool {
         self.missing.is_empty() && !self.runs.is_empty() && self.runs.iter().all(QlvRun::ok)
@@ -188,7 +216,7 @@ pub fn report(runs: Vec<QlvRun>, missing: Vec<String>) -> QlvReport {
         goal_rms_percent: QLV_GOAL_RMS_PERCENT,
         must_rms_percent: QLV_MUST_RMS_PERCENT,
         max_percent: QLV_MAX_PERCENT,
-        elastic_input: "the elastic FE run of the same pose and mesh (fe/<pose>.csv), linearly interpolated in depth along the run's depth-time path, at every tick of the filter".into(),
+        elastic_input: "the elastic FE run of the same pose, mesh and friction (fe/<pose>.csv; frictionless: fe/visco/<pose>_mu0.csv), linearly interpolated in depth along the run's depth-time path, at every tick of the filter".into(),
         missing,
         runs,
     }
@@ -224,6 +252,8 @@ pub struct QlvRun {
     pub run: String,
     /// Feed speed, mm/s.
     pub speed_mm_per_s: f64,
+    /// Coulomb friction of the runs ([`QlvCase::friction`]).
+    pub friction: f64,
     /// The filter's tick, s.
     pub tick_s: f64,
     /// Must points compared (ramp and hold, 0 included).
@@ -272,9 +302,10 @@ impl std::fmt::Display for QlvRun {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "qlv {:<16} {:>5} mm/s: RMS {:.2}% ({}), largest {:.2}% ({} at {:.3} s) of peak |Fy| {:.5} N (goal RMS {}%, must {}%, largest {}%); Fy end of ramp FE {:.5} / filter {:.5} N, end of hold FE {:.5} / filter {:.5} N, elastic {:.5} N{}",
+            "qlv {:<20} {:>5} mm/s, friction {}: RMS {:.2}% ({}), largest {:.2}% ({} at {:.3} s) of peak |Fy| {:.5} N (goal RMS {}%, must {}%, largest {}%); Fy end of ramp FE {:.5} / filter {:.5} N, end of hold FE {:.5} / filter {:.5} N, elastic {:.5} N{}",
             self.run,
             self.speed_mm_per_s,
+            self.friction,
             self.worst_rms_percent,
             self.worst_rms_component,
             self.worst_max_percent,
@@ -336,6 +367,7 @@ pub fn score(case: &QlvCase, filtered: &[[f64; COMPONENT_COUNT]], tick_s: f64, l
         pose: case.pose.clone(),
         run: case.run.clone(),
         speed_mm_per_s: case.loading.ramp_hold.as_ref().map_or(0.0, |r| r.speed_mm_per_s),
+        friction: case.friction,
         tick_s,
         must_points: fe.len(),
         partial: case.partial,

@@ -12,7 +12,7 @@
 //! FEBio's time is then seconds; the must points are [`RampHold::time_s`].
 //! `needle fe verify --qlv` compares these runs with the library's filter.
 
-pub use crate::spec::visco::{run_name, Prony, RampHold, ViscoSettings, MAX_PRONY_TERMS};
+pub use crate::spec::visco::{frictionless_name, run_name, Prony, RampHold, ViscoSettings, FRICTIONLESS_SUFFIX, MAX_PRONY_TERMS};
 
 use crate::spec::{Campaign, PoseSpec};
 
@@ -22,10 +22,48 @@ pub const VISCO_DIR: &str = "visco";
 /// Header of a ramp-and-hold result: the time, s, before the FE result's columns.
 pub const TIME_COLUMN: &str = "time_s";
 
+/// Which contact the runs have: the campaign's (`contact.friction`) or friction 0
+/// (`[viscoelastic] frictionless`, names with [`FRICTIONLESS_SUFFIX`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Friction {
+    /// The campaign's `[contact]` as it is.
+    Campaign,
+    /// `contact.friction` 0, every other contact setting the campaign's.
+    None,
+}
+
+impl Friction {
+    /// The cases `v` asks for, the campaign's first.
+    pub fn cases(v: &ViscoSettings) -> Vec<Friction> {
+        if v.frictionless {
+            vec![Friction::Campaign, Friction::None]
+        } else {
+            vec![Friction::Campaign]
+        }
+    }
+
+    /// `name` as a run of this case.
+    pub fn name(self, name: &str) -> String {
+        match self {
+            Friction::Campaign => name.to_string(),
+            Friction::None => frictionless_name(name),
+        }
+    }
+
+    /// `c` with this case's contact.
+    fn apply(self, c: &mut Campaign) {
+        if self == Friction::None {
+            c.contact.friction = 0.0;
+        }
+    }
+}
+
 /// The campaign as the runs at `speed_mm_per_s` see it (`ramp_steps` must points on the
-/// ramp), and their poses (renamed by [`run_name`]).
-pub fn apply(c: &Campaign, v: &ViscoSettings, speed_mm_per_s: f64, ramp_steps: u32) -> (Campaign, Vec<PoseSpec>) {
+/// ramp, the contact of `friction`), and their poses (renamed by [`run_name`] and
+/// [`Friction::name`]).
+pub fn apply(c: &Campaign, v: &ViscoSettings, speed_mm_per_s: f64, ramp_steps: u32, friction: Friction) -> (Campaign, Vec<PoseSpec>) {
     let mut run = c.clone();
+    friction.apply(&mut run);
     run.tissue.prony = Some(Prony { g: v.g.clone(), tau_s: v.tau_s.clone() });
     run.loading.steps = ramp_steps + v.hold_steps;
     run.loading.ramp_hold = Some(RampHold {
@@ -36,14 +74,29 @@ pub fn apply(c: &Campaign, v: &ViscoSettings, speed_mm_per_s: f64, ramp_steps: u
         hold_first_s: v.hold_first_s,
         min_residual_n: v.min_residual_n,
     });
+    (run, renamed(c, v, |p| friction.name(&run_name(p, speed_mm_per_s))))
+}
+
+/// The campaign of the frictionless elastic companions (`[viscoelastic] frictionless`):
+/// the elastic runs of `v.poses` with friction 0 (`<pose>_mu0`), the filter's input for
+/// the frictionless ramp-and-hold runs; `None` when `v` has no frictionless runs.
+pub fn apply_frictionless_elastic(c: &Campaign, v: &ViscoSettings) -> Option<(Campaign, Vec<PoseSpec>)> {
+    if !v.frictionless {
+        return None;
+    }
+    let mut run = c.clone();
+    Friction::None.apply(&mut run);
+    Some((run, renamed(c, v, frictionless_name)))
+}
+
+/// The poses of `v.poses`, renamed.
+fn renamed(c: &Campaign, v: &ViscoSettings, name: impl Fn(&str) -> String) -> Vec<PoseSpec> {
     let every = c.poses();
-    let poses = v
-        .poses
+    v.poses
         .iter()
         .filter_map(|n| every.iter().find(|p| &p.name == n))
-        .map(|p| PoseSpec { name: run_name(&p.name, speed_mm_per_s), ..p.clone() })
-        .collect();
-    (run, poses)
+        .map(|p| PoseSpec { name: name(&p.name), ..p.clone() })
+        .collect()
 }
 
 /// The manifest's line of a ramp-and-hold run (`None`: not one): its Prony series and
@@ -52,7 +105,7 @@ pub fn describe(c: &Campaign) -> Option<String> {
     let (p, r) = (c.tissue.prony.as_ref()?, c.loading.ramp_hold.as_ref()?);
     let terms: Vec<String> = p.g.iter().zip(&p.tau_s).map(|(g, t)| format!("g {g} tau {t} s")).collect();
     Some(format!(
-        "uncoupled viscoelastic (FEBio normalisation, g0 = 1) {}; ramp to {} mm at {} mm/s ({} s, {} must points), hold {} s ({} must points from {} s); Newton's residual floor {} N",
+        "uncoupled viscoelastic (FEBio normalisation, g0 = 1) {}; ramp to {} mm at {} mm/s ({} s, {} must points), hold {} s ({} must points from {} s); Newton's residual floor {} N; Coulomb friction {}",
         terms.join(", "),
         c.loading.depth_mm,
         r.speed_mm_per_s,
@@ -61,7 +114,8 @@ pub fn describe(c: &Campaign) -> Option<String> {
         r.hold_s,
         r.hold_steps,
         r.hold_first_s,
-        r.min_residual_n
+        r.min_residual_n,
+        c.contact.friction
     ))
 }
 
@@ -84,7 +138,7 @@ mod tests {
         let c = crate::spec::parse(&shipped(), Path::new("campaign.toml")).expect("the shipped spec");
         let v = c.viscoelastic.clone().expect("coeffs/default has [viscoelastic]");
         assert_eq!(v.poses.first().map(String::as_str), Some("centre"), "the quarter model first");
-        let (run, poses) = apply(&c, &v, 10.0, c.loading.steps);
+        let (run, poses) = apply(&c, &v, 10.0, c.loading.steps, Friction::Campaign);
         assert_eq!(run.loading.steps, c.loading.steps + v.hold_steps);
         assert_eq!(poses.first().map(|p| p.name.as_str()), Some("centre_10mm-s"));
         let centre = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");
@@ -95,6 +149,34 @@ mod tests {
         let text = describe(&run).expect("a ramp-and-hold run");
         assert!(text.contains("at 10 mm/s (0.6 s") && text.contains("tau 0.5 s"), "{text}");
         assert_eq!(run_name("x+04", 1.5), "x+04_1p5mm-s");
+    }
+
+    #[test]
+    fn frictionless_runs_and_their_elastic_companions_have_their_own_names_and_hashes() {
+        let mut c = crate::spec::parse(&shipped(), Path::new("campaign.toml")).expect("the shipped spec");
+        assert!(c.contact.friction > 0.0, "the shipped contact has friction");
+        let mut v = c.viscoelastic.clone().expect("coeffs/default has [viscoelastic]");
+        v.frictionless = false;
+        assert_eq!(Friction::cases(&v), [Friction::Campaign]);
+        assert!(apply_frictionless_elastic(&c, &v).is_none());
+        v.frictionless = true;
+        c.viscoelastic = Some(v.clone());
+        assert_eq!(Friction::cases(&v), [Friction::Campaign, Friction::None]);
+        let (with, with_poses) = apply(&c, &v, 3.0, c.loading.steps, Friction::Campaign);
+        let (without, poses) = apply(&c, &v, 3.0, c.loading.steps, Friction::None);
+        assert_eq!(with.contact.friction, c.contact.friction);
+        assert_eq!(without.contact.friction, 0.0);
+        assert_eq!(without.contact.penalty_slope_n_per_mm3, c.contact.penalty_slope_n_per_mm3);
+        assert_eq!(poses.first().map(|p| p.name.as_str()), Some("centre_3mm-s_mu0"));
+        let (w, f) = (&with_poses[0], &poses[0]);
+        assert_ne!(with.run_hash(w, &v.mesh), without.run_hash(f, &v.mesh));
+        assert!(describe(&without).is_some_and(|t| t.ends_with("Coulomb friction 0")));
+        let (elastic, names) = apply_frictionless_elastic(&c, &v).expect("frictionless companions");
+        assert_eq!(elastic.contact.friction, 0.0);
+        assert!(elastic.tissue.prony.is_none() && elastic.loading.ramp_hold.is_none(), "elastic");
+        assert_eq!(names.iter().map(|p| p.name.as_str()).collect::<Vec<_>>(), v.poses.iter().map(|p| frictionless_name(p)).collect::<Vec<_>>());
+        let centre = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");
+        assert_ne!(elastic.run_hash(&names[0], &v.mesh), c.run_hash(&centre, &v.mesh));
     }
 
     #[test]

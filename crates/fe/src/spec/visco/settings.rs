@@ -14,6 +14,15 @@ pub fn run_name(pose: &str, speed_mm_per_s: f64) -> String {
     format!("{pose}_{}mm-s", format!("{speed_mm_per_s}").replace('.', "p"))
 }
 
+/// Suffix of the frictionless runs' names (`[viscoelastic] frictionless`): the
+/// ramp-and-hold run `centre_10mm-s_mu0` and the elastic companion `centre_mu0`.
+pub const FRICTIONLESS_SUFFIX: &str = "_mu0";
+
+/// The name of a frictionless run (ramp-and-hold or elastic companion) of `name`.
+pub fn frictionless_name(name: &str) -> String {
+    format!("{name}{FRICTIONLESS_SUFFIX}")
+}
+
 /// `[viscoelastic]`: the Prony series and the ramp-and-hold loadings of
 /// `needle fe run --visco` (module docs of `crate::visco`, which applies them).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -42,6 +51,13 @@ pub struct ViscoSettings {
     pub mesh: String,
     /// Pose names of the campaign, solved in this order (the centre first: quarter model).
     pub poses: Vec<String>,
+    /// Solve every pose at every speed a second time with `contact.friction` 0
+    /// (`<run>_mu0`), beside elastic companions with friction 0 (`<pose>_mu0`, the
+    /// filter's input for them), all in `fe/visco/`. The QLV filter relaxes the elastic
+    /// wrench as a whole; Coulomb slip during the hold is not part of it, and FEBio's
+    /// hold with friction did not solve at every pose (coeffs/README.md).
+    #[serde(default)]
+    pub frictionless: bool,
 }
 
 /// The Prony series the FE tissue is wrapped with (FEBio's `uncoupled viscoelastic`,
