@@ -495,7 +495,9 @@ impl<'j, 'a> Setup<'j, 'a> {
                 "febio4 {how} after {} of {} steps (t = {} {}), {} time steps, {} retries, {:.1} s{}{}{}{kept}",
                 e.done_steps,
                 job.steps,
-                e.run.last_time,
+                // a continuation that failed before converging a step logs no time: the
+                // must points done are reached
+                e.run.last_time.max(loading.time_at(e.done_steps as u32)),
                 loading.time_unit(),
                 p.totals.time_steps,
                 p.totals.retries,

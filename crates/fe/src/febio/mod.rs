@@ -410,7 +410,7 @@ mod tests {
             if stuck {
                 let f = r.expect_err("a continuation without progress: failed");
                 assert!(
-                    f.message.contains("after 2 of 4 steps")
+                    f.message.contains("after 2 of 4 steps (t = 3 mm)")
                         && f.message.contains("continued 1 time(s) from the last converged must point (3 mm)"),
                     "{}",
                     f.message
