@@ -194,6 +194,11 @@ pub struct VerifyArgs {
     /// Run the mesh study: each level against its refinement (goal 2% RMS, 4% largest after the best scale).
     #[arg(long)]
     pub mesh: bool,
+    /// Run the edge study: the centre with each needle edge radius of
+    /// campaign.edge_study_radii_mm on every mesh-study level, into fe/edge/ (not part of
+    /// the default checks: its fine runs take tens of minutes).
+    #[arg(long)]
+    pub edge: bool,
     /// Check the mirror runs against their counterparts (goal 1% of peak |Fy|).
     #[arg(long)]
     pub mirror: bool,
@@ -425,7 +430,7 @@ fn run_verify(a: VerifyArgs) -> anyhow::Result<ExitCode> {
     if !(a.punch_mesh_scale.is_finite() && a.punch_mesh_scale >= 1.0) {
         anyhow::bail!("--punch-mesh-scale {}: must be a number >= 1", a.punch_mesh_scale);
     }
-    if a.qlv && !(a.punch || a.mesh || a.mirror || a.smooth || a.scaling) {
+    if a.qlv && !(a.punch || a.mesh || a.edge || a.mirror || a.smooth || a.scaling) {
         // the QLV check alone (it is not part of the default five: its runs are the
         // viscoelastic campaign's, `needle fe run --visco`)
         needle_fe::process::stop_jobs_on_termination()?;
@@ -445,9 +450,9 @@ fn run_verify(a: VerifyArgs) -> anyhow::Result<ExitCode> {
         return Ok(if ok { ExitCode::SUCCESS } else { ExitCode::from(1) });
     }
     if a.qlv {
-        anyhow::bail!("--qlv runs alone (not with --punch, --mesh, --mirror, --smooth, --scaling)");
+        anyhow::bail!("--qlv runs alone (not with --punch, --mesh, --edge, --mirror, --smooth, --scaling)");
     }
-    let all = !(a.punch || a.mesh || a.mirror || a.smooth || a.scaling);
+    let all = !(a.punch || a.mesh || a.edge || a.mirror || a.smooth || a.scaling);
     let threads = a.threads.map(|t| t as usize).unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
     let work = a.work.clone().unwrap_or_else(|| a.set.join("fe").join(".work").join("verify"));
     let scaling = (a.scaling || all).then(|| needle_fe::verify::scaling::ScalingOptions {
@@ -459,10 +464,13 @@ fn run_verify(a: VerifyArgs) -> anyhow::Result<ExitCode> {
         threads,
         solve: !a.no_solve,
     });
-    let mesh = (a.mesh || all).then(|| needle_fe::verify::mesh_check::MeshOptions { set_dir: a.set.clone(), threads, solve: !a.no_solve });
+    let study = needle_fe::verify::mesh_check::MeshOptions { set_dir: a.set.clone(), threads, solve: !a.no_solve, edge_radius_mm: None };
+    let mesh = (a.mesh || all).then(|| study.clone());
+    let edge = a.edge.then_some(study);
     let opts = needle_fe::verify::VerifyOptions {
         scaling,
         mesh,
+        edge,
         set_dir: a.set,
         punch: a.punch || all,
         mirror: a.mirror || all,

@@ -193,6 +193,7 @@ fn coarse_flat_punch_with_the_febio_element_matches_sneddon() {
         set_dir: set.clone(),
         punch: true,
         mesh: None,
+        edge: None,
         mirror: false,
         smooth: false,
         scaling: None,

@@ -100,6 +100,10 @@ pub struct RunOptions {
     /// `needle fe verify --scaling`. Part of the run hash through the tissue; needs `out_dir`
     /// (scaled runs never go into `<set>/fe/`).
     pub tissue_scale: Option<f64>,
+    /// `needle.tip_edge_radius_mm` set to this, mm: the edge study of `needle fe verify
+    /// --edge` (`campaign.edge_study_radii_mm`). Part of the run hash through the needle;
+    /// needs `out_dir` (these runs never go into `<set>/fe/`).
+    pub edge_radius_mm: Option<f64>,
     /// The ramp-and-hold runs of `[viscoelastic]` at this speed, mm/s (`crate::visco`):
     /// its poses, mesh and Prony series, `--steps` must points on the ramp, output in
     /// `<set>/fe/visco/` unless `out_dir`.
@@ -132,6 +136,7 @@ impl RunOptions {
             launcher: Launched::Local,
             deep: false,
             tissue_scale: None,
+            edge_radius_mm: None,
             visco_speed_mm_per_s: None,
             visco_frictionless: false,
             visco: false,
@@ -336,6 +341,12 @@ fn apply_variant(opts: &RunOptions, campaign: &mut Campaign, spec_path: &Path) -
             bail!("tissue scale {s}: must be finite and > 0, with its own output folder (never <set>/fe)");
         }
         campaign.tissue.mu_n_per_mm2.iter_mut().for_each(|mu| *mu *= s);
+    }
+    if let Some(r) = opts.edge_radius_mm {
+        if !(r.is_finite() && r > 0.0 && r < campaign.needle.diameter_mm / 2.0) || opts.out_dir.is_none() {
+            bail!("edge radius {r} mm: must be > 0 and below the needle's radius, with its own output folder (never <set>/fe)");
+        }
+        campaign.needle.tip_edge_radius_mm = r;
     }
     Ok(v)
 }

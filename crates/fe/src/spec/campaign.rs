@@ -56,6 +56,13 @@ pub struct CampaignSettings {
     /// refinement (`needle fe verify --mesh`; issue 42: an x, a z and a theta pose).
     #[serde(default)]
     pub mesh_study_poses: Vec<String>,
+    /// Needle edge radii, mm, of the edge study (`needle fe verify --edge`; issue 42): the
+    /// centre solved on every level of `mesh_study` with `needle.tip_edge_radius_mm` set
+    /// to each, into `fe/edge/r<radius>mm/<level>/`, and compared like the mesh study.
+    /// Each > 0, below the needle's radius, not the campaign's own edge (the mesh study
+    /// has it), listed once.
+    #[serde(default)]
+    pub edge_study_radii_mm: Vec<f64>,
 }
 
 /// `[[campaign.train_replaced]]`: a training pose replaced by the next point of the

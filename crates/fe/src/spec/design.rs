@@ -141,6 +141,23 @@ impl Campaign {
                 ));
             }
         }
+        let field = "campaign.edge_study_radii_mm";
+        for (k, r) in self.campaign.edge_study_radii_mm.iter().enumerate() {
+            if !(r.is_finite() && *r > 0.0 && *r < self.needle.diameter_mm / 2.0) {
+                let max = self.needle.diameter_mm / 2.0;
+                return Err(SpecError::range(&p, field, format!("{field}: {r} mm: must be > 0 and below the needle's radius ({max} mm)")));
+            }
+            if *r == self.needle.tip_edge_radius_mm {
+                return Err(SpecError::inconsistent(
+                    &p,
+                    field,
+                    format!("{field}: {r} mm is needle.tip_edge_radius_mm, the campaign's own edge (the mesh study has it)"),
+                ));
+            }
+            if self.campaign.edge_study_radii_mm[..k].contains(r) {
+                return Err(SpecError::duplicate(&p, field, format!("{r}"), format!("{field}: {r} mm is listed twice")));
+            }
+        }
         let mut replaced = std::collections::BTreeSet::new();
         for (k, r) in self.campaign.train_replaced.iter().enumerate() {
             let replacement = self.train_name(self.campaign.train_count as usize + k);

@@ -112,6 +112,30 @@ impl SpecError {
         SpecError::Duplicate { at: at.to_string(), field: field.into(), name: name.into(), message: message.into() }
     }
 
+    /// The error with the line of its key in `text` (the spec's text) added to `at` when
+    /// `at` has none and the key is found: `field` "section.key" or "mesh.<level>.key"
+    /// (array tables such as `[[pose]]` have no single line and stay as they are).
+    #[must_use]
+    pub fn located(self, text: &str) -> Self {
+        let with_line = |at: String, field: &str| -> String {
+            let Some((section, key)) = field.rsplit_once('.') else { return at };
+            if at.contains(':') || section == "pose" {
+                return at;
+            }
+            match crate::deep::key_line(text, section, key) {
+                0 => at,
+                line => format!("{at}:{line}"),
+            }
+        };
+        match self {
+            SpecError::OutOfRange { at, field, message } => SpecError::OutOfRange { at: with_line(at, &field), field, message },
+            SpecError::Inconsistent { at, field, message } => SpecError::Inconsistent { at: with_line(at, &field), field, message },
+            SpecError::Unknown { at, field, name, message } => SpecError::Unknown { at: with_line(at, &field), field, name, message },
+            SpecError::Duplicate { at, field, name, message } => SpecError::Duplicate { at: with_line(at, &field), field, name, message },
+            other => other,
+        }
+    }
+
     /// Where: the spec's path, or `path:line`.
     pub fn at(&self) -> String {
         match self {

@@ -111,7 +111,7 @@ pub fn parse(text: &str, path: &Path) -> SpecResult<Campaign> {
         let line = e.span().map(|s| text[..s.start.min(text.len())].lines().count().max(1)).unwrap_or(0);
         SpecError::Syntax { path: path.to_path_buf(), line, message: e.message().to_string() }
     })?;
-    campaign.validate(path)?;
+    campaign.validate(path).map_err(|e| e.located(text))?;
     validate_deep(&campaign, text, path)?;
     visco::validate(&campaign, text, path).map_err(SpecError::Viscoelastic)?;
     Ok(campaign)

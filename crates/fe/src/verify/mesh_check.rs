@@ -22,6 +22,15 @@ use std::path::PathBuf;
 /// Sub-folder of `<set>/fe/` with the study's runs, one folder per level.
 pub const MESH_DIR: &str = "mesh";
 
+/// Sub-folder of `<set>/fe/` with the edge study's runs: `edge/r<radius>mm/<level>/`
+/// ([`edge_dir`]).
+pub const EDGE_DIR: &str = "edge";
+
+/// The edge study's folder of radius `radius_mm` in `<set>/fe/edge/`: `r0p4mm`.
+pub fn edge_dir(radius_mm: f64) -> String {
+    format!("r{}mm", format!("{radius_mm}").replace('.', "p"))
+}
+
 /// What the study runs on.
 #[derive(Debug, Clone)]
 pub struct MeshOptions {
@@ -31,6 +40,10 @@ pub struct MeshOptions {
     pub threads: usize,
     /// Solve the runs that are not up to date (false: compare what is there).
     pub solve: bool,
+    /// The edge study at this needle edge radius, mm (`campaign.edge_study_radii_mm`):
+    /// the centre only, on every level (the committed one solved too), into
+    /// `fe/edge/<edge_dir>/<level>/`. `None`: the mesh study of the campaign's needle.
+    pub edge_radius_mm: Option<f64>,
 }
 
 /// One run of the study.
@@ -213,21 +226,31 @@ fn plan_study(c: &Campaign) -> Result<(StudyPlan, String, String)> {
 /// The spec, `campaign.mesh_study`, an option or a manifest (a failed solve is a run's
 /// `failure`).
 pub fn mesh_convergence(c: &Campaign, o: &MeshOptions) -> Result<MeshReport> {
-    let (plan, committed, refined) = plan_study(c)?;
+    let (mut plan, committed, refined) = plan_study(c)?;
+    if o.edge_radius_mm.is_some() {
+        plan.iter_mut().for_each(|(_, poses)| poses.truncate(1));
+    }
     let mut results: Vec<(String, PoseRows)> = Vec::new();
     for (level, poses) in &plan {
-        let committed_level = *level == committed;
-        let out_dir = if committed_level { o.set_dir.join("fe") } else { o.set_dir.join("fe").join(MESH_DIR).join(level) };
+        // the committed level's runs of the campaign's needle are the campaign's: read,
+        // never solved here
+        let campaign_runs = *level == committed && o.edge_radius_mm.is_none();
+        let out_dir = match o.edge_radius_mm {
+            Some(r) => o.set_dir.join("fe").join(EDGE_DIR).join(edge_dir(r)).join(level),
+            None if campaign_runs => o.set_dir.join("fe"),
+            None => o.set_dir.join("fe").join(MESH_DIR).join(level),
+        };
         let opts = RunOptions {
             only: Some(poses.join(",")),
             mesh: Some(level.clone()),
             out_dir: Some(out_dir.clone()),
             threads: o.threads,
+            edge_radius_mm: o.edge_radius_mm,
             ..RunOptions::new(&o.set_dir)
         };
-        println!("mesh study, level {level}: {} in {}", poses.join(", "), out_dir.display());
-        // the committed level's runs are the campaign's: read, never solved here
-        let rows = if o.solve && !committed_level { solve_and_read(&opts)? } else { read_current(&opts)? };
+        let what = o.edge_radius_mm.map_or("mesh study".to_string(), |r| format!("edge study r = {r} mm"));
+        println!("{what}, level {level}: {} in {}", poses.join(", "), out_dir.display());
+        let rows = if o.solve && !campaign_runs { solve_and_read(&opts)? } else { read_current(&opts)? };
         results.push((level.clone(), rows));
     }
     let levels = level_runs(c, &results)?;

@@ -17,6 +17,7 @@
 //!    library's QLV filter on the elastic run (run by the CLI, `needle fe verify --qlv`;
 //!    goal RMS 3 %, must 5 %, largest 6 % of peak |Fy|), written with [`write_tables`].
 
+pub mod edge;
 pub mod mesh_check;
 mod mirror;
 pub mod punch;
@@ -50,6 +51,9 @@ pub struct VerifyOptions {
     pub punch: bool,
     /// Run the mesh study with these options (`None`: not run; the fine runs are slow).
     pub mesh: Option<mesh_check::MeshOptions>,
+    /// Run the edge study (`campaign.edge_study_radii_mm`) with these options (their
+    /// `edge_radius_mm` is set per radius; `None`: not run).
+    pub edge: Option<mesh_check::MeshOptions>,
     /// Check the mirror runs (no solve).
     pub mirror: bool,
     /// Check every result present for a must point off its neighbours (no solve).
@@ -83,6 +87,8 @@ pub struct VerifyReport {
     pub smooth: Vec<SmoothReport>,
     /// The scaling law.
     pub scaling: Option<scaling::ScalingReport>,
+    /// The edge study, one per radius.
+    pub edge: Vec<edge::EdgeStudy>,
 }
 
 /// Prints each report's line and says whether every one is within `goal_percent`.
@@ -135,6 +141,9 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
         ok &= m.ok();
         report.mesh = Some(m);
     }
+    if let Some(o) = &opts.edge {
+        report.edge = edge::edge_study(&c, o)?;
+    }
     let mut new: toml::Table = toml::Table::try_from(&report).context("cannot serialise the verify report")?;
     // only the checks that ran replace their part of an earlier verify.toml
     if !opts.mirror {
@@ -142,6 +151,9 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
     }
     if !opts.smooth {
         new.remove("smooth");
+    }
+    if opts.edge.is_none() {
+        new.remove("edge");
     }
     write_tables(&opts.set_dir, new)?;
     Ok((report, ok))

@@ -1,0 +1,130 @@
+//! The edge study of `needle fe verify --edge` (issue 42, item 1): when the shape of the
+//! campaign's needle does not converge under mesh refinement, the needle's edge radius
+//! as a parameter. For each radius of `campaign.edge_study_radii_mm` the centre (quarter
+//! model) is solved on every level of `campaign.mesh_study` with
+//! `needle.tip_edge_radius_mm` set to it ([`mesh_check::mesh_convergence`] with
+//! [`MeshOptions::edge_radius_mm`], into `fe/edge/r<radius>mm/<level>/`), and compared
+//! like the mesh study (shape after the best scale, absolute change, Richardson); beside
+//! it, the committed level's run against the campaign's own centre (`fe/centre.csv`):
+//! how much the edge changes the shape. Not judged: the goals are the campaign mesh's
+//! (`[mesh]`); these are the numbers to choose the mesh and the edge by.
+
+use super::mesh_check::{self, MeshOptions, MeshReport};
+use super::runs::read_current;
+use super::shape::{self, ShapeComparison};
+use crate::campaign::RunOptions;
+use crate::spec::{Campaign, Role};
+use anyhow::{Context, Result};
+use serde::Serialize;
+
+/// One radius of the study.
+#[derive(Debug, Clone, Serialize)]
+pub struct EdgeStudy {
+    /// The needle's edge radius of these runs, mm.
+    pub radius_mm: f64,
+    /// The campaign's own edge radius (`needle.tip_edge_radius_mm`), mm.
+    pub campaign_radius_mm: f64,
+    /// The centre on every level of the mesh study with this edge.
+    pub mesh: MeshReport,
+    /// The committed level's run with this edge against the campaign's centre (coarse:
+    /// the campaign's edge, fine: this one): the shape the edge changes, after the best
+    /// scale. `None` without both results.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub against_campaign_edge: Option<ShapeComparison>,
+}
+
+impl std::fmt::Display for EdgeStudy {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let m = &self.mesh;
+        let pair = m.shape.iter().find(|s| s.coarse == m.committed && s.fine == m.refined);
+        write!(f, "edge r = {} mm: ", self.radius_mm)?;
+        match pair {
+            Some(s) => write!(
+                f,
+                "centre {} vs {} after the best scale RMS {:.2}%, largest {:.2}% of peak |Fy| (the mesh study's goal {} / {}%: {})",
+                m.committed,
+                m.refined,
+                s.worst_rms_percent,
+                s.worst_max_percent,
+                m.shape_goal_percent[0],
+                m.shape_goal_percent[1],
+                if s.ok() { "within" } else { "outside" }
+            )?,
+            None => write!(f, "centre {} vs {}: no comparison", m.committed, m.refined)?,
+        }
+        if let Some(d) = m.difference_percent {
+            write!(f, "; Fy({} mm) {:+.2}%, {}", m.depth_mm, d, m.asymptotic)?;
+        }
+        if let Some(a) = &self.against_campaign_edge {
+            write!(
+                f,
+                "; against the campaign's edge ({} mm) on {}: scale {:.4}, then RMS {:.2}%, largest {:.2}%",
+                self.campaign_radius_mm, m.committed, a.scale, a.worst_rms_percent, a.worst_max_percent
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// Run (or resume, or with `o.solve` false only read) the study of every radius of
+/// `campaign.edge_study_radii_mm`.
+///
+/// # Errors
+/// The spec has no radii, or as [`mesh_check::mesh_convergence`].
+pub fn edge_study(c: &Campaign, o: &MeshOptions) -> Result<Vec<EdgeStudy>> {
+    if c.campaign.edge_study_radii_mm.is_empty() {
+        anyhow::bail!("--edge: campaign.edge_study_radii_mm is empty: name the edge radii to study, mm");
+    }
+    let centre = c.pose.iter().find(|p| p.role == Role::Centre).context("no pose with role centre in the spec")?.name.clone();
+    let mut out = Vec::new();
+    for &r in &c.campaign.edge_study_radii_mm {
+        let mesh = mesh_check::mesh_convergence(c, &MeshOptions { edge_radius_mm: Some(r), ..o.clone() })?;
+        let read = |edge: Option<f64>| -> Result<Option<Vec<crate::results::Row>>> {
+            let out_dir = edge.map(|r| o.set_dir.join("fe").join(mesh_check::EDGE_DIR).join(mesh_check::edge_dir(r)).join(&mesh.committed));
+            let opts = RunOptions {
+                only: Some(centre.clone()),
+                mesh: Some(mesh.committed.clone()),
+                out_dir,
+                edge_radius_mm: edge,
+                ..RunOptions::new(&o.set_dir)
+            };
+            Ok(read_current(&opts)?.remove(&centre).and_then(|r| r.ok()).map(|r| r.rows))
+        };
+        let against_campaign_edge = match (read(None)?, read(Some(r))?) {
+            (Some(a), Some(b)) if super::runs::same_depths(&a, &b) => {
+                let labels = (format!("r {} mm", c.needle.tip_edge_radius_mm), format!("r {r} mm"));
+                Some(shape::compare(&centre, (&labels.0, &labels.1), &a, &b, c.needle.reference_from_tip_mm))
+            }
+            _ => None,
+        };
+        let study = EdgeStudy { radius_mm: r, campaign_radius_mm: c.needle.tip_edge_radius_mm, mesh, against_campaign_edge };
+        println!("{study}");
+        out.push(study);
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::deep::key_line;
+    use std::path::Path;
+
+    #[test]
+    fn bad_radii_are_refused_with_file_line_and_field() {
+        let text = std::fs::read_to_string(crate::workspace_root().join("coeffs/default/campaign.toml")).expect("campaign.toml");
+        let line = key_line(&text, "campaign", "edge_study_radii_mm");
+        assert!(line > 0, "the shipped spec has campaign.edge_study_radii_mm");
+        let shipped = text.lines().nth(line - 1).unwrap_or_default().to_string();
+        for (bad, want) in [
+            ("[0.0]", "must be > 0 and below the needle's radius"),
+            ("[0.7]", "must be > 0 and below the needle's radius"),
+            ("[0.1]", "is needle.tip_edge_radius_mm, the campaign's own edge"),
+            ("[0.4, 0.4]", "0.4 mm is listed twice"),
+        ] {
+            let t = text.replacen(&shipped, &format!("edge_study_radii_mm = {bad}"), 1);
+            let e = crate::spec::parse(&t, Path::new("campaign.toml")).err().map(|e| e.to_string()).unwrap_or_default();
+            assert!(e.starts_with(&format!("campaign.toml:{line}: campaign.edge_study_radii_mm: ")) && e.contains(want), "{bad}: {e}");
+        }
+        assert_eq!(super::super::mesh_check::edge_dir(0.4), "r0p4mm");
+    }
+}
