@@ -31,6 +31,11 @@ pub struct EdgeStudy {
     /// scale. `None` without both results.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub against_campaign_edge: Option<ShapeComparison>,
+    /// The campaign's centre (its edge, committed level) against this edge's run on the
+    /// refined level: whether the committed data carry this edge's converged shape
+    /// (judged like the mesh study: after the best scale). `None` without both results.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub campaign_against_refined: Option<ShapeComparison>,
 }
 
 impl std::fmt::Display for EdgeStudy {
@@ -62,6 +67,19 @@ impl std::fmt::Display for EdgeStudy {
                 self.campaign_radius_mm, m.committed, a.scale, a.worst_rms_percent, a.worst_max_percent
             )?;
         }
+        if let Some(a) = &self.campaign_against_refined {
+            write!(
+                f,
+                "; the campaign's runs ({} mm edge, {}) against this edge on {}: scale {:.4}, then RMS {:.2}%, largest {:.2}% ({})",
+                self.campaign_radius_mm,
+                m.committed,
+                m.refined,
+                a.scale,
+                a.worst_rms_percent,
+                a.worst_max_percent,
+                if a.ok() { "within the goal" } else { "outside the goal" }
+            )?;
+        }
         Ok(())
     }
 }
@@ -79,25 +97,29 @@ pub fn edge_study(c: &Campaign, o: &MeshOptions) -> Result<Vec<EdgeStudy>> {
     let mut out = Vec::new();
     for &r in &c.campaign.edge_study_radii_mm {
         let mesh = mesh_check::mesh_convergence(c, &MeshOptions { edge_radius_mm: Some(r), ..o.clone() })?;
-        let read = |edge: Option<f64>| -> Result<Option<Vec<crate::results::Row>>> {
-            let out_dir = edge.map(|r| o.set_dir.join("fe").join(mesh_check::EDGE_DIR).join(mesh_check::edge_dir(r)).join(&mesh.committed));
+        let read = |edge: Option<f64>, level: &str| -> Result<Option<Vec<crate::results::Row>>> {
+            let out_dir = edge.map(|r| o.set_dir.join("fe").join(mesh_check::EDGE_DIR).join(mesh_check::edge_dir(r)).join(level));
             let opts = RunOptions {
                 only: Some(centre.clone()),
-                mesh: Some(mesh.committed.clone()),
+                mesh: Some(level.to_string()),
                 out_dir,
                 edge_radius_mm: edge,
                 ..RunOptions::new(&o.set_dir)
             };
             Ok(read_current(&opts)?.remove(&centre).and_then(|r| r.ok()).map(|r| r.rows))
         };
-        let against_campaign_edge = match (read(None)?, read(Some(r))?) {
-            (Some(a), Some(b)) if super::runs::same_depths(&a, &b) => {
-                let labels = (format!("r {} mm", c.needle.tip_edge_radius_mm), format!("r {r} mm"));
-                Some(shape::compare(&centre, (&labels.0, &labels.1), &a, &b, c.needle.reference_from_tip_mm))
+        let campaign = read(None, &mesh.committed)?;
+        let compare = |b: Option<Vec<crate::results::Row>>, level: &str| match (&campaign, b) {
+            (Some(a), Some(b)) if super::runs::same_depths(a, &b) => {
+                let labels = (format!("r {} mm {}", c.needle.tip_edge_radius_mm, mesh.committed), format!("r {r} mm {level}"));
+                Some(shape::compare(&centre, (&labels.0, &labels.1), a, &b, c.needle.reference_from_tip_mm))
             }
             _ => None,
         };
-        let study = EdgeStudy { radius_mm: r, campaign_radius_mm: c.needle.tip_edge_radius_mm, mesh, against_campaign_edge };
+        let against_campaign_edge = compare(read(Some(r), &mesh.committed)?, &mesh.committed);
+        let campaign_against_refined = compare(read(Some(r), &mesh.refined)?, &mesh.refined);
+        let study =
+            EdgeStudy { radius_mm: r, campaign_radius_mm: c.needle.tip_edge_radius_mm, mesh, against_campaign_edge, campaign_against_refined };
         println!("{study}");
         out.push(study);
     }
