@@ -52,7 +52,8 @@ fn the_edge_study_is_in_verify_toml_and_a_resolved_edge_converges() {
     let centre = mesh_shape
         .iter()
         .find(|s| {
-            s.get("pose").and_then(toml::Value::as_str) == Some("centre") && s.get("coarse").and_then(toml::Value::as_str) == Some(c.campaign.mesh.as_str())
+            s.get("pose").and_then(toml::Value::as_str) == Some("centre")
+                && s.get("coarse").and_then(toml::Value::as_str) == Some(c.campaign.mesh.as_str())
         })
         .expect("the centre in the mesh study");
     assert!(!within(centre, &[]), "the campaign's edge now converges: the edge study's conclusion changes: {centre}");

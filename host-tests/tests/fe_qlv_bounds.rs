@@ -60,6 +60,11 @@ fn every_ramp_and_hold_run_is_within_the_bounds() {
         }
     }
     let speeds = v.speeds_mm_per_s.len();
-    assert!(whole[0] >= WHOLE_WITH_FRICTION.len() * speeds, "{}: {} runs with friction solved through their hold", path.display(), whole[0]);
+    assert!(
+        whole[0] >= WHOLE_WITH_FRICTION.len() * speeds,
+        "{}: {} runs with friction solved through their hold",
+        path.display(),
+        whole[0]
+    );
     assert_eq!(whole[1], v.poses.len() * speeds, "{}: every frictionless run solved through its hold", path.display());
 }

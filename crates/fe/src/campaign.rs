@@ -331,8 +331,9 @@ fn apply_variant(opts: &RunOptions, campaign: &mut Campaign, spec_path: &Path) -
         if opts.deep {
             bail!("--visco and --deep: the ramp-and-hold runs go to loading.depth_mm only");
         }
-        let (run, poses) = crate::visco::apply_frictionless_elastic(campaign, &v)
-            .with_context(|| format!("{}: the frictionless elastic companions: [viscoelastic] frictionless is not set", spec_path.display()))?;
+        let (run, poses) = crate::visco::apply_frictionless_elastic(campaign, &v).with_context(|| {
+            format!("{}: the frictionless elastic companions: [viscoelastic] frictionless is not set", spec_path.display())
+        })?;
         *campaign = run;
         return Ok(Variant { mesh: v.mesh, poses: Some(poses), out_dir: opts.set_dir.join("fe").join(crate::visco::VISCO_DIR) });
     }

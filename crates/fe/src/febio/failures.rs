@@ -102,7 +102,11 @@ pub fn summary(failures: &[AttemptFailure], unit: &str) -> String {
     let classes: Vec<String> = by_class
         .iter()
         .map(|(c, d)| {
-            format!("{c} x{} ({} {unit})", d.len(), d.iter().map(|v| format!("{}", (v * 100.0).round() / 100.0)).collect::<Vec<_>>().join(", "))
+            format!(
+                "{c} x{} ({} {unit})",
+                d.len(),
+                d.iter().map(|v| format!("{}", (v * 100.0).round() / 100.0)).collect::<Vec<_>>().join(", ")
+            )
         })
         .collect();
     format!("{} failed attempt(s), furthest {:.2} {unit}: {}", failures.len(), furthest, classes.join("; "))

@@ -118,8 +118,13 @@ pub fn edge_study(c: &Campaign, o: &MeshOptions) -> Result<Vec<EdgeStudy>> {
         };
         let against_campaign_edge = compare(read(Some(r), &mesh.committed)?, &mesh.committed);
         let campaign_against_refined = compare(read(Some(r), &mesh.refined)?, &mesh.refined);
-        let study =
-            EdgeStudy { radius_mm: r, campaign_radius_mm: c.needle.tip_edge_radius_mm, mesh, against_campaign_edge, campaign_against_refined };
+        let study = EdgeStudy {
+            radius_mm: r,
+            campaign_radius_mm: c.needle.tip_edge_radius_mm,
+            mesh,
+            against_campaign_edge,
+            campaign_against_refined,
+        };
         println!("{study}");
         out.push(study);
     }

@@ -92,11 +92,7 @@ pub fn apply_frictionless_elastic(c: &Campaign, v: &ViscoSettings) -> Option<(Ca
 /// The poses of `v.poses`, renamed.
 fn renamed(c: &Campaign, v: &ViscoSettings, name: impl Fn(&str) -> String) -> Vec<PoseSpec> {
     let every = c.poses();
-    v.poses
-        .iter()
-        .filter_map(|n| every.iter().find(|p| &p.name == n))
-        .map(|p| PoseSpec { name: name(&p.name), ..p.clone() })
-        .collect()
+    v.poses.iter().filter_map(|n| every.iter().find(|p| &p.name == n)).map(|p| PoseSpec { name: name(&p.name), ..p.clone() }).collect()
 }
 
 /// The manifest's line of a ramp-and-hold run (`None`: not one): its Prony series and
@@ -174,7 +170,10 @@ mod tests {
         let (elastic, names) = apply_frictionless_elastic(&c, &v).expect("frictionless companions");
         assert_eq!(elastic.contact.friction, 0.0);
         assert!(elastic.tissue.prony.is_none() && elastic.loading.ramp_hold.is_none(), "elastic");
-        assert_eq!(names.iter().map(|p| p.name.as_str()).collect::<Vec<_>>(), v.poses.iter().map(|p| frictionless_name(p)).collect::<Vec<_>>());
+        assert_eq!(
+            names.iter().map(|p| p.name.as_str()).collect::<Vec<_>>(),
+            v.poses.iter().map(|p| frictionless_name(p)).collect::<Vec<_>>()
+        );
         let centre = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");
         assert_ne!(elastic.run_hash(&names[0], &v.mesh), c.run_hash(&centre, &v.mesh));
     }
