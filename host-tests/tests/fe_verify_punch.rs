@@ -35,6 +35,7 @@ fn coarse_flat_punch_matches_sneddon() {
         set_dir: set.clone(),
         punch: true,
         mesh: None,
+        edge: None,
         mirror: false,
         smooth: false,
         scaling: None,
