@@ -310,7 +310,7 @@ fn apply_variant(opts: &RunOptions, campaign: &mut Campaign, spec_path: &Path) -
         }
         campaign.loading.steps = s;
     }
-    if let Some(speed) = opts.visco_speed_mm_per_s {
+    if opts.visco_speed_mm_per_s.is_some() || opts.visco_frictionless {
         let v = campaign
             .viscoelastic
             .clone()
@@ -318,22 +318,15 @@ fn apply_variant(opts: &RunOptions, campaign: &mut Campaign, spec_path: &Path) -
         if opts.deep {
             bail!("--visco and --deep: the ramp-and-hold runs go to loading.depth_mm only");
         }
-        let friction = if opts.visco_frictionless { crate::visco::Friction::None } else { crate::visco::Friction::Campaign };
-        let (run, poses) = crate::visco::apply(campaign, &v, speed, campaign.loading.steps, friction);
-        *campaign = run;
-        return Ok(Variant { mesh: v.mesh, poses: Some(poses), out_dir: opts.set_dir.join("fe").join(crate::visco::VISCO_DIR) });
-    }
-    if opts.visco_frictionless {
-        let v = campaign
-            .viscoelastic
-            .clone()
-            .with_context(|| format!("{}: --visco: the spec has no [viscoelastic] section", spec_path.display()))?;
-        if opts.deep {
-            bail!("--visco and --deep: the ramp-and-hold runs go to loading.depth_mm only");
-        }
-        let (run, poses) = crate::visco::apply_frictionless_elastic(campaign, &v).with_context(|| {
-            format!("{}: the frictionless elastic companions: [viscoelastic] frictionless is not set", spec_path.display())
-        })?;
+        let (run, poses) = match opts.visco_speed_mm_per_s {
+            Some(speed) => {
+                let friction = if opts.visco_frictionless { crate::visco::Friction::None } else { crate::visco::Friction::Campaign };
+                crate::visco::apply(campaign, &v, speed, campaign.loading.steps, friction)
+            }
+            None => crate::visco::apply_frictionless_elastic(campaign, &v).with_context(|| {
+                format!("{}: the frictionless elastic companions: [viscoelastic] frictionless is not set", spec_path.display())
+            })?,
+        };
         *campaign = run;
         return Ok(Variant { mesh: v.mesh, poses: Some(poses), out_dir: opts.set_dir.join("fe").join(crate::visco::VISCO_DIR) });
     }
