@@ -63,6 +63,10 @@ pub struct CampaignSettings {
     /// has it), listed once.
     #[serde(default)]
     pub edge_study_radii_mm: Vec<f64>,
+    /// Poses besides the centre that the edge study solves with each radius on the
+    /// committed level and its refinement (as `mesh_study_poses` for the mesh study).
+    #[serde(default)]
+    pub edge_study_poses: Vec<String>,
 }
 
 /// `[[campaign.train_replaced]]`: a training pose replaced by the next point of the

@@ -131,14 +131,11 @@ impl Campaign {
     pub(super) fn validate_design(&self, path: &Path) -> SpecResult<()> {
         let p = path.display();
         let every_pose = self.poses();
-        for name in &self.campaign.mesh_study_poses {
-            if !every_pose.iter().any(|q| &q.name == name) {
-                return Err(SpecError::unknown(
-                    &p,
-                    "campaign.mesh_study_poses",
-                    name,
-                    format!("campaign.mesh_study_poses: {name:?} is not a pose of this campaign"),
-                ));
+        for (field, names) in
+            [("campaign.mesh_study_poses", &self.campaign.mesh_study_poses), ("campaign.edge_study_poses", &self.campaign.edge_study_poses)]
+        {
+            if let Some(name) = names.iter().find(|name| !every_pose.iter().any(|q| &q.name == *name)) {
+                return Err(SpecError::unknown(&p, field, name, format!("{field}: {name:?} is not a pose of this campaign")));
             }
         }
         let field = "campaign.edge_study_radii_mm";

@@ -4,13 +4,15 @@
 //! model) is solved on every level of `campaign.mesh_study` with
 //! `needle.tip_edge_radius_mm` set to it ([`mesh_check::mesh_convergence`] with
 //! [`MeshOptions::edge_radius_mm`], into `fe/edge/r<radius>mm/<level>/`), and compared
-//! like the mesh study (shape after the best scale, absolute change, Richardson); beside
-//! it, the committed level's run against the campaign's own centre (`fe/centre.csv`):
-//! how much the edge changes the shape. Not judged: the goals are the campaign mesh's
+//! like the mesh study (shape after the best scale, absolute change, Richardson), with the
+//! poses of `campaign.edge_study_poses` on the committed level and its refinement; beside
+//! it, each pose's committed-level run against the campaign's own (`fe/<pose>.csv`): how
+//! much the edge changes the shape, and the campaign's run against this edge's on the
+//! refined level: whether the committed data carry its converged shape. Not judged: the goals are the campaign mesh's
 //! (`[mesh]`); these are the numbers to choose the mesh and the edge by.
 
 use super::mesh_check::{self, MeshOptions, MeshReport};
-use super::runs::read_current;
+use super::runs::{read_current, same_depths, PoseRows};
 use super::shape::{self, ShapeComparison};
 use crate::campaign::RunOptions;
 use crate::spec::{Campaign, Role};
@@ -26,27 +28,29 @@ pub struct EdgeStudy {
     pub campaign_radius_mm: f64,
     /// The centre on every level of the mesh study with this edge.
     pub mesh: MeshReport,
-    /// The committed level's run with this edge against the campaign's centre (coarse:
-    /// the campaign's edge, fine: this one): the shape the edge changes, after the best
-    /// scale. `None` without both results.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub against_campaign_edge: Option<ShapeComparison>,
-    /// The campaign's centre (its edge, committed level) against this edge's run on the
-    /// refined level: whether the committed data carry this edge's converged shape
-    /// (judged like the mesh study: after the best scale). `None` without both results.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub campaign_against_refined: Option<ShapeComparison>,
+    /// Per pose (the centre, then `campaign.edge_study_poses`) with both results: the
+    /// committed level's run with this edge against the campaign's (coarse: the
+    /// campaign's edge, fine: this one): the shape the edge changes, after the best scale.
+    pub against_campaign_edge: Vec<ShapeComparison>,
+    /// Per pose with both results: the campaign's run (its edge, committed level) against
+    /// this edge's run on the refined level: whether the committed data carry this
+    /// edge's converged shape (judged like the mesh study: after the best scale).
+    pub campaign_against_refined: Vec<ShapeComparison>,
 }
 
 impl std::fmt::Display for EdgeStudy {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let m = &self.mesh;
-        let pair = m.shape.iter().find(|s| s.coarse == m.committed && s.fine == m.refined);
-        write!(f, "edge r = {} mm: ", self.radius_mm)?;
-        match pair {
-            Some(s) => write!(
+        write!(f, "edge r = {} mm:", self.radius_mm)?;
+        let pairs: Vec<&ShapeComparison> = m.shape.iter().filter(|s| s.coarse == m.committed && s.fine == m.refined).collect();
+        if pairs.is_empty() {
+            write!(f, " {} vs {}: no comparison", m.committed, m.refined)?;
+        }
+        for s in pairs {
+            write!(
                 f,
-                "centre {} vs {} after the best scale RMS {:.2}%, largest {:.2}% of peak |Fy| (the mesh study's goal {} / {}%: {})",
+                " {} {} vs {} after the best scale RMS {:.2}%, largest {:.2}% of peak |Fy| (the mesh study's goal {} / {}%: {});",
+                s.pose,
                 m.committed,
                 m.refined,
                 s.worst_rms_percent,
@@ -54,23 +58,23 @@ impl std::fmt::Display for EdgeStudy {
                 m.shape_goal_percent[0],
                 m.shape_goal_percent[1],
                 if s.ok() { "within" } else { "outside" }
-            )?,
-            None => write!(f, "centre {} vs {}: no comparison", m.committed, m.refined)?,
-        }
-        if let Some(d) = m.difference_percent {
-            write!(f, "; Fy({} mm) {:+.2}%, {}", m.depth_mm, d, m.asymptotic)?;
-        }
-        if let Some(a) = &self.against_campaign_edge {
-            write!(
-                f,
-                "; against the campaign's edge ({} mm) on {}: scale {:.4}, then RMS {:.2}%, largest {:.2}%",
-                self.campaign_radius_mm, m.committed, a.scale, a.worst_rms_percent, a.worst_max_percent
             )?;
         }
-        if let Some(a) = &self.campaign_against_refined {
+        if let Some(d) = m.difference_percent {
+            write!(f, " centre Fy({} mm) {:+.2}%, {}", m.depth_mm, d, m.asymptotic)?;
+        }
+        for a in &self.against_campaign_edge {
             write!(
                 f,
-                "; the campaign's runs ({} mm edge, {}) against this edge on {}: scale {:.4}, then RMS {:.2}%, largest {:.2}% ({})",
+                "; {} against the campaign's edge ({} mm) on {}: scale {:.4}, then RMS {:.2}%, largest {:.2}%",
+                a.pose, self.campaign_radius_mm, m.committed, a.scale, a.worst_rms_percent, a.worst_max_percent
+            )?;
+        }
+        for a in &self.campaign_against_refined {
+            write!(
+                f,
+                "; the campaign's {} ({} mm edge, {}) against this edge on {}: scale {:.4}, then RMS {:.2}%, largest {:.2}% ({})",
+                a.pose,
                 self.campaign_radius_mm,
                 m.committed,
                 m.refined,
@@ -94,30 +98,36 @@ pub fn edge_study(c: &Campaign, o: &MeshOptions) -> Result<Vec<EdgeStudy>> {
         anyhow::bail!("--edge: campaign.edge_study_radii_mm is empty: name the edge radii to study, mm");
     }
     let centre = c.pose.iter().find(|p| p.role == Role::Centre).context("no pose with role centre in the spec")?.name.clone();
+    let poses: Vec<String> = std::iter::once(centre).chain(c.campaign.edge_study_poses.iter().cloned()).collect();
     let mut out = Vec::new();
     for &r in &c.campaign.edge_study_radii_mm {
         let mesh = mesh_check::mesh_convergence(c, &MeshOptions { edge_radius_mm: Some(r), ..o.clone() })?;
-        let read = |edge: Option<f64>, level: &str| -> Result<Option<Vec<crate::results::Row>>> {
+        let read = |edge: Option<f64>, level: &str| -> Result<PoseRows> {
             let out_dir = edge.map(|r| o.set_dir.join("fe").join(mesh_check::EDGE_DIR).join(mesh_check::edge_dir(r)).join(level));
             let opts = RunOptions {
-                only: Some(centre.clone()),
+                only: Some(poses.join(",")),
                 mesh: Some(level.to_string()),
                 out_dir,
                 edge_radius_mm: edge,
                 ..RunOptions::new(&o.set_dir)
             };
-            Ok(read_current(&opts)?.remove(&centre).and_then(|r| r.ok()).map(|r| r.rows))
+            read_current(&opts)
         };
         let campaign = read(None, &mesh.committed)?;
-        let compare = |b: Option<Vec<crate::results::Row>>, level: &str| match (&campaign, b) {
-            (Some(a), Some(b)) if super::runs::same_depths(a, &b) => {
-                let labels = (format!("r {} mm {}", c.needle.tip_edge_radius_mm, mesh.committed), format!("r {r} mm {level}"));
-                Some(shape::compare(&centre, (&labels.0, &labels.1), a, &b, c.needle.reference_from_tip_mm))
-            }
-            _ => None,
+        let compare = |level: &str| -> Result<Vec<ShapeComparison>> {
+            let edge = read(Some(r), level)?;
+            let labels = (format!("r {} mm {}", c.needle.tip_edge_radius_mm, mesh.committed), format!("r {r} mm {level}"));
+            Ok(poses
+                .iter()
+                .filter_map(|p| match (campaign.get(p), edge.get(p)) {
+                    (Some(Ok(a)), Some(Ok(b))) if same_depths(&a.rows, &b.rows) => {
+                        Some(shape::compare(p, (&labels.0, &labels.1), &a.rows, &b.rows, c.needle.reference_from_tip_mm))
+                    }
+                    _ => None,
+                })
+                .collect())
         };
-        let against_campaign_edge = compare(read(Some(r), &mesh.committed)?, &mesh.committed);
-        let campaign_against_refined = compare(read(Some(r), &mesh.refined)?, &mesh.refined);
+        let (against_campaign_edge, campaign_against_refined) = (compare(&mesh.committed)?, compare(&mesh.refined)?);
         let study = EdgeStudy {
             radius_mm: r,
             campaign_radius_mm: c.needle.tip_edge_radius_mm,

@@ -41,7 +41,8 @@ pub struct MeshOptions {
     /// Solve the runs that are not up to date (false: compare what is there).
     pub solve: bool,
     /// The edge study at this needle edge radius, mm (`campaign.edge_study_radii_mm`):
-    /// the centre only, on every level (the committed one solved too), into
+    /// the centre on every level and `campaign.edge_study_poses` on the committed level
+    /// and its refinement (the committed one solved too), into
     /// `fe/edge/<edge_dir>/<level>/`. `None`: the mesh study of the campaign's needle.
     pub edge_radius_mm: Option<f64>,
 }
@@ -228,7 +229,13 @@ fn plan_study(c: &Campaign) -> Result<(StudyPlan, String, String)> {
 pub fn mesh_convergence(c: &Campaign, o: &MeshOptions) -> Result<MeshReport> {
     let (mut plan, committed, refined) = plan_study(c)?;
     if o.edge_radius_mm.is_some() {
-        plan.iter_mut().for_each(|(_, poses)| poses.truncate(1));
+        // the centre, and the edge study's own poses on the committed level and its refinement
+        for (level, poses) in &mut plan {
+            poses.truncate(1);
+            if *level == committed || *level == refined {
+                poses.extend(c.campaign.edge_study_poses.iter().cloned());
+            }
+        }
     }
     let mut results: Vec<(String, PoseRows)> = Vec::new();
     for (level, poses) in &plan {
