@@ -121,23 +121,10 @@ impl Campaign {
             .collect()
     }
 
-    /// Check what `[campaign]` names among the poses (`mesh_study_poses`,
-    /// `train_replaced`, `fit_without`); messages start with the spec's `path`.
-    ///
-    /// # Errors
-    /// An unknown pose, a replaced pose not drawn before its replacement or listed twice
-    /// or without its reason, a pose both replaced and left out, a left-out pose whose
-    /// role is always or never fitted.
-    pub(super) fn validate_design(&self, path: &Path) -> SpecResult<()> {
+    /// `campaign.edge_study_radii_mm`: each > 0 and below the needle's radius, not the
+    /// campaign's own edge, listed once; messages start with the spec's `path`.
+    fn validate_edge_study(&self, path: &Path) -> SpecResult<()> {
         let p = path.display();
-        let every_pose = self.poses();
-        for (field, names) in
-            [("campaign.mesh_study_poses", &self.campaign.mesh_study_poses), ("campaign.edge_study_poses", &self.campaign.edge_study_poses)]
-        {
-            if let Some(name) = names.iter().find(|name| !every_pose.iter().any(|q| &q.name == *name)) {
-                return Err(SpecError::unknown(&p, field, name, format!("{field}: {name:?} is not a pose of this campaign")));
-            }
-        }
         let field = "campaign.edge_study_radii_mm";
         for (k, r) in self.campaign.edge_study_radii_mm.iter().enumerate() {
             if !(r.is_finite() && *r > 0.0 && *r < self.needle.diameter_mm / 2.0) {
@@ -155,6 +142,27 @@ impl Campaign {
                 return Err(SpecError::duplicate(&p, field, format!("{r}"), format!("{field}: {r} mm is listed twice")));
             }
         }
+        Ok(())
+    }
+
+    /// Check what `[campaign]` names among the poses (`mesh_study_poses`,
+    /// `train_replaced`, `fit_without`); messages start with the spec's `path`.
+    ///
+    /// # Errors
+    /// An unknown pose, a replaced pose not drawn before its replacement or listed twice
+    /// or without its reason, a pose both replaced and left out, a left-out pose whose
+    /// role is always or never fitted.
+    pub(super) fn validate_design(&self, path: &Path) -> SpecResult<()> {
+        let p = path.display();
+        let every_pose = self.poses();
+        for (field, names) in
+            [("campaign.mesh_study_poses", &self.campaign.mesh_study_poses), ("campaign.edge_study_poses", &self.campaign.edge_study_poses)]
+        {
+            if let Some(name) = names.iter().find(|name| !every_pose.iter().any(|q| &q.name == *name)) {
+                return Err(SpecError::unknown(&p, field, name, format!("{field}: {name:?} is not a pose of this campaign")));
+            }
+        }
+        self.validate_edge_study(path)?;
         let mut replaced = std::collections::BTreeSet::new();
         for (k, r) in self.campaign.train_replaced.iter().enumerate() {
             let replacement = self.train_name(self.campaign.train_count as usize + k);
