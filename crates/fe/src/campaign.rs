@@ -337,7 +337,7 @@ fn apply_variant(opts: &RunOptions, campaign: &mut Campaign, spec_path: &Path) -
         campaign.tissue.mu_n_per_mm2.iter_mut().for_each(|mu| *mu *= s);
     }
     if let Some(r) = opts.edge_radius_mm {
-        if !(r.is_finite() && r > 0.0 && r < campaign.needle.diameter_mm / 2.0) || opts.out_dir.is_none() {
+        if !campaign.needle.fits_edge_radius(r) || opts.out_dir.is_none() {
             bail!("edge radius {r} mm: must be > 0 and below the needle's radius, with its own output folder (never <set>/fe)");
         }
         campaign.needle.tip_edge_radius_mm = r;

@@ -127,7 +127,7 @@ impl Campaign {
         let p = path.display();
         let field = "campaign.edge_study_radii_mm";
         for (k, r) in self.campaign.edge_study_radii_mm.iter().enumerate() {
-            if !(r.is_finite() && *r > 0.0 && *r < self.needle.diameter_mm / 2.0) {
+            if !self.needle.fits_edge_radius(*r) {
                 let max = self.needle.diameter_mm / 2.0;
                 return Err(SpecError::range(&p, field, format!("{field}: {r} mm: must be > 0 and below the needle's radius ({max} mm)")));
             }

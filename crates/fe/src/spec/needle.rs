@@ -22,6 +22,11 @@ pub struct Needle {
 }
 
 impl Needle {
+    /// Whether `r_mm` can be this needle's edge radius: finite, > 0 and below its radius.
+    pub fn fits_edge_radius(&self, r_mm: f64) -> bool {
+        r_mm.is_finite() && r_mm > 0.0 && r_mm < self.diameter_mm / 2.0
+    }
+
     /// Check the section; messages start with the spec's `path`.
     ///
     /// # Errors

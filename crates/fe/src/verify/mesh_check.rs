@@ -28,7 +28,7 @@ pub const EDGE_DIR: &str = "edge";
 
 /// The edge study's folder of radius `radius_mm` in `<set>/fe/edge/`: `r0p4mm`.
 pub fn edge_dir(radius_mm: f64) -> String {
-    format!("r{}mm", format!("{radius_mm}").replace('.', "p"))
+    format!("r{}mm", crate::spec::visco::decimal_tag(radius_mm))
 }
 
 /// What the study runs on.
@@ -197,8 +197,9 @@ pub fn richardson(f1: f64, f2: f64, f3: f64) -> Option<(f64, f64)> {
 /// The study's levels, coarse to fine, each with the poses it runs.
 type StudyPlan = Vec<(String, Vec<String>)>;
 
-/// The study's plan, the committed level and its refinement.
-fn plan_study(c: &Campaign) -> Result<(StudyPlan, String, String)> {
+/// The study's plan (the centre on every level, `extra` on the committed level and its
+/// refinement), the committed level and its refinement.
+fn plan_study(c: &Campaign, extra: &[String]) -> Result<(StudyPlan, String, String)> {
     let centre = c.pose.iter().find(|p| p.role == Role::Centre).context("no pose with role centre in the spec")?;
     let study = c.mesh_study();
     let committed = c.campaign.mesh.clone();
@@ -213,7 +214,7 @@ fn plan_study(c: &Campaign) -> Result<(StudyPlan, String, String)> {
         .map(|level| {
             let mut poses = vec![centre.name.clone()];
             if *level == committed || *level == refined {
-                poses.extend(c.campaign.mesh_study_poses.iter().cloned());
+                poses.extend(extra.iter().cloned());
             }
             (level.clone(), poses)
         })
@@ -227,16 +228,8 @@ fn plan_study(c: &Campaign) -> Result<(StudyPlan, String, String)> {
 /// The spec, `campaign.mesh_study`, an option or a manifest (a failed solve is a run's
 /// `failure`).
 pub fn mesh_convergence(c: &Campaign, o: &MeshOptions) -> Result<MeshReport> {
-    let (mut plan, committed, refined) = plan_study(c)?;
-    if o.edge_radius_mm.is_some() {
-        // the centre, and the edge study's own poses on the committed level and its refinement
-        for (level, poses) in &mut plan {
-            poses.truncate(1);
-            if *level == committed || *level == refined {
-                poses.extend(c.campaign.edge_study_poses.iter().cloned());
-            }
-        }
-    }
+    let poses = if o.edge_radius_mm.is_some() { &c.campaign.edge_study_poses } else { &c.campaign.mesh_study_poses };
+    let (plan, committed, refined) = plan_study(c, poses)?;
     let mut results: Vec<(String, PoseRows)> = Vec::new();
     for (level, poses) in &plan {
         // the committed level's runs of the campaign's needle are the campaign's: read,

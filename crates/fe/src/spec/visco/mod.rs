@@ -5,7 +5,7 @@ use super::{check_pose_in_block, Campaign, MAX_LOAD_STEPS};
 pub mod settings;
 
 use anyhow::{bail, Result};
-pub use settings::{frictionless_name, run_name, Prony, RampHold, ViscoSettings, FRICTIONLESS_SUFFIX, MAX_PRONY_TERMS};
+pub use settings::{decimal_tag, frictionless_name, run_name, Prony, RampHold, ViscoSettings, FRICTIONLESS_SUFFIX, MAX_PRONY_TERMS};
 use std::path::Path;
 
 /// Check `[viscoelastic]` against the rest of the spec (and that `[tissue]` / `[loading]`

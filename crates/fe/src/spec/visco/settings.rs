@@ -11,7 +11,13 @@ pub use needle_contract::MAX_PRONY_TERMS;
 
 /// The run name of `pose` at `speed_mm_per_s`: `centre_10mm-s`, `x+04_1p5mm-s`.
 pub fn run_name(pose: &str, speed_mm_per_s: f64) -> String {
-    format!("{pose}_{}mm-s", format!("{speed_mm_per_s}").replace('.', "p"))
+    format!("{pose}_{}mm-s", decimal_tag(speed_mm_per_s))
+}
+
+/// A number as it goes into a run or folder name: its shortest decimal form with `p` for
+/// the point (`1.5` -> `1p5`, `10` -> `10`).
+pub fn decimal_tag(x: f64) -> String {
+    format!("{x}").replace('.', "p")
 }
 
 /// Suffix of the frictionless runs' names (`[viscoelastic] frictionless`): the
