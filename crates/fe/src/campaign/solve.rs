@@ -17,6 +17,7 @@ use needle_contract::COMPONENT_COUNT;
 use std::path::{Path, PathBuf};
 use std::time::{Instant, SystemTime};
 
+/// `<out_dir>/.work/<pose>/`
 pub(super) fn work_dir(out_dir: &Path, pose: &str) -> PathBuf {
     out_dir.join(".work").join(pose)
 }
