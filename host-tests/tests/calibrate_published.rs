@@ -21,6 +21,7 @@ fn options<'a>(pieces: &'a Path, sources: &'a Path) -> ModelOptions<'a> {
         description: shipped.description,
         needle_diameter_mm: shipped.needle_diameter_mm,
         replay_speed_mm_per_s: 3.0,
+        with_prony: false,
         fe_shear_modulus_n_per_mm2: needle_codegen::tissue::read_fe_shear_modulus(&set).expect("campaign.toml").expect("a campaign"),
     }
 }
@@ -94,6 +95,42 @@ fn the_derived_values_follow_the_published_table() {
     assert!((at[0] - force(7, 3.59)).abs() < 1e-12 && at[1] == 0.0, "{at:?}");
 }
 
+/// `--with-prony`: the skin's published relaxation function (one QLV term, Wang et al.
+/// 2015: tau1 0.19 s, G_inf 0.28) goes into the stack in the long-term normalisation, the
+/// skin's scale is fitted to the published rise at the replay speed through it, and the
+/// replay at that speed punctures the skin where the published curve does, as the
+/// elastic derivation does; without the flag the shipped stack is elastic and names the
+/// terms in `prony_source`.
+#[test]
+fn the_published_skin_terms_go_in_with_prony_and_keep_the_puncture_at_the_replay_speed() {
+    let (pieces, sources) = (folder().join("pieces.csv"), folder().join("layers.csv"));
+    let elastic = calibrate_published(&options(&pieces, &sources)).unwrap_or_else(|e| panic!("{e:#}"));
+    let visco = calibrate_published(&ModelOptions { with_prony: true, ..options(&pieces, &sources) }).unwrap_or_else(|e| panic!("{e:#}"));
+    let skin = |c: &needle_calibrate::Calibration| c.stack.layers.first().cloned().expect("a skin");
+    let (e, v) = (skin(&elastic), skin(&visco));
+    assert!(e.prony.is_empty() && e.prony_source.as_deref().is_some_and(|s| s.starts_with(needle_calibrate::from_model::NOT_COMPILED_IN)));
+    // the published G_inf = 0.28: g = (1 - 0.28) / 0.28 of the long-term response
+    assert_eq!(v.prony.len(), 1);
+    assert!((v.prony[0].g - 0.72 / 0.28).abs() < 1e-12 && v.prony[0].tau_s == 0.19, "{:?}", v.prony);
+    assert!(
+        v.stiffness_scale < e.stiffness_scale,
+        "the long-term scale lies below the elastic one: {} vs {}",
+        v.stiffness_scale,
+        e.stiffness_scale
+    );
+    let position_error = |c: &needle_calibrate::Calibration| {
+        c.checks.iter().find(|k| k.what == "puncture 1 position").map(|k| k.error.abs()).expect("the first puncture's check")
+    };
+    assert!(
+        position_error(&visco) <= 0.5,
+        "with the skin's terms the replay punctures {} mm off the published curve",
+        position_error(&visco)
+    );
+    assert!(position_error(&elastic) <= 0.5);
+    // only the skin has terms
+    assert!(visco.stack.layers.iter().skip(1).all(|l| l.prony.is_empty()));
+}
+
 fn refused(pieces: &Path, sources: &Path) -> String {
     match calibrate_published(&options(pieces, sources)) {
         Ok(_) => panic!("accepted"),
@@ -126,4 +163,33 @@ fn bad_tables_are_refused_with_file_and_line() {
         std::fs::read_to_string(&sources).expect("sources").lines().filter(|l| !l.starts_with("fat,")).collect::<Vec<_>>().join("\n");
     let uncited = write("uncited.csv", &uncited);
     assert!(refused(&folder().join("pieces.csv"), &uncited).contains("no row for layer \"fat\""));
+    // the skin's published relaxation function (row 2: `0.72,0.19,...`), spoilt
+    let table = std::fs::read_to_string(&sources).expect("sources");
+    assert!(table.contains(",0.72,0.19,"), "the skin's row carries its terms");
+    for (name, with, want) in [
+        ("weight.csv", ",0.7x,0.19,", "weight.csv:2: column prony_g_instantaneous: \"0.7x\" is not a number"),
+        (
+            "sum.csv",
+            ",0.72;0.3,0.19;5,",
+            "sum.csv:2: column prony_g_instantaneous: \"0.72;0.3\": each weight must be finite and >= 0, their sum below 1",
+        ),
+        ("tau.csv", ",0.72,0,", "tau.csv:2: column prony_tau_s: 0 s: must be finite and > 0"),
+        ("count.csv", ",0.72,0.19;5,", "count.csv:2: columns prony_g_instantaneous and prony_tau_s: 1 weights, 2 time constants"),
+    ] {
+        let bad = write(name, &table.replacen(",0.72,0.19,", with, 1));
+        let e = refused(&folder().join("pieces.csv"), &bad);
+        assert!(e.contains(want), "{e}");
+    }
+    let unsourced: Vec<String> = table
+        .lines()
+        .map(|l| {
+            if l.starts_with("skin,") {
+                l.rsplit_once(",0.19,").map_or(l.to_string(), |(a, _)| format!("{a},0.19,"))
+            } else {
+                l.to_string()
+            }
+        })
+        .collect();
+    let e = refused(&folder().join("pieces.csv"), &write("unsourced.csv", &(unsourced.join("\n") + "\n")));
+    assert!(e.contains("unsourced.csv:2: column prony_source"), "{e}");
 }

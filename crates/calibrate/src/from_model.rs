@@ -2,6 +2,7 @@
 //! ([`published`](crate::published) has the rules), written in the tissue format, run
 //! through the library's insertion model along the published curve and compared with it
 //! like a calibration.
+use crate::ramp::RampResponse;
 use crate::{published, replay, to_layer, Calibration, STICK_BAND_MM_PER_S, WINKLER_E_PER_MU};
 use anyhow::{bail, Context, Result};
 use needle_codegen::tissue as file;
@@ -15,7 +16,9 @@ pub struct ModelOptions<'a> {
     /// The published pieces (`pieces.csv`).
     pub pieces: &'a Path,
     /// Per-layer citations written into each layer's `source` (`layers.csv`: `layer`,
-    /// `source`): where the values come from and the measured values beside them.
+    /// `source`): where the values come from and the measured values beside them; and,
+    /// optionally, a layer's published relaxation function (`prony_g_instantaneous`,
+    /// `prony_tau_s`, `prony_source`: [`Cited`]).
     pub layer_sources: &'a Path,
     /// The stack's name (the tissue file's stem).
     pub name: String,
@@ -23,8 +26,15 @@ pub struct ModelOptions<'a> {
     pub description: String,
     /// Diameter of the stack's needle, mm.
     pub needle_diameter_mm: f64,
-    /// Speed of the replay along the published curve, mm/s (the published model has none).
+    /// Speed of the replay along the published curve, mm/s (the published model has none),
+    /// and with `with_prony` the speed at which a layer with Prony terms is fitted to it
+    /// (`crate::ramp`).
     pub replay_speed_mm_per_s: f64,
+    /// Write the layers' published Prony terms into the stack (fitted at the replay speed);
+    /// without, a layer's terms are named in its `prony_source` only ([`NOT_COMPILED_IN`])
+    /// and the stack is elastic (as the firmware's build without the `viscoelastic`
+    /// feature requires of a compiled-in stack: docs/firmware.md, "Features").
+    pub with_prony: bool,
     /// The FE tissue's initial shear modulus `mu0`, N/mm², for the track stiffness.
     pub fe_shear_modulus_n_per_mm2: f64,
 }
@@ -52,7 +62,18 @@ pub fn calibrate_published(opts: &ModelOptions<'_>) -> Result<Calibration> {
     let pieces = published::read_pieces(opts.pieces)?;
     let sources = read_sources(opts.layer_sources)?;
     let similarity = opts.needle_diameter_mm / f64::from(insertion::FE_NEEDLE_DIAMETER_MM);
-    let surrogate = |depth_mm: f64| f64::from(insertion::deflection(&Pose::default(), depth_mm as f32, 1.0, similarity as f32).wrench.fy_n);
+    let elastic = |depth_mm: f64| f64::from(insertion::deflection(&Pose::default(), depth_mm as f32, 1.0, similarity as f32).wrench.fy_n);
+    // a layer with Prony terms against its response at the replay speed (`crate::ramp`)
+    let total_mm: f64 = pieces.iter().map(|p| p.thickness_mm).sum();
+    let responses: Vec<(String, RampResponse)> = sources
+        .iter()
+        .filter(|c| opts.with_prony && !c.prony.is_empty())
+        .map(|c| (c.layer.clone(), RampResponse::new(&elastic, &c.prony, opts.replay_speed_mm_per_s, total_mm)))
+        .collect();
+    let surrogate = |layer: &str, depth_mm: f64| match responses.iter().find(|(name, _)| name == layer) {
+        Some((_, r)) => r.at(depth_mm),
+        None => elastic(depth_mm),
+    };
     let derived = published::derive(&pieces, &surrogate)?;
     if derived.len() > file::MAX_LAYERS {
         bail!("{}: {} layers; a stack has at most {}", opts.pieces.display(), derived.len(), file::MAX_LAYERS);
@@ -60,7 +81,7 @@ pub fn calibrate_published(opts: &ModelOptions<'_>) -> Result<Calibration> {
     let mut layers = Vec::with_capacity(derived.len());
     for d in &derived {
         let cited =
-            sources.iter().find(|(layer, _)| *layer == d.name).map(|(_, s)| s.clone()).with_context(|| {
+            sources.iter().find(|c| c.layer == d.name).cloned().with_context(|| {
                 format!("{}: no row for layer {:?}: every layer needs its citation", opts.layer_sources.display(), d.name)
             })?;
         let f = &d.fit;
@@ -75,9 +96,12 @@ pub fn calibrate_published(opts: &ModelOptions<'_>) -> Result<Calibration> {
             friction_viscous_n_s_per_mm2: 0.0,
             stick_band_mm_per_s: STICK_BAND_MM_PER_S,
             track_stiffness_n_per_mm2: WINKLER_E_PER_MU * f.scale * opts.fe_shear_modulus_n_per_mm2,
-            source: cited,
-            prony: Vec::new(),
-            prony_source: None,
+            source: cited.source,
+            prony: if opts.with_prony { cited.prony.clone() } else { Vec::new() },
+            prony_source: match cited.prony_source {
+                Some(s) if !opts.with_prony && !cited.prony.is_empty() => Some(format!("{NOT_COMPILED_IN} {s}")),
+                other => other,
+            },
         });
     }
     let stack = file::Stack {
@@ -100,22 +124,88 @@ pub fn calibrate_published(opts: &ModelOptions<'_>) -> Result<Calibration> {
     Ok(Calibration { points, events, fit: published::as_fit(&derived), stack, replay, checks, similarity })
 }
 
-/// `(layer, source)` rows of a citations file.
-fn read_sources(path: &Path) -> Result<Vec<(String, String)>> {
+/// The start of a layer's `prony_source` when its published terms are left out (without
+/// `with_prony`).
+pub const NOT_COMPILED_IN: &str = "Published terms not in this stack (elastic; `needle calibrate-published --with-prony` writes them, for a build with the `viscoelastic` feature):";
+
+/// One row of a citations file (`layers.csv`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cited {
+    /// The layer's name.
+    pub layer: String,
+    /// Where its values come from.
+    pub source: String,
+    /// Its published relaxation function in the tissue files' long-term normalisation,
+    /// converted from the columns `prony_g_instantaneous` (the weights `g'_i` normalised
+    /// by the instantaneous response, as relaxation tests publish them: `G(t) / G_0 = 1 -
+    /// sum g'_i (1 - exp(-t / tau_i))`; a one-term QLV fit's `G_inf` gives `g'_1 = 1 -
+    /// G_inf`) and `prony_tau_s` (s), `;`-separated, by
+    /// [`needle_contract::prony_long_term_from_instantaneous`]; empty: elastic.
+    pub prony: Vec<file::PronyTerm>,
+    /// Where the terms come from (`prony_source`; required with terms).
+    pub prony_source: Option<String>,
+}
+
+/// The rows of a citations file: `layer`, `source`, and the optional columns of
+/// [`Cited`].
+///
+/// # Errors
+/// The file cannot be read, a column is missing, a row has no layer or source, or its
+/// Prony columns are refused (`file:line: column ...`).
+pub fn read_sources(path: &Path) -> Result<Vec<Cited>> {
     let mut reader =
         csv::ReaderBuilder::new().trim(csv::Trim::All).from_path(path).with_context(|| format!("{}: cannot read", path.display()))?;
     let header = reader.headers().with_context(|| format!("{}:1: cannot read the header", path.display()))?.clone();
     let column = |name: &str| header.iter().position(|h| h == name).with_context(|| format!("{}:1: no column {name:?}", path.display()));
+    let optional = |name: &str| header.iter().position(|h| h == name);
     let (il, is) = (column("layer")?, column("source")?);
+    let (ig, it, ip) = (optional("prony_g_instantaneous"), optional("prony_tau_s"), optional("prony_source"));
     let mut rows = Vec::new();
     for record in reader.records() {
         let record = record.with_context(|| format!("{}: malformed CSV", path.display()))?;
         let line = record.position().map_or(0, |p| p.line());
-        let (layer, source) = (record.get(il).unwrap_or(""), record.get(is).unwrap_or(""));
+        let get = |i: Option<usize>| i.and_then(|i| record.get(i)).unwrap_or("");
+        let (layer, source) = (get(Some(il)), get(Some(is)));
         if layer.is_empty() || source.is_empty() {
             bail!("{}:{line}: a row needs a layer and its source", path.display());
         }
-        rows.push((layer.to_string(), source.to_string()));
+        let at = format!("{}:{line}", path.display());
+        let prony = prony_terms(&at, get(ig), get(it))?;
+        let prony_source = Some(get(ip).to_string()).filter(|s| !s.is_empty());
+        if !prony.is_empty() && prony_source.is_none() {
+            bail!("{at}: column prony_source: the layer's Prony terms need the published measurement they come from");
+        }
+        rows.push(Cited { layer: layer.to_string(), source: source.to_string(), prony, prony_source });
     }
     Ok(rows)
+}
+
+/// The long-term-normalised terms of one row's `prony_g_instantaneous` and `prony_tau_s`
+/// (`at`: `file:line`).
+fn prony_terms(at: &str, weights: &str, taus: &str) -> Result<Vec<file::PronyTerm>> {
+    let numbers = |column: &str, text: &str| -> Result<Vec<f64>> {
+        text.split(';')
+            .map(str::trim)
+            .filter(|t| !t.is_empty())
+            .map(|t| t.parse::<f64>().map_err(|_| anyhow::anyhow!("{at}: column {column}: {t:?} is not a number")))
+            .collect()
+    };
+    let (g, tau) = (numbers("prony_g_instantaneous", weights)?, numbers("prony_tau_s", taus)?);
+    if g.len() != tau.len() {
+        bail!("{at}: columns prony_g_instantaneous and prony_tau_s: {} weights, {} time constants", g.len(), tau.len());
+    }
+    if let Some(t) = tau.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
+        bail!("{at}: column prony_tau_s: {t} s: must be finite and > 0");
+    }
+    let long_term = match g.as_slice() {
+        [] => Some(Vec::new()),
+        [a] => needle_contract::prony_long_term_from_instantaneous([*a]).map(Vec::from),
+        [a, b] => needle_contract::prony_long_term_from_instantaneous([*a, *b]).map(Vec::from),
+        [a, b, c] => needle_contract::prony_long_term_from_instantaneous([*a, *b, *c]).map(Vec::from),
+        _ => bail!("{at}: column prony_g_instantaneous: {} terms; a layer has at most {}", g.len(), file::MAX_PRONY_TERMS),
+    };
+    let long_term = long_term.with_context(|| {
+        format!("{at}: column prony_g_instantaneous: {weights:?}: each weight must be finite and >= 0, their sum below 1")
+    })?;
+    Ok(long_term.into_iter().zip(tau).map(|(g, tau_s)| file::PronyTerm { g, tau_s }).collect())
 }

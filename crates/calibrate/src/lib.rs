@@ -27,6 +27,7 @@ pub mod from_model;
 mod lsq;
 pub mod measured;
 pub mod published;
+pub mod ramp;
 pub mod replay;
 
 use anyhow::{bail, Result};

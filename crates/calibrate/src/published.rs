@@ -164,13 +164,14 @@ pub struct Derived {
     pub rises: bool,
 }
 
-/// The layers of `pieces` by the module's rules; `surrogate(depth_mm)` is the axial
-/// force of a boundary indented by `depth_mm` at scale 1.
+/// The layers of `pieces` by the module's rules; `surrogate(layer, depth_mm)` is the axial
+/// force of the named layer's boundary indented by `depth_mm` at scale 1 (with its
+/// relaxation function at the replay speed when it has one: `crate::ramp`).
 ///
 /// # Errors
 /// A first layer without a rise (nothing to take a scale from), or a fitted scale that is
 /// not finite and > 0.
-pub fn derive(pieces: &[Piece], surrogate: &dyn Fn(f64) -> f64) -> Result<Vec<Derived>> {
+pub fn derive(pieces: &[Piece], surrogate: &dyn Fn(&str, f64) -> f64) -> Result<Vec<Derived>> {
     let all = samples(pieces);
     let mut out: Vec<Derived> = Vec::new();
     let (mut top, mut first_piece, mut after_peak) = (0.0, 0, 0);
@@ -190,7 +191,7 @@ pub fn derive(pieces: &[Piece], surrogate: &dyn Fn(f64) -> f64) -> Result<Vec<De
         let rises = peak > start && peak_force - before - carried > 0.0;
         let (scale, puncture_force_n, drop_from) = if rises {
             let (sg, gg) = all.get(start + 1..=peak).unwrap_or(&[]).iter().fold((0.0, 0.0), |(sg, gg), s| {
-                let g = surrogate(s.depth_mm - top);
+                let g = surrogate(&first.layer, s.depth_mm - top);
                 (sg + g * (s.force_n - before - carried), gg + g * g)
             });
             (sg / gg, peak_force - before, peak)

@@ -17,7 +17,9 @@ pub struct CalibratePublishedArgs {
     /// The published pieces: CSV with piece, layer, thickness_mm, c0_n .. c3_n_per_mm3.
     #[arg(long)]
     pub pieces: PathBuf,
-    /// The citation of every layer: CSV with layer, source (written into the layer's source).
+    /// The citation of every layer: CSV with layer, source (written into the layer's source),
+    /// optionally a layer's published relaxation function (prony_g_instantaneous,
+    /// prony_tau_s, prony_source).
     #[arg(long)]
     pub layer_sources: PathBuf,
     /// Name of the stack (the tissue file is <set>/tissue/<name>.toml).
@@ -29,9 +31,15 @@ pub struct CalibratePublishedArgs {
     /// Diameter of the stack's needle, mm (the FE needle is carried to it by geometric similarity).
     #[arg(long)]
     pub needle_diameter_mm: f64,
-    /// Speed of the replay along the published curve, mm/s (for the comparison only).
+    /// Speed of the replay along the published curve, mm/s (for the comparison; with
+    /// --with-prony also the speed at which a layer with terms is fitted).
     #[arg(long)]
     pub replay_speed_mm_per_s: f64,
+    /// Write the layers' published Prony terms into the stack (its boundaries then relax:
+    /// the library needs its `viscoelastic` feature for it); without, they are named in
+    /// prony_source only and the stack is elastic.
+    #[arg(long)]
+    pub with_prony: bool,
     /// Write the sampled published curve (position_mm, force_n) here.
     #[arg(long)]
     pub sampled_out: PathBuf,
@@ -59,6 +67,7 @@ pub fn calibrate_published(a: CalibratePublishedArgs) -> Result<ExitCode> {
         description: a.description.clone(),
         needle_diameter_mm: a.needle_diameter_mm,
         replay_speed_mm_per_s: a.replay_speed_mm_per_s,
+        with_prony: a.with_prony,
         fe_shear_modulus_n_per_mm2: mu0,
     };
     let c = run(&opts)?;
