@@ -68,8 +68,8 @@ pub fn calibrate_published(opts: &ModelOptions<'_>) -> Result<Calibration> {
     let responses: Vec<(String, RampResponse)> = sources
         .iter()
         .filter(|c| opts.with_prony && !c.prony.is_empty())
-        .map(|c| (c.layer.clone(), RampResponse::new(&elastic, &c.prony, opts.replay_speed_mm_per_s, total_mm)))
-        .collect();
+        .map(|c| Ok((c.layer.clone(), RampResponse::new(&elastic, &c.prony, opts.replay_speed_mm_per_s, total_mm)?)))
+        .collect::<Result<_>>()?;
     let surrogate = |layer: &str, depth_mm: f64| match responses.iter().find(|(name, _)| name == layer) {
         Some((_, r)) => r.at(depth_mm),
         None => elastic(depth_mm),
