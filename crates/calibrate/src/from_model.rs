@@ -152,7 +152,7 @@ pub struct Cited {
 /// # Errors
 /// The file cannot be read, a column is missing, a row has no layer or source, or its
 /// Prony columns are refused (`file:line: column ...`).
-pub fn read_sources(path: &Path) -> Result<Vec<Cited>> {
+fn read_sources(path: &Path) -> Result<Vec<Cited>> {
     let mut reader =
         csv::ReaderBuilder::new().trim(csv::Trim::All).from_path(path).with_context(|| format!("{}: cannot read", path.display()))?;
     let header = reader.headers().with_context(|| format!("{}:1: cannot read the header", path.display()))?.clone();
