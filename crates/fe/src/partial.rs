@@ -46,6 +46,13 @@ pub fn paths(out_dir: &Path, pose: &str) -> (PathBuf, PathBuf) {
     (out_dir.join(format!("{pose}.partial.csv")), out_dir.join(format!("{pose}.partial.toml")))
 }
 
+/// The pose's `.partial.toml` record in `out_dir`, when there is one that parses.
+#[must_use]
+pub fn read_record(out_dir: &Path, pose: &str) -> Option<PartialRecord> {
+    let (_, record) = paths(out_dir, pose);
+    toml::from_str(&std::fs::read_to_string(record).ok()?).ok()
+}
+
 /// What the campaign knows of the failed run.
 pub struct Failed<'a> {
     /// The spec as run (steps applied).

@@ -206,9 +206,7 @@ pub(crate) fn solve_with_retry(
 /// Why training pose `r.pose` was replaced: the spec's words, then the record of its
 /// furthest failed attempt (`<out>/<pose>.partial.toml`) when there is one.
 fn replaced_because(out_dir: &Path, r: &crate::spec::TrainReplacement) -> String {
-    let (_, record) = crate::partial::paths(out_dir, &r.pose);
-    let partial = std::fs::read_to_string(&record).ok().and_then(|t| toml::from_str::<crate::partial::PartialRecord>(&t).ok());
-    match partial {
+    match crate::partial::read_record(out_dir, &r.pose) {
         Some(p) => format!("{} (its record: reached {} mm of {}; {})", r.why, p.reached_depth_mm, p.depth_mm, p.failure),
         None => r.why.clone(),
     }

@@ -124,8 +124,7 @@ fn local_failures(out_dir: &Path, pose: &str, unit: &str) -> String {
     if !f.is_empty() {
         return failures::summary(&f, unit);
     }
-    let (_, record) = crate::partial::paths(out_dir, pose);
-    let Some(r) = std::fs::read_to_string(&record).ok().and_then(|t| toml::from_str::<crate::partial::PartialRecord>(&t).ok()) else {
+    let Some(r) = crate::partial::read_record(out_dir, pose) else {
         return String::new();
     };
     format!("{} (record {})", failures::summary(&failures::failures_from_record(&r.failure), unit), r.date)
@@ -150,10 +149,7 @@ pub fn attempts_by_class(plan: &Plan) -> String {
         } else {
             let logs = failures::read_failures(&plan.out_dir.join(".work").join(&pose.name));
             if logs.is_empty() {
-                let (_, record) = crate::partial::paths(&plan.out_dir, &pose.name);
-                if let Some(r) =
-                    std::fs::read_to_string(&record).ok().and_then(|t| toml::from_str::<crate::partial::PartialRecord>(&t).ok())
-                {
+                if let Some(r) = crate::partial::read_record(&plan.out_dir, &pose.name) {
                     failed.extend(failures::failures_from_record(&r.failure));
                 }
             } else {

@@ -226,8 +226,8 @@ pub fn report(runs: Vec<QlvRun>, missing: Vec<String>) -> QlvReport {
 /// (a failed run: its furthest attempt's must points from 0 on).
 fn read_partial(plan: &crate::campaign::Plan, run: &str) -> Option<Vec<Row>> {
     let pose = plan.selected.iter().find(|p| p.name == run)?;
-    let (csv, rec) = crate::partial::paths(&plan.out_dir, run);
-    let record: crate::partial::PartialRecord = toml::from_str(&std::fs::read_to_string(rec).ok()?).ok()?;
+    let (csv, _) = crate::partial::paths(&plan.out_dir, run);
+    let record = crate::partial::read_record(&plan.out_dir, run)?;
     if record.spec_hash != plan.campaign.run_hash(pose, &plan.mesh_name) {
         return None;
     }

@@ -43,7 +43,8 @@ pub fn solve_and_read(opts: &RunOptions) -> Result<PoseRows> {
 }
 
 /// Read the selected poses' results without solving: `Ok(rows)` for a result that is up
-/// to date for the spec (hash and content per the manifest), `Err(why)` otherwise.
+/// to date for the spec (hash and content per the manifest), `Err(why)` otherwise (for a
+/// pose with failed attempts, how far the furthest got, from its partial record).
 ///
 /// # Errors
 /// As [`campaign::plan`].
@@ -54,7 +55,20 @@ pub fn read_current(opts: &RunOptions) -> Result<PoseRows> {
         let csv = plan.out_dir.join(format!("{}.csv", pose.name));
         let entry = plan.manifest.pose.get(&pose.name).filter(|_| !plan.to_run.contains(&i));
         let r = match entry {
-            None => Err(format!("{}: no current result (mesh {}, {} steps)", csv.display(), plan.mesh_name, plan.steps)),
+            None => Err(
+                match crate::partial::read_record(&plan.out_dir, &pose.name)
+                    .filter(|r| r.spec_hash == plan.campaign.run_hash(pose, &plan.mesh_name))
+                {
+                    Some(r) => format!(
+                        "{}: not solved; its furthest failed attempt so far reached {} of {} mm (its record: {}.partial.toml)",
+                        csv.display(),
+                        r.reached_depth_mm,
+                        r.depth_mm,
+                        pose.name
+                    ),
+                    None => format!("{}: no current result (mesh {}, {} steps)", csv.display(), plan.mesh_name, plan.steps),
+                },
+            ),
             Some(e) => read_rows(&csv, plan.campaign.loading.ramp_hold.is_some())
                 .map(|rows| Run { rows, entry: e.clone() })
                 .map_err(|e| format!("{e:#}")),
