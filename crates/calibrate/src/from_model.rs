@@ -197,14 +197,13 @@ fn prony_terms(at: &str, weights: &str, taus: &str) -> Result<Vec<file::PronyTer
     if let Some(t) = tau.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
         bail!("{at}: column prony_tau_s: {t} s: must be finite and > 0");
     }
-    let long_term = match g.as_slice() {
-        [] => Some(Vec::new()),
-        [a] => needle_contract::prony_long_term_from_instantaneous([*a]).map(Vec::from),
-        [a, b] => needle_contract::prony_long_term_from_instantaneous([*a, *b]).map(Vec::from),
-        [a, b, c] => needle_contract::prony_long_term_from_instantaneous([*a, *b, *c]).map(Vec::from),
-        _ => bail!("{at}: column prony_g_instantaneous: {} terms; a layer has at most {}", g.len(), file::MAX_PRONY_TERMS),
-    };
-    let long_term = long_term.with_context(|| {
+    if g.len() > file::MAX_PRONY_TERMS {
+        bail!("{at}: column prony_g_instantaneous: {} terms; a layer has at most {}", g.len(), file::MAX_PRONY_TERMS);
+    }
+    // unused slots weigh 0: they add nothing to the sum and convert to 0
+    let mut padded = [0.0; file::MAX_PRONY_TERMS];
+    padded.iter_mut().zip(&g).for_each(|(p, w)| *p = *w);
+    let long_term = needle_contract::prony_long_term_from_instantaneous(padded).with_context(|| {
         format!("{at}: column prony_g_instantaneous: {weights:?}: each weight must be finite and >= 0, their sum below 1")
     })?;
     Ok(long_term.into_iter().zip(tau).map(|(g, tau_s)| file::PronyTerm { g, tau_s }).collect())
