@@ -371,13 +371,6 @@ fn a_pose_failing_every_attempt_keeps_its_furthest_must_points() {
     let text = std::fs::read_to_string(&rec).expect("record");
     assert!(text.contains("reached_depth_mm = 3.0") && text.contains("fake stop 0; retry 1"), "{text}");
     assert!(!fe.join("x+04.csv").exists(), "no result");
-    let why = crate::verify::runs::read_current(&opts(d.path(), "x+04", 4)).expect("plan").remove("x+04").and_then(|r| r.err());
-    assert!(
-        why.as_deref().is_some_and(
-            |w| w.ends_with("not solved; its furthest failed attempt so far reached 3 of 6 mm (its record: x+04.partial.toml)")
-        ),
-        "{why:?}"
-    );
     let r = run_with(&opts(d.path(), "x+04", 4), &mut Fake::default()).expect("solved");
     assert_eq!(r.done(), 1);
     assert!(!csv.exists() && !rec.exists(), "the record goes once the pose solves");

@@ -92,3 +92,26 @@ fn read_rows(csv: &std::path::Path, timed: bool) -> Result<Vec<Row>> {
 pub fn same_depths(a: &[Row], b: &[Row]) -> bool {
     a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x.depth_mm - y.depth_mm).abs() <= 1e-9 * (1.0 + x.depth_mm.abs()))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::read_current;
+    use crate::campaign::run_with;
+    use crate::campaign::tests::{opts, set_dir, Fake};
+
+    /// A pose without a result whose attempts all failed says how far the furthest got.
+    #[test]
+    fn a_pose_without_a_result_names_its_furthest_failed_attempt() {
+        let d = set_dir();
+        let mut fake = Fake { fail_reached: Some("x+04".into()), ..Fake::default() };
+        let r = run_with(&opts(d.path(), "x+04", 4), &mut fake).expect("run");
+        assert_eq!(r.failed(), 1, "{}", r.table());
+        let why = read_current(&opts(d.path(), "x+04", 4)).expect("plan").remove("x+04").and_then(|r| r.err());
+        assert!(
+            why.as_deref().is_some_and(
+                |w| w.ends_with("not solved; its furthest failed attempt so far reached 3 of 6 mm (its record: x+04.partial.toml)")
+            ),
+            "{why:?}"
+        );
+    }
+}
