@@ -186,9 +186,12 @@ impl<'j, 'a> Setup<'j, 'a> {
     }
 
     /// A continuation's restarts set the retry tolerances: the dump carries the run's own.
+    /// The residual floor is the retry's or the ramp-and-hold loading's, the larger (as in
+    /// the input file, `feb.rs`).
     fn tolerances(&self) -> Option<restart::Tolerances> {
         let fs = self.fs();
-        self.plan.retry_tolerances().then_some(restart::Tolerances { dtol: fs.retry_dtol, rtol: fs.retry_rtol })
+        let floor_n = self.loading().ramp_hold.as_ref().map_or(0.0, |r| r.min_residual_n).max(fs.retry_min_residual_n);
+        self.plan.retry_tolerances().then_some(restart::Tolerances { dtol: fs.retry_dtol, rtol: fs.retry_rtol, min_residual_n: floor_n })
     }
 
     /// The first-contact caps of the run whose dump this attempt's restarts read: this

@@ -222,8 +222,11 @@ fn write_control(w: &mut String, s: &FebioSettings, loading: &Loading, steps: u3
     let _ = writeln!(w, "      <max_refs>{}</max_refs>", s.max_refs);
     let _ = writeln!(w, "      <reform_each_time_step>1</reform_each_time_step>");
     let _ = writeln!(w, "      <diverge_reform>1</diverge_reform>");
-    // FEBio compares the squared norm; a ramp-and-hold run sets its floor (`crate::visco`)
-    let min_residual = loading.ramp_hold.as_ref().map_or(1e-20, |r| r.min_residual_n * r.min_residual_n);
+    // FEBio compares the squared norm; a ramp-and-hold run sets its floor (`crate::visco`),
+    // the retry its own (`retry_min_residual_n`); the larger one holds
+    let retry_floor_n = if stepping.retry_tolerances { s.retry_min_residual_n } else { 0.0 };
+    let floor_n = loading.ramp_hold.as_ref().map_or(0.0, |r| r.min_residual_n).max(retry_floor_n);
+    let min_residual = if floor_n > 0.0 { floor_n * floor_n } else { 1e-20 };
     let _ = writeln!(w, "      <min_residual>{}</min_residual>", num(min_residual));
     // the campaign's retry converges on energy and residual with `retry_dtol` /
     // `retry_rtol` (FebioSettings docs)
@@ -514,5 +517,27 @@ mod tests {
         assert!(t.contains("<pt>1.5,1.5</pt>") && t.contains("<pt>36.0,"), "must points");
         let elastic = write(&c, pose, &mesh, 4, 1.0).expect("feb");
         assert!(!elastic.text.contains("viscoelastic"), "an elastic run stays elastic");
+    }
+
+    /// The retry's residual floor is written squared, only with the retry tolerances; a
+    /// ramp-and-hold run keeps the larger of its own floor and the retry's.
+    #[test]
+    fn the_retrys_residual_floor_is_written_squared_only_with_the_retry_tolerances() {
+        let mut c = crate::spec::parse(&shipped(), Path::new("campaign.toml")).expect("the shipped spec");
+        c.solver.febio.retry_min_residual_n = 1e-4;
+        let pose = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");
+        let mesh = c.mesh_level("smoke").expect("smoke").clone();
+        let floor = |c: &Campaign, dt: f64| {
+            let t = write(c, &pose, &mesh, 4, dt).expect("feb").text;
+            let v = t.split("<min_residual>").nth(1).and_then(|r| r.split('<').next()).and_then(|v| v.parse::<f64>().ok());
+            v.unwrap_or(f64::NAN)
+        };
+        let close = |got: f64, want: f64| (got - want).abs() <= 1e-12 * want;
+        assert!(close(floor(&c, 1.0), 1e-20), "a first attempt: FEBio's own");
+        assert!(close(floor(&c, 0.25), 1e-8), "the retry: (1e-4 N)^2");
+        let v = c.viscoelastic.clone().expect("[viscoelastic]");
+        let (run, _) = crate::visco::apply(&c, &v, 1.0, 4, crate::visco::Friction::Campaign);
+        assert!(close(floor(&run, 0.25), 1e-8), "the larger floor: the retry's 1e-4 N over the hold's 1e-5 N");
+        assert!(close(floor(&run, 1.0), 1e-10), "the hold's (1e-5 N)^2");
     }
 }

@@ -14,7 +14,9 @@
 //!   step) and the retry tolerances (`retry_dtol`, `retry_rtol`: FEBio's restart input can set
 //!   the Newton solver's parameters). In the failed logs "max nr of reformations" is the
 //!   displacement norm stalling while the residual and energy norms have converged (a
-//!   contact node chattering), which is what the retry tolerances judge differently.
+//!   contact node chattering), which is what the retry tolerances judge differently;
+//!   with the 0.4 mm edge the retry's own micrometre steps then stalled the residual
+//!   norm, which `retry_min_residual_n` (an absolute floor, `[solver.febio]`) answers.
 //!   FEBio's restart cannot change the contact (`seg_up`, the penalty): a continuation
 //!   keeps the contact of the attempt whose dump it continues, and the manifest says so;
 //! - `seg_up` 5 with whole first increments inverted elements at first contact in 17 of

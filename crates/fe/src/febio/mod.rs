@@ -223,7 +223,7 @@ impl FebioBackend {
 pub fn settings_line(s: &crate::spec::FebioSettings, friction: f64, threads: usize, retry: bool) -> String {
     let (dtol, rtol) = if retry { (s.retry_dtol, s.retry_rtol) } else { (s.dtol, s.rtol) };
     format!(
-        "{} contact, primary {}, {} penalty {}{}{}, friction {friction}, projections updated {}; {}, max_refs {}, dtol {} etol {} rtol {}; Pardiso, {threads} thread(s)",
+        "{} contact, primary {}, {} penalty {}{}{}, friction {friction}, projections updated {}; {}, max_refs {}, dtol {} etol {} rtol {}{}; Pardiso, {threads} thread(s)",
         s.contact,
         s.primary,
         if s.augmented { "augmented Lagrangian" } else { "pure" },
@@ -240,6 +240,7 @@ pub fn settings_line(s: &crate::spec::FebioSettings, friction: f64, threads: usi
         dtol,
         s.etol,
         rtol,
+        if retry && s.retry_min_residual_n > 0.0 { format!(", residual floor {} N", s.retry_min_residual_n) } else { String::new() },
     )
 }
 

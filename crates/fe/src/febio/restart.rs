@@ -155,6 +155,9 @@ pub fn restart_input(r: &Restart<'_>) -> Result<String> {
         let _ = writeln!(s, "    <solver>");
         let _ = writeln!(s, "      <dtol>{:e}</dtol>", t.dtol);
         let _ = writeln!(s, "      <rtol>{:e}</rtol>", t.rtol);
+        if t.min_residual_n > 0.0 {
+            let _ = writeln!(s, "      <min_residual>{:e}</min_residual>", t.min_residual_n * t.min_residual_n);
+        }
         let _ = writeln!(s, "    </solver>");
     }
     let _ = writeln!(s, "  </Control>");
@@ -173,6 +176,8 @@ pub struct Tolerances {
     pub dtol: f64,
     /// Residual (`rtol`; 0: off).
     pub rtol: f64,
+    /// Absolute residual floor, N (`min_residual`, written squared; 0: the dump's own).
+    pub min_residual_n: f64,
 }
 
 /// What the continuations of one attempt did, for the manifest and failure messages.
@@ -262,8 +267,11 @@ mod tests {
             "{r}"
         );
         assert!(r.ends_with("    </load_controller>\n  </LoadData>\n</febio_restart>\n"), "{r}");
-        let r = input(&points, 3, 0.075, Some(Tolerances { dtol: 0.0, rtol: 1e-3 }));
+        let r = input(&points, 3, 0.075, Some(Tolerances { dtol: 0.0, rtol: 1e-3, min_residual_n: 0.0 }));
         assert!(r.contains("<solver>\n      <dtol>0e0</dtol>\n      <rtol>1e-3</rtol>\n    </solver>\n  </Control>"), "{r}");
+        // the floor, squared as FEBio compares it
+        let r = input(&points, 3, 0.075, Some(Tolerances { dtol: 0.0, rtol: 1e-3, min_residual_n: 1e-4 }));
+        assert!(r.contains("<rtol>1e-3</rtol>\n      <min_residual>1e-8</min_residual>\n    </solver>"), "{r}");
         for bad in [0.0, -0.1, f64::NAN, f64::INFINITY] {
             let e = restart_input(&Restart { must_points: &points, from: 3, first_step: bad, dtmin: 3e-5, tolerances: None })
                 .expect_err("a bad first step");

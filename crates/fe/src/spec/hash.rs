@@ -13,7 +13,7 @@ impl Campaign {
 
     /// Hash of everything that determines a run solved by its first attempt: as
     /// [`run_hash`](Self::run_hash), without the settings only later attempts of the
-    /// FEBio retry ladder use (`retry_dtol`, `retry_rtol`: the continuations and the
+    /// FEBio retry ladder use (`retry_dtol`, `retry_rtol`, `retry_min_residual_n`: the continuations and the
     /// quarter-step attempts; `last_attempt_penalty_scale`: the fifth attempt), and marked
     /// so that it never equals a `run_hash`. A run whose first attempt solved it is
     /// reproduced by the spec as long as this hash stays the same, whatever the ladder's
@@ -23,6 +23,7 @@ impl Campaign {
         let mut solver = self.solver.clone();
         solver.febio.retry_dtol = 0.0;
         solver.febio.retry_rtol = 0.0;
+        solver.febio.retry_min_residual_n = 0.0;
         solver.febio.last_attempt_penalty_scale = 0.0;
         self.hash_with(pose, mesh_name, &solver, Some("first attempt"))
     }
