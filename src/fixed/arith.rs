@@ -7,14 +7,18 @@ use needle_contract::TERMS;
 /// `a b` saturated to the `i64` range (the insertion's and the depth extension's
 /// products with a value of the stack or the model).
 ///
-/// Armv6-M has no 64-bit multiply: `i64::saturating_mul` there is several library
-/// multiplies and the overflow test wherever it is inlined; out of line it is one call.
-/// Measured on the M0 (`no_panic_fixed_insertion`, elastic build, model flash as `needle
-/// firmware size` counts it): 25,578 B with every product inlined, 24,086 B with the
-/// insertion's `mul_shr` calling this, 23,394 B with the deflection's gains too, 22,638 B
-/// with the depth extension's products too. The other cores multiply inline.
-#[cfg_attr(all(target_arch = "arm", not(target_has_atomic = "32")), inline(never))]
-#[cfg_attr(not(all(target_arch = "arm", not(target_has_atomic = "32"))), inline(always))]
+/// Out of line on every Arm core (one call instead of the product and its overflow test
+/// at each use), inline on the host. Armv6-M has no 64-bit multiply: there it is several
+/// library multiplies wherever it is inlined. Measured on the M0
+/// (`no_panic_fixed_insertion`, elastic build, model flash as `needle firmware size`
+/// counts it): 25,578 B with every product inlined, 24,086 B with the insertion's
+/// `mul_shr` calling this, 23,394 B with the deflection's gains too, 22,638 B with the
+/// depth extension's products too. On the M3 and M4F, with the insertion's split
+/// products out of line as well (`insertion::geometry`): 22,838 -> 20,150 B and 22,798 ->
+/// 20,184 B (with the `viscoelastic` feature 25,824 -> 22,924 B and 25,984 -> 22,968 B),
+/// for about 3 % more instructions per surface tick (docs/insertion.md, "Cost").
+#[cfg_attr(target_arch = "arm", inline(never))]
+#[cfg_attr(not(target_arch = "arm"), inline(always))]
 pub(crate) fn sat_mul(a: i64, b: i64) -> i64 {
     a.saturating_mul(b)
 }
