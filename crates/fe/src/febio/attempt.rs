@@ -317,6 +317,7 @@ impl<'j, 'a> Setup<'j, 'a> {
             p.totals.time_steps += run.time_steps;
             p.totals.iterations += run.iterations;
             p.totals.retries += run.retries;
+            p.totals.floor_accepted += run.floor_accepted;
             let tail_src = if log_text.trim().is_empty() { &done.log_text } else { &log_text };
             p.log_tail = process::tail(tail_src, LOG_TAIL_LINES);
             let records = std::fs::read_to_string(self.rb_path())
@@ -443,6 +444,9 @@ impl<'j, 'a> Setup<'j, 'a> {
         }
         if let Some(at) = p.resumed_at_mm {
             line.push_str(&format!("; resumed after an interruption at {at} mm"));
+        }
+        if p.totals.floor_accepted > 0 && self.plan.retry_tolerances() && self.fs().retry_min_residual_n > 0.0 {
+            line.push_str(&format!("; the residual floor accepted {} iteration(s)", p.totals.floor_accepted));
         }
         for n in &p.notes {
             line.push_str(&format!("; {n}"));

@@ -73,6 +73,10 @@ pub struct RunLog {
     pub iterations: u32,
     /// Time steps retried with a smaller step ("Retrying time step" lines).
     pub retries: u32,
+    /// Iterations FEBio declared converged by its absolute residual floor
+    /// (`min_residual`; its warning "No force acting on the system", which a system
+    /// without any force prints too).
+    pub floor_accepted: u32,
     /// The last time reached ("converged at time : t").
     pub last_time: f64,
     /// FEBio's own words on why it stopped: the last `*** Error` / `ERROR` /
@@ -90,6 +94,10 @@ pub fn parse_run_log(text: &str) -> RunLog {
     let mut last_failed: Option<String> = None;
     for line in text.lines() {
         let l = line.trim();
+        // inside FEBio's warning box
+        if l.contains("No force acting on the system") {
+            r.floor_accepted += 1;
+        }
         // FEBio's error box: "*   ERROR   *", then "* <message> *" lines, then a row of '*'
         if l.starts_with('*') && l.ends_with('*') && l.len() > 2 {
             let inner = l.trim_matches('*').trim();
@@ -165,7 +173,9 @@ mod tests {
         let text = " ===== beginning time step 1 : 0.3 =====\n ------- converged at time : 0.3\n Retrying time step. Retry attempt 1 of max 5\n ------- converged at time : 0.6\n Total number of equilibrium iterations ............ : 17\n N O R M A L   T E R M I N A T I O N\n";
         let r = parse_run_log(text);
         assert!(r.normal_termination && !r.error_termination);
-        assert_eq!((r.time_steps, r.iterations, r.retries, r.last_time), (2, 17, 1, 0.6));
+        assert_eq!((r.time_steps, r.iterations, r.retries, r.last_time, r.floor_accepted), (2, 17, 1, 0.6, 0));
+        let floor = " *                               WARNING                                 *\n * No force acting on the system.                                        *\n";
+        assert_eq!(parse_run_log(&format!("{text}{floor}{floor}")).floor_accepted, 2, "each acceptance by the residual floor");
         let bad = parse_run_log(
             " *************************************************************************\n *                                ERROR                                  *\n * 2 negative jacobians detected.                                        *\n *************************************************************************\n\n------- failed to converge at time : 0.3\n E R R O R   T E R M I N A T I O N\n",
         );
