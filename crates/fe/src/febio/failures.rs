@@ -21,6 +21,27 @@ pub struct AttemptFailure {
     pub depth_mm: f64,
     /// FEBio's own words, when it gave any.
     pub cause: Option<String>,
+    /// The smallest residual Newton reached in the time step that failed last, N (the
+    /// root of FEBio's squared norm; from the log, `None` without one): where a stalled
+    /// attempt stood against an absolute floor (`[solver.febio] retry_min_residual_n`).
+    pub least_residual_n: Option<f64>,
+}
+
+/// The smallest "residual" norm (the current one, rooted) of the last time step of `log`
+/// that failed to converge.
+fn least_residual_of_last_failure(log: &str) -> Option<f64> {
+    let end = log.rfind("failed to converge at time")?;
+    let step = log.get(..end)?;
+    let start = step.rfind("===== beginning time step").unwrap_or(0);
+    step.get(start..)?
+        .lines()
+        .filter_map(|l| {
+            let mut w = l.split_whitespace();
+            (w.next() == Some("residual")).then(|| w.nth(1).and_then(|v| v.parse::<f64>().ok())).flatten()
+        })
+        .filter(|v| v.is_finite() && *v >= 0.0)
+        .reduce(f64::min)
+        .map(f64::sqrt)
 }
 
 /// The class of a failure from FEBio's words (`None`: no error stated).
@@ -53,6 +74,7 @@ pub fn read_failures(work_dir: &Path) -> Vec<AttemptFailure> {
             class: class_of(run.cause.as_deref()),
             depth_mm: failed_at.unwrap_or(run.last_time),
             cause: run.cause,
+            least_residual_n: least_residual_of_last_failure(&text),
         });
     }
     out
@@ -82,6 +104,7 @@ pub fn failures_from_record(failure: &str) -> Vec<AttemptFailure> {
                 class: if killed { "stopped" } else { class_of(Some(m)) },
                 depth_mm: after("failed to converge at time :").or_else(|| after("(t =")).unwrap_or(0.0),
                 cause: Some(m.trim().to_string()),
+                least_residual_n: None,
             }
         })
         .collect()
@@ -94,19 +117,22 @@ pub fn summary(failures: &[AttemptFailure], unit: &str) -> String {
     if failures.is_empty() {
         return String::new();
     }
-    let mut by_class: BTreeMap<&str, Vec<f64>> = BTreeMap::new();
+    let mut by_class: BTreeMap<&str, Vec<&AttemptFailure>> = BTreeMap::new();
     for f in failures {
-        by_class.entry(f.class).or_default().push(f.depth_mm);
+        by_class.entry(f.class).or_default().push(f);
     }
     let furthest = failures.iter().map(|f| f.depth_mm).fold(0.0, f64::max);
     let classes: Vec<String> = by_class
         .iter()
-        .map(|(c, d)| {
-            format!(
-                "{c} x{} ({} {unit})",
-                d.len(),
-                d.iter().map(|v| format!("{}", (v * 100.0).round() / 100.0)).collect::<Vec<_>>().join(", ")
-            )
+        .map(|(c, fs)| {
+            let depths = fs.iter().map(|f| format!("{}", (f.depth_mm * 100.0).round() / 100.0)).collect::<Vec<_>>().join(", ");
+            let least: Vec<String> = fs.iter().filter_map(|f| f.least_residual_n).map(|r| format!("{r:.1e}")).collect();
+            let stalled = if *c == "max reformations" && !least.is_empty() {
+                format!("; least residual {} N", least.join(", "))
+            } else {
+                String::new()
+            };
+            format!("{c} x{} ({depths} {unit}{stalled})", fs.len())
         })
         .collect();
     format!("{} failed attempt(s), furthest {:.2} {unit}: {}", failures.len(), furthest, classes.join("; "))
@@ -123,7 +149,8 @@ mod tests {
         let d = tempfile::tempdir().expect("tempdir");
         let log = |n: u32, body: &str| std::fs::write(d.path().join(format!("failed-attempt-{n}.log")), body).expect("write");
         log(1, &format!(" ------- converged at time : 0.6\n{BOX} * 2 negative jacobians detected.  *\n ***\n\n ------- failed to converge at time : 0.863\n E R R O R   T E R M I N A T I O N\n"));
-        log(2, &format!(" ------- converged at time : 5.1\n{BOX} * Max nr of reformations reached.  *\n ***\n\n ------- failed to converge at time : 5.22\n E R R O R   T E R M I N A T I O N\n"));
+        let newton = "===== beginning time step 9 : 5.22 =====\n\t   residual            8.5e-08    4.0e-12    8.5e-11 \n\t   residual            8.5e-08    2.5e-11    8.5e-11 \n";
+        log(2, &format!(" ------- converged at time : 5.1\n\t   residual  1 1e-20 1\n{newton}{BOX} * Max nr of reformations reached.  *\n ***\n\n ------- failed to converge at time : 5.22\n E R R O R   T E R M I N A T I O N\n"));
         log(4, " ------- converged at time : 1.5\n");
         let f = read_failures(d.path());
         let got: Vec<(u32, &str, f64)> = f.iter().map(|f| (f.attempt, f.class, f.depth_mm)).collect();
@@ -131,10 +158,12 @@ mod tests {
         let s = summary(&f, "mm");
         assert_eq!(
             s,
-            "3 failed attempt(s), furthest 5.22 mm: max reformations x1 (5.22 mm); negative jacobian x1 (0.86 mm); stopped x1 (1.5 mm)"
+            "3 failed attempt(s), furthest 5.22 mm: max reformations x1 (5.22 mm; least residual 2.0e-6 N); negative jacobian x1 (0.86 mm); stopped x1 (1.5 mm)"
         );
+        // the failing step's own iterations only (not the converged step's 1e-20 before it)
+        assert_eq!(f.iter().map(|f| f.least_residual_n.map(|r| (r * 1e6).round())).collect::<Vec<_>>(), [None, Some(2.0), None]);
         assert_eq!(summary(&[], "mm"), "");
-        assert!(summary(&f, "s").starts_with("3 failed attempt(s), furthest 5.22 s: max reformations x1 (5.22 s)"));
+        assert!(summary(&f, "s").starts_with("3 failed attempt(s), furthest 5.22 s: max reformations x1 (5.22 s; least residual 2.0e-6 N)"));
     }
 
     #[test]
