@@ -185,13 +185,15 @@ impl<'j, 'a> Setup<'j, 'a> {
         shortest * self.fs().dtmin_fraction * restart::CONTINUE_DTMIN_SCALE
     }
 
-    /// A continuation's restarts set the retry tolerances: the dump carries the run's own.
-    /// The residual floor is the retry's or the ramp-and-hold loading's, the larger (as in
-    /// the input file, `feb.rs`).
+    /// A continuation's restarts set the retry tolerances and residual floor
+    /// ([`feb::residual_floor_n`]): the dump carries the run's own.
     fn tolerances(&self) -> Option<restart::Tolerances> {
         let fs = self.fs();
-        let floor_n = self.loading().ramp_hold.as_ref().map_or(0.0, |r| r.min_residual_n).max(fs.retry_min_residual_n);
-        self.plan.retry_tolerances().then_some(restart::Tolerances { dtol: fs.retry_dtol, rtol: fs.retry_rtol, min_residual_n: floor_n })
+        self.plan.retry_tolerances().then(|| restart::Tolerances {
+            dtol: fs.retry_dtol,
+            rtol: fs.retry_rtol,
+            min_residual_n: feb::residual_floor_n(fs, self.loading(), true),
+        })
     }
 
     /// The first-contact caps of the run whose dump this attempt's restarts read: this

@@ -222,10 +222,8 @@ fn write_control(w: &mut String, s: &FebioSettings, loading: &Loading, steps: u3
     let _ = writeln!(w, "      <max_refs>{}</max_refs>", s.max_refs);
     let _ = writeln!(w, "      <reform_each_time_step>1</reform_each_time_step>");
     let _ = writeln!(w, "      <diverge_reform>1</diverge_reform>");
-    // FEBio compares the squared norm; a ramp-and-hold run sets its floor (`crate::visco`),
-    // the retry its own (`retry_min_residual_n`); the larger one holds
-    let retry_floor_n = if stepping.retry_tolerances { s.retry_min_residual_n } else { 0.0 };
-    let floor_n = loading.ramp_hold.as_ref().map_or(0.0, |r| r.min_residual_n).max(retry_floor_n);
+    // FEBio compares the squared norm
+    let floor_n = residual_floor_n(s, loading, stepping.retry_tolerances);
     let min_residual = if floor_n > 0.0 { floor_n * floor_n } else { 1e-20 };
     let _ = writeln!(w, "      <min_residual>{}</min_residual>", num(min_residual));
     // the campaign's retry converges on energy and residual with `retry_dtol` /
@@ -240,6 +238,15 @@ fn write_control(w: &mut String, s: &FebioSettings, loading: &Loading, steps: u3
     let _ = writeln!(w, "      <linear_solver type=\"pardiso\"/>");
     let _ = writeln!(w, "    </solver>");
     let _ = writeln!(w, "  </Control>");
+}
+
+/// Newton's absolute residual floor, N (0: none, FEBio's own 1e-20 N^2): a ramp-and-hold
+/// loading's (`crate::visco`) or, in an attempt with the retry tolerances (`retry`), the
+/// retry's (`retry_min_residual_n`), the larger. The input file and a continuation's
+/// restart input both set it.
+pub(super) fn residual_floor_n(s: &FebioSettings, loading: &Loading, retry: bool) -> f64 {
+    let retry_floor_n = if retry { s.retry_min_residual_n } else { 0.0 };
+    loading.ramp_hold.as_ref().map_or(0.0, |r| r.min_residual_n).max(retry_floor_n)
 }
 
 fn write_material(w: &mut String, c: &Campaign, hub: [f64; 3]) {
