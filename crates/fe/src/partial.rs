@@ -53,6 +53,13 @@ pub fn read_record(out_dir: &Path, pose: &str) -> Option<PartialRecord> {
     toml::from_str(&std::fs::read_to_string(record).ok()?).ok()
 }
 
+/// As [`read_record`], only when the record is of the run with `spec_hash` (a record of
+/// another spec is an earlier problem's, not this run's).
+#[must_use]
+pub fn read_current_record(out_dir: &Path, pose: &str, spec_hash: &str) -> Option<PartialRecord> {
+    read_record(out_dir, pose).filter(|r| r.spec_hash == spec_hash)
+}
+
 /// What the campaign knows of the failed run.
 pub struct Failed<'a> {
     /// The spec as run (steps applied).

@@ -227,10 +227,7 @@ pub fn report(runs: Vec<QlvRun>, missing: Vec<String>) -> QlvReport {
 fn read_partial(plan: &crate::campaign::Plan, run: &str) -> Option<Vec<Row>> {
     let pose = plan.selected.iter().find(|p| p.name == run)?;
     let (csv, _) = crate::partial::paths(&plan.out_dir, run);
-    let record = crate::partial::read_record(&plan.out_dir, run)?;
-    if record.spec_hash != plan.campaign.run_hash(pose, &plan.mesh_name) {
-        return None;
-    }
+    crate::partial::read_current_record(&plan.out_dir, run, &plan.campaign.run_hash(pose, &plan.mesh_name))?;
     let text = std::fs::read_to_string(&csv).ok()?;
     // timed since the record keeps the times; earlier ones have the depth only
     let mut rows = crate::results::parse_timed_csv(&text, &csv).map(|(_, r)| r).or_else(|_| crate::results::parse_csv(&text, &csv)).ok()?;

@@ -55,10 +55,8 @@ pub fn read_current(opts: &RunOptions) -> Result<PoseRows> {
         let csv = plan.out_dir.join(format!("{}.csv", pose.name));
         let entry = plan.manifest.pose.get(&pose.name).filter(|_| !plan.to_run.contains(&i));
         let r = match entry {
-            None => Err(
-                match crate::partial::read_record(&plan.out_dir, &pose.name)
-                    .filter(|r| r.spec_hash == plan.campaign.run_hash(pose, &plan.mesh_name))
-                {
+            None => {
+                Err(match crate::partial::read_current_record(&plan.out_dir, &pose.name, &plan.campaign.run_hash(pose, &plan.mesh_name)) {
                     Some(r) => format!(
                         "{}: not solved; its furthest failed attempt so far reached {} of {} mm (its record: {}.partial.toml)",
                         csv.display(),
@@ -67,8 +65,8 @@ pub fn read_current(opts: &RunOptions) -> Result<PoseRows> {
                         pose.name
                     ),
                     None => format!("{}: no current result (mesh {}, {} steps)", csv.display(), plan.mesh_name, plan.steps),
-                },
-            ),
+                })
+            }
             Some(e) => read_rows(&csv, plan.campaign.loading.ramp_hold.is_some())
                 .map(|rows| Run { rows, entry: e.clone() })
                 .map_err(|e| format!("{e:#}")),
