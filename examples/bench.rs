@@ -26,8 +26,9 @@
 //!   100 bytes), `fixed+k` [`needle_haptics::fixed::wrench_and_stiffness`] (the same in
 //!   integers).
 //! - **Insertion** (per compiled-in stack, a tick deflecting the surface and a tick deep
-//!   inside, from a state advanced there at 3 mm/s): evaluator `insertion`
-//!   ([`needle_haptics::insertion::Insertion::step`]) and `fixed-insertion`
+//!   inside, from a state advanced there at 3 mm/s), the stack's layers without Prony
+//!   terms (the elastic insertion, also for a shipped layer with terms): evaluator
+//!   `insertion` ([`needle_haptics::insertion::Insertion::step`]) and `fixed-insertion`
 //!   ([`needle_haptics::fixed::insertion::Insertion::step`], the same poses in Q16.16).
 //!   With the viscoelastic filter: `insertion+qlv` and `fixed-insertion+qlv`, the same
 //!   stacks and cases with three Prony terms on every layer ([`QLV_TERMS`]: cost inputs,
@@ -58,10 +59,10 @@ mod firmware {
     use cortex_m::peripheral::SYST;
     use needle_haptics::fixed::insertion::Insertion as FixedInsertion;
     use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, InsertionEvaluation};
-    #[cfg(feature = "viscoelastic")]
     use needle_haptics::insertion::{Layer, MAX_LAYERS};
     #[cfg(feature = "viscoelastic")]
-    use needle_haptics::viscoelastic::{PronyTerm, PronyTerms};
+    use needle_haptics::viscoelastic::PronyTerm;
+    use needle_haptics::viscoelastic::PronyTerms;
     use needle_haptics::{fixed, wrench, wrench_and_stiffness, Pose};
 
     /// Evaluations per timed loop.
@@ -74,10 +75,10 @@ mod firmware {
     const QLV_TERMS: [PronyTerm; 3] =
         [PronyTerm { g: 0.8, tau_s: 0.05 }, PronyTerm { g: 0.5, tau_s: 1.0 }, PronyTerm { g: 0.3, tau_s: 20.0 }];
 
-    /// `stack`'s layers with [`QLV_TERMS`] on each (the first `count` used).
-    #[cfg(feature = "viscoelastic")]
-    fn with_qlv(stack: &needle_haptics::insertion::Stack<'_>) -> Option<([Layer; MAX_LAYERS], usize)> {
-        let terms = PronyTerms::from_array(QLV_TERMS, 3)?;
+    /// `stack`'s layers with `terms` on each (the first `count` used): [`QLV_TERMS`] for
+    /// the `+qlv` rows, none for the plain rows (the elastic insertion, whatever terms a
+    /// shipped layer has, so that `+qlv` minus plain is the filter's cost).
+    fn with_terms(stack: &needle_haptics::insertion::Stack<'_>, terms: PronyTerms) -> Option<([Layer; MAX_LAYERS], usize)> {
         let mut layers = [*stack.layers.first()?; MAX_LAYERS];
         for (slot, l) in layers.iter_mut().zip(stack.layers) {
             *slot = Layer { prony: terms, ..*l };
@@ -329,14 +330,18 @@ mod firmware {
         for stack in &stacks::ALL {
             let total: f32 = stack.layers.iter().map(|l| l.thickness_mm).sum();
             let cases = [("surface", Pose::new(3.0, -2.0, 5.0, -7.0, 4.5)), ("deep", Pose::new(3.0, -2.0, 5.0, -7.0, total + 2.0))];
+            let Some((elastic_layers, count)) = with_terms(stack, PronyTerms::NONE) else {
+                continue;
+            };
+            let elastic = needle_haptics::insertion::Stack { layers: elastic_layers.get(..count).unwrap_or(&[]), ..*stack };
             #[cfg(feature = "viscoelastic")]
-            let Some((qlv_layers, count)) = with_qlv(stack) else {
+            let Some((qlv_layers, count)) = PronyTerms::from_array(QLV_TERMS, 3).and_then(|t| with_terms(stack, t)) else {
                 continue;
             };
             #[cfg(feature = "viscoelastic")]
             let qlv = needle_haptics::insertion::Stack { layers: qlv_layers.get(..count).unwrap_or(&[]), ..*stack };
             for (name, pose) in cases {
-                let Some(ins) = advanced(stack, &pose) else { continue };
+                let Some(ins) = advanced(&elastic, &pose) else { continue };
                 bench_insertion(&mut out, &cal, &ins, &pose, (stack.name, name, "insertion"));
                 #[cfg(feature = "viscoelastic")]
                 {
@@ -349,6 +354,13 @@ mod firmware {
         for stack in &fixed::insertion::stacks::ALL {
             let total: i32 = stack.layers().iter().map(|l| l.thickness_q16 as i32).sum();
             let tilted = |depth| fixed::Pose::new(3 * ONE, -2 * ONE, 5 * ONE, -7 * ONE, depth);
+            // without the feature the fixed-point layers carry no terms: the stack is elastic
+            #[cfg_attr(not(feature = "viscoelastic"), allow(unused_mut))]
+            let mut elastic = *stack;
+            #[cfg(feature = "viscoelastic")]
+            for l in &mut elastic.layers {
+                l.prony = fixed::viscoelastic::PronyTerms::NONE;
+            }
             #[cfg(feature = "viscoelastic")]
             let mut qlv = *stack;
             #[cfg(feature = "viscoelastic")]
@@ -358,7 +370,7 @@ mod firmware {
                 }
             }
             for (name, pose) in [("surface", tilted(9 * ONE / 2)), ("deep", tilted(total + 2 * ONE))] {
-                let Some(ins) = advanced_fixed(stack, &pose) else { continue };
+                let Some(ins) = advanced_fixed(&elastic, &pose) else { continue };
                 bench_insertion(&mut out, &cal, &ins, &pose, (stack.name, name, "fixed-insertion"));
                 #[cfg(feature = "viscoelastic")]
                 {

@@ -133,6 +133,10 @@ mod firmware {
                     out.hex(u32::from(phase), 4);
                     out.str(" tick_flags=");
                     out.hex(u32::from(l.core().last().flags.bits()), 4);
+                    // the Prony terms of the deflected boundary's layer (0: no filter ran)
+                    let deflected = if phase & 0xff00 == 0x0100 { stack.layers.get(usize::from(phase & 0xff)) } else { None };
+                    out.str(" qlv_terms=");
+                    out.dec(deflected.map_or(0, |layer| layer.prony.len()) as u64);
                     out.nl();
                 }
             }

@@ -302,26 +302,66 @@ impl QlvCoefficients {
     #[cfg(feature = "viscoelastic")]
     #[inline]
     pub(crate) fn step_increments(&self, h: &mut [[f32; MAX_TERMS]; 3], d: [f32; 3]) -> [f32; 3] {
+        match self.count {
+            1 => self.increments_of::<1>(h, d),
+            2 => self.increments_of::<2>(h, d),
+            _ => self.increments_of::<MAX_TERMS>(h, d),
+        }
+    }
+
+    /// [`step_increments`](Self::step_increments) with the first `N` terms (the others
+    /// are zero and stay zero: `a = b = 0`).
+    #[cfg(feature = "viscoelastic")]
+    #[inline(always)]
+    fn increments_of<const N: usize>(&self, h: &mut [[f32; MAX_TERMS]; 3], d: [f32; 3]) -> [f32; 3] {
         let mut out = [0.0; 3];
-        for ((o, [h0, h1, h2]), d) in out.iter_mut().zip(h.iter_mut()).zip(d) {
-            *h0 = self.a[0] * *h0 + self.b[0] * d;
-            *h1 = self.a[1] * *h1 + self.b[1] * d;
-            *h2 = self.a[2] * *h2 + self.b[2] * d;
-            *o = *h0 + *h1 + *h2;
+        for ((o, h), d) in out.iter_mut().zip(h.iter_mut()).zip(d) {
+            // -0.0 is addition's identity (0.0 is not: 0.0 + -0.0 = 0.0): the bits of `h_0 + h_1 + h_2`
+            *o = self.terms_of::<N>(h, d, -0.0);
         }
         out
+    }
+
+    /// The six components of `w` in place, each with its `[last input, h_0, h_1, h_2]`
+    /// in `state`; only the terms there are computed (a layer with one term pays for one).
+    #[inline]
+    fn step_components(&self, state: &mut [[f32; 1 + MAX_TERMS]; COMPONENT_COUNT], w: &mut [f32; COMPONENT_COUNT]) {
+        match self.count {
+            1 => self.components_of::<1>(state, w),
+            2 => self.components_of::<2>(state, w),
+            _ => self.components_of::<MAX_TERMS>(state, w),
+        }
+    }
+
+    #[inline(always)]
+    fn components_of<const N: usize>(&self, state: &mut [[f32; 1 + MAX_TERMS]; COMPONENT_COUNT], w: &mut [f32; COMPONENT_COUNT]) {
+        for (o, [last, h @ ..]) in w.iter_mut().zip(state.iter_mut()) {
+            let d = *o - *last;
+            *last = *o;
+            *o = self.terms_of::<N>(h, d, *o);
+        }
+    }
+
+    /// The first `N` terms: `h_i <- a_i h_i + b_i d`, and `start + h_0 + ... + h_{N-1}`
+    /// summed in that order (the order of the three-term sum, so `N = 3` gives the bits
+    /// of every term written out; a skipped term is zero).
+    #[inline(always)]
+    fn terms_of<const N: usize>(&self, h: &mut [f32; MAX_TERMS], d: f32, start: f32) -> f32 {
+        let mut sum = start;
+        for ((h, a), b) in h.iter_mut().zip(self.a).zip(self.b).take(N) {
+            *h = a * *h + b * d;
+            sum += *h;
+        }
+        sum
     }
 
     /// One component: `h_i <- a_i h_i + b_i d`, the output `elastic + sum h_i`.
     #[inline]
     fn step_one(&self, state: &mut [f32; 1 + MAX_TERMS], elastic: f32) -> f32 {
-        let [last, h0, h1, h2] = state;
+        let [last, h @ ..] = state;
         let d = elastic - *last;
         *last = elastic;
-        *h0 = self.a[0] * *h0 + self.b[0] * d;
-        *h1 = self.a[1] * *h1 + self.b[1] * d;
-        *h2 = self.a[2] * *h2 + self.b[2] * d;
-        elastic + *h0 + *h1 + *h2
+        self.terms_of::<MAX_TERMS>(h, d, elastic)
     }
 }
 
@@ -393,9 +433,7 @@ impl QlvState {
     /// The six components in place.
     fn filter(&mut self, coefficients: &QlvCoefficients, w: &mut [f32; COMPONENT_COUNT]) {
         self.stored = true;
-        for (o, s) in w.iter_mut().zip(self.state.iter_mut()) {
-            *o = coefficients.step_one(s, *o);
-        }
+        coefficients.step_components(&mut self.state, w);
     }
 
     /// Back to rest.

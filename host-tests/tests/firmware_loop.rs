@@ -53,11 +53,19 @@ fn loop_tick_instructions_on_cortex_m4f() {
         })
         .collect();
     assert_eq!(insertion.len(), 4 * needle_haptics::insertion::stacks::ALL.len(), "{out}");
-    for (what, n) in &insertion {
-        assert!(*n <= 1600.0, "{what}: {n} instructions per loop tick (goal <= 1,600)");
-    }
     let phases: Vec<&str> = out.lines().filter_map(|l| field(l, "insertion_phase")).collect();
     assert_eq!(phases.len(), insertion.len(), "{out}");
+    let terms: Vec<usize> = out.lines().filter_map(|l| field(l, "qlv_terms")?.parse().ok()).collect();
+    assert_eq!(terms.len(), insertion.len(), "{out}");
+    assert!(terms.iter().any(|&t| t > 0), "no case deflects a boundary with Prony terms (the epidural skin has one):\n{out}");
+    for ((what, n), &t) in insertion.iter().zip(&terms) {
+        // Issue 41's 1,600 is the elastic insertion's budget; a tick whose deflected layer
+        // has Prony terms also runs the viscoelastic filter (the insertion's and the
+        // guard's), which has its own budget of 120 instructions per tick (issue 39), so
+        // such a tick is held to the sum of the two goals.
+        let goal = if t == 0 { 1600.0 } else { 1600.0 + 120.0 };
+        assert!(*n <= goal, "{what}: {n} instructions per loop tick with {t} Prony term(s) on the deflected layer (goal <= {goal})");
+    }
     for ((what, _), phase) in insertion.iter().zip(&phases) {
         let want = if what.contains("-surface") { "0x0100" } else { "0x02" };
         assert!(phase.starts_with(want), "{what}: phase {phase}, want {want}..");

@@ -167,7 +167,8 @@ fn no_closed_cycle_delivers_energy_to_the_hand() {
 }
 
 /// Prony terms for the filter-on runs: inputs that exercise the filter, not a tissue's
-/// values (the shipped stacks have none: `coeffs/default/tissue/`). `moderate`: weights
+/// values (of the shipped stacks only the epidural skin has a term, `coeffs/default/tissue/`,
+/// and the stacks as shipped run too). `moderate`: weights
 /// of the order a soft tissue relaxes by over three decades of time constants;
 /// `extreme`: the largest sum the format allows (9) with time constants of the
 /// trajectories' own time scales (1 ms to 0.1 s), where the filter acts most.

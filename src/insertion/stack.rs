@@ -87,7 +87,9 @@ pub mod stacks {
     use super::{Karnopp, Layer, PronyTerm, PronyTerms, Stack};
     include!(concat!(env!("OUT_DIR"), "/tissue_stacks.rs"));
 
-    /// Whether no layer of `stacks` has a Prony term.
+    /// Whether no layer of `stacks` has a Prony term: a build without the `viscoelastic`
+    /// feature holds only such stacks (a stack with terms is compiled with the feature
+    /// alone, and `ALL` then lists the others), checked at compile time.
     #[cfg(not(feature = "viscoelastic"))]
     #[allow(clippy::indexing_slicing)] // const evaluation only: out of range is a compile error
     const fn elastic(stacks: &[Stack<'static>]) -> bool {
@@ -107,7 +109,10 @@ pub mod stacks {
     }
 
     #[cfg(not(feature = "viscoelastic"))]
-    const _: () = assert!(elastic(&ALL), "a tissue file of the set has Prony terms: build needle-haptics with its `viscoelastic` feature");
+    const _: () = assert!(
+        elastic(&ALL),
+        "the elastic build's ALL holds a stack with Prony terms (needle-codegen gates such stacks behind the `viscoelastic` feature)"
+    );
 }
 
 pub use stacks::{FE_NEEDLE_DIAMETER_MM, HUB_FROM_TIP_MM};

@@ -42,7 +42,8 @@ pub struct EvalArgs {
     /// With --insertion: these Prony terms on every layer of the stack in place of its
     /// own, "g:tau_s" pairs comma-separated (e.g. "0.6:0.5, 0.4:5"; at most 3, g >= 0,
     /// tau_s > 0 s, the long-term normalisation of coeffs/README.md): the scripted
-    /// insertion with the viscoelastic filter (a shipped stack has no terms).
+    /// insertion with the viscoelastic filter (of the shipped stacks only the epidural
+    /// skin has terms of its own).
     #[arg(long, value_name = "G:TAU_S,...", requires = "insertion", allow_hyphen_values = true)]
     pub prony: Option<String>,
     /// With --poses: write the rows to this file instead of standard output.
