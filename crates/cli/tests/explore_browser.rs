@@ -169,13 +169,13 @@ async fn explorer_page_shows_what_needle_eval_computes() {
     std::fs::create_dir_all(&shots).expect("screenshot folder");
 
     // a pose inside the domain, an FE run's of the set (x+04: its FE points overlaid), one
-    // whose x is beyond the domain (clamped, SAT_X), and tx+15's, which the FE could not
-    // solve (FE_UNSOLVED: the note shows)
+    // whose x is beyond the domain (clamped, SAT_X), and tx+15's at 6 mm, below the
+    // 5.70 mm its furthest attempt reached (FE_UNSOLVED: the note shows)
     let cases: [(&str, [(&str, &str); 5]); 4] = [
         ("inside", [("x_mm", "2"), ("z_mm", "1"), ("theta_x_deg", "3"), ("theta_z_deg", "-4.5"), ("depth_mm", "5")]),
         ("fe-run", [("x_mm", "4"), ("z_mm", "0"), ("theta_x_deg", "0"), ("theta_z_deg", "0"), ("depth_mm", "4.2")]),
         ("saturated", [("x_mm", "14"), ("z_mm", "-3"), ("theta_x_deg", "-7"), ("theta_z_deg", "11"), ("depth_mm", "2.5")]),
-        ("unsolved", [("x_mm", "0"), ("z_mm", "0"), ("theta_x_deg", "15"), ("theta_z_deg", "0"), ("depth_mm", "4")]),
+        ("unsolved", [("x_mm", "0"), ("z_mm", "0"), ("theta_x_deg", "15"), ("theta_z_deg", "0"), ("depth_mm", "6")]),
     ];
     for (case, pose) in &cases {
         for (name, v) in pose {
