@@ -654,6 +654,9 @@ mod tests {
     #[test]
     fn a_partial_record_joins_the_region_and_validate_names_it() {
         let dir = temp_set("record");
+        // the shipped t2-b is solved: without its result it stands for a held-out pose
+        // whose every attempt failed
+        std::fs::remove_file(dir.join("fe/t2-b.csv")).expect("t2-b's result in the copy");
         let (campaign, _) = spec::load(&dir).expect("spec");
         let pose = campaign.poses().into_iter().find(|p| p.name == "t2-b").expect("t2-b");
         let failed = needle_fe::partial::Failed {
@@ -670,7 +673,7 @@ mod tests {
         let t2b = r.failed.iter().find(|f| f.pose == "t2-b").expect("t2-b is in the region").clone();
         assert_eq!((t2b.source.as_str(), t2b.reached_depth_mm, t2b.depth_q16), ("fe/t2-b.partial.toml", Some(1.8), 117_965));
         assert!(t2b.cause.contains("max reformations"), "{}", t2b.cause);
-        assert!(r.failed.iter().all(|f| f.pose != "lhs-04"), "no record, not fitted without: not in the region");
+        assert!(r.failed.iter().all(|f| f.pose != "lhs-16"), "no record, not fitted without: not in the region");
         assert!(solved_inside(&r).is_empty(), "a ball reaches half way to the nearest solved run: {:?}", solved_inside(&r));
         let entries = r.entries();
         let n = normalised(t2b.at).map(|v| v as f32);
