@@ -335,10 +335,8 @@ impl QlvCoefficients {
 
     #[inline(always)]
     fn components_of<const N: usize>(&self, state: &mut [[f32; 1 + MAX_TERMS]; COMPONENT_COUNT], w: &mut [f32; COMPONENT_COUNT]) {
-        for (o, [last, h @ ..]) in w.iter_mut().zip(state.iter_mut()) {
-            let d = *o - *last;
-            *last = *o;
-            *o = self.terms_of::<N>(h, d, *o);
+        for (o, s) in w.iter_mut().zip(state.iter_mut()) {
+            *o = self.one_of::<N>(s, *o);
         }
     }
 
@@ -358,10 +356,16 @@ impl QlvCoefficients {
     /// One component: `h_i <- a_i h_i + b_i d`, the output `elastic + sum h_i`.
     #[inline]
     fn step_one(&self, state: &mut [f32; 1 + MAX_TERMS], elastic: f32) -> f32 {
+        self.one_of::<MAX_TERMS>(state, elastic)
+    }
+
+    /// [`step_one`](Self::step_one) with the first `N` terms.
+    #[inline(always)]
+    fn one_of<const N: usize>(&self, state: &mut [f32; 1 + MAX_TERMS], elastic: f32) -> f32 {
         let [last, h @ ..] = state;
         let d = elastic - *last;
         *last = elastic;
-        self.terms_of::<MAX_TERMS>(h, d, elastic)
+        self.terms_of::<N>(h, d, elastic)
     }
 }
 
