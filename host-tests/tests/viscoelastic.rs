@@ -176,6 +176,19 @@ fn bad_terms_are_refused() {
         assert_eq!(PronyTerms::new(t), Err(e), "{t:?}");
     }
     assert!(PronyTerms::new(&[PronyTerm { g: 5.0, tau_s: 1.0 }, PronyTerm { g: 4.0, tau_s: 2.0 }]).is_ok(), "sum 9 is allowed");
+    // the sum is taken in f32, in order (the filter's arithmetic): 4 + (5 + 1 ulp) rounds to
+    // 9 and is allowed, 4 + (5 + 2 ulp) is the next f32 above 9 and is refused; `new` and
+    // `from_array` agree
+    let over = |ulps: u32| {
+        let g = (0..ulps).fold(5.0f32, |g, _| g.next_up());
+        [PronyTerm { g: 4.0, tau_s: 1.0 }, PronyTerm { g, tau_s: 2.0 }, PronyTerm::default()]
+    };
+    assert!(PronyTerms::new(&over(1)[..2]).is_ok());
+    assert!(PronyTerms::from_array(over(1), 2).is_some());
+    assert_eq!(PronyTerms::new(&over(2)[..2]), Err(QlvError::WeightSum));
+    assert_eq!(PronyTerms::from_array(over(2), 2), None);
+    let nine = [PronyTerm { g: 4.0, tau_s: 1.0 }, PronyTerm { g: 5.0, tau_s: 2.0 }, PronyTerm::default()];
+    assert_eq!(PronyTerms::from_array(nine, 2).ok_or(QlvError::WeightSum), PronyTerms::new(&nine[..2]));
     for tick in [0.0, -0.001, f32::NAN] {
         assert_eq!(Qlv::new(&terms(), tick), Err(QlvError::Tick));
     }
