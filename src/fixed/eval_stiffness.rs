@@ -76,8 +76,8 @@ fn wrench_and_depth_rates(pose: &Pose, e: &mut StiffnessEvaluation) {
         e.stiffness.by_depth = WrenchRate::from_array(by_depth);
     }
     // the wrench after the rates: its array and `by_depth` are not live together (the
-    // stack, measured on the M0 with a coupled model of sweep degree 2 in Fy: 520 B with
-    // the wrench first)
+    // stack, measured on the M0 with `needle firmware bench`: 496 B, 512 B with the
+    // wrench first)
     e.wrench = Wrench::from_array(output(&a, at.u));
     e.status = at.status;
 }
