@@ -437,7 +437,10 @@ impl QlvState {
         out
     }
 
-    /// The six components in place.
+    /// The six components in place. Out of line: inlined into the insertion's step, its
+    /// registers and stack slots made every step dearer, with or without terms (M4F:
+    /// the elastic step 25-72 instructions and 48 B of stack; docs/insertion.md).
+    #[inline(never)]
     fn filter(&mut self, coefficients: &QlvCoefficients, w: &mut [f32; COMPONENT_COUNT]) {
         self.stored = true;
         coefficients.step_components(&mut self.state, w);
