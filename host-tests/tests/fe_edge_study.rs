@@ -4,9 +4,14 @@
 //! campaign's data rest on holds: with a 0.4 mm edge the centre's shape converges
 //! (needle8 against fine within the mesh study's goal after the best scale), and the
 //! campaign's own needle8 runs (0.1 mm edge) carry that converged shape (the campaign's
-//! centre against the 0.4 mm edge on fine, within the same goal), while the 0.1 mm edge
-//! itself does not converge (`[mesh]`: outside the goal). The numbers are FEBio's, written
-//! by the tool (never typed in); the radius 0.4 is the study's input, read from the spec.
+//! centre against the 0.4 mm edge on fine, within the same goal). The study was measured
+//! against fine runs solved with the campaign's energy tolerance (1e-2); its premise, that
+//! the campaign's 0.1 mm edge does not converge, fell when the mesh study's reference got
+//! its own tolerance (1e-3, `[mesh.fine] etol`): the scatter was the loose Newton
+//! tolerance's, and the campaign's level now carries the reference's shape
+//! (`fe_mesh_study.rs`). Its numbers stay as that study's record. The numbers are
+//! FEBio's, written by the tool (never typed in); the radius 0.4 is the study's input,
+//! read from the spec.
 
 use needle_fe::verify::shape::{SHAPE_MAX_GOAL_PERCENT, SHAPE_RMS_GOAL_PERCENT};
 use std::path::Path;
@@ -57,14 +62,4 @@ fn the_edge_study_is_in_verify_toml_and_a_resolved_edge_converges() {
     assert!(within(pair, &[]), "r {largest} mm: needle8 against fine outside the goal: {pair}");
     let campaign = centre_of(e, "campaign_against_refined").expect("the campaign's centre against the refined level");
     assert!(within(campaign, &[]), "the campaign's centre against r {largest} mm on fine: {campaign}");
-    // and the campaign's own edge does not converge (the reason for the study)
-    let mesh_shape = t.get("mesh").and_then(|m| m.get("shape")).and_then(toml::Value::as_array).expect("[mesh] shape");
-    let centre = mesh_shape
-        .iter()
-        .find(|s| {
-            s.get("pose").and_then(toml::Value::as_str) == Some("centre")
-                && s.get("coarse").and_then(toml::Value::as_str) == Some(c.campaign.mesh.as_str())
-        })
-        .expect("the centre in the mesh study");
-    assert!(!within(centre, &[]), "the campaign's edge now converges: the edge study's conclusion changes: {centre}");
 }

@@ -15,7 +15,7 @@ use super::{
 use super::{FebioBackend, JOB, REACTION_SIGN};
 use crate::backend::{Job, SolveFailure, Solved};
 use crate::process::{self, ExitKind, LOG_TAIL_LINES};
-use crate::spec::{Campaign, FebioSettings, Loading};
+use crate::spec::{Campaign, FebioSettings, Loading, MeshLevel};
 use crate::wrench::expand_mirrors;
 use anyhow::{Context, Result};
 use needle_contract::COMPONENT_COUNT;
@@ -143,7 +143,7 @@ impl<'j, 'a> Setup<'j, 'a> {
             Some(r) => (r.plan, r.continued.clone()),
             None => (plan, resume),
         };
-        let campaign = campaign_for(job.campaign, plan.contact());
+        let campaign = campaign_for(job.campaign, plan.contact(), job.mesh);
         let fs = &campaign.solver.febio;
         let contact_steps = first_contact_steps(fs, &job.campaign.loading, job.steps);
         let first_contact = (!plan.retry_tolerances() && ladder::failed_at_first_contact(&state, contact_steps))
@@ -559,13 +559,17 @@ fn ladder_state(job: &Job<'_>, resuming: bool) -> Result<ladder::State> {
     Ok(s)
 }
 
-/// The campaign with the contact `contact` asks for (`retry_seg_up`, the softer penalty).
-fn campaign_for(campaign: &Campaign, contact: ladder::Fresh) -> Cow<'_, Campaign> {
-    if contact.seg_up == ladder::SegUp::Spec && !contact.softer {
+/// The campaign with the contact `contact` asks for (`retry_seg_up`, the softer penalty)
+/// and the mesh level's own energy tolerance (`[mesh.<level>] etol`).
+fn campaign_for<'c>(campaign: &'c Campaign, contact: ladder::Fresh, mesh: &MeshLevel) -> Cow<'c, Campaign> {
+    if contact.seg_up == ladder::SegUp::Spec && !contact.softer && mesh.etol.is_none() {
         return Cow::Borrowed(campaign);
     }
     let mut c = campaign.clone();
     let s = &mut c.solver.febio;
+    if let Some(etol) = mesh.etol {
+        s.etol = etol;
+    }
     if contact.seg_up == ladder::SegUp::Retry {
         s.seg_up = s.retry_seg_up;
     }
@@ -582,5 +586,41 @@ fn first_contact_steps(fs: &FebioSettings, loading: &Loading, steps: u32) -> u32
         (1..=steps).take_while(|&k| loading.depth_at(k - 1) < fs.first_contact_depth_mm - 1e-9 * loading.depth_mm).count() as u32
     } else {
         ladder::first_contact_steps(fs.first_contact_depth_mm, loading.depth_mm, steps)
+    }
+}
+
+#[cfg(test)]
+mod level_tolerance_tests {
+    use super::*;
+
+    /// `[mesh.<level>] etol` reaches the FEBio input of every attempt on that level, and
+    /// only there (the mesh study's reference level, coeffs/README.md).
+    #[test]
+    fn a_levels_energy_tolerance_replaces_the_solvers() {
+        let set = crate::workspace_root().join("coeffs/default");
+        let (c, _) = crate::spec::load(&set).expect("the shipped spec");
+        let centre = c.pose.iter().find(|p| p.name == "centre").expect("centre");
+        let own = c.mesh_level("fine").expect("fine").clone();
+        let etol = own.etol.expect("the shipped fine level has its own etol");
+        assert_ne!(etol, c.solver.febio.etol, "the shipped fine level's etol differs from the solver's");
+        let plain = MeshLevel { etol: None, ..own.clone() };
+        for contact in [
+            ladder::Fresh { seg_up: ladder::SegUp::Spec, softer: false, quarter: false },
+            ladder::Fresh { seg_up: ladder::SegUp::Retry, softer: true, quarter: true },
+        ] {
+            assert_eq!(campaign_for(&c, contact, &own).solver.febio.etol, etol, "{contact:?}");
+            assert_eq!(campaign_for(&c, contact, &plain).solver.febio.etol, c.solver.febio.etol, "{contact:?}");
+            let text = |level: &MeshLevel| {
+                let stepping = feb::Stepping { first_step_fraction: 1.0, retry_tolerances: false, first_contact: None };
+                feb::write_stepped(&campaign_for(&c, contact, level), centre, level, 2, &stepping).expect("the FEBio input").text
+            };
+            assert!(text(&own).contains(&format!("<etol>{}</etol>", feb::num(etol))), "{contact:?}");
+            assert!(text(&plain).contains(&format!("<etol>{}</etol>", feb::num(c.solver.febio.etol))), "{contact:?}");
+        }
+        assert_ne!(
+            c.run_hash(centre, "fine"),
+            crate::spec::Campaign { mesh: [("fine".to_string(), plain)].into_iter().collect(), ..c.clone() }.run_hash(centre, "fine"),
+            "the level's etol is part of its runs' hash"
+        );
     }
 }

@@ -23,6 +23,12 @@ pub struct MeshLevel {
     pub needle_facets_per_quarter: u32,
     /// Needle layer length near the tip, mm.
     pub needle_axial_mm: f64,
+    /// FEBio's Newton energy tolerance (`etol`) for the runs on this level, instead of
+    /// `[solver.febio] etol`; absent: the solver's. Part of the level, so of its runs'
+    /// hash. For a study's reference level, whose must points are the reference the
+    /// campaign's level is judged against (coeffs/README.md, "Mesh study").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub etol: Option<f64>,
 }
 
 impl MeshLevel {
@@ -49,10 +55,39 @@ impl MeshLevel {
         ] {
             positive(path, &format!("mesh.{name}.{f}"), v)?;
         }
+        if let Some(etol) = self.etol {
+            positive(path, &format!("mesh.{name}.etol"), etol)?;
+        }
         if !(self.growth.is_finite() && self.growth >= 1.0) {
             let field = format!("mesh.{name}.growth");
             return Err(SpecError::range(&p, &field, format!("{field} = {}: must be >= 1", self.growth)));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod mesh_level_tests {
+    use crate::deep::key_line;
+    use crate::spec::{parse, SpecError};
+    use std::path::Path;
+
+    #[test]
+    fn a_levels_energy_tolerance_not_above_zero_is_refused_with_file_line_and_field() {
+        let text = std::fs::read_to_string(crate::workspace_root().join("coeffs/default/campaign.toml")).expect("campaign.toml");
+        let line = key_line(&text, "mesh.fine", "etol");
+        assert!(line > 0, "the shipped [mesh.fine] has its etol");
+        let shipped = text.lines().nth(line - 1).expect("the etol line").to_string();
+        for bad in ["0.0", "-0.001", "nan", "inf"] {
+            let spec = text.replace(&shipped, &format!("etol = {bad}"));
+            assert_ne!(spec, text);
+            match parse(&spec, Path::new("campaign.toml")) {
+                Ok(_) => panic!("etol = {bad} accepted"),
+                Err(e) => {
+                    assert!(matches!(&e, SpecError::OutOfRange { field, .. } if field == "mesh.fine.etol"), "{e:?}");
+                    assert_eq!(e.at(), format!("campaign.toml:{line}"), "{e}");
+                }
+            }
+        }
     }
 }
