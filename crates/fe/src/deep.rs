@@ -28,6 +28,18 @@ pub struct DeepSettings {
     pub poses: Vec<String>,
 }
 
+/// The shipped set's `campaign.toml`, the 1-based line of `key` in its `[section]` and
+/// that line's text: for tests that edit one line of the shipped spec.
+#[cfg(test)]
+pub(crate) fn shipped_key(section: &str, key: &str) -> (String, usize, String) {
+    let path = crate::workspace_root().join("coeffs/default/campaign.toml");
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let line = key_line(&text, section, key);
+    assert!(line > 0, "the shipped campaign.toml has [{section}] {key}");
+    let shipped = text.lines().nth(line - 1).unwrap_or_default().to_string();
+    (text, line, shipped)
+}
+
 /// The 1-based line of `key = ...` inside the `[section]` table of `text` (0 when not
 /// found), for `file:line` in messages.
 pub fn key_line(text: &str, section: &str, key: &str) -> usize {

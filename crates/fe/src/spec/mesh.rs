@@ -68,16 +68,13 @@ impl MeshLevel {
 
 #[cfg(test)]
 mod mesh_level_tests {
-    use crate::deep::key_line;
+    use crate::deep::shipped_key;
     use crate::spec::{parse, SpecError};
     use std::path::Path;
 
     #[test]
     fn a_levels_energy_tolerance_not_above_zero_is_refused_with_file_line_and_field() {
-        let text = std::fs::read_to_string(crate::workspace_root().join("coeffs/default/campaign.toml")).expect("campaign.toml");
-        let line = key_line(&text, "mesh.fine", "etol");
-        assert!(line > 0, "the shipped [mesh.fine] has its etol");
-        let shipped = text.lines().nth(line - 1).expect("the etol line").to_string();
+        let (text, line, shipped) = shipped_key("mesh.fine", "etol");
         for bad in ["0.0", "-0.001", "nan", "inf"] {
             let spec = text.replace(&shipped, &format!("etol = {bad}"));
             assert_ne!(spec, text);

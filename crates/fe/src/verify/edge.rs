@@ -143,15 +143,12 @@ pub fn edge_study(c: &Campaign, o: &MeshOptions) -> Result<Vec<EdgeStudy>> {
 
 #[cfg(test)]
 mod tests {
-    use crate::deep::key_line;
+    use crate::deep::shipped_key;
     use std::path::Path;
 
     #[test]
     fn bad_radii_are_refused_with_file_line_and_field() {
-        let text = std::fs::read_to_string(crate::workspace_root().join("coeffs/default/campaign.toml")).expect("campaign.toml");
-        let line = key_line(&text, "campaign", "edge_study_radii_mm");
-        assert!(line > 0, "the shipped spec has campaign.edge_study_radii_mm");
-        let shipped = text.lines().nth(line - 1).unwrap_or_default().to_string();
+        let (text, line, shipped) = shipped_key("campaign", "edge_study_radii_mm");
         for (bad, want) in [
             ("[0.0]", "must be > 0 and below the needle's radius"),
             ("[0.7]", "must be > 0 and below the needle's radius"),
