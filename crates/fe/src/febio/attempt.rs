@@ -562,13 +562,16 @@ fn ladder_state(job: &Job<'_>, resuming: bool) -> Result<ladder::State> {
 /// The campaign with the contact `contact` asks for (`retry_seg_up`, the softer penalty)
 /// and the mesh level's own energy tolerance (`[mesh.<level>] etol`).
 fn campaign_for<'c>(campaign: &'c Campaign, contact: ladder::Fresh, mesh: &MeshLevel) -> Cow<'c, Campaign> {
-    if contact.seg_up == ladder::SegUp::Spec && !contact.softer && mesh.etol.is_none() {
+    if contact.seg_up == ladder::SegUp::Spec && !contact.softer && mesh.etol.is_none() && mesh.retry_min_residual_n.is_none() {
         return Cow::Borrowed(campaign);
     }
     let mut c = campaign.clone();
     let s = &mut c.solver.febio;
     if let Some(etol) = mesh.etol {
         s.etol = etol;
+    }
+    if let Some(floor_n) = mesh.retry_min_residual_n {
+        s.retry_min_residual_n = floor_n;
     }
     if contact.seg_up == ladder::SegUp::Retry {
         s.seg_up = s.retry_seg_up;
@@ -622,5 +625,32 @@ mod level_tolerance_tests {
             crate::spec::Campaign { mesh: [("fine".to_string(), plain)].into_iter().collect(), ..c.clone() }.run_hash(centre, "fine"),
             "the level's etol is part of its runs' hash"
         );
+    }
+
+    /// `[mesh.<level>] retry_min_residual_n` reaches the retries' FEBio input on that
+    /// level (FEBio's `min_residual`, squared), not the first attempt's, and is part of
+    /// the run hash but not of the first-attempt hash.
+    #[test]
+    fn a_levels_residual_floor_replaces_the_retrys_and_only_there() {
+        let set = crate::workspace_root().join("coeffs/default");
+        let (c, _) = crate::spec::load(&set).expect("the shipped spec");
+        let centre = c.pose.iter().find(|p| p.name == "centre").expect("centre");
+        let own = c.mesh_level("fine").expect("fine").clone();
+        let floor_n = own.retry_min_residual_n.expect("the shipped fine level has its own residual floor");
+        assert_ne!(floor_n, c.solver.febio.retry_min_residual_n, "the shipped fine level's floor differs from the solver's");
+        let plain = MeshLevel { retry_min_residual_n: None, ..own.clone() };
+        let contact = ladder::Fresh { seg_up: ladder::SegUp::Spec, softer: false, quarter: false };
+        assert_eq!(campaign_for(&c, contact, &own).solver.febio.retry_min_residual_n, floor_n);
+        assert_eq!(campaign_for(&c, contact, &plain).solver.febio.retry_min_residual_n, c.solver.febio.retry_min_residual_n);
+        let text = |retry_tolerances: bool| {
+            let stepping = feb::Stepping { first_step_fraction: 1.0, retry_tolerances, first_contact: None };
+            feb::write_stepped(&campaign_for(&c, contact, &own), centre, &own, 2, &stepping).expect("the FEBio input").text
+        };
+        let squared = format!("<min_residual>{}</min_residual>", feb::num(floor_n * floor_n));
+        assert!(text(true).contains(&squared), "the retry's input has {squared}");
+        assert!(!text(false).contains(&squared), "the first attempt's input has FEBio's own floor");
+        let without = crate::spec::Campaign { mesh: [("fine".to_string(), plain)].into_iter().collect(), ..c.clone() };
+        assert_ne!(c.run_hash(centre, "fine"), without.run_hash(centre, "fine"), "the floor is part of the run hash");
+        assert_eq!(c.first_attempt_hash(centre, "fine"), without.first_attempt_hash(centre, "fine"), "but not of the first attempt's");
     }
 }

@@ -13,8 +13,9 @@ impl Campaign {
 
     /// Hash of everything that determines a run solved by its first attempt: as
     /// [`run_hash`](Self::run_hash), without the settings only later attempts of the
-    /// FEBio retry ladder use (`retry_dtol`, `retry_rtol`, `retry_min_residual_n`: the continuations and the
-    /// quarter-step attempts; `last_attempt_penalty_scale`: the fifth attempt), and marked
+    /// FEBio retry ladder use (`retry_dtol`, `retry_rtol`, `retry_min_residual_n`, also a
+    /// level's own: the continuations and the quarter-step attempts;
+    /// `last_attempt_penalty_scale`: the fifth attempt), and marked
     /// so that it never equals a `run_hash`. A run whose first attempt solved it is
     /// reproduced by the spec as long as this hash stays the same, whatever the ladder's
     /// later rungs become (the manifest's `first_attempt_hash`,
@@ -25,10 +26,11 @@ impl Campaign {
         solver.febio.retry_rtol = 0.0;
         solver.febio.retry_min_residual_n = 0.0;
         solver.febio.last_attempt_penalty_scale = 0.0;
-        self.hash_with(pose, mesh_name, &solver, Some("first attempt"))
+        let level = self.mesh.get(mesh_name).map(|m| MeshLevel { retry_min_residual_n: None, ..m.clone() });
+        self.hash_with(pose, mesh_name, &solver, Some(("first attempt", level)))
     }
 
-    fn hash_with(&self, pose: &PoseSpec, mesh_name: &str, solver: &Solver, scope: Option<&str>) -> String {
+    fn hash_with(&self, pose: &PoseSpec, mesh_name: &str, solver: &Solver, scope: Option<(&str, Option<MeshLevel>)>) -> String {
         #[derive(Serialize)]
         struct Key<'a> {
             tissue: &'a Tissue,
@@ -52,14 +54,17 @@ impl Campaign {
             contact: &self.contact,
             loading: &self.loading,
             mesh_name,
-            mesh: self.mesh.get(mesh_name),
+            mesh: match &scope {
+                Some((_, level)) => level.as_ref(),
+                None => self.mesh.get(mesh_name),
+            },
             pose,
             generator: match self.solver.engine {
                 Engine::Ccx => crate::versions::CCX_DECK,
                 Engine::Febio => crate::versions::FEBIO_INPUT,
             },
             solver: (solver.engine != Engine::Ccx).then_some(solver),
-            scope,
+            scope: scope.as_ref().map(|(s, _)| *s),
         };
         // plain data with string keys: serialising cannot fail; if it ever did, an empty
         // key would give every run the same hash, so fail loudly instead

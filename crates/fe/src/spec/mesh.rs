@@ -29,14 +29,23 @@ pub struct MeshLevel {
     /// campaign's level is judged against (coeffs/README.md, "Mesh study").
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub etol: Option<f64>,
+    /// The retry ladder's absolute residual floor on this level, N (FEBio's
+    /// `min_residual`, squared), instead of `[solver.febio] retry_min_residual_n`;
+    /// absent: the solver's. For a reference level solved to a tight `etol`, whose
+    /// continuations restart with micrometre time steps: the relative residual criterion
+    /// then asks for less than the contact's chatter (coeffs/README.md, "Mesh study").
+    /// Part of the level's run hash, not of its first-attempt hash (the first attempt
+    /// does not use it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub retry_min_residual_n: Option<f64>,
 }
 
 impl MeshLevel {
     /// Check the level `name`; messages start with the spec's `path`.
     ///
     /// # Errors
-    /// An odd or too small element count, fewer than 2 facets per quarter, a size not
-    /// finite and > 0, a growth below 1.
+    /// An odd or too small element count, fewer than 2 facets per quarter, a size, `etol`
+    /// or residual floor not finite and > 0, a growth below 1.
     pub fn validate(&self, path: &Path, name: &str) -> SpecResult<()> {
         let p = path.display();
         if self.core_elements < 2 || !self.core_elements.is_multiple_of(2) {
@@ -58,6 +67,9 @@ impl MeshLevel {
         if let Some(etol) = self.etol {
             positive(path, &format!("mesh.{name}.etol"), etol)?;
         }
+        if let Some(floor) = self.retry_min_residual_n {
+            positive(path, &format!("mesh.{name}.retry_min_residual_n"), floor)?;
+        }
         if !(self.growth.is_finite() && self.growth >= 1.0) {
             let field = format!("mesh.{name}.growth");
             return Err(SpecError::range(&p, &field, format!("{field} = {}: must be >= 1", self.growth)));
@@ -72,19 +84,31 @@ mod mesh_level_tests {
     use crate::spec::{parse, SpecError};
     use std::path::Path;
 
-    #[test]
-    fn a_levels_energy_tolerance_not_above_zero_is_refused_with_file_line_and_field() {
-        let (text, line, shipped) = shipped_key("mesh.fine", "etol");
+    /// `key` of the shipped `[mesh.fine]` set to each bad value is refused, naming the
+    /// field and its line.
+    fn refused_on_the_fine_level(key: &str) {
+        let (text, line, shipped) = shipped_key("mesh.fine", key);
         for bad in ["0.0", "-0.001", "nan", "inf"] {
-            let spec = text.replace(&shipped, &format!("etol = {bad}"));
+            let spec = text.replace(&shipped, &format!("{key} = {bad}"));
             assert_ne!(spec, text);
             match parse(&spec, Path::new("campaign.toml")) {
-                Ok(_) => panic!("etol = {bad} accepted"),
+                Ok(_) => panic!("{key} = {bad} accepted"),
                 Err(e) => {
-                    assert!(matches!(&e, SpecError::OutOfRange { field, .. } if field == "mesh.fine.etol"), "{e:?}");
+                    let want = format!("mesh.fine.{key}");
+                    assert!(matches!(&e, SpecError::OutOfRange { field, .. } if *field == want), "{e:?}");
                     assert_eq!(e.at(), format!("campaign.toml:{line}"), "{e}");
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_levels_energy_tolerance_not_above_zero_is_refused_with_file_line_and_field() {
+        refused_on_the_fine_level("etol");
+    }
+
+    #[test]
+    fn a_levels_residual_floor_not_above_zero_is_refused_with_file_line_and_field() {
+        refused_on_the_fine_level("retry_min_residual_n");
     }
 }
