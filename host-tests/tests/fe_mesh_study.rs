@@ -77,7 +77,10 @@ fn the_campaign_level_carries_the_refinements_shape() {
             clean.push(pose);
         } else {
             let met = rms <= SHAPE_RMS_GOAL_PERCENT && max <= SHAPE_MAX_GOAL_PERCENT;
-            println!("{pose}: the reference scatters by {scatter:.2} % about its own fit: the must-point goal {}", if met { "met" } else { "missed" });
+            println!(
+                "{pose}: the reference scatters by {scatter:.2} % about its own fit: the must-point goal {}",
+                if met { "met" } else { "missed" }
+            );
         }
         judged += 1;
     }

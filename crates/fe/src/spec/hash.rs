@@ -8,7 +8,7 @@ impl Campaign {
     /// Hash of everything that determines the result of one run: the whole spec except
     /// the pose list and description, plus this pose and the mesh level. Hex SHA-256.
     pub fn run_hash(&self, pose: &PoseSpec, mesh_name: &str) -> String {
-        self.hash_with(pose, mesh_name, &self.solver, None)
+        self.hash_with(pose, mesh_name, self.mesh.get(mesh_name), &self.solver, None)
     }
 
     /// Hash of everything that determines a run solved by its first attempt: as
@@ -27,10 +27,10 @@ impl Campaign {
         solver.febio.retry_min_residual_n = 0.0;
         solver.febio.last_attempt_penalty_scale = 0.0;
         let level = self.mesh.get(mesh_name).map(|m| MeshLevel { retry_min_residual_n: None, ..m.clone() });
-        self.hash_with(pose, mesh_name, &solver, Some(("first attempt", level)))
+        self.hash_with(pose, mesh_name, level.as_ref(), &solver, Some("first attempt"))
     }
 
-    fn hash_with(&self, pose: &PoseSpec, mesh_name: &str, solver: &Solver, scope: Option<(&str, Option<MeshLevel>)>) -> String {
+    fn hash_with(&self, pose: &PoseSpec, mesh_name: &str, mesh: Option<&MeshLevel>, solver: &Solver, scope: Option<&str>) -> String {
         #[derive(Serialize)]
         struct Key<'a> {
             tissue: &'a Tissue,
@@ -54,17 +54,14 @@ impl Campaign {
             contact: &self.contact,
             loading: &self.loading,
             mesh_name,
-            mesh: match &scope {
-                Some((_, level)) => level.as_ref(),
-                None => self.mesh.get(mesh_name),
-            },
+            mesh,
             pose,
             generator: match self.solver.engine {
                 Engine::Ccx => crate::versions::CCX_DECK,
                 Engine::Febio => crate::versions::FEBIO_INPUT,
             },
             solver: (solver.engine != Engine::Ccx).then_some(solver),
-            scope: scope.as_ref().map(|(s, _)| *s),
+            scope,
         };
         // plain data with string keys: serialising cannot fail; if it ever did, an empty
         // key would give every run the same hash, so fail loudly instead
