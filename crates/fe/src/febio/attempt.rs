@@ -560,7 +560,8 @@ fn ladder_state(job: &Job<'_>, resuming: bool) -> Result<ladder::State> {
 }
 
 /// The campaign with the contact `contact` asks for (`retry_seg_up`, the softer penalty)
-/// and the mesh level's own energy tolerance (`[mesh.<level>] etol`).
+/// and the mesh level's own energy tolerance and retry residual floor (`[mesh.<level>]
+/// etol`, `retry_min_residual_n`).
 fn campaign_for<'c>(campaign: &'c Campaign, contact: ladder::Fresh, mesh: &MeshLevel) -> Cow<'c, Campaign> {
     if contact.seg_up == ladder::SegUp::Spec && !contact.softer && mesh.etol.is_none() && mesh.retry_min_residual_n.is_none() {
         return Cow::Borrowed(campaign);
