@@ -597,14 +597,20 @@ fn first_contact_steps(fs: &FebioSettings, loading: &Loading, steps: u32) -> u32
 mod level_tolerance_tests {
     use super::*;
 
+    /// The shipped spec and its `fine` level (the mesh study's reference).
+    fn shipped_fine() -> (Campaign, MeshLevel) {
+        let set = crate::workspace_root().join("coeffs/default");
+        let (c, _) = crate::spec::load(&set).expect("the shipped spec");
+        let own = c.mesh_level("fine").expect("fine").clone();
+        (c, own)
+    }
+
     /// `[mesh.<level>] etol` reaches the FEBio input of every attempt on that level, and
     /// only there (the mesh study's reference level, coeffs/README.md).
     #[test]
     fn a_levels_energy_tolerance_replaces_the_solvers() {
-        let set = crate::workspace_root().join("coeffs/default");
-        let (c, _) = crate::spec::load(&set).expect("the shipped spec");
+        let (c, own) = shipped_fine();
         let centre = c.pose.iter().find(|p| p.name == "centre").expect("centre");
-        let own = c.mesh_level("fine").expect("fine").clone();
         let etol = own.etol.expect("the shipped fine level has its own etol");
         assert_ne!(etol, c.solver.febio.etol, "the shipped fine level's etol differs from the solver's");
         let plain = MeshLevel { etol: None, ..own.clone() };
@@ -633,10 +639,8 @@ mod level_tolerance_tests {
     /// the run hash but not of the first-attempt hash.
     #[test]
     fn a_levels_residual_floor_replaces_the_retrys_and_only_there() {
-        let set = crate::workspace_root().join("coeffs/default");
-        let (c, _) = crate::spec::load(&set).expect("the shipped spec");
+        let (c, own) = shipped_fine();
         let centre = c.pose.iter().find(|p| p.name == "centre").expect("centre");
-        let own = c.mesh_level("fine").expect("fine").clone();
         let floor_n = own.retry_min_residual_n.expect("the shipped fine level has its own residual floor");
         assert_ne!(floor_n, c.solver.febio.retry_min_residual_n, "the shipped fine level's floor differs from the solver's");
         let plain = MeshLevel { retry_min_residual_n: None, ..own.clone() };
