@@ -12,12 +12,9 @@
 //!   difference of its own fit, `fine_off_fit_percent`), the must points are within the
 //!   goal too. Where it is not, the must-point comparison measures the reference's own
 //!   scatter as much as the campaign's shape: printed, counted as missed in the README,
-//!   not asserted. Measured: solved with the campaign's energy tolerance (1e-2) the
-//!   refinement scattered by up to 7.9 % even at the centre (hence `[mesh.fine] etol`
-//!   1e-3); with 1e-3 and the retries' residual floor (`[mesh.fine]
-//!   retry_min_residual_n`, without which x+04 and z+04 did not solve) the centre is
-//!   clean (1.29 %) while the half-model poses scatter in their lateral components
-//!   (Fx/Mz, Fz/Mx) by 3.1-4.8 % (coeffs/default/README.md, "Mesh study").
+//!   not asserted. Why a reference can be unclean, and which poses are, is measured in
+//!   coeffs/default/README.md ("Mesh study": the loose energy tolerance at every pose,
+//!   then the lateral components' chatter at the half-model poses).
 //! - the centre is compared, clean and within the goal.
 //!
 //! The numbers are FEBio's, written by the tool (never typed in).
@@ -52,7 +49,6 @@ fn the_campaign_level_carries_the_refinements_shape() {
     let shapes = mesh.get("shape").and_then(toml::Value::as_array).cloned().unwrap_or_default();
     let levels = mesh.get("levels").and_then(toml::Value::as_array).cloned().unwrap_or_default();
     let poses: Vec<&str> = std::iter::once("centre").chain(c.campaign.mesh_study_poses.iter().map(String::as_str)).collect();
-    let mut judged = 0;
     let mut clean = Vec::new();
     for pose in poses {
         let pair = shapes.iter().find(|s| text(s, "pose") == pose && text(s, "coarse") == committed && text(s, "fine") == refined);
@@ -82,8 +78,6 @@ fn the_campaign_level_carries_the_refinements_shape() {
                 if met { "met" } else { "missed" }
             );
         }
-        judged += 1;
     }
     assert!(clean.contains(&"centre"), "the centre's reference is clean and within the goal (clean: {clean:?})");
-    assert!(judged >= 1, "no pose compared");
 }
