@@ -12,9 +12,9 @@
 //!   difference of its own fit, `fine_off_fit_percent`), the must points are within the
 //!   goal too. Where it is not, the must-point comparison measures the reference's own
 //!   scatter as much as the campaign's shape: printed, counted as missed in the README,
-//!   not asserted. Why a reference can be unclean, and which poses are, is measured in
-//!   coeffs/default/README.md ("Mesh study": the loose energy tolerance at every pose,
-//!   then the lateral components' chatter at the half-model poses).
+//!   not asserted. Why a reference can be unclean is measured in
+//!   coeffs/default/README.md ("Mesh study": Newton's loose energy, then residual,
+//!   tolerance, under which the must points depended on the time steps taken).
 //! - the centre is compared, clean and within the goal.
 //!
 //! The numbers are FEBio's, written by the tool (never typed in).
@@ -46,6 +46,7 @@ fn the_campaign_level_carries_the_refinements_shape() {
     assert_eq!(committed, c.campaign.mesh, "the study judges the campaign's level");
     let refined_level = c.mesh_level(refined).expect("the refinement is a level of the spec");
     assert!(refined_level.etol.is_some(), "the reference level {refined} is solved to its own energy tolerance");
+    assert!(refined_level.rtol.is_some(), "and to its own residual tolerance");
     let shapes = mesh.get("shape").and_then(toml::Value::as_array).cloned().unwrap_or_default();
     let levels = mesh.get("levels").and_then(toml::Value::as_array).cloned().unwrap_or_default();
     let poses: Vec<&str> = std::iter::once("centre").chain(c.campaign.mesh_study_poses.iter().map(String::as_str)).collect();

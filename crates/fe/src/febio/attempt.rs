@@ -560,16 +560,22 @@ fn ladder_state(job: &Job<'_>, resuming: bool) -> Result<ladder::State> {
 }
 
 /// The campaign with the contact `contact` asks for (`retry_seg_up`, the softer penalty)
-/// and the mesh level's own energy tolerance and retry residual floor (`[mesh.<level>]
-/// etol`, `retry_min_residual_n`).
+/// and the mesh level's own energy and residual tolerances and retry residual floor
+/// (`[mesh.<level>] etol`, `rtol`, `retry_min_residual_n`; the level's `rtol` replaces
+/// the retries' `retry_rtol` too).
 fn campaign_for<'c>(campaign: &'c Campaign, contact: ladder::Fresh, mesh: &MeshLevel) -> Cow<'c, Campaign> {
-    if contact.seg_up == ladder::SegUp::Spec && !contact.softer && mesh.etol.is_none() && mesh.retry_min_residual_n.is_none() {
+    let own_tolerances = mesh.etol.is_some() || mesh.rtol.is_some() || mesh.retry_min_residual_n.is_some();
+    if contact.seg_up == ladder::SegUp::Spec && !contact.softer && !own_tolerances {
         return Cow::Borrowed(campaign);
     }
     let mut c = campaign.clone();
     let s = &mut c.solver.febio;
     if let Some(etol) = mesh.etol {
         s.etol = etol;
+    }
+    if let Some(rtol) = mesh.rtol {
+        s.rtol = rtol;
+        s.retry_rtol = rtol;
     }
     if let Some(floor_n) = mesh.retry_min_residual_n {
         s.retry_min_residual_n = floor_n;
@@ -632,6 +638,34 @@ mod level_tolerance_tests {
             crate::spec::Campaign { mesh: [("fine".to_string(), plain)].into_iter().collect(), ..c.clone() }.run_hash(centre, "fine"),
             "the level's etol is part of its runs' hash"
         );
+    }
+
+    /// `[mesh.<level>] rtol` reaches the FEBio input of every attempt on that level, the
+    /// first (in place of `rtol`) and the retries and their restarts (in place of
+    /// `retry_rtol`), and is part of both hashes.
+    #[test]
+    fn a_levels_residual_tolerance_replaces_both_of_the_solvers() {
+        let (c, shipped) = shipped_fine();
+        let centre = c.pose.iter().find(|p| p.name == "centre").expect("centre");
+        let fs = &c.solver.febio;
+        let rtol = fs.rtol.min(fs.retry_rtol) / 100.0;
+        let own = MeshLevel { rtol: Some(rtol), ..shipped.clone() };
+        let plain = MeshLevel { rtol: None, ..shipped };
+        let contact = ladder::Fresh { seg_up: ladder::SegUp::Spec, softer: false, quarter: false };
+        let text = |level: &MeshLevel, retry_tolerances: bool| {
+            let stepping = feb::Stepping { first_step_fraction: 1.0, retry_tolerances, first_contact: None };
+            feb::write_stepped(&campaign_for(&c, contact, level), centre, level, 2, &stepping).expect("the FEBio input").text
+        };
+        let tag = |v: f64| format!("<rtol>{}</rtol>", feb::num(v));
+        for retry in [false, true] {
+            assert!(text(&own, retry).contains(&tag(rtol)), "retry tolerances {retry}");
+        }
+        assert!(text(&plain, false).contains(&tag(fs.rtol)) && text(&plain, true).contains(&tag(fs.retry_rtol)));
+        assert_eq!(campaign_for(&c, contact, &own).solver.febio.retry_rtol, rtol, "a continuation's restart reads retry_rtol");
+        let on = |level: MeshLevel| crate::spec::Campaign { mesh: [("fine".to_string(), level)].into_iter().collect(), ..c.clone() };
+        let (with, without) = (on(own), on(plain));
+        assert_ne!(with.run_hash(centre, "fine"), without.run_hash(centre, "fine"), "the level's rtol is part of the run hash");
+        assert_ne!(with.first_attempt_hash(centre, "fine"), without.first_attempt_hash(centre, "fine"), "and of the first attempt's");
     }
 
     /// `[mesh.<level>] retry_min_residual_n` reaches the retries' FEBio input on that

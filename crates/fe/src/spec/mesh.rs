@@ -29,6 +29,14 @@ pub struct MeshLevel {
     /// campaign's level is judged against (coeffs/README.md, "Mesh study").
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub etol: Option<f64>,
+    /// FEBio's Newton residual tolerance (`rtol`: relative to the time step's first
+    /// residual, on squared norms) for every attempt on this level, the first and the
+    /// retries, instead of `[solver.febio] rtol` and `retry_rtol`; absent: the solver's.
+    /// Part of the level, so of its runs' hash. For a study's reference level: with the
+    /// campaign's 1e-3 (a residual norm cut by only 1/sqrt(1000)) the reference's must
+    /// points depended on the time-step sequence (coeffs/README.md, "Mesh study").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rtol: Option<f64>,
     /// The retry ladder's absolute residual floor on this level, N (FEBio's
     /// `min_residual`, squared), instead of `[solver.febio] retry_min_residual_n`;
     /// absent: the solver's. For a reference level solved to a tight `etol`, whose
@@ -44,8 +52,8 @@ impl MeshLevel {
     /// Check the level `name`; messages start with the spec's `path`.
     ///
     /// # Errors
-    /// An odd or too small element count, fewer than 2 facets per quarter, a size, `etol`
-    /// or residual floor not finite and > 0, a growth below 1.
+    /// An odd or too small element count, fewer than 2 facets per quarter, a size, `etol`,
+    /// `rtol` or residual floor not finite and > 0, a growth below 1.
     pub fn validate(&self, path: &Path, name: &str) -> SpecResult<()> {
         let p = path.display();
         if self.core_elements < 2 || !self.core_elements.is_multiple_of(2) {
@@ -66,6 +74,9 @@ impl MeshLevel {
         }
         if let Some(etol) = self.etol {
             positive(path, &format!("mesh.{name}.etol"), etol)?;
+        }
+        if let Some(rtol) = self.rtol {
+            positive(path, &format!("mesh.{name}.rtol"), rtol)?;
         }
         if let Some(floor) = self.retry_min_residual_n {
             positive(path, &format!("mesh.{name}.retry_min_residual_n"), floor)?;
@@ -105,6 +116,11 @@ mod mesh_level_tests {
     #[test]
     fn a_levels_energy_tolerance_not_above_zero_is_refused_with_file_line_and_field() {
         refused_on_the_fine_level("etol");
+    }
+
+    #[test]
+    fn a_levels_residual_tolerance_not_above_zero_is_refused_with_file_line_and_field() {
+        refused_on_the_fine_level("rtol");
     }
 
     #[test]

@@ -122,6 +122,7 @@ pub fn punch_mesh(radius_mm: f64, core_elements: u32, mesh_scale: f64) -> spec::
         needle_facets_per_quarter: 4,
         needle_axial_mm: 0.3,
         etol: None,
+        rtol: None,
         retry_min_residual_n: None,
     }
 }
