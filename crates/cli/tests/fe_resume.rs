@@ -106,15 +106,19 @@ fn smoke_campaign_skips_and_resumes_after_a_kill() {
     // 3. a second pose, killed (SIGTERM to needle alone, as `kill PID` does) once ccx
     //    has finished its first of three steps: needle must stop its ccx itself
     let work = fe.join(".work").join("x+04");
-    let mut child = needle_after_first_step(&set, "x+04", "3");
+    let child = needle_after_first_step(&set, "x+04", "3");
     let pgid = child.id();
     // SIGTERM, not SIGINT (Ctrl-C): a shell without job control starts background
     // commands with SIGINT ignored, and needle and ccx inherit that, so a SIGINT would
     // not stop them when the tests run from such a script (seen: the run then finished).
     let kill = Command::new("kill").args(["-TERM", &pgid.to_string()]).status().expect("kill");
     assert!(kill.success());
-    let status = child.wait().expect("wait");
+    let killed = child.wait_with_output().expect("wait");
+    let status = killed.status;
     assert_eq!(status.code(), Some(i32::from(ccx::EXIT_INTERRUPTED)), "interrupted run: {status}");
+    // its summary: interrupted, not FAILED (no attempt was used up)
+    let table = String::from_utf8_lossy(&killed.stdout);
+    assert!(table.contains("0 failed, 1 interrupted and 0 not run (a rerun resumes them)") && !table.contains("FAILED"), "{table}");
     // wait until ccx (same process group) is gone too
     let gone = Instant::now();
     while group_alive(pgid) {
@@ -210,7 +214,7 @@ fn needle_after_first_step(set: &Path, pose: &str, steps: &str) -> std::process:
     let mut child = Command::new(NEEDLE)
         .args(run_args(set, pose, steps))
         .stdin(Stdio::null())
-        .stdout(Stdio::null())
+        .stdout(Stdio::piped())
         .stderr(Stdio::null())
         .process_group(0)
         .spawn()

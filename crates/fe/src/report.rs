@@ -19,6 +19,14 @@ pub enum Status {
         /// The last lines of ccx's output.
         log_tail: String,
     },
+    /// Stopped by an interruption (SIGINT, SIGTERM, SIGHUP) while solving: not failed,
+    /// a rerun resumes the attempt it was in. `message` says where it stopped.
+    Interrupted {
+        /// One line: the attempts so far and where the interrupted one stopped.
+        message: String,
+    },
+    /// Selected and not up to date, but never started: the run was interrupted first.
+    NotRun,
 }
 
 /// One line of the final report.
@@ -68,6 +76,14 @@ impl Report {
     pub fn failed(&self) -> usize {
         self.poses.iter().filter(|p| matches!(p.status, Status::Failed { .. })).count()
     }
+    /// Number of poses stopped by an interruption while solving.
+    pub fn interrupted(&self) -> usize {
+        self.poses.iter().filter(|p| matches!(p.status, Status::Interrupted { .. })).count()
+    }
+    /// Number of selected poses that were not up to date and never started.
+    pub fn not_run(&self) -> usize {
+        self.poses.iter().filter(|p| p.status == Status::NotRun).count()
+    }
 
     /// The summary table (pose, status, wall time, increments, Fy at the final depth),
     /// then one paragraph per failure with its log tail.
@@ -80,6 +96,8 @@ impl Report {
                 Status::Done => "done",
                 Status::UpToDate => "up to date",
                 Status::Failed { .. } => "FAILED",
+                Status::Interrupted { .. } => "interrupted",
+                Status::NotRun => "not run",
             };
             s.push_str(&format!(
                 "{:<10} {:<10} {:>9} {:>10} {:>14}\n",
@@ -90,8 +108,12 @@ impl Report {
                 opt(p.fy_final_n.map(|f| format!("{f:.6e}"))),
             ));
         }
+        let stopped = match (self.interrupted(), self.not_run()) {
+            (0, 0) => String::new(),
+            (i, n) => format!(", {i} interrupted and {n} not run (a rerun resumes them)"),
+        };
         s.push_str(&format!(
-            "{} done, {} up to date, {} failed; mesh {}, {} steps, {:.1} s\n",
+            "{} done, {} up to date, {} failed{stopped}; mesh {}, {} steps, {:.1} s\n",
             self.done(),
             self.up_to_date(),
             self.failed(),
@@ -112,7 +134,48 @@ impl Report {
                     }
                 }
             }
+            if let Status::Interrupted { message } = &p.status {
+                s.push_str(&format!("\ninterrupted {}: {message}; a rerun resumes it\n", p.pose));
+            }
         }
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pose(name: &str, status: Status) -> PoseReport {
+        PoseReport { pose: name.into(), status, wall_s: None, increments: None, fy_final_n: None, work_dir: None }
+    }
+
+    /// An interrupted campaign says which poses it stopped and which it never started: not
+    /// "FAILED" (their attempts are not used up) and not "up to date" (they are stale).
+    #[test]
+    fn an_interrupted_run_reports_its_stopped_and_unstarted_poses_apart() {
+        let r = Report {
+            poses: vec![
+                pose("centre", Status::UpToDate),
+                pose("x+04", Status::Done),
+                pose("z+04", Status::Interrupted { message: "febio4 interrupted (killed) after 3 of 20 steps".into() }),
+                pose("z+08", Status::NotRun),
+            ],
+            mesh: "needle8".into(),
+            steps: 20,
+            depth_mm: 6.0,
+            out_dir: PathBuf::from("fe"),
+            wall: Duration::from_secs(1),
+        };
+        assert_eq!((r.done(), r.up_to_date(), r.failed(), r.interrupted(), r.not_run()), (1, 1, 0, 1, 1));
+        let t = r.table();
+        let row = |name: &str| t.lines().find(|l| l.starts_with(&format!("{name} "))).unwrap_or_default().to_string();
+        assert!(row("z+04").contains("interrupted") && row("z+08").contains("not run"), "{t}");
+        assert!(row("centre").contains("up to date") && !row("z+08").contains("up to date"), "{t}");
+        assert!(t.contains("1 done, 1 up to date, 0 failed, 1 interrupted and 1 not run (a rerun resumes them)"), "{t}");
+        assert!(
+            t.contains("interrupted z+04: febio4 interrupted (killed) after 3 of 20 steps; a rerun resumes it") && !t.contains("FAILED"),
+            "{t}"
+        );
     }
 }

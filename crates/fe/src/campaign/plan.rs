@@ -29,7 +29,8 @@ pub struct Plan {
     /// The manifest as read.
     pub manifest: Manifest,
     /// One report per selected pose, in campaign order: [`Status::UpToDate`] (with the
-    /// manifest's figures) or a placeholder for the poses in `to_run`.
+    /// manifest's figures) or, for the poses in `to_run`, [`Status::NotRun`] until their
+    /// solve reports.
     pub reports: Vec<PoseReport>,
     /// Indices into `reports` (and the selected poses) of the poses to solve.
     pub to_run: Vec<usize>,
@@ -102,7 +103,10 @@ pub fn plan(opts: &RunOptions) -> Result<Plan> {
                 report.increments = Some(e.increments);
                 report.fy_final_n = rows.last().map(Row::fy_n);
             }
-            _ => to_run.push(reports.len()),
+            _ => {
+                report.status = Status::NotRun;
+                to_run.push(reports.len());
+            }
         }
         reports.push(report);
     }

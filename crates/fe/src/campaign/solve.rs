@@ -91,6 +91,12 @@ pub(super) fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
         }
         Err(f) => {
             let kept = if f.reached.is_empty() { String::new() } else { keep(&f.reached, &f.message) };
+            if process::interrupted() {
+                return PoseReport {
+                    status: Status::Interrupted { message: format!("{}{kept}", f.message) },
+                    ..fail(String::new(), String::new())
+                };
+            }
             return fail(format!("{}{kept}", f.message), f.log_tail);
         }
     };

@@ -392,3 +392,15 @@ fn refuses_bad_options_and_a_corrupt_manifest_before_solving() {
     assert!(e.contains("delete it"), "{e}");
     assert_eq!((fake.prepared, fake.solves.load(Ordering::SeqCst)), (0, 0));
 }
+
+/// The poses a plan would solve are "not run" until their solve reports, never "up to
+/// date": an interruption before they start must not show them as current.
+#[test]
+fn the_poses_a_plan_would_solve_are_not_run_until_they_report() {
+    let d = set_dir();
+    let plan = super::plan(&opts(d.path(), "centre,x+04", 4)).expect("plan");
+    assert_eq!(plan.to_run.len(), 2, "nothing solved yet: both stale");
+    for r in &plan.reports {
+        assert_eq!(r.status, crate::report::Status::NotRun, "{}", r.pose);
+    }
+}

@@ -233,6 +233,9 @@ fn ended_task(out_dir: &Path, task: &str, pose: &str) -> (String, String) {
         let what = l.find("***").and_then(|i| l.get(i..)).unwrap_or(l);
         return ("cancelled".into(), what.trim().to_string());
     }
+    if let Some(l) = text.lines().find(|l| l.starts_with(&format!("interrupted {pose}:"))) {
+        return ("interrupted".into(), l.trim().to_string());
+    }
     if let Some(l) = text.lines().find(|l| l.starts_with(&format!("FAILED {pose}:"))) {
         return ("failed".into(), l.trim().to_string());
     }
