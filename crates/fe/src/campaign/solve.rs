@@ -23,9 +23,14 @@ pub(super) fn work_dir(out_dir: &Path, pose: &str) -> PathBuf {
 }
 
 pub(super) fn failed_report(pose: &PoseSpec, ctx: &Ctx<'_>, message: String, log_tail: String) -> PoseReport {
+    unsolved_report(pose, ctx, Status::Failed { message, log_tail })
+}
+
+/// The report of a pose left unsolved (failed or interrupted): its work folder is kept.
+fn unsolved_report(pose: &PoseSpec, ctx: &Ctx<'_>, status: Status) -> PoseReport {
     PoseReport {
         pose: pose.name.clone(),
-        status: Status::Failed { message, log_tail },
+        status,
         wall_s: None,
         increments: None,
         fy_final_n: None,
