@@ -97,21 +97,24 @@ pub(super) fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
         Err(f) => {
             let kept = if f.reached.is_empty() { String::new() } else { keep(&f.reached, &f.message) };
             if process::interrupted() {
-                return PoseReport {
-                    status: Status::Interrupted { message: format!("{}{kept}", f.message) },
-                    ..fail(String::new(), String::new())
-                };
+                return unsolved_report(pose, ctx, Status::Interrupted { message: format!("{}{kept}", f.message) });
             }
             return fail(format!("{}{kept}", f.message), f.log_tail);
         }
     };
     let wall_s = (start.elapsed().as_secs_f64() * 1000.0).round() / 1000.0;
-    match write_results(ctx, pose, &solved, wall_s) {
+    solved_report(ctx, pose, &wd, &solved, wall_s)
+}
+
+/// Write a solved pose's results and report it done (or failed, if they cannot be
+/// written); the work folder `wd` goes unless `--keep-work`.
+fn solved_report(ctx: &Ctx<'_>, pose: &PoseSpec, wd: &Path, solved: &Solved, wall_s: f64) -> PoseReport {
+    match write_results(ctx, pose, solved, wall_s) {
         Ok(fy) => {
             partial::remove(ctx.out_dir, &pose.name);
             // the work folder is only for debugging failed runs; a leftover is harmless
             if !ctx.keep_work {
-                let _ = std::fs::remove_dir_all(&wd);
+                let _ = std::fs::remove_dir_all(wd);
             }
             PoseReport {
                 pose: pose.name.clone(),
@@ -122,7 +125,7 @@ pub(super) fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
                 work_dir: None,
             }
         }
-        Err(e) => fail(format!("{e:#}"), String::new()),
+        Err(e) => failed_report(pose, ctx, format!("{e:#}"), String::new()),
     }
 }
 
