@@ -131,7 +131,7 @@ impl Progress {
                 self.failed += 1;
                 self.line(&format!("FAILED {}: {message}", r.pose));
             }
-            Status::Interrupted { message } => self.line(&format!("interrupted {}: {message}; a rerun resumes it", r.pose)),
+            Status::Interrupted { message } => self.line(&crate::report::interrupted_line(&r.pose, message)),
             _ => {
                 self.done += 1;
                 if let (Some(w), Some(model)) = (r.wall_s.filter(|w| w.is_finite() && *w > 0.0), self.models.get(i)) {

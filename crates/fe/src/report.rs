@@ -29,6 +29,12 @@ pub enum Status {
     NotRun,
 }
 
+/// The line that says pose `pose` was interrupted (progress and summary; `needle fe
+/// status` finds it by its `interrupted <pose>:` start).
+pub(crate) fn interrupted_line(pose: &str, message: &str) -> String {
+    format!("interrupted {pose}: {message}; a rerun resumes it")
+}
+
 /// One line of the final report.
 #[derive(Debug, Clone)]
 pub struct PoseReport {
@@ -135,7 +141,7 @@ impl Report {
                 }
             }
             if let Status::Interrupted { message } = &p.status {
-                s.push_str(&format!("\ninterrupted {}: {message}; a rerun resumes it\n", p.pose));
+                s.push_str(&format!("\n{}\n", interrupted_line(&p.pose, message)));
             }
         }
         s
