@@ -55,10 +55,11 @@ fn the_edge_study_is_in_verify_toml_and_a_resolved_edge_converges() {
     let largest = radii.iter().copied().fold(0.0, f64::max);
     let e = edges.iter().find(|e| e.get("radius_mm").and_then(toml::Value::as_float) == Some(largest)).expect("the largest radius");
     let shape = e.get("mesh").and_then(|m| m.get("shape")).and_then(toml::Value::as_array).expect("shape comparisons");
+    let (level, _) = c.edge_study_pair().expect("the edge study's pair");
     let pair = shape
         .iter()
-        .find(|s| s.get("coarse").and_then(toml::Value::as_str) == Some(c.campaign.mesh.as_str()))
-        .expect("the committed level against its refinement");
+        .find(|s| s.get("coarse").and_then(toml::Value::as_str) == Some(level.as_str()))
+        .expect("the edge study's level against its refinement");
     assert!(within(pair, &[]), "r {largest} mm: needle8 against fine outside the goal: {pair}");
     let campaign = centre_of(e, "campaign_against_refined").expect("the campaign's centre against the refined level");
     assert!(within(campaign, &[]), "the campaign's centre against r {largest} mm on fine: {campaign}");

@@ -47,11 +47,17 @@ pub struct CampaignSettings {
     /// (`replaced_because`). A replacement that fails every attempt is listed in turn.
     #[serde(default)]
     pub train_replaced: Vec<TrainReplacement>,
-    /// Mesh levels of `needle fe verify --mesh`, coarse to fine, each a 2x refinement of
-    /// the one before; the committed level (`mesh`) must be followed by its refinement.
-    /// Empty: `[mesh, "fine"]`.
+    /// Mesh levels of `needle fe verify --mesh`, the ladder: coarse to fine, each a 2x
+    /// refinement of the one before. A committed level (`mesh`) on the ladder is judged
+    /// against the level after it; one off the ladder against `mesh_reference`
+    /// ([`super::mesh_study`]). Empty: `[mesh, "fine"]`.
     #[serde(default)]
     pub mesh_study: Vec<String>,
+    /// The level a committed level off the ladder of `mesh_study` is judged against by the
+    /// mesh study: a level of the ladder, not its first, that refines it everywhere
+    /// (checked when the spec loads). Absent: the committed level is on the ladder.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mesh_reference: Option<String>,
     /// Poses besides the centre that the mesh study solves on the committed level and its
     /// refinement (`needle fe verify --mesh`; issue 42: an x, a z and a theta pose).
     #[serde(default)]

@@ -19,6 +19,7 @@ pub mod fit;
 pub mod hash;
 pub mod loading;
 pub mod mesh;
+pub mod mesh_study;
 pub mod needle;
 pub mod pose;
 pub mod set;
@@ -157,6 +158,7 @@ impl Campaign {
                 return Err(SpecError::unknown(&p, "campaign.mesh_study", level, format!("campaign.mesh_study: no [mesh.{level}] level")));
             }
         }
+        self.validate_mesh_reference(path)?;
         Ok(())
     }
 
@@ -187,16 +189,6 @@ impl Campaign {
             }
         }
         Ok(())
-    }
-
-    /// The levels of the mesh study (`campaign.mesh_study`, or the committed level and
-    /// `fine` when it is empty).
-    pub fn mesh_study(&self) -> Vec<String> {
-        if self.campaign.mesh_study.is_empty() {
-            vec![self.campaign.mesh.clone(), "fine".to_string()]
-        } else {
-            self.campaign.mesh_study.clone()
-        }
     }
 
     /// The mesh level named `name`.

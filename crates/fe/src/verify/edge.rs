@@ -5,11 +5,14 @@
 //! `needle.tip_edge_radius_mm` set to it ([`mesh_check::mesh_convergence`] with
 //! [`MeshOptions::edge_radius_mm`], into `fe/edge/r<radius>mm/<level>/`), and compared
 //! like the mesh study (shape after the best scale, absolute change, Richardson), with the
-//! poses of `campaign.edge_study_poses` on the committed level and its refinement; beside
-//! it, each pose's committed-level run against the campaign's own (`fe/<pose>.csv`): how
-//! much the edge changes the shape, and the campaign's run against this edge's on the
-//! refined level: whether the committed data carry its converged shape. Not judged: the goals are the campaign mesh's
-//! (`[mesh]`); these are the numbers to choose the mesh and the edge by.
+//! poses of `campaign.edge_study_poses` on the pair [`Campaign::edge_study_pair`] (the
+//! committed level and its refinement, or, when the committed level is off the ladder,
+//! the ladder's level before the mesh study's reference and that reference); beside it,
+//! each pose's run on the pair's first level against the same level's run with the
+//! campaign's edge (`fe/<pose>.csv`, or `fe/mesh/<level>/`): how much the edge changes
+//! the shape, and the campaign's edge's run against this edge's on the refined level:
+//! whether the data carry its converged shape. Not judged: the goals are the campaign
+//! mesh's (`[mesh]`); these are the numbers to choose the mesh and the edge by.
 
 use super::mesh_check::{self, MeshOptions, MeshReport};
 use super::runs::{read_current, same_depths, PoseRows};
@@ -103,7 +106,14 @@ pub fn edge_study(c: &Campaign, o: &MeshOptions) -> Result<Vec<EdgeStudy>> {
     for &r in &c.campaign.edge_study_radii_mm {
         let mesh = mesh_check::mesh_convergence(c, &MeshOptions { edge_radius_mm: Some(r), ..o.clone() })?;
         let read = |edge: Option<f64>, level: &str| -> Result<PoseRows> {
-            let out_dir = edge.map(|r| o.set_dir.join("fe").join(mesh_check::EDGE_DIR).join(mesh_check::edge_dir(r)).join(level));
+            // the campaign's edge: its runs in fe/ on the committed level, the mesh study's
+            // in fe/mesh/<level>/ on another level of the ladder
+            let fe = o.set_dir.join("fe");
+            let out_dir = match edge {
+                Some(r) => Some(fe.join(mesh_check::EDGE_DIR).join(mesh_check::edge_dir(r)).join(level)),
+                None if level != c.campaign.mesh => Some(fe.join(mesh_check::MESH_DIR).join(level)),
+                None => None,
+            };
             let opts = RunOptions {
                 only: Some(poses.join(",")),
                 mesh: Some(level.to_string()),

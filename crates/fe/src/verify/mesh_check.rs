@@ -1,7 +1,8 @@
 //! The mesh study of `needle fe verify --mesh`: the centre pose on every level of
 //! `campaign.mesh_study` (coarse to fine, each a 2x refinement of the one before) and the
 //! half-model poses of `campaign.mesh_study_poses` on the committed level and its
-//! refinement. Runs of the committed level are the committed `fe/<pose>.csv`; the others
+//! refinement (the level after it, or `campaign.mesh_reference` for a committed level
+//! off the ladder: [`crate::spec::mesh_study`]). Runs of the committed level are the committed `fe/<pose>.csv`; the others
 //! are solved through the campaign's machinery into `fe/mesh/<level>/` (with a manifest:
 //! an interrupted study resumes, a solved run is read, not solved again).
 //!
@@ -14,7 +15,7 @@ use super::runs::{read_current, same_depths, solve_and_read, PoseRows};
 use super::shape::{self, ShapeComparison};
 use crate::campaign::RunOptions;
 use crate::spec::{Campaign, Role};
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use needle_contract::FY;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -197,29 +198,29 @@ pub fn richardson(f1: f64, f2: f64, f3: f64) -> Option<(f64, f64)> {
 /// The study's levels, coarse to fine, each with the poses it runs.
 type StudyPlan = Vec<(String, Vec<String>)>;
 
-/// The study's plan (the centre on every level, `extra` on the committed level and its
-/// refinement), the committed level and its refinement.
-fn plan_study(c: &Campaign, extra: &[String]) -> Result<(StudyPlan, String, String)> {
+/// The study's plan (the centre on every level of the ladder, and on the committed level
+/// when it is off the ladder, just before its reference; `extra` on the judged pair), the
+/// judged level and its reference. The edge study (`edge`) runs on the ladder only, its
+/// pair is [`Campaign::edge_study_pair`].
+fn plan_study(c: &Campaign, extra: &[String], edge: bool) -> Result<(StudyPlan, String, String)> {
     let centre = c.pose.iter().find(|p| p.role == Role::Centre).context("no pose with role centre in the spec")?;
-    let study = c.mesh_study();
-    let committed = c.campaign.mesh.clone();
-    let Some(k) = study.iter().position(|l| *l == committed) else {
-        bail!("campaign.mesh_study {study:?} does not hold the committed level {committed:?}");
-    };
-    let Some(refined) = study.get(k + 1).cloned() else {
-        bail!("campaign.mesh_study {study:?}: the committed level {committed:?} needs its 2x refinement after it");
-    };
-    let plan = study
+    let mut levels = c.mesh_study();
+    let (judged, refined) = if edge { c.edge_study_pair() } else { c.mesh_study_pair() }.map_err(anyhow::Error::msg)?;
+    if !levels.contains(&judged) {
+        let k = levels.iter().position(|l| *l == refined).unwrap_or(levels.len());
+        levels.insert(k, judged.clone());
+    }
+    let plan = levels
         .iter()
         .map(|level| {
             let mut poses = vec![centre.name.clone()];
-            if *level == committed || *level == refined {
+            if *level == judged || *level == refined {
                 poses.extend(extra.iter().cloned());
             }
             (level.clone(), poses)
         })
         .collect();
-    Ok((plan, committed, refined))
+    Ok((plan, judged, refined))
 }
 
 /// Run (or resume) the study and compare.
@@ -229,12 +230,12 @@ fn plan_study(c: &Campaign, extra: &[String]) -> Result<(StudyPlan, String, Stri
 /// `failure`).
 pub fn mesh_convergence(c: &Campaign, o: &MeshOptions) -> Result<MeshReport> {
     let poses = if o.edge_radius_mm.is_some() { &c.campaign.edge_study_poses } else { &c.campaign.mesh_study_poses };
-    let (plan, committed, refined) = plan_study(c, poses)?;
+    let (plan, committed, refined) = plan_study(c, poses, o.edge_radius_mm.is_some())?;
     let mut results: Vec<(String, PoseRows)> = Vec::new();
     for (level, poses) in &plan {
         // the committed level's runs of the campaign's needle are the campaign's: read,
         // never solved here
-        let campaign_runs = *level == committed && o.edge_radius_mm.is_none();
+        let campaign_runs = *level == c.campaign.mesh && o.edge_radius_mm.is_none();
         let out_dir = match o.edge_radius_mm {
             Some(r) => o.set_dir.join("fe").join(EDGE_DIR).join(edge_dir(r)).join(level),
             None if campaign_runs => o.set_dir.join("fe"),
@@ -326,7 +327,9 @@ fn report(
 ) -> MeshReport {
     let centre = plan.first().and_then(|(_, p)| p.first()).cloned().unwrap_or_default();
     let fy = |level: &str| levels.iter().find(|l| l.level == level && l.pose == centre).and_then(|l| l.fy_n);
-    let study: Vec<Option<f64>> = plan.iter().map(|(l, _)| fy(l)).collect();
+    // Richardson's estimate on the ladder's levels only (each a 2x refinement)
+    let ladder = c.mesh_study();
+    let study: Vec<Option<f64>> = plan.iter().filter(|(l, _)| ladder.contains(l)).map(|(l, _)| fy(l)).collect();
     let difference_percent = fy(&committed).zip(fy(&refined)).map(|(a, b)| 100.0 * (a - b) / b);
     let last3 = match study.as_slice() {
         [.., Some(a), Some(b), Some(d)] => Some((*a, *b, *d)),
@@ -359,7 +362,7 @@ fn report(
 
 #[cfg(test)]
 mod tests {
-    use super::{richardson, shape_trends};
+    use super::{plan_study, richardson, shape_trends};
     use crate::results::Row;
     use crate::verify::shape;
 
@@ -394,5 +397,24 @@ mod tests {
         assert!((f - 3.0).abs() < 1e-12 && (p - 1.0).abs() < 1e-12, "{f} {p}");
         assert!(richardson(1.0, 2.0, 1.5).is_none(), "oscillating");
         assert!(richardson(1.0, 1.1, 1.3).is_none(), "growing differences");
+    }
+
+    #[test]
+    fn a_committed_level_off_the_ladder_runs_beside_its_reference_and_the_edge_study_on_the_ladder() {
+        let set = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../coeffs/default");
+        let (mut c, _) = crate::spec::load(&set).expect("the shipped spec");
+        c.campaign.mesh = "core6".into();
+        c.campaign.mesh_reference = Some("fine".into());
+        c.campaign.mesh_study = vec!["coarse8".into(), "needle8".into(), "fine".into()];
+        let extra = vec!["x+04".to_string()];
+        let names = |plan: &[(String, Vec<String>)]| -> Vec<String> { plan.iter().map(|(l, p)| format!("{l}: {}", p.join(" "))).collect() };
+        let (plan, judged, refined) = plan_study(&c, &extra, false).expect("the mesh study");
+        assert_eq!((judged.as_str(), refined.as_str()), ("core6", "fine"));
+        assert_eq!(names(&plan), ["coarse8: centre", "needle8: centre", "core6: centre x+04", "fine: centre x+04"]);
+        let (plan, judged, refined) = plan_study(&c, &extra, true).expect("the edge study");
+        assert_eq!((judged.as_str(), refined.as_str()), ("needle8", "fine"));
+        assert_eq!(names(&plan), ["coarse8: centre", "needle8: centre x+04", "fine: centre x+04"]);
+        c.campaign.mesh_reference = None;
+        assert!(plan_study(&c, &extra, false).is_err(), "off the ladder without a reference");
     }
 }

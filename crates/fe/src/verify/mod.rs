@@ -4,7 +4,7 @@
 //!    radius pressed into the block, against Sneddon's half-space force (goal: within 5%).
 //! 2. **Mesh study** ([`mesh_check`]): the centre on the levels of `campaign.mesh_study`
 //!    and the poses of `campaign.mesh_study_poses` on the committed level and its
-//!    refinement; the shape after the best scale ([`shape`]: goal 2 % RMS, 4 % largest),
+//!    refinement (the next level, or `campaign.mesh_reference`); the shape after the best scale ([`shape`]: goal 2 % RMS, 4 % largest),
 //!    the absolute change of Fy and Richardson's estimate when in the asymptotic range.
 //! 3. **Mirror runs**: each `mirror` pose against its mirrored counterpart from the
 //!    committed data, with the sign flips of coeffs/README.md (goal 1% of peak |Fy|).
