@@ -561,10 +561,10 @@ fn ladder_state(job: &Job<'_>, resuming: bool) -> Result<ladder::State> {
 
 /// The campaign with the contact `contact` asks for (`retry_seg_up`, the softer penalty)
 /// and the mesh level's own energy and residual tolerances and retry residual floor
-/// (`[mesh.<level>] etol`, `rtol`, `retry_min_residual_n`; the level's `rtol` replaces
-/// the retries' `retry_rtol` too).
+/// (`[mesh.<level>] etol`, `rtol`, `retry_rtol`, `retry_min_residual_n`; the level's
+/// `rtol` replaces the retries' `retry_rtol` too, unless the level has its own).
 fn campaign_for<'c>(campaign: &'c Campaign, contact: ladder::Fresh, mesh: &MeshLevel) -> Cow<'c, Campaign> {
-    let own_tolerances = mesh.etol.is_some() || mesh.rtol.is_some() || mesh.retry_min_residual_n.is_some();
+    let own_tolerances = mesh.etol.is_some() || mesh.rtol.is_some() || mesh.retry_rtol.is_some() || mesh.retry_min_residual_n.is_some();
     if contact.seg_up == ladder::SegUp::Spec && !contact.softer && !own_tolerances {
         return Cow::Borrowed(campaign);
     }
@@ -575,6 +575,9 @@ fn campaign_for<'c>(campaign: &'c Campaign, contact: ladder::Fresh, mesh: &MeshL
     }
     if let Some(rtol) = mesh.rtol {
         s.rtol = rtol;
+        s.retry_rtol = rtol;
+    }
+    if let Some(rtol) = mesh.retry_rtol {
         s.retry_rtol = rtol;
     }
     if let Some(floor_n) = mesh.retry_min_residual_n {
@@ -691,5 +694,33 @@ mod level_tolerance_tests {
         let without = crate::spec::Campaign { mesh: [("fine".to_string(), plain)].into_iter().collect(), ..c.clone() };
         assert_ne!(c.run_hash(centre, "fine"), without.run_hash(centre, "fine"), "the floor is part of the run hash");
         assert_eq!(c.first_attempt_hash(centre, "fine"), without.first_attempt_hash(centre, "fine"), "but not of the first attempt's");
+    }
+
+    /// `[mesh.<level>] retry_rtol` reaches the retries' FEBio input on that level (and a
+    /// continuation's restart), not the first attempt's, and is part of the run hash but
+    /// not of the first-attempt hash.
+    #[test]
+    fn a_levels_retry_residual_tolerance_replaces_the_retrys_and_only_there() {
+        let set = crate::workspace_root().join("coeffs/default");
+        let (c, _) = crate::spec::load(&set).expect("the shipped spec");
+        let own = c.mesh_level("core6").expect("core6").clone();
+        let centre = c.pose.iter().find(|p| p.name == "centre").expect("centre");
+        let fs = &c.solver.febio;
+        let rtol = own.retry_rtol.expect("the shipped core6 level has its own retry tolerance");
+        assert!(rtol != fs.retry_rtol && rtol != fs.rtol, "core6's retry_rtol differs from the solver's rtol and retry_rtol");
+        let plain = MeshLevel { retry_rtol: None, ..own.clone() };
+        let contact = ladder::Fresh { seg_up: ladder::SegUp::Spec, softer: false, quarter: false };
+        assert_eq!(campaign_for(&c, contact, &own).solver.febio.retry_rtol, rtol, "a continuation's restart reads retry_rtol");
+        let text = |retry_tolerances: bool| {
+            let stepping = feb::Stepping { first_step_fraction: 1.0, retry_tolerances, first_contact: None };
+            feb::write_stepped(&campaign_for(&c, contact, &own), centre, &own, 2, &stepping).expect("the FEBio input").text
+        };
+        let tag = |v: f64| format!("<rtol>{}</rtol>", feb::num(v));
+        assert!(text(true).contains(&tag(rtol)), "the retry's input has {}", tag(rtol));
+        assert!(text(false).contains(&tag(fs.rtol)) && !text(false).contains(&tag(rtol)), "the first attempt's has the solver's rtol");
+        let on = |level: MeshLevel| crate::spec::Campaign { mesh: [("core6".to_string(), level)].into_iter().collect(), ..c.clone() };
+        let (with, without) = (on(own), on(plain));
+        assert_ne!(with.run_hash(centre, "core6"), without.run_hash(centre, "core6"), "part of the run hash");
+        assert_eq!(with.first_attempt_hash(centre, "core6"), without.first_attempt_hash(centre, "core6"), "not of the first attempt's");
     }
 }

@@ -26,7 +26,7 @@ impl Campaign {
         solver.febio.retry_rtol = 0.0;
         solver.febio.retry_min_residual_n = 0.0;
         solver.febio.last_attempt_penalty_scale = 0.0;
-        let level = self.mesh.get(mesh_name).map(|m| MeshLevel { retry_min_residual_n: None, ..m.clone() });
+        let level = self.mesh.get(mesh_name).map(|m| MeshLevel { retry_rtol: None, retry_min_residual_n: None, ..m.clone() });
         self.hash_with(pose, mesh_name, level.as_ref(), &solver, Some("first attempt"))
     }
 

@@ -37,6 +37,17 @@ pub struct MeshLevel {
     /// points depended on the time-step sequence (coeffs/README.md, "Mesh study").
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rtol: Option<f64>,
+    /// FEBio's Newton residual tolerance for the retries on this level (the ladder's
+    /// attempts after the first and their continuations), instead of `[solver.febio]
+    /// retry_rtol` (and of this level's `rtol` there); absent: those. The retries judge
+    /// convergence without the displacement norm (`retry_dtol` 0), so with the
+    /// campaign's 1e-3 a retried must point could be accepted off the equilibrium path by
+    /// up to 2.7 % of peak |Fy| (coeffs/default/README.md, "The retries' tolerance"); a
+    /// tight one here, with `retry_min_residual_n`, keeps the first attempt's speed and
+    /// the retries' points on the path. Part of the level's run hash, not of its
+    /// first-attempt hash (the first attempt does not use it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub retry_rtol: Option<f64>,
     /// The retry ladder's absolute residual floor on this level, N (FEBio's
     /// `min_residual`, squared), instead of `[solver.febio] retry_min_residual_n`;
     /// absent: the solver's. For a reference level solved to a tight `etol`, whose
@@ -53,7 +64,7 @@ impl MeshLevel {
     ///
     /// # Errors
     /// An odd or too small element count, fewer than 2 facets per quarter, a size, `etol`,
-    /// `rtol` or residual floor not finite and > 0, a growth below 1.
+    /// `rtol`, `retry_rtol` or residual floor not finite and > 0, a growth below 1.
     pub fn validate(&self, path: &Path, name: &str) -> SpecResult<()> {
         let p = path.display();
         if self.core_elements < 2 || !self.core_elements.is_multiple_of(2) {
@@ -78,6 +89,9 @@ impl MeshLevel {
         if let Some(rtol) = self.rtol {
             positive(path, &format!("mesh.{name}.rtol"), rtol)?;
         }
+        if let Some(rtol) = self.retry_rtol {
+            positive(path, &format!("mesh.{name}.retry_rtol"), rtol)?;
+        }
         if let Some(floor) = self.retry_min_residual_n {
             positive(path, &format!("mesh.{name}.retry_min_residual_n"), floor)?;
         }
@@ -98,9 +112,15 @@ mod mesh_level_tests {
     /// `key` of the shipped `[mesh.fine]` set to each bad value is refused, naming the
     /// field and its line.
     fn refused_on_the_fine_level(key: &str) {
-        let (text, line, shipped) = shipped_key("mesh.fine", key);
+        refused_on_level("fine", key);
+    }
+
+    /// `key` of the shipped `[mesh.<level>]` set to each bad value is refused, naming the
+    /// field and its line.
+    fn refused_on_level(level: &str, key: &str) {
+        let (text, line, shipped) = shipped_key(&format!("mesh.{level}"), key);
         for bad in ["0.0", "-0.001", "nan", "inf"] {
-            // only the fine level's line: another level may ship the same value
+            // only this level's line: another level may ship the same value
             let spec: String = text
                 .lines()
                 .enumerate()
@@ -110,7 +130,7 @@ mod mesh_level_tests {
             match parse(&spec, Path::new("campaign.toml")) {
                 Ok(_) => panic!("{key} = {bad} accepted"),
                 Err(e) => {
-                    let want = format!("mesh.fine.{key}");
+                    let want = format!("mesh.{level}.{key}");
                     assert!(matches!(&e, SpecError::OutOfRange { field, .. } if *field == want), "{e:?}");
                     assert_eq!(e.at(), format!("campaign.toml:{line}"), "{e}");
                 }
@@ -126,6 +146,11 @@ mod mesh_level_tests {
     #[test]
     fn a_levels_residual_tolerance_not_above_zero_is_refused_with_file_line_and_field() {
         refused_on_the_fine_level("rtol");
+    }
+
+    #[test]
+    fn a_levels_retry_residual_tolerance_not_above_zero_is_refused_with_file_line_and_field() {
+        refused_on_level("core6", "retry_rtol");
     }
 
     #[test]

@@ -123,6 +123,7 @@ pub fn punch_mesh(radius_mm: f64, core_elements: u32, mesh_scale: f64) -> spec::
         needle_axial_mm: 0.3,
         etol: None,
         rtol: None,
+        retry_rtol: None,
         retry_min_residual_n: None,
     }
 }
