@@ -255,7 +255,7 @@ pub fn mesh_convergence(c: &Campaign, o: &MeshOptions) -> Result<MeshReport> {
         results.push((level.clone(), rows));
     }
     let levels = level_runs(c, &results)?;
-    let shape = shape_comparisons(c, &results);
+    let shape = shape_comparisons(c, &results, (&committed, &refined));
     for s in &shape {
         println!("{s}");
     }
@@ -298,19 +298,33 @@ fn level_runs(c: &Campaign, results: &[(String, PoseRows)]) -> Result<Vec<LevelR
     Ok(out)
 }
 
-/// Each pose between each pair of successive levels it has results on.
-fn shape_comparisons(c: &Campaign, results: &[(String, PoseRows)]) -> Vec<ShapeComparison> {
+/// Each pose between each pair of successive levels of the ladder it has results on, and
+/// between the judged pair `(committed, refined)` when the committed level is off the
+/// ladder (its refinement is not a 2x one: no trend is drawn through it).
+fn shape_comparisons(c: &Campaign, results: &[(String, PoseRows)], judged: (&str, &str)) -> Vec<ShapeComparison> {
+    let ladder = c.mesh_study();
     let mut poses: Vec<&String> = results.iter().flat_map(|(_, r)| r.keys()).collect();
     poses.sort();
     poses.dedup();
     let mut out = Vec::new();
+    let mut push = |pose: &str, (la, a): (&str, &[crate::results::Row]), (lb, b): (&str, &[crate::results::Row])| {
+        if same_depths(a, b) {
+            out.push(shape::compare(pose, (la, lb), a, b, c.needle.reference_from_tip_mm));
+        }
+    };
     for pose in poses {
-        let have: Vec<(&String, &[crate::results::Row])> =
-            results.iter().filter_map(|(l, r)| r.get(pose).and_then(|r| r.as_ref().ok()).map(|r| (l, r.rows.as_slice()))).collect();
-        for w in have.windows(2) {
-            let ((la, a), (lb, b)) = (w[0], w[1]);
-            if same_depths(a, b) {
-                out.push(shape::compare(pose, (la, lb), a, b, c.needle.reference_from_tip_mm));
+        let have: Vec<(&str, &[crate::results::Row])> = results
+            .iter()
+            .filter_map(|(l, r)| r.get(pose).and_then(|r| r.as_ref().ok()).map(|r| (l.as_str(), r.rows.as_slice())))
+            .collect();
+        let on_ladder: Vec<_> = have.iter().copied().filter(|(l, _)| ladder.iter().any(|k| k == l)).collect();
+        for w in on_ladder.windows(2) {
+            push(pose, w[0], w[1]);
+        }
+        if !ladder.iter().any(|k| k == judged.0) {
+            let find = |level: &str| have.iter().copied().find(|(l, _)| *l == level);
+            if let (Some(a), Some(b)) = (find(judged.0), find(judged.1)) {
+                push(pose, a, b);
             }
         }
     }
@@ -362,7 +376,7 @@ fn report(
 
 #[cfg(test)]
 mod tests {
-    use super::{plan_study, richardson, shape_trends};
+    use super::{plan_study, richardson, shape_comparisons, shape_trends};
     use crate::results::Row;
     use crate::verify::shape;
 
@@ -416,5 +430,31 @@ mod tests {
         assert_eq!(names(&plan), ["coarse8: centre", "needle8: centre x+04", "fine: centre x+04"]);
         c.campaign.mesh_reference = None;
         assert!(plan_study(&c, &extra, false).is_err(), "off the ladder without a reference");
+    }
+
+    #[test]
+    fn a_committed_level_off_the_ladder_is_compared_with_its_reference_and_the_ladder_with_itself() {
+        let set = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../coeffs/default");
+        let (mut c, _) = crate::spec::load(&set).expect("the shipped spec");
+        c.campaign.mesh = "core6".into();
+        c.campaign.mesh_reference = Some("fine".into());
+        c.campaign.mesh_study = vec!["coarse8".into(), "needle8".into(), "fine".into()];
+        let manifest = crate::manifest::read_manifest(&set.join("fe/manifest.toml")).expect("the shipped manifest");
+        let entry = manifest.pose.get("centre").expect("the centre's entry").clone();
+        let run = |k: f64| super::super::runs::Run {
+            rows: (0..=6).map(f64::from).map(|d| Row { depth_mm: d, wrench: [0.0, k * d * d, 0.0, 0.0, 0.0, 0.0] }).collect(),
+            entry: entry.clone(),
+        };
+        let results: Vec<(String, super::super::runs::PoseRows)> = ["coarse8", "needle8", "core6", "fine"]
+            .iter()
+            .enumerate()
+            .map(|(i, l)| (l.to_string(), [("centre".to_string(), Ok(run(1.0 + 0.1 * i as f64)))].into_iter().collect()))
+            .collect();
+        let pairs: Vec<String> =
+            shape_comparisons(&c, &results, ("core6", "fine")).iter().map(|s| format!("{} {}", s.coarse, s.fine)).collect();
+        assert_eq!(pairs, ["coarse8 needle8", "needle8 fine", "core6 fine"]);
+        let trends = shape_trends(&shape_comparisons(&c, &results, ("core6", "fine")));
+        assert_eq!(trends.len(), 1, "one trend, on the ladder");
+        assert_eq!(trends[0].levels, ["coarse8".to_string(), "needle8".into(), "fine".into()]);
     }
 }
