@@ -413,13 +413,20 @@ mod tests {
         assert!(richardson(1.0, 1.1, 1.3).is_none(), "growing differences");
     }
 
-    #[test]
-    fn a_committed_level_off_the_ladder_runs_beside_its_reference_and_the_edge_study_on_the_ladder() {
+    /// The shipped spec with core6 committed, judged against fine, off the ladder
+    /// coarse8, needle8, fine; and the shipped set's folder.
+    fn off_the_ladder() -> (crate::spec::Campaign, std::path::PathBuf) {
         let set = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../coeffs/default");
         let (mut c, _) = crate::spec::load(&set).expect("the shipped spec");
         c.campaign.mesh = "core6".into();
         c.campaign.mesh_reference = Some("fine".into());
         c.campaign.mesh_study = vec!["coarse8".into(), "needle8".into(), "fine".into()];
+        (c, set)
+    }
+
+    #[test]
+    fn a_committed_level_off_the_ladder_runs_beside_its_reference_and_the_edge_study_on_the_ladder() {
+        let (mut c, _) = off_the_ladder();
         let extra = vec!["x+04".to_string()];
         let names = |plan: &[(String, Vec<String>)]| -> Vec<String> { plan.iter().map(|(l, p)| format!("{l}: {}", p.join(" "))).collect() };
         let (plan, judged, refined) = plan_study(&c, &extra, false).expect("the mesh study");
@@ -434,11 +441,7 @@ mod tests {
 
     #[test]
     fn a_committed_level_off_the_ladder_is_compared_with_its_reference_and_the_ladder_with_itself() {
-        let set = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../coeffs/default");
-        let (mut c, _) = crate::spec::load(&set).expect("the shipped spec");
-        c.campaign.mesh = "core6".into();
-        c.campaign.mesh_reference = Some("fine".into());
-        c.campaign.mesh_study = vec!["coarse8".into(), "needle8".into(), "fine".into()];
+        let (c, set) = off_the_ladder();
         let manifest = crate::manifest::read_manifest(&set.join("fe/manifest.toml")).expect("the shipped manifest");
         let entry = manifest.pose.get("centre").expect("the centre's entry").clone();
         let run = |k: f64| super::super::runs::Run {
