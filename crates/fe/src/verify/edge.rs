@@ -106,18 +106,10 @@ pub fn edge_study(c: &Campaign, o: &MeshOptions) -> Result<Vec<EdgeStudy>> {
     for &r in &c.campaign.edge_study_radii_mm {
         let mesh = mesh_check::mesh_convergence(c, &MeshOptions { edge_radius_mm: Some(r), ..o.clone() })?;
         let read = |edge: Option<f64>, level: &str| -> Result<PoseRows> {
-            // the campaign's edge: its runs in fe/ on the committed level, the mesh study's
-            // in fe/mesh/<level>/ on another level of the ladder
-            let fe = o.set_dir.join("fe");
-            let out_dir = match edge {
-                Some(r) => Some(fe.join(mesh_check::EDGE_DIR).join(mesh_check::edge_dir(r)).join(level)),
-                None if level != c.campaign.mesh => Some(fe.join(mesh_check::MESH_DIR).join(level)),
-                None => None,
-            };
             let opts = RunOptions {
                 only: Some(poses.join(",")),
                 mesh: Some(level.to_string()),
-                out_dir,
+                out_dir: Some(mesh_check::run_dir(c, &o.set_dir, level, edge)),
                 edge_radius_mm: edge,
                 ..RunOptions::new(&o.set_dir)
             };

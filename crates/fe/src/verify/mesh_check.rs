@@ -18,7 +18,7 @@ use crate::spec::{Campaign, Role};
 use anyhow::{Context, Result};
 use needle_contract::FY;
 use serde::Serialize;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Sub-folder of `<set>/fe/` with the study's runs, one folder per level.
 pub const MESH_DIR: &str = "mesh";
@@ -30,6 +30,18 @@ pub const EDGE_DIR: &str = "edge";
 /// The edge study's folder of radius `radius_mm` in `<set>/fe/edge/`: `r0p4mm`.
 pub fn edge_dir(radius_mm: f64) -> String {
     format!("r{}mm", crate::spec::visco::decimal_tag(radius_mm))
+}
+
+/// The folder of `level`'s runs in `<set_dir>/fe/`: with an edge radius the edge study's
+/// `edge/r<radius>mm/<level>/`; with the campaign's needle `fe/` itself on the committed
+/// level (the campaign's runs) and the mesh study's `mesh/<level>/` on another.
+pub fn run_dir(c: &Campaign, set_dir: &Path, level: &str, edge_radius_mm: Option<f64>) -> PathBuf {
+    let fe = set_dir.join("fe");
+    match edge_radius_mm {
+        Some(r) => fe.join(EDGE_DIR).join(edge_dir(r)).join(level),
+        None if level == c.campaign.mesh => fe,
+        None => fe.join(MESH_DIR).join(level),
+    }
 }
 
 /// What the study runs on.
@@ -236,11 +248,7 @@ pub fn mesh_convergence(c: &Campaign, o: &MeshOptions) -> Result<MeshReport> {
         // the committed level's runs of the campaign's needle are the campaign's: read,
         // never solved here
         let campaign_runs = *level == c.campaign.mesh && o.edge_radius_mm.is_none();
-        let out_dir = match o.edge_radius_mm {
-            Some(r) => o.set_dir.join("fe").join(EDGE_DIR).join(edge_dir(r)).join(level),
-            None if campaign_runs => o.set_dir.join("fe"),
-            None => o.set_dir.join("fe").join(MESH_DIR).join(level),
-        };
+        let out_dir = run_dir(c, &o.set_dir, level, o.edge_radius_mm);
         let opts = RunOptions {
             only: Some(poses.join(",")),
             mesh: Some(level.clone()),
