@@ -393,7 +393,7 @@ fn runs_solved_from_another_spec_are_stale_for_the_fit_and_for_validate() {
     let e = needle_fit::fit_set(dir.path()).expect_err("no manifest: nothing is current");
     match e.downcast_ref::<RunError>() {
         Some(RunError::Stale { runs, .. }) => {
-            assert!(runs.iter().any(|(p, why)| p == "centre" && why.starts_with("no entry in fe/manifest.toml")), "{runs:?}");
+            assert!(runs.iter().any(|(p, why)| p == "centre" && why.starts_with("no entry in manifest.toml")), "{runs:?}");
         }
         _ => panic!("runs without an entry must be RunError::Stale: {e:#}"),
     }

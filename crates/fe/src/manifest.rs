@@ -135,16 +135,16 @@ impl Manifest {
     /// and validator's refusal of stale runs.
     ///
     /// # Errors
-    /// The reason, e.g. `no entry in fe/manifest.toml` or `solved from another spec (...)`.
+    /// The reason, e.g. `no entry in manifest.toml` or `solved from another spec (...)`.
     pub fn current_entry(&self, campaign: &Campaign, pose: &PoseSpec, mesh_name: &str) -> std::result::Result<&ManifestEntry, String> {
         let want = campaign.run_hash(pose, mesh_name);
         let short = |h: &str| h.get(..12).unwrap_or(h).to_string();
         match self.pose.get(&pose.name) {
-            None => Err(format!("no entry in fe/{MANIFEST}")),
+            None => Err(format!("no entry in {MANIFEST}")),
             Some(e) if e.spec_hash == want => Ok(e),
             Some(e) if e.first_attempt_hash.as_deref() == Some(campaign.first_attempt_hash(pose, mesh_name).as_str()) => Ok(e),
             Some(e) => Err(format!(
-                "solved from another spec (spec_hash {} in fe/{MANIFEST}, {} for the current campaign.toml)",
+                "solved from another spec (spec_hash {} in {MANIFEST}, {} for the current campaign.toml)",
                 short(&e.spec_hash),
                 short(&want)
             )),

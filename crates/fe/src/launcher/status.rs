@@ -17,7 +17,7 @@ pub struct PoseState {
     pub pose: String,
     /// The result is up to date.
     pub done: bool,
-    /// Why it is not (`no entry in fe/manifest.toml`, `solved from another spec`...).
+    /// Why it is not (`no entry in manifest.toml`, `solved from another spec`...).
     pub result: String,
     /// The latest array task of the pose, `<job>_<task>`.
     pub task: Option<String>,
