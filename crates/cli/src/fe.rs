@@ -16,8 +16,8 @@ about the needle hub) and its record to <set>/fe/manifest.toml. Poses whose resu
 skipped; a failed attempt is retried on the engine's retry ladder (docs/usage.md). A run killed in the middle of a \
 pose (Ctrl-C, kill -9, the end of a session) resumes it on the rerun at the attempt it was in \
 (<out>/.work/<pose>/progress.toml): FEBio goes on from the attempt's last dump (its last must point), ccx reruns the \
-attempt from its start; --force, another spec or a pose whose attempts all failed start afresh. Exit status 1 when a \
-run failed (the others are kept), 2 on an error before any run.")]
+attempt from its start; --force, another spec or a pose whose attempts all failed start afresh (--skip-failed \
+leaves the last). Exit status 1 when a run failed (the others are kept), 2 on an error before any run.")]
     Run(RunArgs),
     /// Verify the FE setup: flat punch, mesh study, mirror runs, smoothness, scaling law.
     #[command(after_help = "Without --punch, --mesh, --mirror, --smooth or --scaling all five run (the mesh study's \
@@ -85,6 +85,11 @@ pub struct SolveArgs {
     /// pose starts afresh instead of resuming.
     #[arg(long)]
     pub force: bool,
+    /// Do not run again a pose whose attempts all failed with the same spec, engine and
+    /// mesh (its <out>/.work/<pose>/progress.toml says so): report it failed with the
+    /// recorded failures. For a long campaign resumed in pieces.
+    #[arg(long, conflicts_with = "force")]
+    pub skip_failed: bool,
     /// Keep the work folder (<out>/.work/<pose>: solver input and logs) of successful
     /// runs too; failed runs always keep theirs.
     #[arg(long)]
@@ -101,6 +106,7 @@ pub struct SolveArgs {
 fn with_solve(opts: RunOptions, a: &SolveArgs) -> RunOptions {
     RunOptions {
         force: a.force,
+        skip_failed: a.skip_failed,
         keep_work: a.keep_work,
         timeout: a.timeout_s.map(Duration::from_secs_f64),
         stall: Some(Duration::from_secs_f64(a.stall_s)),

@@ -11,7 +11,9 @@
 //!
 //! On a rerun, [`decide`] keeps the work folder and resumes at the recorded attempt only
 //! when the record is readable, matches the current run exactly and has attempts left
-//! and `--force` is not given; otherwise the folder is cleared as before, with the reason
+//! and `--force` is not given; a record of exactly this run whose attempts all failed is
+//! [`Decision::Finished`] (the campaign clears it, or with `--skip-failed` keeps it and
+//! runs nothing); otherwise the folder is cleared as before, with the reason
 //! ([`Decision::Fresh`]). What an engine does with an interrupted attempt is its own
 //! affair: FEBio continues it from its last dump (`febio/running.rs`), CalculiX reruns it
 //! from its start.
@@ -79,6 +81,9 @@ pub struct Start {
 pub enum Decision {
     /// Keep the folder and start at the recorded attempt.
     Resume(Start),
+    /// Every attempt of exactly this run failed before (the failure messages as
+    /// recorded): the campaign starts it afresh, or with `--skip-failed` runs nothing.
+    Finished(Vec<String>),
     /// Clear the folder and start at attempt 1; `Some(why)` when a record was there but is
     /// not resumed (one line for stderr).
     Fresh(Option<String>),
@@ -131,8 +136,10 @@ pub fn read(work_dir: &Path) -> Result<Option<Record>> {
 /// Whether the pose whose work folder is `work_dir` resumes (module docs). Guarantees: a
 /// [`Decision::Resume`] only for a readable record of exactly `run` with
 /// `attempt < attempts` (the engine's count now) and `force` false, its attempt index,
-/// failures and must points as recorded; [`Decision::Fresh`] with a reason whenever a
-/// record exists but is not resumed, `Fresh(None)` when there is none.
+/// failures and must points as recorded; [`Decision::Finished`] only for a readable
+/// record of exactly `run` and the same count whose attempts all finished, with one
+/// failure message each, and `force` false; [`Decision::Fresh`] with a reason whenever a
+/// record exists but is neither, `Fresh(None)` when there is none.
 pub fn decide(work_dir: &Path, run: &Identity, attempts: u32, force: bool) -> Decision {
     let record = match read(work_dir) {
         Ok(Some(r)) => r,
@@ -146,8 +153,10 @@ pub fn decide(work_dir: &Path, run: &Identity, attempts: u32, force: bool) -> De
         Some(format!("it is the record of another run ({})", differences(&record.run, run)))
     } else if record.attempts != attempts {
         Some(format!("it counts {} attempts, the engine now {attempts}", record.attempts))
+    } else if record.attempt >= record.attempts && record.failures.len() == record.attempts as usize {
+        return Decision::Finished(record.failures);
     } else if record.attempt >= record.attempts {
-        Some(format!("all {} attempts of that run finished (failed)", record.attempts))
+        Some(format!("all {} attempts finished with {} failure message(s)", record.attempts, record.failures.len()))
     } else if record.failures.len() != record.attempt as usize {
         Some(format!("attempt {} with {} failure message(s)", record.attempt + 1, record.failures.len()))
     } else {
@@ -208,7 +217,11 @@ mod tests {
         assert!(fresh(&Identity { engine_version: "2".into(), ..run() }, 5, false).contains("engine_version 1 != 2"));
         assert!(fresh(&run(), 2, false).contains("counts 5 attempts, the engine now 2"));
         write(d.path(), &run(), 5, &start(5)).expect("write");
-        assert!(fresh(&run(), 5, false).contains("all 5 attempts of that run finished"));
+        assert_eq!(decide(d.path(), &run(), 5, false), Decision::Finished(start(5).failures), "every attempt failed");
+        assert!(fresh(&run(), 5, true).ends_with("not resumed: --force"));
+        assert!(fresh(&other, 5, false).contains("another run"), "a changed spec runs afresh");
+        write(d.path(), &run(), 5, &Start { failures: vec!["one".into()], ..start(5) }).expect("write");
+        assert!(fresh(&run(), 5, false).contains("all 5 attempts finished with 1 failure message(s)"));
         std::fs::write(path(d.path()), "attempt = \"x\"").expect("corrupt");
         assert!(fresh(&run(), 5, false).contains("not a progress record"));
         remove(d.path());

@@ -19,7 +19,11 @@
 //!   `<pose>: resuming attempt K of N (interrupted at X mm)` on stderr. Another run's
 //!   record (spec hash, engine and version, mesh, steps), an unreadable one, one whose
 //!   attempts all failed, or `--force`: the folder is cleared and attempt 1 starts, with
-//!   the reason on stderr.
+//!   the reason on stderr. With `skip_failed` a record of exactly this run whose
+//!   attempts all failed is not run again (a solver that does not converge fails the
+//!   same way on the same spec; a campaign resumed session after session would spend the
+//!   attempts' hours each time): the pose is reported failed with the recorded failures
+//!   and its folder stays.
 //!
 //! A pose is up to date, and skipped, when its CSV exists with `steps + 1` rows and its
 //! manifest entry has the spec hash of the current run ([`Campaign::run_hash`] of the
@@ -90,6 +94,9 @@ pub struct RunOptions {
     pub out_dir: Option<PathBuf>,
     /// Solve every selected pose, even when its result is up to date.
     pub force: bool,
+    /// Do not run again a pose whose attempts all failed with exactly this run (its
+    /// progress record says so): report it failed with the recorded failures.
+    pub skip_failed: bool,
     /// Wall-clock limit of one solver attempt (FEBio or ccx); the attempt is killed and counted failed after it.
     pub timeout: Option<Duration>,
     /// A solver job that writes no output for this long is killed as stalled (then retried).
@@ -134,6 +141,7 @@ impl RunOptions {
             steps: None,
             out_dir: None,
             force: false,
+            skip_failed: false,
             timeout: None,
             stall: Some(DEFAULT_STALL),
             launcher: Launched::Local,
@@ -183,6 +191,8 @@ struct Ctx<'a> {
     keep_work: bool,
     /// `--force`: a pose's progress record is not resumed.
     force: bool,
+    /// `--skip-failed` ([`RunOptions::skip_failed`]).
+    skip_failed: bool,
     launcher: &'a Launched,
 }
 
@@ -241,6 +251,7 @@ fn run_planned(opts: &RunOptions, plan: Plan, backend: &mut dyn Backend) -> Resu
             manifest_lock: Mutex::new(()),
             keep_work: opts.keep_work,
             force: opts.force,
+            skip_failed: opts.skip_failed,
             launcher: &opts.launcher,
         };
         let earlier_walls_s = manifest.wall_times_s(ctx.campaign.solver.engine.name(), &mesh_name, steps);

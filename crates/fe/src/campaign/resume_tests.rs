@@ -1,6 +1,6 @@
 //! Tests of the campaign's resume (`crate::resume`): a run killed in the middle of a pose
 //! goes on at its attempt; another run's record, `--force` and a pose whose attempts all
-//! failed start afresh. (A module of `campaign`, in its own file: `resume` holds the
+//! failed start afresh (with `--skip-failed` the last is not run again). (A module of `campaign`, in its own file: `resume` holds the
 //! record, `campaign` uses it, these tests use both.)
 
 use crate::backend::{Backend, Job, SolveFailure, Solved};
@@ -123,7 +123,21 @@ fn a_killed_run_resumes_at_its_attempt_with_the_earlier_failures() {
     let rec = read(&wd).expect("readable").expect("kept with the failed pose");
     assert_eq!((rec.attempt, rec.failures.len()), (ATTEMPTS, ATTEMPTS as usize), "every attempt finished");
 
-    // a pose whose attempts all failed starts afresh
+    // with --skip-failed a pose whose attempts all failed is not run again: reported
+    // failed with the recorded failures, its record kept
+    let skip = RunOptions { skip_failed: true, ..o.clone() };
+    let (ran, again, _) = run(&skip, None, None);
+    assert!(ran.is_empty(), "no attempt runs: {ran:?}");
+    assert_eq!(
+        again,
+        format!(
+            "not run again (--skip-failed): all 4 attempts of this spec failed in an earlier run: {}",
+            failures(ATTEMPTS, &b).join("; ")
+        )
+    );
+    assert!(read(&wd).expect("readable").is_some(), "its record and logs stay");
+
+    // without it, the pose starts afresh
     let (ran, ..) = run(&o, None, None);
     assert_eq!(ran, [0, 1, 2, 3]);
 }

@@ -52,7 +52,8 @@ pub(super) fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
     };
     let attempts = ctx.backend.attempts().max(1);
     let from = match starting_point(ctx, pose, &wd, &run, attempts) {
-        Ok(from) => from,
+        Ok(Begin::At(from)) => from,
+        Ok(Begin::FailedBefore(failures)) => return fail(failed_before(attempts, &failures), String::new()),
         Err(e) => return fail(format!("{e:#}"), String::new()),
     };
     let job = Job {
@@ -129,16 +130,38 @@ fn solved_report(ctx: &Ctx<'_>, pose: &PoseSpec, wd: &Path, solved: &Solved, wal
     }
 }
 
+/// Where a pose's attempts begin.
+enum Begin {
+    /// At this attempt, with the failures before it.
+    At(resume::Start),
+    /// Nowhere: every attempt of exactly this run failed before (their messages).
+    FailedBefore(Vec<String>),
+}
+
+/// The failure message of a pose not run again ([`resume::Decision::Finished`]).
+fn failed_before(attempts: u32, failures: &[String]) -> String {
+    format!("not run again (--skip-failed): all {attempts} attempts of this spec failed in an earlier run: {}", failures.join("; "))
+}
+
 /// Where `pose` starts: an interrupted run of the same pose resumes at its attempt
-/// ([`resume`]); anything else starts afresh in an empty work folder `wd`. The earlier
-/// result and its entry stay until the new ones replace them: a failed or interrupted
-/// rerun (`--force`) costs nothing (module docs).
+/// ([`resume`]); with `--skip-failed` a run of the same spec whose attempts all failed
+/// is not run again (its work folder stays); anything else starts afresh in an empty
+/// work folder `wd`. The earlier result and its entry stay until the new ones replace
+/// them: a failed or interrupted rerun (`--force`) costs nothing (module docs).
 ///
 /// # Errors
 /// The work folder cannot be cleared or made.
-fn starting_point(ctx: &Ctx<'_>, pose: &PoseSpec, wd: &Path, run: &resume::Identity, attempts: u32) -> Result<resume::Start> {
+fn starting_point(ctx: &Ctx<'_>, pose: &PoseSpec, wd: &Path, run: &resume::Identity, attempts: u32) -> Result<Begin> {
     let decision = if wd.exists() { resume::decide(wd, run, attempts, ctx.force) } else { resume::Decision::Fresh(None) };
     match decision {
+        resume::Decision::Finished(failures) if ctx.skip_failed => Ok(Begin::FailedBefore(failures)),
+        resume::Decision::Finished(_) => {
+            eprintln!(
+                "{}: starting afresh: all {attempts} attempts of this spec failed in an earlier run (--skip-failed leaves it)",
+                pose.name
+            );
+            fresh_folder(wd)
+        }
         resume::Decision::Resume(start) => {
             let reached = ctx.backend.steps_done(wd);
             eprintln!(
@@ -147,19 +170,24 @@ fn starting_point(ctx: &Ctx<'_>, pose: &PoseSpec, wd: &Path, run: &resume::Ident
                 start.attempt + 1,
                 ctx.campaign.loading.depth_at(reached.min(ctx.steps))
             );
-            Ok(start)
+            Ok(Begin::At(start))
         }
         resume::Decision::Fresh(why) => {
             if let Some(why) = why {
                 eprintln!("{}: starting afresh: {why}", pose.name);
             }
-            if wd.exists() {
-                std::fs::remove_dir_all(wd).with_context(|| format!("{}: cannot clear", wd.display()))?;
-            }
-            std::fs::create_dir_all(wd).with_context(|| format!("{}: cannot create", wd.display()))?;
-            Ok(resume::Start::default())
+            fresh_folder(wd)
         }
     }
+}
+
+/// Clear (or make) the work folder `wd` for attempt 1.
+fn fresh_folder(wd: &Path) -> Result<Begin> {
+    if wd.exists() {
+        std::fs::remove_dir_all(wd).with_context(|| format!("{}: cannot clear", wd.display()))?;
+    }
+    std::fs::create_dir_all(wd).with_context(|| format!("{}: cannot create", wd.display()))?;
+    Ok(Begin::At(resume::Start::default()))
 }
 
 /// Solve `job`; when that fails, again with [`RETRY_FIRST_INCREMENT`](crate::backend::RETRY_FIRST_INCREMENT), up to the
