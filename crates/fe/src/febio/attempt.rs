@@ -148,8 +148,7 @@ impl<'j, 'a> Setup<'j, 'a> {
         let contact_steps = first_contact_steps(fs, &job.campaign.loading, job.steps);
         let first_contact = (!plan.retry_tolerances() && ladder::failed_at_first_contact(&state, contact_steps))
             .then_some(feb::FirstContact { depth_mm: fs.first_contact_depth_mm, step_fraction: fs.first_contact_step_fraction });
-        let stepping =
-            feb::Stepping { first_step_fraction: plan.first_increment(), retry_tolerances: plan.retry_tolerances(), first_contact };
+        let stepping = stepping(&plan, job.mesh, first_contact);
         // a continuation writes the model too: the record of its contact, kept with its logs
         let feb = feb::write_stepped(&campaign, job.pose, job.mesh, job.steps, &stepping).context("writing the FEBio input")?;
         let input = job.work_dir.join(format!("{JOB}.feb"));
@@ -159,6 +158,13 @@ impl<'j, 'a> Setup<'j, 'a> {
 
     fn fs(&self) -> &FebioSettings {
         &self.campaign.solver.febio
+    }
+
+    /// Whether the attempt converges with the retry tolerances: the ladder's retries, and
+    /// every attempt on a level that asks for them first
+    /// ([`MeshLevel::retry_tolerances_first`]).
+    fn retry_tolerances(&self) -> bool {
+        self.plan.retry_tolerances() || self.job.mesh.retry_tolerances_first()
     }
 
     fn loading(&self) -> &'a Loading {
@@ -189,7 +195,7 @@ impl<'j, 'a> Setup<'j, 'a> {
     /// ([`feb::residual_floor_n`]): the dump carries the run's own.
     fn tolerances(&self) -> Option<restart::Tolerances> {
         let fs = self.fs();
-        self.plan.retry_tolerances().then(|| restart::Tolerances {
+        self.retry_tolerances().then(|| restart::Tolerances {
             dtol: fs.retry_dtol,
             rtol: fs.retry_rtol,
             min_residual_n: feb::residual_floor_n(fs, self.loading(), true),
@@ -428,7 +434,7 @@ impl<'j, 'a> Setup<'j, 'a> {
     /// The manifest's settings line of the attempt.
     fn settings(&self, threads: usize, p: &Progress) -> String {
         let loading = self.loading();
-        let mut line = settings_line(self.fs(), self.campaign.contact.friction, threads, self.plan.retry_tolerances());
+        let mut line = settings_line(self.fs(), self.campaign.contact.friction, threads, self.retry_tolerances());
         if let Some(fc) = self.first_contact {
             line.push_str(&format!("; time steps <= {} of a load step to {} mm (first contact)", fc.step_fraction, fc.depth_mm));
         }
@@ -447,7 +453,7 @@ impl<'j, 'a> Setup<'j, 'a> {
         if let Some(at) = p.resumed_at_mm {
             line.push_str(&format!("; resumed after an interruption at {at} mm"));
         }
-        if p.totals.floor_accepted > 0 && self.plan.retry_tolerances() && self.fs().retry_min_residual_n > 0.0 {
+        if p.totals.floor_accepted > 0 && self.retry_tolerances() && self.fs().retry_min_residual_n > 0.0 {
             line.push_str(&format!("; the residual floor accepted {} iteration(s)", p.totals.floor_accepted));
         }
         for n in &p.notes {
@@ -592,6 +598,14 @@ fn campaign_for<'c>(campaign: &'c Campaign, contact: ladder::Fresh, mesh: &MeshL
     Cow::Owned(c)
 }
 
+/// How an attempt with `plan` on level `mesh` steps and converges: the plan's first
+/// increment, the retry tolerances for the ladder's retries and for every attempt on a
+/// level that asks for them first ([`MeshLevel::retry_tolerances_first`]).
+fn stepping(plan: &ladder::Plan, mesh: &MeshLevel, first_contact: Option<feb::FirstContact>) -> feb::Stepping {
+    let retry_tolerances = plan.retry_tolerances() || mesh.retry_tolerances_first();
+    feb::Stepping { first_step_fraction: plan.first_increment(), retry_tolerances, first_contact }
+}
+
 /// The load steps that start within the first-contact depth.
 fn first_contact_steps(fs: &FebioSettings, loading: &Loading, steps: u32) -> u32 {
     if loading.ramp_hold.is_some() {
@@ -722,5 +736,40 @@ mod level_tolerance_tests {
         let (with, without) = (on(own), on(plain));
         assert_ne!(with.run_hash(centre, "core6"), without.run_hash(centre, "core6"), "part of the run hash");
         assert_eq!(with.first_attempt_hash(centre, "core6"), without.first_attempt_hash(centre, "core6"), "not of the first attempt's");
+    }
+
+    /// `[mesh.<level>] first_attempt_retry_tolerances = true`: the first attempt's FEBio
+    /// input on that level has the retries' dtol, the level's retry_rtol and its squared
+    /// residual floor, with whole load steps; the flag is part of both hashes, and with it
+    /// the retry settings are part of the first attempt's.
+    #[test]
+    fn a_level_may_give_its_first_attempt_the_retry_tolerances() {
+        let set = crate::workspace_root().join("coeffs/default");
+        let (c, _) = crate::spec::load(&set).expect("the shipped spec");
+        let plain = MeshLevel { first_attempt_retry_tolerances: None, ..c.mesh_level("core6").expect("core6").clone() };
+        let own = MeshLevel { first_attempt_retry_tolerances: Some(true), ..plain.clone() };
+        let centre = c.pose.iter().find(|p| p.name == "centre").expect("centre");
+        let fs = &c.solver.febio;
+        let (rtol, floor_n) = (own.retry_rtol.expect("core6's retry_rtol"), own.retry_min_residual_n.expect("core6's floor"));
+        assert!(fs.dtol != fs.retry_dtol && fs.rtol != rtol, "the shipped first and retry tolerances differ");
+        let first = ladder::Plan::Fresh(ladder::Fresh { seg_up: ladder::SegUp::Spec, softer: false, quarter: false });
+        let text = |level: &MeshLevel| {
+            let st = stepping(&first, level, None);
+            assert_eq!(st.first_step_fraction, 1.0, "whole load steps");
+            feb::write_stepped(&campaign_for(&c, first.contact(), level), centre, level, 2, &st).expect("the FEBio input").text
+        };
+        let tags = |dtol: f64, rtol: f64| [format!("<dtol>{}</dtol>", feb::num(dtol)), format!("<rtol>{}</rtol>", feb::num(rtol))];
+        let floor = format!("<min_residual>{}</min_residual>", feb::num(floor_n * floor_n));
+        let (with, without) = (text(&own), text(&plain));
+        assert!(tags(fs.retry_dtol, rtol).iter().all(|t| with.contains(t)) && with.contains(&floor), "the retries' tolerances");
+        assert!(tags(fs.dtol, fs.rtol).iter().all(|t| without.contains(t)) && !without.contains(&floor), "the solver's");
+        let on = |level: MeshLevel| crate::spec::Campaign { mesh: [("core6".to_string(), level)].into_iter().collect(), ..c.clone() };
+        let first_hash = |level: &MeshLevel| on(level.clone()).first_attempt_hash(centre, "core6");
+        assert_ne!(on(own.clone()).run_hash(centre, "core6"), on(plain.clone()).run_hash(centre, "core6"), "the flag: run hash");
+        assert_ne!(first_hash(&own), first_hash(&plain), "the flag: first-attempt hash");
+        let looser = MeshLevel { retry_rtol: Some(rtol * 10.0), ..own.clone() };
+        assert_ne!(first_hash(&own), first_hash(&looser), "with the flag, retry_rtol is part of the first attempt's hash");
+        let looser_plain = MeshLevel { retry_rtol: Some(rtol * 10.0), ..plain.clone() };
+        assert_eq!(first_hash(&plain), first_hash(&looser_plain), "without it, not");
     }
 }

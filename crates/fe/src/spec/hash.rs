@@ -20,13 +20,21 @@ impl Campaign {
     /// reproduced by the spec as long as this hash stays the same, whatever the ladder's
     /// later rungs become (the manifest's `first_attempt_hash`,
     /// [`Manifest::current_entry`](crate::manifest::Manifest::current_entry)).
+    /// On a level whose first attempt uses the retries' tolerances
+    /// ([`MeshLevel::retry_tolerances_first`]) those stay in this hash.
     pub fn first_attempt_hash(&self, pose: &PoseSpec, mesh_name: &str) -> String {
         let mut solver = self.solver.clone();
-        solver.febio.retry_dtol = 0.0;
-        solver.febio.retry_rtol = 0.0;
-        solver.febio.retry_min_residual_n = 0.0;
+        let level = self.mesh.get(mesh_name);
+        if !level.is_some_and(MeshLevel::retry_tolerances_first) {
+            solver.febio.retry_dtol = 0.0;
+            solver.febio.retry_rtol = 0.0;
+            solver.febio.retry_min_residual_n = 0.0;
+        }
         solver.febio.last_attempt_penalty_scale = 0.0;
-        let level = self.mesh.get(mesh_name).map(|m| MeshLevel { retry_rtol: None, retry_min_residual_n: None, ..m.clone() });
+        let level = level.map(|m| match m.retry_tolerances_first() {
+            true => m.clone(),
+            false => MeshLevel { retry_rtol: None, retry_min_residual_n: None, ..m.clone() },
+        });
         self.hash_with(pose, mesh_name, level.as_ref(), &solver, Some("first attempt"))
     }
 

@@ -125,6 +125,7 @@ pub fn punch_mesh(radius_mm: f64, core_elements: u32, mesh_scale: f64) -> spec::
         rtol: None,
         retry_rtol: None,
         retry_min_residual_n: None,
+        first_attempt_retry_tolerances: None,
     }
 }
 
