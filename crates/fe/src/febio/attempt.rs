@@ -160,11 +160,9 @@ impl<'j, 'a> Setup<'j, 'a> {
         &self.campaign.solver.febio
     }
 
-    /// Whether the attempt converges with the retry tolerances: the ladder's retries, and
-    /// every attempt on a level that asks for them first
-    /// ([`MeshLevel::retry_tolerances_first`]).
+    /// Whether the attempt converges with the retry tolerances ([`with_retry_tolerances`]).
     fn retry_tolerances(&self) -> bool {
-        self.plan.retry_tolerances() || self.job.mesh.retry_tolerances_first()
+        with_retry_tolerances(&self.plan, self.job.mesh)
     }
 
     fn loading(&self) -> &'a Loading {
@@ -602,8 +600,12 @@ fn campaign_for<'c>(campaign: &'c Campaign, contact: ladder::Fresh, mesh: &MeshL
 /// increment, the retry tolerances for the ladder's retries and for every attempt on a
 /// level that asks for them first ([`MeshLevel::retry_tolerances_first`]).
 fn stepping(plan: &ladder::Plan, mesh: &MeshLevel, first_contact: Option<feb::FirstContact>) -> feb::Stepping {
-    let retry_tolerances = plan.retry_tolerances() || mesh.retry_tolerances_first();
-    feb::Stepping { first_step_fraction: plan.first_increment(), retry_tolerances, first_contact }
+    feb::Stepping { first_step_fraction: plan.first_increment(), retry_tolerances: with_retry_tolerances(plan, mesh), first_contact }
+}
+
+/// Whether an attempt with `plan` on level `mesh` converges with the retry tolerances.
+fn with_retry_tolerances(plan: &ladder::Plan, mesh: &MeshLevel) -> bool {
+    plan.retry_tolerances() || mesh.retry_tolerances_first()
 }
 
 /// The load steps that start within the first-contact depth.

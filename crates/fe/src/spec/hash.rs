@@ -31,9 +31,12 @@ impl Campaign {
             solver.febio.retry_min_residual_n = 0.0;
         }
         solver.febio.last_attempt_penalty_scale = 0.0;
-        let level = level.map(|m| match m.retry_tolerances_first() {
-            true => m.clone(),
-            false => MeshLevel { retry_rtol: None, retry_min_residual_n: None, ..m.clone() },
+        let level = level.map(|m| {
+            if m.retry_tolerances_first() {
+                m.clone()
+            } else {
+                MeshLevel { retry_rtol: None, retry_min_residual_n: None, ..m.clone() }
+            }
         });
         self.hash_with(pose, mesh_name, level.as_ref(), &solver, Some("first attempt"))
     }
