@@ -14,7 +14,9 @@
 //! and `--force` is not given; a record of exactly this run whose attempts all failed is
 //! [`Decision::Finished`] (the campaign clears it, or with `--skip-failed` keeps it and
 //! runs nothing); otherwise the folder is cleared as before, with the reason
-//! ([`Decision::Fresh`]). What an engine does with an interrupted attempt is its own
+//! ([`Decision::Fresh`]). A `--force` rerun of an up-to-date pose that was interrupted
+//! leaves a record of exactly this run ([`unfinished`]): a rerun without `--force`
+//! resumes it rather than skip the pose as up to date. What an engine does with an interrupted attempt is its own
 //! affair: FEBio continues it from its last dump (`febio/running.rs`), CalculiX reruns it
 //! from its start.
 
@@ -131,6 +133,16 @@ pub fn read(work_dir: &Path) -> Result<Option<Record>> {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
         Err(e) => Err(e).with_context(|| format!("{}: cannot read", p.display())),
     }
+}
+
+/// Whether `work_dir` holds the record of an unfinished run (attempts left) of this
+/// spec hash, mesh level and step count. A pose whose result is up to date has such a
+/// record only when a `--force` rerun of it was interrupted: `campaign::plan` then
+/// solves it again, and [`decide`] resumes that run (or, if the engine or its version
+/// changed since, starts afresh and says why). Reads the record only; an unreadable
+/// record or none is no unfinished run.
+pub fn unfinished(work_dir: &Path, spec_hash: &str, mesh: &str, steps: u32) -> bool {
+    matches!(read(work_dir), Ok(Some(r)) if r.run.spec_hash == spec_hash && r.run.mesh == mesh && r.run.steps == steps && r.attempt < r.attempts)
 }
 
 /// Whether the pose whose work folder is `work_dir` resumes (module docs). Guarantees: a

@@ -27,7 +27,9 @@
 //!
 //! A pose is up to date, and skipped, when its CSV exists with `steps + 1` rows and its
 //! manifest entry has the spec hash of the current run ([`Campaign::run_hash`] of the
-//! spec with the `--steps` override applied, the pose and the mesh level). A rerun
+//! spec with the `--steps` override applied, the pose and the mesh level), unless its
+//! work folder holds the record of an interrupted `--force` rerun of that same run
+//! ([`crate::resume::unfinished`]): then the rerun resumes it. A rerun
 //! (stale spec, `--force`) leaves the earlier CSV and its entry alone until it succeeds:
 //! then the new CSV is renamed over the old one and the new entry replaces the old. A
 //! failed or interrupted rerun therefore keeps the earlier result usable. Killed between

@@ -2,10 +2,11 @@
 //! run's variant applied (`--steps`, `--deep`, `--visco`, a tissue scale, an edge radius),
 //! the mesh level, the output folder and which poses are up to date.
 
-use super::RunOptions;
+use super::{work_dir, RunOptions};
 use crate::manifest::{read_manifest, Manifest, MANIFEST};
 use crate::report::{PoseReport, Status};
 use crate::results::{self, Row};
+use crate::resume;
 use crate::spec::{self, Campaign, PoseSpec};
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
@@ -97,8 +98,10 @@ pub fn plan(opts: &RunOptions) -> Result<Plan> {
             fy_final_n: None,
             work_dir: None,
         };
+        // an interrupted `--force` rerun of an up-to-date pose resumes (crate::resume)
+        let interrupted = resume::unfinished(&work_dir(&out_dir, &pose.name), &campaign.run_hash(pose, &mesh_name), &mesh_name, steps);
         match (entry, rows) {
-            (Some(e), Some(rows)) if !opts.force => {
+            (Some(e), Some(rows)) if !opts.force && !interrupted => {
                 report.wall_s = Some(e.wall_s);
                 report.increments = Some(e.increments);
                 report.fy_final_n = rows.last().map(Row::fy_n);

@@ -1,5 +1,6 @@
 //! Tests of the campaign's resume (`crate::resume`): a run killed in the middle of a pose
-//! goes on at its attempt; another run's record, `--force` and a pose whose attempts all
+//! goes on at its attempt (also a `--force` rerun of an up-to-date pose, resumed without
+//! `--force`); another run's record, `--force` and a pose whose attempts all
 //! failed start afresh (with `--skip-failed` the last is not run again). (A module of `campaign`, in its own file: `resume` holds the
 //! record, `campaign` uses it, these tests use both.)
 
@@ -174,6 +175,28 @@ fn another_runs_record_or_force_starts_afresh() {
     run(&o, Some(1), None);
     let (ran, ..) = run(&opts(d.path(), "x+04", 3), None, None);
     assert_eq!(ran, [0, 1, 2, 3]);
+}
+
+#[test]
+fn an_interrupted_forced_rerun_of_an_up_to_date_pose_resumes_without_force() {
+    let d = set_dir();
+    let o = opts(d.path(), "x+04", 2);
+    let (ran, ..) = run(&o, None, Some(0));
+    assert_eq!(ran, [0], "solved by attempt 1");
+    let (ran, ..) = run(&o, None, None);
+    assert!(ran.is_empty(), "up to date: skipped ({ran:?})");
+    // a --force rerun killed in its attempt 2: the earlier result and its entry stay
+    let (ran, ..) = run(&RunOptions { force: true, ..o.clone() }, Some(1), None);
+    assert_eq!(ran, [0, 1]);
+    let m = read_manifest(&d.path().join("fe").join(MANIFEST)).expect("manifest");
+    assert_eq!(m.pose["x+04"].retry, None, "the first run's entry");
+    // a rerun without --force goes on with the forced run at its attempt 2
+    let (ran, message, b) = run(&o, None, Some(2));
+    assert_eq!((ran, message), (vec![1, 2], String::new()), "attempts 2 and 3, solved by 3");
+    let m = read_manifest(&d.path().join("fe").join(MANIFEST)).expect("manifest");
+    assert_eq!(m.pose["x+04"].retry.as_deref(), Some(failures(2, &b).join("; ").as_str()), "the forced run's entry");
+    let (ran, ..) = run(&o, None, None);
+    assert!(ran.is_empty(), "up to date again ({ran:?})");
 }
 
 /// The FEBio backend with its solver given (`prepare` would look for the real one).
