@@ -46,6 +46,19 @@ impl Plan {
     pub fn to_run_names(&self) -> Vec<String> {
         self.to_run.iter().filter_map(|&i| self.selected.get(i)).map(|p| p.name.clone()).collect()
     }
+
+    /// Whether `pose` is solved again only to resume an interrupted `--force` rerun (its
+    /// earlier result is current; [`resume::unfinished`]).
+    pub fn resumes_forced_rerun(&self, pose: &PoseSpec) -> bool {
+        interrupted_force_rerun(&self.out_dir, &self.campaign, pose, &self.mesh_name, self.steps)
+    }
+}
+
+/// Whether `pose`'s work folder in `out_dir` holds an unfinished run of exactly this spec,
+/// mesh level and step count: an interrupted `--force` rerun, which a rerun resumes even
+/// when the pose's result is up to date.
+fn interrupted_force_rerun(out_dir: &Path, campaign: &Campaign, pose: &PoseSpec, mesh_name: &str, steps: u32) -> bool {
+    resume::unfinished(&work_dir(out_dir, &pose.name), &campaign.run_hash(pose, mesh_name), mesh_name, steps)
 }
 
 /// Work out what `opts` asks for without changing any file: load and check the spec, pick
@@ -98,8 +111,7 @@ pub fn plan(opts: &RunOptions) -> Result<Plan> {
             fy_final_n: None,
             work_dir: None,
         };
-        // an interrupted `--force` rerun of an up-to-date pose resumes (crate::resume)
-        let interrupted = resume::unfinished(&work_dir(&out_dir, &pose.name), &campaign.run_hash(pose, &mesh_name), &mesh_name, steps);
+        let interrupted = interrupted_force_rerun(&out_dir, &campaign, pose, &mesh_name, steps);
         match (entry, rows) {
             (Some(e), Some(rows)) if !opts.force && !interrupted => {
                 report.wall_s = Some(e.wall_s);

@@ -96,6 +96,7 @@ pub fn status(plan: &Plan) -> Result<StatusReport> {
         } else {
             match plan.manifest.current_entry(&plan.campaign, pose, &plan.mesh_name) {
                 Err(why) => why,
+                Ok(_) if plan.resumes_forced_rerun(pose) => "up to date; an interrupted --force rerun resumes".to_string(),
                 Ok(_) => "CSV missing, changed or of other steps".to_string(),
             }
         };
