@@ -274,4 +274,27 @@ mod tests {
         let classes = attempts_by_class(&plan);
         assert!(classes.contains("solved runs by the attempt that solved them: attempt 1: 1"), "{classes}");
     }
+
+    /// A pose whose interrupted `--force` rerun will resume says so, not that its CSV is off.
+    #[test]
+    fn a_pose_whose_interrupted_forced_rerun_resumes_says_so() {
+        let d = set_dir();
+        let o = opts(d.path(), "x+04", 4);
+        run_with(&o, &mut Fake::default()).expect("run");
+        let p = plan(&o).expect("plan");
+        let pose = p.selected.first().expect("x+04");
+        let run = crate::resume::Identity {
+            spec_hash: p.campaign.run_hash(pose, &p.mesh_name),
+            engine: "fake".into(),
+            engine_version: "1".into(),
+            mesh: p.mesh_name.clone(),
+            steps: p.steps,
+        };
+        let wd = p.out_dir.join(".work").join(&pose.name);
+        std::fs::create_dir_all(&wd).expect("work folder");
+        crate::resume::write(&wd, &run, 5, &crate::resume::Start::default()).expect("record");
+        let s = status(&plan(&o).expect("plan")).expect("status");
+        let states: Vec<(bool, &str)> = s.poses.iter().map(|p| (p.done, p.result.as_str())).collect();
+        assert_eq!(states, [(false, "up to date; an interrupted --force rerun resumes")]);
+    }
 }
