@@ -76,6 +76,11 @@ pub struct SpecArgs {
     /// pose at each speed, --steps must points on the ramp), into <set>/fe/visco/.
     #[arg(long, conflicts_with = "deep")]
     pub visco: bool,
+    /// The material family of campaign.toml's [family] section: the centre of each member
+    /// (one-term Ogden, exponent family.alpha) to family.depth_mm on family.mesh, then
+    /// family.check_poses at family.check_alpha, into <set>/fe/family/.
+    #[arg(long, conflicts_with_all = ["deep", "visco"])]
+    pub family: bool,
 }
 
 /// How each pose is solved (shared by `fe run` and the array tasks' `fe run-one`).
@@ -287,8 +292,8 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
         RunOptions { jobs, threads: a.threads.map(|t| t as usize).unwrap_or((cores / jobs).max(1)), ..spec_options(a.spec)? },
         &a.solve,
     );
-    if a.launcher == LauncherArg::Slurm && opts.visco {
-        anyhow::bail!("--visco runs locally only (--launcher local): each speed is its own campaign run");
+    if a.launcher == LauncherArg::Slurm && (opts.visco || opts.family) {
+        anyhow::bail!("--visco and --family run locally only (--launcher local): each speed or member is its own campaign run");
     }
     if a.launcher == LauncherArg::Slurm {
         let slurm = SlurmOptions {
@@ -305,7 +310,7 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
     }
     needle_fe::process::stop_jobs_on_termination()?;
     let mut failed = 0;
-    for opts in visco_variants(opts)? {
+    for opts in variants(opts)? {
         let report = campaign::run(&opts)?;
         print!("{}", report.table());
         if needle_fe::process::interrupted() {
@@ -314,6 +319,37 @@ fn run_campaign(a: RunArgs) -> anyhow::Result<ExitCode> {
         failed += report.failed();
     }
     Ok(if failed > 0 { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+/// The campaign runs `opts` asks for: one per member run with `family`, one per speed
+/// with `visco`, else `opts` itself.
+fn variants(opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
+    if opts.family {
+        family_variants(opts)
+    } else {
+        visco_variants(opts)
+    }
+}
+
+/// One run per run of `[family]` (`needle_fe::family::FamilyRun::all`), in order; the
+/// runs `--only` selects nothing of are left out.
+fn family_variants(opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
+    let (c, path) = needle_fe::spec::load(&opts.set_dir)?;
+    let f = c.family.clone().ok_or_else(|| anyhow::anyhow!("{}: --family: the spec has no [family] section", path.display()))?;
+    let mut out = Vec::new();
+    for run in needle_fe::family::FamilyRun::all(&f) {
+        let (_, runs, _) = needle_fe::family::apply(&c, &f, run);
+        if needle_fe::spec::select(&runs, opts.only.as_deref()).is_ok_and(|r| !r.is_empty()) {
+            out.push(RunOptions { family_run: Some(run), ..opts.clone() });
+        }
+    }
+    if out.is_empty() {
+        anyhow::bail!(
+            "--family --only {:?}: matches no run (names: <pose>_a<alpha>, e.g. centre_a2, x+04_a20, centre_a0p5)",
+            opts.only.as_deref().unwrap_or("")
+        );
+    }
+    Ok(out)
 }
 
 /// `opts` as it is, or with `visco`: once per speed of `[viscoelastic]`, in order; with
@@ -378,7 +414,7 @@ fn submit_summary(r: &slurm::SubmitReport) -> String {
 }
 
 fn run_status(a: StatusArgs) -> anyhow::Result<ExitCode> {
-    let variants = visco_variants(spec_options(a.spec)?)?;
+    let variants = variants(spec_options(a.spec)?)?;
     for extra in variants.iter().skip(1) {
         let plan = campaign::plan(extra)?;
         print!("{}", needle_fe::launcher::status::status(&plan)?.table());
@@ -412,6 +448,7 @@ fn spec_options(spec: SpecArgs) -> anyhow::Result<RunOptions> {
         out_dir: spec.out,
         deep: spec.deep,
         visco: spec.visco,
+        family: spec.family,
         ..RunOptions::new(spec.set)
     })
 }

@@ -8,6 +8,7 @@ pub mod campaign;
 pub mod ccx;
 pub mod deep;
 pub mod engines;
+pub mod family;
 pub mod febio;
 pub mod launcher;
 pub mod manifest;

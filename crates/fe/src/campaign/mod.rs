@@ -127,6 +127,12 @@ pub struct RunOptions {
     /// Every speed of `[viscoelastic]` is meant (the CLI's `--visco`: one run of the
     /// campaign per speed, each with `visco_speed_mm_per_s`); not read by [`run`].
     pub visco: bool,
+    /// One run of the material family of `[family]` (`crate::family`): the member's tissue,
+    /// its poses, depth and mesh, output in `<set>/fe/family/` unless `out_dir`.
+    pub family_run: Option<crate::family::FamilyRun>,
+    /// Every run of `[family]` is meant (the CLI's `--family`: one campaign run each, with
+    /// `family_run`); not read by [`run`].
+    pub family: bool,
 }
 
 impl RunOptions {
@@ -153,6 +159,8 @@ impl RunOptions {
             visco_speed_mm_per_s: None,
             visco_frictionless: false,
             visco: false,
+            family_run: None,
+            family: false,
         }
     }
 }

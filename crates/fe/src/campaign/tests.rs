@@ -355,6 +355,38 @@ fn deep_runs_go_to_their_own_folder_at_the_deep_depth() {
     assert!(e.contains("matches no pose (poses: centre, x+04, tz+08, z+04)"), "{e}");
 }
 
+/// The material family's runs (issue 64) go to `fe/family/` under their member names, at
+/// the family's depth for a centre and the campaign's for a check, each with its member's
+/// one-term tissue in its manifest entry's hash; the campaign's own results are untouched.
+#[test]
+fn family_runs_go_to_their_own_folder_with_the_members_tissue() {
+    use crate::family::FamilyRun;
+    let d = set_dir();
+    let (c, _) = spec::load(d.path()).expect("spec");
+    let f = c.family.clone().expect("a [family] section");
+    let alpha = *f.alpha.first().expect("a member");
+    let run = |r: FamilyRun| RunOptions { family_run: Some(r), mesh: Some("smoke".into()), steps: Some(4), ..RunOptions::new(d.path()) };
+    let r = run_with(&run(FamilyRun::Centre { alpha }), &mut Fake::default()).expect("family centre");
+    assert_eq!((r.done(), r.depth_mm), (1, f.depth_mm), "{}", r.table());
+    let name = spec::family::member_name("centre", alpha);
+    let rows = results::read_csv(&d.path().join(format!("fe/family/{name}.csv"))).expect("family csv");
+    assert_eq!(rows.last().map(|r| r.depth_mm), Some(f.depth_mm));
+    assert!(!d.path().join("fe/centre.csv").exists(), "nothing written beside the campaign's runs");
+    let m = read_manifest(&d.path().join("fe/family").join(MANIFEST)).expect("family manifest");
+    let (member, poses, _) = crate::family::apply(&c, &f, FamilyRun::Centre { alpha });
+    let mut member = member;
+    member.loading.steps = 4;
+    let pose = poses.first().expect("the centre");
+    assert_eq!(m.pose[&name].spec_hash, member.run_hash(pose, "smoke"), "the member's tissue is in the hash");
+    let check = *f.check_alpha.first().expect("a check member");
+    let r = run_with(&run(FamilyRun::Check { alpha: check }), &mut Fake::default()).expect("family checks");
+    assert_eq!((r.done(), r.depth_mm), (f.check_poses.len(), c.loading.depth_mm), "{}", r.table());
+    let again = run_with(&run(FamilyRun::Centre { alpha }), &mut Fake::default()).expect("rerun");
+    assert_eq!(again.up_to_date(), 1, "resumes like the campaign");
+    let both = RunOptions { deep: true, ..run(FamilyRun::Centre { alpha }) };
+    assert!(run_with(&both, &mut Fake::default()).is_err(), "--family with --deep is refused");
+}
+
 /// A pose that fails every attempt keeps the furthest attempt's must points as its
 /// partial record; solving it later removes the record.
 #[test]

@@ -4,7 +4,7 @@
 //! One module per section, each section's struct checking its own values (`validate`):
 //! [`set`], [`tissue`], [`needle`], [`block`], [`contact`], [`loading`], [`mesh`],
 //! [`solver`] and [`febio`] (`[solver.febio]`), [`fit`], [`campaign`], [`pose`]
-//! (`[[pose]]`), [`deep`] (`[deep]`). Here, the whole spec: reading it and the checks
+//! (`[[pose]]`), [`deep`] (`[deep]`), [`family`] (`[family]`). Here, the whole spec: reading it and the checks
 //! across sections; [`design`] generates the poses `[campaign]` asks for, [`hash`] is the
 //! run hash.
 
@@ -14,6 +14,7 @@ pub mod contact;
 pub mod deep;
 pub mod design;
 pub mod error;
+pub mod family;
 pub mod febio;
 pub mod fit;
 pub mod hash;
@@ -32,6 +33,7 @@ pub use campaign::{CampaignSettings, TrainReplacement, MAX_GENERATED_POSES};
 pub use contact::Contact;
 pub use deep::validate_deep;
 pub use error::{SpecError, SpecResult};
+pub use family::{validate_family, FamilySettings};
 pub use febio::FebioSettings;
 pub use fit::{FitSettings, ModelForm};
 pub use hash::hex;
@@ -82,6 +84,9 @@ pub struct Campaign {
     /// The ramp-and-hold runs of `needle fe run --visco` (`crate::visco`); absent: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub viscoelastic: Option<visco::ViscoSettings>,
+    /// The material family of `needle fe run --family` (`crate::family`); absent: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub family: Option<FamilySettings>,
     /// The named poses as written (the Latin hypercube poses are added by [`Campaign::poses`]).
     #[serde(rename = "pose", default)]
     pub pose: Vec<PoseSpec>,
@@ -114,6 +119,7 @@ pub fn parse(text: &str, path: &Path) -> SpecResult<Campaign> {
     })?;
     campaign.validate(path).map_err(|e| e.located(text))?;
     validate_deep(&campaign, text, path)?;
+    validate_family(&campaign, text, path)?;
     visco::validate(&campaign, text, path).map_err(SpecError::Viscoelastic)?;
     Ok(campaign)
 }

@@ -1,0 +1,168 @@
+//! `[family]`: the material family (issue 64): the centre pose solved deep for a family of
+//! one-term Ogden tissues (strain-stiffening exponent `alpha`, the initial shear modulus of
+//! `[tissue]`), and a few off-centre poses at two members to check the ratio law that carries
+//! the coupled model's pose dependence over to the family. The runs themselves are
+//! `crate::family`'s; here the section's type and its checks.
+
+use super::error::{SpecError, SpecResult};
+use super::loading::MAX_LOAD_STEPS;
+use super::pose::check_pose_in_block;
+use super::Campaign;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// The largest |alpha| a member may have: past it `lambda^alpha` over the checked stretch
+/// range spans more than 1e12 and FEBio's Newton iterations stop being meaningful.
+pub const MAX_ABS_ALPHA: f64 = 30.0;
+
+/// `[family]`: which members are solved how deep, in how many load steps, on which mesh,
+/// and which off-centre poses check the ratio law at which members.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FamilySettings {
+    /// The members' one-term Ogden exponents, solved in this order (each a distinct
+    /// tissue, hence a distinct run hash).
+    pub alpha: Vec<f64>,
+    /// Final depth of the centre runs along the needle axis, mm.
+    pub depth_mm: f64,
+    /// Number of equal load steps to `depth_mm`.
+    pub steps: u32,
+    /// Mesh level (`[mesh.<level>]`) of the centre runs; its fine layers reach past `depth_mm`.
+    pub mesh: String,
+    /// Off-centre poses of the campaign solved at `check_alpha` to `loading.depth_mm` on
+    /// the campaign's mesh level.
+    #[serde(default)]
+    pub check_poses: Vec<String>,
+    /// The members (each one of `alpha`) the off-centre poses are solved at.
+    #[serde(default)]
+    pub check_alpha: Vec<f64>,
+}
+
+/// The run name of `pose` at the member `alpha`: `centre_a2`, `x+04_a20`, `centre_a0p5`,
+/// `centre_a-2` (a file name: no dot).
+pub fn member_name(pose: &str, alpha: f64) -> String {
+    format!("{pose}_a{}", format!("{alpha}").replace('.', "p"))
+}
+
+/// Check `[family]` against the rest of the spec; messages start with `file:line:` and
+/// name the field (`family.alpha = ...`).
+///
+/// # Errors
+/// No members, an exponent that is not finite, zero or beyond [`MAX_ABS_ALPHA`], a member
+/// listed twice (names collide), a depth outside the block, 0 steps or too many, an
+/// unknown mesh level or one whose fine layers stop above the depth, an unknown or
+/// repeated check pose, a check pose whose needle leaves the block, or a check member
+/// that is not one of `alpha`.
+pub fn validate_family(c: &Campaign, text: &str, path: &Path) -> SpecResult<()> {
+    let Some(f) = &c.family else { return Ok(()) };
+    let at = |key: &str| format!("{}:{}", path.display(), crate::deep::key_line(text, "family", key));
+    if f.alpha.is_empty() {
+        return Err(SpecError::range(at("alpha"), "family.alpha", "family.alpha is empty: name at least one member"));
+    }
+    for (k, &a) in f.alpha.iter().enumerate() {
+        if !(a.is_finite() && a != 0.0 && a.abs() <= MAX_ABS_ALPHA) {
+            let message = format!("family.alpha = {a}: must be finite, not 0 and within +-{MAX_ABS_ALPHA}");
+            return Err(SpecError::range(at("alpha"), "family.alpha", message));
+        }
+        let name = member_name("centre", a);
+        if f.alpha[..k].iter().any(|&b| member_name("centre", b) == name) {
+            return Err(SpecError::duplicate(at("alpha"), "family.alpha", a.to_string(), format!("family.alpha: {a} is listed twice")));
+        }
+    }
+    if !(f.depth_mm.is_finite() && f.depth_mm > 0.0 && f.depth_mm < c.block.depth_mm) {
+        let message =
+            format!("family.depth_mm = {}: must be > 0 and inside the block (block.depth_mm = {} mm)", f.depth_mm, c.block.depth_mm);
+        return Err(SpecError::range(at("depth_mm"), "family.depth_mm", message));
+    }
+    if f.steps == 0 || f.steps > MAX_LOAD_STEPS {
+        return Err(SpecError::range(at("steps"), "family.steps", format!("family.steps = {}: must be 1 ..= {MAX_LOAD_STEPS}", f.steps)));
+    }
+    let Some(level) = c.mesh.get(&f.mesh) else {
+        let levels: Vec<&str> = c.mesh.keys().map(String::as_str).collect();
+        let message = format!("family.mesh = {:?}: no [mesh.{}] level (levels: {})", f.mesh, f.mesh, levels.join(", "));
+        return Err(SpecError::unknown(at("mesh"), "family.mesh", &f.mesh, message));
+    };
+    if level.fine_depth_mm < f.depth_mm {
+        let message = format!(
+            "family.mesh = {:?}: its fine layers end at fine_depth_mm = {} mm, above family.depth_mm = {} mm",
+            f.mesh, level.fine_depth_mm, f.depth_mm
+        );
+        return Err(SpecError::inconsistent(at("mesh"), "family.mesh", message));
+    }
+    validate_checks(c, f, &at)
+}
+
+/// The off-centre check runs: known poses inside the block, listed once; members of the family.
+fn validate_checks(c: &Campaign, f: &FamilySettings, at: &dyn Fn(&str) -> String) -> SpecResult<()> {
+    let every = c.poses();
+    for (k, name) in f.check_poses.iter().enumerate() {
+        if f.check_poses[..k].contains(name) {
+            return Err(SpecError::duplicate(
+                at("check_poses"),
+                "family.check_poses",
+                name,
+                format!("family.check_poses: {name:?} is listed twice"),
+            ));
+        }
+        let Some(pose) = every.iter().find(|p| &p.name == name) else {
+            let message = format!("family.check_poses: {name:?} is not a pose of this campaign");
+            return Err(SpecError::unknown(at("check_poses"), "family.check_poses", name, message));
+        };
+        check_pose_in_block(pose, &c.block, c.needle.diameter_mm / 2.0, c.loading.depth_mm, &at("check_poses"))?;
+    }
+    for &a in &f.check_alpha {
+        if !f.alpha.contains(&a) {
+            let message = format!("family.check_alpha = {a}: not a member (family.alpha)");
+            return Err(SpecError::inconsistent(at("check_alpha"), "family.check_alpha", message));
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::deep::shipped_key;
+    use crate::spec::parse;
+
+    fn refusal(text: &str) -> SpecError {
+        match parse(text, Path::new("campaign.toml")) {
+            Ok(_) => panic!("the spec was accepted"),
+            Err(e) => e,
+        }
+    }
+
+    #[test]
+    fn member_names_are_file_names() {
+        assert_eq!(member_name("centre", 2.0), "centre_a2");
+        assert_eq!(member_name("x+04", 20.0), "x+04_a20");
+        assert_eq!(member_name("centre", 0.5), "centre_a0p5");
+        assert_eq!(member_name("centre", -2.0), "centre_a-2");
+    }
+
+    #[test]
+    fn bad_family_sections_are_refused_with_file_line_and_field() {
+        let (text, alpha_line, alpha) = shipped_key("family", "alpha");
+        let (_, _, depth) = shipped_key("family", "depth_mm");
+        let (_, _, mesh) = shipped_key("family", "mesh");
+        let (_, check_line, check) = shipped_key("family", "check_alpha");
+        let (_, poses_line, poses) = shipped_key("family", "check_poses");
+        let cases = [
+            (text.replace(&alpha, "alpha = []"), "family.alpha", alpha_line),
+            (text.replace(&alpha, "alpha = [2.0, 0.0]"), "family.alpha", alpha_line),
+            (text.replace(&alpha, "alpha = [2.0, 40.0]"), "family.alpha", alpha_line),
+            (text.replace(&alpha, "alpha = [2.0, 4.0, 2.0]"), "family.alpha", alpha_line),
+            (text.replace(&depth, "depth_mm = 31.0"), "family.depth_mm", shipped_key("family", "depth_mm").1),
+            (text.replace(&mesh, "mesh = \"needle8\""), "family.mesh", shipped_key("family", "mesh").1),
+            (text.replace(&check, "check_alpha = [7.5]"), "family.check_alpha", check_line),
+            (text.replace(&poses, "check_poses = [\"nowhere\"]"), "family.check_poses", poses_line),
+            (text.replace(&poses, "check_poses = [\"x+04\", \"x+04\"]"), "family.check_poses", poses_line),
+        ];
+        for (spec, field, line) in cases {
+            assert_ne!(spec, text, "the test's edit did not apply ({field})");
+            let e = refusal(&spec);
+            assert_eq!(e.field(), field, "{e:?}");
+            assert!(e.to_string().starts_with(&format!("campaign.toml:{line}: ")), "file:line first: {e}");
+        }
+    }
+}
