@@ -5,14 +5,21 @@ function out_dir = build_needle_mex()
 % `mex` compiles and links. The MEX file lands in <repo>/target/bindings-matlab.
 %
 %   octave --eval "run crates/bindings-matlab/build_needle_mex.m"
+%
+% cargo's profile is the environment's NEEDLE_CARGO_PROFILE (default release; .ci/test
+% passes ci, the profile its workspace tests built).
 here = fileparts(mfilename('fullpath'));
 root = fullfile(here, '..', '..');
 target = fullfile(root, 'target');
 out_dir = fullfile(target, 'bindings-matlab');
 inc = fullfile(out_dir, 'include');
-run_or_fail(sprintf('cd "%s" && cargo build --release -q -p needle-capi -p needle-cli', root));
-run_or_fail(sprintf('"%s" header --out "%s"', fullfile(target, 'release', 'needle'), inc));
-lib = fullfile(target, 'release', 'libneedle_capi.a');
+profile = getenv('NEEDLE_CARGO_PROFILE');
+if isempty(profile)
+  profile = 'release';
+end
+run_or_fail(sprintf('cd "%s" && cargo build --profile %s -q -p needle-capi -p needle-cli', root, profile));
+run_or_fail(sprintf('"%s" header --out "%s"', fullfile(target, profile, 'needle'), inc));
+lib = fullfile(target, profile, 'libneedle_capi.a');
 src = fullfile(here, 'needle_haptics.c');
 % One list of flags for both compilers: the header's folder, the source, the C API's
 % static library and what a Rust static library needs on Linux (threads, dl, libm).

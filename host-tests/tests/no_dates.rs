@@ -1,6 +1,6 @@
 //! Specifications and code comments carry no dates (issue 37, item 5): the format
 //! (`coeffs/README.md`), the architecture (`docs/architecture.md`) and the comments of
-//! the sources say what is true now; dated history goes to `docs/CHANGELOG.md` and
+//! the sources say what is true now; dated history goes to `docs/measurement-notebook.md` and
 //! measured figures to the set's README. A date is `YYYY-MM-DD` not followed by `T` (an
 //! RFC 3339 timestamp in a format example is not history). Test modules aside (a file
 //! stops at its first `#[cfg(test)]` at the start of a line).
@@ -71,5 +71,10 @@ fn specs_and_code_comments_carry_no_dates() {
             }
         }
     }
-    assert!(found.is_empty(), "{} date(s) in specs or comments (history goes to docs/CHANGELOG.md):\n{}", found.len(), found.join("\n"));
+    assert!(
+        found.is_empty(),
+        "{} date(s) in specs or comments (history goes to docs/measurement-notebook.md):\n{}",
+        found.len(),
+        found.join("\n")
+    );
 }

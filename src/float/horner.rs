@@ -13,7 +13,7 @@
 //! The starts are computed at compile time from the generated tables
 //! ([`matrix_starts`], [`start`] in const items), so no coefficient is tested at run
 //! time. Measured side by side with `needle firmware bench` on the coupled default model
-//! fitted on 21 training runs (docs/CHANGELOG.md, "Horner trimming"): the M4F's wrench
+//! fitted on 21 training runs (docs/measurement-notebook.md, "Horner trimming"): the M4F's wrench
 //! 541.1 -> 481.1 instructions, with the stiffness 973.0 -> 874.1; soft-float M3
 //! 37,014 -> 29,312, M0 61,588 -> 50,786.
 use needle_contract::TERMS;

@@ -35,7 +35,7 @@
 //! Measured on the smoke mesh (centre, 10 load steps of 0.6 mm, restart from must point
 //! 3 at 1.8 mm, 1/16 of a load step asked: `tests/febio_restart_first_step.rs`): 1.8 ->
 //! 1.8375 mm with the curve; 1.8 -> 2.4 mm, the dump's step, without it. Before this
-//! fix (docs/CHANGELOG.md) the input set only `<step_size>`: every continuation and resumed run so far
+//! fix (docs/measurement-notebook.md) the input set only `<step_size>`: every continuation and resumed run so far
 //! started with the dump's own step (e.g. 9.6 -> 9.66704 mm), and the manifests' settings
 //! lines of those runs ("first time step 1/16" or "0.25 of a load step") overstate it.
 //!
