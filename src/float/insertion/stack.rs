@@ -2,7 +2,7 @@
 //! compiled in from the set's `tissue/*.toml` (format: `coeffs/README.md`, "Tissue
 //! stacks") into [`stacks`].
 
-use crate::viscoelastic::{PronyTerm, PronyTerms};
+use crate::float::viscoelastic::{PronyTerm, PronyTerms};
 
 /// Shaft friction per mm of shaft in a layer: Karnopp's static and Coulomb levels, a
 /// viscous term and the stick band (Okamura, Simone and O'Leary 2004, modified: inside
@@ -58,7 +58,7 @@ pub struct Layer {
     /// Lateral stiffness of the cut track per mm of shaft in the layer, N/mm per mm.
     pub track_stiffness_n_per_mm2: f32,
     /// The relaxation function of the layer's boundary deflection (quasi-linear
-    /// viscoelasticity, [`viscoelastic`](crate::viscoelastic)); [`PronyTerms::NONE`]:
+    /// viscoelasticity, [`viscoelastic`](crate::float::viscoelastic)); [`PronyTerms::NONE`]:
     /// elastic.
     pub prony: PronyTerms,
 }
