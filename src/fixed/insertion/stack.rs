@@ -271,6 +271,13 @@ pub mod stacks {
         }
         out
     };
+
+    /// The compiled-in stack named `name` (its file's stem) in integers, `None` when
+    /// [`ALL`] has no such stack (the f32 twin: `float::insertion::stacks::by_name`).
+    #[must_use]
+    pub fn by_name(name: &str) -> Option<&'static Stack> {
+        ALL.iter().find(|s| s.name == name)
+    }
 }
 
 const EMPTY_STACK: Stack =

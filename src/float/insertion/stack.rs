@@ -87,6 +87,13 @@ pub mod stacks {
     use super::{Karnopp, Layer, PronyTerm, PronyTerms, Stack};
     include!(concat!(env!("OUT_DIR"), "/tissue_stacks.rs"));
 
+    /// The compiled-in stack named `name` (its file's stem), `None` when [`ALL`] has no
+    /// such stack (the fixed-point twin: `fixed::insertion::stacks::by_name`).
+    #[must_use]
+    pub fn by_name(name: &str) -> Option<&'static Stack<'static>> {
+        ALL.iter().find(|s| s.name == name)
+    }
+
     /// Whether no layer of `stacks` has a Prony term: a build without the `viscoelastic`
     /// feature holds only such stacks (a stack with terms is compiled with the feature
     /// alone, and `ALL` then lists the others), checked at compile time.
