@@ -26,8 +26,8 @@
 //! `alpha = period / (period + tau)` (Q16, once): `v += floor(alpha (raw - v) / 2^16)`.
 //! No division per tick but one: the path coordinate of a boundary is its depth below
 //! the surface over the axis's vertical component (`2^60 / a_y`, once per tick).
-mod track;
 mod stack;
+mod track;
 
 pub use stack::{
     stacks, Karnopp, Layer, Stack, CUTTING_MAX_Q16, FRICTION_LEVEL_MAX_Q16, MAX_LAYERS, SIMILARITY_MAX, STICK_BAND_MAX_Q16,
