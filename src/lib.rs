@@ -55,27 +55,19 @@
 mod bit_flags;
 pub mod command;
 pub mod control;
-pub mod depth_extension;
 mod evaluation;
 pub mod fixed;
-mod float;
-pub mod insertion;
+pub mod float;
 pub mod model_info;
 pub mod orientation;
-mod pose;
 mod status;
-mod stiffness;
 pub mod telemetry;
 mod unsolved;
-pub mod viscoelastic;
-mod wrench;
 
-pub use depth_extension::extended_wrench;
 pub use evaluation::Evaluation;
-pub use float::depth_rate::wrench_and_depth_rate;
-pub use float::eval::wrench;
-pub use float::eval_stiffness::wrench_and_stiffness;
-pub use pose::Pose;
+// The f32 evaluator's API at the root, where it has always been (`needle_haptics::wrench`,
+// `needle_haptics::insertion::Insertion`...): `float` mirrors `fixed` module for module.
+pub use float::{depth_extension, insertion, viscoelastic};
+pub use float::{extended_wrench, wrench, wrench_and_depth_rate, wrench_and_stiffness};
+pub use float::{Pose, Stiffness, StiffnessEvaluation, Wrench, WrenchRate};
 pub use status::Status;
-pub use stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
-pub use wrench::Wrench;

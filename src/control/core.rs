@@ -4,7 +4,7 @@
 use super::config::check_limit;
 use super::passivity::Guard;
 use super::{ConfigError, LoopConfig, LoopFlags, OverLimit, Passivity, PoseFault, Sample};
-use crate::insertion::{GuardTerms, Insertion, InsertionEvaluation};
+use crate::float::insertion::{GuardTerms, Insertion, InsertionEvaluation};
 use crate::{Pose, Status, Wrench};
 
 /// One channel's command: a duty fraction and a direction.

@@ -35,7 +35,7 @@
 //!   `P` the preload and the track's hold. The guard limits first and filters after: the
 //!   rule above runs on the elastic part `F - D - V` (the insertion names `V` and `E`:
 //!   `Insertion::guard_filter`, beside the layer's coefficients), at the stiffness `rho K` (`rho`:
-//!   [`QlvCoefficients::effective_stiffness_ratio`](crate::viscoelastic::QlvCoefficients::effective_stiffness_ratio),
+//!   [`QlvCoefficients::effective_stiffness_ratio`](crate::float::viscoelastic::QlvCoefficients::effective_stiffness_ratio),
 //!   the filter's worst-case stiffness ratio in a sampled loop, Colgate's general
 //!   condition at the Nyquist frequency: `1 + sum 2 b_i / (1 + a_i)`), and the guard's own
 //!   filter, the same coefficients, runs on the guarded deflection force `E'` (its
@@ -64,10 +64,10 @@
 //!   Colgate's ratio at `wT` from `0.2 pi` to `pi`).
 use super::ConfigError;
 #[cfg(feature = "viscoelastic")]
-use crate::insertion::FilterTerms;
-use crate::insertion::{FilterShare, GuardTerms};
+use crate::float::insertion::FilterTerms;
+use crate::float::insertion::{FilterShare, GuardTerms};
 #[cfg(feature = "viscoelastic")]
-use crate::viscoelastic::QlvCoefficients;
+use crate::float::viscoelastic::QlvCoefficients;
 
 /// The fraction of Colgate's bound `2 b / T` the guard renders at most.
 pub const GUARD_FRACTION: f32 = 0.5;
@@ -128,7 +128,7 @@ impl Guard {
 
     /// The guarded force for the model force `f_n` with its stiffness and dissipative
     /// part `terms` (the module's rule; `filter` the deflected boundary's viscoelastic
-    /// filter, [`Insertion::guard_filter`](crate::insertion::Insertion::guard_filter)),
+    /// filter, [`Insertion::guard_filter`](crate::float::insertion::Insertion::guard_filter)),
     /// and whether the stiffness was limited.
     pub(crate) fn apply(&mut self, p: &Passivity, f_n: [f32; 3], terms: &GuardTerms, filter: FilterShare<'_>) -> ([f32; 3], bool) {
         #[cfg(feature = "viscoelastic")]
@@ -208,7 +208,7 @@ impl Guard {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 struct GuardFilter {
     last_deflection_n: Option<[f32; 3]>,
-    h_n: [[f32; crate::viscoelastic::MAX_TERMS]; 3],
+    h_n: [[f32; crate::float::viscoelastic::MAX_TERMS]; 3],
     /// Set by [`rest`](Self::rest), cleared by [`step`](Self::step): a filter at rest
     /// is not written again (a tick without terms pays no 13 stores).
     at_rest: bool,
@@ -221,7 +221,7 @@ impl GuardFilter {
     /// whole, as in the insertion's filter).
     fn rest(&mut self) {
         if !self.at_rest {
-            *self = Self { last_deflection_n: Some([0.0; 3]), h_n: [[0.0; crate::viscoelastic::MAX_TERMS]; 3], at_rest: true };
+            *self = Self { last_deflection_n: Some([0.0; 3]), h_n: [[0.0; crate::float::viscoelastic::MAX_TERMS]; 3], at_rest: true };
         }
     }
 
@@ -229,7 +229,7 @@ impl GuardFilter {
     /// filter times `scale` (the guard's rule; with `scale` `None`, the first tick after
     /// a reset, or no last force: nothing enters, the filter starts relaxed at `E`);
     /// the filter's viscous force out.
-    fn step(&mut self, c: &crate::viscoelastic::QlvCoefficients, e_n: [f32; 3], scale: Option<f32>) -> [f32; 3] {
+    fn step(&mut self, c: &crate::float::viscoelastic::QlvCoefficients, e_n: [f32; 3], scale: Option<f32>) -> [f32; 3] {
         let d = match (self.last_deflection_n, scale) {
             (Some(l), Some(s)) => [s * (e_n[0] - l[0]), s * (e_n[1] - l[1]), s * (e_n[2] - l[2])],
             _ => [0.0; 3],

@@ -14,7 +14,7 @@ use needle_contract::TERMS;
 /// counts it): 25,578 B with every product inlined, 24,086 B with the insertion's
 /// `mul_shr` calling this, 23,394 B with the deflection's gains too, 22,638 B with the
 /// depth extension's products too. On the M3 and M4F, with the insertion's split
-/// products out of line as well (`insertion::geometry`): 22,838 -> 20,150 B and 22,798 ->
+/// products out of line as well (`insertion::track`): 22,838 -> 20,150 B and 22,798 ->
 /// 20,184 B (with the `viscoelastic` feature 25,824 -> 22,924 B and 25,984 -> 22,968 B),
 /// for about 3 % more instructions per surface tick (docs/insertion.md, "Cost").
 #[cfg_attr(target_arch = "arm", inline(never))]

@@ -16,7 +16,7 @@
 //! `host-tests/tests/insertion_fixed.rs` bounds the whole insertion.
 use super::arith::sat_mul;
 use super::{wrench, Evaluation, Pose, Wrench};
-use crate::depth_extension::tables as f32_tables;
+use crate::float::depth_extension::tables as f32_tables;
 use crate::Status;
 
 const Q30: f64 = (1u64 << 30) as f64;

@@ -26,6 +26,14 @@
 //! [`tables::ERROR_BOUND_MICRO`]. The algorithm is the fixed-point contract in
 //! `coeffs/README.md`; the fitter's independent implementation writes
 //! `coeffs/<set>/golden-fixed.csv`, which this evaluator reproduces bit for bit.
+//!
+//! Its modules mirror the f32 evaluator's ([`crate::float`]) name for name: `pose`,
+//! `wrench`, `stiffness`, `depth_extension`, `insertion` (`stack`, `track`),
+//! `viscoelastic` (`identity`), `tables`, `eval`, `cross`, `eval_stiffness`. Modules of
+//! this precision alone (`host-tests/tests/precision_mirrors.rs` reads these lines):
+//!
+//! - precision-only: `arith` because the Q15 product, the normalisation and the saturating
+//!   `i64` product are integer arithmetic; the f32 evaluator's is `float::horner`.
 
 mod arith;
 mod cross;

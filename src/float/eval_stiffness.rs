@@ -3,8 +3,8 @@
 use crate::float::cross::{add_cross, add_cross_rates, COUPLED, CROSS_SCALES};
 use crate::float::eval::{clamp_to_domain, skip_sweep, sweep_t, unsolved_flag, BASELINE_STARTS, ODD, ONE_THIRD, STARTS, SWEEP_SCALES};
 use crate::float::horner::{horner_from, horner_with_rate_from, MatrixStarts, Start};
+use crate::float::stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
 use crate::float::tables::{BASELINE, DEVIATION, FITTED};
-use crate::stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
 use crate::{Pose, Status, Wrench};
 use needle_contract::COMPONENT_COUNT;
 use needle_contract::TERMS;

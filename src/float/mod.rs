@@ -1,14 +1,47 @@
-//! The f32 evaluator, laid out as the fixed-point one (`crate::fixed`): `tables` (the
-//! generated f32 tables), `horner` (its arithmetic: Horner in the contract's operation
-//! order), `eval` (the wrench), `cross` (the coupled form's cross terms), `eval_stiffness`
-//! (the wrench and its rates), `depth_rate` (the wrench and its forces' rate by depth).
-//! Its entry points are re-exported at the crate's root (`wrench`, `wrench_and_stiffness`,
-//! `wrench_and_depth_rate`); the value types (`Pose`, `Wrench`, `Stiffness`...) live
-//! there too.
+//! The f32 evaluator: the model in `f32`, bit for bit the contract's operation order
+//! (`coeffs/README.md`), for cores with an FPU and for the host. Its modules mirror the
+//! fixed-point evaluator's ([`crate::fixed`]) name for name: `pose`, `wrench`,
+//! `stiffness`, `depth_extension`, `insertion` (`stack`, `track`), `viscoelastic`
+//! (`identity`), and the evaluator's internals `tables` (the generated f32 tables),
+//! `eval` (the wrench), `cross` (the coupled form's cross terms), `eval_stiffness` (the
+//! wrench and its rates).
+//!
+//! Modules of this precision alone (`host-tests/tests/precision_mirrors.rs` reads these
+//! lines):
+//!
+//! - precision-only: `horner` because f32 Horner in the contract's operation order (skipping
+//!   the exact `+0.0` steps) is float arithmetic; the fixed evaluator's is `fixed::arith`.
+//! - precision-only: `depth_rate` because the forces' rate by depth feeds the passivity
+//!   guard of the control loop (`crate::control`), which runs the f32 insertion only.
+//!
+//! The whole API is also at the crate's root (`needle_haptics::wrench`,
+//! `needle_haptics::Pose`, `needle_haptics::insertion`...), re-exported from here.
+//!
+//! ```
+//! use needle_haptics::float::{self, Pose};
+//!
+//! let pose = Pose { x_mm: 3.0, z_mm: -2.0, theta_x_deg: 5.0, theta_z_deg: 0.0, depth_mm: 4.5 };
+//! let eval = float::wrench(&pose);
+//! assert_eq!(eval, needle_haptics::wrench(&pose));
+//! ```
 
 pub(crate) mod cross;
+pub mod depth_extension;
 pub(crate) mod depth_rate;
 pub(crate) mod eval;
 pub(crate) mod eval_stiffness;
 pub(crate) mod horner;
+pub mod insertion;
+mod pose;
+mod stiffness;
 pub(crate) mod tables;
+pub mod viscoelastic;
+mod wrench;
+
+pub use depth_extension::extended_wrench;
+pub use depth_rate::wrench_and_depth_rate;
+pub use eval::wrench;
+pub use eval_stiffness::wrench_and_stiffness;
+pub use pose::Pose;
+pub use stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
+pub use wrench::Wrench;

@@ -42,7 +42,7 @@ impl Insertion {
     #[new]
     #[pyo3(signature = (stack, period_s = InsertionConfig::DEFAULT_1KHZ.period_s, velocity_time_constant_s = InsertionConfig::DEFAULT_1KHZ.velocity_time_constant_s))]
     fn new(stack: &str, period_s: f32, velocity_time_constant_s: f32) -> PyResult<Self> {
-        let Some(s) = stacks::ALL.iter().find(|s| s.name == stack) else {
+        let Some(s) = stacks::by_name(stack) else {
             let names: Vec<&str> = stacks::ALL.iter().map(|s| s.name).collect();
             return Err(PyValueError::new_err(format!("no tissue stack {stack:?} in this build; there are: {}", names.join(", "))));
         };

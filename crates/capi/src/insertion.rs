@@ -50,7 +50,8 @@ pub unsafe extern "C" fn needle_insertion_init(
     }
     // SAFETY: non-NULL and NUL-terminated (the caller's contract).
     let name = unsafe { CStr::from_ptr(stack) }.to_bytes();
-    let Some(s) = stacks::ALL.iter().find(|s| s.name.as_bytes() == name) else {
+    // a name that is not UTF-8 names no stack (as the byte comparison found none)
+    let Some(s) = core::str::from_utf8(name).ok().and_then(stacks::by_name) else {
         return NEEDLE_E_ARG;
     };
     let config = InsertionConfig { period_s, velocity_time_constant_s };

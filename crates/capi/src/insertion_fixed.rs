@@ -49,7 +49,8 @@ pub unsafe extern "C" fn needle_fixed_insertion_init(
     }
     // SAFETY: non-NULL and NUL-terminated (the caller's contract).
     let name = unsafe { CStr::from_ptr(stack) }.to_bytes();
-    let Some(s) = stacks::ALL.iter().find(|s| s.name.as_bytes() == name) else {
+    // a name that is not UTF-8 names no stack (as the byte comparison found none)
+    let Some(s) = core::str::from_utf8(name).ok().and_then(stacks::by_name) else {
         return NEEDLE_E_ARG;
     };
     let Ok(state) = Insertion::new(s, InsertionConfig { period_us, velocity_time_constant_us }) else {

@@ -29,7 +29,7 @@ pub const PERIOD_TOLERANCE_S: f64 = 1e-6;
 /// # Errors
 /// No such stack (the compiled-in ones are listed).
 pub fn stack(name: &str) -> Result<&'static needle_haptics::insertion::Stack<'static>> {
-    stacks::ALL.iter().find(|s| s.name == name).with_context(|| {
+    stacks::by_name(name).with_context(|| {
         let names: Vec<&str> = stacks::ALL.iter().map(|s| s.name).collect();
         format!("--insertion {name:?}: no such tissue stack in the compiled-in set (it has: {})", names.join(", "))
     })

@@ -1,4 +1,4 @@
-//! The whole insertion in integers: [`Insertion`] is [`crate::insertion::Insertion`]'s
+//! The whole insertion in integers: [`Insertion`] is [`crate::float::insertion::Insertion`]'s
 //! state machine (the same phases, punctures, cutting, friction and track, documented
 //! there) computed without floating point, for cores without an FPU.
 //!
@@ -9,7 +9,7 @@
 //!   ([`Stack::from_f32`]).
 //! - The surrogate: [`fixed::extended_wrench`](super::extended_wrench) at `x/λ, z/λ, δ/λ`,
 //!   scaled by `s λ²` (forces) and `s λ³` (moments), each gain `s λ^k` in Q16.
-//! - Internally `i64`: path coordinates in mm Q16, the axis in Q30 ([`geometry`]), forces
+//! - Internally `i64`: path coordinates in mm Q16, the axis in Q30 ([`track`]), forces
 //!   in µN Q16; the output rounds to whole µN and saturates to `i32`.
 //!
 //! **Inputs clamped**: `x`, `z` to ±64 mm, `depth` to ±128 mm, tilts to ±89 degrees (the
@@ -26,8 +26,8 @@
 //! `alpha = period / (period + tau)` (Q16, once): `v += floor(alpha (raw - v) / 2^16)`.
 //! No division per tick but one: the path coordinate of a boundary is its depth below
 //! the surface over the axis's vertical component (`2^60 / a_y`, once per tick).
-mod geometry;
 mod stack;
+mod track;
 
 pub use stack::{
     stacks, Karnopp, Layer, Stack, CUTTING_MAX_Q16, FRICTION_LEVEL_MAX_Q16, MAX_LAYERS, SIMILARITY_MAX, STICK_BAND_MAX_Q16,
@@ -41,9 +41,9 @@ use super::viscoelastic::identity::{QlvCoefficients, QlvState};
 #[cfg(feature = "viscoelastic")]
 use super::viscoelastic::{QlvCoefficients, QlvState};
 use super::{extended_wrench, Pose, Wrench};
-use crate::insertion::{InsertionError, Phase};
+use crate::float::insertion::{InsertionError, Phase};
 use crate::Status;
-use geometry::{axis, dot, mul_q30, mul_shr, HoldSums, Track, Vec3, TRACK_STIFFNESS_MAX_Q8};
+use track::{axis, dot, mul_q30, mul_shr, HoldSums, Track, Vec3, TRACK_STIFFNESS_MAX_Q8};
 
 /// The insertion's tick settings in integers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -57,7 +57,7 @@ pub struct InsertionConfig {
 
 impl InsertionConfig {
     /// 1 kHz, velocity filtered with a 5 ms time constant (the f32 model's
-    /// [`DEFAULT_1KHZ`](crate::insertion::InsertionConfig::DEFAULT_1KHZ)).
+    /// [`DEFAULT_1KHZ`](crate::float::insertion::InsertionConfig::DEFAULT_1KHZ)).
     pub const DEFAULT_1KHZ: Self = Self { period_us: 1000, velocity_time_constant_us: 5000 };
 }
 
@@ -232,7 +232,7 @@ impl<'a> Insertion<'a> {
     }
 
     /// One tick: the pose in, the wrench out (the f32 model's
-    /// [`step`](crate::insertion::Insertion::step), in integers). Call it once per
+    /// [`step`](crate::float::insertion::Insertion::step), in integers). Call it once per
     /// period of the configuration. Never panics.
     ///
     /// Never inlined: one function per image, which the no-float check of

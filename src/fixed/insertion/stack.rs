@@ -1,5 +1,5 @@
 //! [`Stack`] and [`Layer`] in integers: the f32 tissue stacks
-//! ([`crate::insertion::stacks`]) converted once, in `const` evaluation on the build host
+//! ([`crate::float::insertion::stacks`]) converted once, in `const` evaluation on the build host
 //! ([`Stack::from_f32`]: the same integers on every target, no float at run time), into
 //! the units the fixed-point insertion computes in.
 //!
@@ -16,15 +16,15 @@
 use crate::fixed::depth_extension::round_i64;
 #[cfg(feature = "viscoelastic")]
 use crate::fixed::viscoelastic::PronyTerms;
-use crate::insertion as f32_insertion;
+use crate::float::insertion as f32_insertion;
 
 /// Most layers a stack has.
-pub use crate::insertion::MAX_LAYERS;
+pub use crate::float::insertion::MAX_LAYERS;
 
 const Q16: f64 = 65536.0;
 const MICRO: f64 = 1.0e6;
 
-/// Shaft friction per mm of shaft, in integers ([`crate::insertion::Karnopp`]).
+/// Shaft friction per mm of shaft, in integers ([`crate::float::insertion::Karnopp`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Karnopp {
@@ -67,7 +67,7 @@ impl Karnopp {
     }
 }
 
-/// One layer in integers ([`crate::insertion::Layer`]).
+/// One layer in integers ([`crate::float::insertion::Layer`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Layer {
@@ -255,10 +255,10 @@ impl Stack {
     }
 }
 
-/// The compiled-in stacks ([`crate::insertion::stacks::ALL`]) in integers, same order.
+/// The compiled-in stacks ([`crate::float::insertion::stacks::ALL`]) in integers, same order.
 pub mod stacks {
     use super::Stack;
-    use crate::insertion::stacks as f32_stacks;
+    use crate::float::insertion::stacks as f32_stacks;
 
     /// Every stack of the set, in integers (a `static`: an insertion borrows its stack).
     #[allow(clippy::indexing_slicing)] // const evaluation only: an index out of range is a compile error
@@ -271,6 +271,13 @@ pub mod stacks {
         }
         out
     };
+
+    /// The compiled-in stack named `name` (its file's stem) in integers, `None` when
+    /// [`ALL`] has no such stack (the f32 twin: `float::insertion::stacks::by_name`).
+    #[must_use]
+    pub fn by_name(name: &str) -> Option<&'static Stack> {
+        ALL.iter().find(|s| s.name == name)
+    }
 }
 
 const EMPTY_STACK: Stack =

@@ -1,6 +1,6 @@
 //! The insertion's filter without the `viscoelastic` feature: the identity, with the
 //! API of [`QlvCoefficients`](super::QlvCoefficients) and [`QlvState`](super::QlvState)
-//! that [`crate::insertion`] uses. Zero-sized: an elastic build carries no filter code
+//! that [`crate::float::insertion`] uses. Zero-sized: an elastic build carries no filter code
 //! or state (flash; `docs/firmware.md`, "Features"). Terms are refused, not ignored.
 
 use needle_contract::COMPONENT_COUNT;

@@ -1,4 +1,4 @@
-//! The quasi-linear viscoelastic filter ([`crate::viscoelastic`]: the same
+//! The quasi-linear viscoelastic filter ([`crate::float::viscoelastic`]: the same
 //! normalisation and recursion) in integers, for cores without an FPU.
 //!
 //! - Terms ([`PronyTerms`]): `g` in Q16 (`i32`), `tau` in whole µs (`u32`, clamped to
@@ -23,7 +23,7 @@ use super::depth_extension::round_i64;
 
 #[cfg(not(feature = "viscoelastic"))]
 pub(crate) mod identity;
-use crate::viscoelastic::{PronyTerms as F32PronyTerms, MAX_TERMS};
+use crate::float::viscoelastic::{PronyTerms as F32PronyTerms, MAX_TERMS};
 
 /// Largest time constant, µs (`u32::MAX`: 71.6 min; a longer one is clamped here).
 pub const TAU_MAX_US: u32 = u32::MAX;

@@ -1,5 +1,5 @@
 //! The needle's line and the track's hold in integers: the formulas of the f32 `track`
-//! module (`src/insertion/track.rs`), with positions and path coordinates in mm Q16.16,
+//! module (`src/float/insertion/track.rs`), with positions and path coordinates in mm Q16.16,
 //! directions in Q30, forces in µN Q16 and moments in µN·mm Q16, all in `i64`.
 //!
 //! Every product is `floor(a b / 2^k)` (an arithmetic shift). Products of two pose

@@ -18,7 +18,7 @@
 //!   `λ` times the FE needle's). Elastic for a layer without Prony terms: withdrawing
 //!   gives the same force back. With terms ([`Layer::prony`]) each of the six components
 //!   passes the layer's quasi-linear viscoelastic filter
-//!   ([`viscoelastic`](crate::viscoelastic), the state in the insertion): faster
+//!   ([`viscoelastic`](crate::float::viscoelastic), the state in the insertion): faster
 //!   indentation gives more force, a held needle feels it relax to the elastic one;
 //!   withdrawing, the filter keeps running (the force falls below the elastic one). The
 //!   puncture threshold compares the filtered axial force.
@@ -62,11 +62,11 @@ mod track;
 
 pub use stack::{stacks, Karnopp, Layer, Stack, FE_NEEDLE_DIAMETER_MM, HUB_FROM_TIP_MM, MAX_LAYERS};
 
-use crate::depth_extension::extended_wrench_and_depth_rate;
+use crate::float::depth_extension::extended_wrench_and_depth_rate;
 #[cfg(not(feature = "viscoelastic"))]
-use crate::viscoelastic::identity::{QlvCoefficients, QlvState};
+use crate::float::viscoelastic::identity::{QlvCoefficients, QlvState};
 #[cfg(feature = "viscoelastic")]
-use crate::viscoelastic::{QlvCoefficients, QlvState};
+use crate::float::viscoelastic::{QlvCoefficients, QlvState};
 use crate::{extended_wrench, Pose, Status, Wrench};
 use track::{axis, dot, Track, Vec3};
 
@@ -382,7 +382,7 @@ impl Insertion {
         let mut qlv = [QlvCoefficients::NONE; MAX_LAYERS];
         for (k, l) in qlv.iter_mut().zip(stack.layers) {
             // a run-time stack's terms are checked like the file's (`PronyTerms::new`)
-            let terms = crate::viscoelastic::PronyTerms::new(l.prony.as_slice()).map_err(|_| InsertionError::Value)?;
+            let terms = crate::float::viscoelastic::PronyTerms::new(l.prony.as_slice()).map_err(|_| InsertionError::Value)?;
             *k = QlvCoefficients::new(&terms, config.period_s).map_err(|_| InsertionError::Config)?;
         }
         let mut layers = [stack.layers.first().copied().ok_or(InsertionError::LayerCount)?; MAX_LAYERS];

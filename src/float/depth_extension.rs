@@ -15,7 +15,7 @@ pub mod tables {
     include!(concat!(env!("OUT_DIR"), "/depth_extension_f32.rs"));
 }
 
-const MODEL_DEPTH_MAX_MM: f32 = crate::model_info::DEPTH_MAX_MM;
+const MODEL_DEPTH_MAX_MM: f32 = crate::float::tables::DEPTH_MAX_MM;
 
 /// The wrench at `pose`, extended in depth past the model's domain (the module's law).
 #[must_use]

@@ -2,7 +2,7 @@
 //! compiled in from the set's `tissue/*.toml` (format: `coeffs/README.md`, "Tissue
 //! stacks") into [`stacks`].
 
-use crate::viscoelastic::{PronyTerm, PronyTerms};
+use crate::float::viscoelastic::{PronyTerm, PronyTerms};
 
 /// Shaft friction per mm of shaft in a layer: Karnopp's static and Coulomb levels, a
 /// viscous term and the stick band (Okamura, Simone and O'Leary 2004, modified: inside
@@ -58,7 +58,7 @@ pub struct Layer {
     /// Lateral stiffness of the cut track per mm of shaft in the layer, N/mm per mm.
     pub track_stiffness_n_per_mm2: f32,
     /// The relaxation function of the layer's boundary deflection (quasi-linear
-    /// viscoelasticity, [`viscoelastic`](crate::viscoelastic)); [`PronyTerms::NONE`]:
+    /// viscoelasticity, [`viscoelastic`](crate::float::viscoelastic)); [`PronyTerms::NONE`]:
     /// elastic.
     pub prony: PronyTerms,
 }
@@ -86,6 +86,13 @@ pub mod stacks {
     #[allow(unused_imports)] // a set without tissue files uses none
     use super::{Karnopp, Layer, PronyTerm, PronyTerms, Stack};
     include!(concat!(env!("OUT_DIR"), "/tissue_stacks.rs"));
+
+    /// The compiled-in stack named `name` (its file's stem), `None` when [`ALL`] has no
+    /// such stack (the fixed-point twin: `fixed::insertion::stacks::by_name`).
+    #[must_use]
+    pub fn by_name(name: &str) -> Option<&'static Stack<'static>> {
+        ALL.iter().find(|s| s.name == name)
+    }
 
     /// Whether no layer of `stacks` has a Prony term: a build without the `viscoelastic`
     /// feature holds only such stacks (a stack with terms is compiled with the feature
