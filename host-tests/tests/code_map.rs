@@ -82,6 +82,7 @@ fn the_library_table_names_every_module_of_src() {
 #[test]
 fn the_crates_table_names_every_crate() {
     let root = source_walk::workspace().join("crates");
-    let named: BTreeSet<String> = first_cells(&doc(), "`crates/`").into_iter().filter(|n| !n.starts_with("needle-")).map(|n| format!("{n}/")).collect();
+    let named: BTreeSet<String> =
+        first_cells(&doc(), "`crates/`").into_iter().filter(|n| !n.starts_with("needle-")).map(|n| format!("{n}/")).collect();
     matches("crates/", &named, &entries(&root, false));
 }

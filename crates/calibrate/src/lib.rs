@@ -29,6 +29,7 @@ pub mod measured;
 pub mod published;
 pub mod ramp;
 pub mod replay;
+pub mod trial;
 
 use anyhow::{bail, Result};
 use needle_codegen::tissue as file;

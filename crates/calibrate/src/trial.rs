@@ -1,0 +1,206 @@
+//! A whole measured trial (issue 65): stage travel and axial force against time
+//! (`time_s,position_mm,force_n`), read and checked, and cut into its phases: the
+//! insertion (the stage advancing), the hold (the stage at rest at its furthest travel)
+//! and the withdrawal (the stage returning), each with its speed fitted from the
+//! encoder, and the contact (the first sample where the force leaves the tare's noise).
+//!
+//! Nothing here is fitted to a tissue: the phases come from the stage's position alone,
+//! the contact from the force's own noise before the stage moved, so the same code cuts
+//! a trial of any speed, travel or hold.
+
+use anyhow::{bail, Context, Result};
+use std::ops::Range;
+use std::path::Path;
+
+/// One sample of a trial, in the file's order.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    /// Time from the trial's start, s.
+    pub time_s: f64,
+    /// Stage travel, mm (from where the trial started, not from the tissue).
+    pub position_mm: f64,
+    /// Axial force on the needle, N (positive resisting the insertion).
+    pub force_n: f64,
+    /// 1-based line in its file.
+    pub line: usize,
+}
+
+/// The columns a trial file must have, each once.
+pub const TRIAL_COLUMNS: [&str; 3] = ["time_s", "position_mm", "force_n"];
+
+/// Fewest samples a trial may have.
+pub const MIN_SAMPLES: usize = 50;
+
+/// Largest sample count read (about 28 h at 100 Hz): a bigger file is refused before
+/// its rows are kept, so memory stays bounded.
+pub const MAX_SAMPLES: usize = 10_000_000;
+
+/// Reads a whole trial.
+///
+/// # Errors
+/// Unreadable file; a missing or repeated column (`FILE:1: ...`); a value that is not a
+/// finite number or a time that does not increase (`FILE:LINE: column NAME: ...`); fewer
+/// than [`MIN_SAMPLES`] or more than [`MAX_SAMPLES`] samples.
+pub fn read_trial(path: &Path) -> Result<Vec<Sample>> {
+    let mut reader =
+        csv::ReaderBuilder::new().trim(csv::Trim::All).from_path(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let header = reader.headers().with_context(|| format!("{}:1: cannot read the header", path.display()))?.clone();
+    let mut index = [0usize; 3];
+    for (slot, name) in index.iter_mut().zip(TRIAL_COLUMNS) {
+        let found: Vec<usize> = header.iter().enumerate().filter(|(_, h)| *h == name).map(|(i, _)| i).collect();
+        match found.as_slice() {
+            [i] => *slot = *i,
+            [] => bail!(
+                "{}:1: no column {name:?} (the header has {:?}; needed: {:?})",
+                path.display(),
+                header.iter().collect::<Vec<_>>(),
+                TRIAL_COLUMNS
+            ),
+            _ => bail!("{}:1: column {name:?} appears {} times", path.display(), found.len()),
+        }
+    }
+    let mut samples: Vec<Sample> = Vec::new();
+    for record in reader.records() {
+        let record = record.with_context(|| format!("{}: malformed CSV", path.display()))?;
+        let line = record.position().map_or(0, |p| p.line() as usize);
+        if samples.len() == MAX_SAMPLES {
+            bail!("{}:{line}: more than {MAX_SAMPLES} samples: not a trial of an insertion (split it)", path.display());
+        }
+        let mut v = [0.0f64; 3];
+        for ((slot, &i), name) in v.iter_mut().zip(&index).zip(TRIAL_COLUMNS) {
+            let text = record.get(i).unwrap_or("");
+            let shown: String = text.chars().take(40).collect();
+            *slot = text
+                .parse()
+                .ok()
+                .filter(|x: &f64| x.is_finite())
+                .with_context(|| format!("{}:{line}: column {name}: {shown:?} is not a finite number", path.display()))?;
+        }
+        if let Some(last) = samples.last() {
+            if v[0] <= last.time_s {
+                bail!(
+                    "{}:{line}: column time_s: {} s does not follow {} s of line {}: times must increase",
+                    path.display(),
+                    v[0],
+                    last.time_s,
+                    last.line
+                );
+            }
+        }
+        samples.push(Sample { time_s: v[0], position_mm: v[1], force_n: v[2], line });
+    }
+    if samples.len() < MIN_SAMPLES {
+        bail!("{}: {} samples: a trial needs at least {MIN_SAMPLES}", path.display(), samples.len());
+    }
+    Ok(samples)
+}
+
+/// A trial cut into its phases (index ranges into its samples).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Phases {
+    /// The stage advancing: from the last sample at the start position to the first at
+    /// the furthest travel.
+    pub insertion: Range<usize>,
+    /// The stage at rest at its furthest travel.
+    pub hold: Range<usize>,
+    /// The stage returning, to the trial's end.
+    pub withdrawal: Range<usize>,
+    /// The first sample of the insertion where the force leaves the tare's noise band.
+    pub contact: usize,
+    /// The insertion's speed, mm/s (least squares of position against time over its
+    /// middle 80 %).
+    pub insertion_speed_mm_per_s: f64,
+    /// The withdrawal's speed, mm/s (negative: the stage returns), as the insertion's.
+    pub withdrawal_speed_mm_per_s: f64,
+    /// The hold's duration, s.
+    pub hold_s: f64,
+    /// The stage's furthest travel from its start, mm.
+    pub travel_mm: f64,
+}
+
+/// How close to the start or furthest position the stage counts as there, as a
+/// fraction of the travel (an encoder's quantisation and the servo's settling are far
+/// below it).
+pub const AT_REST_FRACTION: f64 = 0.002;
+
+/// The force's noise band of the tare, in standard deviations of the force before the
+/// stage moves: the contact is the first sample of the insertion beyond it (and beyond
+/// [`CONTACT_FLOOR_N`]).
+pub const CONTACT_SIGMAS: f64 = 6.0;
+
+/// The contact's smallest force above the tare, N (a sensor quieter than this still
+/// needs a real contact).
+pub const CONTACT_FLOOR_N: f64 = 0.005;
+
+/// Cuts `s` into insertion, hold and withdrawal, and finds the contact (module docs).
+///
+/// # Errors
+/// The stage does not advance, does not rest at its furthest travel, or does not return;
+/// no sample before the stage moves to measure the tare on; no contact.
+pub fn phases(s: &[Sample], what: &str) -> Result<Phases> {
+    let (Some(first), Some(max)) = (s.first(), s.iter().map(|x| x.position_mm).reduce(f64::max)) else {
+        bail!("{what}: no samples");
+    };
+    let start = first.position_mm;
+    let travel_mm = max - start;
+    if travel_mm.is_nan() || travel_mm <= 0.0 {
+        bail!("{what}: the stage never advances (position_mm stays at or below {start} mm)");
+    }
+    let tol = AT_REST_FRACTION * travel_mm;
+    let top = s.iter().position(|x| x.position_mm >= max - tol).unwrap_or(0);
+    let leave = s.iter().rposition(|x| x.position_mm >= max - tol).unwrap_or(top);
+    let begin = s[..top].iter().rposition(|x| x.position_mm <= start + tol).unwrap_or(0);
+    if begin < 2 {
+        bail!("{what}: the stage moves from its first sample: no tare to measure the force's noise on");
+    }
+    if leave + 2 >= s.len() {
+        bail!("{what}: the stage does not return after its furthest travel ({max} mm): no withdrawal");
+    }
+    let fit = |r: Range<usize>| slope(&s[r.clone()]).with_context(|| format!("{what}: samples {r:?}: too few to fit a speed"));
+    let insertion = begin..top + 1;
+    let withdrawal = leave..s.len();
+    let hold = top..leave + 1;
+    let hold_s = s[leave].time_s - s[top].time_s;
+    let insertion_speed_mm_per_s = fit(middle(&insertion))?;
+    let withdrawal_speed_mm_per_s = fit(middle(&until_back(s, &withdrawal, start + tol)))?;
+    let contact =
+        contact(s, begin, &insertion).with_context(|| format!("{what}: the force never leaves the tare's noise during the insertion"))?;
+    Ok(Phases { insertion, hold, withdrawal, contact, insertion_speed_mm_per_s, withdrawal_speed_mm_per_s, hold_s, travel_mm })
+}
+
+/// The withdrawal up to where the stage is back at its start (`back_mm`; the trial may
+/// rest there).
+fn until_back(s: &[Sample], w: &Range<usize>, back_mm: f64) -> Range<usize> {
+    let end = s[w.clone()].iter().position(|x| x.position_mm <= back_mm).map_or(w.end, |k| w.start + k + 1);
+    w.start..end
+}
+
+/// The middle 80 % of a range.
+fn middle(r: &Range<usize>) -> Range<usize> {
+    let cut = r.len() / 10;
+    r.start + cut..r.end - cut
+}
+
+/// Least-squares slope of position against time, mm/s; `None` under 3 samples.
+fn slope(s: &[Sample]) -> Option<f64> {
+    if s.len() < 3 {
+        return None;
+    }
+    let n = s.len() as f64;
+    let (mt, mp) = s.iter().fold((0.0, 0.0), |(t, p), x| (t + x.time_s / n, p + x.position_mm / n));
+    let (stp, stt) = s.iter().fold((0.0, 0.0), |(a, b), x| (a + (x.time_s - mt) * (x.position_mm - mp), b + (x.time_s - mt).powi(2)));
+    (stt > 0.0).then(|| stp / stt)
+}
+
+/// The first sample of `insertion` whose force is beyond the tare's noise band, the
+/// tare measured on the samples before the stage moves (`..begin`).
+fn contact(s: &[Sample], begin: usize, insertion: &Range<usize>) -> Option<usize> {
+    let tare = &s[..begin];
+    let n = tare.len() as f64;
+    let mean = tare.iter().map(|x| x.force_n).sum::<f64>() / n;
+    let sd = (tare.iter().map(|x| (x.force_n - mean).powi(2)).sum::<f64>() / n).sqrt();
+    let band = (CONTACT_SIGMAS * sd).max(CONTACT_FLOOR_N);
+    // beyond the band and staying beyond it for the next samples (one spike is not a contact)
+    let beyond = |k: usize| s.get(k).is_some_and(|x| x.force_n - mean > band);
+    insertion.clone().find(|&k| (k..k + 5).all(beyond))
+}
