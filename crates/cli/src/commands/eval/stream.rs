@@ -143,7 +143,7 @@ fn read_chunk(rdr: &mut csv::Reader<std::fs::File>, file: &Path, chunk: &mut Chu
 }
 
 /// Parses `records` (pose columns `idx`); with `write` and every row good, evaluates
-/// and formats them (each its inputs, wrench and status: `eval_batch`'s row) into
+/// and formats them (each its inputs, wrench and status: `batch`'s row) into
 /// `out.text`.
 fn process(records: &[csv::ByteRecord], idx: &[usize; 5], file: &Path, write: bool, out: &mut Slice) {
     out.rows = 0;
