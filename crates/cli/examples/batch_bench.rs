@@ -32,7 +32,7 @@ const GOAL_S_PER_MILLION: f64 = 1.0;
 /// Poses of the smaller callgrind run (the larger one has twice as many): more than the
 /// two chunks of records the batch path allocates once (2 x `CHUNK_ROWS`), so that the
 /// difference is the steady state of a long file.
-const CALLGRIND_POSES: usize = 2 * needle_cli::eval_stream::CHUNK_ROWS + 10_000;
+const CALLGRIND_POSES: usize = 2 * needle_cli::commands::eval::stream::CHUNK_ROWS + 10_000;
 
 /// What one child run measured.
 struct Measured {
@@ -87,12 +87,12 @@ fn child(mode: &str, input: &Path, output: Option<&Path>, passes: usize) -> Resu
         "batch" => {
             let out = output.context("--run batch needs --output FILE")?;
             let (t, c) = (Instant::now(), cpu_s()?);
-            needle_cli::eval_stream::eval_csv(input, Some(out))?;
+            needle_cli::commands::eval::stream::eval_csv(input, Some(out))?;
             (t.elapsed().as_secs_f64(), c)
         }
         "single" => {
             let text = std::fs::read_to_string(input).with_context(|| format!("{}: cannot read", input.display()))?;
-            let poses = needle_cli::eval_batch::parse_poses(&text, input)?;
+            let poses = needle_cli::commands::eval::batch::parse_poses(&text, input)?;
             let (t, c) = (Instant::now(), cpu_s()?);
             let mut sum = 0.0f32;
             for _ in 0..passes {

@@ -1,6 +1,7 @@
 //! `needle`: the needle-haptics command-line tool (FE campaign, fitter, model queries).
 
 use clap::{Parser, Subcommand};
+use needle_cli::commands;
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -14,33 +15,33 @@ struct Cli {
 enum Command {
     /// FE campaign of a set (FEBio or CalculiX): run, verify, status.
     #[command(subcommand)]
-    Fe(needle_cli::fe::FeCommand),
+    Fe(needle_cli::commands::fe::FeCommand),
     /// Fit the set's model in its [fit] form (paper or coupled); write model.toml and golden vectors.
     #[command(after_help = "The form is campaign.toml's [fit] form: paper (the paper's single-axis sweeps, superposed) \
 or coupled (those terms plus cross terms, fitted together on the centre, sweep and training runs, sized per \
 component by cross-validation). Writes model.toml and the four golden files all or nothing; refuses stale FE runs.")]
-    Fit(needle_cli::fit::FitArgs),
+    Fit(needle_cli::commands::fit::FitArgs),
     /// The wrench at one pose, or at every row of a CSV, from the library (the firmware's code).
-    Eval(needle_cli::model::EvalArgs),
+    Eval(needle_cli::commands::eval::EvalArgs),
     /// Write the golden insertion paths as scripts for `needle eval --poses FILE --insertion STACK`.
-    InsertionPaths(needle_cli::insertion_paths::InsertionPathsArgs),
+    InsertionPaths(needle_cli::commands::insertion_paths::InsertionPathsArgs),
     /// Fit a tissue stack (<set>/tissue/<name>.toml) to a measured force against needle position.
-    Calibrate(needle_cli::calibrate::CalibrateArgs),
+    Calibrate(needle_cli::commands::calibrate::CalibrateArgs),
     /// Derive a tissue stack from a published model's force polynomials per layer (no measured curve).
-    CalibratePublished(needle_cli::calibrate_published::CalibratePublishedArgs),
+    CalibratePublished(needle_cli::commands::calibrate_published::CalibratePublishedArgs),
     /// Compare the model with the FE runs it was not fitted on; exit 1 when a goal is missed.
-    Validate(needle_cli::fit::ValidateArgs),
+    Validate(needle_cli::commands::validate::ValidateArgs),
     /// Serve the model explorer (the library compiled to wasm) to a browser on a local port.
-    Explore(needle_cli::explore::ExploreArgs),
+    Explore(needle_cli::commands::explore::ExploreArgs),
     /// Draw the set's figures as SVG (Figs 4, 6, 7, 8, parity, FE verification).
-    Plot(needle_cli::plot::PlotArgs),
+    Plot(needle_cli::commands::plot::PlotArgs),
     /// The fixed-point evaluator's largest error against f64 on a grid and random poses, beside its bound.
-    FixedError(needle_cli::fixed::FixedErrorArgs),
+    FixedError(needle_cli::commands::fixed_error::FixedErrorArgs),
     /// Write the C headers: needle.h (the C API) and needle_coeffs.h (the model's tables).
-    Header(needle_cli::model::HeaderArgs),
+    Header(needle_cli::commands::header::HeaderArgs),
     /// The library on Cortex-M under QEMU: size, bench, golden, check.
     #[command(subcommand)]
-    Firmware(needle_cli::firmware::FirmwareCommand),
+    Firmware(needle_cli::commands::firmware::FirmwareCommand),
 }
 
 /// SIGPIPE to its default action: a reader that closes the pipe early (`| head`) ends
@@ -66,18 +67,18 @@ fn main() -> ExitCode {
         default_sigpipe();
     }
     let result = match cli.command {
-        Command::Fe(c) => needle_cli::fe::run(c),
-        Command::Fit(a) => needle_cli::fit::fit(a),
-        Command::Eval(a) => needle_cli::model::eval(a),
-        Command::Validate(a) => needle_cli::fit::validate(a),
-        Command::InsertionPaths(a) => needle_cli::insertion_paths::insertion_paths(a),
-        Command::Calibrate(a) => needle_cli::calibrate::calibrate(a),
-        Command::CalibratePublished(a) => needle_cli::calibrate_published::calibrate_published(a),
-        Command::Explore(a) => needle_cli::explore::explore(a),
-        Command::Plot(a) => needle_cli::plot::plot(a),
-        Command::Header(a) => needle_cli::model::header(a),
-        Command::FixedError(a) => needle_cli::fixed::fixed_error(a),
-        Command::Firmware(c) => needle_cli::firmware::run(c),
+        Command::Fe(c) => commands::fe::run(c),
+        Command::Fit(a) => commands::fit::run(a),
+        Command::Eval(a) => commands::eval::run(a),
+        Command::Validate(a) => commands::validate::run(a),
+        Command::InsertionPaths(a) => commands::insertion_paths::run(a),
+        Command::Calibrate(a) => commands::calibrate::run(a),
+        Command::CalibratePublished(a) => commands::calibrate_published::run(a),
+        Command::Explore(a) => commands::explore::run(a),
+        Command::Plot(a) => commands::plot::run(a),
+        Command::Header(a) => commands::header::run(a),
+        Command::FixedError(a) => commands::fixed_error::run(a),
+        Command::Firmware(c) => commands::firmware::run(c),
     };
     match result {
         Ok(code) => code,

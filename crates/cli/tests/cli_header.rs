@@ -1,13 +1,14 @@
 //! `needle header --out DIR` writes both C headers a C user needs: needle_coeffs.h (the
 //! model's tables, from the build) and needle.h (the C API, from needle-capi).
 
-use std::process::Command;
+mod common;
+use common::needle;
 
 #[test]
 fn header_writes_the_tables_and_the_api_header() {
     let d = tempfile::tempdir().expect("tempdir");
     let out_dir = d.path().join("include");
-    let out = Command::new(env!("CARGO_BIN_EXE_needle")).args(["header", "--out"]).arg(&out_dir).output().expect("run needle header");
+    let out = needle(&["header".as_ref(), "--out".as_ref(), out_dir.as_os_str()]);
     assert!(out.status.success(), "needle header failed: {}", String::from_utf8_lossy(&out.stderr));
     let coeffs = std::fs::read_to_string(out_dir.join("needle_coeffs.h")).expect("needle_coeffs.h written");
     assert_eq!(coeffs, needle_haptics::model_info::C_HEADER);
@@ -29,7 +30,7 @@ fn header_writes_both_or_neither() {
     let out_dir = d.path().join("include");
     std::fs::create_dir_all(out_dir.join("needle.h")).expect("a folder where needle.h goes");
     std::fs::write(out_dir.join("needle_coeffs.h"), "old\n").expect("old header");
-    let out = Command::new(env!("CARGO_BIN_EXE_needle")).args(["header", "--out"]).arg(&out_dir).output().expect("run needle header");
+    let out = needle(&["header".as_ref(), "--out".as_ref(), out_dir.as_os_str()]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("needle.h: is a folder"), "{err}");

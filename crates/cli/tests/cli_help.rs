@@ -6,45 +6,11 @@
 //! command is held to the same rules.
 
 use std::path::PathBuf;
-use std::process::Command;
+
+mod common;
+use common::{all_commands, help};
 
 const WIDTH: usize = 100;
-
-fn help(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_needle")).args(args).output().expect("run needle");
-    assert!(out.status.success(), "needle {args:?} failed: {}", String::from_utf8_lossy(&out.stderr));
-    String::from_utf8(out.stdout).expect("help is UTF-8")
-}
-
-/// The subcommands a help text lists under "Commands:", without `help`.
-fn listed_commands(text: &str) -> Vec<String> {
-    text.lines()
-        .skip_while(|l| *l != "Commands:")
-        .skip(1)
-        .take_while(|l| !l.is_empty())
-        .filter_map(|l| l.split_whitespace().next())
-        .filter(|name| *name != "help")
-        .map(String::from)
-        .collect()
-}
-
-/// Every command and subcommand of `needle`, depth first, in the order the help lists them.
-fn all_commands() -> Vec<Vec<String>> {
-    fn walk(prefix: &[String], out: &mut Vec<Vec<String>>) {
-        let mut args: Vec<&str> = prefix.iter().map(String::as_str).collect();
-        args.push("--help");
-        for name in listed_commands(&help(&args)) {
-            let mut cmd = prefix.to_vec();
-            cmd.push(name);
-            out.push(cmd.clone());
-            walk(&cmd, out);
-        }
-    }
-    let mut out = Vec::new();
-    walk(&[], &mut out);
-    assert!(out.len() >= 10, "found only {out:?}");
-    out
-}
 
 #[test]
 fn every_summary_is_one_short_line() {

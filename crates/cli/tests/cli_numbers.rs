@@ -1,19 +1,12 @@
 //! Numbers on the command line: negative and non-finite values are accepted as values
 //! (not taken for options), and out-of-range counts are refused with the range.
 
-use std::process::Command;
-
-fn needle(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_needle")).args(args).output().expect("run needle")
-}
-
-fn set() -> String {
-    needle_firmware_host::workspace_root().join("coeffs/default").to_string_lossy().into_owned()
-}
+mod common;
+use common::{needle, shipped_set_arg};
 
 #[test]
 fn negative_and_infinite_pose_values_are_values() {
-    let s = set();
+    let s = shipped_set_arg();
     let o = needle(&[
         "eval",
         "--set",
@@ -39,7 +32,7 @@ fn negative_and_infinite_pose_values_are_values() {
 
 #[test]
 fn out_of_range_counts_are_refused_with_their_range() {
-    let s = set();
+    let s = shipped_set_arg();
     for (args, want) in [
         (vec!["fe", "run", "--set", &s, "--jobs", "-1"], "invalid value '-1' for '--jobs <N>': -1 is not in 1..=256"),
         (vec!["fe", "run", "--set", &s, "--jobs", "0"], "invalid value '0' for '--jobs <N>': 0 is not in 1..=256"),

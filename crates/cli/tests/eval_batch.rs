@@ -3,16 +3,10 @@
 //! file comes from the fitter's own f32 implementation, not from the library); bad rows
 //! are named by file and line and nothing is written.
 
-use std::path::PathBuf;
 use std::process::Command;
 
-fn default_set() -> PathBuf {
-    needle_firmware_host::workspace_root().join("coeffs/default")
-}
-
-fn needle(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_needle")).args(args).output().expect("run needle")
-}
+mod common;
+use common::{needle, shipped_set, NEEDLE};
 
 fn hex_f32(t: &str) -> f32 {
     f32::from_bits(u32::from_str_radix(t.trim_start_matches("0x"), 16).expect("hex bits"))
@@ -20,7 +14,7 @@ fn hex_f32(t: &str) -> f32 {
 
 #[test]
 fn batch_eval_reproduces_every_golden_vector() {
-    let set = default_set();
+    let set = shipped_set();
     let golden = std::fs::read_to_string(set.join("golden-f32.csv")).expect("golden-f32.csv");
     let rows: Vec<Vec<&str>> = golden.lines().skip(1).map(|l| l.split(',').collect()).collect();
     assert!(rows.len() > 1000, "golden file has {} rows", rows.len());
@@ -59,7 +53,7 @@ fn bad_rows_are_named_by_line_and_nothing_is_written() {
     let file = d.path().join("poses.csv");
     std::fs::write(&file, "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n1,2,3,4,5\n1,two,3,4,5\n1,2,3,4,5\n1,2,3\n").expect("write");
     let out = d.path().join("w.csv");
-    let set = default_set();
+    let set = shipped_set();
     let o = needle(&["eval", "--set", &set.to_string_lossy(), "--poses", &file.to_string_lossy(), "--out", &out.to_string_lossy()]);
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);
@@ -82,7 +76,7 @@ fn a_pose_column_named_twice_is_refused() {
     let d = tempfile::tempdir().expect("tempdir");
     let file = d.path().join("poses.csv");
     std::fs::write(&file, "x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,x_mm\n1,2,3,4,5,9\n").expect("write");
-    let o = needle(&["eval", "--set", &default_set().to_string_lossy(), "--poses", &file.to_string_lossy()]);
+    let o = needle(&["eval", "--set", &shipped_set().to_string_lossy(), "--poses", &file.to_string_lossy()]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains(&format!("{}:1: column \"x_mm\" appears twice in the header (columns 1 and 6)", file.display())), "{err}");
@@ -95,7 +89,7 @@ fn a_huge_bad_field_is_cut_in_the_message() {
     let file = d.path().join("poses.csv");
     let field = "z".repeat(5_000_000);
     std::fs::write(&file, format!("x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n1,{field},3,4,5\n")).expect("write");
-    let o = needle(&["eval", "--set", &default_set().to_string_lossy(), "--poses", &file.to_string_lossy()]);
+    let o = needle(&["eval", "--set", &shipped_set().to_string_lossy(), "--poses", &file.to_string_lossy()]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2));
     assert!(err.len() < 2_000, "the message echoes {} bytes", err.len());
@@ -109,7 +103,7 @@ fn a_huge_bad_field_is_cut_in_the_message() {
 fn out_without_poses_is_refused() {
     let d = tempfile::tempdir().expect("tempdir");
     let out = d.path().join("w.csv");
-    let set = default_set();
+    let set = shipped_set();
     let args = ["--x-mm", "0", "--z-mm", "0", "--theta-x-deg", "0", "--theta-z-deg", "0", "--depth-mm", "3", "--out"];
     let o = needle(&[&["eval", "--set", &set.to_string_lossy()], &args[..], &[&out.to_string_lossy()]].concat());
     let err = String::from_utf8_lossy(&o.stderr);
@@ -122,7 +116,7 @@ fn out_without_poses_is_refused() {
 fn a_reader_that_closes_the_pipe_ends_needle_quietly() {
     use std::os::unix::process::ExitStatusExt;
     use std::process::Stdio;
-    let set = default_set();
+    let set = shipped_set();
     let set = set.to_str().expect("utf-8");
     // 20,000 rows: more output than a pipe buffers (64 KiB), so the writes do hit the
     // closed pipe
@@ -133,8 +127,7 @@ fn a_reader_that_closes_the_pipe_ends_needle_quietly() {
     let single: Vec<&str> = ["eval", "--set", set].into_iter().chain(one).collect();
     let batch = vec!["eval", "--set", set, "--poses", poses.to_str().expect("utf-8")];
     for args in [single, batch] {
-        let mut child =
-            Command::new(env!("CARGO_BIN_EXE_needle")).args(&args).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("spawn");
+        let mut child = Command::new(NEEDLE).args(&args).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("spawn");
         drop(child.stdout.take()); // `| head -0`: the reader is gone
         let o = child.wait_with_output().expect("wait");
         let err = String::from_utf8_lossy(&o.stderr);
@@ -156,7 +149,7 @@ fn out_onto_a_symlink_or_a_fifo_is_refused_and_left_alone() {
     let fifo = d.path().join("fifo.csv");
     let made = Command::new("mkfifo").arg(&fifo).status().expect("mkfifo (coreutils)");
     assert!(made.success());
-    let set = default_set();
+    let set = shipped_set();
     for (out, what) in [(&link, "a symbolic link"), (&fifo, "not a regular file")] {
         let o = needle(&["eval", "--set", &set.to_string_lossy(), "--poses", &poses.to_string_lossy(), "--out", &out.to_string_lossy()]);
         let err = String::from_utf8_lossy(&o.stderr);
@@ -175,13 +168,13 @@ fn out_onto_a_symlink_or_a_fifo_is_refused_and_left_alone() {
 fn a_bad_row_after_several_chunks_leaves_nothing_written() {
     let d = tempfile::tempdir().expect("tempdir");
     let file = d.path().join("poses.csv");
-    let rows = needle_cli::eval_stream::CHUNK_ROWS * 2 + 17;
+    let rows = needle_cli::commands::eval::stream::CHUNK_ROWS * 2 + 17;
     let mut text = String::from("x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n");
     for i in 0..rows {
         text.push_str(&format!("{},0,0,0,{}\n", i % 7, (i % 60) as f32 / 10.0));
     }
     std::fs::write(&file, &text).expect("write");
-    let set = default_set();
+    let set = shipped_set();
     let (set, poses) = (set.to_string_lossy(), file.to_string_lossy());
     let out = d.path().join("w.csv");
     let o = needle(&["eval", "--set", &set, "--poses", &poses, "--out", &out.to_string_lossy()]);
@@ -209,7 +202,7 @@ fn a_bad_row_after_several_chunks_leaves_nothing_written() {
 fn bad_rows_in_several_slices_are_listed_in_line_order() {
     let d = tempfile::tempdir().expect("tempdir");
     let file = d.path().join("poses.csv");
-    let chunk = needle_cli::eval_stream::CHUNK_ROWS;
+    let chunk = needle_cli::commands::eval::stream::CHUNK_ROWS;
     // 0-based rows: early in the first slice, late in the chunk (the last slice), next chunk
     let bad = [3, chunk - 2, chunk + 5];
     let mut text = String::from("x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n");
@@ -217,7 +210,7 @@ fn bad_rows_in_several_slices_are_listed_in_line_order() {
         text.push_str(if bad.contains(&i) { "1,x,0,0,1\n" } else { "1,0,0,0,1\n" });
     }
     std::fs::write(&file, &text).expect("write");
-    let set = default_set();
+    let set = shipped_set();
     let o = needle(&["eval", "--set", &set.to_string_lossy(), "--poses", &file.to_string_lossy()]);
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);
@@ -232,7 +225,7 @@ fn bad_rows_in_several_slices_are_listed_in_line_order() {
 #[test]
 fn padded_fields_read_as_the_numbers_they_hold() {
     let d = tempfile::tempdir().expect("tempdir");
-    let set = default_set();
+    let set = shipped_set();
     let run = |name: &str, text: &str| {
         let file = d.path().join(name);
         std::fs::write(&file, text).expect("write");

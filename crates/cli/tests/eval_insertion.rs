@@ -3,15 +3,9 @@
 //! with their line.
 use needle_haptics::insertion::{stacks, Insertion, InsertionConfig};
 use needle_haptics::Pose;
-use std::process::Command;
 
-fn needle(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_needle")).args(args).output().expect("run needle")
-}
-
-fn set() -> String {
-    format!("{}/../../coeffs/default", env!("CARGO_MANIFEST_DIR"))
-}
+mod common;
+use common::{needle, shipped_set_arg};
 
 /// The script file of `poses`, one tick of 1 ms each, and the poses.
 fn script_of(poses: Vec<Pose>) -> (String, Vec<Pose>) {
@@ -27,7 +21,7 @@ fn script_of(poses: Vec<Pose>) -> (String, Vec<Pose>) {
 fn eval_liver(dir: &std::path::Path, name: &str, text: &str, extra: &[&str]) -> std::process::Output {
     let file = dir.join(name);
     std::fs::write(&file, text).expect("script");
-    let set = set();
+    let set = shipped_set_arg();
     let mut args = vec!["eval", "--set", &set, "--poses", file.to_str().expect("path"), "--insertion", "liver"];
     args.extend_from_slice(extra);
     needle(&args)
@@ -88,14 +82,14 @@ fn bad_scripts_are_refused_with_their_line() {
     for (text, want) in cases {
         let file = dir.path().join("script.csv");
         std::fs::write(&file, text).expect("script");
-        let out = needle(&["eval", "--set", &set(), "--poses", file.to_str().expect("path"), "--insertion", "liver"]);
+        let out = needle(&["eval", "--set", &shipped_set_arg(), "--poses", file.to_str().expect("path"), "--insertion", "liver"]);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success(), "{want}: accepted");
         assert!(stderr.contains(want), "{want}: {stderr}");
     }
     let file = dir.path().join("script.csv");
     std::fs::write(&file, "time_s,x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n0,0,0,0,0,1\n0.001,0,0,0,0,2\n").expect("script");
-    let out = needle(&["eval", "--set", &set(), "--poses", file.to_str().expect("path"), "--insertion", "no_such"]);
+    let out = needle(&["eval", "--set", &shipped_set_arg(), "--poses", file.to_str().expect("path"), "--insertion", "no_such"]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("no such tissue stack"), "{}", String::from_utf8_lossy(&out.stderr));
 }
 

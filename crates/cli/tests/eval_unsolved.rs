@@ -2,16 +2,8 @@
 //! unsolved region"): a pose the FE could not solve is flagged in the text and the JSON
 //! with its wrench (exit 0), and `--set` must carry the compiled-in region.
 
-use std::path::Path;
-use std::process::Command;
-
-fn needle(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_needle")).args(args).output().expect("run needle")
-}
-
-fn set() -> String {
-    needle_firmware_host::workspace_root().join("coeffs/default").to_string_lossy().into_owned()
-}
+mod common;
+use common::{needle, shipped_set, shipped_set_arg};
 
 /// tx+15 failed every attempt: the pose is in the region below the depth its furthest
 /// attempt reached (5.70 mm, `fe/tx+15.partial.toml`), so at 6 mm; the centre is not.
@@ -21,7 +13,7 @@ fn pose(theta_x: &str) -> Vec<String> {
 
 #[test]
 fn eval_names_the_flag_and_keeps_the_wrench() {
-    let s = set();
+    let s = shipped_set_arg();
     let run = |theta_x: &str, json: bool| {
         let mut args: Vec<String> = vec!["eval".into(), "--set".into(), s.clone()];
         args.extend(pose(theta_x));
@@ -51,7 +43,7 @@ fn eval_names_the_flag_and_keeps_the_wrench() {
 #[test]
 fn another_region_than_the_compiled_in_one_is_refused() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let from = Path::new(&set()).to_path_buf();
+    let from = shipped_set();
     for f in ["model.toml", "unsolved.toml"] {
         std::fs::copy(from.join(f), dir.path().join(f)).expect("copy");
     }

@@ -24,10 +24,13 @@ impl Drop for Killed {
 
 use needle_contract::COMPONENTS;
 
+mod common;
+use common::{shipped_set, NEEDLE};
+
 /// Starts `needle explore --port 0` and returns it with the URL it printed.
 fn start_explorer() -> (Killed, String) {
     let root = workspace_root();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_needle"))
+    let mut child = Command::new(NEEDLE)
         .args(["explore", "--set", "coeffs/default", "--port", "0"])
         .current_dir(&root)
         .stdout(Stdio::piped())
@@ -65,7 +68,7 @@ fn start_chromedriver() -> (Killed, String) {
 
 /// `needle eval --json` at `pose`: the six components' bits and the status bits.
 fn needle_eval(pose: &[(&str, &str); 5]) -> (Vec<String>, u32) {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_needle"));
+    let mut cmd = Command::new(NEEDLE);
     cmd.args(["eval", "--set", "coeffs/default", "--json"]).current_dir(workspace_root());
     for (name, v) in pose {
         cmd.arg(format!("--{}", name.replace('_', "-"))).arg(v);
@@ -224,7 +227,7 @@ async fn explorer_page_shows_what_needle_eval_computes() {
         set_field(&c, name, v).await;
     }
     let prony_text = c.find(Locator::Id("prony")).await.expect("Prony field").prop("value").await.expect("prop").expect("a value");
-    let (spec, _) = needle_fe::spec::load(&workspace_root().join("coeffs/default")).expect("campaign.toml");
+    let (spec, _) = needle_fe::spec::load(&shipped_set()).expect("campaign.toml");
     let visco = spec.viscoelastic.expect("the default set has [viscoelastic]");
     let want_text = visco.g.iter().zip(&visco.tau_s).map(|(g, t)| format!("{g}:{t}")).collect::<Vec<_>>().join(", ");
     assert_eq!(prony_text, want_text, "the page's Prony terms are the campaign's [viscoelastic]");

@@ -3,32 +3,11 @@
 //! manifest; the scaled runs reproduce s x the s = 1 wrench. They need `febio4`
 //! (`.ci/install-febio`); without it they fail, they are not skipped.
 
+mod common;
+use common::{campaign_copy, needle_on, show};
+
 use needle_fe::manifest::{read_manifest, MANIFEST};
 use needle_fe::results;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
-
-const NEEDLE: &str = env!("CARGO_BIN_EXE_needle");
-
-/// A copy of coeffs/default/campaign.toml in a fresh temporary folder: (tempdir, set dir).
-fn default_set() -> (tempfile::TempDir, PathBuf) {
-    let d = tempfile::tempdir().expect("tempdir");
-    let set = d.path().join("set");
-    std::fs::create_dir_all(&set).expect("mkdir");
-    let src = needle_firmware_host::workspace_root().join("coeffs/default/campaign.toml");
-    std::fs::copy(&src, set.join("campaign.toml")).expect("copy the default spec");
-    (d, set)
-}
-
-fn needle(args: &[&str], set: &Path) -> Output {
-    let mut c = Command::new(NEEDLE);
-    c.args(args).arg("--set").arg(set).stdin(Stdio::null());
-    c.output().expect("run needle")
-}
-
-fn show(o: &Output) -> String {
-    format!("status {:?}\n--- stdout\n{}\n--- stderr\n{}", o.status, String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
-}
 
 /// Load steps of the deep smoke run: about 0.6 mm each (with steps of 2.6 mm the smoke
 /// mesh's contact is never found: Fy = 0 at every depth).
@@ -38,8 +17,8 @@ const STEPS: u32 = 22;
 /// deep.depth_mm with Fy growing, its manifest entry at that depth, nothing in fe/.
 #[test]
 fn deep_centre_run_on_the_smoke_mesh() {
-    let (_d, set) = default_set();
-    let o = needle(&["fe", "run", "--deep", "--only", "centre", "--mesh", "smoke", "--steps", "22", "--threads", "1"], &set);
+    let (_d, set) = campaign_copy();
+    let o = needle_on(&["fe", "run", "--deep", "--only", "centre", "--mesh", "smoke", "--steps", "22", "--threads", "1"], &set);
     assert!(o.status.success(), "{}", show(&o));
     let (c, _) = needle_fe::spec::load(&set).expect("spec");
     let depth_mm = c.deep.as_ref().map(|d| d.depth_mm).expect("a [deep] section");
@@ -52,7 +31,7 @@ fn deep_centre_run_on_the_smoke_mesh() {
     assert_eq!((m.pose["centre"].depth_mm, m.pose["centre"].steps, m.pose["centre"].mesh.as_str()), (depth_mm, STEPS, "smoke"));
     assert!(!set.join("fe/centre.csv").exists(), "the shallow folder is not written");
     // resumed, not solved again
-    let again = needle(&["fe", "run", "--deep", "--only", "centre", "--mesh", "smoke", "--steps", "22", "--threads", "1"], &set);
+    let again = needle_on(&["fe", "run", "--deep", "--only", "centre", "--mesh", "smoke", "--steps", "22", "--threads", "1"], &set);
     assert!(again.status.success() && String::from_utf8_lossy(&again.stdout).contains("up to date"), "{}", show(&again));
 }
 
@@ -60,12 +39,12 @@ fn deep_centre_run_on_the_smoke_mesh() {
 /// runs at s = 0.5 and 2 equal s x the s = 1 wrench within the goal, in verify.toml.
 #[test]
 fn scaling_check_on_the_smoke_mesh() {
-    let (_d, set) = default_set();
-    let base = needle(&["fe", "run", "--only", "centre", "--mesh", "smoke", "--steps", "5", "--threads", "1"], &set);
+    let (_d, set) = campaign_copy();
+    let base = needle_on(&["fe", "run", "--only", "centre", "--mesh", "smoke", "--steps", "5", "--threads", "1"], &set);
     assert!(base.status.success(), "{}", show(&base));
     let args =
         ["fe", "verify", "--scaling", "--scaling-poses", "centre", "--scaling-mesh", "smoke", "--scaling-steps", "5", "--threads", "1"];
-    let o = needle(&args, &set);
+    let o = needle_on(&args, &set);
     assert!(o.status.success(), "{}", show(&o));
     let text = std::fs::read_to_string(set.join("fe/verify.toml")).expect("verify.toml");
     let runs: Vec<&str> = text.split("[[scaling.runs]]").skip(1).collect();
@@ -80,6 +59,6 @@ fn scaling_check_on_the_smoke_mesh() {
     }
     assert!(set.join("fe/.work/verify/scaling-s0.5/centre.csv").exists(), "the scaled runs are kept for resuming");
     // a scaled run that is there is read, not solved again
-    let again = needle(&args, &set);
+    let again = needle_on(&args, &set);
     assert!(again.status.success() && String::from_utf8_lossy(&again.stdout).contains("up to date"), "{}", show(&again));
 }

@@ -5,15 +5,17 @@
 //! on. They need `febio4` (`.ci/install-febio`, which `.ci/test` runs first); without it
 //! they fail, they are not skipped.
 
+mod common;
+use common::{campaign_copy, needle_env, show};
+
 use needle_fe::febio;
 use needle_fe::manifest::{read_manifest, MANIFEST};
 use needle_fe::results;
 use needle_fe::spec::Engine;
 use needle_fe::verify::{self, VerifyOptions};
+use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
-
-const NEEDLE: &str = env!("CARGO_BIN_EXE_needle");
+use std::process::Output;
 
 /// The FEBio these tests run, and its version.
 fn require_febio() -> (PathBuf, String) {
@@ -23,27 +25,19 @@ fn require_febio() -> (PathBuf, String) {
     (p, v)
 }
 
-/// A copy of coeffs/default/campaign.toml in a fresh temporary folder: (tempdir, set dir).
-fn default_set() -> (tempfile::TempDir, PathBuf) {
-    let d = tempfile::tempdir().expect("tempdir");
-    let set = d.path().join("set");
+/// [`campaign_copy`] with its fe/ folder.
+fn febio_set() -> (tempfile::TempDir, PathBuf) {
+    let (d, set) = campaign_copy();
     std::fs::create_dir_all(set.join("fe")).expect("mkdir");
-    let src = needle_firmware_host::workspace_root().join("coeffs/default/campaign.toml");
-    std::fs::copy(&src, set.join("campaign.toml")).expect("copy the default spec");
     (d, set)
 }
 
-fn needle(args: &[&str], set: &Path, env: &[(&str, &str)]) -> Output {
-    let mut c = Command::new(NEEDLE);
-    c.args(["fe", "run", "--set"]).arg(set).args(args).stdin(Stdio::null());
-    for (k, v) in env {
-        c.env(k, v);
-    }
-    c.output().expect("run needle")
-}
-
-fn show(o: &Output) -> String {
-    format!("status {:?}\n--- stdout\n{}\n--- stderr\n{}", o.status, String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+/// `needle fe run --set <set> <args>` with extra environment variables.
+fn fe_run(args: &[&str], set: &Path, env: &[(&str, &str)]) -> Output {
+    let mut all: Vec<&OsStr> = ["fe", "run", "--set"].into_iter().map(OsStr::new).collect();
+    all.push(set.as_os_str());
+    all.extend(args.iter().map(OsStr::new));
+    needle_env(&all, env)
 }
 
 /// Smoke campaign: three poses (quarter and two half models) on the smoke mesh, 10 load
@@ -53,8 +47,8 @@ fn show(o: &Output) -> String {
 #[test]
 fn smoke_campaign_on_febio() {
     let (_, version) = require_febio();
-    let (_d, set) = default_set();
-    let o = needle(
+    let (_d, set) = febio_set();
+    let o = fe_run(
         &["--solver", "febio", "--mesh", "smoke", "--steps", "10", "--only", "centre,z+02,tx+04", "--jobs", "2", "--threads", "1"],
         &set,
         &[],
@@ -84,9 +78,9 @@ fn smoke_campaign_on_febio() {
 /// A `FEBIO` that is not an executable is an error that names it, before any solve.
 #[test]
 fn a_bad_febio_path_is_a_clear_error() {
-    let (_d, set) = default_set();
+    let (_d, set) = febio_set();
     let o =
-        needle(&["--solver", "febio", "--mesh", "smoke", "--steps", "2", "--only", "centre"], &set, &[("FEBIO", "/nonexistent/febio4")]);
+        fe_run(&["--solver", "febio", "--mesh", "smoke", "--steps", "2", "--only", "centre"], &set, &[("FEBIO", "/nonexistent/febio4")]);
     assert_eq!(o.status.code(), Some(2), "{}", show(&o));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("FEBIO=/nonexistent/febio4: not an executable"), "{err}");
@@ -102,7 +96,7 @@ fn a_bad_febio_path_is_a_clear_error() {
 #[test]
 fn a_failing_run_keeps_its_log_and_the_campaign_goes_on() {
     let (real, _) = require_febio();
-    let (d, set) = default_set();
+    let (d, set) = febio_set();
     let wrapper = d.path().join("febio4-failing-on-z02");
     std::fs::write(
         &wrapper,
@@ -115,7 +109,7 @@ fn a_failing_run_keeps_its_log_and_the_campaign_goes_on() {
     use std::os::unix::fs::PermissionsExt;
     std::fs::set_permissions(&wrapper, std::fs::Permissions::from_mode(0o755)).expect("chmod");
     let w = wrapper.to_string_lossy().into_owned();
-    let o = needle(
+    let o = fe_run(
         &["--solver", "febio", "--mesh", "smoke", "--steps", "10", "--only", "centre,z+02,t2-a", "--threads", "1"],
         &set,
         &[("FEBIO", &w)],
@@ -188,7 +182,7 @@ const COARSE_TOLERANCE_PERCENT: f64 = 8.0;
 #[test]
 fn coarse_flat_punch_with_the_febio_element_matches_sneddon() {
     require_febio();
-    let (_d, set) = default_set();
+    let (_d, set) = febio_set();
     let opts = VerifyOptions {
         set_dir: set.clone(),
         punch: true,

@@ -3,8 +3,8 @@
 //! interrupted halfway through a solve. These tests need `ccx` (Debian `calculix-ccx`);
 //! without it they fail, they are not skipped.
 
-mod fe_common;
-use fe_common::{default_set, needle, show, NEEDLE};
+mod common;
+use common::{campaign_copy, needle_env, show, NEEDLE};
 
 use needle_fe::campaign::MANIFEST_LOCK;
 use needle_fe::manifest::{read_manifest, MANIFEST};
@@ -62,11 +62,11 @@ fn ccx_is_installed() {
 #[test]
 fn smoke_campaign_skips_and_resumes_after_a_kill() {
     require_ccx();
-    let (_tmp, set) = default_set();
+    let (_tmp, set) = campaign_copy();
     let fe = set.join("fe");
 
     // 1. one pose, two steps, end to end
-    let out = needle(&run_args(&set, "centre", "2"), &[]);
+    let out = needle_env(&run_args(&set, "centre", "2"), &[]);
     assert!(out.status.success(), "{}", show(&out));
     check_csv(&fe, "centre", 2);
     assert_eq!(
@@ -95,7 +95,7 @@ fn smoke_campaign_skips_and_resumes_after_a_kill() {
     let csv_before = std::fs::read(fe.join("centre.csv")).expect("csv");
     let manifest_before = std::fs::read(fe.join(MANIFEST)).expect("manifest");
     let t = Instant::now();
-    let out = needle(&run_args(&set, "centre", "2"), &[]);
+    let out = needle_env(&run_args(&set, "centre", "2"), &[]);
     assert!(out.status.success(), "{}", show(&out));
     assert!(String::from_utf8_lossy(&out.stderr).contains("skipped 1 up to date"), "{}", show(&out));
     assert!(String::from_utf8_lossy(&out.stdout).contains("up to date"), "{}", show(&out));
@@ -132,7 +132,7 @@ fn smoke_campaign_skips_and_resumes_after_a_kill() {
     assert_eq!(std::fs::read(fe.join("centre.csv")).expect("csv"), csv_before, "finished poses are kept");
 
     // 4. the rerun completes it
-    let out = needle(&run_args(&set, "x+04", "3"), &[]);
+    let out = needle_env(&run_args(&set, "x+04", "3"), &[]);
     assert!(out.status.success(), "{}", show(&out));
     assert!(String::from_utf8_lossy(&out.stderr).contains("skipped 0 up to date"), "{}", show(&out));
     check_csv(&fe, "x+04", 3);
@@ -147,8 +147,8 @@ fn smoke_campaign_skips_and_resumes_after_a_kill() {
 
 #[test]
 fn missing_ccx_is_a_clear_error() {
-    let (_tmp, set) = default_set();
-    let out = needle(&run_args(&set, "centre", "2"), &[("NEEDLE_CCX", "/nonexistent/ccx")]);
+    let (_tmp, set) = campaign_copy();
+    let out = needle_env(&run_args(&set, "centre", "2"), &[("NEEDLE_CCX", "/nonexistent/ccx")]);
     assert_eq!(out.status.code(), Some(2), "{}", show(&out));
     assert!(String::from_utf8_lossy(&out.stderr).contains("ccx not found"), "{}", show(&out));
     assert!(!set.join("fe").join("centre.csv").exists());
@@ -156,7 +156,7 @@ fn missing_ccx_is_a_clear_error() {
 
 #[test]
 fn unstable_tissue_stops_before_any_solve() {
-    let (_tmp, set) = default_set();
+    let (_tmp, set) = campaign_copy();
     // the paper's Table 1 as printed: mu_1 negative, sum of mu_i < 0
     let path = set.join("campaign.toml");
     let text = std::fs::read_to_string(&path).expect("spec");
@@ -164,7 +164,7 @@ fn unstable_tissue_stops_before_any_solve() {
     let printed = line.replace("e-3", "").replacen('[', "[-", 1);
     std::fs::write(&path, text.replace(&line, &printed)).expect("write");
     // with no ccx at all: the material check must come first
-    let out = needle(&run_args(&set, "*", "2"), &[("NEEDLE_CCX", "/nonexistent/ccx")]);
+    let out = needle_env(&run_args(&set, "*", "2"), &[("NEEDLE_CCX", "/nonexistent/ccx")]);
     assert_eq!(out.status.code(), Some(2), "{}", show(&out));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("unstable") && !err.contains("ccx not found"), "{}", show(&out));
@@ -173,23 +173,23 @@ fn unstable_tissue_stops_before_any_solve() {
 
 #[test]
 fn bad_options_are_refused() {
-    let (_tmp, set) = default_set();
-    let out = needle(&run_args(&set, "no-such-pose", "2"), &[]);
+    let (_tmp, set) = campaign_copy();
+    let out = needle_env(&run_args(&set, "no-such-pose", "2"), &[]);
     assert_eq!(out.status.code(), Some(2), "{}", show(&out));
     assert!(String::from_utf8_lossy(&out.stderr).contains("matches no pose"), "{}", show(&out));
     let mut args = run_args(&set, "centre", "2");
     args.extend([std::ffi::OsStr::new("--timeout-s"), std::ffi::OsStr::new("0")]);
-    let out = needle(&args, &[]);
+    let out = needle_env(&args, &[]);
     assert_eq!(out.status.code(), Some(2), "{}", show(&out));
 }
 
 #[test]
 fn a_timed_out_job_is_reported_and_kept_for_debugging() {
     require_ccx();
-    let (_tmp, set) = default_set();
+    let (_tmp, set) = campaign_copy();
     let mut args = run_args(&set, "centre", "2");
     args.extend([std::ffi::OsStr::new("--timeout-s"), std::ffi::OsStr::new("0.3")]);
-    let out = needle(&args, &[]);
+    let out = needle_env(&args, &[]);
     assert_eq!(out.status.code(), Some(1), "a failed run gives exit status 1\n{}", show(&out));
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("FAILED centre: ccx timed out (killed) after 0 of 2 steps"), "{}", show(&out));
@@ -241,7 +241,7 @@ fn group_alive(pgid: u32) -> bool {
 #[test]
 fn a_sigkill_of_needle_takes_its_solver_with_it() {
     require_ccx();
-    let (_tmp, set) = default_set();
+    let (_tmp, set) = campaign_copy();
     let work = set.join("fe").join(".work").join("x+04");
     let mut child = needle_after_first_step(&set, "x+04", "3");
     let pgid = child.id();

@@ -4,8 +4,8 @@
 //! resubmitted alone, and the clear errors that leave the set unchanged. Without a
 //! running cluster these tests fail, they are not skipped.
 
-mod fe_common;
-use fe_common::{default_set, needle, show};
+mod common;
+use common::{campaign_copy, needle_env, show};
 
 use needle_fe::manifest::{read_manifest, MANIFEST};
 use std::path::{Path, PathBuf};
@@ -51,7 +51,7 @@ fn submit(set: &str, steps: &str) -> (String, Output) {
     let mut a = vec!["fe", "run"];
     a.extend(spec_args(set, steps));
     a.extend(["--launcher", "slurm"]);
-    let out = needle(&a, &[]);
+    let out = needle_env(&a, &[]);
     assert!(out.status.success(), "{}", show(&out));
     let text = String::from_utf8_lossy(&out.stdout).into_owned();
     let id = text
@@ -80,7 +80,7 @@ fn wait_for(job: &str, limit: Duration) {
 fn status(set: &str, steps: &str) -> String {
     let mut a = vec!["fe", "status"];
     a.extend(spec_args(set, steps));
-    let out = needle(&a, &[]);
+    let out = needle_env(&a, &[]);
     assert!(out.status.success(), "{}", show(&out));
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
@@ -112,7 +112,7 @@ fn tree(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
 #[test]
 fn a_campaign_through_sbatch_equals_a_local_run() {
     require_cluster();
-    let (_tmp, set) = default_set();
+    let (_tmp, set) = campaign_copy();
     let s = set.to_str().expect("utf-8 path");
     let (job, out) = submit(s, "2");
     assert!(!job.is_empty(), "no job id: {}", show(&out));
@@ -129,7 +129,7 @@ fn a_campaign_through_sbatch_equals_a_local_run() {
     a.extend(spec_args(s, "2"));
     let local_s = local.to_str().expect("utf-8");
     a.extend(["--out", local_s, "--jobs", "2"]);
-    let out = needle(&a, &[]);
+    let out = needle_env(&a, &[]);
     assert!(out.status.success(), "{}", show(&out));
 
     let slurm_m = read_manifest(&set.join("fe").join(MANIFEST)).expect("slurm manifest");
@@ -157,7 +157,7 @@ fn a_campaign_through_sbatch_equals_a_local_run() {
 #[test]
 fn a_cancelled_task_is_resubmitted_alone_and_nothing_finished_is_redone() {
     require_cluster();
-    let (_tmp, set) = default_set();
+    let (_tmp, set) = campaign_copy();
     let s = set.to_str().expect("utf-8 path");
     // 8 steps: x+04 (a half model) takes about 10 s on the smoke mesh, long enough to
     // be cancelled after its first step
@@ -209,7 +209,7 @@ fn a_cancelled_task_is_resubmitted_alone_and_nothing_finished_is_redone() {
 #[test]
 fn no_sbatch_a_down_controller_or_a_refused_job_is_one_error_and_changes_nothing() {
     require_cluster();
-    let (tmp, set) = default_set();
+    let (tmp, set) = campaign_copy();
     let s = set.to_str().expect("utf-8 path");
     let before = tree(&set);
     let mut a = vec!["fe", "run"];
@@ -217,7 +217,7 @@ fn no_sbatch_a_down_controller_or_a_refused_job_is_one_error_and_changes_nothing
     a.extend(["--launcher", "slurm"]);
 
     // no sbatch on PATH
-    let out = needle(&a, &[("PATH", "/nonexistent")]);
+    let out = needle_env(&a, &[("PATH", "/nonexistent")]);
     assert_eq!(out.status.code(), Some(2), "{}", show(&out));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("sbatch not found on PATH") && err.contains("no file of the set changed"), "{err}");
@@ -228,7 +228,7 @@ fn no_sbatch_a_down_controller_or_a_refused_job_is_one_error_and_changes_nothing
     let down: String = conf.lines().map(|l| format!("{l}\n")).collect::<String>() + "SlurmctldPort=6999\n";
     let down_conf = tmp.path().join("down.conf");
     std::fs::write(&down_conf, down).expect("write");
-    let out = needle(&a, &[("SLURM_CONF", down_conf.to_str().expect("utf-8"))]);
+    let out = needle_env(&a, &[("SLURM_CONF", down_conf.to_str().expect("utf-8"))]);
     assert_eq!(out.status.code(), Some(2), "{}", show(&out));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("Unable to contact slurm controller") && err.contains("Nothing was submitted"), "{err}");
@@ -238,7 +238,7 @@ fn no_sbatch_a_down_controller_or_a_refused_job_is_one_error_and_changes_nothing
     // a job SLURM refuses
     let mut refused = a.clone();
     refused.extend(["--partition", "no-such-partition"]);
-    let out = needle(&refused, &[]);
+    let out = needle_env(&refused, &[]);
     assert_eq!(out.status.code(), Some(2), "{}", show(&out));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("sbatch refused the job array") && err.contains("invalid partition"), "{err}");

@@ -6,32 +6,23 @@
 //! (`.ci/install-febio`); without it they fail, they are not skipped. The bounds are
 //! judged on the campaign's runs (host-tests/tests/fe_qlv_bounds.rs), not on this mesh.
 
-mod fe_common;
+mod common;
 
-use fe_common::{default_set, show};
+use common::{campaign_copy, needle_on, show};
 use needle_fe::manifest::{read_manifest, MANIFEST};
 use needle_fe::visco::Friction;
-use std::ffi::OsStr;
 use std::path::Path;
-use std::process::Output;
 
 /// Must points on the ramp (1.2 mm each; the smoke mesh finds the contact at this step).
 const RAMP_STEPS: &str = "5";
 
-/// `needle <args> --set <set>`.
-fn needle(args: &[&str], set: &Path) -> Output {
-    let mut all: Vec<&OsStr> = args.iter().map(OsStr::new).collect();
-    all.extend([OsStr::new("--set"), set.as_os_str()]);
-    fe_common::needle(&all, &[])
-}
-
 #[test]
 fn centre_ramp_and_hold_on_the_smoke_mesh_against_the_filter() {
-    let (_d, set) = default_set();
+    let (_d, set) = campaign_copy();
     let (c, _) = needle_fe::spec::load(&set).expect("spec");
     let v = c.viscoelastic.clone().expect("[viscoelastic]");
     let args = ["fe", "verify", "--qlv", "--qlv-poses", "centre", "--qlv-mesh", "smoke", "--qlv-steps", RAMP_STEPS, "--threads", "1"];
-    let o = needle(&args, &set);
+    let o = needle_on(&args, &set);
     let out = String::from_utf8_lossy(&o.stdout).to_string();
     // solved and compared (the exit status judges the bounds, which are the campaign's)
     assert!(o.status.code().is_some_and(|c| c <= 1) && out.contains("qlv centre_10mm-s"), "{}", show(&o));
@@ -61,7 +52,8 @@ fn centre_ramp_and_hold_on_the_smoke_mesh_against_the_filter() {
     assert_eq!(verify.matches("[[qlv.runs]]").count(), v.speeds_mm_per_s.len() * frictions.len(), "{verify}");
     assert!(set.join("figures").join("qlv-ramp-hold.svg").is_file(), "the figure");
     // resumed, not solved again
-    let again = needle(&["fe", "run", "--visco", "--only", "centre_*", "--mesh", "smoke", "--steps", RAMP_STEPS, "--threads", "1"], &set);
+    let again =
+        needle_on(&["fe", "run", "--visco", "--only", "centre_*", "--mesh", "smoke", "--steps", RAMP_STEPS, "--threads", "1"], &set);
     let out = String::from_utf8_lossy(&again.stdout);
     let runs = v.speeds_mm_per_s.len() * frictions.len() + 1;
     assert!(again.status.success() && out.matches("up to date").count() >= runs, "{}", show(&again));

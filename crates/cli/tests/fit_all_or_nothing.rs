@@ -3,10 +3,12 @@
 //! temporaries of an earlier, killed run are removed by the next one.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
+
+mod common;
+use common::{needle, shipped_set};
 
 fn copy_set(to: &Path) -> PathBuf {
-    let from = needle_firmware_host::workspace_root().join("coeffs/default");
+    let from = shipped_set();
     let set = to.join("default");
     std::fs::create_dir_all(set.join("fe")).expect("mkdir");
     for f in ["campaign.toml", "model.toml", "golden-f32.csv", "golden-fixed.csv"] {
@@ -21,7 +23,7 @@ fn copy_set(to: &Path) -> PathBuf {
 }
 
 fn fit(set: &Path) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_needle")).args(["fit", "--set", &set.to_string_lossy()]).output().expect("run needle fit")
+    needle(&["fit".as_ref(), "--set".as_ref(), set.as_os_str()])
 }
 
 fn temporaries(set: &Path) -> Vec<String> {

@@ -1,19 +1,13 @@
 //! `needle plot`: the committed figures of the default set are what a fresh rendering of
 //! its model and FE runs gives (byte for byte), and a changed model makes them stale.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 
-fn default_set() -> PathBuf {
-    needle_firmware_host::workspace_root().join("coeffs/default")
-}
+mod common;
+use common::{needle, shipped_set, show};
 
 fn plot(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_needle")).arg("plot").args(args).output().expect("run needle plot")
-}
-
-fn show(o: &std::process::Output) -> String {
-    format!("status {:?}\nstdout:\n{}\nstderr:\n{}", o.status, String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
+    needle(&[&["plot"], args].concat())
 }
 
 fn copy_dir(from: &Path, to: &Path) {
@@ -35,7 +29,7 @@ fn copy_dir(from: &Path, to: &Path) {
 /// The README and docs/usage.md show coeffs/default/figures: they must be current.
 #[test]
 fn committed_figures_are_up_to_date() {
-    let set = default_set();
+    let set = shipped_set();
     let o = plot(&["--set", &set.to_string_lossy(), "--check"]);
     assert!(o.status.success(), "stale or missing figures (regenerate with `needle plot --set coeffs/default`):\n{}", show(&o));
     let out = String::from_utf8_lossy(&o.stdout);
@@ -50,7 +44,7 @@ fn committed_figures_are_up_to_date() {
 fn a_changed_model_makes_the_figures_stale() {
     let d = tempfile::tempdir().expect("tempdir");
     let set = d.path().join("default");
-    copy_dir(&default_set(), &set);
+    copy_dir(&shipped_set(), &set);
     let model = set.join("model.toml");
     let text = std::fs::read_to_string(&model).expect("model.toml");
     // the Fy baseline's constant term (second [[baseline]]) times 1.01, and its f32 twin

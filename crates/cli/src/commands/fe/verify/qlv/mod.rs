@@ -2,7 +2,10 @@
 //! f32, one tick of `InsertionConfig::DEFAULT_1KHZ`) run on the elastic FE wrench along
 //! each ramp-and-hold run's depth-time path, against FEBio's viscoelastic solution
 //! (`needle_fe::verify::qlv`: pairing, scores, bounds). The filter is the firmware's own
-//! code; this module only feeds it and samples its output at the FE's must points.
+//! code; this module only feeds it and samples its output at the FE's must points;
+//! [`filtered`] steps the filter, [`figure`] draws the comparison.
+pub mod figure;
+pub mod filtered;
 
 use needle_fe::verify::qlv::{self, QlvCase, QlvOptions, QlvRun};
 
@@ -20,12 +23,7 @@ pub fn check(opts: &QlvOptions) -> anyhow::Result<bool> {
     for case in qlv::cases(opts)? {
         match case {
             Ok(case) => {
-                let r = qlv::score(
-                    &case,
-                    &crate::qlv_filtered::filtered(&case)?,
-                    crate::qlv_filtered::tick_s(),
-                    c.needle.reference_from_tip_mm,
-                )?;
+                let r = qlv::score(&case, &filtered::filtered(&case)?, filtered::tick_s(), c.needle.reference_from_tip_mm)?;
                 println!("{r}");
                 runs.push(r);
                 compared.push(case);
@@ -40,8 +38,8 @@ pub fn check(opts: &QlvOptions) -> anyhow::Result<bool> {
     report.summary().iter().for_each(|l| println!("{l}"));
     needle_fe::verify::write_table(&opts.set_dir, "qlv", &report)?;
     if !compared.is_empty() {
-        let svg = crate::fe_qlv_figure::svg(&compared)?;
-        let path = opts.set_dir.join("figures").join(crate::fe_qlv_figure::FILE);
+        let svg = figure::svg(&compared)?;
+        let path = opts.set_dir.join("figures").join(figure::FILE);
         needle_fe::results::write_atomic(&path, svg.as_bytes())?;
         println!("wrote {}", path.display());
     }

@@ -1,10 +1,10 @@
 //! `needle calibrate-published`: a tissue stack from a published piecewise force-depth
 //! model (needle-calibrate's `published` rules), written into the set's `tissue/`, its
 //! published curve sampled into a CSV, and the stack replayed against that curve.
-use crate::model::check_compiled_set;
+use crate::compiled_set::check_compiled_set;
 use anyhow::{Context, Result};
 use clap::Args;
-use needle_calibrate::from_model::{calibrate_published as run, ModelOptions};
+use needle_calibrate::from_model::{calibrate_published as derive, ModelOptions};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -56,7 +56,7 @@ pub struct CalibratePublishedArgs {
 ///
 /// # Errors
 /// The set is not the compiled-in one, a file is refused, or a file cannot be written.
-pub fn calibrate_published(a: CalibratePublishedArgs) -> Result<ExitCode> {
+pub fn run(a: CalibratePublishedArgs) -> Result<ExitCode> {
     check_compiled_set(&a.set)?;
     let mu0 = needle_codegen::tissue::read_fe_shear_modulus(&a.set)?
         .with_context(|| format!("{}: no campaign.toml: the FE tissue's shear modulus sets the track stiffness", a.set.display()))?;
@@ -70,7 +70,7 @@ pub fn calibrate_published(a: CalibratePublishedArgs) -> Result<ExitCode> {
         with_prony: a.with_prony,
         fe_shear_modulus_n_per_mm2: mu0,
     };
-    let c = run(&opts)?;
+    let c = derive(&opts)?;
     println!(
         "{} published pieces sampled every {} mm ({} points); geometric similarity: needle {} mm / FE needle {} mm = {:.4}",
         needle_calibrate::published::read_pieces(&a.pieces)?.len(),
@@ -86,7 +86,7 @@ pub fn calibrate_published(a: CalibratePublishedArgs) -> Result<ExitCode> {
             l.name, f.boundary_mm, l.thickness_mm, l.stiffness_scale, l.puncture_force_n, l.cutting_force_n, l.friction_coulomb_n_per_mm, l.track_stiffness_n_per_mm2
         );
     }
-    crate::calibrate::print_checks(&c.checks);
+    super::calibrate::print_checks(&c.checks);
     let mut sampled = String::from("position_mm,force_n\n");
     for p in &c.points {
         sampled.push_str(&format!("{},{}\n", p.position_mm, p.force_n));
@@ -102,7 +102,7 @@ pub fn calibrate_published(a: CalibratePublishedArgs) -> Result<ExitCode> {
     );
     write(&out, &c.stack.to_toml(&header))?;
     let figure = a.figure.unwrap_or_else(|| a.set.join("figures").join(format!("calibration-{}.svg", a.name)));
-    write(&figure, &crate::calibrate_figure::svg(&c, &a.name, "published model (sampled)")?)?;
+    write(&figure, &super::calibrate::figure::svg(&c, &a.name, "published model (sampled)")?)?;
     println!("result: stack derived by the published-model rules (the comparison above is reported, not a goal)");
     Ok(ExitCode::SUCCESS)
 }

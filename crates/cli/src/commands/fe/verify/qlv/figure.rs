@@ -37,7 +37,7 @@ pub fn svg(cases: &[QlvCase]) -> anyhow::Result<String> {
             let end = times.last().copied().unwrap_or(0.0);
             let n = (end * LINE_SAMPLES_PER_S).ceil() as usize;
             let grid: Vec<f64> = (0..=n).map(|k| end * k as f64 / n.max(1) as f64).collect();
-            let line: Vec<(f64, f64)> = grid.iter().zip(crate::qlv_filtered::filtered_at(c, &grid)?).map(|(t, w)| (*t, w[FY])).collect();
+            let line: Vec<(f64, f64)> = grid.iter().zip(super::filtered::filtered_at(c, &grid)?).map(|(t, w)| (*t, w[FY])).collect();
             let fe: Vec<(f64, f64)> = times.iter().zip(&c.fe).map(|(t, r)| (*t, r.fy_n())).collect();
             let within = |v: &[(f64, f64)]| v.iter().copied().filter(|(t, _)| *t <= ZOOM_S).collect::<Vec<_>>();
             for (set, l, f) in [(&mut full, line.clone(), fe.clone()), (&mut zoom, within(&line), within(&fe))] {

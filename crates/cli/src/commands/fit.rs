@@ -1,9 +1,9 @@
-//! `needle fit`, `needle validate`: fit the model, compare it with FE.
+//! `needle fit`: fit the set's model in its form, write model.toml and the golden vectors.
 use anyhow::{Context, Result};
 use clap::Args;
 use needle_fe::results::write_all_atomic;
 use needle_fe::set_folder::SetFolder;
-use needle_fit::{self as fit, validate as val};
+use needle_fit::{self as fit};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -19,22 +19,6 @@ pub struct FitArgs {
     /// write nothing.
     #[arg(long)]
     pub check: bool,
-}
-
-/// Arguments of `needle validate`.
-#[derive(Args)]
-pub struct ValidateArgs {
-    /// The set folder (holds campaign.toml, fe/ and model.toml).
-    #[arg(long, value_name = "DIR")]
-    pub set: PathBuf,
-    /// Print the report as JSON instead of a table.
-    #[arg(long)]
-    pub json: bool,
-    /// Depth degree of each run's floor (the smallest error any model that is a
-    /// polynomial of this degree in depth at a pose could have on the run), 1 to 10;
-    /// default: the contract's degree. Goals and errors do not depend on it.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u8).range(1..=10))]
-    pub floor_degree: Option<u8>,
 }
 
 /// First differing line of two texts (1-based), if any.
@@ -79,7 +63,7 @@ fn check_file(path: &Path, want: &str) -> Result<bool> {
 /// # Errors
 /// A fitted run is missing (every missing pose is named) or malformed, the spec is
 /// invalid, a fit is rank deficient, or a file cannot be written.
-pub fn fit(a: FitArgs) -> Result<ExitCode> {
+pub fn run(a: FitArgs) -> Result<ExitCode> {
     let set = SetFolder::open(&a.set).with_context(|| format!("needle fit --set {}", a.set.display()))?;
     let out = fit::fit_set_in(&set).with_context(|| format!("needle fit --set {}", a.set.display()))?;
     let files: Vec<(PathBuf, &str)> = out.files().iter().map(|(name, text)| (a.set.join(name), *text)).collect();
@@ -106,22 +90,4 @@ pub fn fit(a: FitArgs) -> Result<ExitCode> {
         }
     }
     Ok(ExitCode::SUCCESS)
-}
-
-/// `needle validate --set DIR [--json]`: compare the set's model with every FE run it was
-/// not fitted on; print the table (or JSON). Exit code 1 when a goal is missed.
-///
-/// # Errors
-/// model.toml or the spec is missing or malformed, or a validation run is malformed.
-pub fn validate(a: ValidateArgs) -> Result<ExitCode> {
-    let floor_degree = a.floor_degree.map_or(needle_contract::DEGREE, usize::from);
-    let report = SetFolder::open(&a.set)
-        .and_then(|set| val::validate_in(&set, floor_degree))
-        .with_context(|| format!("needle validate --set {}", a.set.display()))?;
-    if a.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
-        print!("{}", val::to_table(&report));
-    }
-    Ok(if report.passed { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }

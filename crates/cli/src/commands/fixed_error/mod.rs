@@ -1,8 +1,10 @@
 //! `needle fixed-error`: the fixed-point evaluator's measured error against f64, beside
 //! the bound derived at code generation.
-use crate::fixed_error::{self, ErrorStats, GOAL_PCT};
-use crate::model::check_compiled_set;
+pub mod measure;
+
+use crate::compiled_set::check_compiled_set;
 use clap::Args;
+use measure::{ErrorStats, GOAL_PCT};
 use needle_contract::COMPONENT_COUNT;
 use rand::{RngCore, SeedableRng};
 use std::path::PathBuf;
@@ -31,10 +33,10 @@ pub struct FixedErrorArgs {
 ///
 /// # Errors
 /// `DIR` is not the compiled-in set, or its model.toml / campaign.toml is unreadable.
-pub fn fixed_error(a: FixedErrorArgs) -> anyhow::Result<ExitCode> {
+pub fn run(a: FixedErrorArgs) -> anyhow::Result<ExitCode> {
     check_compiled_set(&a.set)?;
 
-    let (model, lever) = fixed_error::load(&a.set)?;
+    let (model, lever) = measure::load(&a.set)?;
     let mut stats = ErrorStats::default();
     stats.add_grid(&model, usize::try_from(a.grid)?);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x6669_7865_6400_0001);
@@ -47,9 +49,9 @@ pub fn fixed_error(a: FixedErrorArgs) -> anyhow::Result<ExitCode> {
         stats.add(&model, pose);
     }
     println!("needle fixed-error: set {} ({}^5 grid + {} random poses)", a.set.display(), a.grid, a.random);
-    print!("{}", fixed_error::table(&stats, lever));
-    let within = (0..COMPONENT_COUNT).all(|c| stats.max_error[c] <= fixed_error::bound(c));
-    let goal = (0..COMPONENT_COUNT).all(|c| 100.0 * fixed_error::bound(c) / fixed_error::scale(&stats, c, lever) <= GOAL_PCT);
+    print!("{}", measure::table(&stats, lever));
+    let within = (0..COMPONENT_COUNT).all(|c| stats.max_error[c] <= measure::bound(c));
+    let goal = (0..COMPONENT_COUNT).all(|c| 100.0 * measure::bound(c) / measure::scale(&stats, c, lever) <= GOAL_PCT);
     println!("every measured error within its bound: {}", if within { "yes" } else { "NO" });
     Ok(if within && goal { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }

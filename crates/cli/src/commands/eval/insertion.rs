@@ -3,13 +3,13 @@
 //! `--prony`, those terms on every layer (the viscoelastic filter: the force relaxes
 //! while the needle is still).
 //!
-//! Input: the pose file of [`super::eval_batch`] with one more column, `time_s`, equally
+//! Input: the pose file of [`super::batch`] with one more column, `time_s`, equally
 //! spaced (the tick period; within 1e-6 s); rows in time order. Each row is one tick of
 //! [`Insertion::step`]: the wrench depends on the rows before it (punctures, the track,
 //! the velocity). Output: `time_s`, the pose, the wrench, the status byte, the phase
 //! (`approach`, `deflecting:<layer>`, `cutting:<layer>`, `in-track:<layer>`) and the
 //! punctures of the tick.
-use super::eval_batch::{parse_poses, push_pose_wrench_status, POSE_COLUMNS};
+use super::batch::{parse_poses, push_pose_wrench_status, POSE_COLUMNS};
 use anyhow::{bail, Context, Result};
 use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, InsertionEvaluation, Phase};
 use needle_haptics::Pose;
@@ -99,7 +99,7 @@ pub fn parse_times(text: &str, path: &Path) -> Result<(Vec<f64>, f64)> {
 ///
 /// # Errors
 /// The period is not a usable tick (the insertion's configuration check).
-pub fn run(stack: &needle_haptics::insertion::Stack<'_>, poses: &[Pose], period_s: f64) -> Result<Vec<InsertionEvaluation>> {
+pub fn step_all(stack: &needle_haptics::insertion::Stack<'_>, poses: &[Pose], period_s: f64) -> Result<Vec<InsertionEvaluation>> {
     let config = InsertionConfig { period_s: period_s as f32, ..InsertionConfig::DEFAULT_1KHZ };
     let mut insertion = Insertion::new(stack, config).map_err(|e| anyhow::anyhow!("{e}"))?;
     Ok(poses.iter().map(|p| insertion.step(p)).collect())
@@ -142,7 +142,7 @@ pub fn eval_script(file: &Path, stack_name: &str, prony: Option<&str>, out: Opti
     let text = std::fs::read_to_string(file).with_context(|| format!("{}: cannot read", file.display()))?;
     let (times, period) = parse_times(&text, file)?;
     let poses = parse_poses(&text, file)?;
-    let evals = run(stack, &poses, period)?;
+    let evals = step_all(stack, &poses, period)?;
     let body = to_csv(&times, &poses, &evals);
     match out {
         Some(path) => {

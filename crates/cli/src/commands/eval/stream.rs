@@ -2,16 +2,16 @@
 //! of [`CHUNK_ROWS`] records; each chunk is parsed, evaluated and formatted on every core
 //! (one slice per thread, written in input order) while the main thread writes the one
 //! before and splits the next one, so memory stays bounded (two chunks of records and two
-//! of text) however long the file is. The rows and messages are those of [`eval_batch`](super::eval_batch): the
+//! of text) however long the file is. The rows and messages are those of [`batch`](super::batch): the
 //! same parse ([`parse_row`]), the same output bytes (the floats through
-//! [`float_text::push_f32`](super::float_text::push_f32), `{:?}`'s text), the problems
+//! [`float_text::push_f32`](crate::output::float_text::push_f32), `{:?}`'s text), the problems
 //! listed in line order.
 //!
 //! Nothing is written when a row is bad: the output goes to a temporary renamed at the
 //! end (`--out`), or, for standard output, the file is checked in a first pass before
 //! the second one writes.
-use super::eval_batch::{bad_rows_error, parse_row, pose_columns, OUTPUT_HEADER};
-use super::float_text::push_f32;
+use super::batch::{bad_rows_error, parse_row, pose_columns, OUTPUT_HEADER};
+use crate::output::float_text::push_f32;
 use anyhow::{Context, Result};
 use needle_haptics::{wrench, Pose};
 use std::io::Write;
@@ -143,7 +143,7 @@ fn read_chunk(rdr: &mut csv::Reader<std::fs::File>, file: &Path, chunk: &mut Chu
 }
 
 /// Parses `records` (pose columns `idx`); with `write` and every row good, evaluates
-/// and formats them (each its inputs, wrench and status: `eval_batch`'s row) into
+/// and formats them (each its inputs, wrench and status: `batch`'s row) into
 /// `out.text`.
 fn process(records: &[csv::ByteRecord], idx: &[usize; 5], file: &Path, write: bool, out: &mut Slice) {
     out.rows = 0;

@@ -3,7 +3,7 @@
 //! --poses FILE --insertion STACK`: one CSV per path, `time_s` and the five pose columns,
 //! one row per 1 kHz tick, the depths scaled for the stack as the golden tests scale them.
 //! Other programs (the CHAI3D binding's test) replay the same ticks from these files.
-#[path = "../../../examples/common/insertion_paths.rs"]
+#[path = "../../../../examples/common/insertion_paths.rs"]
 mod paths;
 
 use anyhow::{Context, Result};
@@ -41,8 +41,8 @@ pub fn script(path: &[paths::Waypoint], stack: &needle_haptics::insertion::Stack
 ///
 /// # Errors
 /// No such stack; the folder or a file cannot be written.
-pub fn insertion_paths(a: InsertionPathsArgs) -> Result<ExitCode> {
-    let stack = crate::eval_insertion::stack(&a.stack)?;
+pub fn run(a: InsertionPathsArgs) -> Result<ExitCode> {
+    let stack = super::eval::insertion::stack(&a.stack)?;
     std::fs::create_dir_all(&a.out_dir).with_context(|| format!("{}: cannot create", a.out_dir.display()))?;
     for (i, path) in paths::PATHS.iter().enumerate() {
         let file = a.out_dir.join(format!("{}-path{i}.csv", stack.name));

@@ -25,7 +25,7 @@ pub struct PlotArgs {
 ///
 /// # Errors
 /// The set cannot be read or a figure cannot be written.
-pub fn plot(a: PlotArgs) -> Result<ExitCode> {
+pub fn run(a: PlotArgs) -> Result<ExitCode> {
     let figures = needle_fe::set_folder::SetFolder::open(&a.set)
         .and_then(|set| needle_plot::render_set(&set))
         .with_context(|| format!("needle plot --set {}", a.set.display()))?;

@@ -1,6 +1,8 @@
 //! `needle calibrate`: a tissue stack fitted to a measured axial force (needle-calibrate),
 //! written into the set's `tissue/` and checked against the curve.
-use crate::model::check_compiled_set;
+pub mod figure;
+
+use crate::compiled_set::check_compiled_set;
 use anyhow::{Context, Result};
 use clap::Args;
 use needle_calibrate::{calibrate as run_calibration, events::EventRule, Options};
@@ -40,7 +42,7 @@ pub struct CalibrateArgs {
 ///
 /// # Errors
 /// The set is not the compiled-in one, the curve is refused, or the file cannot be written.
-pub fn calibrate(a: CalibrateArgs) -> Result<ExitCode> {
+pub fn run(a: CalibrateArgs) -> Result<ExitCode> {
     check_compiled_set(&a.set)?;
     let rule = EventRule { drop_fraction: a.drop_fraction, ..EventRule::default() };
     let mu0 = needle_codegen::tissue::read_fe_shear_modulus(&a.set)?
@@ -94,7 +96,7 @@ pub fn calibrate(a: CalibrateArgs) -> Result<ExitCode> {
     if let Some(dir) = figure.parent() {
         std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
     }
-    let svg = crate::calibrate_figure::svg(&c, &a.name, "measured")?;
+    let svg = self::figure::svg(&c, &a.name, "measured")?;
     needle_fe::results::write_atomic(&figure, svg.as_bytes())?;
     println!("wrote {}", figure.display());
     println!("result: {}", if all_met { "every calibration goal met" } else { "FAIL (a goal is missed)" });
