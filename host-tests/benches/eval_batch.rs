@@ -7,8 +7,8 @@
 //! two per pose.
 //!
 //! `cargo bench -p needle-host-tests --bench eval_batch` (plain `std::time`, no harness).
-use needle_cli::eval_batch::{evaluate, parse_poses, to_csv};
-use needle_cli::eval_stream;
+use needle_cli::commands::eval::batch::{evaluate, parse_poses, to_csv};
+use needle_cli::commands::eval::stream as eval_stream;
 use std::hint::black_box;
 use std::path::Path;
 use std::time::Instant;

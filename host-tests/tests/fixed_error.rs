@@ -2,7 +2,7 @@
 //! exceeds the bound derived at code generation (`fixed::tables::ERROR_BOUND_MICRO`): on a
 //! dense grid over the domain and on proptest-random poses. The bounds meet the goal of
 //! issue 5: <= 0.1 % of peak |Fy| (moments: of peak |Fy| x the lever arm).
-use needle_cli::fixed_error::{self, ErrorStats, GOAL_PCT};
+use needle_cli::commands::fixed_error::measure::{self as fixed_error, ErrorStats, GOAL_PCT};
 use needle_fit::eval::float64 as eval_f64;
 use needle_haptics::{fixed, model_info};
 use proptest::prelude::*;
