@@ -42,7 +42,7 @@ pub fn check(opts: &QlvOptions) -> anyhow::Result<bool> {
     if !compared.is_empty() {
         let svg = crate::fe_qlv_figure::svg(&compared)?;
         let path = opts.set_dir.join("figures").join(crate::fe_qlv_figure::FILE);
-        needle_fe::results::write_atomic(&path, svg.as_bytes())?;
+        needle_stdx::fs::write_atomic(&path, svg.as_bytes())?;
         println!("wrote {}", path.display());
     }
     Ok(report.ok())

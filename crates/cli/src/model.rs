@@ -282,7 +282,7 @@ fn eval_file(file: &Path, out: Option<&Path>, json: bool) -> anyhow::Result<Exit
     let body = serde_json::to_string_pretty(&to_json(&poses, &evals))? + "\n";
     match out {
         Some(path) => {
-            needle_fe::results::write_atomic(path, body.as_bytes())?;
+            needle_stdx::fs::write_atomic(path, body.as_bytes())?;
             eprintln!("wrote {} ({} poses)", path.display(), poses.len());
         }
         None => {
@@ -304,7 +304,7 @@ pub fn header(a: HeaderArgs) -> anyhow::Result<ExitCode> {
     // the C API's own header (functions, types, NEEDLE_STATUS_* / NEEDLE_LOOP_* constants)
     let api = a.out.join("needle.h");
     // both or neither: a failure leaves the old pair as it was
-    needle_fe::results::write_all_atomic(&[(&path, model_info::C_HEADER.as_bytes()), (&api, needle_capi::HEADER.as_bytes())])?;
+    needle_stdx::fs::write_all_atomic(&[(&path, model_info::C_HEADER.as_bytes()), (&api, needle_capi::HEADER.as_bytes())])?;
     println!("wrote {} (the C API: link libneedle_capi.a from `cargo build --release -p needle-capi`)", api.display());
     if model_info::FITTED {
         println!("wrote {} (set {}, fe_sha256 {})", path.display(), model_info::SET, model_info::FE_SHA256);

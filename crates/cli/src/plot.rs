@@ -2,7 +2,7 @@
 
 use anyhow::{Context, Result};
 use clap::Args;
-use needle_fe::results::write_all_atomic;
+use needle_stdx::fs::write_all_atomic;
 use std::path::PathBuf;
 use std::process::ExitCode;
 

@@ -8,7 +8,7 @@ fn needle(args: &[&str]) -> std::process::Output {
 }
 
 fn set() -> String {
-    needle_firmware_host::workspace_root().join("coeffs/default").to_string_lossy().into_owned()
+    needle_stdx::workspace_root().join("coeffs/default").to_string_lossy().into_owned()
 }
 
 #[test]

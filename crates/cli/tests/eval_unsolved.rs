@@ -10,7 +10,7 @@ fn needle(args: &[&str]) -> std::process::Output {
 }
 
 fn set() -> String {
-    needle_firmware_host::workspace_root().join("coeffs/default").to_string_lossy().into_owned()
+    needle_stdx::workspace_root().join("coeffs/default").to_string_lossy().into_owned()
 }
 
 /// tx+15 failed every attempt: the pose is in the region below the depth its furthest

@@ -7,7 +7,7 @@
 //! them); missing, the test fails.
 
 use fantoccini::{key::Key, wd::Capabilities, ClientBuilder, Locator};
-use needle_firmware_host::workspace_root;
+use needle_stdx::workspace_root;
 use std::io::{BufRead, BufReader};
 use std::net::{TcpListener, TcpStream};
 use std::process::{Child, Command, Stdio};

@@ -28,7 +28,7 @@ fn default_set() -> (tempfile::TempDir, PathBuf) {
     let d = tempfile::tempdir().expect("tempdir");
     let set = d.path().join("set");
     std::fs::create_dir_all(set.join("fe")).expect("mkdir");
-    let src = needle_firmware_host::workspace_root().join("coeffs/default/campaign.toml");
+    let src = needle_stdx::workspace_root().join("coeffs/default/campaign.toml");
     std::fs::copy(&src, set.join("campaign.toml")).expect("copy the default spec");
     (d, set)
 }

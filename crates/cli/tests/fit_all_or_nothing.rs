@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn copy_set(to: &Path) -> PathBuf {
-    let from = needle_firmware_host::workspace_root().join("coeffs/default");
+    let from = needle_stdx::workspace_root().join("coeffs/default");
     let set = to.join("default");
     std::fs::create_dir_all(set.join("fe")).expect("mkdir");
     for f in ["campaign.toml", "model.toml", "golden-f32.csv", "golden-fixed.csv"] {

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn default_set() -> PathBuf {
-    needle_firmware_host::workspace_root().join("coeffs/default")
+    needle_stdx::workspace_root().join("coeffs/default")
 }
 
 fn plot(args: &[&str]) -> std::process::Output {

@@ -56,7 +56,7 @@ fn a_client_that_never_reads_does_not_stall_another() {
 
 #[test]
 fn set_json_leaves_out_a_run_without_a_manifest_entry() {
-    let root = needle_firmware_host::workspace_root().join("coeffs/default");
+    let root = needle_stdx::workspace_root().join("coeffs/default");
     let d = tempfile::tempdir().expect("tempdir");
     let set = d.path().join("set");
     std::fs::create_dir_all(set.join("fe")).expect("mkdir");

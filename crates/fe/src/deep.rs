@@ -32,7 +32,7 @@ pub struct DeepSettings {
 /// that line's text: for tests that edit one line of the shipped spec.
 #[cfg(test)]
 pub(crate) fn shipped_key(section: &str, key: &str) -> (String, usize, String) {
-    let path = crate::workspace_root().join("coeffs/default/campaign.toml");
+    let path = needle_stdx::workspace_root().join("coeffs/default/campaign.toml");
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let line = key_line(&text, section, key);
     assert!(line > 0, "the shipped campaign.toml has [{section}] {key}");

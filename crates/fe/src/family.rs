@@ -92,7 +92,7 @@ mod tests {
     use std::path::Path;
 
     fn shipped() -> Campaign {
-        let text = std::fs::read_to_string(crate::workspace_root().join("coeffs/default/campaign.toml")).expect("campaign.toml");
+        let text = std::fs::read_to_string(needle_stdx::workspace_root().join("coeffs/default/campaign.toml")).expect("campaign.toml");
         crate::spec::parse(&text, Path::new("campaign.toml")).expect("the shipped spec")
     }
 

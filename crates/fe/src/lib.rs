@@ -29,9 +29,3 @@ pub mod verify;
 pub mod versions;
 pub mod visco;
 pub mod wrench;
-
-/// The workspace root (this crate is `crates/fe`), for the unit tests' `coeffs/default`.
-#[cfg(test)]
-pub(crate) fn workspace_root() -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}

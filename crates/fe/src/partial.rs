@@ -108,7 +108,7 @@ pub fn write(out_dir: &Path, f: &Failed<'_>, reached: &[[f64; COMPONENT_COUNT]])
         toml::to_string(&record).context("cannot serialise the partial record")?
     );
     let (csv, rec) = paths(out_dir, &f.pose.name);
-    results::write_all_atomic(&[(&csv, text.as_bytes()), (&rec, toml.as_bytes())])
+    needle_stdx::fs::write_all_atomic(&[(&csv, text.as_bytes()), (&rec, toml.as_bytes())])
 }
 
 /// Remove a pose's partial record (it solved); a missing one is fine.
@@ -125,7 +125,7 @@ mod tests {
     #[test]
     fn a_partial_record_holds_the_reached_must_points_and_goes_when_removed() {
         let d = tempfile::tempdir().expect("tempdir");
-        let set = crate::workspace_root().join("coeffs/default");
+        let set = needle_stdx::workspace_root().join("coeffs/default");
         let (mut c, _) = crate::spec::load(&set).expect("spec");
         c.loading.steps = 4;
         let pose = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");

@@ -343,7 +343,7 @@ mod tests {
     /// model, so both rows of `needle fit` showed the coupled form's errors.)
     #[test]
     fn the_paper_row_leaves_the_cross_terms_out() {
-        let path = crate::workspace_root().join("coeffs/default/model.toml");
+        let path = needle_stdx::workspace_root().join("coeffs/default/model.toml");
         let mut model = crate::model_file::read(&path).unwrap_or_else(|e| panic!("{e:#}"));
         let pose = PoseSpec { name: "lhs-test".into(), role: Role::Lhs, x_mm: 6.0, z_mm: 0.0, theta_x_deg: 0.0, theta_z_deg: 9.0 };
         let rows: Vec<Row> = (1..=20)

@@ -169,9 +169,3 @@ pub fn summary(m: &model::Model) -> String {
     }
     s
 }
-
-/// The workspace root (this crate is `crates/fit`), for the unit tests' `coeffs/default`.
-#[cfg(test)]
-pub(crate) fn workspace_root() -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}

@@ -220,7 +220,7 @@ mod tests {
     use std::path::Path;
 
     fn committed() -> String {
-        std::fs::read_to_string(crate::workspace_root().join("coeffs/default/model.toml")).expect("coeffs/default/model.toml")
+        std::fs::read_to_string(needle_stdx::workspace_root().join("coeffs/default/model.toml")).expect("coeffs/default/model.toml")
     }
 
     /// Each kind of refusal is its own variant; the messages start with the file.

@@ -632,7 +632,7 @@ mod tests {
 
     /// A copy of the default set's spec, FE runs and model in a temporary folder.
     fn temp_set(tag: &str) -> std::path::PathBuf {
-        let root = crate::workspace_root().join("coeffs/default");
+        let root = needle_stdx::workspace_root().join("coeffs/default");
         let dir = std::env::temp_dir().join(format!("needle-fit-unsolved-{tag}-{}", std::process::id()));
         let fe = dir.join("fe");
         std::fs::create_dir_all(&fe).expect("temp set");

@@ -83,7 +83,7 @@ mod deep_tests {
     use crate::spec::parse;
 
     fn shipped() -> String {
-        std::fs::read_to_string(crate::workspace_root().join("coeffs/default/campaign.toml")).expect("campaign.toml")
+        std::fs::read_to_string(needle_stdx::workspace_root().join("coeffs/default/campaign.toml")).expect("campaign.toml")
     }
 
     fn refusal(text: &str) -> SpecError {

@@ -122,7 +122,7 @@ mod tests {
     use std::path::Path;
 
     fn shipped() -> String {
-        std::fs::read_to_string(crate::workspace_root().join("coeffs/default/campaign.toml")).expect("campaign.toml")
+        std::fs::read_to_string(needle_stdx::workspace_root().join("coeffs/default/campaign.toml")).expect("campaign.toml")
     }
 
     fn error_of(text: &str) -> String {
