@@ -355,7 +355,7 @@ fn fit_without_accepts_only_sweep_and_training_runs() {
         (r#"["lhs-01"]"#, "only sweep and training runs can be left out"),
     ] {
         set_fit_without(dir.path(), list);
-        let e = needle_fe::spec::load(dir.path()).expect_err(list);
+        let e = needle_set::spec::load(dir.path()).expect_err(list);
         let msg = format!("{e:#}");
         assert!(msg.contains("campaign.fit_without") && msg.contains(want), "{list}: {msg}");
     }
@@ -411,14 +411,14 @@ fn a_table2_run_with_a_wrong_fz_fails_its_goal() {
     let fy_pct = good.fy_rel_max_pct;
     // Fz + 10 % of the run's peak |Fy| at every depth (Fy untouched)
     let csv = dir.path().join("fe").join(format!("{name}.csv"));
-    let rows = needle_fe::results::read_csv(&csv).expect("read run");
-    let peak_fy = needle_fe::results::peak_fy_n(&rows);
+    let rows = needle_set::results::read_csv(&csv).expect("read run");
+    let peak_fy = needle_set::results::peak_fy_n(&rows);
     let edited: Vec<_> = rows
         .iter()
         .map(|r| {
             let mut w = r.wrench;
             w[2] += 0.1 * peak_fy;
-            needle_fe::results::Row { depth_mm: r.depth_mm, wrench: w }
+            needle_set::results::Row { depth_mm: r.depth_mm, wrench: w }
         })
         .collect();
     fit_synthetic::rewrite_run(dir.path(), &name, &edited);
@@ -458,10 +458,10 @@ fn a_hand_edited_fe_csv_is_refused_by_fit_and_validate() {
 #[test]
 fn a_run_whose_entry_has_no_hash_is_refused() {
     let (dir, _) = fit_synthetic::fitted();
-    let path = dir.path().join("fe").join(needle_fe::manifest::MANIFEST);
-    let mut m = needle_fe::manifest::read_manifest(&path).expect("manifest");
+    let path = dir.path().join("fe").join(needle_set::manifest::MANIFEST);
+    let mut m = needle_set::manifest::read_manifest(&path).expect("manifest");
     m.pose.get_mut("x+02").expect("entry").csv_sha256 = None;
-    std::fs::write(&path, needle_fe::manifest::manifest_text(&m).expect("manifest text")).expect("write manifest");
+    std::fs::write(&path, needle_set::manifest::manifest_text(&m).expect("manifest text")).expect("write manifest");
     let e = needle_fit::fit_set(dir.path()).expect_err("the fit must refuse x+02");
     assert!(matches!(e.downcast_ref::<RunError>(), Some(RunError::NoHash { pose, .. }) if pose == "x+02"), "{e:#}");
     assert!(format!("{e:#}").contains("needle fe run --force --only x+02"), "the message says how to fix it: {e:#}");

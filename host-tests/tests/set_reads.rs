@@ -5,7 +5,7 @@
 //! binary: the count is per process.
 mod fit_synthetic;
 
-use needle_fe::set_folder::{spec_and_manifest_reads, SetFolder};
+use needle_set::set_folder::{spec_and_manifest_reads, SetFolder};
 
 #[test]
 fn the_commands_read_the_spec_and_the_manifest_once() {

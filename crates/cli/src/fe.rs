@@ -2,7 +2,7 @@
 use clap::{Args, Subcommand};
 use needle_fe::campaign::{self, RunOptions};
 use needle_fe::launcher::slurm::{self, SlurmOptions};
-use needle_fe::manifest::Launched;
+use needle_set::manifest::Launched;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
@@ -334,12 +334,12 @@ fn variants(opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
 /// One run per run of `[family]` (`needle_fe::family::FamilyRun::all`), in order; the
 /// runs `--only` selects nothing of are left out.
 fn family_variants(opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
-    let (c, path) = needle_fe::spec::load(&opts.set_dir)?;
+    let (c, path) = needle_set::spec::load(&opts.set_dir)?;
     let f = c.family.clone().ok_or_else(|| anyhow::anyhow!("{}: --family: the spec has no [family] section", path.display()))?;
     let mut out = Vec::new();
     for run in needle_fe::family::FamilyRun::all(&f) {
         let (_, runs, _) = needle_fe::family::apply(&c, &f, run);
-        if needle_fe::spec::select(&runs, opts.only.as_deref()).is_ok_and(|r| !r.is_empty()) {
+        if needle_set::spec::select(&runs, opts.only.as_deref()).is_ok_and(|r| !r.is_empty()) {
             out.push(RunOptions { family_run: Some(run), ..opts.clone() });
         }
     }
@@ -360,9 +360,9 @@ fn visco_variants(opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
     if !opts.visco {
         return Ok(vec![opts]);
     }
-    let (c, path) = needle_fe::spec::load(&opts.set_dir)?;
+    let (c, path) = needle_set::spec::load(&opts.set_dir)?;
     let v = c.viscoelastic.clone().ok_or_else(|| anyhow::anyhow!("{}: --visco: the spec has no [viscoelastic] section", path.display()))?;
-    let selects = |runs: &[needle_fe::spec::PoseSpec]| needle_fe::spec::select(runs, opts.only.as_deref()).is_ok_and(|r| !r.is_empty());
+    let selects = |runs: &[needle_set::spec::PoseSpec]| needle_set::spec::select(runs, opts.only.as_deref()).is_ok_and(|r| !r.is_empty());
     let mut out = Vec::new();
     for friction in Friction::cases(&v) {
         let frictionless = friction == Friction::None;
@@ -424,7 +424,7 @@ fn run_status(a: StatusArgs) -> anyhow::Result<ExitCode> {
     let r = needle_fe::launcher::status::status(&plan)?;
     print!("{}", r.table());
     print!("{}", needle_fe::launcher::status::attempts_by_class(&plan));
-    if plan.selected.iter().any(|p| p.role == needle_fe::spec::Role::Train) {
+    if plan.selected.iter().any(|p| p.role == needle_set::spec::Role::Train) {
         if let Some(t) = needle_fe::launcher::status::training_coverage(&plan) {
             println!("{t}");
         }
@@ -441,7 +441,7 @@ fn run_status(a: StatusArgs) -> anyhow::Result<ExitCode> {
 /// The run options of `spec`, the others at their defaults.
 fn spec_options(spec: SpecArgs) -> anyhow::Result<RunOptions> {
     Ok(RunOptions {
-        solver: spec.solver.as_deref().map(needle_fe::spec::Engine::parse).transpose()?,
+        solver: spec.solver.as_deref().map(needle_set::spec::Engine::parse).transpose()?,
         only: spec.only,
         mesh: spec.mesh,
         steps: spec.steps,
@@ -522,7 +522,7 @@ fn run_verify(a: VerifyArgs) -> anyhow::Result<ExitCode> {
         punch_mesh_scale: a.punch_mesh_scale,
         punch_campaign_element: !a.no_campaign_element,
         threads,
-        engine: a.solver.as_deref().map(needle_fe::spec::Engine::parse).transpose()?,
+        engine: a.solver.as_deref().map(needle_set::spec::Engine::parse).transpose()?,
     };
     needle_fe::process::stop_jobs_on_termination()?;
     let (_, ok) = needle_fe::verify::run(&opts)?;

@@ -13,7 +13,7 @@ use needle_fe::verify::qlv::{self, QlvCase, QlvOptions, QlvRun};
 /// # Errors
 /// As [`qlv::cases`], or verify.toml cannot be written.
 pub fn check(opts: &QlvOptions) -> anyhow::Result<bool> {
-    let (c, _) = needle_fe::spec::load(&opts.set_dir)?;
+    let (c, _) = needle_set::spec::load(&opts.set_dir)?;
     let mut runs: Vec<QlvRun> = Vec::new();
     let mut missing: Vec<String> = Vec::new();
     let mut compared: Vec<QlvCase> = Vec::new();

@@ -1,8 +1,8 @@
 //! `needle fit`, `needle validate`: fit the model, compare it with FE.
 use anyhow::{Context, Result};
 use clap::Args;
-use needle_fe::set_folder::SetFolder;
 use needle_fit::{self as fit, validate as val};
+use needle_set::set_folder::SetFolder;
 use needle_stdx::fs::write_all_atomic;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;

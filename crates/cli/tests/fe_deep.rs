@@ -3,8 +3,8 @@
 //! manifest; the scaled runs reproduce s x the s = 1 wrench. They need `febio4`
 //! (`.ci/install-febio`); without it they fail, they are not skipped.
 
-use needle_fe::manifest::{read_manifest, MANIFEST};
-use needle_fe::results;
+use needle_set::manifest::{read_manifest, MANIFEST};
+use needle_set::results;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
@@ -41,7 +41,7 @@ fn deep_centre_run_on_the_smoke_mesh() {
     let (_d, set) = default_set();
     let o = needle(&["fe", "run", "--deep", "--only", "centre", "--mesh", "smoke", "--steps", "22", "--threads", "1"], &set);
     assert!(o.status.success(), "{}", show(&o));
-    let (c, _) = needle_fe::spec::load(&set).expect("spec");
+    let (c, _) = needle_set::spec::load(&set).expect("spec");
     let depth_mm = c.deep.as_ref().map(|d| d.depth_mm).expect("a [deep] section");
     let rows = results::read_csv(&set.join("fe/deep/centre.csv")).expect("deep csv");
     let want: Vec<f64> = (0..=STEPS).map(|k| depth_mm * f64::from(k) / f64::from(STEPS)).collect();

@@ -7,7 +7,7 @@
 mod fe_common;
 use fe_common::{default_set, needle, show};
 
-use needle_fe::manifest::{read_manifest, MANIFEST};
+use needle_set::manifest::{read_manifest, MANIFEST};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};

@@ -18,8 +18,7 @@
 
 use crate::spec::{family::member_name, Campaign, FamilySettings, PoseSpec, Tissue};
 
-/// Sub-folder of `<set>/fe/` holding the family's runs and their manifest.
-pub const FAMILY_DIR: &str = "family";
+pub use needle_set::set_folder::FAMILY_DIR;
 
 /// One run variant of the family: a campaign run of its own (its tissue, loading, mesh
 /// and poses).

@@ -14,8 +14,8 @@ use super::validate::TABLE2_MIN_DEPTH_MM;
 use crate::contract::COMPONENT_COUNT;
 use crate::eval::float64::{eval, eval_paper, Pose64};
 use anyhow::Result;
-use needle_fe::set_folder::SetFolder;
-use needle_fe::spec::Role;
+use needle_set::set_folder::SetFolder;
+use needle_set::spec::Role;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -70,7 +70,7 @@ pub struct CoupledReport {
 pub fn held_out(runs: &[&Run], lever_arm_mm: f64, model: impl Fn(Pose64) -> [f64; COMPONENT_COUNT]) -> HeldOut {
     let mut h = HeldOut::default();
     for r in runs {
-        let scale = needle_contract::error_scales(needle_fe::results::peak_fy_n(&r.rows), lever_arm_mm);
+        let scale = needle_contract::error_scales(needle_set::results::peak_fy_n(&r.rows), lever_arm_mm);
         let mut s = [0.0f64; COMPONENT_COUNT];
         for row in &r.rows {
             let w = model(r.pose_at(row.depth_mm));
@@ -314,8 +314,8 @@ mod tests {
     use super::*;
     use crate::cross_terms::{CrossForm, CrossTerms};
     use crate::model::Coupled;
-    use needle_fe::results::Row;
-    use needle_fe::spec::{PoseSpec, Role};
+    use needle_set::results::Row;
+    use needle_set::spec::{PoseSpec, Role};
 
     fn point(runs: usize, lhs: f64, max: f64) -> CurvePoint {
         let h = HeldOut { lhs_worst_rms_pct: lhs, table2_worst_rms_pct: 0.5, table2_fy_max_pct: 20.0, worst_max_pct: max };

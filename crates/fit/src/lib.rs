@@ -34,7 +34,7 @@ pub mod unsolved;
 pub mod validate;
 
 use anyhow::Result;
-use needle_fe::set_folder::SetFolder;
+use needle_set::set_folder::SetFolder;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -111,7 +111,7 @@ pub fn fit_set_in(set: &SetFolder) -> Result<FitOutput> {
     let set_dir = set.dir();
     let data = data::load_fit_data(set)?;
     let mut model = model::fit(&data)?;
-    if data.campaign.fit.form == needle_fe::spec::ModelForm::Coupled {
+    if data.campaign.fit.form == needle_set::spec::ModelForm::Coupled {
         model = coupled::fit_coupled(&data, &model, data.campaign.needle.reference_from_tip_mm)?;
     }
     // replaced training runs (campaign.train_replaced) are not fitted either: named with

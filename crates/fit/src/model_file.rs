@@ -8,7 +8,7 @@ use super::cross_terms::{monomials, CrossForm, CrossTerms, Exponents, CANDIDATES
 use super::model::{Baseline, Coupled, Deviation, Model};
 use crate::contract::COMPONENT_COUNT;
 use crate::model_file_error::ModelFileError;
-use needle_fe::spec::ModelForm;
+use needle_set::spec::ModelForm;
 use std::fmt::Write as _;
 use std::path::Path;
 

@@ -38,8 +38,8 @@ use crate::contract::{COMPONENT_COUNT, DEGREE};
 use crate::eval::float32::{eval as eval32, Tables32};
 use crate::eval::float64::{eval as eval64, eval_paper};
 use anyhow::Result;
-use needle_fe::set_folder::SetFolder;
-use needle_fe::spec::Role;
+use needle_set::set_folder::SetFolder;
+use needle_set::spec::Role;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -246,7 +246,7 @@ pub fn compare_run(
     let w64: Vec<[f64; COMPONENT_COUNT]> = run.rows.iter().map(|r| eval64(model, run.pose_at(r.depth_mm)).0).collect();
     let w32: Vec<[f64; COMPONENT_COUNT]> =
         run.rows.iter().map(|r| eval32(tables, run.pose_at(r.depth_mm).map(|v| v as f32)).0.map(f64::from)).collect();
-    let peak = needle_fe::results::peak_fy_n(&run.rows);
+    let peak = needle_set::results::peak_fy_n(&run.rows);
     let scale = needle_contract::error_scales(peak, lever_arm_mm);
     let e64 = errors(&w64, run, scale);
     let e32 = errors(&w32, run, scale);
@@ -628,7 +628,7 @@ fn worst(r: &Report, role: &str, f: fn(&RunReport) -> f64) -> String {
 mod tests {
     use super::*;
     use crate::unsolved::{inside_f32, normalised, solved_inside, to_toml, FILE};
-    use needle_fe::spec;
+    use needle_set::spec;
 
     /// A copy of the default set's spec, FE runs and model in a temporary folder.
     fn temp_set(tag: &str) -> std::path::PathBuf {
@@ -659,16 +659,16 @@ mod tests {
         std::fs::remove_file(dir.join("fe/t2-b.csv")).expect("t2-b's result in the copy");
         let (campaign, _) = spec::load(&dir).expect("spec");
         let pose = campaign.poses().into_iter().find(|p| p.name == "t2-b").expect("t2-b");
-        let failed = needle_fe::partial::Failed {
+        let failed = needle_set::partial::Failed {
             campaign: &campaign,
             pose: &pose,
             mesh: &campaign.campaign.mesh,
             engine: ("febio", "4.11.0"),
             failure:
-                "febio4 exit code 1 after 6 of 20 steps (t = 1.95 mm): Max nr of reformations reached. (failed to converge at time : 1.95)",
+                "solver exit code 1 after 6 of 20 steps (t = 1.95 mm): Max nr of reformations reached. (failed to converge at time : 1.95)",
         };
         let reached: Vec<[f64; 6]> = (1..=6).map(|k| [0.0, 0.001 * f64::from(k), 0.0, 0.0, 0.0, 0.0]).collect();
-        needle_fe::partial::write(&dir.join("fe"), &failed, &reached).expect("partial record");
+        needle_set::partial::write(&dir.join("fe"), &failed, &reached).expect("partial record");
         let r = crate::unsolved::region(&dir).expect("region");
         let t2b = r.failed.iter().find(|f| f.pose == "t2-b").expect("t2-b is in the region").clone();
         assert_eq!((t2b.source.as_str(), t2b.reached_depth_mm, t2b.depth_q16), ("fe/t2-b.partial.toml", Some(1.8), 117_965));

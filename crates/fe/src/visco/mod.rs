@@ -16,11 +16,8 @@ pub use crate::spec::visco::{frictionless_name, run_name, Prony, RampHold, Visco
 
 use crate::spec::{Campaign, PoseSpec};
 
-/// Sub-folder of `<set>/fe/` holding the ramp-and-hold runs and their manifest.
-pub const VISCO_DIR: &str = "visco";
-
-/// Header of a ramp-and-hold result: the time, s, before the FE result's columns.
-pub const TIME_COLUMN: &str = "time_s";
+pub use needle_set::results::TIME_COLUMN;
+pub use needle_set::set_folder::VISCO_DIR;
 
 /// Which contact the runs have: the campaign's (`contact.friction`) or friction 0
 /// (`[viscoelastic] frictionless`, names with [`FRICTIONLESS_SUFFIX`]).

@@ -84,7 +84,7 @@ pub fn write(out_dir: &Path, f: &Failed<'_>, reached: &[[f64; COMPONENT_COUNT]])
     }
     let mut rows = vec![Row { depth_mm: 0.0, wrench: [0.0; COMPONENT_COUNT] }];
     rows.extend((1u32..).zip(reached).map(|(k, w)| Row { depth_mm: f.campaign.loading.depth_at(k), wrench: *w }));
-    // a ramp-and-hold run's record keeps its times (`crate::visco`: the hold's depths repeat)
+    // a ramp-and-hold run's record keeps its times (`needle_fe::visco`: the hold's depths repeat)
     let loading = &f.campaign.loading;
     let text = match loading.ramp_hold {
         Some(_) => results::to_timed_csv(&(0..rows.len() as u32).map(|k| loading.time_at(k)).collect::<Vec<_>>(), &rows),

@@ -6,6 +6,10 @@ use anyhow::{bail, Context, Result};
 use needle_contract::COMPONENT_COUNT;
 use std::path::Path;
 
+/// Header of a ramp-and-hold result's first column: the time, s, before the FE result's
+/// columns ([`to_timed_csv`]).
+pub const TIME_COLUMN: &str = "time_s";
+
 /// The header line of every FE result file (the contract's [`FE_COLUMNS`](needle_contract::FE_COLUMNS)).
 pub fn header() -> String {
     needle_contract::FE_COLUMNS.join(",")
@@ -95,14 +99,14 @@ pub fn parse_csv(text: &str, path: &Path) -> std::result::Result<Vec<Row>, CsvEr
     Ok(rows)
 }
 
-/// The CSV text of a ramp-and-hold result (`crate::visco`): a `time_s` column (s) before
+/// The CSV text of a ramp-and-hold result (`needle_fe::visco`): a `time_s` column (s) before
 /// the columns of [`to_csv`], one time per row.
 pub fn to_timed_csv(times_s: &[f64], rows: &[Row]) -> String {
     let plain = to_csv(rows);
     let mut s = String::with_capacity(plain.len() + 24 * (rows.len() + 1));
     for (i, line) in plain.lines().enumerate() {
         match i.checked_sub(1).map(|k| times_s.get(k)) {
-            None => s.push_str(crate::visco::TIME_COLUMN),
+            None => s.push_str(TIME_COLUMN),
             Some(t) => s.push_str(&format!("{}", t.copied().unwrap_or(f64::NAN))),
         }
         s.push(',');
@@ -124,11 +128,11 @@ pub fn parse_timed_csv(text: &str, path: &Path) -> Result<(Vec<f64>, Vec<Row>)> 
             continue;
         }
         let Some((t, rest)) = line.split_once(',') else {
-            bail!("{}:{}: no {} column: {line:?}", path.display(), i + 1, crate::visco::TIME_COLUMN);
+            bail!("{}:{}: no {} column: {line:?}", path.display(), i + 1, TIME_COLUMN);
         };
         if i == 0 {
-            if t.trim() != crate::visco::TIME_COLUMN {
-                bail!("{}:1: first column {t:?}, expected {:?}", path.display(), crate::visco::TIME_COLUMN);
+            if t.trim() != TIME_COLUMN {
+                bail!("{}:1: first column {t:?}, expected {:?}", path.display(), TIME_COLUMN);
             }
         } else {
             let v: f64 = t.trim().parse().with_context(|| format!("{}:{}: time {t:?} s is not a number", path.display(), i + 1))?;
