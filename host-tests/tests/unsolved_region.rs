@@ -15,7 +15,8 @@ fn set_dir() -> &'static Path {
 }
 
 fn region() -> unsolved::Region {
-    unsolved::region(set_dir()).unwrap_or_else(|e| panic!("{e:#}"))
+    unsolved::region(&needle_set::set_folder::SetFolder::open(set_dir()).unwrap_or_else(|e| panic!("{e:#}")))
+        .unwrap_or_else(|e| panic!("{e:#}"))
 }
 
 fn entries() -> Vec<Entry> {

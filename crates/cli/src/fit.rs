@@ -81,7 +81,7 @@ fn check_file(path: &Path, want: &str) -> Result<bool> {
 /// invalid, a fit is rank deficient, or a file cannot be written.
 pub fn fit(a: FitArgs) -> Result<ExitCode> {
     let set = SetFolder::open(&a.set).with_context(|| format!("needle fit --set {}", a.set.display()))?;
-    let out = fit::fit_set_in(&set).with_context(|| format!("needle fit --set {}", a.set.display()))?;
+    let out = fit::fit_set(&set).with_context(|| format!("needle fit --set {}", a.set.display()))?;
     let files: Vec<(PathBuf, &str)> = out.files().iter().map(|(name, text)| (a.set.join(name), *text)).collect();
     if a.check {
         let mut same = true;
@@ -93,8 +93,8 @@ pub fn fit(a: FitArgs) -> Result<ExitCode> {
     let writes: Vec<(&Path, &[u8])> = files.iter().map(|(path, text)| (path.as_path(), text.as_bytes())).collect();
     write_all_atomic(&writes)?;
     print!("{}", fit::summary(&out.model));
-    let coupled = fit::coupled_report::measure_in(&set)
-        .with_context(|| format!("needle fit --set {}: measuring the coupled form", a.set.display()))?;
+    let coupled =
+        fit::coupled_report::measure(&set).with_context(|| format!("needle fit --set {}: measuring the coupled form", a.set.display()))?;
     print!("{}", fit::coupled_report::to_table(&coupled));
     print!("{}", fit::unsolved::summary(&out.unsolved));
     print!("{}", fit::depth_extension::law_summary(&out.depth_law));
@@ -116,7 +116,7 @@ pub fn fit(a: FitArgs) -> Result<ExitCode> {
 pub fn validate(a: ValidateArgs) -> Result<ExitCode> {
     let floor_degree = a.floor_degree.map_or(needle_contract::DEGREE, usize::from);
     let report = SetFolder::open(&a.set)
-        .and_then(|set| val::validate_in(&set, floor_degree))
+        .and_then(|set| val::validate(&set, floor_degree))
         .with_context(|| format!("needle validate --set {}", a.set.display()))?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

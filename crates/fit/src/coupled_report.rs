@@ -18,7 +18,6 @@ use needle_set::set_folder::SetFolder;
 use needle_set::spec::Role;
 use serde::Serialize;
 use std::fmt::Write as _;
-use std::path::Path;
 
 /// Held-out errors of one form.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
@@ -144,21 +143,13 @@ pub fn paper_held_out(runs: &[&Run], lever_arm_mm: f64, model: &Model) -> HeldOu
     held_out(runs, lever_arm_mm, |p| eval_paper(model, p).0)
 }
 
-/// Measure the coupled form of the set in `set_dir` against its paper form (fitted here
+/// Measure the coupled form of the opened set `set` against its paper form (fitted here
 /// on the centre and sweep runs, as `form = "paper"` does), whichever form the set
 /// ships: the coupled form is fitted on the training runs present.
 ///
 /// # Errors
 /// The spec, the manifest or a run cannot be read; the paper form cannot be fitted.
-pub fn measure(set_dir: &Path) -> Result<CoupledReport> {
-    measure_in(&SetFolder::open(set_dir)?)
-}
-
-/// [`measure`] of an opened set.
-///
-/// # Errors
-/// As [`measure`].
-pub fn measure_in(set: &SetFolder) -> Result<CoupledReport> {
+pub fn measure(set: &SetFolder) -> Result<CoupledReport> {
     let data = load_paper_data(set)?;
     let paper = fit_paper(&data)?;
     let (campaign, train, unusable) = load_training_runs(set)?;

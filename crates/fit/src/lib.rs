@@ -36,7 +36,6 @@ pub mod validate;
 use anyhow::Result;
 use needle_set::set_folder::SetFolder;
 use std::fmt::Write as _;
-use std::path::Path;
 
 /// Name of the model file inside a set folder (the generator's, which reads it).
 pub use needle_codegen::MODEL_FILE;
@@ -93,21 +92,13 @@ impl FitOutput {
     }
 }
 
-/// Fit the set in `set_dir` and render its output files ([`FitOutput::files`]), without
+/// Fit the opened set `set` and render its output files ([`FitOutput::files`]), without
 /// writing anything.
 ///
 /// # Errors
 /// As [`data::load_fit_data`] (missing or malformed runs, bad spec) and [`model::fit`]
 /// (rank-deficient fits); a model too large for the fixed-point evaluator.
-pub fn fit_set(set_dir: &Path) -> Result<FitOutput> {
-    fit_set_in(&SetFolder::open(set_dir)?)
-}
-
-/// [`fit_set`] of an opened set.
-///
-/// # Errors
-/// As [`fit_set`].
-pub fn fit_set_in(set: &SetFolder) -> Result<FitOutput> {
+pub fn fit_set(set: &SetFolder) -> Result<FitOutput> {
     let set_dir = set.dir();
     let data = data::load_fit_data(set)?;
     let mut model = model::fit(&data)?;
@@ -125,7 +116,7 @@ pub fn fit_set_in(set: &SetFolder) -> Result<FitOutput> {
             .map(|r| format!("{} (replaced by {})", r.pose, data.campaign.replacement_of(&r.pose).unwrap_or_default())),
     );
     let model_toml = model_file::to_toml(&model, &left_out);
-    let region = unsolved::region_in(set)?;
+    let region = unsolved::region(set)?;
     let unsolved_toml = unsolved::to_toml(&model.set, &region);
     let tables = eval::float32::Tables32::from_model(&model).with_unsolved(region.entries());
     let golden_csv = golden::float32::to_csv(&tables);

@@ -130,20 +130,12 @@ fn partial_record(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Optio
     Some((r.reached_depth_mm, failures::summary(&failures::failures_from_record(&r.failure), "mm")))
 }
 
-/// The region of the set in `set_dir`, from its records (module docs).
+/// The region of the opened set `set`, from its records (module docs).
 ///
 /// # Errors
 /// The spec or the manifest cannot be read; no run of the set is solved while a pose
 /// failed (no radius); more than [`MAX_ENTRIES`] balls.
-pub fn region(set_dir: &Path) -> Result<Region> {
-    region_in(&SetFolder::open(set_dir)?)
-}
-
-/// [`region`] of an opened set.
-///
-/// # Errors
-/// As [`region`].
-pub fn region_in(set: &SetFolder) -> Result<Region> {
+pub fn region(set: &SetFolder) -> Result<Region> {
     let (campaign, manifest, set_dir) = (set.campaign(), set.manifest(), set.dir());
     let poses = campaign.poses();
     let mut solved_points: Vec<(String, [f64; 4])> = Vec::new();

@@ -104,7 +104,9 @@ fn synthetic_entry(campaign: &spec::Campaign, pose: &PoseSpec) -> ManifestEntry 
 pub fn fitted() -> (tempfile::TempDir, FitOutput) {
     let dir = tempfile::tempdir().expect("tempdir");
     make_set(dir.path(), &[]);
-    let out = fit_set(dir.path()).unwrap_or_else(|e| panic!("fit of the synthetic set: {e:#}"));
+    let out = needle_set::set_folder::SetFolder::open(dir.path())
+        .and_then(|s| fit_set(&s))
+        .unwrap_or_else(|e| panic!("fit of the synthetic set: {e:#}"));
     (dir, out)
 }
 
