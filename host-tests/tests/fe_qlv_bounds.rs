@@ -11,7 +11,7 @@
 //! z+04 runs at every speed (stopped at 19.0, 4.9 and 7.7 s with the current retry
 //! ladder), which this test lists, not fails.
 
-use needle_fe::verify::qlv::{QLV_MAX_PERCENT, QLV_MUST_RMS_PERCENT};
+use needle_fe::visco::qlv::{QLV_MAX_PERCENT, QLV_MUST_RMS_PERCENT};
 use needle_fe::visco::{run_name, Friction};
 use std::path::Path;
 

@@ -478,7 +478,7 @@ fn run_verify(a: VerifyArgs) -> anyhow::Result<ExitCode> {
         // viscoelastic campaign's, `needle fe run --visco`)
         needle_fe::process::stop_jobs_on_termination()?;
         let threads = a.threads.map(|t| t as usize).unwrap_or(1);
-        let opts = needle_fe::verify::qlv::QlvOptions {
+        let opts = needle_fe::visco::qlv::QlvOptions {
             set_dir: a.set.clone(),
             steps: a.qlv_steps,
             mesh: a.qlv_mesh.clone(),

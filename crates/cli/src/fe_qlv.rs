@@ -1,10 +1,10 @@
 //! `needle fe verify --qlv`: the library's QLV filter (`needle_haptics::viscoelastic`,
 //! f32, one tick of `InsertionConfig::DEFAULT_1KHZ`) run on the elastic FE wrench along
 //! each ramp-and-hold run's depth-time path, against FEBio's viscoelastic solution
-//! (`needle_fe::verify::qlv`: pairing, scores, bounds). The filter is the firmware's own
+//! (`needle_fe::visco::qlv`: pairing, scores, bounds). The filter is the firmware's own
 //! code; this module only feeds it and samples its output at the FE's must points.
 
-use needle_fe::verify::qlv::{self, QlvCase, QlvOptions, QlvRun};
+use needle_fe::visco::qlv::{self, QlvCase, QlvOptions, QlvRun};
 
 /// Run the check: solve (when `opts.solve`) and read the runs, filter, score, print each
 /// run's line, write `[[qlv]]` of `<set>/fe/verify.toml`. Returns whether every run is

@@ -305,7 +305,7 @@ fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Res
         batch_job: ctx.launcher.batch_job(),
         replaces: ctx.campaign.replaced_by(&pose.name).map(|r| r.pose.clone()),
         replaced_because: ctx.campaign.replaced_by(&pose.name).map(|r| replaced_because(ctx.out_dir, r)),
-        viscoelastic: crate::visco::describe(ctx.campaign),
+        viscoelastic: crate::spec::visco::describe(ctx.campaign),
     };
     update_manifest(ctx, |m| {
         m.pose.insert(pose.name.clone(), entry);

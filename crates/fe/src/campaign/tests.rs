@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::backend::{Job, SolveFailure, Solved};
-use crate::mesh_summary::MeshSummary;
+use crate::mesh::summary::MeshSummary;
 use crate::partial;
 use crate::results::Row;
 use crate::resume;

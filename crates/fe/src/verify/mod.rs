@@ -22,7 +22,6 @@ pub mod mesh_check;
 mod mirror;
 pub mod punch;
 pub mod punch_febio;
-pub mod qlv;
 pub mod runs;
 pub mod scaling;
 pub mod shape;

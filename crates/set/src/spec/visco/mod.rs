@@ -2,9 +2,11 @@
 //! ramp-and-hold runs, `needle_fe::visco`).
 
 use super::{check_pose_in_block, Campaign, MAX_LOAD_STEPS};
+pub mod runs;
 pub mod settings;
 
 use anyhow::{bail, Result};
+pub use runs::{apply, apply_frictionless_elastic, describe, Friction};
 pub use settings::{decimal_tag, frictionless_name, run_name, Prony, RampHold, ViscoSettings, FRICTIONLESS_SUFFIX, MAX_PRONY_TERMS};
 use std::path::Path;
 
