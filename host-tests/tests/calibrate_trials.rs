@@ -5,6 +5,8 @@
 //! its name), the 5 s hold and the 24.3-25.0 mm of travel the README states, and contact
 //! "at about 4-7 mm" of travel.
 
+// a test binary uses only `workspace` of the shared walker
+#[allow(dead_code)]
 mod source_walk;
 
 use needle_calibrate::trial::{phases, read_trial};

@@ -7,6 +7,8 @@
 //!   named module exists;
 //! - "`crates/`": every folder of `crates/` is named, and every named crate exists.
 
+// a test binary uses only `workspace` of the shared walker
+#[allow(dead_code)]
 mod source_walk;
 
 use std::collections::BTreeSet;

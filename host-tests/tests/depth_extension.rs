@@ -45,7 +45,7 @@ fn past_six_mm_the_library_follows_the_fitters_law() {
 #[test]
 fn the_extended_centre_follows_the_deep_fe_run() {
     let path = set().join("fe/deep/centre.csv");
-    let rows = needle_fe::results::read_csv(&path).expect("deep centre run");
+    let rows = needle_set::results::read_csv(&path).expect("deep centre run");
     let peak = rows.iter().map(|r| r.wrench[1].abs()).fold(0.0, f64::max);
     let mut worst = 0.0f64;
     for r in rows.iter().filter(|r| r.depth_mm >= 6.0) {
@@ -67,7 +67,7 @@ const LAW_MAX_PCT: f64 = 3.0;
 #[test]
 fn the_law_holds_on_the_deep_half_model_runs() {
     let e = fit(&set()).expect("fit").expect("a deep centre run");
-    let folder = needle_fe::set_folder::SetFolder::open(&set()).expect("the shipped set");
+    let folder = needle_set::set_folder::SetFolder::open(&set()).expect("the shipped set");
     let checks = needle_fit::depth_extension::law_checks(&folder, &e).expect("the deep runs");
     println!("{}", needle_fit::depth_extension::law_summary(&checks));
     assert!(checks.iter().any(|c| c.pose == "x+04"), "the set ships the deep x+04 run");

@@ -5,7 +5,7 @@
 //! target are required (`.ci/test` installs both); missing, the test fails.
 
 use needle_explore as explore;
-use needle_firmware_host::workspace_root;
+use needle_stdx::workspace_root;
 use std::process::Command;
 
 #[test]

@@ -34,7 +34,7 @@ fn centre_of<'a>(e: &'a toml::Value, key: &str) -> Option<&'a toml::Value> {
 #[test]
 fn the_edge_study_is_in_verify_toml_and_a_resolved_edge_converges() {
     let set = Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default");
-    let (c, _) = needle_fe::spec::load(&set).expect("the shipped spec");
+    let (c, _) = needle_set::spec::load(&set).expect("the shipped spec");
     let radii = &c.campaign.edge_study_radii_mm;
     assert!(!radii.is_empty(), "the shipped set has an edge study");
     let path = set.join("fe/verify.toml");

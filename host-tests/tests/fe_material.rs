@@ -1,7 +1,7 @@
 //! The material check run before any FE solve (crates/fe/src/material.rs).
 
 use needle_fe::material::{self, Mode};
-use needle_fe::spec::{self, Tissue};
+use needle_set::spec::{self, Tissue};
 use std::path::{Path, PathBuf};
 
 fn repo() -> PathBuf {

@@ -37,7 +37,7 @@ fn text<'a>(t: &'a toml::Value, key: &str) -> &'a str {
 #[test]
 fn the_campaign_level_carries_the_refinements_shape() {
     let set = Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default");
-    let (c, _) = needle_fe::spec::load(&set).expect("the shipped spec");
+    let (c, _) = needle_set::spec::load(&set).expect("the shipped spec");
     let path = set.join("fe/verify.toml");
     let t: toml::Value = std::fs::read_to_string(&path).expect("fe/verify.toml").parse().expect("TOML");
     let mesh = t.get("mesh").unwrap_or_else(|| panic!("{}: no [mesh]", path.display()));

@@ -11,7 +11,7 @@
 //! z+04 runs at every speed (stopped at 19.0, 4.9 and 7.7 s with the current retry
 //! ladder), which this test lists, not fails.
 
-use needle_fe::verify::qlv::{QLV_MAX_PERCENT, QLV_MUST_RMS_PERCENT};
+use needle_fe::visco::qlv::{QLV_MAX_PERCENT, QLV_MUST_RMS_PERCENT};
 use needle_fe::visco::{run_name, Friction};
 use std::path::Path;
 
@@ -22,7 +22,7 @@ const WHOLE_WITH_FRICTION: [&str; 2] = ["centre", "x+04"];
 #[test]
 fn every_ramp_and_hold_run_is_within_the_bounds() {
     let set = Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default");
-    let (c, _) = needle_fe::spec::load(&set).expect("the shipped spec");
+    let (c, _) = needle_set::spec::load(&set).expect("the shipped spec");
     let v = c.viscoelastic.expect("coeffs/default has [viscoelastic]");
     assert!(v.frictionless, "the shipped set verifies the filter without friction too");
     let path = set.join("fe/verify.toml");

@@ -16,7 +16,7 @@ fn build_defmt_log() -> std::path::PathBuf {
     let set = firmware::fitted_set(&firmware::compiled_set()).unwrap_or_else(|e| panic!("{e:#}"));
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     let out = Command::new(cargo)
-        .current_dir(firmware::workspace_root())
+        .current_dir(needle_stdx::workspace_root())
         .args(["build", "--release", "-p", "needle-haptics", "--example", "defmt_log", "--features", "defmt"])
         .args(["--target", core.target, "--target-dir"])
         .arg(build::target_dir())

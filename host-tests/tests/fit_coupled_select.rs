@@ -4,12 +4,12 @@
 //! representable with sweep degree 4) plus, on the training runs, a known cross term in fy
 //! and in fx a wiggle whose sign alternates from run to run (no function of the pose), fy gets its term back, fx none, and the joint fit
 //! reproduces the paper model.
-use needle_fe::results::Row;
-use needle_fe::spec::{PoseSpec, Role};
 use needle_fit::contract::COMPONENTS;
 use needle_fit::coupled::{scales, select_and_fit};
 use needle_fit::data::{load_paper_data, Run};
 use needle_fit::eval::float64::{eval, eval_paper};
+use needle_set::results::Row;
+use needle_set::spec::{PoseSpec, Role};
 use std::path::Path;
 
 fn pose_of(p: &PoseSpec, depth_mm: f64) -> [f64; 5] {
@@ -20,7 +20,7 @@ fn pose_of(p: &PoseSpec, depth_mm: f64) -> [f64; 5] {
 fn each_component_chooses_its_own_size_and_the_cross_term_is_recovered() {
     // The paper form of the default set, fitted here on its sweeps (the set may ship
     // either form): its deviations are degree 4 in the swept value.
-    let set = needle_fe::set_folder::SetFolder::open(Path::new(needle_haptics::model_info::SET_DIR)).unwrap_or_else(|e| panic!("{e:#}"));
+    let set = needle_set::set_folder::SetFolder::open(Path::new(needle_haptics::model_info::SET_DIR)).unwrap_or_else(|e| panic!("{e:#}"));
     let mut data = load_paper_data(&set).unwrap_or_else(|e| panic!("{e:#}"));
     let paper = needle_fit::model::fit(&data).unwrap_or_else(|e| panic!("{e:#}"));
     // The centre and sweep runs become the paper model's own values.

@@ -16,7 +16,7 @@ fn first_difference(a: &str, b: &str) -> usize {
 #[test]
 fn committed_model_and_golden_vectors_are_reproducible() {
     let set = set_dir();
-    let out = match fit_set(&set) {
+    let out = match needle_set::set_folder::SetFolder::open(&set).and_then(|s| fit_set(&s)) {
         Ok(o) => o,
         Err(e) => panic!("regenerating the fit of {} failed: {e:#}", set.display()),
     };

@@ -24,7 +24,10 @@ fn fitter_tables() -> &'static TablesFixed {
         }
         let model = model_file::read(&Path::new(model_info::SET_DIR).join("model.toml")).unwrap_or_else(|e| panic!("{e:#}"));
         // the set's unsolved region too: the library flags FE_UNSOLVED in the status
-        let region = needle_fit::unsolved::region(Path::new(model_info::SET_DIR)).unwrap_or_else(|e| panic!("{e:#}"));
+        let region = needle_fit::unsolved::region(
+            &needle_set::set_folder::SetFolder::open(Path::new(model_info::SET_DIR)).unwrap_or_else(|e| panic!("{e:#}")),
+        )
+        .unwrap_or_else(|e| panic!("{e:#}"));
         TablesFixed::from_model(&model).unwrap_or_else(|e| panic!("{e:#}")).with_unsolved(region.entries())
     })
 }

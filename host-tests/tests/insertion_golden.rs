@@ -270,7 +270,7 @@ fn the_c_api_refuses_bad_arguments() {
 
 #[test]
 fn golden_insertions_in_wasm_under_node() {
-    let root = needle_firmware_host::workspace_root();
+    let root = needle_stdx::workspace_root();
     let set = root.join("coeffs/default");
     let wasm = needle_explore::wasm::build(&set).expect("build the wasm evaluator");
     let dir = tempfile::tempdir().expect("temp dir");

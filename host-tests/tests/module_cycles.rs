@@ -10,9 +10,11 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// The crates' source folders, from the workspace root.
-const CRATES: [&str; 13] = [
+const CRATES: [&str; 15] = [
     "src",
     "crates/contract/src",
+    "crates/stdx/src",
+    "crates/set/src",
     "crates/codegen/src",
     "crates/capi/src",
     "crates/wasm/src",

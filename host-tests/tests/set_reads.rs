@@ -5,7 +5,7 @@
 //! binary: the count is per process.
 mod fit_synthetic;
 
-use needle_fe::set_folder::{spec_and_manifest_reads, SetFolder};
+use needle_set::set_folder::{spec_and_manifest_reads, SetFolder};
 
 #[test]
 fn the_commands_read_the_spec_and_the_manifest_once() {
@@ -14,10 +14,10 @@ fn the_commands_read_the_spec_and_the_manifest_once() {
     let before = spec_and_manifest_reads();
     let set = SetFolder::open(dir.path()).unwrap_or_else(|e| panic!("{e:#}"));
     assert_eq!(spec_and_manifest_reads() - before, 2, "opening reads the spec and the manifest");
-    let fitted = needle_fit::fit_set_in(&set).unwrap_or_else(|e| panic!("fit: {e:#}"));
+    let fitted = needle_fit::fit_set(&set).unwrap_or_else(|e| panic!("fit: {e:#}"));
     assert_eq!(fitted.model_toml, out.model_toml, "the same fit as from the folder's path");
-    needle_fit::coupled_report::measure_in(&set).unwrap_or_else(|e| panic!("coupled report: {e:#}"));
-    let report = needle_fit::validate::validate_in(&set, needle_contract::DEGREE).unwrap_or_else(|e| panic!("validate: {e:#}"));
+    needle_fit::coupled_report::measure(&set).unwrap_or_else(|e| panic!("coupled report: {e:#}"));
+    let report = needle_fit::validate::validate(&set, needle_contract::DEGREE).unwrap_or_else(|e| panic!("validate: {e:#}"));
     assert!(!report.runs.is_empty(), "validate compared runs");
     let figures = needle_plot::render_set(&set).unwrap_or_else(|e| panic!("plot: {e:#}"));
     assert!(!figures.is_empty(), "plot drew figures");

@@ -15,7 +15,8 @@ fn set_dir() -> &'static Path {
 }
 
 fn region() -> unsolved::Region {
-    unsolved::region(set_dir()).unwrap_or_else(|e| panic!("{e:#}"))
+    unsolved::region(&needle_set::set_folder::SetFolder::open(set_dir()).unwrap_or_else(|e| panic!("{e:#}")))
+        .unwrap_or_else(|e| panic!("{e:#}"))
 }
 
 fn entries() -> Vec<Entry> {
@@ -80,7 +81,7 @@ fn every_failed_pose_is_flagged_and_no_solved_run_is() {
         }
     }
     // every run that solved, at every depth of its CSV and its mirror images: never flagged
-    let (campaign, _) = needle_fe::spec::load(set_dir()).expect("campaign");
+    let (campaign, _) = needle_set::spec::load(set_dir()).expect("campaign");
     let mut checked = 0;
     for p in campaign.poses() {
         if !set_dir().join("fe").join(format!("{}.csv", p.name)).is_file() || r.failed.iter().any(|f| f.pose == p.name) {

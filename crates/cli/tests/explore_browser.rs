@@ -7,7 +7,7 @@
 //! them); missing, the test fails.
 
 use fantoccini::{key::Key, wd::Capabilities, ClientBuilder, Locator};
-use needle_firmware_host::workspace_root;
+use needle_stdx::workspace_root;
 use std::io::{BufRead, BufReader};
 use std::net::{TcpListener, TcpStream};
 use std::process::{Child, Command, Stdio};
@@ -227,7 +227,7 @@ async fn explorer_page_shows_what_needle_eval_computes() {
         set_field(&c, name, v).await;
     }
     let prony_text = c.find(Locator::Id("prony")).await.expect("Prony field").prop("value").await.expect("prop").expect("a value");
-    let (spec, _) = needle_fe::spec::load(&shipped_set()).expect("campaign.toml");
+    let (spec, _) = needle_set::spec::load(&shipped_set()).expect("campaign.toml");
     let visco = spec.viscoelastic.expect("the default set has [viscoelastic]");
     let want_text = visco.g.iter().zip(&visco.tau_s).map(|(g, t)| format!("{g}:{t}")).collect::<Vec<_>>().join(", ");
     assert_eq!(prony_text, want_text, "the page's Prony terms are the campaign's [viscoelastic]");

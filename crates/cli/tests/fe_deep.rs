@@ -6,8 +6,8 @@
 mod common;
 use common::{campaign_copy, needle_on, show};
 
-use needle_fe::manifest::{read_manifest, MANIFEST};
-use needle_fe::results;
+use needle_set::manifest::{read_manifest, MANIFEST};
+use needle_set::results;
 
 /// Load steps of the deep smoke run: about 0.6 mm each (with steps of 2.6 mm the smoke
 /// mesh's contact is never found: Fy = 0 at every depth).
@@ -20,7 +20,7 @@ fn deep_centre_run_on_the_smoke_mesh() {
     let (_d, set) = campaign_copy();
     let o = needle_on(&["fe", "run", "--deep", "--only", "centre", "--mesh", "smoke", "--steps", "22", "--threads", "1"], &set);
     assert!(o.status.success(), "{}", show(&o));
-    let (c, _) = needle_fe::spec::load(&set).expect("spec");
+    let (c, _) = needle_set::spec::load(&set).expect("spec");
     let depth_mm = c.deep.as_ref().map(|d| d.depth_mm).expect("a [deep] section");
     let rows = results::read_csv(&set.join("fe/deep/centre.csv")).expect("deep csv");
     let want: Vec<f64> = (0..=STEPS).map(|k| depth_mm * f64::from(k) / f64::from(STEPS)).collect();

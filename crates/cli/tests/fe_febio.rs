@@ -9,10 +9,10 @@ mod common;
 use common::{campaign_copy, needle_env, show};
 
 use needle_fe::febio;
-use needle_fe::manifest::{read_manifest, MANIFEST};
-use needle_fe::results;
-use needle_fe::spec::Engine;
 use needle_fe::verify::{self, VerifyOptions};
+use needle_set::manifest::{read_manifest, MANIFEST};
+use needle_set::results;
+use needle_set::spec::Engine;
 use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::Output;
@@ -62,7 +62,7 @@ fn smoke_campaign_on_febio() {
         assert!(e.solver_settings.contains("sliding-elastic"), "{name}: {}", e.solver_settings);
         let rows = results::read_csv(&set.join("fe").join(format!("{name}.csv"))).expect("csv");
         assert_eq!(rows.len(), 11, "{name}: 10 steps + depth 0");
-        let fy: Vec<f64> = rows.iter().map(needle_fe::results::Row::fy_n).collect();
+        let fy: Vec<f64> = rows.iter().map(needle_set::results::Row::fy_n).collect();
         assert!(fy.windows(2).skip(1).all(|w| w[1] > w[0]), "{name}: Fy grows with depth: {fy:?}");
         let last = rows.last().expect("rows").wrench;
         assert!(last[1] > 0.03 && last[1] < 0.15, "{name}: Fy at 6 mm {} N", last[1]);

@@ -7,8 +7,8 @@ mod common;
 use common::{campaign_copy, needle_env, show, NEEDLE};
 
 use needle_fe::campaign::MANIFEST_LOCK;
-use needle_fe::manifest::{read_manifest, MANIFEST};
 use needle_fe::{ccx, results, spec};
+use needle_set::manifest::{read_manifest, MANIFEST};
 use std::os::unix::process::CommandExt;
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -46,7 +46,7 @@ fn check_csv(fe: &Path, pose: &str, steps: usize) {
     let want: Vec<f64> = (0..=steps).map(|k| 6.0 * k as f64 / steps as f64).collect();
     assert_eq!(depths, want, "{pose}: depths");
     assert!(rows.iter().all(|r| r.wrench.iter().all(|v| v.is_finite())));
-    let fy: Vec<f64> = rows.iter().map(needle_fe::results::Row::fy_n).collect();
+    let fy: Vec<f64> = rows.iter().map(needle_set::results::Row::fy_n).collect();
     let last = fy[steps];
     // The centred needle at 6 mm gives about 0.1 N on the smoke and committed meshes; a
     // value near zero means ccx found no needle-tissue contact.

@@ -7,7 +7,7 @@
 mod common;
 use common::{campaign_copy, needle_env, show};
 
-use needle_fe::manifest::{read_manifest, MANIFEST};
+use needle_set::manifest::{read_manifest, MANIFEST};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};

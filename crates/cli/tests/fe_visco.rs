@@ -9,8 +9,8 @@
 mod common;
 
 use common::{campaign_copy, needle_on, show};
-use needle_fe::manifest::{read_manifest, MANIFEST};
 use needle_fe::visco::Friction;
+use needle_set::manifest::{read_manifest, MANIFEST};
 use std::path::Path;
 
 /// Must points on the ramp (1.2 mm each; the smoke mesh finds the contact at this step).
@@ -19,7 +19,7 @@ const RAMP_STEPS: &str = "5";
 #[test]
 fn centre_ramp_and_hold_on_the_smoke_mesh_against_the_filter() {
     let (_d, set) = campaign_copy();
-    let (c, _) = needle_fe::spec::load(&set).expect("spec");
+    let (c, _) = needle_set::spec::load(&set).expect("spec");
     let v = c.viscoelastic.clone().expect("[viscoelastic]");
     let args = ["fe", "verify", "--qlv", "--qlv-poses", "centre", "--qlv-mesh", "smoke", "--qlv-steps", RAMP_STEPS, "--threads", "1"];
     let o = needle_on(&args, &set);
@@ -32,7 +32,7 @@ fn centre_ramp_and_hold_on_the_smoke_mesh_against_the_filter() {
     for (friction, &speed) in frictions.iter().flat_map(|f| v.speeds_mm_per_s.iter().map(move |s| (f, s))) {
         let run = friction.name(&needle_fe::visco::run_name("centre", speed));
         let text = std::fs::read_to_string(set.join(format!("fe/visco/{run}.csv"))).expect("visco csv");
-        let (times, rows) = needle_fe::results::parse_timed_csv(&text, Path::new(&run)).expect("timed csv");
+        let (times, rows) = needle_set::results::parse_timed_csv(&text, Path::new(&run)).expect("timed csv");
         let steps = 5 + v.hold_steps as usize;
         assert_eq!((times.len(), rows.len()), (steps + 1, steps + 1), "{run}");
         let end = c.loading.depth_mm / speed + v.hold_s;

@@ -1,8 +1,8 @@
 //! `/set.json` of the explorer: what the page needs besides the evaluator.
 
 use anyhow::{Context, Result};
-use needle_fe::set_folder::SetFolder;
 use needle_fit::data::{run_path, FeRuns};
+use needle_set::set_folder::SetFolder;
 use serde_json::{json, Value};
 
 /// The set's name, the folder as given on the command line (for "copy as command"), the

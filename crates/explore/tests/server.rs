@@ -56,7 +56,7 @@ fn a_client_that_never_reads_does_not_stall_another() {
 
 #[test]
 fn set_json_leaves_out_a_run_without_a_manifest_entry() {
-    let root = needle_firmware_host::workspace_root().join("coeffs/default");
+    let root = needle_stdx::workspace_root().join("coeffs/default");
     let d = tempfile::tempdir().expect("tempdir");
     let set = d.path().join("set");
     std::fs::create_dir_all(set.join("fe")).expect("mkdir");
@@ -65,10 +65,10 @@ fn set_json_leaves_out_a_run_without_a_manifest_entry() {
         std::fs::copy(root.join("fe").join(f), set.join("fe").join(f)).expect("copy run");
     }
     let path = set.join("fe").join("manifest.toml");
-    let mut m = needle_fe::manifest::read_manifest(&path).expect("manifest");
+    let mut m = needle_set::manifest::read_manifest(&path).expect("manifest");
     m.pose.retain(|name, _| name == "centre");
-    std::fs::write(&path, needle_fe::manifest::manifest_text(&m).expect("text")).expect("write");
-    let opened = needle_fe::set_folder::SetFolder::open(&set).expect("open the set");
+    std::fs::write(&path, needle_set::manifest::manifest_text(&m).expect("text")).expect("write");
+    let opened = needle_set::set_folder::SetFolder::open(&set).expect("open the set");
     let v = needle_explore::set_json::set_json(&opened).expect("set.json");
     let names: Vec<&str> = v["runs"].as_array().expect("runs").iter().filter_map(|r| r["name"].as_str()).collect();
     assert_eq!(names, ["centre"], "x+04.csv has no manifest entry: not served");

@@ -3,7 +3,7 @@
 //! `fe::ccx::CcxBackend` and `fe::febio::FebioBackend` (the engine of a run:
 //! [`engines::backend_for`](crate::engines::backend_for)); tests inject other backends.
 
-use crate::mesh_summary::MeshSummary;
+use crate::mesh::summary::MeshSummary;
 use crate::spec::{Campaign, MeshLevel, PoseSpec};
 use anyhow::Result;
 use needle_contract::COMPONENT_COUNT;

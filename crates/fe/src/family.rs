@@ -18,8 +18,7 @@
 
 use crate::spec::{family::member_name, Campaign, FamilySettings, PoseSpec, Tissue};
 
-/// Sub-folder of `<set>/fe/` holding the family's runs and their manifest.
-pub const FAMILY_DIR: &str = "family";
+pub use needle_set::set_folder::FAMILY_DIR;
 
 /// One run variant of the family: a campaign run of its own (its tissue, loading, mesh
 /// and poses).
@@ -92,7 +91,7 @@ mod tests {
     use std::path::Path;
 
     fn shipped() -> Campaign {
-        let text = std::fs::read_to_string(crate::workspace_root().join("coeffs/default/campaign.toml")).expect("campaign.toml");
+        let text = std::fs::read_to_string(needle_stdx::workspace_root().join("coeffs/default/campaign.toml")).expect("campaign.toml");
         crate::spec::parse(&text, Path::new("campaign.toml")).expect("the shipped spec")
     }
 

@@ -1,6 +1,8 @@
-//! The FE campaign: spec, material check, mesh, the engines behind the `Backend` trait
+//! The FE campaign: material check, mesh, the engines behind the `Backend` trait
 //! (`ccx/`: deck writer, runner, result parser, reduction of nodal reactions to the needle
-//! wrench; `febio/`), and the campaign driver (manifest, report, progress, launchers).
+//! wrench; `febio/`), and the campaign driver (report, progress, launchers). The set it
+//! writes (spec, manifest, result and partial-record formats) is `needle-set`'s,
+//! re-exported here under its old paths for the engine's own code.
 #![forbid(unsafe_code)]
 
 pub mod backend;
@@ -11,27 +13,14 @@ pub mod engines;
 pub mod family;
 pub mod febio;
 pub mod launcher;
-pub mod manifest;
 pub mod material;
 pub mod mesh;
-pub mod mesh_summary;
-pub mod partial;
 pub mod process;
-mod progress;
-pub mod read_count;
+mod progress_bar;
 pub mod report;
-pub mod results;
-pub mod results_error;
 pub mod resume;
-pub mod set_folder;
-pub mod spec;
 pub mod verify;
-pub mod versions;
 pub mod visco;
-pub mod wrench;
 
-/// The workspace root (this crate is `crates/fe`), for the unit tests' `coeffs/default`.
-#[cfg(test)]
-pub(crate) fn workspace_root() -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
+// The set (needle-set) under the paths the engine code has always used.
+pub use needle_set::{failures, manifest, partial, read_count, results, results_error, set_folder, spec, versions, wrench};

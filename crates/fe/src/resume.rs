@@ -3,7 +3,7 @@
 //! where it was instead of from attempt 1: `<out>/.work/<pose>/progress.toml`
 //! ([`RECORD_FILE`]).
 //!
-//! The campaign writes it atomically ([`results::write_atomic`]) at the start of each
+//! The campaign writes it atomically ([`needle_stdx::fs::write_atomic`]) at the start of each
 //! attempt and after each failed attempt ([`write()`]), and removes it when the pose is
 //! solved. It holds what identifies the run ([`Identity`]: spec hash, engine and its
 //! version, mesh level, steps), the attempt running (or, after a failure, the next one),
@@ -21,7 +21,6 @@
 //! from its start.
 
 use crate::manifest::rfc3339_utc;
-use crate::results;
 use anyhow::{Context, Result};
 use needle_contract::COMPONENT_COUNT;
 use serde::{Deserialize, Serialize};
@@ -114,7 +113,7 @@ pub fn write(work_dir: &Path, run: &Identity, attempts: u32, start: &Start) -> R
         "# the campaign's record of this pose's attempts (fe/src/resume.rs): a rerun resumes here\n{}",
         toml::to_string(&record).with_context(|| format!("{}: cannot serialise the record", p.display()))?
     );
-    results::write_atomic(&p, text.as_bytes())
+    needle_stdx::fs::write_atomic(&p, text.as_bytes())
 }
 
 /// Remove the record (the pose is solved); a missing record is fine.

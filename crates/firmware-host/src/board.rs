@@ -4,8 +4,9 @@
 //! config applies) into `<target dir>/firmware/<board>`; a build with a warning is an
 //! error.
 use super::build::{check_target, nested_cargo, run_cargo_in, target_dir};
-use super::{size, workspace_root, Core};
+use super::{size, Core};
 use anyhow::bail;
+use needle_stdx::workspace_root;
 use std::path::{Path, PathBuf};
 
 /// One board crate.

@@ -1,22 +1,19 @@
 //! Nested `cargo build`s of the library and its firmware examples for a core.
-use super::{workspace_root, Core};
+use super::Core;
 use anyhow::{bail, Context};
+pub use needle_stdx::cargo::{check_target, nested_cargo};
+use needle_stdx::workspace_root;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Command;
 
 /// The undefined symbol the `no_panic` example's panic handler calls.
 pub const NO_PANIC_SYMBOL: &str = "needle_haptics_panic_path_not_optimised_away";
 
 /// Target folder of the firmware builds: `firmware/` inside the workspace's target folder
-/// (`CARGO_TARGET_DIR`, relative to the workspace root, or `target`).
+/// ([`needle_stdx::cargo::target_dir`]).
 #[must_use]
 pub fn target_dir() -> PathBuf {
-    let root = workspace_root();
-    let base = match std::env::var_os("CARGO_TARGET_DIR") {
-        Some(d) if !d.is_empty() => root.join(d),
-        _ => root.join("target"),
-    };
-    base.join("firmware")
+    needle_stdx::cargo::target_dir().join("firmware")
 }
 
 /// Folder of the release examples of `core` in [`target_dir`].
@@ -25,36 +22,8 @@ pub fn examples_dir(core: &Core) -> PathBuf {
     target_dir().join(core.target).join("release").join("examples")
 }
 
-/// `cargo` as the outer cargo named it (`$CARGO`), else from `PATH`.
-#[must_use]
-pub fn nested_cargo() -> Command {
-    Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()))
-}
-
-/// Checks that the Rust standard library of `target` is installed (rustup target).
-///
-/// # Errors
-/// `rustc` cannot be run, or the target is missing, with the command that installs it.
-pub fn check_target(target: &str) -> anyhow::Result<()> {
-    let rustc = std::env::var_os("RUSTC").unwrap_or_else(|| "rustc".into());
-    let out = Command::new(&rustc)
-        .args(["--print", "sysroot"])
-        .current_dir(workspace_root())
-        .output()
-        .with_context(|| format!("cannot run {} --print sysroot", rustc.to_string_lossy()))?;
-    let sysroot = PathBuf::from(String::from_utf8_lossy(&out.stdout).trim());
-    let lib = sysroot.join("lib").join("rustlib").join(target).join("lib");
-    if !out.status.success() || !lib.is_dir() {
-        bail!(
-            "the Rust target {target} is not installed ({} does not exist): `rustup target add {target}` \
-             (.ci/test installs thumbv7em-none-eabihf, thumbv7m-none-eabi, thumbv6m-none-eabi and wasm32-unknown-unknown)",
-            lib.display()
-        );
-    }
-    Ok(())
-}
-
-/// Runs a nested cargo build; on failure the error holds the end of cargo's output.
+/// Runs a nested cargo build in the workspace root; on failure the error holds the end
+/// of cargo's output.
 ///
 /// # Errors
 /// cargo cannot be started or exits with an error (`what` names the build).
@@ -62,32 +31,23 @@ pub fn run_cargo(cmd: Command, what: &str) -> anyhow::Result<()> {
     run_cargo_in(cmd, &workspace_root(), what).map(drop)
 }
 
-/// [`run_cargo`] in `dir` (cargo reads the `.cargo/config.toml` files from there up);
-/// returns cargo's stderr (its warnings, replayed from the cache on a rebuild).
+/// [`run_cargo`] in `dir` ([`needle_stdx::cargo::run_cargo_in`] with the hint of a
+/// panic path left in the evaluator); returns cargo's stderr.
 ///
 /// # Errors
 /// As [`run_cargo`].
-pub fn run_cargo_in(mut cmd: Command, dir: &Path, what: &str) -> anyhow::Result<String> {
-    cmd.current_dir(dir).stdin(Stdio::null());
-    eprintln!("firmware: building {what}");
-    let out = cmd.output().with_context(|| format!("cannot run cargo to build {what}"))?;
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    if out.status.success() {
-        return Ok(stderr.into_owned());
-    }
-    let tail: Vec<&str> = stderr.lines().rev().take(60).collect::<Vec<_>>().into_iter().rev().collect();
-    let hint = if stderr.contains(NO_PANIC_SYMBOL) {
-        format!(
-            "\nThe link failed on `{NO_PANIC_SYMBOL}`: a panic path (index, unwrap, overflow or \
-             division check) is left in the evaluator. Find it with arm-none-eabi-objdump -d on the \
-             golden example (whose panic handler is defined)."
-        )
-    } else if stderr.contains("can't find crate for `core`") {
-        "\nThe target's standard library is missing: rustup target add it.".to_string()
-    } else {
-        String::new()
-    };
-    bail!("cargo build of {what} failed ({}):\n{}{hint}", out.status, tail.join("\n"))
+pub fn run_cargo_in(cmd: Command, dir: &Path, what: &str) -> anyhow::Result<String> {
+    needle_stdx::cargo::run_cargo_in(cmd, dir, "firmware", what, &|stderr| {
+        if stderr.contains(NO_PANIC_SYMBOL) {
+            format!(
+                "\nThe link failed on `{NO_PANIC_SYMBOL}`: a panic path (index, unwrap, overflow or \
+                 division check) is left in the evaluator. Find it with arm-none-eabi-objdump -d on the \
+                 golden example (whose panic handler is defined)."
+            )
+        } else {
+            String::new()
+        }
+    })
 }
 
 /// The library features of a firmware example build.

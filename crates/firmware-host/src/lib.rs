@@ -71,13 +71,6 @@ pub fn cores(names: &[String]) -> anyhow::Result<Vec<Core>> {
     names.iter().map(|n| core(n)).collect()
 }
 
-/// Root of the workspace (the `needle-haptics` package: Cargo.toml, examples/, memory.x),
-/// two folders above this crate (`crates/firmware-host`).
-#[must_use]
-pub fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).ancestors().nth(2).map_or_else(|| PathBuf::from("../.."), Path::to_path_buf)
-}
-
 /// The set compiled into this build of the host tools (absolute path), the default set
 /// of every firmware command.
 #[must_use]

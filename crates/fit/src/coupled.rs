@@ -200,7 +200,7 @@ pub fn eval_component(f: &ComponentFit, c: usize, pose: Pose64) -> f64 {
 /// Per-component error scales of a set of runs: the largest |Fy| over them (N) for the
 /// forces, times `lever_arm_mm` for the moments (as `needle validate` scales errors).
 pub fn scales(runs: &[&Run], lever_arm_mm: f64) -> [f64; COMPONENT_COUNT] {
-    needle_contract::error_scales(needle_fe::results::peak_fy_n(runs.iter().flat_map(|r| r.rows.iter())), lever_arm_mm)
+    needle_contract::error_scales(needle_set::results::peak_fy_n(runs.iter().flat_map(|r| r.rows.iter())), lever_arm_mm)
 }
 
 /// RMS error per component of `model` over every depth of `runs`, in % of `scale`.

@@ -14,11 +14,10 @@ use super::validate::TABLE2_MIN_DEPTH_MM;
 use crate::contract::COMPONENT_COUNT;
 use crate::eval::float64::{eval, eval_paper, Pose64};
 use anyhow::Result;
-use needle_fe::set_folder::SetFolder;
-use needle_fe::spec::Role;
+use needle_set::set_folder::SetFolder;
+use needle_set::spec::Role;
 use serde::Serialize;
 use std::fmt::Write as _;
-use std::path::Path;
 
 /// Held-out errors of one form.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
@@ -70,7 +69,7 @@ pub struct CoupledReport {
 pub fn held_out(runs: &[&Run], lever_arm_mm: f64, model: impl Fn(Pose64) -> [f64; COMPONENT_COUNT]) -> HeldOut {
     let mut h = HeldOut::default();
     for r in runs {
-        let scale = needle_contract::error_scales(needle_fe::results::peak_fy_n(&r.rows), lever_arm_mm);
+        let scale = needle_contract::error_scales(needle_set::results::peak_fy_n(&r.rows), lever_arm_mm);
         let mut s = [0.0f64; COMPONENT_COUNT];
         for row in &r.rows {
             let w = model(r.pose_at(row.depth_mm));
@@ -144,21 +143,13 @@ pub fn paper_held_out(runs: &[&Run], lever_arm_mm: f64, model: &Model) -> HeldOu
     held_out(runs, lever_arm_mm, |p| eval_paper(model, p).0)
 }
 
-/// Measure the coupled form of the set in `set_dir` against its paper form (fitted here
+/// Measure the coupled form of the opened set `set` against its paper form (fitted here
 /// on the centre and sweep runs, as `form = "paper"` does), whichever form the set
 /// ships: the coupled form is fitted on the training runs present.
 ///
 /// # Errors
 /// The spec, the manifest or a run cannot be read; the paper form cannot be fitted.
-pub fn measure(set_dir: &Path) -> Result<CoupledReport> {
-    measure_in(&SetFolder::open(set_dir)?)
-}
-
-/// [`measure`] of an opened set.
-///
-/// # Errors
-/// As [`measure`].
-pub fn measure_in(set: &SetFolder) -> Result<CoupledReport> {
+pub fn measure(set: &SetFolder) -> Result<CoupledReport> {
     let data = load_paper_data(set)?;
     let paper = fit_paper(&data)?;
     let (campaign, train, unusable) = load_training_runs(set)?;
@@ -314,8 +305,8 @@ mod tests {
     use super::*;
     use crate::cross_terms::{CrossForm, CrossTerms};
     use crate::model::Coupled;
-    use needle_fe::results::Row;
-    use needle_fe::spec::{PoseSpec, Role};
+    use needle_set::results::Row;
+    use needle_set::spec::{PoseSpec, Role};
 
     fn point(runs: usize, lhs: f64, max: f64) -> CurvePoint {
         let h = HeldOut { lhs_worst_rms_pct: lhs, table2_worst_rms_pct: 0.5, table2_fy_max_pct: 20.0, worst_max_pct: max };
@@ -343,7 +334,7 @@ mod tests {
     /// model, so both rows of `needle fit` showed the coupled form's errors.)
     #[test]
     fn the_paper_row_leaves_the_cross_terms_out() {
-        let path = crate::workspace_root().join("coeffs/default/model.toml");
+        let path = needle_stdx::workspace_root().join("coeffs/default/model.toml");
         let mut model = crate::model_file::read(&path).unwrap_or_else(|e| panic!("{e:#}"));
         let pose = PoseSpec { name: "lhs-test".into(), role: Role::Lhs, x_mm: 6.0, z_mm: 0.0, theta_x_deg: 0.0, theta_z_deg: 9.0 };
         let rows: Vec<Row> = (1..=20)

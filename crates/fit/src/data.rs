@@ -4,10 +4,10 @@
 use super::contract::{Sweep, DEPTH_MAX_MM, NCOEF};
 pub use super::run_error::RunError;
 use anyhow::{bail, Context, Result};
-use needle_fe::manifest::Manifest;
-use needle_fe::results::{parse_csv, Row};
-use needle_fe::set_folder::SetFolder;
-use needle_fe::spec::{hex, Campaign, ModelForm, PoseSpec, Role};
+use needle_set::manifest::Manifest;
+use needle_set::results::{parse_csv, Row};
+use needle_set::set_folder::SetFolder;
+use needle_set::spec::{hex, Campaign, ModelForm, PoseSpec, Role};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 
@@ -76,7 +76,7 @@ fn sweep_value(pose: &PoseSpec, k: Sweep) -> (f64, f64) {
     (v, others)
 }
 
-pub use needle_fe::set_folder::run_path;
+pub use needle_set::set_folder::run_path;
 
 /// A set's FE results as the fitter reads them: the spec's loading and the manifest, the
 /// manifest read once ([`FeRuns::open`]) and every run checked against that copy (issue 37:
@@ -138,7 +138,7 @@ fn check_content(manifest: &Manifest, pose: &PoseSpec, path: &Path, bytes: &[u8]
         return Err(RunError::NoHash { path: path.into(), pose: pose.name.clone() });
     };
     if !entry.content_matches(bytes) {
-        let now = needle_fe::results::content_sha256(bytes);
+        let now = needle_set::results::content_sha256(bytes);
         return Err(RunError::ContentChanged { path: path.into(), pose: pose.name.clone(), now, recorded: want.clone() });
     }
     Ok(())
@@ -359,9 +359,9 @@ pub const FAILED_PREFIX: &str = "no result;";
 /// `<set>/fe/<pose>.partial.toml`, written when every attempt failed): the depth reached
 /// and its attempts by class; `None` without a record of the current spec.
 fn failed_record(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Option<String> {
-    use needle_fe::febio::failures;
-    let (_, path) = needle_fe::partial::paths(&set_dir.join("fe"), &pose.name);
-    let r: needle_fe::partial::PartialRecord = toml::from_str(&std::fs::read_to_string(path).ok()?).ok()?;
+    use needle_set::failures;
+    let (_, path) = needle_set::partial::paths(&set_dir.join("fe"), &pose.name);
+    let r: needle_set::partial::PartialRecord = toml::from_str(&std::fs::read_to_string(path).ok()?).ok()?;
     if r.spec_hash != campaign.run_hash(pose, &campaign.campaign.mesh) {
         return None;
     }
@@ -397,7 +397,7 @@ fn load_runs_where(set: &SetFolder, keep: impl Fn(Role) -> bool) -> Result<(Camp
 #[cfg(test)]
 mod tests {
     use super::*;
-    use needle_fe::spec;
+    use needle_set::spec;
 
     /// Issue 42, item 4: a validation run that cannot be solved says how far its furthest
     /// attempt got and why, from the campaign's partial record (of the current spec only).
@@ -410,8 +410,8 @@ mod tests {
         std::fs::copy(root.join("coeffs/default/campaign.toml"), dir.join("campaign.toml")).expect("copy the default spec");
         let (campaign, _) = spec::load(&dir).expect("spec");
         let pose = campaign.poses().into_iter().find(|p| p.name == "t2-b").expect("t2-b");
-        let failure = "febio4 exit code 1 after 6 of 20 steps (t = 1.95 mm): Max nr of reformations reached. (failed to converge at time : 1.95); retry 1 (first increment 1): febio4 exit code 1 after 0 of 20 steps (t = 0.2 mm): 9 negative jacobians detected. (failed to converge at time : 0.21)";
-        let failed = needle_fe::partial::Failed {
+        let failure = "solver exit code 1 after 6 of 20 steps (t = 1.95 mm): Max nr of reformations reached. (failed to converge at time : 1.95); retry 1 (first increment 1): solver exit code 1 after 0 of 20 steps (t = 0.2 mm): 9 negative jacobians detected. (failed to converge at time : 0.21)";
+        let failed = needle_set::partial::Failed {
             campaign: &campaign,
             pose: &pose,
             mesh: &campaign.campaign.mesh,
@@ -419,7 +419,7 @@ mod tests {
             failure,
         };
         let reached: Vec<[f64; 6]> = (1..=6).map(|k| [0.0, 0.001 * f64::from(k), 0.0, 0.0, 0.0, 0.0]).collect();
-        needle_fe::partial::write(&fe, &failed, &reached).expect("partial record");
+        needle_set::partial::write(&fe, &failed, &reached).expect("partial record");
         let (_, _, unusable) = load_validation_runs(&SetFolder::open(&dir).expect("open")).expect("load");
         let why = |name: &str| unusable.iter().find(|u| u.pose.name == name).map(|u| u.why.clone()).unwrap_or_default();
         let t2b = why("t2-b");

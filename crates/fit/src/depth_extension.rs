@@ -11,14 +11,13 @@ use crate::lsq;
 use anyhow::{bail, Context, Result};
 use nalgebra::{DMatrix, DVector};
 use needle_contract::{DEPTH_MAX_MM, FY};
-use needle_fe::results::{content_sha256, parse_csv, Row};
+use needle_set::results::{content_sha256, parse_csv, Row};
 use std::fmt::Write as _;
 use std::path::Path;
 
 /// The file's name inside a set folder.
 pub const FILE: &str = "depth-extension.toml";
-/// The deep runs' folder inside a set's `fe/`.
-pub const DEEP_DIR: &str = "deep";
+pub use needle_set::set_folder::DEEP_DIR;
 /// The run the growth is fitted on.
 pub const CENTRE_RUN: &str = "centre.csv";
 /// Terms of `R - 1` (powers 1..=4 of v).
@@ -123,7 +122,7 @@ pub struct LawCheck {
 ///
 /// # Errors
 /// A run that exists but is unreadable or malformed, or has no row at 6 mm.
-pub fn law_checks(set: &needle_fe::set_folder::SetFolder, e: &DepthExtension) -> Result<Vec<LawCheck>> {
+pub fn law_checks(set: &needle_set::set_folder::SetFolder, e: &DepthExtension) -> Result<Vec<LawCheck>> {
     let c = set.campaign();
     let Some(deep) = &c.deep else { return Ok(Vec::new()) };
     let mut out = Vec::new();

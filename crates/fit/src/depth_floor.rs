@@ -31,7 +31,7 @@ use super::lsq::{lstsq, vandermonde};
 use super::model::rms_max;
 use anyhow::{bail, Result};
 use nalgebra::DVector;
-use needle_fe::results::Row;
+use needle_set::results::Row;
 use serde::Serialize;
 
 /// The floors of one run (module docs).

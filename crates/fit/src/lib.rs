@@ -34,9 +34,8 @@ pub mod unsolved;
 pub mod validate;
 
 use anyhow::Result;
-use needle_fe::set_folder::SetFolder;
+use needle_set::set_folder::SetFolder;
 use std::fmt::Write as _;
-use std::path::Path;
 
 /// Name of the model file inside a set folder (the generator's, which reads it).
 pub use needle_codegen::MODEL_FILE;
@@ -93,25 +92,17 @@ impl FitOutput {
     }
 }
 
-/// Fit the set in `set_dir` and render its output files ([`FitOutput::files`]), without
+/// Fit the opened set `set` and render its output files ([`FitOutput::files`]), without
 /// writing anything.
 ///
 /// # Errors
 /// As [`data::load_fit_data`] (missing or malformed runs, bad spec) and [`model::fit`]
 /// (rank-deficient fits); a model too large for the fixed-point evaluator.
-pub fn fit_set(set_dir: &Path) -> Result<FitOutput> {
-    fit_set_in(&SetFolder::open(set_dir)?)
-}
-
-/// [`fit_set`] of an opened set.
-///
-/// # Errors
-/// As [`fit_set`].
-pub fn fit_set_in(set: &SetFolder) -> Result<FitOutput> {
+pub fn fit_set(set: &SetFolder) -> Result<FitOutput> {
     let set_dir = set.dir();
     let data = data::load_fit_data(set)?;
     let mut model = model::fit(&data)?;
-    if data.campaign.fit.form == needle_fe::spec::ModelForm::Coupled {
+    if data.campaign.fit.form == needle_set::spec::ModelForm::Coupled {
         model = coupled::fit_coupled(&data, &model, data.campaign.needle.reference_from_tip_mm)?;
     }
     // replaced training runs (campaign.train_replaced) are not fitted either: named with
@@ -125,7 +116,7 @@ pub fn fit_set_in(set: &SetFolder) -> Result<FitOutput> {
             .map(|r| format!("{} (replaced by {})", r.pose, data.campaign.replacement_of(&r.pose).unwrap_or_default())),
     );
     let model_toml = model_file::to_toml(&model, &left_out);
-    let region = unsolved::region_in(set)?;
+    let region = unsolved::region(set)?;
     let unsolved_toml = unsolved::to_toml(&model.set, &region);
     let tables = eval::float32::Tables32::from_model(&model).with_unsolved(region.entries());
     let golden_csv = golden::float32::to_csv(&tables);
@@ -168,10 +159,4 @@ pub fn summary(m: &model::Model) -> String {
         }
     }
     s
-}
-
-/// The workspace root (this crate is `crates/fit`), for the unit tests' `coeffs/default`.
-#[cfg(test)]
-pub(crate) fn workspace_root() -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }

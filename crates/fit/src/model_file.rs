@@ -8,7 +8,7 @@ use super::cross_terms::{monomials, CrossForm, CrossTerms, Exponents, CANDIDATES
 use super::model::{Baseline, Coupled, Deviation, Model};
 use crate::contract::COMPONENT_COUNT;
 use crate::model_file_error::ModelFileError;
-use needle_fe::spec::ModelForm;
+use needle_set::spec::ModelForm;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -220,7 +220,7 @@ mod tests {
     use std::path::Path;
 
     fn committed() -> String {
-        std::fs::read_to_string(crate::workspace_root().join("coeffs/default/model.toml")).expect("coeffs/default/model.toml")
+        std::fs::read_to_string(needle_stdx::workspace_root().join("coeffs/default/model.toml")).expect("coeffs/default/model.toml")
     }
 
     /// Each kind of refusal is its own variant; the messages start with the file.

@@ -17,8 +17,8 @@
 use crate::data::{run_path, stale_reason};
 use anyhow::{bail, Result};
 use needle_contract::{DEPTH_MAX_MM, HALF_RANGES};
-use needle_fe::set_folder::SetFolder;
-use needle_fe::spec::{Campaign, PoseSpec};
+use needle_set::set_folder::SetFolder;
+use needle_set::spec::{Campaign, PoseSpec};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -114,36 +114,28 @@ fn round_i64(v: f64) -> i64 {
 }
 
 /// Whether `pose` has a current result in the set (its CSV and a current manifest entry).
-fn solved(set_dir: &Path, manifest: &needle_fe::manifest::Manifest, campaign: &Campaign, pose: &PoseSpec) -> bool {
+fn solved(set_dir: &Path, manifest: &needle_set::manifest::Manifest, campaign: &Campaign, pose: &PoseSpec) -> bool {
     run_path(set_dir, pose).is_file() && stale_reason(manifest, campaign, pose).is_none()
 }
 
 /// A partial record of the current spec: depth reached and the failures by class.
 fn partial_record(set_dir: &Path, campaign: &Campaign, pose: &PoseSpec) -> Option<(f64, String)> {
-    use needle_fe::febio::failures;
-    let (_, path) = needle_fe::partial::paths(&set_dir.join("fe"), &pose.name);
+    use needle_set::failures;
+    let (_, path) = needle_set::partial::paths(&set_dir.join("fe"), &pose.name);
     let text = std::fs::read_to_string(path).ok()?;
-    let r: needle_fe::partial::PartialRecord = toml::from_str(&text).ok()?;
+    let r: needle_set::partial::PartialRecord = toml::from_str(&text).ok()?;
     if r.spec_hash != campaign.run_hash(pose, &campaign.campaign.mesh) {
         return None;
     }
     Some((r.reached_depth_mm, failures::summary(&failures::failures_from_record(&r.failure), "mm")))
 }
 
-/// The region of the set in `set_dir`, from its records (module docs).
+/// The region of the opened set `set`, from its records (module docs).
 ///
 /// # Errors
 /// The spec or the manifest cannot be read; no run of the set is solved while a pose
 /// failed (no radius); more than [`MAX_ENTRIES`] balls.
-pub fn region(set_dir: &Path) -> Result<Region> {
-    region_in(&SetFolder::open(set_dir)?)
-}
-
-/// [`region`] of an opened set.
-///
-/// # Errors
-/// As [`region`].
-pub fn region_in(set: &SetFolder) -> Result<Region> {
+pub fn region(set: &SetFolder) -> Result<Region> {
     let (campaign, manifest, set_dir) = (set.campaign(), set.manifest(), set.dir());
     let poses = campaign.poses();
     let mut solved_points: Vec<(String, [f64; 4])> = Vec::new();

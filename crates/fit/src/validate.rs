@@ -34,12 +34,12 @@ use super::depth_floor::{depth_floor, DepthFloor};
 use super::error_trend::{trend, ErrorTrend};
 use super::model::{rms_max, Model};
 use super::model_file;
-use crate::contract::{COMPONENT_COUNT, DEGREE};
+use crate::contract::COMPONENT_COUNT;
 use crate::eval::float32::{eval as eval32, Tables32};
 use crate::eval::float64::{eval as eval64, eval_paper};
 use anyhow::Result;
-use needle_fe::set_folder::SetFolder;
-use needle_fe::spec::Role;
+use needle_set::set_folder::SetFolder;
+use needle_set::spec::Role;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -246,7 +246,7 @@ pub fn compare_run(
     let w64: Vec<[f64; COMPONENT_COUNT]> = run.rows.iter().map(|r| eval64(model, run.pose_at(r.depth_mm)).0).collect();
     let w32: Vec<[f64; COMPONENT_COUNT]> =
         run.rows.iter().map(|r| eval32(tables, run.pose_at(r.depth_mm).map(|v| v as f32)).0.map(f64::from)).collect();
-    let peak = needle_fe::results::peak_fy_n(&run.rows);
+    let peak = needle_set::results::peak_fy_n(&run.rows);
     let scale = needle_contract::error_scales(peak, lever_arm_mm);
     let e64 = errors(&w64, run, scale);
     let e32 = errors(&w32, run, scale);
@@ -288,28 +288,13 @@ pub fn compare_run(
     )
 }
 
-/// Validate the model of `set_dir` (its `model.toml`) against the set's validation runs.
+/// Validate the model of the opened set `set` (its `model.toml`) against the set's
+/// validation runs, each run's floor computed for models of depth degree `floor_degree`
+/// (the contract's is [`DEGREE`](crate::contract::DEGREE); the goals and errors do not depend on it).
 ///
 /// # Errors
-/// The spec or model.toml cannot be read or is malformed; a present run is malformed.
-pub fn validate(set_dir: &Path) -> Result<Report> {
-    validate_with(set_dir, DEGREE)
-}
-
-/// [`validate_in`] of the set folder `set_dir`, opened once.
-///
-/// # Errors
-/// As [`validate`].
-pub fn validate_with(set_dir: &Path, floor_degree: usize) -> Result<Report> {
-    validate_in(&SetFolder::open(set_dir)?, floor_degree)
-}
-
-/// [`validate`] with each run's floor computed for models of depth degree `floor_degree`
-/// (the contract's is [`DEGREE`]; the goals and errors do not depend on it).
-///
-/// # Errors
-/// As [`validate`].
-pub fn validate_in(set: &SetFolder, floor_degree: usize) -> Result<Report> {
+/// The model.toml cannot be read or is malformed; a present run is malformed.
+pub fn validate(set: &SetFolder, floor_degree: usize) -> Result<Report> {
     let set_dir = set.dir();
     let model = model_file::read(&set.file(super::MODEL_FILE))?;
     let tables = Tables32::from_model(&model);
@@ -341,7 +326,8 @@ pub fn validate_in(set: &SetFolder, floor_degree: usize) -> Result<Report> {
     };
     let table2_goal_met = goal(Role::Table2);
     let lhs_goal_met = goal(Role::Lhs);
-    let flag_tables = Tables32::from_model(&model).with_unsolved(read_region(set_dir)?);
+    // the tables of the comparison, now with the set's unsolved region (built once)
+    let flag_tables = tables.with_unsolved(read_region(set_dir)?);
     let unsolved = missing
         .iter()
         .filter(|u| u.pose.role.is_validation())
@@ -628,11 +614,11 @@ fn worst(r: &Report, role: &str, f: fn(&RunReport) -> f64) -> String {
 mod tests {
     use super::*;
     use crate::unsolved::{inside_f32, normalised, solved_inside, to_toml, FILE};
-    use needle_fe::spec;
+    use needle_set::spec;
 
     /// A copy of the default set's spec, FE runs and model in a temporary folder.
     fn temp_set(tag: &str) -> std::path::PathBuf {
-        let root = crate::workspace_root().join("coeffs/default");
+        let root = needle_stdx::workspace_root().join("coeffs/default");
         let dir = std::env::temp_dir().join(format!("needle-fit-unsolved-{tag}-{}", std::process::id()));
         let fe = dir.join("fe");
         std::fs::create_dir_all(&fe).expect("temp set");
@@ -659,17 +645,17 @@ mod tests {
         std::fs::remove_file(dir.join("fe/t2-b.csv")).expect("t2-b's result in the copy");
         let (campaign, _) = spec::load(&dir).expect("spec");
         let pose = campaign.poses().into_iter().find(|p| p.name == "t2-b").expect("t2-b");
-        let failed = needle_fe::partial::Failed {
+        let failed = needle_set::partial::Failed {
             campaign: &campaign,
             pose: &pose,
             mesh: &campaign.campaign.mesh,
             engine: ("febio", "4.11.0"),
             failure:
-                "febio4 exit code 1 after 6 of 20 steps (t = 1.95 mm): Max nr of reformations reached. (failed to converge at time : 1.95)",
+                "solver exit code 1 after 6 of 20 steps (t = 1.95 mm): Max nr of reformations reached. (failed to converge at time : 1.95)",
         };
         let reached: Vec<[f64; 6]> = (1..=6).map(|k| [0.0, 0.001 * f64::from(k), 0.0, 0.0, 0.0, 0.0]).collect();
-        needle_fe::partial::write(&dir.join("fe"), &failed, &reached).expect("partial record");
-        let r = crate::unsolved::region(&dir).expect("region");
+        needle_set::partial::write(&dir.join("fe"), &failed, &reached).expect("partial record");
+        let r = crate::unsolved::region(&SetFolder::open(&dir).expect("the set")).expect("region");
         let t2b = r.failed.iter().find(|f| f.pose == "t2-b").expect("t2-b is in the region").clone();
         assert_eq!((t2b.source.as_str(), t2b.reached_depth_mm, t2b.depth_q16), ("fe/t2-b.partial.toml", Some(1.8), 117_965));
         assert!(t2b.cause.contains("max reformations"), "{}", t2b.cause);
@@ -680,7 +666,7 @@ mod tests {
         assert!(!inside_f32(&entries, n, 1.8) && inside_f32(&entries, n, 2.1), "deeper than it reached only");
         // the model carries it once `needle fit` writes unsolved.toml; validate then says so
         std::fs::write(dir.join(FILE), to_toml("default", &r)).expect("unsolved.toml");
-        let report = validate(&dir).expect("validate");
+        let report = validate(&SetFolder::open(&dir).expect("the set"), crate::contract::DEGREE).expect("validate");
         let table = to_table(&report);
         let _ = std::fs::remove_dir_all(&dir);
         let u = report.unsolved.iter().find(|u| u.name == "t2-b").expect("t2-b reported");

@@ -8,12 +8,12 @@
 
 use super::panel::{Panel, Series, Style, COMPONENT_COLOURS, MIN_SPAN_OF_SCALE};
 use anyhow::Result;
-use needle_fe::set_folder::SetFolder;
-use needle_fe::spec::Role;
 use needle_fit::contract::{unit, Sweep, COMPONENTS, DEPTH_MAX_MM};
 use needle_fit::data::{load_fit_data, load_validation_runs, Run};
 use needle_fit::eval::float64::eval;
 use needle_fit::model::Model;
+use needle_set::set_folder::SetFolder;
+use needle_set::spec::Role;
 use plotters::style::RGBColor;
 
 const GREY: RGBColor = RGBColor(90, 90, 90);
@@ -138,7 +138,7 @@ fn fig8(model: &Model, table2: &[&Run]) -> Vec<Panel> {
 
 /// Parity: model against FE at every depth of every validation run, forces and moments.
 fn parity(model: &Model, held: &[&Run], lever_arm_mm: f64) -> Vec<Panel> {
-    let scales = needle_contract::error_scales(needle_fe::results::peak_fy_n(held.iter().flat_map(|r| r.rows.iter())), lever_arm_mm);
+    let scales = needle_contract::error_scales(needle_set::results::peak_fy_n(held.iter().flat_map(|r| r.rows.iter())), lever_arm_mm);
     [(0..3, "forces", "N"), (3..6, "moments about the hub", "N*mm")]
         .into_iter()
         .map(|(cs, what, u)| {
@@ -273,7 +273,7 @@ pub fn figures(set: &SetFolder, model: &Model) -> Result<Vec<Figure>> {
     let held: Vec<&Run> = validation.iter().filter(|r| r.pose.role.is_validation()).collect();
     // The model curves' scales: the centre run's peak |Fy|, times the lever arm for moments.
     let scales =
-        needle_contract::error_scales(needle_fe::results::peak_fy_n(data.centre.rows.iter()), campaign.needle.reference_from_tip_mm);
+        needle_contract::error_scales(needle_set::results::peak_fy_n(data.centre.rows.iter()), campaign.needle.reference_from_tip_mm);
     let mut out = vec![
         Figure {
             file: "fig4-centre.svg",

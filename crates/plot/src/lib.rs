@@ -7,8 +7,8 @@ pub mod figures;
 pub mod panel;
 
 use anyhow::{Context, Result};
-use needle_fe::set_folder::SetFolder;
 use needle_fit::{model_file, MODEL_FILE};
+use needle_set::set_folder::SetFolder;
 
 /// Width and height of one panel, pixels.
 pub const PANEL_PX: (u32, u32) = (520, 360);

@@ -4,10 +4,10 @@
 
 #![allow(dead_code)]
 
-use needle_fe::manifest::{manifest_text, Manifest, ManifestEntry, MANIFEST};
-use needle_fe::results::{content_sha256, to_csv, Row};
-use needle_fe::spec::{self, PoseSpec};
 use needle_fit::{fit_set, FitOutput};
+use needle_set::manifest::{manifest_text, Manifest, ManifestEntry, MANIFEST};
+use needle_set::results::{content_sha256, to_csv, Row};
+use needle_set::spec::{self, PoseSpec};
 use std::path::{Path, PathBuf};
 
 /// Lever arm used to scale moments in the tolerances, mm (the default set's hub).
@@ -104,7 +104,9 @@ fn synthetic_entry(campaign: &spec::Campaign, pose: &PoseSpec) -> ManifestEntry 
 pub fn fitted() -> (tempfile::TempDir, FitOutput) {
     let dir = tempfile::tempdir().expect("tempdir");
     make_set(dir.path(), &[]);
-    let out = fit_set(dir.path()).unwrap_or_else(|e| panic!("fit of the synthetic set: {e:#}"));
+    let out = needle_set::set_folder::SetFolder::open(dir.path())
+        .and_then(|s| fit_set(&s))
+        .unwrap_or_else(|e| panic!("fit of the synthetic set: {e:#}"));
     (dir, out)
 }
 
@@ -114,7 +116,7 @@ pub fn rewrite_run(dir: &Path, pose: &str, rows: &[Row]) {
     let text = to_csv(rows);
     std::fs::write(dir.join("fe").join(format!("{pose}.csv")), &text).expect("write csv");
     let path = dir.join("fe").join(MANIFEST);
-    let mut m = needle_fe::manifest::read_manifest(&path).expect("manifest");
+    let mut m = needle_set::manifest::read_manifest(&path).expect("manifest");
     m.pose.get_mut(pose).expect("entry").csv_sha256 = Some(content_sha256(text.as_bytes()));
     std::fs::write(&path, manifest_text(&m).expect("manifest text")).expect("write manifest");
 }

@@ -8,9 +8,7 @@ pub fn manifest_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-pub fn workspace_root() -> PathBuf {
-    manifest_dir().join("..").join("..")
-}
+pub use needle_stdx::workspace_root;
 
 pub fn golden_csv() -> PathBuf {
     let p = Path::new(needle_haptics::model_info::SET_DIR).join("golden-f32.csv");

@@ -111,7 +111,7 @@ fn write(path: &std::path::Path, text: &str) -> Result<()> {
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
     }
-    needle_fe::results::write_atomic(path, text.as_bytes())?;
+    needle_stdx::fs::write_atomic(path, text.as_bytes())?;
     println!("wrote {}", path.display());
     Ok(())
 }

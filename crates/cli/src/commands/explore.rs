@@ -28,7 +28,7 @@ pub struct ExploreArgs {
 /// The set cannot be read, the wasm build fails, or the port cannot be bound.
 pub fn run(a: ExploreArgs) -> Result<ExitCode> {
     let set = std::path::absolute(&a.set).with_context(|| format!("{}: not a usable path", a.set.display()))?;
-    let set_json = explore::set_json::set_json(&needle_fe::set_folder::SetFolder::open(&a.set)?)?;
+    let set_json = explore::set_json::set_json(&needle_set::set_folder::SetFolder::open(&a.set)?)?;
     let runs = set_json["runs"].as_array().map_or(0, Vec::len);
     eprintln!("needle explore: building the wasm evaluator of {} ...", a.set.display());
     let wasm_path = explore::wasm::build(&set)?;

@@ -1,9 +1,9 @@
 //! `needle fit`: fit the set's model in its form, write model.toml and the golden vectors.
 use anyhow::{Context, Result};
 use clap::Args;
-use needle_fe::results::write_all_atomic;
-use needle_fe::set_folder::SetFolder;
 use needle_fit::{self as fit};
+use needle_set::set_folder::SetFolder;
+use needle_stdx::fs::write_all_atomic;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -65,7 +65,7 @@ fn check_file(path: &Path, want: &str) -> Result<bool> {
 /// invalid, a fit is rank deficient, or a file cannot be written.
 pub fn run(a: FitArgs) -> Result<ExitCode> {
     let set = SetFolder::open(&a.set).with_context(|| format!("needle fit --set {}", a.set.display()))?;
-    let out = fit::fit_set_in(&set).with_context(|| format!("needle fit --set {}", a.set.display()))?;
+    let out = fit::fit_set(&set).with_context(|| format!("needle fit --set {}", a.set.display()))?;
     let files: Vec<(PathBuf, &str)> = out.files().iter().map(|(name, text)| (a.set.join(name), *text)).collect();
     if a.check {
         let mut same = true;
@@ -77,8 +77,8 @@ pub fn run(a: FitArgs) -> Result<ExitCode> {
     let writes: Vec<(&Path, &[u8])> = files.iter().map(|(path, text)| (path.as_path(), text.as_bytes())).collect();
     write_all_atomic(&writes)?;
     print!("{}", fit::summary(&out.model));
-    let coupled = fit::coupled_report::measure_in(&set)
-        .with_context(|| format!("needle fit --set {}: measuring the coupled form", a.set.display()))?;
+    let coupled =
+        fit::coupled_report::measure(&set).with_context(|| format!("needle fit --set {}: measuring the coupled form", a.set.display()))?;
     print!("{}", fit::coupled_report::to_table(&coupled));
     print!("{}", fit::unsolved::summary(&out.unsolved));
     print!("{}", fit::depth_extension::law_summary(&out.depth_law));

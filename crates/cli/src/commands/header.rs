@@ -25,7 +25,7 @@ pub fn run(a: HeaderArgs) -> anyhow::Result<ExitCode> {
     // the C API's own header (functions, types, NEEDLE_STATUS_* / NEEDLE_LOOP_* constants)
     let api = a.out.join("needle.h");
     // both or neither: a failure leaves the old pair as it was
-    needle_fe::results::write_all_atomic(&[(&path, model_info::C_HEADER.as_bytes()), (&api, needle_capi::HEADER.as_bytes())])?;
+    needle_stdx::fs::write_all_atomic(&[(&path, model_info::C_HEADER.as_bytes()), (&api, needle_capi::HEADER.as_bytes())])?;
     println!("wrote {} (the C API: link libneedle_capi.a from `cargo build --release -p needle-capi`)", api.display());
     if model_info::FITTED {
         println!("wrote {} (set {}, fe_sha256 {})", path.display(), model_info::SET, model_info::FE_SHA256);

@@ -46,7 +46,7 @@ pub fn run(a: InsertionPathsArgs) -> Result<ExitCode> {
     std::fs::create_dir_all(&a.out_dir).with_context(|| format!("{}: cannot create", a.out_dir.display()))?;
     for (i, path) in paths::PATHS.iter().enumerate() {
         let file = a.out_dir.join(format!("{}-path{i}.csv", stack.name));
-        needle_fe::results::write_atomic(&file, script(path, stack).as_bytes())?;
+        needle_stdx::fs::write_atomic(&file, script(path, stack).as_bytes())?;
         println!("wrote {}", file.display());
     }
     Ok(ExitCode::SUCCESS)

@@ -2,7 +2,7 @@
 
 use anyhow::{Context, Result};
 use clap::Args;
-use needle_fe::results::write_all_atomic;
+use needle_stdx::fs::write_all_atomic;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -26,7 +26,7 @@ pub struct PlotArgs {
 /// # Errors
 /// The set cannot be read or a figure cannot be written.
 pub fn run(a: PlotArgs) -> Result<ExitCode> {
-    let figures = needle_fe::set_folder::SetFolder::open(&a.set)
+    let figures = needle_set::set_folder::SetFolder::open(&a.set)
         .and_then(|set| needle_plot::render_set(&set))
         .with_context(|| format!("needle plot --set {}", a.set.display()))?;
     let out = a.out.unwrap_or_else(|| a.set.join("figures"));

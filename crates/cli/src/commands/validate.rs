@@ -1,8 +1,8 @@
 //! `needle validate`: compare the set's model with the FE runs it was not fitted on.
 use anyhow::{Context, Result};
 use clap::Args;
-use needle_fe::set_folder::SetFolder;
 use needle_fit::validate as val;
+use needle_set::set_folder::SetFolder;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -30,7 +30,7 @@ pub struct ValidateArgs {
 pub fn run(a: ValidateArgs) -> Result<ExitCode> {
     let floor_degree = a.floor_degree.map_or(needle_contract::DEGREE, usize::from);
     let report = SetFolder::open(&a.set)
-        .and_then(|set| val::validate_in(&set, floor_degree))
+        .and_then(|set| val::validate(&set, floor_degree))
         .with_context(|| format!("needle validate --set {}", a.set.display()))?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

@@ -39,7 +39,7 @@ pub fn show(o: &Output) -> String {
 /// The shipped default set, coeffs/default, the one compiled into the library (read
 /// only: a test that writes into a set works on a copy).
 pub fn shipped_set() -> PathBuf {
-    needle_firmware_host::workspace_root().join("coeffs/default")
+    needle_stdx::workspace_root().join("coeffs/default")
 }
 
 /// [`shipped_set`] as a command-line argument.

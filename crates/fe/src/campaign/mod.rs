@@ -5,7 +5,7 @@
 //!
 //! Files, in the output folder (default `<set>/fe/`):
 //! - `<pose>.csv`: the wrench at `steps + 1` depths (format: coeffs/README.md). Written
-//!   with [`results::write_atomic`]: a killed run never leaves a half-written CSV.
+//!   with [`needle_stdx::fs::write_atomic`]: a killed run never leaves a half-written CSV.
 //! - `manifest.toml`: one table per finished pose (see [`ManifestEntry`]), sorted by
 //!   pose name, rewritten atomically after each pose.
 //! - `manifest.toml.lock`: the lock ([`lock_manifest`]) under which every process
@@ -59,11 +59,10 @@ use solve::{failed_report, solve_pose, work_dir};
 use crate::backend::Backend;
 use crate::engines::backend_for;
 use crate::manifest::{manifest_text, read_manifest, Launched, MANIFEST};
-use crate::mesh_summary;
+use crate::mesh::summary as mesh_summary;
 use crate::process;
-use crate::progress::Progress;
+use crate::progress_bar::Progress;
 use crate::report::{PoseReport, Report};
-use crate::results;
 use crate::spec::{Campaign, Engine, MeshLevel, PoseSpec};
 use anyhow::{Context, Result};
 use std::collections::BTreeMap;
@@ -227,7 +226,7 @@ fn run_planned(opts: &RunOptions, plan: Plan, backend: &mut dyn Backend) -> Resu
         let mut m = read_manifest(&manifest_path)?;
         let recorded = m.record_first_attempts(&campaign, &all, &mesh_name);
         if recorded > 0 {
-            results::write_atomic(&manifest_path, manifest_text(&m)?.as_bytes())?;
+            needle_stdx::fs::write_atomic(&manifest_path, manifest_text(&m)?.as_bytes())?;
             eprintln!(
                 "recorded the first attempt's hash of {recorded} run(s) solved by their first attempt in {}",
                 manifest_path.display()

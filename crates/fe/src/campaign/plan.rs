@@ -169,15 +169,16 @@ fn apply_variant(opts: &RunOptions, campaign: &mut Campaign, spec_path: &Path) -
         }
         let (run, poses) = match opts.visco_speed_mm_per_s {
             Some(speed) => {
-                let friction = if opts.visco_frictionless { crate::visco::Friction::None } else { crate::visco::Friction::Campaign };
-                crate::visco::apply(campaign, &v, speed, campaign.loading.steps, friction)
+                let friction =
+                    if opts.visco_frictionless { crate::spec::visco::Friction::None } else { crate::spec::visco::Friction::Campaign };
+                crate::spec::visco::apply(campaign, &v, speed, campaign.loading.steps, friction)
             }
-            None => crate::visco::apply_frictionless_elastic(campaign, &v).with_context(|| {
+            None => crate::spec::visco::apply_frictionless_elastic(campaign, &v).with_context(|| {
                 format!("{}: the frictionless elastic companions: [viscoelastic] frictionless is not set", spec_path.display())
             })?,
         };
         *campaign = run;
-        return Ok(Variant { mesh: v.mesh, poses: Some(poses), out_dir: opts.set_dir.join("fe").join(crate::visco::VISCO_DIR) });
+        return Ok(Variant { mesh: v.mesh, poses: Some(poses), out_dir: opts.set_dir.join("fe").join(crate::set_folder::VISCO_DIR) });
     }
     if let Some(s) = opts.tissue_scale {
         if !(s.is_finite() && s > 0.0) || opts.out_dir.is_none() {

@@ -8,7 +8,7 @@ use crate::backend::{Backend, Job, SolveFailure, Solved};
 use crate::campaign::tests::{opts, set_dir};
 use crate::campaign::{run_with, RunOptions};
 use crate::manifest::{read_manifest, MANIFEST};
-use crate::mesh_summary::MeshSummary;
+use crate::mesh::summary::MeshSummary;
 use crate::resume::{path, read};
 use anyhow::Result;
 use std::path::Path;

@@ -271,7 +271,7 @@ fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Res
         Some(_) => results::to_timed_csv(&(0..=ctx.steps).map(|k| ctx.campaign.loading.time_at(k)).collect::<Vec<_>>(), &rows),
         None => results::to_csv(&rows),
     };
-    results::write_atomic(&csv, text.as_bytes())?;
+    needle_stdx::fs::write_atomic(&csv, text.as_bytes())?;
     let entry = ManifestEntry {
         spec_hash: ctx.campaign.run_hash(pose, ctx.mesh_name),
         first_attempt_hash: s.retry.is_none().then(|| ctx.campaign.first_attempt_hash(pose, ctx.mesh_name)),
@@ -305,7 +305,7 @@ fn write_results(ctx: &Ctx<'_>, pose: &PoseSpec, s: &Solved, wall_s: f64) -> Res
         batch_job: ctx.launcher.batch_job(),
         replaces: ctx.campaign.replaced_by(&pose.name).map(|r| r.pose.clone()),
         replaced_because: ctx.campaign.replaced_by(&pose.name).map(|r| replaced_because(ctx.out_dir, r)),
-        viscoelastic: crate::visco::describe(ctx.campaign),
+        viscoelastic: crate::spec::visco::describe(ctx.campaign),
     };
     update_manifest(ctx, |m| {
         m.pose.insert(pose.name.clone(), entry);
@@ -325,5 +325,5 @@ fn update_manifest(ctx: &Ctx<'_>, f: impl FnOnce(&mut Manifest)) -> Result<()> {
     if m == before && path.exists() {
         return Ok(());
     }
-    results::write_atomic(&path, manifest_text(&m)?.as_bytes())
+    needle_stdx::fs::write_atomic(&path, manifest_text(&m)?.as_bytes())
 }

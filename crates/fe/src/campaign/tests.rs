@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::backend::{Job, SolveFailure, Solved};
-use crate::mesh_summary::MeshSummary;
+use crate::mesh::summary::MeshSummary;
 use crate::partial;
 use crate::results::Row;
 use crate::resume;
@@ -91,7 +91,7 @@ impl Backend for Fake {
 
 pub(crate) fn set_dir() -> tempfile::TempDir {
     let d = tempfile::tempdir().expect("tempdir");
-    let src = crate::workspace_root().join("coeffs/default/campaign.toml");
+    let src = needle_stdx::workspace_root().join("coeffs/default/campaign.toml");
     std::fs::copy(&src, d.path().join("campaign.toml")).expect("copy the default spec");
     d
 }
@@ -130,7 +130,7 @@ fn writes_results_and_skips_up_to_date_poses() {
     assert_eq!((r.done(), r.up_to_date(), r.failed()), (2, 0, 0), "{}", r.table());
     let fe = d.path().join("fe");
     for name in ["x+02", "x+04"] {
-        let rows = results::read_csv(&fe.join(format!("{name}.csv"))).expect("csv");
+        let rows = crate::results::read_csv(&fe.join(format!("{name}.csv"))).expect("csv");
         assert_eq!(rows.len(), 3);
         assert_eq!(rows[0], Row { depth_mm: 0.0, wrench: [0.0; COMPONENT_COUNT] });
         assert_eq!(rows.iter().map(|r| r.depth_mm).collect::<Vec<_>>(), [0.0, 3.0, 6.0]);
@@ -163,7 +163,7 @@ fn writes_results_and_skips_up_to_date_poses() {
     // another step count is another spec: rerun
     let r = run_with(&opts(d.path(), "x+02", 3), &mut again).expect("steps 3");
     assert_eq!(r.done(), 1);
-    assert_eq!(results::read_csv(&fe.join("x+02.csv")).expect("csv").len(), 4);
+    assert_eq!(crate::results::read_csv(&fe.join("x+02.csv")).expect("csv").len(), 4);
     // --force reruns an up-to-date pose
     let r = run_with(&RunOptions { force: true, ..opts(d.path(), "x+04", 2) }, &mut again).expect("force");
     assert_eq!(r.done(), 1);
@@ -266,7 +266,7 @@ fn a_failed_pose_keeps_its_work_dir_and_the_others_finish() {
     // (issue 18: the entry used to be deleted, and `needle fit` then refused the set)
     let m = read_manifest(&fe.join(MANIFEST)).expect("manifest");
     assert_eq!(m.pose.keys().cloned().collect::<Vec<_>>(), ["x+02", "x+04"]);
-    assert_eq!(results::read_csv(&fe.join("x+04.csv")).expect("csv").len(), 3, "the first result's CSV");
+    assert_eq!(crate::results::read_csv(&fe.join("x+04.csv")).expect("csv").len(), 3, "the first result's CSV");
     // so the next run only solves x+06
     let mut ok = Fake::default();
     let r = run_with(&opts(d.path(), "x+0[246]", 2), &mut ok).expect("resume");
@@ -342,7 +342,7 @@ fn deep_runs_go_to_their_own_folder_at_the_deep_depth() {
     let depth_mm = c.deep.as_ref().map(|d| d.depth_mm).expect("a [deep] section");
     let r = run_with(&deep("centre"), &mut Fake::default()).expect("deep run");
     assert_eq!((r.done(), r.depth_mm), (1, depth_mm), "{}", r.table());
-    let rows = results::read_csv(&d.path().join("fe/deep/centre.csv")).expect("deep csv");
+    let rows = crate::results::read_csv(&d.path().join("fe/deep/centre.csv")).expect("deep csv");
     let want: Vec<f64> = (0..=5).map(|k| depth_mm * f64::from(k) / 5.0).collect();
     assert_eq!(rows.iter().map(|r| r.depth_mm).collect::<Vec<_>>(), want);
     assert_eq!(rows[5].wrench[1], depth_mm * depth_mm, "the fake's depth squared at the deep depth");
@@ -369,7 +369,7 @@ fn family_runs_go_to_their_own_folder_with_the_members_tissue() {
     let r = run_with(&run(FamilyRun::Centre { alpha }), &mut Fake::default()).expect("family centre");
     assert_eq!((r.done(), r.depth_mm), (1, f.depth_mm), "{}", r.table());
     let name = spec::family::member_name("centre", alpha);
-    let rows = results::read_csv(&d.path().join(format!("fe/family/{name}.csv"))).expect("family csv");
+    let rows = crate::results::read_csv(&d.path().join(format!("fe/family/{name}.csv"))).expect("family csv");
     assert_eq!(rows.last().map(|r| r.depth_mm), Some(f.depth_mm));
     assert!(!d.path().join("fe/centre.csv").exists(), "nothing written beside the campaign's runs");
     let m = read_manifest(&d.path().join("fe/family").join(MANIFEST)).expect("family manifest");
@@ -398,7 +398,7 @@ fn a_pose_failing_every_attempt_keeps_its_furthest_must_points() {
     assert_eq!(r.failed(), 1, "{}", r.table());
     assert!(r.table().contains("the 2 must point(s) reached are kept in x+04.partial.csv"), "{}", r.table());
     let (csv, rec) = partial::paths(&fe, "x+04");
-    let rows = results::read_csv(&csv).expect("partial csv");
+    let rows = crate::results::read_csv(&csv).expect("partial csv");
     assert_eq!(rows.iter().map(|r| (r.depth_mm, r.fy_n())).collect::<Vec<_>>(), [(0.0, 0.0), (1.5, 1.0), (3.0, 2.0)]);
     let text = std::fs::read_to_string(&rec).expect("record");
     assert!(text.contains("reached_depth_mm = 3.0") && text.contains("fake stop 0; retry 1"), "{text}");

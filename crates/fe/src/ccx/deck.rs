@@ -14,8 +14,8 @@
 //! - `*FRICTION` second value: stick slope (ABAQUS: `SLIP TOLERANCE` / `ELASTIC SLIP`);
 //! - `*TIME POINTS` and `TIME POINTS=` on print requests (ABAQUS: `*OUTPUT, TIME POINTS=`).
 
+use crate::mesh::summary::{model_name, MeshSummary};
 use crate::mesh::{self, NeedleMesh, TissueMesh};
-use crate::mesh_summary::{model_name, MeshSummary};
 use crate::spec::{Campaign, MeshLevel, PoseSpec, Symmetry};
 use anyhow::{bail, Result};
 use std::fmt::Write;

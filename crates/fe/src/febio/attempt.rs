@@ -624,7 +624,7 @@ mod level_tolerance_tests {
 
     /// The shipped spec and its `fine` level (the mesh study's reference).
     fn shipped_fine() -> (Campaign, MeshLevel) {
-        let set = crate::workspace_root().join("coeffs/default");
+        let set = needle_stdx::workspace_root().join("coeffs/default");
         let (c, _) = crate::spec::load(&set).expect("the shipped spec");
         let own = c.mesh_level("fine").expect("fine").clone();
         (c, own)
@@ -717,7 +717,7 @@ mod level_tolerance_tests {
     /// not of the first-attempt hash.
     #[test]
     fn a_levels_retry_residual_tolerance_replaces_the_retrys_and_only_there() {
-        let set = crate::workspace_root().join("coeffs/default");
+        let set = needle_stdx::workspace_root().join("coeffs/default");
         let (c, _) = crate::spec::load(&set).expect("the shipped spec");
         let own = c.mesh_level("core6").expect("core6").clone();
         let centre = c.pose.iter().find(|p| p.name == "centre").expect("centre");
@@ -746,7 +746,7 @@ mod level_tolerance_tests {
     /// the retry settings are part of the first attempt's.
     #[test]
     fn a_level_may_give_its_first_attempt_the_retry_tolerances() {
-        let set = crate::workspace_root().join("coeffs/default");
+        let set = needle_stdx::workspace_root().join("coeffs/default");
         let (c, _) = crate::spec::load(&set).expect("the shipped spec");
         let plain = MeshLevel { first_attempt_retry_tolerances: None, ..c.mesh_level("core6").expect("core6").clone() };
         let own = MeshLevel { first_attempt_retry_tolerances: Some(true), ..plain.clone() };

@@ -1,31 +1,12 @@
 //! Why a pose could not be solved, by class, from the logs its failed FEBio attempts
 //! left in its work folder (`failed-attempt-<n>.log`, kept by the campaign; issue 42:
 //! the failed attempts by class, where and at which depth). `needle fe status` shows the
-//! summary in its cause column.
+//! summary in its cause column. The classes and the summary are the set's
+//! (`needle_set::failures`): the fitter reads them from a pose's partial record.
 
 use super::logs::parse_run_log;
-use std::collections::BTreeMap;
+pub use needle_set::failures::{class_of, failures_from_record, summary, AttemptFailure};
 use std::path::Path;
-
-/// One failed attempt.
-#[derive(Debug, Clone, PartialEq)]
-pub struct AttemptFailure {
-    /// Attempt number, 1-based (the ladder of `FebioBackend::attempts`).
-    pub attempt: u32,
-    /// The class: `negative jacobian`, `max reformations`, `diverged`, `stopped` (no
-    /// error in the log: killed on a stall, timeout or Ctrl-C) or `other`.
-    pub class: &'static str,
-    /// Where it failed in the solver's time (depth in mm; s of a ramp-and-hold run,
-    /// `Loading::time_unit`): FEBio's "failed to converge at time",
-    /// else the last converged time.
-    pub depth_mm: f64,
-    /// FEBio's own words, when it gave any.
-    pub cause: Option<String>,
-    /// The smallest residual Newton reached in the time step that failed last, N (the
-    /// root of FEBio's squared norm; from the log, `None` without one): where a stalled
-    /// attempt stood against an absolute floor (`[solver.febio] retry_min_residual_n`).
-    pub least_residual_n: Option<f64>,
-}
 
 /// The smallest "residual" norm (the current one, rooted) of the last time step of `log`
 /// that failed to converge.
@@ -42,20 +23,6 @@ fn least_residual_of_last_failure(log: &str) -> Option<f64> {
         .filter(|v| v.is_finite() && *v >= 0.0)
         .reduce(f64::min)
         .map(f64::sqrt)
-}
-
-/// The class of a failure from FEBio's words (`None`: no error stated).
-pub fn class_of(cause: Option<&str>) -> &'static str {
-    let Some(c) = cause.map(str::to_ascii_lowercase) else { return "stopped" };
-    if c.contains("negative jacobian") {
-        "negative jacobian"
-    } else if c.contains("max nr of reformations") {
-        "max reformations"
-    } else if c.contains("diverg") {
-        "diverged"
-    } else {
-        "other"
-    }
 }
 
 /// Read `failed-attempt-<n>.log` (n = 1, 2, ...) in `work_dir`.
@@ -78,64 +45,6 @@ pub fn read_failures(work_dir: &Path) -> Vec<AttemptFailure> {
         });
     }
     out
-}
-
-/// The attempts of a pose's `.partial.toml` record (its `failure`: the campaign's
-/// messages of every attempt, `"; retry "` between them), for a pose whose work folder
-/// and its logs are gone: class from FEBio's words in each message (`stopped` when the
-/// runner killed it: interrupted, timed out or stalled), depth from "failed to converge
-/// at time" or else the message's `t = ... mm`.
-pub fn failures_from_record(failure: &str) -> Vec<AttemptFailure> {
-    failure
-        .split("; retry ")
-        .filter(|m| !m.trim().is_empty())
-        .zip(1u32..)
-        .map(|(m, attempt)| {
-            let after = |key: &str| {
-                m.rfind(key).and_then(|i| m.get(i + key.len()..)).and_then(|r| {
-                    let num: String =
-                        r.trim_start().chars().take_while(|c| c.is_ascii_digit() || *c == '.' || *c == 'e' || *c == '-').collect();
-                    num.parse::<f64>().ok()
-                })
-            };
-            let killed = m.contains("(killed)");
-            AttemptFailure {
-                attempt,
-                class: if killed { "stopped" } else { class_of(Some(m)) },
-                depth_mm: after("failed to converge at time :").or_else(|| after("(t =")).unwrap_or(0.0),
-                cause: Some(m.trim().to_string()),
-                least_residual_n: None,
-            }
-        })
-        .collect()
-}
-
-/// One line: `5 failed attempt(s), furthest 5.22 mm: negative jacobian x3 (0.6, 0.86, 2.69 mm), max reformations x2 (...)`;
-/// empty when there are none. `unit`: of the solver's time, `Loading::time_unit` (mm of
-/// depth, s of a ramp-and-hold run).
-pub fn summary(failures: &[AttemptFailure], unit: &str) -> String {
-    if failures.is_empty() {
-        return String::new();
-    }
-    let mut by_class: BTreeMap<&str, Vec<&AttemptFailure>> = BTreeMap::new();
-    for f in failures {
-        by_class.entry(f.class).or_default().push(f);
-    }
-    let furthest = failures.iter().map(|f| f.depth_mm).fold(0.0, f64::max);
-    let classes: Vec<String> = by_class
-        .iter()
-        .map(|(c, fs)| {
-            let depths = fs.iter().map(|f| format!("{}", (f.depth_mm * 100.0).round() / 100.0)).collect::<Vec<_>>().join(", ");
-            let least: Vec<String> = fs.iter().filter_map(|f| f.least_residual_n).map(|r| format!("{r:.1e}")).collect();
-            let stalled = if *c == "max reformations" && !least.is_empty() {
-                format!("; least residual {} N", least.join(", "))
-            } else {
-                String::new()
-            };
-            format!("{c} x{} ({depths} {unit}{stalled})", fs.len())
-        })
-        .collect();
-    format!("{} failed attempt(s), furthest {:.2} {unit}: {}", failures.len(), furthest, classes.join("; "))
 }
 
 #[cfg(test)]

@@ -24,8 +24,8 @@
 //!   stress; the bulk modulus stays the Ogden's) and its time is seconds: the feed curve
 //!   ramps to the depth at the set speed and holds, the must points are the run's.
 
+use crate::mesh::summary::{model_name, MeshSummary};
 use crate::mesh::{self, NeedleMesh, TissueMesh, FACES};
-use crate::mesh_summary::{model_name, MeshSummary};
 use crate::spec::{Campaign, FebioSettings, Loading, MeshLevel, PoseSpec, Symmetry};
 use anyhow::{bail, Result};
 use std::fmt::Write;
@@ -505,14 +505,14 @@ mod tests {
     use std::path::Path;
 
     fn shipped() -> String {
-        std::fs::read_to_string(crate::workspace_root().join("coeffs/default/campaign.toml")).expect("campaign.toml")
+        std::fs::read_to_string(needle_stdx::workspace_root().join("coeffs/default/campaign.toml")).expect("campaign.toml")
     }
 
     #[test]
     fn the_feb_wraps_the_ogden_and_runs_in_seconds() {
         let c = crate::spec::parse(&shipped(), Path::new("campaign.toml")).expect("the shipped spec");
         let v = c.viscoelastic.clone().expect("[viscoelastic]");
-        let (run, poses) = crate::visco::apply(&c, &v, 1.0, 4, crate::visco::Friction::Campaign);
+        let (run, poses) = crate::spec::visco::apply(&c, &v, 1.0, 4, crate::spec::visco::Friction::Campaign);
         let pose = poses.first().expect("a pose");
         let mesh = run.mesh_level("smoke").expect("smoke").clone();
         let feb = write(&run, pose, &mesh, run.loading.steps, 1.0).expect("feb");
@@ -543,7 +543,7 @@ mod tests {
         assert!(close(floor(&c, 1.0), 1e-20), "a first attempt: FEBio's own");
         assert!(close(floor(&c, 0.25), 1e-8), "the retry: (1e-4 N)^2");
         let v = c.viscoelastic.clone().expect("[viscoelastic]");
-        let (run, _) = crate::visco::apply(&c, &v, 1.0, 4, crate::visco::Friction::Campaign);
+        let (run, _) = crate::spec::visco::apply(&c, &v, 1.0, 4, crate::spec::visco::Friction::Campaign);
         assert!(close(floor(&run, 0.25), 1e-8), "the larger floor: the retry's 1e-4 N over the hold's 1e-5 N");
         assert!(close(floor(&run, 1.0), 1e-10), "the hold's (1e-5 N)^2");
     }

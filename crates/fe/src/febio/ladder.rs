@@ -236,7 +236,7 @@ impl State {
             "# the FEBio retry ladder's state of this pose (fe/febio/ladder.rs); removed with the work folder\n{}",
             toml::to_string(self).context("cannot serialise the ladder's state")?
         );
-        crate::results::write_atomic(&p, text.as_bytes())
+        needle_stdx::fs::write_atomic(&p, text.as_bytes())
     }
 
     /// Whether a failed attempt that reached `steps` must points is further than the kept

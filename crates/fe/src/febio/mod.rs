@@ -382,7 +382,7 @@ mod tests {
         let d = tempfile::tempdir().expect("tempdir");
         let set = d.path().join("set");
         std::fs::create_dir_all(&set).expect("mkdir");
-        std::fs::copy(crate::workspace_root().join("coeffs/default/campaign.toml"), set.join("campaign.toml")).expect("copy");
+        std::fs::copy(needle_stdx::workspace_root().join("coeffs/default/campaign.toml"), set.join("campaign.toml")).expect("copy");
         let (mut c, _) = crate::spec::load(&set).expect("spec");
         c.loading.steps = 4;
         let pose = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");
@@ -446,7 +446,7 @@ mod tests {
         let d = tempfile::tempdir().expect("tempdir");
         let set = d.path().join("set");
         std::fs::create_dir_all(&set).expect("mkdir");
-        std::fs::copy(crate::workspace_root().join("coeffs/default/campaign.toml"), set.join("campaign.toml")).expect("copy");
+        std::fs::copy(needle_stdx::workspace_root().join("coeffs/default/campaign.toml"), set.join("campaign.toml")).expect("copy");
         let (mut c, _) = crate::spec::load(&set).expect("spec");
         c.loading.steps = 4;
         let pose = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");

@@ -30,7 +30,6 @@
 
 use super::logs::RigidRecord;
 use super::{feb, ladder, pick_steps};
-use crate::results;
 use crate::spec::Loading;
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
@@ -83,7 +82,7 @@ pub fn write(work_dir: &Path, r: &Running) -> Result<()> {
         "# the running FEBio attempt of this pose (fe/febio/running.rs): a rerun goes on from pose.dmp\n{}",
         toml::to_string(r).with_context(|| format!("{}: cannot serialise", p.display()))?
     );
-    results::write_atomic(&p, text.as_bytes())
+    needle_stdx::fs::write_atomic(&p, text.as_bytes())
 }
 
 /// Read `running.toml`; `Ok(None)` when there is none.
@@ -342,7 +341,7 @@ pub(crate) mod tests {
         let d = tmp.path().to_path_buf();
         let set = d.join("set");
         std::fs::create_dir_all(&set).expect("mkdir");
-        std::fs::copy(crate::workspace_root().join("coeffs/default/campaign.toml"), set.join("campaign.toml")).expect("copy");
+        std::fs::copy(needle_stdx::workspace_root().join("coeffs/default/campaign.toml"), set.join("campaign.toml")).expect("copy");
         let (mut c, _) = crate::spec::load(&set).expect("spec");
         c.loading.steps = 4;
         let pose = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");

@@ -5,7 +5,7 @@
 //! neither queue waiting nor the slower cores a cluster may have.
 
 use crate::campaign::Plan;
-use crate::mesh_summary;
+use crate::mesh::summary as mesh_summary;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 

@@ -26,7 +26,6 @@
 use crate::campaign::{self, Plan, RunOptions};
 use crate::manifest::rfc3339_utc;
 use crate::process::which;
-use crate::results;
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -241,11 +240,11 @@ pub fn submit(opts: &RunOptions, slurm: &SlurmOptions) -> Result<SubmitReport> {
         }
     };
     let sub = Submission { job_id: job_id.clone(), date: rfc3339_utc(SystemTime::now()), poses, sbatch: args };
-    results::write_atomic(&slurm_dir.join(format!("{job_id}.sh")), script.as_bytes())?;
+    needle_stdx::fs::write_atomic(&slurm_dir.join(format!("{job_id}.sh")), script.as_bytes())?;
     let mut all = earlier;
     all.submission.push(sub.clone());
     let text = toml::to_string(&all).context("cannot write the submissions record")?;
-    results::write_atomic(&slurm_dir.join(SUBMISSIONS), text.as_bytes())?;
+    needle_stdx::fs::write_atomic(&slurm_dir.join(SUBMISSIONS), text.as_bytes())?;
     report.submission = Some(sub);
     report.resources = Some(res);
     Ok(report)

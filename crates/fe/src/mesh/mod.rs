@@ -7,6 +7,7 @@
 //! block occupies |x| <= size_x/2, |z| <= size_z/2, -depth <= y <= 0.
 
 mod needle;
+pub mod summary;
 mod tissue;
 
 pub use needle::needle;

@@ -145,7 +145,7 @@ pub fn edge_study(c: &Campaign, o: &MeshOptions) -> Result<Vec<EdgeStudy>> {
 
 #[cfg(test)]
 mod tests {
-    use crate::deep::shipped_key;
+    use crate::spec::shipped_key;
     use std::path::Path;
 
     #[test]

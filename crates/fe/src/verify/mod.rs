@@ -22,7 +22,6 @@ pub mod mesh_check;
 mod mirror;
 pub mod punch;
 pub mod punch_febio;
-pub mod qlv;
 pub mod runs;
 pub mod scaling;
 pub mod shape;
@@ -36,7 +35,6 @@ pub use punch::{
 };
 pub use smooth::{SmoothReport, SMOOTH_GOAL_PERCENT};
 
-use super::results;
 use super::spec;
 use anyhow::{Context, Result};
 use serde::Serialize;
@@ -234,7 +232,7 @@ pub fn write_tables(set_dir: &std::path::Path, new: toml::Table) -> Result<()> {
         old.insert(k, v);
     }
     let text = format!("# written by `needle fe verify`; do not edit\n{}", toml::to_string(&old)?);
-    results::write_atomic(&path, text.as_bytes())?;
+    needle_stdx::fs::write_atomic(&path, text.as_bytes())?;
     println!("wrote {}", path.display());
     Ok(())
 }

@@ -90,14 +90,14 @@ pub fn run(a: CalibrateArgs) -> Result<ExitCode> {
         a.needle_diameter_mm,
         a.speed_mm_per_s
     );
-    needle_fe::results::write_atomic(&out, c.stack.to_toml(&header).as_bytes())?;
+    needle_stdx::fs::write_atomic(&out, c.stack.to_toml(&header).as_bytes())?;
     println!("wrote {}", out.display());
     let figure = a.figure.unwrap_or_else(|| a.set.join("figures").join(format!("calibration-{}.svg", a.name)));
     if let Some(dir) = figure.parent() {
         std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
     }
     let svg = self::figure::svg(&c, &a.name, "measured")?;
-    needle_fe::results::write_atomic(&figure, svg.as_bytes())?;
+    needle_stdx::fs::write_atomic(&figure, svg.as_bytes())?;
     println!("wrote {}", figure.display());
     println!("result: {}", if all_met { "every calibration goal met" } else { "FAIL (a goal is missed)" });
     Ok(if all_met { ExitCode::SUCCESS } else { ExitCode::from(1) })

@@ -30,7 +30,7 @@ pub const MAX_ECHO_CHARS: usize = 40;
 /// `text` as a message shows it: quoted, cut after [`MAX_ECHO_CHARS`] characters with
 /// its length in bytes.
 fn echo(text: &str) -> String {
-    needle_fe::results_error::echo_cut(text, MAX_ECHO_CHARS)
+    needle_set::results_error::echo_cut(text, MAX_ECHO_CHARS)
 }
 
 /// The pose columns' indices in `header` (in [`POSE_COLUMNS`] order).

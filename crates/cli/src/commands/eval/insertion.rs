@@ -146,7 +146,7 @@ pub fn eval_script(file: &Path, stack_name: &str, prony: Option<&str>, out: Opti
     let body = to_csv(&times, &poses, &evals);
     match out {
         Some(path) => {
-            needle_fe::results::write_atomic(path, body.as_bytes())?;
+            needle_stdx::fs::write_atomic(path, body.as_bytes())?;
             eprintln!("wrote {} ({} ticks of {} s through {})", path.display(), poses.len(), period, stack.name);
         }
         None => {

@@ -140,7 +140,7 @@ fn eval_file(file: &Path, out: Option<&Path>, json: bool) -> anyhow::Result<Exit
     let body = serde_json::to_string_pretty(&to_json(&poses, &evals))? + "\n";
     match out {
         Some(path) => {
-            needle_fe::results::write_atomic(path, body.as_bytes())?;
+            needle_stdx::fs::write_atomic(path, body.as_bytes())?;
             eprintln!("wrote {} ({} poses)", path.display(), poses.len());
         }
         None => {

@@ -192,7 +192,7 @@ fn format_rows(poses: &[Pose], text: &mut String) {
 /// As [`stream`]; nothing is written then.
 pub fn eval_csv(file: &Path, out: Option<&Path>) -> Result<usize> {
     match out {
-        Some(path) => needle_fe::results::write_atomic_streamed(path, |w| stream(file, Some(w))),
+        Some(path) => needle_stdx::fs::write_atomic_streamed(path, |w| stream(file, Some(w))),
         None => {
             stream(file, None)?;
             let stdout = std::io::stdout();

@@ -4,7 +4,7 @@ use super::solve::{with_solve, SolveArgs};
 use super::spec::{spec_options, SpecArgs};
 use clap::Args;
 use needle_fe::campaign::{self, RunOptions};
-use needle_fe::manifest::Launched;
+use needle_set::manifest::Launched;
 use std::process::ExitCode;
 
 /// Arguments of the hidden `needle fe run-one`: the spec options of `fe run` (the batch

@@ -46,7 +46,7 @@ pub struct SpecArgs {
 /// The run options of `spec`, the others at their defaults.
 pub fn spec_options(spec: SpecArgs) -> anyhow::Result<RunOptions> {
     Ok(RunOptions {
-        solver: spec.solver.as_deref().map(needle_fe::spec::Engine::parse).transpose()?,
+        solver: spec.solver.as_deref().map(needle_set::spec::Engine::parse).transpose()?,
         only: spec.only,
         mesh: spec.mesh,
         steps: spec.steps,
@@ -71,12 +71,12 @@ pub fn variants(opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
 /// One run per run of `[family]` (`needle_fe::family::FamilyRun::all`), in order; the
 /// runs `--only` selects nothing of are left out.
 fn family_variants(opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
-    let (c, path) = needle_fe::spec::load(&opts.set_dir)?;
+    let (c, path) = needle_set::spec::load(&opts.set_dir)?;
     let f = c.family.clone().ok_or_else(|| anyhow::anyhow!("{}: --family: the spec has no [family] section", path.display()))?;
     let mut out = Vec::new();
     for run in needle_fe::family::FamilyRun::all(&f) {
         let (_, runs, _) = needle_fe::family::apply(&c, &f, run);
-        if needle_fe::spec::select(&runs, opts.only.as_deref()).is_ok_and(|r| !r.is_empty()) {
+        if needle_set::spec::select(&runs, opts.only.as_deref()).is_ok_and(|r| !r.is_empty()) {
             out.push(RunOptions { family_run: Some(run), ..opts.clone() });
         }
     }
@@ -97,9 +97,9 @@ fn visco_variants(opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
     if !opts.visco {
         return Ok(vec![opts]);
     }
-    let (c, path) = needle_fe::spec::load(&opts.set_dir)?;
+    let (c, path) = needle_set::spec::load(&opts.set_dir)?;
     let v = c.viscoelastic.clone().ok_or_else(|| anyhow::anyhow!("{}: --visco: the spec has no [viscoelastic] section", path.display()))?;
-    let selects = |runs: &[needle_fe::spec::PoseSpec]| needle_fe::spec::select(runs, opts.only.as_deref()).is_ok_and(|r| !r.is_empty());
+    let selects = |runs: &[needle_set::spec::PoseSpec]| needle_set::spec::select(runs, opts.only.as_deref()).is_ok_and(|r| !r.is_empty());
     let mut out = Vec::new();
     for friction in Friction::cases(&v) {
         let frictionless = friction == Friction::None;

@@ -31,7 +31,7 @@ pub fn run(a: StatusArgs) -> anyhow::Result<ExitCode> {
     let r = needle_fe::launcher::status::status(&plan)?;
     print!("{}", r.table());
     print!("{}", needle_fe::launcher::status::attempts_by_class(&plan));
-    if plan.selected.iter().any(|p| p.role == needle_fe::spec::Role::Train) {
+    if plan.selected.iter().any(|p| p.role == needle_set::spec::Role::Train) {
         if let Some(t) = needle_fe::launcher::status::training_coverage(&plan) {
             println!("{t}");
         }

@@ -88,7 +88,7 @@ pub fn bound(c: usize) -> f64 {
 /// model.toml or campaign.toml missing or malformed.
 pub fn load(set_dir: &Path) -> Result<(Model, f64)> {
     let model = model_file::read(&set_dir.join(MODEL_FILE))?;
-    let (campaign, _) = needle_fe::spec::load(set_dir).with_context(|| format!("{}", set_dir.display()))?;
+    let (campaign, _) = needle_set::spec::load(set_dir).with_context(|| format!("{}", set_dir.display()))?;
     Ok((model, campaign.needle.reference_from_tip_mm))
 }
 

@@ -90,7 +90,7 @@ pub fn run(a: VerifyArgs) -> anyhow::Result<ExitCode> {
         // viscoelastic campaign's, `needle fe run --visco`)
         needle_fe::process::stop_jobs_on_termination()?;
         let threads = a.threads.map(|t| t as usize).unwrap_or(1);
-        let opts = needle_fe::verify::qlv::QlvOptions {
+        let opts = needle_fe::visco::qlv::QlvOptions {
             set_dir: a.set.clone(),
             steps: a.qlv_steps,
             mesh: a.qlv_mesh.clone(),
@@ -134,7 +134,7 @@ pub fn run(a: VerifyArgs) -> anyhow::Result<ExitCode> {
         punch_mesh_scale: a.punch_mesh_scale,
         punch_campaign_element: !a.no_campaign_element,
         threads,
-        engine: a.solver.as_deref().map(needle_fe::spec::Engine::parse).transpose()?,
+        engine: a.solver.as_deref().map(needle_set::spec::Engine::parse).transpose()?,
     };
     needle_fe::process::stop_jobs_on_termination()?;
     let (_, ok) = needle_fe::verify::run(&opts)?;

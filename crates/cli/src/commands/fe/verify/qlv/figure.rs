@@ -3,7 +3,7 @@
 //! QLV filter on the elastic run (lines), one colour per speed; beside it the first
 //! seconds (the ramps and the early hold).
 use needle_contract::FY;
-use needle_fe::verify::qlv::QlvCase;
+use needle_fe::visco::qlv::QlvCase;
 use needle_plot::panel::{render, Panel, Series, Style, COMPONENT_COLOURS};
 
 /// File name of the figure in `<set>/figures/`.

@@ -3,7 +3,7 @@
 //! the elastic FE wrench: what `needle fe verify --qlv` scores and its figure draws.
 
 use needle_contract::COMPONENT_COUNT;
-use needle_fe::verify::qlv::QlvCase;
+use needle_fe::visco::qlv::QlvCase;
 use needle_haptics::insertion::InsertionConfig;
 use needle_haptics::viscoelastic::{PronyTerm, PronyTerms, WrenchQlv};
 

@@ -1,13 +1,13 @@
 //! `needle fe verify --qlv`: the library's QLV filter (`needle_haptics::viscoelastic`,
 //! f32, one tick of `InsertionConfig::DEFAULT_1KHZ`) run on the elastic FE wrench along
 //! each ramp-and-hold run's depth-time path, against FEBio's viscoelastic solution
-//! (`needle_fe::verify::qlv`: pairing, scores, bounds). The filter is the firmware's own
+//! (`needle_fe::visco::qlv`: pairing, scores, bounds). The filter is the firmware's own
 //! code; this module only feeds it and samples its output at the FE's must points;
 //! [`filtered`] steps the filter, [`figure`] draws the comparison.
 pub mod figure;
 pub mod filtered;
 
-use needle_fe::verify::qlv::{self, QlvCase, QlvOptions, QlvRun};
+use needle_fe::visco::qlv::{self, QlvCase, QlvOptions, QlvRun};
 
 /// Run the check: solve (when `opts.solve`) and read the runs, filter, score, print each
 /// run's line, write `[[qlv]]` of `<set>/fe/verify.toml`. Returns whether every run is
@@ -16,7 +16,7 @@ use needle_fe::verify::qlv::{self, QlvCase, QlvOptions, QlvRun};
 /// # Errors
 /// As [`qlv::cases`], or verify.toml cannot be written.
 pub fn check(opts: &QlvOptions) -> anyhow::Result<bool> {
-    let (c, _) = needle_fe::spec::load(&opts.set_dir)?;
+    let (c, _) = needle_set::spec::load(&opts.set_dir)?;
     let mut runs: Vec<QlvRun> = Vec::new();
     let mut missing: Vec<String> = Vec::new();
     let mut compared: Vec<QlvCase> = Vec::new();
@@ -40,7 +40,7 @@ pub fn check(opts: &QlvOptions) -> anyhow::Result<bool> {
     if !compared.is_empty() {
         let svg = figure::svg(&compared)?;
         let path = opts.set_dir.join("figures").join(figure::FILE);
-        needle_fe::results::write_atomic(&path, svg.as_bytes())?;
+        needle_stdx::fs::write_atomic(&path, svg.as_bytes())?;
         println!("wrote {}", path.display());
     }
     Ok(report.ok())

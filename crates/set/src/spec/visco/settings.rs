@@ -30,7 +30,7 @@ pub fn frictionless_name(name: &str) -> String {
 }
 
 /// `[viscoelastic]`: the Prony series and the ramp-and-hold loadings of
-/// `needle fe run --visco` (module docs of `crate::visco`, which applies them).
+/// `needle fe run --visco` (module docs of `needle_fe::visco`, which applies them).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ViscoSettings {

@@ -20,7 +20,7 @@ pub struct Loading {
     /// Number of equal load steps (results at steps + 1 depths, 0 included); of a
     /// ramp-and-hold run, its must points on the ramp and the hold.
     pub steps: u32,
-    /// The time course of a viscoelastic ramp-and-hold run (`crate::visco::apply`; never
+    /// The time course of a viscoelastic ramp-and-hold run (`needle_fe::visco::apply`; never
     /// in the file); absent: quasi-static, time = depth in mm.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ramp_hold: Option<super::visco::RampHold>,

@@ -232,7 +232,7 @@ mod tests {
     /// Issue 18: a pose outside the block and a sweep pose off its axis were accepted.
     #[test]
     fn poses_outside_the_block_or_off_their_sweep_axis_are_refused() {
-        let set = crate::workspace_root().join("coeffs/default");
+        let set = needle_stdx::workspace_root().join("coeffs/default");
         let text = std::fs::read_to_string(set.join("campaign.toml")).expect("campaign.toml");
         // block 10 mm wide: x+06 (the first listed pose beyond 4.5 mm) is outside
         let narrow = text.replace("size_x_mm = 50.0", "size_x_mm = 10.0");

@@ -14,11 +14,11 @@
 //! largest |filter - FE| in % of the viscoelastic run's peak |Fy| (moments: x the hub's
 //! lever arm, the contract's [`error_scales`]).
 
-use super::runs::{read_current, solve_and_read, PoseRows};
+use super::{run_name, Friction, Prony};
 use crate::campaign::RunOptions;
 use crate::results::{peak_fy_n, Row};
 use crate::spec::{self, Loading};
-use crate::visco::{run_name, Friction, Prony};
+use crate::verify::runs::{read_current, solve_and_read, PoseRows};
 use anyhow::{Context, Result};
 use needle_contract::{error_scales, COMPONENTS, COMPONENT_COUNT, FY};
 use serde::Serialize;

@@ -19,7 +19,7 @@ pub struct Tissue {
     pub stretch_min: f64,
     /// Largest principal stretch the stability check covers.
     pub stretch_max: f64,
-    /// The Prony series of a viscoelastic run (`crate::visco::apply`; never in the
+    /// The Prony series of a viscoelastic run (`needle_fe::visco::apply`; never in the
     /// file); absent: elastic.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub prony: Option<super::visco::Prony>,

@@ -1,10 +1,12 @@
 //! The `[viscoelastic]` section of the campaign spec checked against the rest of it (the
-//! ramp-and-hold runs, `crate::visco`).
+//! ramp-and-hold runs, `needle_fe::visco`).
 
 use super::{check_pose_in_block, Campaign, MAX_LOAD_STEPS};
+pub mod runs;
 pub mod settings;
 
 use anyhow::{bail, Result};
+pub use runs::{apply, apply_frictionless_elastic, describe, Friction};
 pub use settings::{decimal_tag, frictionless_name, run_name, Prony, RampHold, ViscoSettings, FRICTIONLESS_SUFFIX, MAX_PRONY_TERMS};
 use std::path::Path;
 
@@ -16,13 +18,13 @@ use std::path::Path;
 /// g_i < 0 or not finite, a tau_i <= 0 or not finite, a speed <= 0 or repeated, a hold
 /// or its first point out of range, an unknown mesh level, an unknown or repeated pose.
 pub(crate) fn validate(c: &Campaign, text: &str, path: &Path) -> Result<()> {
-    let at = |key: &str| format!("{}:{}", path.display(), crate::deep::key_line(text, "viscoelastic", key));
+    let at = |key: &str| format!("{}:{}", path.display(), crate::spec::key_line(text, "viscoelastic", key));
     if c.tissue.prony.is_some() || c.loading.ramp_hold.is_some() {
         let (s, k) = if c.tissue.prony.is_some() { ("tissue", "prony") } else { ("loading", "ramp_hold") };
         bail!(
             "{}:{}: {s}.{k}: set by [viscoelastic] for its runs only, not in the file",
             path.display(),
-            crate::deep::key_line(text, s, k).max(crate::deep::key_line(text, &format!("{s}.{k}"), ""))
+            crate::spec::key_line(text, s, k).max(crate::spec::key_line(text, &format!("{s}.{k}"), ""))
         );
     }
     let Some(v) = &c.viscoelastic else { return Ok(()) };

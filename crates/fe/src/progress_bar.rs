@@ -16,7 +16,7 @@ use std::time::{Duration, Instant};
 /// Progress display: an indicatif bar on a terminal, plain lines otherwise (CI).
 pub(crate) struct Progress {
     names: Vec<String>,
-    /// Model of each run (`mesh_summary::model_name`), the key of `walls_s`.
+    /// Model of each run (`mesh::summary::model_name`), the key of `walls_s`.
     models: Vec<String>,
     /// Runs finished (done or failed).
     finished: Vec<bool>,

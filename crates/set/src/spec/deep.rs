@@ -1,13 +1,28 @@
-//! `[deep]` (`crate::deep`) checked and applied beside the rest of the spec: the
-//! section's type lives in `deep`, which does not depend on `spec`.
+//! `[deep]` of campaign.toml: the section's type, checked and applied beside the rest of
+//! the spec (the engine's `needle_fe::deep` runs it).
 
 use super::error::{SpecError, SpecResult};
 use super::loading::{Loading, MAX_LOAD_STEPS};
 use super::pose::check_pose_in_block;
 use super::Campaign;
+use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-impl crate::deep::DeepSettings {
+/// `[deep]`: which poses are solved how deep, in how many load steps, on which mesh.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DeepSettings {
+    /// Final depth along the needle axis, mm (beyond `loading.depth_mm`, inside the block).
+    pub depth_mm: f64,
+    /// Number of equal load steps to `depth_mm` (results at steps + 1 depths).
+    pub steps: u32,
+    /// Mesh level (`[mesh.<level>]`) whose fine layers reach past `depth_mm`.
+    pub mesh: String,
+    /// Pose names of the campaign (listed or generated), solved in this order.
+    pub poses: Vec<String>,
+}
+
+impl DeepSettings {
     /// The campaign's spec as a deep run sees it: `[loading]` to the deep depth and steps.
     pub fn apply(&self, c: &Campaign) -> Campaign {
         let mut deep = c.clone();
@@ -25,7 +40,7 @@ impl crate::deep::DeepSettings {
 /// repeated pose, or a pose whose needle leaves the block at the deep depth.
 pub fn validate_deep(c: &Campaign, text: &str, path: &Path) -> SpecResult<()> {
     let Some(d) = &c.deep else { return Ok(()) };
-    let at = |key: &str| format!("{}:{}", path.display(), crate::deep::key_line(text, "deep", key));
+    let at = |key: &str| format!("{}:{}", path.display(), super::key_line(text, "deep", key));
     if !(d.depth_mm.is_finite() && d.depth_mm > c.loading.depth_mm && d.depth_mm < c.block.depth_mm) {
         return Err(SpecError::range(
             at("depth_mm"),
@@ -79,11 +94,11 @@ pub fn validate_deep(c: &Campaign, text: &str, path: &Path) -> SpecResult<()> {
 #[cfg(test)]
 mod deep_tests {
     use super::*;
-    use crate::deep::key_line;
+    use crate::spec::key_line;
     use crate::spec::parse;
 
     fn shipped() -> String {
-        std::fs::read_to_string(crate::workspace_root().join("coeffs/default/campaign.toml")).expect("campaign.toml")
+        std::fs::read_to_string(needle_stdx::workspace_root().join("coeffs/default/campaign.toml")).expect("campaign.toml")
     }
 
     fn refusal(text: &str) -> SpecError {

@@ -18,6 +18,7 @@ pub mod family;
 pub mod febio;
 pub mod fit;
 pub mod hash;
+pub mod lines;
 pub mod loading;
 pub mod mesh;
 pub mod mesh_study;
@@ -31,12 +32,13 @@ pub mod visco;
 pub use block::Block;
 pub use campaign::{CampaignSettings, TrainReplacement, MAX_GENERATED_POSES};
 pub use contact::Contact;
-pub use deep::validate_deep;
+pub use deep::{validate_deep, DeepSettings};
 pub use error::{SpecError, SpecResult};
 pub use family::{validate_family, FamilySettings};
 pub use febio::FebioSettings;
 pub use fit::{FitSettings, ModelForm};
 pub use hash::hex;
+pub use lines::{key_line, shipped_key};
 pub use loading::{Loading, MAX_LOAD_STEPS};
 pub use mesh::MeshLevel;
 pub use needle::Needle;
@@ -78,13 +80,13 @@ pub struct Campaign {
     /// What `needle fit` fits; absent: the paper's model.
     #[serde(default)]
     pub fit: FitSettings,
-    /// The deep runs of `needle fe run --deep` (`crate::deep`); absent: none.
+    /// The deep runs of `needle fe run --deep` (`needle_fe::deep`); absent: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub deep: Option<crate::deep::DeepSettings>,
-    /// The ramp-and-hold runs of `needle fe run --visco` (`crate::visco`); absent: none.
+    pub deep: Option<DeepSettings>,
+    /// The ramp-and-hold runs of `needle fe run --visco` (`needle_fe::visco`); absent: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub viscoelastic: Option<visco::ViscoSettings>,
-    /// The material family of `needle fe run --family` (`crate::family`); absent: none.
+    /// The material family of `needle fe run --family` (`needle_fe::family`); absent: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub family: Option<FamilySettings>,
     /// The named poses as written (the Latin hypercube poses are added by [`Campaign::poses`]).

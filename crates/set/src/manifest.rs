@@ -118,7 +118,7 @@ pub struct ManifestEntry {
     /// attempt from its `.partial.toml` when there is one.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub replaced_because: Option<String>,
-    /// A viscoelastic ramp-and-hold run (`crate::visco`): its Prony series and time
+    /// A viscoelastic ramp-and-hold run (`needle_fe::visco`): its Prony series and time
     /// course, one line with units.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub viscoelastic: Option<String>,

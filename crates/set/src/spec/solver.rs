@@ -13,7 +13,7 @@ pub enum Engine {
     /// CalculiX `ccx` (Debian `calculix-ccx`): C3D8 tissue, penalty contact.
     #[default]
     Ccx,
-    /// FEBio 4 `febio4`: three-field hex8 tissue, rigid-body needle, sliding-elastic contact.
+    /// FEBio 4: three-field hex8 tissue, rigid-body needle, sliding-elastic contact.
     Febio,
 }
 

@@ -121,7 +121,7 @@ impl MeshLevel {
 
 #[cfg(test)]
 mod mesh_level_tests {
-    use crate::deep::shipped_key;
+    use crate::spec::shipped_key;
     use crate::spec::{parse, SpecError};
     use std::path::Path;
 

@@ -122,7 +122,7 @@ impl SpecError {
             if at.contains(':') || section == "pose" {
                 return at;
             }
-            match crate::deep::key_line(text, section, key) {
+            match crate::spec::key_line(text, section, key) {
                 0 => at,
                 line => format!("{at}:{line}"),
             }

@@ -84,7 +84,7 @@ pub fn write(out_dir: &Path, f: &Failed<'_>, reached: &[[f64; COMPONENT_COUNT]])
     }
     let mut rows = vec![Row { depth_mm: 0.0, wrench: [0.0; COMPONENT_COUNT] }];
     rows.extend((1u32..).zip(reached).map(|(k, w)| Row { depth_mm: f.campaign.loading.depth_at(k), wrench: *w }));
-    // a ramp-and-hold run's record keeps its times (`crate::visco`: the hold's depths repeat)
+    // a ramp-and-hold run's record keeps its times (`needle_fe::visco`: the hold's depths repeat)
     let loading = &f.campaign.loading;
     let text = match loading.ramp_hold {
         Some(_) => results::to_timed_csv(&(0..rows.len() as u32).map(|k| loading.time_at(k)).collect::<Vec<_>>(), &rows),
@@ -108,7 +108,7 @@ pub fn write(out_dir: &Path, f: &Failed<'_>, reached: &[[f64; COMPONENT_COUNT]])
         toml::to_string(&record).context("cannot serialise the partial record")?
     );
     let (csv, rec) = paths(out_dir, &f.pose.name);
-    results::write_all_atomic(&[(&csv, text.as_bytes()), (&rec, toml.as_bytes())])
+    needle_stdx::fs::write_all_atomic(&[(&csv, text.as_bytes()), (&rec, toml.as_bytes())])
 }
 
 /// Remove a pose's partial record (it solved); a missing one is fine.
@@ -125,7 +125,7 @@ mod tests {
     #[test]
     fn a_partial_record_holds_the_reached_must_points_and_goes_when_removed() {
         let d = tempfile::tempdir().expect("tempdir");
-        let set = crate::workspace_root().join("coeffs/default");
+        let set = needle_stdx::workspace_root().join("coeffs/default");
         let (mut c, _) = crate::spec::load(&set).expect("spec");
         c.loading.steps = 4;
         let pose = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");

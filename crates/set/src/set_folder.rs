@@ -15,6 +15,17 @@ use crate::spec::{self, Campaign, PoseSpec};
 use anyhow::Result;
 use std::path::{Path, PathBuf};
 
+/// Sub-folder of `<set>/fe/` holding the deep runs and their manifest (`[deep]`).
+pub const DEEP_DIR: &str = "deep";
+
+/// Sub-folder of `<set>/fe/` holding the ramp-and-hold runs and their manifest
+/// (`[viscoelastic]`).
+pub const VISCO_DIR: &str = "visco";
+
+/// Sub-folder of `<set>/fe/` holding the material family's runs and their manifest
+/// (`[family]`).
+pub const FAMILY_DIR: &str = "family";
+
 /// A set folder with its spec and manifest read once.
 #[derive(Debug, Clone)]
 pub struct SetFolder {

@@ -2,7 +2,7 @@
 //! one-term Ogden tissues (strain-stiffening exponent `alpha`, the initial shear modulus of
 //! `[tissue]`), and a few off-centre poses at two members to check the ratio law that carries
 //! the coupled model's pose dependence over to the family. The runs themselves are
-//! `crate::family`'s; here the section's type and its checks.
+//! `needle_fe::family`'s; here the section's type and its checks.
 
 use super::error::{SpecError, SpecResult};
 use super::loading::MAX_LOAD_STEPS;
@@ -55,7 +55,7 @@ pub fn member_name(pose: &str, alpha: f64) -> String {
 /// that is not one of `alpha`.
 pub fn validate_family(c: &Campaign, text: &str, path: &Path) -> SpecResult<()> {
     let Some(f) = &c.family else { return Ok(()) };
-    let at = |key: &str| format!("{}:{}", path.display(), crate::deep::key_line(text, "family", key));
+    let at = |key: &str| format!("{}:{}", path.display(), crate::spec::key_line(text, "family", key));
     if f.alpha.is_empty() {
         return Err(SpecError::range(at("alpha"), "family.alpha", "family.alpha is empty: name at least one member"));
     }
@@ -122,8 +122,8 @@ fn validate_checks(c: &Campaign, f: &FamilySettings, at: &dyn Fn(&str) -> String
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::deep::shipped_key;
     use crate::spec::parse;
+    use crate::spec::shipped_key;
 
     fn refusal(text: &str) -> SpecError {
         match parse(text, Path::new("campaign.toml")) {

@@ -273,7 +273,7 @@ mod tests {
             let s = FebioSettings { first_contact_depth_mm: depth, first_contact_step_fraction: fraction, ..FebioSettings::default() };
             assert_eq!(s.validate(p).is_ok(), ok, "depth {depth} mm, fraction {fraction}");
         }
-        let set = crate::workspace_root().join("coeffs/default");
+        let set = needle_stdx::workspace_root().join("coeffs/default");
         let Ok((c, _)) = crate::spec::load(&set) else { panic!("cannot load {}", set.display()) };
         let centre = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");
         let h = c.run_hash(&centre, "needle8");
@@ -290,7 +290,7 @@ mod tests {
     /// uses; it is never a run hash.
     #[test]
     fn the_first_attempts_hash_leaves_out_only_the_later_attempts_settings() {
-        let set = crate::workspace_root().join("coeffs/default");
+        let set = needle_stdx::workspace_root().join("coeffs/default");
         let Ok((c, _)) = crate::spec::load(&set) else { panic!("cannot load {}", set.display()) };
         let centre = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");
         let (run, first) = (c.run_hash(&centre, "needle8"), c.first_attempt_hash(&centre, "needle8"));

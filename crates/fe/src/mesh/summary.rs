@@ -1,7 +1,7 @@
 //! The size of a pose's model and the name of the part of the block it covers, for the
 //! manifest and the wall-time projection, whatever the engine.
 
-use crate::mesh::{NeedleMesh, TissueMesh};
+use super::{NeedleMesh, TissueMesh};
 use crate::spec::Symmetry;
 use serde::Serialize;
 

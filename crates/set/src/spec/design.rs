@@ -239,7 +239,7 @@ mod tests {
     /// another design.
     #[test]
     fn training_poses_are_nested_stratified_sobol_prefixes() {
-        let set = crate::workspace_root().join("coeffs/default");
+        let set = needle_stdx::workspace_root().join("coeffs/default");
         let Ok((mut c, _)) = load(&set) else { panic!("cannot load {}", set.display()) };
         c.campaign.train_replaced.clear();
         c.campaign.train_seed = 7;
@@ -276,7 +276,7 @@ mod tests {
     /// point of the sequence; a replacement that fails is replaced in turn.
     #[test]
     fn replaced_training_poses_take_the_next_points_of_the_sequence() {
-        let set = crate::workspace_root().join("coeffs/default");
+        let set = needle_stdx::workspace_root().join("coeffs/default");
         let text = std::fs::read_to_string(set.join("campaign.toml")).expect("campaign.toml");
         let Ok((mut c, _)) = load(&set) else { panic!("cannot load {}", set.display()) };
         c.campaign.train_replaced.clear();
