@@ -212,3 +212,23 @@ fn only_the_engines_name_the_engine_executables() {
     let named = fe.iter().filter(|f| std::fs::read_to_string(f).unwrap_or_default().lines().any(names_an_executable)).count();
     assert!(named > 0, "the rule finds no executable in crates/fe either: it checks nothing");
 }
+
+/// "Inside the CLI only `commands/fe/` names the engines" (docs/architecture.md §6): the
+/// CLI's other commands read a set through `needle_set`, never through `needle_fe`.
+#[test]
+fn inside_the_cli_only_the_fe_commands_use_the_engine_crate() {
+    let src = workspace_root().join("crates/cli/src");
+    let fe = src.join("commands/fe");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    assert!(files.iter().any(|f| f.starts_with(&fe)), "the walk finds the fe commands");
+    let offenders: Vec<String> = files
+        .iter()
+        .filter(|f| !f.starts_with(&fe))
+        .filter(|f| std::fs::read_to_string(f).is_ok_and(|t| t.contains("needle_fe")))
+        .map(|f| f.display().to_string())
+        .collect();
+    assert!(offenders.is_empty(), "CLI modules outside commands/fe/ use needle_fe: {offenders:?}");
+    let uses = files.iter().filter(|f| f.starts_with(&fe)).any(|f| std::fs::read_to_string(f).is_ok_and(|t| t.contains("needle_fe")));
+    assert!(uses, "commands/fe/ uses needle_fe (else this check cannot fail)");
+}
