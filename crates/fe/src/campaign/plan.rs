@@ -143,7 +143,7 @@ struct Variant {
 fn apply_variant(opts: &RunOptions, campaign: &mut Campaign, spec_path: &Path) -> Result<Variant> {
     let mut v = Variant { mesh: campaign.campaign.mesh.clone(), poses: None, out_dir: opts.set_dir.join("fe") };
     if let Some(run) = opts.family_run {
-        return apply_family(opts, campaign, spec_path, run);
+        v = apply_family(opts, campaign, spec_path, run)?;
     }
     if opts.deep {
         let d = campaign.deep.clone().with_context(|| format!("{}: --deep: the spec has no [deep] section", spec_path.display()))?;
@@ -196,10 +196,17 @@ fn apply_variant(opts: &RunOptions, campaign: &mut Campaign, spec_path: &Path) -
 }
 
 /// A run of the material family (`crate::family`): the member's tissue (material-checked),
-/// its poses, depth and mesh; `--steps` overrides the family's steps.
+/// its poses, depth and mesh (`--steps` then overrides the family's steps in
+/// [`apply_variant`], as it does the deep runs').
 fn apply_family(opts: &RunOptions, campaign: &mut Campaign, spec_path: &Path, run: crate::family::FamilyRun) -> Result<Variant> {
     let f = campaign.family.clone().with_context(|| format!("{}: --family: the spec has no [family] section", spec_path.display()))?;
-    if opts.deep || opts.visco || opts.visco_speed_mm_per_s.is_some() || opts.tissue_scale.is_some() || opts.edge_radius_mm.is_some() {
+    if opts.deep
+        || opts.visco
+        || opts.visco_speed_mm_per_s.is_some()
+        || opts.visco_frictionless
+        || opts.tissue_scale.is_some()
+        || opts.edge_radius_mm.is_some()
+    {
         bail!("--family runs its own members: not with --deep, --visco, a tissue scale or an edge radius");
     }
     let (member, poses, mesh) = crate::family::apply(campaign, &f, run);
@@ -207,11 +214,5 @@ fn apply_family(opts: &RunOptions, campaign: &mut Campaign, spec_path: &Path, ru
         format!("{}: family member alpha = {} fails the material stability check; nothing was run", spec_path.display(), run.alpha())
     })?;
     *campaign = member;
-    if let Some(s) = opts.steps {
-        if s == 0 {
-            bail!("--steps 0: must be >= 1");
-        }
-        campaign.loading.steps = s;
-    }
     Ok(Variant { mesh, poses: Some(poses), out_dir: opts.set_dir.join("fe").join(crate::family::FAMILY_DIR) })
 }
