@@ -59,17 +59,10 @@ pub fn read_curve(path: &Path) -> Result<Vec<Point>> {
     let header = reader.headers().with_context(|| format!("{}:1: cannot read the header", path.display()))?.clone();
     let mut index = [0usize; 2];
     for (slot, name) in index.iter_mut().zip(COLUMNS) {
-        let found: Vec<usize> = header.iter().enumerate().filter(|(_, h)| *h == name).map(|(i, _)| i).collect();
-        let problem = match found.as_slice() {
-            [i] => {
-                *slot = *i;
-                continue;
-            }
-            [] => format!("no column {name:?} (the header has {:?}; needed: {:?})", header.iter().collect::<Vec<_>>(), COLUMNS),
-            _ => format!("column {name:?} appears {} times", found.len()),
-        };
-        let at = format!("{}:1", path.display());
-        return Err(CurveError { at, line: Some(1), row: None, column: Some(name), problem }.into());
+        *slot = column_index(&header, name, &COLUMNS).map_err(|problem| {
+            let at = format!("{}:1", path.display());
+            CurveError { at, line: Some(1), row: None, column: Some(name), problem }
+        })?;
     }
     let mut points = Vec::new();
     for (row, record) in reader.records().enumerate() {
@@ -120,6 +113,17 @@ pub fn from_columns(position_mm: &[f64], force_n: &[f64]) -> Result<Vec<Point>> 
         points.push(Point { position_mm: p, force_n: f, line: row + 1 });
     }
     enough(points, "the curve")
+}
+
+/// The index of the one column `name` of `header`; the problem, naming the columns
+/// `needed`, when it is missing or repeated.
+pub(crate) fn column_index(header: &csv::StringRecord, name: &str, needed: &[&str]) -> Result<usize, String> {
+    let found: Vec<usize> = header.iter().enumerate().filter(|(_, h)| *h == name).map(|(i, _)| i).collect();
+    match found.as_slice() {
+        [i] => Ok(*i),
+        [] => Err(format!("no column {name:?} (the header has {:?}; needed: {needed:?})", header.iter().collect::<Vec<_>>())),
+        _ => Err(format!("column {name:?} appears {} times", found.len())),
+    }
 }
 
 fn enough(points: Vec<Point>, what: &str) -> Result<Vec<Point>> {

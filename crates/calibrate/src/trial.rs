@@ -47,17 +47,8 @@ pub fn read_trial(path: &Path) -> Result<Vec<Sample>> {
     let header = reader.headers().with_context(|| format!("{}:1: cannot read the header", path.display()))?.clone();
     let mut index = [0usize; 3];
     for (slot, name) in index.iter_mut().zip(TRIAL_COLUMNS) {
-        let found: Vec<usize> = header.iter().enumerate().filter(|(_, h)| *h == name).map(|(i, _)| i).collect();
-        match found.as_slice() {
-            [i] => *slot = *i,
-            [] => bail!(
-                "{}:1: no column {name:?} (the header has {:?}; needed: {:?})",
-                path.display(),
-                header.iter().collect::<Vec<_>>(),
-                TRIAL_COLUMNS
-            ),
-            _ => bail!("{}:1: column {name:?} appears {} times", path.display(), found.len()),
-        }
+        *slot = crate::measured::column_index(&header, name, &TRIAL_COLUMNS)
+            .map_err(|problem| anyhow::anyhow!("{}:1: {problem}", path.display()))?;
     }
     let mut samples: Vec<Sample> = Vec::new();
     for record in reader.records() {
