@@ -1,5 +1,8 @@
 //! The material family's runs (issue 64; `[family]` of campaign.toml, checked in
 //! `spec::family`): `needle fe run --family` solves
+//! - first the reference: the centre of the paper's own tissue (`[tissue]` as it is) to
+//!   `family.depth_mm` on `family.mesh`, named `centre_paper`: the denominator of the ratio
+//!   law on the members' own mesh and depth (the deep run is on another mesh, not as deep);
 //! - the centre pose (quarter model) of each member to `family.depth_mm` in `family.steps`
 //!   load steps on `family.mesh` (the deep runs' machinery: resume, retry ladder,
 //!   continuation from the last must point), named `centre_a<alpha>`;
@@ -24,6 +27,8 @@ pub use needle_set::set_folder::FAMILY_DIR;
 /// and poses).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum FamilyRun {
+    /// The centre pose of the paper's own tissue, solved as deep as the members on their mesh.
+    Reference,
     /// The centre pose of the member `alpha`, solved deep.
     Centre {
         /// The member's Ogden exponent.
@@ -37,21 +42,30 @@ pub enum FamilyRun {
 }
 
 impl FamilyRun {
-    /// Every run of `f`, in the order they are solved: the centres (in `alpha`'s order),
-    /// then the checks (none when `check_poses` is empty).
+    /// Every run of `f`, in the order they are solved: the reference, the centres (in
+    /// `alpha`'s order), then the checks (none when `check_poses` is empty).
     pub fn all(f: &FamilySettings) -> Vec<FamilyRun> {
         let centres = f.alpha.iter().map(|&alpha| FamilyRun::Centre { alpha });
         let checks = f.check_alpha.iter().filter(|_| !f.check_poses.is_empty()).map(|&alpha| FamilyRun::Check { alpha });
-        centres.chain(checks).collect()
+        std::iter::once(FamilyRun::Reference).chain(centres).chain(checks).collect()
     }
 
-    /// The member's exponent.
-    pub fn alpha(self) -> f64 {
+    /// The member's exponent; `None` for the reference (the paper's tissue).
+    pub fn alpha(self) -> Option<f64> {
         match self {
-            FamilyRun::Centre { alpha } | FamilyRun::Check { alpha } => alpha,
+            FamilyRun::Reference => None,
+            FamilyRun::Centre { alpha } | FamilyRun::Check { alpha } => Some(alpha),
         }
     }
+
+    /// What the run solves, for messages: `alpha = 2` or `the paper's tissue`.
+    pub fn label(self) -> String {
+        self.alpha().map_or_else(|| "the paper's tissue".to_string(), |a| format!("alpha = {a}"))
+    }
 }
+
+/// The reference run's name (the paper's tissue at the family's depth and mesh).
+pub const REFERENCE_RUN: &str = "centre_paper";
 
 /// The member `alpha` of `t`: one Ogden term with mu = sum mu_i of `t`, the rest of `t` kept.
 pub fn member_tissue(t: &Tissue, alpha: f64) -> Tissue {
@@ -62,17 +76,19 @@ pub fn member_tissue(t: &Tissue, alpha: f64) -> Tissue {
 /// depth and steps), its renamed poses and its mesh level.
 pub fn apply(c: &Campaign, f: &FamilySettings, run: FamilyRun) -> (Campaign, Vec<PoseSpec>, String) {
     let mut out = c.clone();
-    out.tissue = member_tissue(&c.tissue, run.alpha());
+    if let Some(alpha) = run.alpha() {
+        out.tissue = member_tissue(&c.tissue, alpha);
+    }
     let every = c.poses();
     let named = |names: &[String]| -> Vec<PoseSpec> {
         names
             .iter()
             .filter_map(|n| every.iter().find(|p| &p.name == n))
-            .map(|p| PoseSpec { name: member_name(&p.name, run.alpha()), ..p.clone() })
+            .map(|p| PoseSpec { name: run.alpha().map_or_else(|| REFERENCE_RUN.to_string(), |a| member_name(&p.name, a)), ..p.clone() })
             .collect()
     };
     match run {
-        FamilyRun::Centre { .. } => {
+        FamilyRun::Reference | FamilyRun::Centre { .. } => {
             out.loading.depth_mm = f.depth_mm;
             out.loading.steps = f.steps;
             out.loading.ramp_hold = None;
@@ -112,17 +128,22 @@ mod tests {
         let c = shipped();
         let f = c.family.clone().expect("[family]");
         let runs = FamilyRun::all(&f);
-        assert_eq!(runs.len(), f.alpha.len() + f.check_alpha.len());
+        assert_eq!(runs.len(), 1 + f.alpha.len() + f.check_alpha.len());
         let mut hashes = std::collections::BTreeSet::new();
         for run in runs {
             let (campaign, poses, mesh) = apply(&c, &f, run);
             assert!(!poses.is_empty(), "{run:?}");
             for p in &poses {
-                assert!(p.name.ends_with(&format!("_a{}", format!("{}", run.alpha()).replace('.', "p"))), "{}", p.name);
+                match run.alpha() {
+                    Some(a) => assert!(p.name.ends_with(&format!("_a{}", format!("{a}").replace('.', "p"))), "{}", p.name),
+                    None => assert_eq!(p.name, REFERENCE_RUN),
+                }
                 assert!(hashes.insert(campaign.run_hash(p, &mesh)), "{} repeats a hash", p.name);
             }
             match run {
-                FamilyRun::Centre { .. } => assert_eq!((campaign.loading.depth_mm, mesh.as_str()), (f.depth_mm, f.mesh.as_str())),
+                FamilyRun::Reference | FamilyRun::Centre { .. } => {
+                    assert_eq!((campaign.loading.depth_mm, mesh.as_str()), (f.depth_mm, f.mesh.as_str()))
+                }
                 FamilyRun::Check { .. } => {
                     assert_eq!((campaign.loading.depth_mm, mesh.as_str()), (c.loading.depth_mm, c.campaign.mesh.as_str()));
                     assert_eq!(poses.len(), f.check_poses.len());
@@ -131,5 +152,8 @@ mod tests {
         }
         let centre = c.poses().into_iter().find(|p| p.name == "centre").expect("centre");
         assert!(!hashes.contains(&c.run_hash(&centre, &c.campaign.mesh)), "a member never passes for the campaign's run");
+        if let Some(d) = &c.deep {
+            assert!(!hashes.contains(&c.run_hash(&centre, &d.mesh)), "the reference never passes for the deep run");
+        }
     }
 }

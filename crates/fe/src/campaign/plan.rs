@@ -211,7 +211,7 @@ fn apply_family(opts: &RunOptions, campaign: &mut Campaign, spec_path: &Path, ru
     }
     let (member, poses, mesh) = crate::family::apply(campaign, &f, run);
     crate::material::check(&member.tissue).with_context(|| {
-        format!("{}: family member alpha = {} fails the material stability check; nothing was run", spec_path.display(), run.alpha())
+        format!("{}: family run of {} fails the material stability check; nothing was run", spec_path.display(), run.label())
     })?;
     *campaign = member;
     Ok(Variant { mesh, poses: Some(poses), out_dir: opts.set_dir.join("fe").join(crate::family::FAMILY_DIR) })

@@ -82,7 +82,7 @@ fn family_variants(opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
     }
     if out.is_empty() {
         anyhow::bail!(
-            "--family --only {:?}: matches no run (names: <pose>_a<alpha>, e.g. centre_a2, x+04_a20, centre_a0p5)",
+            "--family --only {:?}: matches no run (names: centre_paper, the paper's tissue; <pose>_a<alpha>, e.g. centre_a2, x+04_a20, centre_a0p5)",
             opts.only.as_deref().unwrap_or("")
         );
     }
