@@ -5,18 +5,23 @@
 //!   law on the members' own mesh and depth (the deep run is on another mesh, not as deep);
 //! - the centre pose (quarter model) of each member to `family.depth_mm` in `family.steps`
 //!   load steps on `family.mesh` (the deep runs' machinery: resume, retry ladder,
-//!   continuation from the last must point), named `centre_a<alpha>`;
-//! - each of `family.check_poses` at each of `family.check_alpha` to `loading.depth_mm` on
+//!   continuation from the last must point), named `centre_w<weight>`;
+//! - each of `family.check_poses` at each of `family.check_weight` to `loading.depth_mm` on
 //!   the campaign's mesh level (half models, as the campaign solves them), named
-//!   `<pose>_a<alpha>`: the check of the ratio law that carries the coupled model's pose
+//!   `<pose>_w<weight>`: the check of the ratio law that carries the coupled model's pose
 //!   dependence over to the family;
 //!
 //! into `<set>/fe/family/<run>.csv` with one `<set>/fe/family/manifest.toml`.
 //!
-//! A member is the one-term Ogden tissue with the exponent `alpha` and the initial shear
-//! modulus of `[tissue]` (mu = sum mu_i), the same bulk ratio and stretch range: it differs
-//! from the paper's material in its strain stiffening only, so the family spans shapes
-//! at one initial stiffness. Each member's tissue is in its run hash, so no two members'
+//! A member is a blend of the paper's material and a soft one: the Ogden terms of
+//! `[tissue]` with their mu_i scaled by `weight`, plus one term of exponent
+//! `family.soft_alpha` (2: neo-Hookean) with mu = (1 - weight) mu0, so that every member has
+//! the initial shear modulus mu0 = sum mu_i of `[tissue]`, its bulk ratio and stretch
+//! range: the members differ in their strain stiffening only, from the paper's (weight 1,
+//! the reference) down to the soft term's (weight 0), so the family spans shapes at one
+//! initial stiffness. (One-term Ogden members of alpha 0.5 to 4 were tried first: they
+//! inverted elements under the wedge at about 2 mm on the family's mesh; the paper's
+//! stiffening terms, even at a small weight, keep the elements under the tip sane.) Each member's tissue is in its run hash, so no two members'
 //! results mix, and none mixes with the campaign's.
 
 use crate::spec::{family::member_name, Campaign, FamilySettings, PoseSpec, Tissue};
@@ -29,62 +34,69 @@ pub use needle_set::set_folder::FAMILY_DIR;
 pub enum FamilyRun {
     /// The centre pose of the paper's own tissue, solved as deep as the members on their mesh.
     Reference,
-    /// The centre pose of the member `alpha`, solved deep.
+    /// The centre pose of the member `weight`, solved deep.
     Centre {
-        /// The member's Ogden exponent.
-        alpha: f64,
+        /// The member's weight of the paper's terms.
+        weight: f64,
     },
-    /// The check poses at the member `alpha`, solved to `loading.depth_mm`.
+    /// The check poses at the member `weight`, solved to `loading.depth_mm`.
     Check {
-        /// The member's Ogden exponent.
-        alpha: f64,
+        /// The member's weight of the paper's terms.
+        weight: f64,
     },
 }
 
 impl FamilyRun {
     /// Every run of `f`, in the order they are solved: the reference, the centres (in
-    /// `alpha`'s order), then the checks (none when `check_poses` is empty).
+    /// `weight`'s order), then the checks (none when `check_poses` is empty).
     pub fn all(f: &FamilySettings) -> Vec<FamilyRun> {
-        let centres = f.alpha.iter().map(|&alpha| FamilyRun::Centre { alpha });
-        let checks = f.check_alpha.iter().filter(|_| !f.check_poses.is_empty()).map(|&alpha| FamilyRun::Check { alpha });
+        let centres = f.weight.iter().map(|&weight| FamilyRun::Centre { weight });
+        let checks = f.check_weight.iter().filter(|_| !f.check_poses.is_empty()).map(|&weight| FamilyRun::Check { weight });
         std::iter::once(FamilyRun::Reference).chain(centres).chain(checks).collect()
     }
 
-    /// The member's exponent; `None` for the reference (the paper's tissue).
-    pub fn alpha(self) -> Option<f64> {
+    /// The member's weight of the paper's terms; `None` for the reference (the paper's
+    /// tissue itself, weight 1).
+    pub fn weight(self) -> Option<f64> {
         match self {
             FamilyRun::Reference => None,
-            FamilyRun::Centre { alpha } | FamilyRun::Check { alpha } => Some(alpha),
+            FamilyRun::Centre { weight } | FamilyRun::Check { weight } => Some(weight),
         }
     }
 
-    /// What the run solves, for messages: `alpha = 2` or `the paper's tissue`.
+    /// What the run solves, for messages: `weight = 0.05` or `the paper's tissue`.
     pub fn label(self) -> String {
-        self.alpha().map_or_else(|| "the paper's tissue".to_string(), |a| format!("alpha = {a}"))
+        self.weight().map_or_else(|| "the paper's tissue".to_string(), |w| format!("weight = {w}"))
     }
 }
 
 /// The reference run's name (the paper's tissue at the family's depth and mesh).
 pub const REFERENCE_RUN: &str = "centre_paper";
 
-/// The member `alpha` of `t`: one Ogden term with mu = sum mu_i of `t`, the rest of `t` kept.
-pub fn member_tissue(t: &Tissue, alpha: f64) -> Tissue {
-    Tissue { mu_n_per_mm2: vec![t.mu0_n_per_mm2()], alpha: vec![alpha], ..t.clone() }
+/// The member `weight` of `t`: `t`'s Ogden terms with mu_i x `weight`, then one term of
+/// exponent `soft_alpha` with mu = (1 - `weight`) x mu0 of `t`; the initial shear modulus,
+/// bulk ratio and stretch range of `t` kept.
+pub fn member_tissue(t: &Tissue, weight: f64, soft_alpha: f64) -> Tissue {
+    let mut mu: Vec<f64> = t.mu_n_per_mm2.iter().map(|m| m * weight).collect();
+    let mut alpha = t.alpha.clone();
+    mu.push((1.0 - weight) * t.mu0_n_per_mm2());
+    alpha.push(soft_alpha);
+    Tissue { mu_n_per_mm2: mu, alpha, ..t.clone() }
 }
 
 /// The campaign of `run` (`c` with the member's tissue, and for a centre run the family's
 /// depth and steps), its renamed poses and its mesh level.
 pub fn apply(c: &Campaign, f: &FamilySettings, run: FamilyRun) -> (Campaign, Vec<PoseSpec>, String) {
     let mut out = c.clone();
-    if let Some(alpha) = run.alpha() {
-        out.tissue = member_tissue(&c.tissue, alpha);
+    if let Some(weight) = run.weight() {
+        out.tissue = member_tissue(&c.tissue, weight, f.soft_alpha);
     }
     let every = c.poses();
     let named = |names: &[String]| -> Vec<PoseSpec> {
         names
             .iter()
             .filter_map(|n| every.iter().find(|p| &p.name == n))
-            .map(|p| PoseSpec { name: run.alpha().map_or_else(|| REFERENCE_RUN.to_string(), |a| member_name(&p.name, a)), ..p.clone() })
+            .map(|p| PoseSpec { name: run.weight().map_or_else(|| REFERENCE_RUN.to_string(), |w| member_name(&p.name, w)), ..p.clone() })
             .collect()
     };
     match run {
@@ -112,15 +124,21 @@ mod tests {
     }
 
     #[test]
-    fn every_member_is_a_stable_one_term_ogden_tissue_at_the_initial_shear_modulus() {
+    fn every_member_is_a_stable_blend_at_the_initial_shear_modulus() {
         let c = shipped();
         let f = c.family.clone().expect("coeffs/default has a [family] section");
-        for &alpha in &f.alpha {
-            let t = member_tissue(&c.tissue, alpha);
-            assert_eq!(t.alpha, vec![alpha]);
-            assert!((t.mu0_n_per_mm2() - c.tissue.mu0_n_per_mm2()).abs() <= 1e-15, "alpha {alpha}");
-            crate::material::check(&t).unwrap_or_else(|e| panic!("member alpha = {alpha}: {e:#}"));
+        let n = c.tissue.alpha.len();
+        for &weight in &f.weight {
+            let t = member_tissue(&c.tissue, weight, f.soft_alpha);
+            assert_eq!(t.alpha.len(), n + 1);
+            assert_eq!(t.alpha.last(), Some(&f.soft_alpha));
+            assert_eq!(&t.alpha[..n], &c.tissue.alpha[..]);
+            assert!((t.mu0_n_per_mm2() - c.tissue.mu0_n_per_mm2()).abs() <= 1e-15, "weight {weight}");
+            crate::material::check(&t).unwrap_or_else(|e| panic!("member weight = {weight}: {e:#}"));
         }
+        let paper = member_tissue(&c.tissue, 1.0, f.soft_alpha);
+        assert_eq!(&paper.mu_n_per_mm2[..n], &c.tissue.mu_n_per_mm2[..], "weight 1 keeps the paper's terms");
+        assert_eq!(paper.mu_n_per_mm2[n], 0.0, "weight 1 has no soft term");
     }
 
     #[test]
@@ -128,14 +146,14 @@ mod tests {
         let c = shipped();
         let f = c.family.clone().expect("[family]");
         let runs = FamilyRun::all(&f);
-        assert_eq!(runs.len(), 1 + f.alpha.len() + f.check_alpha.len());
+        assert_eq!(runs.len(), 1 + f.weight.len() + f.check_weight.len());
         let mut hashes = std::collections::BTreeSet::new();
         for run in runs {
             let (campaign, poses, mesh) = apply(&c, &f, run);
             assert!(!poses.is_empty(), "{run:?}");
             for p in &poses {
-                match run.alpha() {
-                    Some(a) => assert!(p.name.ends_with(&format!("_a{}", format!("{a}").replace('.', "p"))), "{}", p.name),
+                match run.weight() {
+                    Some(w) => assert!(p.name.ends_with(&format!("_w{}", format!("{w}").replace('.', "p"))), "{}", p.name),
                     None => assert_eq!(p.name, REFERENCE_RUN),
                 }
                 assert!(hashes.insert(campaign.run_hash(p, &mesh)), "{} repeats a hash", p.name);

@@ -364,26 +364,26 @@ fn family_runs_go_to_their_own_folder_with_the_members_tissue() {
     let d = set_dir();
     let (c, _) = spec::load(d.path()).expect("spec");
     let f = c.family.clone().expect("a [family] section");
-    let alpha = *f.alpha.first().expect("a member");
+    let weight = *f.weight.first().expect("a member");
     let run = |r: FamilyRun| RunOptions { family_run: Some(r), mesh: Some("smoke".into()), steps: Some(4), ..RunOptions::new(d.path()) };
-    let r = run_with(&run(FamilyRun::Centre { alpha }), &mut Fake::default()).expect("family centre");
+    let r = run_with(&run(FamilyRun::Centre { weight }), &mut Fake::default()).expect("family centre");
     assert_eq!((r.done(), r.depth_mm), (1, f.depth_mm), "{}", r.table());
-    let name = spec::family::member_name("centre", alpha);
+    let name = spec::family::member_name("centre", weight);
     let rows = crate::results::read_csv(&d.path().join(format!("fe/family/{name}.csv"))).expect("family csv");
     assert_eq!(rows.last().map(|r| r.depth_mm), Some(f.depth_mm));
     assert!(!d.path().join("fe/centre.csv").exists(), "nothing written beside the campaign's runs");
     let m = read_manifest(&d.path().join("fe/family").join(MANIFEST)).expect("family manifest");
-    let (member, poses, _) = crate::family::apply(&c, &f, FamilyRun::Centre { alpha });
+    let (member, poses, _) = crate::family::apply(&c, &f, FamilyRun::Centre { weight });
     let mut member = member;
     member.loading.steps = 4;
     let pose = poses.first().expect("the centre");
     assert_eq!(m.pose[&name].spec_hash, member.run_hash(pose, "smoke"), "the member's tissue is in the hash");
-    let check = *f.check_alpha.first().expect("a check member");
-    let r = run_with(&run(FamilyRun::Check { alpha: check }), &mut Fake::default()).expect("family checks");
+    let check = *f.check_weight.first().expect("a check member");
+    let r = run_with(&run(FamilyRun::Check { weight: check }), &mut Fake::default()).expect("family checks");
     assert_eq!((r.done(), r.depth_mm), (f.check_poses.len(), c.loading.depth_mm), "{}", r.table());
-    let again = run_with(&run(FamilyRun::Centre { alpha }), &mut Fake::default()).expect("rerun");
+    let again = run_with(&run(FamilyRun::Centre { weight }), &mut Fake::default()).expect("rerun");
     assert_eq!(again.up_to_date(), 1, "resumes like the campaign");
-    let both = RunOptions { deep: true, ..run(FamilyRun::Centre { alpha }) };
+    let both = RunOptions { deep: true, ..run(FamilyRun::Centre { weight }) };
     assert!(run_with(&both, &mut Fake::default()).is_err(), "--family with --deep is refused");
 }
 

@@ -1,7 +1,8 @@
 //! `[family]`: the material family (issue 64): the centre pose solved deep for a family of
-//! one-term Ogden tissues (strain-stiffening exponent `alpha`, the initial shear modulus of
-//! `[tissue]`), and a few off-centre poses at two members to check the ratio law that carries
-//! the coupled model's pose dependence over to the family. The runs themselves are
+//! blended tissues (the paper's Ogden terms of `[tissue]` weighted by `weight`, a soft
+//! one-term Ogden of exponent `soft_alpha` by `1 - weight`, at the initial shear modulus of
+//! `[tissue]`), and a few off-centre poses at two members to check the ratio law that
+//! carries the coupled model's pose dependence over to the family. The runs themselves are
 //! `needle_fe::family`'s; here the section's type and its checks.
 
 use super::error::{SpecError, SpecResult};
@@ -11,8 +12,8 @@ use super::Campaign;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-/// The largest |alpha| a member may have: past it `lambda^alpha` over the checked stretch
-/// range spans more than 1e12 and FEBio's Newton iterations stop being meaningful.
+/// The largest |soft_alpha| the soft term may have: past it `lambda^alpha` over the checked
+/// stretch range spans more than 1e12 and FEBio's Newton iterations stop being meaningful.
 pub const MAX_ABS_ALPHA: f64 = 30.0;
 
 /// `[family]`: which members are solved how deep, in how many load steps, on which mesh,
@@ -20,54 +21,62 @@ pub const MAX_ABS_ALPHA: f64 = 30.0;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FamilySettings {
-    /// The members' one-term Ogden exponents, solved in this order (each a distinct
+    /// The members' weights of the paper's terms, each in `0 ..= 1` (exclusive of 1: the
+    /// paper's own tissue is the reference run), solved in this order (each a distinct
     /// tissue, hence a distinct run hash).
-    pub alpha: Vec<f64>,
+    pub weight: Vec<f64>,
+    /// The Ogden exponent of the soft term (2: neo-Hookean), weighted by `1 - weight`.
+    pub soft_alpha: f64,
     /// Final depth of the centre runs along the needle axis, mm.
     pub depth_mm: f64,
     /// Number of equal load steps to `depth_mm`.
     pub steps: u32,
     /// Mesh level (`[mesh.<level>]`) of the centre runs; its fine layers reach past `depth_mm`.
     pub mesh: String,
-    /// Off-centre poses of the campaign solved at `check_alpha` to `loading.depth_mm` on
+    /// Off-centre poses of the campaign solved at `check_weight` to `loading.depth_mm` on
     /// the campaign's mesh level.
     #[serde(default)]
     pub check_poses: Vec<String>,
-    /// The members (each one of `alpha`) the off-centre poses are solved at.
+    /// The members (each one of `weight`) the off-centre poses are solved at.
     #[serde(default)]
-    pub check_alpha: Vec<f64>,
+    pub check_weight: Vec<f64>,
 }
 
-/// The run name of `pose` at the member `alpha`: `centre_a2`, `x+04_a20`, `centre_a0p5`,
-/// `centre_a-2` (a file name: no dot).
-pub fn member_name(pose: &str, alpha: f64) -> String {
-    format!("{pose}_a{}", format!("{alpha}").replace('.', "p"))
+/// The run name of `pose` at the member `weight`: `centre_w0p05`, `x+04_w0p2`, `centre_w0`
+/// (a file name: no dot).
+pub fn member_name(pose: &str, weight: f64) -> String {
+    format!("{pose}_w{}", format!("{weight}").replace('.', "p"))
 }
 
 /// Check `[family]` against the rest of the spec; messages start with `file:line:` and
-/// name the field (`family.alpha = ...`).
+/// name the field (`family.weight = ...`).
 ///
 /// # Errors
-/// No members, an exponent that is not finite, zero or beyond [`MAX_ABS_ALPHA`], a member
-/// listed twice (names collide), a depth outside the block, 0 steps or too many, an
+/// No members, a weight outside `0 ..= 1` or equal to 1 (the reference), a soft exponent
+/// that is not finite, zero or beyond [`MAX_ABS_ALPHA`], a member listed twice (names collide), a depth outside the block, 0 steps or too many, an
 /// unknown mesh level or one whose fine layers stop above the depth, an unknown or
 /// repeated check pose, a check pose whose needle leaves the block, or a check member
-/// that is not one of `alpha`.
+/// that is not one of `weight`.
 pub fn validate_family(c: &Campaign, text: &str, path: &Path) -> SpecResult<()> {
     let Some(f) = &c.family else { return Ok(()) };
     let at = |key: &str| format!("{}:{}", path.display(), crate::spec::key_line(text, "family", key));
-    if f.alpha.is_empty() {
-        return Err(SpecError::range(at("alpha"), "family.alpha", "family.alpha is empty: name at least one member"));
+    if f.weight.is_empty() {
+        return Err(SpecError::range(at("weight"), "family.weight", "family.weight is empty: name at least one member"));
     }
-    for (k, &a) in f.alpha.iter().enumerate() {
-        if !(a.is_finite() && a != 0.0 && a.abs() <= MAX_ABS_ALPHA) {
-            let message = format!("family.alpha = {a}: must be finite, not 0 and within +-{MAX_ABS_ALPHA}");
-            return Err(SpecError::range(at("alpha"), "family.alpha", message));
+    for (k, &w) in f.weight.iter().enumerate() {
+        if !(w.is_finite() && (0.0..1.0).contains(&w)) {
+            let message = format!("family.weight = {w}: must be in 0 ..= 1, not 1 (weight 1 is the paper's tissue, the reference run)");
+            return Err(SpecError::range(at("weight"), "family.weight", message));
         }
-        let name = member_name("centre", a);
-        if f.alpha[..k].iter().any(|&b| member_name("centre", b) == name) {
-            return Err(SpecError::duplicate(at("alpha"), "family.alpha", a.to_string(), format!("family.alpha: {a} is listed twice")));
+        let name = member_name("centre", w);
+        if f.weight[..k].iter().any(|&b| member_name("centre", b) == name) {
+            return Err(SpecError::duplicate(at("weight"), "family.weight", w.to_string(), format!("family.weight: {w} is listed twice")));
         }
+    }
+    let a = f.soft_alpha;
+    if !(a.is_finite() && a != 0.0 && a.abs() <= MAX_ABS_ALPHA) {
+        let message = format!("family.soft_alpha = {a}: must be finite, not 0 and within +-{MAX_ABS_ALPHA}");
+        return Err(SpecError::range(at("soft_alpha"), "family.soft_alpha", message));
     }
     if !(f.depth_mm.is_finite() && f.depth_mm > 0.0 && f.depth_mm < c.block.depth_mm) {
         let message =
@@ -110,10 +119,10 @@ fn validate_checks(c: &Campaign, f: &FamilySettings, at: &dyn Fn(&str) -> String
         };
         check_pose_in_block(pose, &c.block, c.needle.diameter_mm / 2.0, c.loading.depth_mm, &at("check_poses"))?;
     }
-    for &a in &f.check_alpha {
-        if !f.alpha.contains(&a) {
-            let message = format!("family.check_alpha = {a}: not a member (family.alpha)");
-            return Err(SpecError::inconsistent(at("check_alpha"), "family.check_alpha", message));
+    for &w in &f.check_weight {
+        if !f.weight.contains(&w) {
+            let message = format!("family.check_weight = {w}: not a member (family.weight)");
+            return Err(SpecError::inconsistent(at("check_weight"), "family.check_weight", message));
         }
     }
     Ok(())
@@ -134,27 +143,30 @@ mod tests {
 
     #[test]
     fn member_names_are_file_names() {
-        assert_eq!(member_name("centre", 2.0), "centre_a2");
-        assert_eq!(member_name("x+04", 20.0), "x+04_a20");
-        assert_eq!(member_name("centre", 0.5), "centre_a0p5");
-        assert_eq!(member_name("centre", -2.0), "centre_a-2");
+        assert_eq!(member_name("centre", 0.05), "centre_w0p05");
+        assert_eq!(member_name("x+04", 0.2), "x+04_w0p2");
+        assert_eq!(member_name("centre", 0.0), "centre_w0");
     }
 
     #[test]
     fn bad_family_sections_are_refused_with_file_line_and_field() {
-        let (text, alpha_line, alpha) = shipped_key("family", "alpha");
+        let (text, weight_line, weight) = shipped_key("family", "weight");
+        let (_, soft_line, soft) = shipped_key("family", "soft_alpha");
         let (_, _, depth) = shipped_key("family", "depth_mm");
         let (_, _, mesh) = shipped_key("family", "mesh");
-        let (_, check_line, check) = shipped_key("family", "check_alpha");
+        let (_, check_line, check) = shipped_key("family", "check_weight");
         let (_, poses_line, poses) = shipped_key("family", "check_poses");
         let cases = [
-            (text.replace(&alpha, "alpha = []"), "family.alpha", alpha_line),
-            (text.replace(&alpha, "alpha = [2.0, 0.0]"), "family.alpha", alpha_line),
-            (text.replace(&alpha, "alpha = [2.0, 40.0]"), "family.alpha", alpha_line),
-            (text.replace(&alpha, "alpha = [2.0, 4.0, 2.0]"), "family.alpha", alpha_line),
+            (text.replace(&weight, "weight = []"), "family.weight", weight_line),
+            (text.replace(&weight, "weight = [0.1, 1.0]"), "family.weight", weight_line),
+            (text.replace(&weight, "weight = [0.1, -0.2]"), "family.weight", weight_line),
+            (text.replace(&weight, "weight = [0.1, nan]"), "family.weight", weight_line),
+            (text.replace(&weight, "weight = [0.1, 0.2, 0.1]"), "family.weight", weight_line),
+            (text.replace(&soft, "soft_alpha = 0.0"), "family.soft_alpha", soft_line),
+            (text.replace(&soft, "soft_alpha = 40.0"), "family.soft_alpha", soft_line),
             (text.replace(&depth, "depth_mm = 31.0"), "family.depth_mm", shipped_key("family", "depth_mm").1),
             (text.replace(&mesh, "mesh = \"needle8\""), "family.mesh", shipped_key("family", "mesh").1),
-            (text.replace(&check, "check_alpha = [7.5]"), "family.check_alpha", check_line),
+            (text.replace(&check, "check_weight = [0.75]"), "family.check_weight", check_line),
             (text.replace(&poses, "check_poses = [\"nowhere\"]"), "family.check_poses", poses_line),
             (text.replace(&poses, "check_poses = [\"x+04\", \"x+04\"]"), "family.check_poses", poses_line),
         ];

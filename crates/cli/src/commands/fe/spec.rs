@@ -37,8 +37,8 @@ pub struct SpecArgs {
     #[arg(long, conflicts_with = "deep")]
     pub visco: bool,
     /// The material family of campaign.toml's [family] section: the centre of each member
-    /// (one-term Ogden, exponent family.alpha) to family.depth_mm on family.mesh, then
-    /// family.check_poses at family.check_alpha, into <set>/fe/family/.
+    /// (the paper's terms x family.weight plus a soft term x (1 - weight)) to family.depth_mm on family.mesh, then
+    /// family.check_poses at family.check_weight, into <set>/fe/family/.
     #[arg(long, conflicts_with_all = ["deep", "visco"])]
     pub family: bool,
 }
@@ -82,7 +82,7 @@ fn family_variants(opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
     }
     if out.is_empty() {
         anyhow::bail!(
-            "--family --only {:?}: matches no run (names: centre_paper, the paper's tissue; <pose>_a<alpha>, e.g. centre_a2, x+04_a20, centre_a0p5)",
+            "--family --only {:?}: matches no run (names: centre_paper, the paper's tissue; <pose>_w<weight>, e.g. centre_w0p05, x+04_w0p2)",
             opts.only.as_deref().unwrap_or("")
         );
     }
