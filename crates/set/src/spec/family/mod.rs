@@ -5,6 +5,8 @@
 //! carries the coupled model's pose dependence over to the family. The runs themselves are
 //! `needle_fe::family`'s; here the section's type and its checks.
 
+pub mod runs;
+
 use super::error::{SpecError, SpecResult};
 use super::loading::MAX_LOAD_STEPS;
 use super::pose::check_pose_in_block;
