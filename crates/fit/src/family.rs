@@ -22,6 +22,7 @@ use anyhow::{bail, Context, Result};
 use nalgebra::{DMatrix, DVector};
 use needle_contract::FY;
 use needle_set::manifest::{read_manifest, Manifest, MANIFEST};
+use needle_set::partial;
 use needle_set::results::{content_sha256, parse_csv, Row};
 use needle_set::set_folder::{SetFolder, FAMILY_DIR};
 use needle_set::spec::family::runs::{apply, FamilyRun, REFERENCE_RUN};
@@ -49,6 +50,9 @@ pub struct MemberRun {
     pub fy: Vec<(f64, f64)>,
     /// SHA-256 of its CSV.
     pub csv_sha256: String,
+    /// Whether the run reached the family's depth (false: the must points of its furthest
+    /// failed attempt, its `.partial.csv`).
+    pub complete: bool,
 }
 
 /// How the law meets one member's run.
@@ -58,6 +62,8 @@ pub struct MemberCheck {
     pub weight: f64,
     /// Whether the law was fitted on it (false: held out).
     pub fitted: bool,
+    /// Whether its run reached the family's depth (false: a partial record).
+    pub complete: bool,
     /// Deepest depth compared, mm.
     pub depth_mm: f64,
     /// RMS over its must points of `F_paper g - F_w`, % of the run's peak |Fy|.
@@ -73,7 +79,9 @@ pub struct FamilyLaw {
     pub reference_sha256: String,
     /// The fitted members: weight and SHA-256 of the CSV.
     pub fitted: Vec<(f64, String)>,
-    /// Deepest depth of the law, mm (the shallowest of the fitted runs' deepest points).
+    /// Deepest depth of the law, mm: the shallowest of the fitted runs' deepest points (a
+    /// member that failed every attempt counts with the must points it reached); past it
+    /// the library holds `g` at its value there (the member grows as the paper's tissue).
     pub depth_max_mm: f64,
     /// `a_jk`, at `j * (WEIGHT_DEGREE + 1) + k`.
     pub coeffs: [f64; TERMS],
@@ -122,14 +130,24 @@ pub fn read_runs(set: &SetFolder) -> Result<Option<(MemberRun, Vec<MemberRun>)>>
     Ok(Some((reference, members)))
 }
 
-/// The centre run of `run`, or `None` when its CSV is absent.
+/// The centre run of `run`: its result, or when it failed every attempt so far the must
+/// points of its furthest attempt (a current `.partial.csv`: converged FE states, only
+/// not as deep as asked); `None` when there is neither.
 fn read_run(c: &Campaign, manifest: &Manifest, dir: &std::path::Path, run: FamilyRun) -> Result<Option<MemberRun>> {
     let Some(f) = &c.family else { return Ok(None) };
     let (campaign, poses, mesh) = apply(c, f, run);
     let Some(pose) = poses.first() else { return Ok(None) };
     let path = dir.join(format!("{}.csv", pose.name));
     if !path.is_file() {
-        return Ok(None);
+        let Some(record) = partial::read_current_record(dir, &pose.name, &campaign.run_hash(pose, &mesh)) else { return Ok(None) };
+        let (csv, _) = partial::paths(dir, &pose.name);
+        let bytes = std::fs::read(&csv).with_context(|| format!("{}: cannot read", csv.display()))?;
+        if content_sha256(&bytes) != record.csv_sha256 {
+            bail!("{}: content changed since the FE run wrote it (not the csv_sha256 of its .partial.toml)", csv.display());
+        }
+        let rows: Vec<Row> = parse_csv(&String::from_utf8_lossy(&bytes), &csv)?;
+        let fy = rows.iter().map(|r| (r.depth_mm, r.wrench[FY])).collect();
+        return Ok(Some(MemberRun { weight: run.weight().unwrap_or(1.0), fy, csv_sha256: record.csv_sha256, complete: false }));
     }
     let entry = manifest
         .current_entry(&campaign, pose, &mesh)
@@ -140,7 +158,7 @@ fn read_run(c: &Campaign, manifest: &Manifest, dir: &std::path::Path, run: Famil
     }
     let rows: Vec<Row> = parse_csv(&String::from_utf8_lossy(&bytes), &path)?;
     let fy = rows.iter().map(|r| (r.depth_mm, r.wrench[FY])).collect();
-    Ok(Some(MemberRun { weight: run.weight().unwrap_or(1.0), fy, csv_sha256: content_sha256(&bytes) }))
+    Ok(Some(MemberRun { weight: run.weight().unwrap_or(1.0), fy, csv_sha256: content_sha256(&bytes), complete: true }))
 }
 
 /// The reference's Fy at `depth_mm` (a must point of both runs: the same load steps).
@@ -166,6 +184,11 @@ pub enum FamilyFit {
 /// A failed least squares, and [`read_runs`]'s.
 pub fn fit(set: &SetFolder) -> Result<FamilyFit> {
     let Some((reference, members)) = read_runs(set)? else { return Ok(FamilyFit::None) };
+    if !reference.complete {
+        return Ok(FamilyFit::Pending(
+            "material family law: not fitted: the reference run centre_paper has not reached the family's depth".into(),
+        ));
+    }
     let held_out = set.campaign().family.as_ref().map(|f| f.held_out.clone()).unwrap_or_default();
     let fitted: Vec<&MemberRun> = members.iter().filter(|m| !held_out.contains(&m.weight)).collect();
     if fitted.len() < WEIGHT_DEGREE + 1 {
@@ -218,7 +241,7 @@ fn check(reference: &MemberRun, m: &MemberRun, coeffs: &[f64; TERMS], depth_max_
         deepest = deepest.max(d);
     }
     let rms_pct = if n > 0 { (sum / n as f64).sqrt() } else { f64::NAN };
-    MemberCheck { weight: m.weight, fitted, depth_mm: deepest, rms_pct, max_pct: max }
+    MemberCheck { weight: m.weight, fitted, complete: m.complete, depth_mm: deepest, rms_pct, max_pct: max }
 }
 
 /// The text of `family.toml`.
@@ -246,6 +269,7 @@ pub fn to_toml(law: &FamilyLaw) -> String {
         let _ = writeln!(s, "\n[[check]]");
         let _ = writeln!(s, "weight = {:?}", c.weight);
         let _ = writeln!(s, "fitted = {}", c.fitted);
+        let _ = writeln!(s, "complete = {}", c.complete);
         let _ = writeln!(s, "depth_mm = {:?}", c.depth_mm);
         let _ = writeln!(s, "rms_pct = {:?}", c.rms_pct);
         let _ = writeln!(s, "max_pct = {:?}", c.max_pct);
@@ -263,10 +287,11 @@ pub fn summary(law: &FamilyLaw) -> String {
         law.fitted.iter().map(|f| f.0).collect::<Vec<_>>(),
         law.depth_max_mm
     );
-    let _ = writeln!(s, "weight      role      to mm    rms %    max %");
+    let _ = writeln!(s, "weight      role      run       to mm    rms %    max %");
     for c in &law.checks {
         let role = if c.fitted { "fitted" } else { "held out" };
-        let _ = writeln!(s, "{:<10} {role:<9} {:6.2} {:8.3} {:8.3}", c.weight, c.depth_mm, c.rms_pct, c.max_pct);
+        let run = if c.complete { "complete" } else { "partial" };
+        let _ = writeln!(s, "{:<10} {role:<9} {run:<9} {:6.2} {:8.3} {:8.3}", c.weight, c.depth_mm, c.rms_pct, c.max_pct);
     }
     s
 }
