@@ -29,14 +29,9 @@ use needle_set::spec::family::runs::{apply, FamilyRun, REFERENCE_RUN};
 use needle_set::spec::Campaign;
 use std::fmt::Write as _;
 
-/// The file's name inside a set folder.
-pub const FILE: &str = "family.toml";
-/// Degree of the law in depth (`u^0 ..= u^DEPTH_DEGREE`).
-pub const DEPTH_DEGREE: usize = 4;
-/// Degree of the law in `t = sqrt(w)`.
-pub const WEIGHT_DEGREE: usize = 2;
-/// Coefficients of the law, `a_jk` at `j * (WEIGHT_DEGREE + 1) + k`.
-pub const TERMS: usize = (DEPTH_DEGREE + 1) * (WEIGHT_DEGREE + 1);
+/// The file's name, the law's degrees in depth and in `t = sqrt(w)`, its coefficient
+/// count (`a_jk` at `j * (WEIGHT_DEGREE + 1) + k`): the generator's, which reads the file.
+pub use needle_codegen::family::{DEPTH_DEGREE, FILE, TERMS, WEIGHT_DEGREE};
 /// Must points shallower than this are not fitted: the forces there are below 1 % of
 /// the peak and their ratio is the solver's noise.
 pub const MIN_DEPTH_MM: f64 = 0.25;
@@ -307,5 +302,26 @@ mod tests {
             assert_eq!(ratio(&coeffs, 16.2, d, 1.0), 1.0);
         }
         assert!((ratio(&coeffs, 16.2, 0.0, 0.0) - (1.0 + coeffs[0])).abs() < 1e-15, "u = t = 0 leaves a_00");
+    }
+
+    /// What the fitter writes, the generator reads back: the same f32 coefficients and
+    /// depth (the format round trip; a field renamed on one side fails here).
+    #[test]
+    fn the_generator_reads_what_the_fitter_writes() {
+        let coeffs: [f64; TERMS] = std::array::from_fn(|i| (i as f64 - 7.0) * 0.123_456_789);
+        let check = MemberCheck { weight: 0.1, fitted: false, complete: true, depth_mm: 16.2, rms_pct: 0.5, max_pct: 1.0 };
+        let law = FamilyLaw {
+            reference_sha256: "ab".repeat(32),
+            fitted: vec![(0.05, "cd".repeat(32)), (0.2, "ef".repeat(32))],
+            depth_max_mm: 15.9,
+            coeffs,
+            checks: vec![check],
+        };
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join(FILE);
+        std::fs::write(&path, to_toml(&law)).expect("write");
+        let read = needle_codegen::family::parse(&path).expect("the generator reads the fitter's file");
+        assert_eq!(read.depth_max_mm, 15.9);
+        assert_eq!(read.coeffs_f32.map(f32::to_bits), coeffs.map(|c| (c as f32).to_bits()));
     }
 }
