@@ -51,6 +51,7 @@
 //! `progress` the display.
 
 mod plan;
+pub mod runs;
 mod solve;
 
 pub use plan::{plan, Plan};
@@ -63,6 +64,7 @@ use crate::mesh::summary as mesh_summary;
 use crate::process;
 use crate::progress_bar::Progress;
 use crate::report::{PoseReport, Report};
+use crate::set_folder::SetFolder;
 use crate::spec::{Campaign, Engine, MeshLevel, PoseSpec};
 use anyhow::{Context, Result};
 use std::collections::BTreeMap;
@@ -169,18 +171,19 @@ impl RunOptions {
 /// silence is not progress.
 pub const DEFAULT_STALL: Duration = Duration::from_secs(600);
 
-/// Run the campaign on its engine (`opts.solver`, else the spec's `[solver] engine`).
-/// See the module docs.
+/// Run the campaign of the set `set` (opened once by the caller; `opts.set_dir` is its
+/// folder) on its engine (`opts.solver`, else the spec's `[solver] engine`). See the
+/// module docs.
 ///
 /// # Errors
-/// The spec cannot be loaded or is invalid, the tissue fails the material check,
+/// The spec is invalid for the run, `opts.set_dir` is not `set`'s folder, the tissue fails the material check,
 /// `--mesh` names no level, `--only` matches no pose or is not a glob, `--steps 0`,
 /// ccx is missing, the manifest is corrupt or the output folder cannot be written.
 /// Failed solves are not errors: they are in the [`Report`].
-pub fn run(opts: &RunOptions) -> Result<Report> {
-    // the spec is read once, by the plan; its engine (with `opts.solver` applied) picks
-    // the backend
-    let plan = plan(opts)?;
+pub fn run(set: &SetFolder, opts: &RunOptions) -> Result<Report> {
+    // the spec was read once, when `set` was opened; its engine (with `opts.solver`
+    // applied) picks the backend
+    let plan = plan(set, opts)?;
     let engine = plan.campaign.solver.engine;
     run_planned(opts, plan, backend_for(engine, opts.threads).as_mut())
 }
@@ -209,8 +212,8 @@ struct Ctx<'a> {
 ///
 /// # Errors
 /// As [`run`].
-pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> {
-    run_planned(opts, plan(opts)?, backend)
+pub fn run_with(set: &SetFolder, opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> {
+    run_planned(opts, plan(set, opts)?, backend)
 }
 
 /// [`run_with`] of a plan already made for `opts`.

@@ -15,9 +15,10 @@
 //! mesh's (`[mesh]`); these are the numbers to choose the mesh and the edge by.
 
 use super::mesh_check::{self, MeshOptions, MeshReport};
-use super::runs::{read_current, same_depths, PoseRows};
 use super::shape::{self, ShapeComparison};
+use crate::campaign::runs::{read_current, same_depths, PoseRows};
 use crate::campaign::RunOptions;
+use crate::set_folder::SetFolder;
 use crate::spec::{Campaign, Role};
 use anyhow::{Context, Result};
 use serde::Serialize;
@@ -96,7 +97,7 @@ impl std::fmt::Display for EdgeStudy {
 ///
 /// # Errors
 /// The spec has no radii, or as [`mesh_check::mesh_convergence`].
-pub fn edge_study(c: &Campaign, o: &MeshOptions) -> Result<Vec<EdgeStudy>> {
+pub fn edge_study(set: &SetFolder, c: &Campaign, o: &MeshOptions) -> Result<Vec<EdgeStudy>> {
     if c.campaign.edge_study_radii_mm.is_empty() {
         anyhow::bail!("--edge: campaign.edge_study_radii_mm is empty: name the edge radii to study, mm");
     }
@@ -104,7 +105,7 @@ pub fn edge_study(c: &Campaign, o: &MeshOptions) -> Result<Vec<EdgeStudy>> {
     let poses: Vec<String> = std::iter::once(centre).chain(c.campaign.edge_study_poses.iter().cloned()).collect();
     let mut out = Vec::new();
     for &r in &c.campaign.edge_study_radii_mm {
-        let mesh = mesh_check::mesh_convergence(c, &MeshOptions { edge_radius_mm: Some(r), ..o.clone() })?;
+        let mesh = mesh_check::mesh_convergence(set, c, &MeshOptions { edge_radius_mm: Some(r), ..o.clone() })?;
         let read = |edge: Option<f64>, level: &str| -> Result<PoseRows> {
             let opts = RunOptions {
                 only: Some(poses.join(",")),
@@ -113,7 +114,7 @@ pub fn edge_study(c: &Campaign, o: &MeshOptions) -> Result<Vec<EdgeStudy>> {
                 edge_radius_mm: edge,
                 ..RunOptions::new(&o.set_dir)
             };
-            read_current(&opts)
+            read_current(set, &opts)
         };
         let campaign = read(None, &mesh.committed)?;
         let compare = |level: &str| -> Result<Vec<ShapeComparison>> {

@@ -11,9 +11,10 @@
 //! ratio of successive changes), and per pose and pair of levels the shape comparison of
 //! [`shape`](super::shape) (judged: the goal of issue 42).
 
-use super::runs::{read_current, same_depths, solve_and_read, PoseRows};
 use super::shape::{self, ShapeComparison};
+use crate::campaign::runs::{read_current, same_depths, solve_and_read, PoseRows};
 use crate::campaign::RunOptions;
+use crate::set_folder::SetFolder;
 use crate::spec::{Campaign, Role};
 use anyhow::{Context, Result};
 use needle_contract::FY;
@@ -240,7 +241,7 @@ fn plan_study(c: &Campaign, extra: &[String], edge: bool) -> Result<(StudyPlan, 
 /// # Errors
 /// The spec, `campaign.mesh_study`, an option or a manifest (a failed solve is a run's
 /// `failure`).
-pub fn mesh_convergence(c: &Campaign, o: &MeshOptions) -> Result<MeshReport> {
+pub fn mesh_convergence(set: &SetFolder, c: &Campaign, o: &MeshOptions) -> Result<MeshReport> {
     let poses = if o.edge_radius_mm.is_some() { &c.campaign.edge_study_poses } else { &c.campaign.mesh_study_poses };
     let (plan, committed, refined) = plan_study(c, poses, o.edge_radius_mm.is_some())?;
     let mut results: Vec<(String, PoseRows)> = Vec::new();
@@ -259,7 +260,7 @@ pub fn mesh_convergence(c: &Campaign, o: &MeshOptions) -> Result<MeshReport> {
         };
         let what = o.edge_radius_mm.map_or("mesh study".to_string(), |r| format!("edge study r = {r} mm"));
         println!("{what}, level {level}: {} in {}", poses.join(", "), out_dir.display());
-        let rows = if o.solve && !campaign_runs { solve_and_read(&opts)? } else { read_current(&opts)? };
+        let rows = if o.solve && !campaign_runs { solve_and_read(set, &opts)? } else { read_current(set, &opts)? };
         results.push((level.clone(), rows));
     }
     let levels = level_runs(c, &results)?;
@@ -452,11 +453,11 @@ mod tests {
         let (c, set) = off_the_ladder();
         let manifest = crate::manifest::read_manifest(&set.join("fe/manifest.toml")).expect("the shipped manifest");
         let entry = manifest.pose.get("centre").expect("the centre's entry").clone();
-        let run = |k: f64| super::super::runs::Run {
+        let run = |k: f64| crate::campaign::runs::Run {
             rows: (0..=6).map(f64::from).map(|d| Row { depth_mm: d, wrench: [0.0, k * d * d, 0.0, 0.0, 0.0, 0.0] }).collect(),
             entry: entry.clone(),
         };
-        let results: Vec<(String, super::super::runs::PoseRows)> = ["coarse8", "needle8", "core6", "fine"]
+        let results: Vec<(String, crate::campaign::runs::PoseRows)> = ["coarse8", "needle8", "core6", "fine"]
             .iter()
             .enumerate()
             .map(|(i, l)| (l.to_string(), [("centre".to_string(), Ok(run(1.0 + 0.1 * i as f64)))].into_iter().collect()))

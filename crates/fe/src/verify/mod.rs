@@ -22,7 +22,6 @@ pub mod mesh_check;
 mod mirror;
 pub mod punch;
 pub mod punch_febio;
-pub mod runs;
 pub mod scaling;
 pub mod shape;
 pub mod smooth;
@@ -36,6 +35,7 @@ pub use punch::{
 pub use smooth::{SmoothReport, SMOOTH_GOAL_PERCENT};
 
 use super::spec;
+use crate::set_folder::SetFolder;
 use anyhow::{Context, Result};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -99,12 +99,13 @@ fn print_judged<R: std::fmt::Display>(reports: &[R], percent: impl Fn(&R) -> f64
     ok
 }
 
-/// Run the checks, print the table, write `<set>/fe/verify.toml`.
+/// Run the checks on the set `set` (opened once by the caller; `opts.set_dir` is its
+/// folder), print the table, write `<set>/fe/verify.toml`.
 ///
 /// # Errors
 /// ccx missing or failing, missing FE files for the mirror check.
-pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
-    let (mut c, _) = spec::load(&opts.set_dir)?;
+pub fn run(set: &SetFolder, opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
+    let mut c = set.campaign().clone();
     if let Some(e) = opts.engine {
         c.solver.engine = e;
     }
@@ -120,7 +121,7 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
         ok &= print_judged(&report.smooth, |s| s.percent_of_peak_fy, SMOOTH_GOAL_PERCENT);
     }
     if let Some(o) = &opts.scaling {
-        let s = scaling::scaling_check(&c, o)?;
+        let s = scaling::scaling_check(set, &c, o)?;
         ok &= s.ok();
         report.scaling = Some(s);
     }
@@ -134,13 +135,13 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
         report.punch = Some(p);
     }
     if let Some(o) = &opts.mesh {
-        let m = mesh_check::mesh_convergence(&c, o)?;
+        let m = mesh_check::mesh_convergence(set, &c, o)?;
         print_mesh_study(&m);
         ok &= m.ok();
         report.mesh = Some(m);
     }
     if let Some(o) = &opts.edge {
-        report.edge = edge::edge_study(&c, o)?;
+        report.edge = edge::edge_study(set, &c, o)?;
     }
     let mut new: toml::Table = toml::Table::try_from(&report).context("cannot serialise the verify report")?;
     // only the checks that ran replace their part of an earlier verify.toml

@@ -4,6 +4,7 @@
 pub mod qlv;
 
 use clap::Args;
+use needle_set::set_folder::SetFolder;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -98,7 +99,7 @@ pub fn run(a: VerifyArgs) -> anyhow::Result<ExitCode> {
             threads,
             solve: !a.no_solve,
         };
-        let ok = qlv::check(&opts)?;
+        let ok = qlv::check(&SetFolder::open(&a.set)?, &opts)?;
         if !ok {
             eprintln!("needle fe verify --qlv: a run missed its bound or has no comparison");
         }
@@ -136,8 +137,9 @@ pub fn run(a: VerifyArgs) -> anyhow::Result<ExitCode> {
         threads,
         engine: a.solver.as_deref().map(needle_set::spec::Engine::parse).transpose()?,
     };
+    let set = SetFolder::open(&opts.set_dir)?;
     needle_fe::process::stop_jobs_on_termination()?;
-    let (_, ok) = needle_fe::verify::run(&opts)?;
+    let (_, ok) = needle_fe::verify::run(&set, &opts)?;
     if !ok {
         eprintln!("needle fe verify: a check missed its goal");
     }
