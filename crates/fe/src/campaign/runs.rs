@@ -5,25 +5,11 @@
 //! read, not solved again.
 
 use crate::campaign::{self, RunOptions};
-use crate::manifest::ManifestEntry;
+pub use crate::pose_rows::{same_depths, PoseRows, Run};
 use crate::report::Status;
 use crate::results::{self, Row};
 use crate::set_folder::SetFolder;
 use anyhow::Result;
-use std::collections::BTreeMap;
-
-/// A current result: its rows and how it was made.
-#[derive(Debug, Clone)]
-pub struct Run {
-    /// The CSV's rows, depth 0 first.
-    pub rows: Vec<Row>,
-    /// Its manifest entry.
-    pub entry: ManifestEntry,
-}
-
-/// Each selected pose's result, or why there is none (the run failed, or the result is
-/// not current for this spec).
-pub type PoseRows = BTreeMap<String, std::result::Result<Run, String>>;
 
 /// Solve what is not up to date among the poses `opts` selects of `set` (one job), print
 /// the campaign's table, then read every selected pose's result.
@@ -85,11 +71,6 @@ fn read_rows(csv: &std::path::Path, timed: bool) -> Result<Vec<Row>> {
     }
     let text = std::fs::read_to_string(csv).map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", csv.display()))?;
     Ok(results::parse_timed_csv(&text, csv)?.1)
-}
-
-/// The depths of `a` and `b` agree row by row (the same must points).
-pub fn same_depths(a: &[Row], b: &[Row]) -> bool {
-    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x.depth_mm - y.depth_mm).abs() <= 1e-9 * (1.0 + x.depth_mm.abs()))
 }
 
 #[cfg(test)]

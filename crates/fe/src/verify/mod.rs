@@ -2,9 +2,9 @@
 //!
 //! 1. **Flat punch (Sneddon)** ([`punch`]): a rigid flat-ended punch of the needle's
 //!    radius pressed into the block, against Sneddon's half-space force (goal: within 5%).
-//! 2. **Mesh study** ([`mesh_check`]): the centre on the levels of `campaign.mesh_study`
+//! 2. **Mesh study** ([`crate::mesh::study`]): the centre on the levels of `campaign.mesh_study`
 //!    and the poses of `campaign.mesh_study_poses` on the committed level and its
-//!    refinement (the next level, or `campaign.mesh_reference`); the shape after the best scale ([`shape`]: goal 2 % RMS, 4 % largest),
+//!    refinement (the next level, or `campaign.mesh_reference`); the shape after the best scale ([`crate::mesh::shape`]: goal 2 % RMS, 4 % largest),
 //!    the absolute change of Fy and Richardson's estimate when in the asymptotic range.
 //! 3. **Mirror runs**: each `mirror` pose against its mirrored counterpart from the
 //!    committed data, with the sign flips of coeffs/README.md (goal 1% of peak |Fy|).
@@ -18,15 +18,13 @@
 //!    goal RMS 3 %, must 5 %, largest 6 % of peak |Fy|), written with [`write_tables`].
 
 pub mod edge;
-pub mod mesh_check;
 mod mirror;
 pub mod punch;
 pub mod punch_febio;
 pub mod scaling;
-pub mod shape;
 pub mod smooth;
 
-pub use mesh_check::{richardson, LevelRun, MeshReport};
+pub use crate::mesh::study::{richardson, LevelRun, MeshReport};
 pub use mirror::{MirrorReport, MIRROR_GOAL_PERCENT};
 pub use punch::{
     bonded_punch_force, poisson, punch_deck, punch_mesh, sneddon_force, PunchDeck, PunchElement, PunchReport, PunchRun,
@@ -35,6 +33,7 @@ pub use punch::{
 pub use smooth::{SmoothReport, SMOOTH_GOAL_PERCENT};
 
 use super::spec;
+use crate::campaign;
 use crate::set_folder::SetFolder;
 use anyhow::{Context, Result};
 use serde::Serialize;
@@ -48,10 +47,10 @@ pub struct VerifyOptions {
     /// Run the flat-punch check.
     pub punch: bool,
     /// Run the mesh study with these options (`None`: not run; the fine runs are slow).
-    pub mesh: Option<mesh_check::MeshOptions>,
+    pub mesh: Option<crate::mesh::study::MeshOptions>,
     /// Run the edge study (`campaign.edge_study_radii_mm`) with these options (their
     /// `edge_radius_mm` is set per radius; `None`: not run).
-    pub edge: Option<mesh_check::MeshOptions>,
+    pub edge: Option<crate::mesh::study::MeshOptions>,
     /// Check the mirror runs (no solve).
     pub mirror: bool,
     /// Check every result present for a must point off its neighbours (no solve).
@@ -135,7 +134,7 @@ pub fn run(set: &SetFolder, opts: &VerifyOptions) -> Result<(VerifyReport, bool)
         report.punch = Some(p);
     }
     if let Some(o) = &opts.mesh {
-        let m = mesh_check::mesh_convergence(set, &c, o)?;
+        let m = mesh_study(set, &c, o)?;
         print_mesh_study(&m);
         ok &= m.ok();
         report.mesh = Some(m);
@@ -156,6 +155,30 @@ pub fn run(set: &SetFolder, opts: &VerifyOptions) -> Result<(VerifyReport, bool)
     }
     write_tables(&opts.set_dir, new)?;
     Ok((report, ok))
+}
+
+/// The mesh study of `o` ([`crate::mesh::study::mesh_convergence`]) with the campaign's
+/// runner: each level's runs solved (when the study asks) and read through
+/// `campaign::runs` on `set`, `o.threads` solver threads each.
+///
+/// # Errors
+/// As [`crate::mesh::study::mesh_convergence`] and [`campaign::runs::solve_and_read`].
+pub fn mesh_study(set: &SetFolder, c: &spec::Campaign, o: &crate::mesh::study::MeshOptions) -> Result<MeshReport> {
+    crate::mesh::study::mesh_convergence(c, o, &mut |l| {
+        let opts = campaign::RunOptions {
+            only: Some(l.poses.join(",")),
+            mesh: Some(l.level.to_string()),
+            out_dir: Some(l.out_dir.to_path_buf()),
+            threads: o.threads,
+            edge_radius_mm: o.edge_radius_mm,
+            ..campaign::RunOptions::new(&o.set_dir)
+        };
+        if l.solve {
+            campaign::runs::solve_and_read(set, &opts)
+        } else {
+            campaign::runs::read_current(set, &opts)
+        }
+    })
 }
 
 /// The flat-punch check's lines: the block, twice the block, the half-space extrapolated

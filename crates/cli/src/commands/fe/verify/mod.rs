@@ -120,7 +120,7 @@ pub fn run(a: VerifyArgs) -> anyhow::Result<ExitCode> {
         threads,
         solve: !a.no_solve,
     });
-    let study = needle_fe::verify::mesh_check::MeshOptions { set_dir: a.set.clone(), threads, solve: !a.no_solve, edge_radius_mm: None };
+    let study = needle_fe::mesh::study::MeshOptions { set_dir: a.set.clone(), threads, solve: !a.no_solve, edge_radius_mm: None };
     let mesh = (a.mesh || all).then(|| study.clone());
     let edge = a.edge.then_some(study);
     let opts = needle_fe::verify::VerifyOptions {
