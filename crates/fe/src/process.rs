@@ -76,7 +76,7 @@ pub fn stop_jobs_on_termination() -> Result<()> {
         .get_or_init(|| {
             ctrlc::set_handler(|| {
                 STOP.store(true, Ordering::SeqCst);
-                eprintln!("needle: interrupted: stopping the running solver jobs; finished poses are kept, a rerun resumes");
+                needle_stdx::noteln!("needle: interrupted: stopping the running solver jobs; finished poses are kept, a rerun resumes");
                 std::thread::sleep(STOP_GRACE);
                 std::process::exit(i32::from(EXIT_INTERRUPTED));
             })
@@ -141,7 +141,7 @@ fn dies_with_parent(cmd: &Command) -> Result<Command> {
 
 /// Run `cmd` (program, arguments, environment already set) in `work_dir`, stdin from
 /// /dev/null, stdout and stderr to `log_path`; the solver dies with the thread that runs
-/// this ([`dies_with_parent`]). With a `timeout` the process is killed when
+/// this (`dies_with_parent`). With a `timeout` the process is killed when
 /// it runs longer (wall clock); with a `stall` limit, when none of `log_path` and
 /// `progress_files` has grown for that long (a solver spinning without output is a
 /// failed run, not a slow one). Polls every 50 ms; kills the process on [`interrupted`].

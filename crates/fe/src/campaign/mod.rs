@@ -6,13 +6,13 @@
 //! Files, in the output folder (default `<set>/fe/`):
 //! - `<pose>.csv`: the wrench at `steps + 1` depths (format: coeffs/README.md). Written
 //!   with [`needle_stdx::fs::write_atomic`]: a killed run never leaves a half-written CSV.
-//! - `manifest.toml`: one table per finished pose (see [`ManifestEntry`]), sorted by
+//! - `manifest.toml`: one table per finished pose (see [`ManifestEntry`](crate::manifest::ManifestEntry)), sorted by
 //!   pose name, rewritten atomically after each pose.
 //! - `manifest.toml.lock`: the lock ([`lock_manifest`]) under which every process
 //!   (this one's jobs, SLURM array tasks, another `needle fe run`) rewrites the manifest.
 //! - `.work/<pose>/`: the solver's input and files of a run; removed when the run
 //!   succeeds (unless `keep_work`), kept for debugging when it fails. Its
-//!   `progress.toml` ([`resume`]) records the attempt running, the finished attempts'
+//!   `progress.toml` ([`resume`](crate::resume)) records the attempt running, the finished attempts'
 //!   failures and the furthest must points: a run killed in the middle of a pose (a
 //!   session's end) resumes on the rerun at the attempt it was in, which the engine
 //!   continues from its last dump (FEBio) or reruns from its start (ccx), with
@@ -230,7 +230,7 @@ fn run_planned(opts: &RunOptions, plan: Plan, backend: &mut dyn Backend) -> Resu
         let recorded = m.record_first_attempts(&campaign, &all, &mesh_name);
         if recorded > 0 {
             needle_stdx::fs::write_atomic(&manifest_path, manifest_text(&m)?.as_bytes())?;
-            eprintln!(
+            needle_stdx::noteln!(
                 "recorded the first attempt's hash of {recorded} run(s) solved by their first attempt in {}",
                 manifest_path.display()
             );
@@ -240,7 +240,7 @@ fn run_planned(opts: &RunOptions, plan: Plan, backend: &mut dyn Backend) -> Resu
     let to_run: Vec<(usize, &PoseSpec)> = to_run.iter().filter_map(|&i| selected.get(i).map(|p| (i, p))).collect();
     let skipped = reports.len() - to_run.len();
     let jobs = opts.jobs.clamp(1, to_run.len().max(1));
-    eprintln!(
+    needle_stdx::noteln!(
         "needle fe run: {} pose(s) selected; skipped {skipped} up to date; {} to run with {jobs} job(s) (mesh {mesh_name}, {steps} steps to {} mm) -> {}",
         reports.len(),
         to_run.len(),

@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 /// What a campaign run will do, worked out before anything is solved or submitted:
 /// the spec (with the `--solver` and `--steps` overrides applied), the mesh level, the
 /// output folder and, per selected pose, whether its result is up to date. Shared by the
-/// local run ([`run_with`]), the SLURM submission
+/// local run ([`run_with`](super::run_with)), the SLURM submission
 /// ([`launcher::slurm`](crate::launcher::slurm)) and `needle fe status`.
 pub struct Plan {
     /// The spec with the overrides applied.
@@ -78,7 +78,7 @@ pub fn plan(set: &SetFolder, opts: &RunOptions) -> Result<Plan> {
     let spec_path = set.spec_path().to_path_buf();
     let stability = crate::material::check(&campaign.tissue)
         .with_context(|| format!("{}: the tissue fails the material stability check; nothing was run", spec_path.display()))?;
-    eprintln!("material check passed: {}", stability.to_string().replace('\n', "\n  "));
+    needle_stdx::noteln!("material check passed: {}", stability.to_string().replace('\n', "\n  "));
     if let Some(engine) = opts.solver {
         campaign.solver.engine = engine;
     }

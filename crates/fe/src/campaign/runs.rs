@@ -19,7 +19,7 @@ use anyhow::Result;
 /// the pose's `Err`).
 pub fn solve_and_read(set: &SetFolder, opts: &RunOptions) -> Result<PoseRows> {
     let report = campaign::run(set, opts)?;
-    print!("{}", report.table());
+    needle_stdx::out!("{}", report.table());
     let mut rows = read_current(set, opts)?;
     for p in &report.poses {
         if let (Status::Failed { message, .. }, Some(Err(why))) = (&p.status, rows.get_mut(&p.pose)) {

@@ -10,7 +10,7 @@
 //! Reported: the absolute change of Fy at full depth between levels (the centre's, with
 //! Richardson's estimate when the finest three are in the asymptotic range, else the
 //! ratio of successive changes), and per pose and pair of levels the shape comparison of
-//! [`shape`](super::shape) (judged: the goal of issue 42).
+//! [`shape`] (judged: the goal of issue 42).
 
 use super::shape::{self, ShapeComparison};
 use crate::pose_rows::{same_depths, PoseRows};
@@ -265,17 +265,17 @@ pub fn mesh_convergence(c: &Campaign, o: &MeshOptions, runs: &mut dyn FnMut(&Lev
         let campaign_runs = *level == c.campaign.mesh && o.edge_radius_mm.is_none();
         let out_dir = run_dir(c, &o.set_dir, level, o.edge_radius_mm);
         let what = o.edge_radius_mm.map_or("mesh study".to_string(), |r| format!("edge study r = {r} mm"));
-        println!("{what}, level {level}: {} in {}", poses.join(", "), out_dir.display());
+        needle_stdx::outln!("{what}, level {level}: {} in {}", poses.join(", "), out_dir.display());
         let rows = runs(&LevelRuns { level, poses, out_dir: &out_dir, solve: o.solve && !campaign_runs })?;
         results.push((level.clone(), rows));
     }
     let levels = level_runs(c, &results)?;
     let shape = shape_comparisons(c, &results, (&committed, &refined));
     for s in &shape {
-        println!("{s}");
+        needle_stdx::outln!("{s}");
     }
     for t in shape_trends(&shape) {
-        println!("{t}");
+        needle_stdx::outln!("{t}");
     }
     Ok(report(c, committed, refined, levels, shape, &plan))
 }
@@ -295,7 +295,7 @@ fn level_runs(c: &Campaign, results: &[(String, PoseRows)]) -> Result<Vec<LevelR
                 failure: r.as_ref().err().cloned(),
                 retry: r.as_ref().ok().and_then(|r| r.entry.retry.clone()),
             };
-            println!(
+            needle_stdx::outln!(
                 "  {pose} on {level}: {}",
                 match (run.fy_n, &run.failure) {
                     (Some(f), _) => format!(

@@ -138,7 +138,7 @@ pub fn edge_study(set: &SetFolder, c: &Campaign, o: &MeshOptions) -> Result<Vec<
             against_campaign_edge,
             campaign_against_refined,
         };
-        println!("{study}");
+        needle_stdx::outln!("{study}");
         out.push(study);
     }
     Ok(out)

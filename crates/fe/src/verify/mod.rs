@@ -13,7 +13,7 @@
 //!    solver accepted off the equilibrium path shows as such a point.
 //! 5. **Scaling law** ([`scaling`]): the centre and a half-model pose with every Ogden
 //!    mu_i scaled by 0.5 and 2 against s times the committed run (goal 0.5 % of peak |Fy|).
-//! 6. **Viscoelastic ramp and hold** ([`qlv`]): the `[viscoelastic]` runs against the
+//! 6. **Viscoelastic ramp and hold** ([`qlv`](crate::visco::qlv)): the `[viscoelastic]` runs against the
 //!    library's QLV filter on the elastic run (run by the CLI, `needle fe verify --qlv`;
 //!    goal RMS 3 %, must 5 %, largest 6 % of peak |Fy|), written with [`write_tables`].
 
@@ -92,7 +92,7 @@ pub struct VerifyReport {
 fn print_judged<R: std::fmt::Display>(reports: &[R], percent: impl Fn(&R) -> f64, goal_percent: f64) -> bool {
     let mut ok = true;
     for r in reports {
-        println!("{r}");
+        needle_stdx::outln!("{r}");
         ok &= percent(r) <= goal_percent;
     }
     ok
@@ -184,7 +184,7 @@ pub fn mesh_study(set: &SetFolder, c: &spec::Campaign, o: &crate::mesh::study::M
 /// The flat-punch check's lines: the block, twice the block, the half-space extrapolated
 /// against Sneddon, and the campaign element's (no goal) when it ran.
 fn print_punch(p: &PunchReport) {
-    println!(
+    needle_stdx::outln!(
         "flat punch a = {} mm, delta = {} mm, nu = {:.4}, {}: F(block) = {:.5e} N, F(2x block) = {:.5e} N, \
          F(half-space, extrapolated) = {:.5e} N, Sneddon {:.5e} N: error {:+.2}% (goal within {}%); {} {:.0} s + {:.0} s",
         p.radius_mm,
@@ -202,7 +202,7 @@ fn print_punch(p: &PunchReport) {
         p.check.wall_s[1]
     );
     if let Some(r) = &p.campaign_element {
-        println!(
+        needle_stdx::outln!(
             "  campaign element {}: F(block) = {:.5e} N, F(2x block) = {:.5e} N, F(half-space) = {:.5e} N: {:+.2}% \
              (no goal: volumetric locking of the fully integrated C3D8 at K0/mu0 = {}); ccx {:.0} s + {:.0} s",
             r.element,
@@ -220,7 +220,7 @@ fn print_punch(p: &PunchReport) {
 /// The mesh study's lines: the committed and refined centre Fy, and Richardson's estimate
 /// when three levels are in the asymptotic range.
 fn print_mesh_study(m: &MeshReport) {
-    println!(
+    needle_stdx::outln!(
         "mesh study, centre Fy({} mm): {} vs {} {}; {}{}",
         m.depth_mm,
         m.committed,
@@ -230,7 +230,9 @@ fn print_mesh_study(m: &MeshReport) {
         m.ratio_of_changes.map(|r| format!(" (ratio of successive changes {r:.3})")).unwrap_or_default()
     );
     if let (Some(f), Some(p), Some(d)) = (m.richardson_fy_n, m.richardson_order, m.committed_vs_richardson_percent) {
-        println!("  Richardson estimate of the converged Fy: {f:.5e} N (observed order {p:.2}); committed level {d:+.2}% from it");
+        needle_stdx::outln!(
+            "  Richardson estimate of the converged Fy: {f:.5e} N (observed order {p:.2}); committed level {d:+.2}% from it"
+        );
     }
 }
 
@@ -257,6 +259,6 @@ pub fn write_tables(set_dir: &std::path::Path, new: toml::Table) -> Result<()> {
     }
     let text = format!("# written by `needle fe verify`; do not edit\n{}", toml::to_string(&old)?);
     needle_stdx::fs::write_atomic(&path, text.as_bytes())?;
-    println!("wrote {}", path.display());
+    needle_stdx::outln!("wrote {}", path.display());
     Ok(())
 }

@@ -112,7 +112,7 @@ pub fn scaling_check(set: &SetFolder, c: &Campaign, o: &ScalingOptions) -> Resul
     let mut runs = Vec::new();
     for s in SCALES {
         let out_dir = o.work_dir.join(format!("scaling-s{s}"));
-        println!("scaling s = {s}: {} with every Ogden mu_i x {s}, runs in {}", o.poses.join(", "), out_dir.display());
+        needle_stdx::outln!("scaling s = {s}: {} with every Ogden mu_i x {s}, runs in {}", o.poses.join(", "), out_dir.display());
         let opts = RunOptions { tissue_scale: Some(s), out_dir: Some(out_dir), ..base.clone() };
         let scaled = if o.solve { solve_and_read(set, &opts)? } else { read_current(set, &opts)? };
         for pose in &o.poses {
@@ -123,7 +123,7 @@ pub fn scaling_check(set: &SetFolder, c: &Campaign, o: &ScalingOptions) -> Resul
                 (Ok(a), Ok(b)) => compare(pose, s, &a.rows, &b.rows, lever_mm),
                 (Err(e), _) | (_, Err(e)) => failed(pose, s, e),
             };
-            println!("{run}");
+            needle_stdx::outln!("{run}");
             runs.push(run);
         }
     }

@@ -9,6 +9,9 @@ use std::path::PathBuf;
 /// What a campaign command works on: the set, its engine, mesh level, steps, poses and
 /// output folder (shared by `fe run` and `fe status`).
 #[derive(Args, Debug)]
+// The fields' doc comments are the --help text, written for the terminal: <set>, <pose>
+// and [section] are placeholders and campaign.toml sections there, not HTML or links.
+#[allow(rustdoc::invalid_html_tags, rustdoc::broken_intra_doc_links)]
 pub struct SpecArgs {
     /// Set folder holding campaign.toml, e.g. coeffs/default.
     #[arg(long, value_name = "DIR")]

@@ -10,6 +10,9 @@ use std::process::ExitCode;
 
 /// Arguments of `needle fe verify`.
 #[derive(Args, Debug)]
+// The fields' doc comments are the --help text, written for the terminal: <set>, <pose>
+// and [section] are placeholders and campaign.toml sections there, not HTML or links.
+#[allow(rustdoc::invalid_html_tags, rustdoc::broken_intra_doc_links)]
 pub struct VerifyArgs {
     /// Set folder holding campaign.toml and fe/, e.g. coeffs/default.
     #[arg(long, value_name = "DIR")]
