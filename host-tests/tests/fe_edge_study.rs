@@ -13,7 +13,7 @@
 //! FEBio's, written by the tool (never typed in); the radius 0.4 is the study's input,
 //! read from the spec.
 
-use needle_fe::verify::shape::{SHAPE_MAX_GOAL_PERCENT, SHAPE_RMS_GOAL_PERCENT};
+use needle_fe::mesh::shape::{SHAPE_MAX_GOAL_PERCENT, SHAPE_RMS_GOAL_PERCENT};
 use std::path::Path;
 
 fn num(t: &toml::Value, path: &[&str]) -> f64 {

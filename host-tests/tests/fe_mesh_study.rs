@@ -18,7 +18,7 @@
 //!
 //! The numbers are FEBio's, written by the tool (never typed in).
 
-use needle_fe::verify::shape::{SHAPE_MAX_GOAL_PERCENT, SHAPE_RMS_GOAL_PERCENT};
+use needle_fe::mesh::shape::{SHAPE_MAX_GOAL_PERCENT, SHAPE_RMS_GOAL_PERCENT};
 use std::path::Path;
 
 /// A reference whose must points lie within this of its own depth fit (% of peak |Fy|) is

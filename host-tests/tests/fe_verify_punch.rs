@@ -45,7 +45,8 @@ fn coarse_flat_punch_matches_sneddon() {
         threads: 1,
         engine: Some(spec::Engine::Ccx),
     };
-    let (r, ok) = verify::run(&opts).unwrap_or_else(|e| panic!("{e:#}"));
+    let folder = needle_set::set_folder::SetFolder::open(&opts.set_dir).unwrap_or_else(|e| panic!("{e:#}"));
+    let (r, ok) = verify::run(&folder, &opts).unwrap_or_else(|e| panic!("{e:#}"));
     let p = r.punch.expect("a punch report");
     assert_eq!(p.check.element, "C3D20R");
     assert!(p.campaign_element.is_none());

@@ -5,6 +5,7 @@
 use needle_cli::commands::fixed_error::measure::{self as fixed_error, ErrorStats, GOAL_PCT};
 use needle_fit::eval::float64 as eval_f64;
 use needle_haptics::{fixed, model_info};
+use needle_set::set_folder::SetFolder;
 use proptest::prelude::*;
 use std::path::Path;
 use std::sync::OnceLock;
@@ -15,7 +16,8 @@ fn set() -> &'static (needle_fit::model::Model, f64) {
         if !model_info::FITTED {
             panic!("no fitted model compiled in: run `needle fit`");
         }
-        fixed_error::load(Path::new(model_info::SET_DIR)).unwrap_or_else(|e| panic!("{e:#}"))
+        let folder = SetFolder::open(Path::new(model_info::SET_DIR)).unwrap_or_else(|e| panic!("{e:#}"));
+        fixed_error::load(&folder).unwrap_or_else(|e| panic!("{e:#}"))
     })
 }
 

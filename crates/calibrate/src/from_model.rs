@@ -1,5 +1,5 @@
 //! `needle calibrate-published`: the stack of a published piecewise force-depth model
-//! ([`published`](crate::published) has the rules), written in the tissue format, run
+//! ([`published`] has the rules), written in the tissue format, run
 //! through the library's insertion model along the published curve and compared with it
 //! like a calibration.
 use crate::ramp::RampResponse;

@@ -27,7 +27,7 @@ pub fn replay(stack: &Stack<'_>, onset_mm: f64, start_mm: f64, end_mm: f64, spee
     let mut insertion = match Insertion::new(stack, config) {
         Ok(i) => i,
         Err(e) => {
-            eprintln!("replay: {e}: {stack:?}");
+            needle_stdx::noteln!("replay: {e}: {stack:?}");
             return Replay { samples: Vec::new(), punctures: Vec::new() };
         }
     };

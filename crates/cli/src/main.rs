@@ -12,6 +12,9 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
+// The variants' doc comments are the --help text, written for the terminal: <set> and
+// [fit] are placeholders and campaign.toml sections there, not HTML or links.
+#[allow(rustdoc::invalid_html_tags, rustdoc::broken_intra_doc_links)]
 enum Command {
     /// FE campaign of a set (FEBio or CalculiX): run, verify, status.
     #[command(subcommand)]
@@ -63,6 +66,8 @@ fn default_sigpipe() {}
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // the library crates print nothing themselves: their text goes to the terminal here
+    needle_cli::output::terminal::install();
     if !matches!(cli.command, Command::Fe(_) | Command::Explore(_)) {
         default_sigpipe();
     }

@@ -197,7 +197,8 @@ fn coarse_flat_punch_with_the_febio_element_matches_sneddon() {
         threads: 1,
         engine: Some(Engine::Febio),
     };
-    let (r, _) = verify::run(&opts).unwrap_or_else(|e| panic!("{e:#}"));
+    let folder = needle_set::set_folder::SetFolder::open(&opts.set_dir).unwrap_or_else(|e| panic!("{e:#}"));
+    let (r, _) = verify::run(&folder, &opts).unwrap_or_else(|e| panic!("{e:#}"));
     let p = r.punch.expect("a punch report");
     assert!(p.check.element.contains("FEBio hex8"), "{}", p.check.element);
     assert!(p.solver.starts_with("febio 4."), "{}", p.solver);

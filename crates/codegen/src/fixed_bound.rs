@@ -142,7 +142,7 @@ pub(crate) fn error_bound(model: &Model, c: usize, comp: &FixedComponent) -> Err
 }
 
 /// Chooses every format of `model`, quantises its coefficients ([`fixed_formats`]) and
-/// bounds each component's error ([`error_bound`]): the fixed-point tables the generator
+/// bounds each component's error (`error_bound`): the fixed-point tables the generator
 /// writes.
 ///
 /// # Errors

@@ -127,7 +127,7 @@ pub fn render_rust(model: &Model) -> String {
 
 /// The C header `needle_coeffs.h`: the same tables as `static const float`, the domain,
 /// the normalisation constants and the status bits (a set without an unsolved region:
-/// [`render_c_header_with`] adds the region's part).
+/// `render_c_header_with` adds the region's part).
 pub fn render_c_header(model: &Model) -> String {
     render_c_header_with(model, &crate::unsolved::render_c(&crate::unsolved::Region::default()))
 }

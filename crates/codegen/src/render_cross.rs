@@ -95,7 +95,7 @@ pub fn render_rust_cross(model: &Model) -> String {
     let _ = writeln!(w);
     let coupled = model.coupled.as_ref();
     let _ = writeln!(w, "/// `true` when the compiled-in model is the coupled form (`form = \"coupled\"`): the paper's");
-    let _ = writeln!(w, "/// superposition plus the cross terms of [`add_cross`].");
+    let _ = writeln!(w, "/// superposition plus the cross terms of `add_cross`.");
     let _ = writeln!(w, "pub const COUPLED: bool = {};", coupled.is_some());
     let _ = writeln!(w, "/// Number of cross terms (0 for the paper form).");
     let _ = writeln!(w, "pub const CROSS_TERMS: usize = {};", model.cross.len());

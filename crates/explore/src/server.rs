@@ -107,6 +107,6 @@ fn answer(request: Request, content: &Content, port: u16) {
         }
     }
     if let Err(e) = request.respond(response) {
-        eprintln!("needle explore: answering GET {path}: {e}");
+        needle_stdx::noteln!("needle explore: answering GET {path}: {e}");
     }
 }

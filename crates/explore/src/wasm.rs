@@ -16,7 +16,7 @@ pub const TARGET: &str = "wasm32-unknown-unknown";
 
 /// Builds `needle-wasm` (release, without debug info) with the coefficient set `set`
 /// (an absolute path or one relative to the workspace root) and returns the `.wasm`
-/// file's path, under [`target_dir`].
+/// file's path, under `target_dir`.
 ///
 /// # Errors
 /// The wasm32 target is not installed (the message has the `rustup` command), or the build

@@ -15,6 +15,7 @@ pub mod febio;
 pub mod launcher;
 pub mod material;
 pub mod mesh;
+pub mod pose_rows;
 pub mod process;
 mod progress_bar;
 pub mod report;

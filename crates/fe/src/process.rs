@@ -65,16 +65,26 @@ pub const EXIT_INTERRUPTED: u8 = 130;
 /// keep their CSV and manifest entry; the interrupted pose keeps its earlier result, if
 /// any, and is solved again by a rerun.
 ///
+/// Installs the handler once per process: a second call (a second command run in the same
+/// process, as the tests do) is a no-op.
+///
 /// # Errors
-/// A handler is already installed in this process.
+/// Another handler is already installed in this process.
 pub fn stop_jobs_on_termination() -> Result<()> {
-    ctrlc::set_handler(|| {
-        STOP.store(true, Ordering::SeqCst);
-        eprintln!("needle: interrupted: stopping the running solver jobs; finished poses are kept, a rerun resumes");
-        std::thread::sleep(STOP_GRACE);
-        std::process::exit(i32::from(EXIT_INTERRUPTED));
-    })
-    .context("cannot install the SIGINT/SIGTERM handler")
+    static INSTALLED: std::sync::OnceLock<std::result::Result<(), String>> = std::sync::OnceLock::new();
+    INSTALLED
+        .get_or_init(|| {
+            ctrlc::set_handler(|| {
+                STOP.store(true, Ordering::SeqCst);
+                needle_stdx::noteln!("needle: interrupted: stopping the running solver jobs; finished poses are kept, a rerun resumes");
+                std::thread::sleep(STOP_GRACE);
+                std::process::exit(i32::from(EXIT_INTERRUPTED));
+            })
+            .map_err(|e| e.to_string())
+        })
+        .clone()
+        .map_err(anyhow::Error::msg)
+        .context("cannot install the SIGINT/SIGTERM handler")
 }
 
 /// The outcome of one solver process.
@@ -131,7 +141,7 @@ fn dies_with_parent(cmd: &Command) -> Result<Command> {
 
 /// Run `cmd` (program, arguments, environment already set) in `work_dir`, stdin from
 /// /dev/null, stdout and stderr to `log_path`; the solver dies with the thread that runs
-/// this ([`dies_with_parent`]). With a `timeout` the process is killed when
+/// this (`dies_with_parent`). With a `timeout` the process is killed when
 /// it runs longer (wall clock); with a `stall` limit, when none of `log_path` and
 /// `progress_files` has grown for that long (a solver spinning without output is a
 /// failed run, not a slow one). Polls every 50 ms; kills the process on [`interrupted`].

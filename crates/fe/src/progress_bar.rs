@@ -103,7 +103,7 @@ impl Progress {
         let t = self.start.elapsed().as_secs();
         match &self.bar {
             Some(b) => b.println(format!("[{t:>5}s] {text}")),
-            None => eprintln!("[{t:>5}s] {text}"),
+            None => needle_stdx::noteln!("[{t:>5}s] {text}"),
         }
     }
 

@@ -79,7 +79,7 @@ fn sweep_value(pose: &PoseSpec, k: Sweep) -> (f64, f64) {
 pub use needle_set::set_folder::run_path;
 
 /// A set's FE results as the fitter reads them: the spec's loading and the manifest, the
-/// manifest read once ([`FeRuns::open`]) and every run checked against that copy (issue 37:
+/// manifest read once ([`FeRuns::new`]) and every run checked against that copy (issue 37:
 /// the manifest used to be parsed again for each run).
 pub struct FeRuns<'a> {
     set: &'a SetFolder,
@@ -98,7 +98,7 @@ impl<'a> FeRuns<'a> {
         self.set.manifest()
     }
 
-    /// Read one run, check its content against the manifest ([`check_content`]) and its
+    /// Read one run, check its content against the manifest (`check_content`) and its
     /// depth grid against the spec's loading (steps + 1 rows at `depth_at(k)`, to 1e-9 mm).
     ///
     /// # Errors

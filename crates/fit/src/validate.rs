@@ -25,8 +25,8 @@
 //!
 //! Beside each run's errors: its floor ([`crate::depth_floor`]), the smallest Table 2 Fy
 //! error and RMS errors any model of the contract's form could have on it (no goal: it
-//! says whether a missed goal is the model's or the FE curve's); [`validate_with`] takes
-//! another depth degree for the floor, to ask what a contract of that degree could reach.
+//! says whether a missed goal is the model's or the FE curve's); [`validate`] takes the
+//! floor's depth degree, to ask what a contract of another degree could reach.
 
 use super::contract::{unit, COMPONENTS};
 use super::data::{fitted_fe_sha256, fitted_poses, load_paper_data, load_validation_runs, run_path, Run};

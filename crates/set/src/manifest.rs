@@ -226,7 +226,7 @@ pub enum ManifestError {
 /// # Errors
 /// [`ManifestError`]: the file exists but cannot be read or is not a valid manifest.
 pub fn read_manifest(path: &Path) -> std::result::Result<Manifest, ManifestError> {
-    crate::read_count::count_read();
+    crate::read_count::count_manifest_read();
     let text = match std::fs::read_to_string(path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Manifest::default()),

@@ -8,7 +8,7 @@
 //! ([`spec::load`]) and of a manifest ([`read_manifest`]) in this process, so that a test
 //! can hold a command to one of each.
 
-pub use crate::read_count::spec_and_manifest_reads;
+pub use crate::read_count::{spec_and_manifest_reads, spec_reads};
 
 use crate::manifest::{read_manifest, Manifest, MANIFEST};
 use crate::spec::{self, Campaign, PoseSpec};

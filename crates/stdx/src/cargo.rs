@@ -56,7 +56,7 @@ pub fn check_target(target: &str) -> anyhow::Result<()> {
 /// cargo cannot be started or exits with an error: the end of its output, the hint.
 pub fn run_cargo_in(mut cmd: Command, dir: &Path, who: &str, what: &str, hint: &dyn Fn(&str) -> String) -> anyhow::Result<String> {
     cmd.current_dir(dir).stdin(Stdio::null());
-    eprintln!("{who}: building {what}");
+    crate::noteln!("{who}: building {what}");
     let out = cmd.output().with_context(|| format!("cannot run cargo to build {what}"))?;
     let stderr = String::from_utf8_lossy(&out.stderr);
     if out.status.success() {

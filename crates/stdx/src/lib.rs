@@ -1,10 +1,12 @@
 //! Generic helpers of the host crates, each written once (as rust-analyzer keeps `stdx`):
 //! atomic file writes (`fs`), the workspace root (`workspace_root`), nested cargo builds
-//! (`cargo`). Nothing here knows the set, the model, an engine or the firmware.
+//! (`cargo`), the library crates' output, which only the binary prints (`report`).
+//! Nothing here knows the set, the model, an engine or the firmware.
 #![forbid(unsafe_code)]
 
 pub mod cargo;
 pub mod fs;
+pub mod report;
 
 /// The workspace root (the `needle-haptics` package: Cargo.toml, coeffs/, examples/),
 /// two folders above this crate (`crates/stdx`), as compiled in.

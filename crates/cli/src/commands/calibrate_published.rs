@@ -10,6 +10,9 @@ use std::process::ExitCode;
 
 /// Derive a tissue stack from a published model's force polynomials per layer.
 #[derive(Args)]
+// The fields' doc comments are the --help text, written for the terminal: <set>, <pose>
+// and [section] are placeholders and campaign.toml sections there, not HTML or links.
+#[allow(rustdoc::invalid_html_tags, rustdoc::broken_intra_doc_links)]
 pub struct CalibratePublishedArgs {
     /// The set whose FE surrogate is scaled (the one compiled in).
     #[arg(long, default_value = "coeffs/default")]

@@ -14,6 +14,9 @@ use std::process::ExitCode;
 
 /// Write the golden insertion paths as `needle eval --insertion` scripts.
 #[derive(Args)]
+// The fields' doc comments are the --help text, written for the terminal: <set>, <pose>
+// and [section] are placeholders and campaign.toml sections there, not HTML or links.
+#[allow(rustdoc::invalid_html_tags, rustdoc::broken_intra_doc_links)]
 pub struct InsertionPathsArgs {
     /// The compiled-in tissue stack whose depth the paths are scaled to (e.g. liver).
     #[arg(long)]

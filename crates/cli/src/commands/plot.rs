@@ -8,6 +8,9 @@ use std::process::ExitCode;
 
 /// Arguments of `needle plot`.
 #[derive(Args, Debug)]
+// The fields' doc comments are the --help text, written for the terminal: <set>, <pose>
+// and [section] are placeholders and campaign.toml sections there, not HTML or links.
+#[allow(rustdoc::invalid_html_tags, rustdoc::broken_intra_doc_links)]
 pub struct PlotArgs {
     /// Set folder holding campaign.toml, fe/ and model.toml, e.g. coeffs/default.
     #[arg(long, value_name = "DIR")]

@@ -6,13 +6,13 @@
 //! Files, in the output folder (default `<set>/fe/`):
 //! - `<pose>.csv`: the wrench at `steps + 1` depths (format: coeffs/README.md). Written
 //!   with [`needle_stdx::fs::write_atomic`]: a killed run never leaves a half-written CSV.
-//! - `manifest.toml`: one table per finished pose (see [`ManifestEntry`]), sorted by
+//! - `manifest.toml`: one table per finished pose (see [`ManifestEntry`](crate::manifest::ManifestEntry)), sorted by
 //!   pose name, rewritten atomically after each pose.
 //! - `manifest.toml.lock`: the lock ([`lock_manifest`]) under which every process
 //!   (this one's jobs, SLURM array tasks, another `needle fe run`) rewrites the manifest.
 //! - `.work/<pose>/`: the solver's input and files of a run; removed when the run
 //!   succeeds (unless `keep_work`), kept for debugging when it fails. Its
-//!   `progress.toml` ([`resume`]) records the attempt running, the finished attempts'
+//!   `progress.toml` ([`resume`](crate::resume)) records the attempt running, the finished attempts'
 //!   failures and the furthest must points: a run killed in the middle of a pose (a
 //!   session's end) resumes on the rerun at the attempt it was in, which the engine
 //!   continues from its last dump (FEBio) or reruns from its start (ccx), with
@@ -51,6 +51,7 @@
 //! `progress` the display.
 
 mod plan;
+pub mod runs;
 mod solve;
 
 pub use plan::{plan, Plan};
@@ -63,6 +64,7 @@ use crate::mesh::summary as mesh_summary;
 use crate::process;
 use crate::progress_bar::Progress;
 use crate::report::{PoseReport, Report};
+use crate::set_folder::SetFolder;
 use crate::spec::{Campaign, Engine, MeshLevel, PoseSpec};
 use anyhow::{Context, Result};
 use std::collections::BTreeMap;
@@ -169,18 +171,19 @@ impl RunOptions {
 /// silence is not progress.
 pub const DEFAULT_STALL: Duration = Duration::from_secs(600);
 
-/// Run the campaign on its engine (`opts.solver`, else the spec's `[solver] engine`).
-/// See the module docs.
+/// Run the campaign of the set `set` (opened once by the caller; `opts.set_dir` is its
+/// folder) on its engine (`opts.solver`, else the spec's `[solver] engine`). See the
+/// module docs.
 ///
 /// # Errors
-/// The spec cannot be loaded or is invalid, the tissue fails the material check,
+/// The spec is invalid for the run, `opts.set_dir` is not `set`'s folder, the tissue fails the material check,
 /// `--mesh` names no level, `--only` matches no pose or is not a glob, `--steps 0`,
 /// ccx is missing, the manifest is corrupt or the output folder cannot be written.
 /// Failed solves are not errors: they are in the [`Report`].
-pub fn run(opts: &RunOptions) -> Result<Report> {
-    // the spec is read once, by the plan; its engine (with `opts.solver` applied) picks
-    // the backend
-    let plan = plan(opts)?;
+pub fn run(set: &SetFolder, opts: &RunOptions) -> Result<Report> {
+    // the spec was read once, when `set` was opened; its engine (with `opts.solver`
+    // applied) picks the backend
+    let plan = plan(set, opts)?;
     let engine = plan.campaign.solver.engine;
     run_planned(opts, plan, backend_for(engine, opts.threads).as_mut())
 }
@@ -209,8 +212,8 @@ struct Ctx<'a> {
 ///
 /// # Errors
 /// As [`run`].
-pub fn run_with(opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> {
-    run_planned(opts, plan(opts)?, backend)
+pub fn run_with(set: &SetFolder, opts: &RunOptions, backend: &mut dyn Backend) -> Result<Report> {
+    run_planned(opts, plan(set, opts)?, backend)
 }
 
 /// [`run_with`] of a plan already made for `opts`.
@@ -227,7 +230,7 @@ fn run_planned(opts: &RunOptions, plan: Plan, backend: &mut dyn Backend) -> Resu
         let recorded = m.record_first_attempts(&campaign, &all, &mesh_name);
         if recorded > 0 {
             needle_stdx::fs::write_atomic(&manifest_path, manifest_text(&m)?.as_bytes())?;
-            eprintln!(
+            needle_stdx::noteln!(
                 "recorded the first attempt's hash of {recorded} run(s) solved by their first attempt in {}",
                 manifest_path.display()
             );
@@ -237,7 +240,7 @@ fn run_planned(opts: &RunOptions, plan: Plan, backend: &mut dyn Backend) -> Resu
     let to_run: Vec<(usize, &PoseSpec)> = to_run.iter().filter_map(|&i| selected.get(i).map(|p| (i, p))).collect();
     let skipped = reports.len() - to_run.len();
     let jobs = opts.jobs.clamp(1, to_run.len().max(1));
-    eprintln!(
+    needle_stdx::noteln!(
         "needle fe run: {} pose(s) selected; skipped {skipped} up to date; {} to run with {jobs} job(s) (mesh {mesh_name}, {steps} steps to {} mm) -> {}",
         reports.len(),
         to_run.len(),

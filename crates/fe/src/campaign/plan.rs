@@ -7,6 +7,7 @@ use crate::manifest::{read_manifest, Manifest, MANIFEST};
 use crate::report::{PoseReport, Status};
 use crate::results::{self, Row};
 use crate::resume;
+use crate::set_folder::SetFolder;
 use crate::spec::{self, Campaign, PoseSpec};
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
@@ -14,7 +15,7 @@ use std::path::{Path, PathBuf};
 /// What a campaign run will do, worked out before anything is solved or submitted:
 /// the spec (with the `--solver` and `--steps` overrides applied), the mesh level, the
 /// output folder and, per selected pose, whether its result is up to date. Shared by the
-/// local run ([`run_with`]), the SLURM submission
+/// local run ([`run_with`](super::run_with)), the SLURM submission
 /// ([`launcher::slurm`](crate::launcher::slurm)) and `needle fe status`.
 pub struct Plan {
     /// The spec with the overrides applied.
@@ -61,17 +62,23 @@ fn interrupted_force_rerun(out_dir: &Path, campaign: &Campaign, pose: &PoseSpec,
     resume::unfinished(&work_dir(out_dir, &pose.name), &campaign.run_hash(pose, mesh_name), mesh_name, steps)
 }
 
-/// Work out what `opts` asks for without changing any file: load and check the spec, pick
-/// the mesh level and the poses, read the manifest, and sort the poses into up to date
-/// and to solve (module docs).
+/// Work out what `opts` asks for of the set `set` (opened once by the caller: its spec is
+/// not read again) without changing any file: check the spec, pick the mesh level and the
+/// poses, read the output folder's manifest, and sort the poses into up to date and to
+/// solve (module docs).
 ///
 /// # Errors
-/// As [`run`], except solver problems (nothing is solved here).
-pub fn plan(opts: &RunOptions) -> Result<Plan> {
-    let (mut campaign, spec_path) = spec::load(&opts.set_dir)?;
+/// As [`run`](super::run), except solver problems (nothing is solved here); `opts.set_dir`
+/// is not the folder `set` was opened from.
+pub fn plan(set: &SetFolder, opts: &RunOptions) -> Result<Plan> {
+    if opts.set_dir != set.dir() {
+        bail!("the run options name the set {} but the set opened is {}", opts.set_dir.display(), set.dir().display());
+    }
+    let mut campaign = set.campaign().clone();
+    let spec_path = set.spec_path().to_path_buf();
     let stability = crate::material::check(&campaign.tissue)
         .with_context(|| format!("{}: the tissue fails the material stability check; nothing was run", spec_path.display()))?;
-    eprintln!("material check passed: {}", stability.to_string().replace('\n', "\n  "));
+    needle_stdx::noteln!("material check passed: {}", stability.to_string().replace('\n', "\n  "));
     if let Some(engine) = opts.solver {
         campaign.solver.engine = engine;
     }

@@ -5,8 +5,9 @@
 //! record, `campaign` uses it, these tests use both.)
 
 use crate::backend::{Backend, Job, SolveFailure, Solved};
+use crate::campaign::tests::run_with;
 use crate::campaign::tests::{opts, set_dir};
-use crate::campaign::{run_with, RunOptions};
+use crate::campaign::RunOptions;
 use crate::manifest::{read_manifest, MANIFEST};
 use crate::mesh::summary::MeshSummary;
 use crate::resume::{path, read};
@@ -190,7 +191,7 @@ fn an_interrupted_forced_rerun_of_an_up_to_date_pose_resumes_without_force() {
     assert_eq!(ran, [0, 1]);
     let m = read_manifest(&d.path().join("fe").join(MANIFEST)).expect("manifest");
     assert_eq!(m.pose["x+04"].retry, None, "the first run's entry");
-    let plan = crate::campaign::plan(&o).expect("plan");
+    let plan = crate::campaign::tests::plan(&o).expect("plan");
     assert_eq!(plan.to_run, [0], "solved again to resume");
     assert!(plan.selected.iter().all(|p| plan.resumes_forced_rerun(p)));
     // a rerun without --force goes on with the forced run at its attempt 2

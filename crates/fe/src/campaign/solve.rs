@@ -86,7 +86,7 @@ pub(super) fn solve_pose(ctx: &Ctx<'_>, pose: &PoseSpec) -> PoseReport {
     // a record that cannot be written costs the resumability only, not the run
     let mut record = |at: &resume::Start| {
         if let Err(e) = resume::write(&wd, &run, attempts, at) {
-            eprintln!("{}: {e:#} (an interruption would restart this pose from attempt 1)", pose.name);
+            needle_stdx::noteln!("{}: {e:#} (an interruption would restart this pose from attempt 1)", pose.name);
         }
     };
     let solved = match solve_with_retry(ctx.backend, &job, from, &mut keep, &mut record) {
@@ -156,7 +156,7 @@ fn starting_point(ctx: &Ctx<'_>, pose: &PoseSpec, wd: &Path, run: &resume::Ident
     match decision {
         resume::Decision::Finished(failures) if ctx.skip_failed => Ok(Begin::FailedBefore(failures)),
         resume::Decision::Finished(_) => {
-            eprintln!(
+            needle_stdx::noteln!(
                 "{}: starting afresh: all {attempts} attempts of this spec failed in an earlier run (--skip-failed leaves it)",
                 pose.name
             );
@@ -164,7 +164,7 @@ fn starting_point(ctx: &Ctx<'_>, pose: &PoseSpec, wd: &Path, run: &resume::Ident
         }
         resume::Decision::Resume(start) => {
             let reached = ctx.backend.steps_done(wd);
-            eprintln!(
+            needle_stdx::noteln!(
                 "{}: resuming attempt {} of {attempts} (interrupted at {} mm)",
                 pose.name,
                 start.attempt + 1,
@@ -174,7 +174,7 @@ fn starting_point(ctx: &Ctx<'_>, pose: &PoseSpec, wd: &Path, run: &resume::Ident
         }
         resume::Decision::Fresh(why) => {
             if let Some(why) = why {
-                eprintln!("{}: starting afresh: {why}", pose.name);
+                needle_stdx::noteln!("{}: starting afresh: {why}", pose.name);
             }
             fresh_folder(wd)
         }
@@ -231,7 +231,7 @@ pub(crate) fn solve_with_retry(
                 if attempt + 1 == attempts || process::interrupted() {
                     return Err(SolveFailure { message: failures.join("; "), log_tail: f.log_tail, reached: furthest });
                 }
-                eprintln!(
+                needle_stdx::noteln!(
                     "{}: {}; retry {} of {} {}",
                     job.pose.name,
                     failures.last().map(String::as_str).unwrap_or_default(),

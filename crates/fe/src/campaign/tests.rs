@@ -89,6 +89,17 @@ impl Backend for Fake {
     }
 }
 
+/// [`super::run_with`] on the set of `o.set_dir`, opened afresh: the tests change the spec
+/// and the manifest between runs, as a user between two commands.
+pub(crate) fn run_with(o: &RunOptions, backend: &mut dyn Backend) -> Result<Report> {
+    super::run_with(&SetFolder::open(&o.set_dir)?, o, backend)
+}
+
+/// [`super::plan`] on the set of `o.set_dir`, opened afresh.
+pub(crate) fn plan(o: &RunOptions) -> Result<Plan> {
+    super::plan(&SetFolder::open(&o.set_dir)?, o)
+}
+
 pub(crate) fn set_dir() -> tempfile::TempDir {
     let d = tempfile::tempdir().expect("tempdir");
     let src = needle_stdx::workspace_root().join("coeffs/default/campaign.toml");
@@ -430,7 +441,7 @@ fn refuses_bad_options_and_a_corrupt_manifest_before_solving() {
 #[test]
 fn the_poses_a_plan_would_solve_are_not_run_until_they_report() {
     let d = set_dir();
-    let plan = super::plan(&opts(d.path(), "centre,x+04", 4)).expect("plan");
+    let plan = plan(&opts(d.path(), "centre,x+04", 4)).expect("plan");
     assert_eq!(plan.to_run.len(), 2, "nothing solved yet: both stale");
     for r in &plan.reports {
         assert_eq!(r.status, crate::report::Status::NotRun, "{}", r.pose);

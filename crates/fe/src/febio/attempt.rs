@@ -254,7 +254,7 @@ impl<'j, 'a> Setup<'j, 'a> {
         let resumed = self.interrupted.take().and_then(|r| match self.resume_point(&r) {
             Ok(p) => Some((r, p)),
             Err(why) => {
-                eprintln!(
+                needle_stdx::noteln!(
                     "{}: attempt {}: the interrupted run cannot go on from its dump ({why}); the attempt starts again from its start",
                     job.pose.name,
                     job.attempt + 1
@@ -271,7 +271,7 @@ impl<'j, 'a> Setup<'j, 'a> {
             self.restart_from(&job.work_dir.join(restart::DUMP), p.steps, self.plan.first_increment())?;
             progress.resumed_at_mm = Some(loading.depth_at(p.steps));
             progress.resumed_first = true;
-            eprintln!(
+            needle_stdx::noteln!(
                 "{}: attempt {}: going on from its dump at {} {} ({})",
                 job.pose.name,
                 job.attempt + 1,
@@ -293,7 +293,7 @@ impl<'j, 'a> Setup<'j, 'a> {
         if let Some(f) = &self.resume {
             self.restart_from(&job.work_dir.join(ladder::FURTHEST_DUMP), f.steps, self.plan.first_increment())?;
             progress.segments = f.rigid_records(loading);
-            eprintln!("{}: attempt {}: {}", job.pose.name, job.attempt + 1, self.plan.describe(loading.depth_mm, job.steps));
+            needle_stdx::noteln!("{}: attempt {}: {}", job.pose.name, job.attempt + 1, self.plan.describe(loading.depth_mm, job.steps));
             progress.restarting = true;
         }
         Ok(progress)
@@ -353,7 +353,7 @@ impl<'j, 'a> Setup<'j, 'a> {
             };
             // the must point reached, in the solver's time (mm of depth, or s)
             let last_mm = loading.time_at(done_steps as u32);
-            eprintln!(
+            needle_stdx::noteln!(
                 "{}: febio4 stopped at t = {} {unit} ({}); continuing from the must point at {last_mm} {unit} with a first time step of {} {unit}",
                 job.pose.name,
                 run.last_time,
@@ -402,7 +402,7 @@ impl<'j, 'a> Setup<'j, 'a> {
             segments: p.segment,
         };
         if let Err(e) = running::write(job.work_dir, &now) {
-            eprintln!("{}: {e:#} (a killed campaign would rerun this attempt from its start)", job.pose.name);
+            needle_stdx::noteln!("{}: {e:#} (a killed campaign would rerun this attempt from its start)", job.pose.name);
         }
         let timeout = job.timeout.map(|t| t.saturating_sub(started.elapsed()));
         let out_path = job.work_dir.join("febio.out");
@@ -477,7 +477,7 @@ impl<'j, 'a> Setup<'j, 'a> {
         self.state.tried.push(ladder::Tried { attempt: job.attempt + 1, plan: self.plan, reached_steps: steps });
         self.state.write(job.work_dir)?;
         if kept_dump {
-            eprintln!(
+            needle_stdx::noteln!(
                 "{}: attempt {}'s dump at {} mm kept for the next attempt",
                 job.pose.name,
                 job.attempt + 1,

@@ -97,10 +97,10 @@ pub fn write(c: &Campaign, pose: &PoseSpec, mesh_level: &MeshLevel, steps: u32, 
     write_stepped(c, pose, mesh_level, steps, &Stepping::first_increment(dt_fraction))
 }
 
-/// As [`write`], with the time stepper's start given in full ([`Stepping`]).
+/// As [`write()`], with the time stepper's start given in full ([`Stepping`]).
 ///
 /// # Errors
-/// As [`write`]; a first-contact cap outside (0, 1] or a negative depth.
+/// As [`write()`]; a first-contact cap outside (0, 1] or a negative depth.
 pub fn write_stepped(c: &Campaign, pose: &PoseSpec, mesh_level: &MeshLevel, steps: u32, stepping: &Stepping) -> Result<Feb> {
     write_with_symmetry(c, pose, mesh_level, steps, stepping, pose.symmetry())
 }

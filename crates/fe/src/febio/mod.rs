@@ -188,7 +188,7 @@ impl Backend for FebioBackend {
         let r = self.solve_attempt(job, true, &mut unreadable, None);
         match unreadable {
             Some(why) => {
-                eprintln!("{}: attempt {}: {why}; the attempt starts again from its start", job.pose.name, job.attempt + 1);
+                needle_stdx::noteln!("{}: attempt {}: {why}; the attempt starts again from its start", job.pose.name, job.attempt + 1);
                 self.solve_attempt(job, false, &mut None, Some(why))
             }
             None => r,
@@ -281,7 +281,7 @@ fn interrupted_run(job: &Job<'_>) -> Option<running::Running> {
     let r = match running::read(job.work_dir) {
         Ok(r) => r?,
         Err(e) => {
-            eprintln!("{}: {e:#}; the attempt starts from its start", job.pose.name);
+            needle_stdx::noteln!("{}: {e:#}; the attempt starts from its start", job.pose.name);
             return None;
         }
     };

@@ -26,6 +26,7 @@
 use crate::campaign::{self, Plan, RunOptions};
 use crate::manifest::rfc3339_utc;
 use crate::process::which;
+use crate::set_folder::SetFolder;
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -194,13 +195,13 @@ pub struct SubmitReport {
     pub resources: Option<Resources>,
 }
 
-/// Submit the poses of `opts` that are neither up to date nor queued as one job array.
+/// Submit the poses of `opts` (of the set `set`, opened once by the caller) that are neither up to date nor queued as one job array.
 /// See the module docs.
 ///
 /// # Errors
 /// `sbatch` or `squeue` is missing, the controller does not answer, `sbatch` refuses the
 /// job, or the spec is invalid: nothing was submitted and no file of the set changed.
-pub fn submit(opts: &RunOptions, slurm: &SlurmOptions) -> Result<SubmitReport> {
+pub fn submit(set: &SetFolder, opts: &RunOptions, slurm: &SlurmOptions) -> Result<SubmitReport> {
     let sbatch = which(Path::new("sbatch")).with_context(|| {
         format!("sbatch not found on PATH: --launcher slurm submits with SLURM's sbatch (install the SLURM client or load your cluster's slurm module). {UNCHANGED}")
     })?;
@@ -208,7 +209,7 @@ pub fn submit(opts: &RunOptions, slurm: &SlurmOptions) -> Result<SubmitReport> {
         Some(p) => p.clone(),
         None => std::env::current_exe().context("cannot find this needle executable for the batch script")?,
     };
-    let plan = campaign::plan(opts)?;
+    let plan = campaign::plan(set, opts)?;
     let earlier = read_submissions(&plan.out_dir)?;
     let mut report =
         SubmitReport { selected: plan.selected.len(), up_to_date: Vec::new(), in_queue: Vec::new(), submission: None, resources: None };

@@ -252,7 +252,8 @@ fn ended_task(out_dir: &Path, task: &str, pose: &str) -> (String, String) {
 mod tests {
     use super::*;
     use crate::campaign::tests::{opts, set_dir, Fake};
-    use crate::campaign::{plan, run_with, RunOptions};
+    use crate::campaign::tests::{plan, run_with};
+    use crate::campaign::RunOptions;
     use crate::spec;
 
     /// Issue 42, item 3: `needle fe status` counts the design's slots (a replacement that

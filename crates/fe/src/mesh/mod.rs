@@ -1,12 +1,15 @@
 //! Hexahedral meshes of the tissue block (an O-grid refined around the needle's path)
 //! and of the needle (an O-grid cross-section swept along the axis, wedge tip): the
 //! types and the shared geometry here, the tissue's steps in `tissue`, the needle's in
-//! `needle`.
+//! `needle`; `summary` the model's size; the mesh study in `study` (its levels' runs
+//! through the campaign, compared by `shape`).
 //!
 //! Frame (docs/architecture.md section 3): origin at the centre of the top surface, y up, the
 //! block occupies |x| <= size_x/2, |z| <= size_z/2, -depth <= y <= 0.
 
 mod needle;
+pub mod shape;
+pub mod study;
 pub mod summary;
 mod tissue;
 

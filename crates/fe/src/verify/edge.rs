@@ -2,7 +2,7 @@
 //! campaign's needle does not converge under mesh refinement, the needle's edge radius
 //! as a parameter. For each radius of `campaign.edge_study_radii_mm` the centre (quarter
 //! model) is solved on every level of `campaign.mesh_study` with
-//! `needle.tip_edge_radius_mm` set to it ([`mesh_check::mesh_convergence`] with
+//! `needle.tip_edge_radius_mm` set to it ([`super::mesh_study`] with
 //! [`MeshOptions::edge_radius_mm`], into `fe/edge/r<radius>mm/<level>/`), and compared
 //! like the mesh study (shape after the best scale, absolute change, Richardson), with the
 //! poses of `campaign.edge_study_poses` on the pair [`Campaign::edge_study_pair`] (the
@@ -14,10 +14,11 @@
 //! whether the data carry its converged shape. Not judged: the goals are the campaign
 //! mesh's (`[mesh]`); these are the numbers to choose the mesh and the edge by.
 
-use super::mesh_check::{self, MeshOptions, MeshReport};
-use super::runs::{read_current, same_depths, PoseRows};
-use super::shape::{self, ShapeComparison};
+use crate::campaign::runs::{read_current, same_depths, PoseRows};
 use crate::campaign::RunOptions;
+use crate::mesh::shape::{self, ShapeComparison};
+use crate::mesh::study::{self, MeshOptions, MeshReport};
+use crate::set_folder::SetFolder;
 use crate::spec::{Campaign, Role};
 use anyhow::{Context, Result};
 use serde::Serialize;
@@ -95,8 +96,8 @@ impl std::fmt::Display for EdgeStudy {
 /// `campaign.edge_study_radii_mm`.
 ///
 /// # Errors
-/// The spec has no radii, or as [`mesh_check::mesh_convergence`].
-pub fn edge_study(c: &Campaign, o: &MeshOptions) -> Result<Vec<EdgeStudy>> {
+/// The spec has no radii, or as [`super::mesh_study`].
+pub fn edge_study(set: &SetFolder, c: &Campaign, o: &MeshOptions) -> Result<Vec<EdgeStudy>> {
     if c.campaign.edge_study_radii_mm.is_empty() {
         anyhow::bail!("--edge: campaign.edge_study_radii_mm is empty: name the edge radii to study, mm");
     }
@@ -104,16 +105,16 @@ pub fn edge_study(c: &Campaign, o: &MeshOptions) -> Result<Vec<EdgeStudy>> {
     let poses: Vec<String> = std::iter::once(centre).chain(c.campaign.edge_study_poses.iter().cloned()).collect();
     let mut out = Vec::new();
     for &r in &c.campaign.edge_study_radii_mm {
-        let mesh = mesh_check::mesh_convergence(c, &MeshOptions { edge_radius_mm: Some(r), ..o.clone() })?;
+        let mesh = super::mesh_study(set, c, &MeshOptions { edge_radius_mm: Some(r), ..o.clone() })?;
         let read = |edge: Option<f64>, level: &str| -> Result<PoseRows> {
             let opts = RunOptions {
                 only: Some(poses.join(",")),
                 mesh: Some(level.to_string()),
-                out_dir: Some(mesh_check::run_dir(c, &o.set_dir, level, edge)),
+                out_dir: Some(study::run_dir(c, &o.set_dir, level, edge)),
                 edge_radius_mm: edge,
                 ..RunOptions::new(&o.set_dir)
             };
-            read_current(&opts)
+            read_current(set, &opts)
         };
         let campaign = read(None, &mesh.committed)?;
         let compare = |level: &str| -> Result<Vec<ShapeComparison>> {
@@ -137,7 +138,7 @@ pub fn edge_study(c: &Campaign, o: &MeshOptions) -> Result<Vec<EdgeStudy>> {
             against_campaign_edge,
             campaign_against_refined,
         };
-        println!("{study}");
+        needle_stdx::outln!("{study}");
         out.push(study);
     }
     Ok(out)
@@ -161,6 +162,6 @@ mod tests {
             let e = crate::spec::parse(&t, Path::new("campaign.toml")).err().map(|e| e.to_string()).unwrap_or_default();
             assert!(e.starts_with(&format!("campaign.toml:{line}: campaign.edge_study_radii_mm: ")) && e.contains(want), "{bad}: {e}");
         }
-        assert_eq!(super::super::mesh_check::edge_dir(0.4), "r0p4mm");
+        assert_eq!(crate::mesh::study::edge_dir(0.4), "r0p4mm");
     }
 }

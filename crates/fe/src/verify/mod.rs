@@ -2,9 +2,9 @@
 //!
 //! 1. **Flat punch (Sneddon)** ([`punch`]): a rigid flat-ended punch of the needle's
 //!    radius pressed into the block, against Sneddon's half-space force (goal: within 5%).
-//! 2. **Mesh study** ([`mesh_check`]): the centre on the levels of `campaign.mesh_study`
+//! 2. **Mesh study** ([`crate::mesh::study`]): the centre on the levels of `campaign.mesh_study`
 //!    and the poses of `campaign.mesh_study_poses` on the committed level and its
-//!    refinement (the next level, or `campaign.mesh_reference`); the shape after the best scale ([`shape`]: goal 2 % RMS, 4 % largest),
+//!    refinement (the next level, or `campaign.mesh_reference`); the shape after the best scale ([`crate::mesh::shape`]: goal 2 % RMS, 4 % largest),
 //!    the absolute change of Fy and Richardson's estimate when in the asymptotic range.
 //! 3. **Mirror runs**: each `mirror` pose against its mirrored counterpart from the
 //!    committed data, with the sign flips of coeffs/README.md (goal 1% of peak |Fy|).
@@ -13,21 +13,18 @@
 //!    solver accepted off the equilibrium path shows as such a point.
 //! 5. **Scaling law** ([`scaling`]): the centre and a half-model pose with every Ogden
 //!    mu_i scaled by 0.5 and 2 against s times the committed run (goal 0.5 % of peak |Fy|).
-//! 6. **Viscoelastic ramp and hold** ([`qlv`]): the `[viscoelastic]` runs against the
+//! 6. **Viscoelastic ramp and hold** ([`qlv`](crate::visco::qlv)): the `[viscoelastic]` runs against the
 //!    library's QLV filter on the elastic run (run by the CLI, `needle fe verify --qlv`;
 //!    goal RMS 3 %, must 5 %, largest 6 % of peak |Fy|), written with [`write_tables`].
 
 pub mod edge;
-pub mod mesh_check;
 mod mirror;
 pub mod punch;
 pub mod punch_febio;
-pub mod runs;
 pub mod scaling;
-pub mod shape;
 pub mod smooth;
 
-pub use mesh_check::{richardson, LevelRun, MeshReport};
+pub use crate::mesh::study::{richardson, LevelRun, MeshReport};
 pub use mirror::{MirrorReport, MIRROR_GOAL_PERCENT};
 pub use punch::{
     bonded_punch_force, poisson, punch_deck, punch_mesh, sneddon_force, PunchDeck, PunchElement, PunchReport, PunchRun,
@@ -36,6 +33,8 @@ pub use punch::{
 pub use smooth::{SmoothReport, SMOOTH_GOAL_PERCENT};
 
 use super::spec;
+use crate::campaign;
+use crate::set_folder::SetFolder;
 use anyhow::{Context, Result};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -48,10 +47,10 @@ pub struct VerifyOptions {
     /// Run the flat-punch check.
     pub punch: bool,
     /// Run the mesh study with these options (`None`: not run; the fine runs are slow).
-    pub mesh: Option<mesh_check::MeshOptions>,
+    pub mesh: Option<crate::mesh::study::MeshOptions>,
     /// Run the edge study (`campaign.edge_study_radii_mm`) with these options (their
     /// `edge_radius_mm` is set per radius; `None`: not run).
-    pub edge: Option<mesh_check::MeshOptions>,
+    pub edge: Option<crate::mesh::study::MeshOptions>,
     /// Check the mirror runs (no solve).
     pub mirror: bool,
     /// Check every result present for a must point off its neighbours (no solve).
@@ -93,18 +92,19 @@ pub struct VerifyReport {
 fn print_judged<R: std::fmt::Display>(reports: &[R], percent: impl Fn(&R) -> f64, goal_percent: f64) -> bool {
     let mut ok = true;
     for r in reports {
-        println!("{r}");
+        needle_stdx::outln!("{r}");
         ok &= percent(r) <= goal_percent;
     }
     ok
 }
 
-/// Run the checks, print the table, write `<set>/fe/verify.toml`.
+/// Run the checks on the set `set` (opened once by the caller; `opts.set_dir` is its
+/// folder), print the table, write `<set>/fe/verify.toml`.
 ///
 /// # Errors
 /// ccx missing or failing, missing FE files for the mirror check.
-pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
-    let (mut c, _) = spec::load(&opts.set_dir)?;
+pub fn run(set: &SetFolder, opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
+    let mut c = set.campaign().clone();
     if let Some(e) = opts.engine {
         c.solver.engine = e;
     }
@@ -120,7 +120,7 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
         ok &= print_judged(&report.smooth, |s| s.percent_of_peak_fy, SMOOTH_GOAL_PERCENT);
     }
     if let Some(o) = &opts.scaling {
-        let s = scaling::scaling_check(&c, o)?;
+        let s = scaling::scaling_check(set, &c, o)?;
         ok &= s.ok();
         report.scaling = Some(s);
     }
@@ -134,13 +134,13 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
         report.punch = Some(p);
     }
     if let Some(o) = &opts.mesh {
-        let m = mesh_check::mesh_convergence(&c, o)?;
+        let m = mesh_study(set, &c, o)?;
         print_mesh_study(&m);
         ok &= m.ok();
         report.mesh = Some(m);
     }
     if let Some(o) = &opts.edge {
-        report.edge = edge::edge_study(&c, o)?;
+        report.edge = edge::edge_study(set, &c, o)?;
     }
     let mut new: toml::Table = toml::Table::try_from(&report).context("cannot serialise the verify report")?;
     // only the checks that ran replace their part of an earlier verify.toml
@@ -157,10 +157,34 @@ pub fn run(opts: &VerifyOptions) -> Result<(VerifyReport, bool)> {
     Ok((report, ok))
 }
 
+/// The mesh study of `o` ([`crate::mesh::study::mesh_convergence`]) with the campaign's
+/// runner: each level's runs solved (when the study asks) and read through
+/// `campaign::runs` on `set`, `o.threads` solver threads each.
+///
+/// # Errors
+/// As [`crate::mesh::study::mesh_convergence`] and [`campaign::runs::solve_and_read`].
+pub fn mesh_study(set: &SetFolder, c: &spec::Campaign, o: &crate::mesh::study::MeshOptions) -> Result<MeshReport> {
+    crate::mesh::study::mesh_convergence(c, o, &mut |l| {
+        let opts = campaign::RunOptions {
+            only: Some(l.poses.join(",")),
+            mesh: Some(l.level.to_string()),
+            out_dir: Some(l.out_dir.to_path_buf()),
+            threads: o.threads,
+            edge_radius_mm: o.edge_radius_mm,
+            ..campaign::RunOptions::new(&o.set_dir)
+        };
+        if l.solve {
+            campaign::runs::solve_and_read(set, &opts)
+        } else {
+            campaign::runs::read_current(set, &opts)
+        }
+    })
+}
+
 /// The flat-punch check's lines: the block, twice the block, the half-space extrapolated
 /// against Sneddon, and the campaign element's (no goal) when it ran.
 fn print_punch(p: &PunchReport) {
-    println!(
+    needle_stdx::outln!(
         "flat punch a = {} mm, delta = {} mm, nu = {:.4}, {}: F(block) = {:.5e} N, F(2x block) = {:.5e} N, \
          F(half-space, extrapolated) = {:.5e} N, Sneddon {:.5e} N: error {:+.2}% (goal within {}%); {} {:.0} s + {:.0} s",
         p.radius_mm,
@@ -178,7 +202,7 @@ fn print_punch(p: &PunchReport) {
         p.check.wall_s[1]
     );
     if let Some(r) = &p.campaign_element {
-        println!(
+        needle_stdx::outln!(
             "  campaign element {}: F(block) = {:.5e} N, F(2x block) = {:.5e} N, F(half-space) = {:.5e} N: {:+.2}% \
              (no goal: volumetric locking of the fully integrated C3D8 at K0/mu0 = {}); ccx {:.0} s + {:.0} s",
             r.element,
@@ -196,7 +220,7 @@ fn print_punch(p: &PunchReport) {
 /// The mesh study's lines: the committed and refined centre Fy, and Richardson's estimate
 /// when three levels are in the asymptotic range.
 fn print_mesh_study(m: &MeshReport) {
-    println!(
+    needle_stdx::outln!(
         "mesh study, centre Fy({} mm): {} vs {} {}; {}{}",
         m.depth_mm,
         m.committed,
@@ -206,7 +230,9 @@ fn print_mesh_study(m: &MeshReport) {
         m.ratio_of_changes.map(|r| format!(" (ratio of successive changes {r:.3})")).unwrap_or_default()
     );
     if let (Some(f), Some(p), Some(d)) = (m.richardson_fy_n, m.richardson_order, m.committed_vs_richardson_percent) {
-        println!("  Richardson estimate of the converged Fy: {f:.5e} N (observed order {p:.2}); committed level {d:+.2}% from it");
+        needle_stdx::outln!(
+            "  Richardson estimate of the converged Fy: {f:.5e} N (observed order {p:.2}); committed level {d:+.2}% from it"
+        );
     }
 }
 
@@ -233,6 +259,6 @@ pub fn write_tables(set_dir: &std::path::Path, new: toml::Table) -> Result<()> {
     }
     let text = format!("# written by `needle fe verify`; do not edit\n{}", toml::to_string(&old)?);
     needle_stdx::fs::write_atomic(&path, text.as_bytes())?;
-    println!("wrote {}", path.display());
+    needle_stdx::outln!("wrote {}", path.display());
     Ok(())
 }

@@ -243,7 +243,7 @@ pub(super) fn punch(c: &Campaign, work: &Path, opts: &VerifyOptions) -> Result<P
             let dir = work.join(&name);
             std::fs::create_dir_all(&dir).with_context(|| format!("{}: cannot create", dir.display()))?;
             std::fs::write(dir.join(format!("{name}.inp")), &d.text)?;
-            println!(
+            needle_stdx::outln!(
                 "solving the flat punch with {} on the block scaled {scale}x ({} nodes, {} elements) ...",
                 el.name(),
                 d.nodes,

@@ -196,7 +196,7 @@ pub(super) fn punch(c: &Campaign, work: &Path, opts: &VerifyOptions) -> Result<P
     let mut nel = [0; 2];
     for (k, scale) in [1.0, 2.0].into_iter().enumerate() {
         let dir = work.join(format!("punch-febio-hex8-{scale}x"));
-        println!("solving the flat punch with FEBio hex8 (three-field) on the block scaled {scale}x ...");
+        needle_stdx::outln!("solving the flat punch with FEBio hex8 (three-field) on the block scaled {scale}x ...");
         let (force, w, feb) = solve_punch(&exe, c, opts.punch_mesh_scale, a, delta, scale, &dir)?;
         (f[k], wall[k], nodes[k], nel[k]) = (force, w, feb.nodes, feb.elements);
     }

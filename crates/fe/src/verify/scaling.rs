@@ -7,9 +7,10 @@
 //! at every must point: the largest |difference| per component as % of s x peak |Fy|
 //! (moments: x the hub's lever arm), goal [`SCALING_GOAL_PERCENT`].
 
-use super::runs::{read_current, same_depths, solve_and_read};
+use crate::campaign::runs::{read_current, same_depths, solve_and_read};
 use crate::campaign::RunOptions;
 use crate::results::{peak_fy_n, Row};
+use crate::set_folder::SetFolder;
 use crate::spec::Campaign;
 use anyhow::Result;
 use needle_contract::{error_scales, COMPONENTS, COMPONENT_COUNT, FY};
@@ -98,7 +99,7 @@ impl ScalingReport {
 ///
 /// # Errors
 /// The spec, an option or a manifest (failed solves are the runs' `failure`).
-pub fn scaling_check(c: &Campaign, o: &ScalingOptions) -> Result<ScalingReport> {
+pub fn scaling_check(set: &SetFolder, c: &Campaign, o: &ScalingOptions) -> Result<ScalingReport> {
     let base = RunOptions {
         only: Some(o.poses.join(",")),
         mesh: o.mesh.clone(),
@@ -106,14 +107,14 @@ pub fn scaling_check(c: &Campaign, o: &ScalingOptions) -> Result<ScalingReport> 
         threads: o.threads,
         ..RunOptions::new(&o.set_dir)
     };
-    let ones = read_current(&base)?;
+    let ones = read_current(set, &base)?;
     let lever_mm = c.needle.reference_from_tip_mm;
     let mut runs = Vec::new();
     for s in SCALES {
         let out_dir = o.work_dir.join(format!("scaling-s{s}"));
-        println!("scaling s = {s}: {} with every Ogden mu_i x {s}, runs in {}", o.poses.join(", "), out_dir.display());
+        needle_stdx::outln!("scaling s = {s}: {} with every Ogden mu_i x {s}, runs in {}", o.poses.join(", "), out_dir.display());
         let opts = RunOptions { tissue_scale: Some(s), out_dir: Some(out_dir), ..base.clone() };
-        let scaled = if o.solve { solve_and_read(&opts)? } else { read_current(&opts)? };
+        let scaled = if o.solve { solve_and_read(set, &opts)? } else { read_current(set, &opts)? };
         for pose in &o.poses {
             let one = ones.get(pose).cloned().unwrap_or_else(|| Err(format!("{pose}: not selected")));
             let one = one.map_err(|e| format!("the s = 1 run: {e}"));
@@ -122,7 +123,7 @@ pub fn scaling_check(c: &Campaign, o: &ScalingOptions) -> Result<ScalingReport> 
                 (Ok(a), Ok(b)) => compare(pose, s, &a.rows, &b.rows, lever_mm),
                 (Err(e), _) | (_, Err(e)) => failed(pose, s, e),
             };
-            println!("{run}");
+            needle_stdx::outln!("{run}");
             runs.push(run);
         }
     }

@@ -15,10 +15,11 @@
 //! lever arm, the contract's [`error_scales`]).
 
 use super::{run_name, Friction, Prony};
+use crate::campaign::runs::{read_current, solve_and_read, PoseRows};
 use crate::campaign::RunOptions;
 use crate::results::{peak_fy_n, Row};
-use crate::spec::{self, Loading};
-use crate::verify::runs::{read_current, solve_and_read, PoseRows};
+use crate::set_folder::SetFolder;
+use crate::spec::Loading;
 use anyhow::{Context, Result};
 use needle_contract::{error_scales, COMPONENTS, COMPONENT_COUNT, FY};
 use serde::Serialize;
@@ -108,16 +109,16 @@ pub fn elastic_at_depth(rows: &[Row], depth_mm: f64) -> [f64; COMPONENT_COUNT] {
 ///
 /// # Errors
 /// The spec has no `[viscoelastic]`, or as [`crate::campaign::run`].
-pub fn cases(opts: &QlvOptions) -> Result<Vec<std::result::Result<QlvCase, (String, String)>>> {
-    let (c, path) = spec::load(&opts.set_dir)?;
+pub fn cases(set: &SetFolder, opts: &QlvOptions) -> Result<Vec<std::result::Result<QlvCase, (String, String)>>> {
+    let (c, path) = (set.campaign(), set.spec_path());
     let v = c.viscoelastic.clone().with_context(|| format!("{}: --qlv: the spec has no [viscoelastic] section", path.display()))?;
     let mesh = opts.mesh.clone().unwrap_or_else(|| v.mesh.clone());
     let base = RunOptions { steps: opts.steps, mesh: Some(mesh), threads: opts.threads, ..RunOptions::new(&opts.set_dir) };
     let read = |o: &RunOptions| -> Result<PoseRows> {
         if opts.solve {
-            solve_and_read(o)
+            solve_and_read(set, o)
         } else {
-            read_current(o)
+            read_current(set, o)
         }
     };
     let poses: Vec<String> = if opts.poses.is_empty() { v.poses.clone() } else { opts.poses.clone() };
@@ -133,7 +134,7 @@ pub fn cases(opts: &QlvOptions) -> Result<Vec<std::result::Result<QlvCase, (Stri
             let only = poses.iter().map(|p| friction.name(&run_name(p, speed))).collect::<Vec<_>>().join(",");
             let o = RunOptions { visco_speed_mm_per_s: Some(speed), visco_frictionless: frictionless, only: Some(only), ..base.clone() };
             let visco = read(&o)?;
-            let plan = crate::campaign::plan(&o)?;
+            let plan = crate::campaign::plan(set, &o)?;
             for pose in &poses {
                 let run = friction.name(&run_name(pose, speed));
                 let fe = visco.get(&run).cloned().unwrap_or_else(|| Err("not selected".into()));

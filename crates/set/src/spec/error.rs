@@ -113,7 +113,7 @@ impl SpecError {
     }
 
     /// The error with the line of its key in `text` (the spec's text) added to `at` when
-    /// `at` has none and the key is found: `field` "section.key" or "mesh.<level>.key"
+    /// `at` has none and the key is found: `field` `"section.key"` or `"mesh.<level>.key"`
     /// (array tables such as `[[pose]]` have no single line and stay as they are).
     #[must_use]
     pub fn located(self, text: &str) -> Self {

@@ -101,7 +101,7 @@ pub struct Campaign {
 /// and line), or a value is out of range (the message names the field and the value).
 pub fn load(set_dir: &Path) -> SpecResult<(Campaign, PathBuf)> {
     let path = set_dir.join("campaign.toml");
-    crate::read_count::count_read();
+    crate::read_count::count_spec_read();
     let text = match std::fs::read_to_string(&path) {
         Ok(text) => text,
         Err(source) => return Err(SpecError::Read { path, source }),

@@ -112,7 +112,7 @@ impl PoseSpec {
         (-a[0] * depth_mm, -a[2] * depth_mm)
     }
 
-    /// Check the pose on its own (its place in the block: [`check_pose_in_block`]);
+    /// Check the pose on its own (its place in the block: `check_pose_in_block`);
     /// messages start with `p`, the spec's path or `path:line`.
     ///
     /// # Errors

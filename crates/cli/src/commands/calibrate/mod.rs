@@ -11,6 +11,9 @@ use std::process::ExitCode;
 
 /// Fit a tissue stack to a measured axial force against needle position.
 #[derive(Args)]
+// The fields' doc comments are the --help text, written for the terminal: <set>, <pose>
+// and [section] are placeholders and campaign.toml sections there, not HTML or links.
+#[allow(rustdoc::invalid_html_tags, rustdoc::broken_intra_doc_links)]
 pub struct CalibrateArgs {
     /// The set whose FE surrogate is scaled (the one compiled in).
     #[arg(long, default_value = "coeffs/default")]

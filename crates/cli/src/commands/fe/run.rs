@@ -4,6 +4,7 @@ use super::spec::{spec_options, variants, SpecArgs};
 use clap::Args;
 use needle_fe::campaign::{self, RunOptions};
 use needle_fe::launcher::slurm::{self, SlurmOptions};
+use needle_set::set_folder::SetFolder;
 use std::process::ExitCode;
 
 /// Where the solver jobs run.
@@ -69,6 +70,7 @@ pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
     if a.launcher == LauncherArg::Slurm && (opts.visco || opts.family) {
         anyhow::bail!("--visco and --family run locally only (--launcher local): each speed or member is its own campaign run");
     }
+    let set = SetFolder::open(&opts.set_dir)?;
     if a.launcher == LauncherArg::Slurm {
         let slurm = SlurmOptions {
             partition: a.partition,
@@ -78,14 +80,14 @@ pub fn run(a: RunArgs) -> anyhow::Result<ExitCode> {
             extra: a.sbatch_arg,
             needle: None,
         };
-        let r = slurm::submit(&opts, &slurm)?;
+        let r = slurm::submit(&set, &opts, &slurm)?;
         print!("{}", submit_summary(&r));
         return Ok(ExitCode::SUCCESS);
     }
     needle_fe::process::stop_jobs_on_termination()?;
     let mut failed = 0;
-    for opts in variants(opts)? {
-        let report = campaign::run(&opts)?;
+    for opts in variants(&set, opts)? {
+        let report = campaign::run(&set, &opts)?;
         print!("{}", report.table());
         if needle_fe::process::interrupted() {
             return Ok(ExitCode::from(needle_fe::process::EXIT_INTERRUPTED));

@@ -5,6 +5,7 @@ use super::spec::{spec_options, SpecArgs};
 use clap::Args;
 use needle_fe::campaign::{self, RunOptions};
 use needle_set::manifest::Launched;
+use needle_set::set_folder::SetFolder;
 use std::process::ExitCode;
 
 /// Arguments of the hidden `needle fe run-one`: the spec options of `fe run` (the batch
@@ -28,8 +29,9 @@ pub fn run(a: RunOneArgs) -> anyhow::Result<ExitCode> {
     let threads = std::env::var("SLURM_CPUS_PER_TASK").ok().and_then(|v| v.trim().parse::<usize>().ok()).unwrap_or(1).max(1);
     let only = Some(a.pose.clone());
     let opts = with_solve(RunOptions { jobs: 1, threads, only, launcher: Launched::from_env(), ..spec_options(a.spec)? }, &a.solve);
+    let set = SetFolder::open(&opts.set_dir)?;
     needle_fe::process::stop_jobs_on_termination()?;
-    let report = campaign::run(&opts)?;
+    let report = campaign::run(&set, &opts)?;
     print!("{}", report.table());
     if needle_fe::process::interrupted() {
         return Ok(ExitCode::from(needle_fe::process::EXIT_INTERRUPTED));

@@ -5,6 +5,9 @@ use std::time::Duration;
 
 /// How each pose is solved (shared by `fe run` and the array tasks' `fe run-one`).
 #[derive(Args, Debug)]
+// The fields' doc comments are the --help text, written for the terminal: <set>, <pose>
+// and [section] are placeholders and campaign.toml sections there, not HTML or links.
+#[allow(rustdoc::invalid_html_tags, rustdoc::broken_intra_doc_links)]
 pub struct SolveArgs {
     /// Rerun the selected poses even when their results are up to date; an interrupted
     /// pose starts afresh instead of resuming.

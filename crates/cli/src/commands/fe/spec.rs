@@ -3,11 +3,15 @@
 //! they ask for (`--family`, `--visco`).
 use clap::Args;
 use needle_fe::campaign::RunOptions;
+use needle_set::set_folder::SetFolder;
 use std::path::PathBuf;
 
 /// What a campaign command works on: the set, its engine, mesh level, steps, poses and
 /// output folder (shared by `fe run` and `fe status`).
 #[derive(Args, Debug)]
+// The fields' doc comments are the --help text, written for the terminal: <set>, <pose>
+// and [section] are placeholders and campaign.toml sections there, not HTML or links.
+#[allow(rustdoc::invalid_html_tags, rustdoc::broken_intra_doc_links)]
 pub struct SpecArgs {
     /// Set folder holding campaign.toml, e.g. coeffs/default.
     #[arg(long, value_name = "DIR")]
@@ -58,24 +62,24 @@ pub fn spec_options(spec: SpecArgs) -> anyhow::Result<RunOptions> {
     })
 }
 
-/// The campaign runs `opts` asks for: one per member run with `family`, one per speed
-/// with `visco`, else `opts` itself.
-pub fn variants(opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
+/// The campaign runs `opts` asks for of the set `set` (opened once by the command): one
+/// per member run with `family`, one per speed with `visco`, else `opts` itself.
+pub fn variants(set: &SetFolder, opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
     if opts.family {
-        family_variants(opts)
+        family_variants(set, opts)
     } else {
-        visco_variants(opts)
+        visco_variants(set, opts)
     }
 }
 
 /// One run per run of `[family]` (`needle_fe::family::FamilyRun::all`), in order; the
 /// runs `--only` selects nothing of are left out.
-fn family_variants(opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
-    let (c, path) = needle_set::spec::load(&opts.set_dir)?;
+fn family_variants(set: &SetFolder, opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
+    let (c, path) = (set.campaign(), set.spec_path());
     let f = c.family.clone().ok_or_else(|| anyhow::anyhow!("{}: --family: the spec has no [family] section", path.display()))?;
     let mut out = Vec::new();
     for run in needle_fe::family::FamilyRun::all(&f) {
-        let (_, runs, _) = needle_fe::family::apply(&c, &f, run);
+        let (_, runs, _) = needle_fe::family::apply(c, &f, run);
         if needle_set::spec::select(&runs, opts.only.as_deref()).is_ok_and(|r| !r.is_empty()) {
             out.push(RunOptions { family_run: Some(run), ..opts.clone() });
         }
@@ -92,24 +96,24 @@ fn family_variants(opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
 /// `opts` as it is, or with `visco`: once per speed of `[viscoelastic]`, in order; with
 /// `[viscoelastic] frictionless` then the frictionless elastic companions and once per
 /// speed frictionless. Variants whose runs `--only` does not select are left out.
-fn visco_variants(opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
+fn visco_variants(set: &SetFolder, opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
     use needle_fe::visco::Friction;
     if !opts.visco {
         return Ok(vec![opts]);
     }
-    let (c, path) = needle_set::spec::load(&opts.set_dir)?;
+    let (c, path) = (set.campaign(), set.spec_path());
     let v = c.viscoelastic.clone().ok_or_else(|| anyhow::anyhow!("{}: --visco: the spec has no [viscoelastic] section", path.display()))?;
     let selects = |runs: &[needle_set::spec::PoseSpec]| needle_set::spec::select(runs, opts.only.as_deref()).is_ok_and(|r| !r.is_empty());
     let mut out = Vec::new();
     for friction in Friction::cases(&v) {
         let frictionless = friction == Friction::None;
-        if let Some((_, runs)) = needle_fe::visco::apply_frictionless_elastic(&c, &v).filter(|_| frictionless) {
+        if let Some((_, runs)) = needle_fe::visco::apply_frictionless_elastic(c, &v).filter(|_| frictionless) {
             if selects(&runs) {
                 out.push(RunOptions { visco_frictionless: true, ..opts.clone() });
             }
         }
         for &speed in &v.speeds_mm_per_s {
-            let (_, runs) = needle_fe::visco::apply(&c, &v, speed, c.loading.steps, friction);
+            let (_, runs) = needle_fe::visco::apply(c, &v, speed, c.loading.steps, friction);
             if selects(&runs) {
                 out.push(RunOptions { visco_speed_mm_per_s: Some(speed), visco_frictionless: frictionless, ..opts.clone() });
             }

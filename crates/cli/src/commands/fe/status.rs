@@ -2,6 +2,7 @@
 use super::spec::{spec_options, variants, SpecArgs};
 use clap::Args;
 use needle_fe::campaign;
+use needle_set::set_folder::SetFolder;
 use std::process::ExitCode;
 
 /// Arguments of `needle fe status`.
@@ -21,13 +22,15 @@ pub struct StatusArgs {
 
 /// `needle fe status`.
 pub fn run(a: StatusArgs) -> anyhow::Result<ExitCode> {
-    let variants = variants(spec_options(a.spec)?)?;
+    let opts = spec_options(a.spec)?;
+    let set = SetFolder::open(&opts.set_dir)?;
+    let variants = variants(&set, opts)?;
     for extra in variants.iter().skip(1) {
-        let plan = campaign::plan(extra)?;
+        let plan = campaign::plan(&set, extra)?;
         print!("{}", needle_fe::launcher::status::status(&plan)?.table());
     }
     let Some(first) = variants.first() else { return Ok(ExitCode::SUCCESS) };
-    let plan = campaign::plan(first)?;
+    let plan = campaign::plan(&set, first)?;
     let r = needle_fe::launcher::status::status(&plan)?;
     print!("{}", r.table());
     print!("{}", needle_fe::launcher::status::attempts_by_class(&plan));

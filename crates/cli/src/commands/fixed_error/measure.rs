@@ -8,13 +8,13 @@
 //! and relative to the model's peak |Fy| over the grid (moments: to peak |Fy| times the
 //! needle's lever arm `needle.reference_from_tip_mm`, as in the validation reports).
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use needle_contract::COMPONENT_COUNT;
 use needle_fit::contract::{unit, COMPONENTS};
 use needle_fit::{eval::float64 as eval_f64, model::Model, model_file, MODEL_FILE};
 use needle_haptics::fixed::{self, tables::ERROR_BOUND_MICRO};
+use needle_set::set_folder::SetFolder;
 use std::fmt::Write as _;
-use std::path::Path;
 
 /// Goal of issue 5: error <= 0.1 % of peak |Fy| (moments: of peak |Fy| x lever arm).
 pub const GOAL_PCT: f64 = 0.1;
@@ -82,14 +82,14 @@ pub fn bound(c: usize) -> f64 {
     f64::from(ERROR_BOUND_MICRO[c]) * 1e-6
 }
 
-/// Reads the f64 model and the lever arm (mm) of the set `set_dir`.
+/// Reads the f64 model of the set `set` (its model.toml) and gives it with the lever arm
+/// (mm) of the set's spec, as read when `set` was opened.
 ///
 /// # Errors
-/// model.toml or campaign.toml missing or malformed.
-pub fn load(set_dir: &Path) -> Result<(Model, f64)> {
-    let model = model_file::read(&set_dir.join(MODEL_FILE))?;
-    let (campaign, _) = needle_set::spec::load(set_dir).with_context(|| format!("{}", set_dir.display()))?;
-    Ok((model, campaign.needle.reference_from_tip_mm))
+/// model.toml missing or malformed.
+pub fn load(set: &SetFolder) -> Result<(Model, f64)> {
+    let model = model_file::read(&set.file(MODEL_FILE))?;
+    Ok((model, set.campaign().needle.reference_from_tip_mm))
 }
 
 /// The scale of component `c` for relative figures: peak |Fy| (forces) or peak |Fy| x

@@ -6,6 +6,7 @@ use crate::compiled_set::check_compiled_set;
 use clap::Args;
 use measure::{ErrorStats, GOAL_PCT};
 use needle_contract::COMPONENT_COUNT;
+use needle_set::set_folder::SetFolder;
 use rand::{RngCore, SeedableRng};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -36,7 +37,8 @@ pub struct FixedErrorArgs {
 pub fn run(a: FixedErrorArgs) -> anyhow::Result<ExitCode> {
     check_compiled_set(&a.set)?;
 
-    let (model, lever) = measure::load(&a.set)?;
+    let set = SetFolder::open(&a.set)?;
+    let (model, lever) = measure::load(&set)?;
     let mut stats = ErrorStats::default();
     stats.add_grid(&model, usize::try_from(a.grid)?);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x6669_7865_6400_0001);

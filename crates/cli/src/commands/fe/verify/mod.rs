@@ -4,11 +4,15 @@
 pub mod qlv;
 
 use clap::Args;
+use needle_set::set_folder::SetFolder;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Arguments of `needle fe verify`.
 #[derive(Args, Debug)]
+// The fields' doc comments are the --help text, written for the terminal: <set>, <pose>
+// and [section] are placeholders and campaign.toml sections there, not HTML or links.
+#[allow(rustdoc::invalid_html_tags, rustdoc::broken_intra_doc_links)]
 pub struct VerifyArgs {
     /// Set folder holding campaign.toml and fe/, e.g. coeffs/default.
     #[arg(long, value_name = "DIR")]
@@ -98,7 +102,7 @@ pub fn run(a: VerifyArgs) -> anyhow::Result<ExitCode> {
             threads,
             solve: !a.no_solve,
         };
-        let ok = qlv::check(&opts)?;
+        let ok = qlv::check(&SetFolder::open(&a.set)?, &opts)?;
         if !ok {
             eprintln!("needle fe verify --qlv: a run missed its bound or has no comparison");
         }
@@ -119,7 +123,7 @@ pub fn run(a: VerifyArgs) -> anyhow::Result<ExitCode> {
         threads,
         solve: !a.no_solve,
     });
-    let study = needle_fe::verify::mesh_check::MeshOptions { set_dir: a.set.clone(), threads, solve: !a.no_solve, edge_radius_mm: None };
+    let study = needle_fe::mesh::study::MeshOptions { set_dir: a.set.clone(), threads, solve: !a.no_solve, edge_radius_mm: None };
     let mesh = (a.mesh || all).then(|| study.clone());
     let edge = a.edge.then_some(study);
     let opts = needle_fe::verify::VerifyOptions {
@@ -136,8 +140,9 @@ pub fn run(a: VerifyArgs) -> anyhow::Result<ExitCode> {
         threads,
         engine: a.solver.as_deref().map(needle_set::spec::Engine::parse).transpose()?,
     };
+    let set = SetFolder::open(&opts.set_dir)?;
     needle_fe::process::stop_jobs_on_termination()?;
-    let (_, ok) = needle_fe::verify::run(&opts)?;
+    let (_, ok) = needle_fe::verify::run(&set, &opts)?;
     if !ok {
         eprintln!("needle fe verify: a check missed its goal");
     }

@@ -8,19 +8,20 @@ pub mod figure;
 pub mod filtered;
 
 use needle_fe::visco::qlv::{self, QlvCase, QlvOptions, QlvRun};
+use needle_set::set_folder::SetFolder;
 
-/// Run the check: solve (when `opts.solve`) and read the runs, filter, score, print each
+/// Run the check on the set `set` (opened once by the caller; `opts.set_dir` is its folder): solve (when `opts.solve`) and read the runs, filter, score, print each
 /// run's line, write `[[qlv]]` of `<set>/fe/verify.toml`. Returns whether every run is
 /// within the bounds (a missing run is a miss).
 ///
 /// # Errors
 /// As [`qlv::cases`], or verify.toml cannot be written.
-pub fn check(opts: &QlvOptions) -> anyhow::Result<bool> {
-    let (c, _) = needle_set::spec::load(&opts.set_dir)?;
+pub fn check(set: &SetFolder, opts: &QlvOptions) -> anyhow::Result<bool> {
+    let c = set.campaign();
     let mut runs: Vec<QlvRun> = Vec::new();
     let mut missing: Vec<String> = Vec::new();
     let mut compared: Vec<QlvCase> = Vec::new();
-    for case in qlv::cases(opts)? {
+    for case in qlv::cases(set, opts)? {
         match case {
             Ok(case) => {
                 let r = qlv::score(&case, &filtered::filtered(&case)?, filtered::tick_s(), c.needle.reference_from_tip_mm)?;

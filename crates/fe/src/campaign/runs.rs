@@ -1,39 +1,26 @@
-//! The verification's FE runs go through the campaign's own machinery
-//! ([`campaign::run`]): each variant (a mesh level, a tissue scale) has its own output
+//! Runs solved and read through the campaign's own machinery ([`campaign::run`]), as the
+//! verification's checks, the mesh study and the QLV comparison use them: each variant (a mesh level, a tissue scale) has its own output
 //! folder with a manifest, so an interrupted check resumes where it stopped, failed poses
 //! get the campaign's retry ladder and continuations, and a run already up to date is
 //! read, not solved again.
 
 use crate::campaign::{self, RunOptions};
-use crate::manifest::ManifestEntry;
+pub use crate::pose_rows::{same_depths, PoseRows, Run};
 use crate::report::Status;
 use crate::results::{self, Row};
+use crate::set_folder::SetFolder;
 use anyhow::Result;
-use std::collections::BTreeMap;
 
-/// A current result: its rows and how it was made.
-#[derive(Debug, Clone)]
-pub struct Run {
-    /// The CSV's rows, depth 0 first.
-    pub rows: Vec<Row>,
-    /// Its manifest entry.
-    pub entry: ManifestEntry,
-}
-
-/// Each selected pose's result, or why there is none (the run failed, or the result is
-/// not current for this spec).
-pub type PoseRows = BTreeMap<String, std::result::Result<Run, String>>;
-
-/// Solve what is not up to date among the poses `opts` selects (one job), print the
-/// campaign's table, then read every selected pose's result.
+/// Solve what is not up to date among the poses `opts` selects of `set` (one job), print
+/// the campaign's table, then read every selected pose's result.
 ///
 /// # Errors
 /// As [`campaign::run`]: the spec, an option, the manifest (not a failed solve: that is
 /// the pose's `Err`).
-pub fn solve_and_read(opts: &RunOptions) -> Result<PoseRows> {
-    let report = campaign::run(opts)?;
-    print!("{}", report.table());
-    let mut rows = read_current(opts)?;
+pub fn solve_and_read(set: &SetFolder, opts: &RunOptions) -> Result<PoseRows> {
+    let report = campaign::run(set, opts)?;
+    needle_stdx::out!("{}", report.table());
+    let mut rows = read_current(set, opts)?;
     for p in &report.poses {
         if let (Status::Failed { message, .. }, Some(Err(why))) = (&p.status, rows.get_mut(&p.pose)) {
             *why = format!("{message} ({why})");
@@ -42,14 +29,14 @@ pub fn solve_and_read(opts: &RunOptions) -> Result<PoseRows> {
     Ok(rows)
 }
 
-/// Read the selected poses' results without solving: `Ok(rows)` for a result that is up
+/// Read the selected poses' results of `set` without solving: `Ok(rows)` for a result that is up
 /// to date for the spec (hash and content per the manifest), `Err(why)` otherwise (for a
 /// pose with failed attempts, how far the furthest got, from its partial record).
 ///
 /// # Errors
 /// As [`campaign::plan`].
-pub fn read_current(opts: &RunOptions) -> Result<PoseRows> {
-    let plan = campaign::plan(opts)?;
+pub fn read_current(set: &SetFolder, opts: &RunOptions) -> Result<PoseRows> {
+    let plan = campaign::plan(set, opts)?;
     let mut out = PoseRows::new();
     for (i, pose) in plan.selected.iter().enumerate() {
         let csv = plan.out_dir.join(format!("{}.csv", pose.name));
@@ -86,16 +73,11 @@ fn read_rows(csv: &std::path::Path, timed: bool) -> Result<Vec<Row>> {
     Ok(results::parse_timed_csv(&text, csv)?.1)
 }
 
-/// The depths of `a` and `b` agree row by row (the same must points).
-pub fn same_depths(a: &[Row], b: &[Row]) -> bool {
-    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x.depth_mm - y.depth_mm).abs() <= 1e-9 * (1.0 + x.depth_mm.abs()))
-}
-
 #[cfg(test)]
 mod tests {
     use super::read_current;
-    use crate::campaign::run_with;
-    use crate::campaign::tests::{opts, set_dir, Fake};
+    use crate::campaign::tests::{opts, run_with, set_dir, Fake};
+    use crate::set_folder::SetFolder;
 
     /// A pose without a result whose attempts all failed says how far the furthest got.
     #[test]
@@ -104,7 +86,10 @@ mod tests {
         let mut fake = Fake { fail_reached: Some("x+04".into()), ..Fake::default() };
         let r = run_with(&opts(d.path(), "x+04", 4), &mut fake).expect("run");
         assert_eq!(r.failed(), 1, "{}", r.table());
-        let why = read_current(&opts(d.path(), "x+04", 4)).expect("plan").remove("x+04").and_then(|r| r.err());
+        let why = read_current(&SetFolder::open(d.path()).expect("set"), &opts(d.path(), "x+04", 4))
+            .expect("plan")
+            .remove("x+04")
+            .and_then(|r| r.err());
         assert!(
             why.as_deref().is_some_and(
                 |w| w.ends_with("not solved; its furthest failed attempt so far reached 3 of 6 mm (its record: x+04.partial.toml)")

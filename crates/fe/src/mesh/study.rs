@@ -1,4 +1,5 @@
-//! The mesh study of `needle fe verify --mesh`: the centre pose on every level of
+//! The mesh study (run by `needle fe verify --mesh`, and by its edge study
+//! `crate::verify::edge` with the needle's edge radius as a parameter): the centre pose on every level of
 //! `campaign.mesh_study` (coarse to fine, each a 2x refinement of the one before) and the
 //! half-model poses of `campaign.mesh_study_poses` on the committed level and its
 //! refinement (the level after it, or `campaign.mesh_reference` for a committed level
@@ -9,11 +10,10 @@
 //! Reported: the absolute change of Fy at full depth between levels (the centre's, with
 //! Richardson's estimate when the finest three are in the asymptotic range, else the
 //! ratio of successive changes), and per pose and pair of levels the shape comparison of
-//! [`shape`](super::shape) (judged: the goal of issue 42).
+//! [`shape`] (judged: the goal of issue 42).
 
-use super::runs::{read_current, same_depths, solve_and_read, PoseRows};
 use super::shape::{self, ShapeComparison};
-use crate::campaign::RunOptions;
+use crate::pose_rows::{same_depths, PoseRows};
 use crate::spec::{Campaign, Role};
 use anyhow::{Context, Result};
 use needle_contract::FY;
@@ -235,12 +235,27 @@ fn plan_study(c: &Campaign, extra: &[String], edge: bool) -> Result<(StudyPlan, 
     Ok((plan, judged, refined))
 }
 
-/// Run (or resume) the study and compare.
+/// The runs of one level the study asks its runner for.
+#[derive(Debug, Clone, Copy)]
+pub struct LevelRuns<'a> {
+    /// The mesh level.
+    pub level: &'a str,
+    /// The poses, exact names.
+    pub poses: &'a [String],
+    /// Their output folder ([`run_dir`]).
+    pub out_dir: &'a Path,
+    /// Solve what is not up to date (else read what is there): `o.solve`, never for the
+    /// committed level's campaign runs.
+    pub solve: bool,
+}
+
+/// Run (or resume) the study and compare. `runs` solves (when asked) and reads one
+/// level's runs: the campaign's machinery, which the caller hands in
+/// (`crate::verify::mesh_study`), so that the study needs no campaign code.
 ///
 /// # Errors
-/// The spec, `campaign.mesh_study`, an option or a manifest (a failed solve is a run's
-/// `failure`).
-pub fn mesh_convergence(c: &Campaign, o: &MeshOptions) -> Result<MeshReport> {
+/// The spec, `campaign.mesh_study`, or as `runs` (a failed solve is a run's `failure`).
+pub fn mesh_convergence(c: &Campaign, o: &MeshOptions, runs: &mut dyn FnMut(&LevelRuns<'_>) -> Result<PoseRows>) -> Result<MeshReport> {
     let poses = if o.edge_radius_mm.is_some() { &c.campaign.edge_study_poses } else { &c.campaign.mesh_study_poses };
     let (plan, committed, refined) = plan_study(c, poses, o.edge_radius_mm.is_some())?;
     let mut results: Vec<(String, PoseRows)> = Vec::new();
@@ -249,26 +264,18 @@ pub fn mesh_convergence(c: &Campaign, o: &MeshOptions) -> Result<MeshReport> {
         // never solved here
         let campaign_runs = *level == c.campaign.mesh && o.edge_radius_mm.is_none();
         let out_dir = run_dir(c, &o.set_dir, level, o.edge_radius_mm);
-        let opts = RunOptions {
-            only: Some(poses.join(",")),
-            mesh: Some(level.clone()),
-            out_dir: Some(out_dir.clone()),
-            threads: o.threads,
-            edge_radius_mm: o.edge_radius_mm,
-            ..RunOptions::new(&o.set_dir)
-        };
         let what = o.edge_radius_mm.map_or("mesh study".to_string(), |r| format!("edge study r = {r} mm"));
-        println!("{what}, level {level}: {} in {}", poses.join(", "), out_dir.display());
-        let rows = if o.solve && !campaign_runs { solve_and_read(&opts)? } else { read_current(&opts)? };
+        needle_stdx::outln!("{what}, level {level}: {} in {}", poses.join(", "), out_dir.display());
+        let rows = runs(&LevelRuns { level, poses, out_dir: &out_dir, solve: o.solve && !campaign_runs })?;
         results.push((level.clone(), rows));
     }
     let levels = level_runs(c, &results)?;
     let shape = shape_comparisons(c, &results, (&committed, &refined));
     for s in &shape {
-        println!("{s}");
+        needle_stdx::outln!("{s}");
     }
     for t in shape_trends(&shape) {
-        println!("{t}");
+        needle_stdx::outln!("{t}");
     }
     Ok(report(c, committed, refined, levels, shape, &plan))
 }
@@ -288,7 +295,7 @@ fn level_runs(c: &Campaign, results: &[(String, PoseRows)]) -> Result<Vec<LevelR
                 failure: r.as_ref().err().cloned(),
                 retry: r.as_ref().ok().and_then(|r| r.entry.retry.clone()),
             };
-            println!(
+            needle_stdx::outln!(
                 "  {pose} on {level}: {}",
                 match (run.fy_n, &run.failure) {
                     (Some(f), _) => format!(
@@ -385,8 +392,8 @@ fn report(
 #[cfg(test)]
 mod tests {
     use super::{plan_study, richardson, shape_comparisons, shape_trends};
+    use crate::mesh::shape;
     use crate::results::Row;
-    use crate::verify::shape;
 
     #[test]
     fn a_shape_difference_that_halves_is_a_shrinking_trend() {
@@ -452,11 +459,11 @@ mod tests {
         let (c, set) = off_the_ladder();
         let manifest = crate::manifest::read_manifest(&set.join("fe/manifest.toml")).expect("the shipped manifest");
         let entry = manifest.pose.get("centre").expect("the centre's entry").clone();
-        let run = |k: f64| super::super::runs::Run {
+        let run = |k: f64| crate::pose_rows::Run {
             rows: (0..=6).map(f64::from).map(|d| Row { depth_mm: d, wrench: [0.0, k * d * d, 0.0, 0.0, 0.0, 0.0] }).collect(),
             entry: entry.clone(),
         };
-        let results: Vec<(String, super::super::runs::PoseRows)> = ["coarse8", "needle8", "core6", "fine"]
+        let results: Vec<(String, crate::pose_rows::PoseRows)> = ["coarse8", "needle8", "core6", "fine"]
             .iter()
             .enumerate()
             .map(|(i, l)| (l.to_string(), [("centre".to_string(), Ok(run(1.0 + 0.1 * i as f64)))].into_iter().collect()))
