@@ -24,14 +24,15 @@ pub const OUTPUT_HEADER: &str =
 /// Largest departure of a time step from the first one, s.
 pub const PERIOD_TOLERANCE_S: f64 = 1e-6;
 
-/// The stack compiled in under `name` (its file's stem).
+/// The stack compiled in under `name` (its file's stem), named by `option` (`--insertion`,
+/// `--stack`) in the message.
 ///
 /// # Errors
 /// No such stack (the compiled-in ones are listed).
-pub fn stack(name: &str) -> Result<&'static needle_haptics::insertion::Stack<'static>> {
+pub fn stack(option: &str, name: &str) -> Result<&'static needle_haptics::insertion::Stack<'static>> {
     stacks::by_name(name).with_context(|| {
         let names: Vec<&str> = stacks::ALL.iter().map(|s| s.name).collect();
-        format!("--insertion {name:?}: no such tissue stack in the compiled-in set (it has: {})", names.join(", "))
+        format!("{option} {name:?}: no such tissue stack in the compiled-in set (it has: {})", names.join(", "))
     })
 }
 
@@ -134,7 +135,7 @@ pub fn to_csv(times: &[f64], poses: &[Pose], evals: &[InsertionEvaluation]) -> S
 /// As [`parse_poses`], [`parse_times`], [`stack`], [`parse_prony`]; the output cannot be
 /// written.
 pub fn eval_script(file: &Path, stack_name: &str, prony: Option<&str>, out: Option<&Path>) -> Result<()> {
-    let compiled = stack(stack_name)?;
+    let compiled = stack("--insertion", stack_name)?;
     let terms = prony.map(parse_prony).transpose()?;
     let layers: Vec<needle_haptics::insertion::Layer> =
         compiled.layers.iter().map(|l| needle_haptics::insertion::Layer { prony: terms.unwrap_or(l.prony), ..*l }).collect();
