@@ -65,7 +65,8 @@ pub fn check_replay(span_mm: f64, speed_mm_per_s: f64, period_s: f64, speed_opti
     let ticks = span_mm / (speed_mm_per_s * period_s);
     if ticks.is_nan() || ticks > MAX_REPLAY_TICKS {
         bail!(
-            "{speed_option} {speed_mm_per_s}: the replay of {span_mm} mm of positions at {speed_mm_per_s} mm/s takes {ticks:.3e} ticks of {period_s} s, more than {MAX_REPLAY_TICKS:e} (a speed in m/s? or positions in another unit?)"
+            "{speed_option} {speed_mm_per_s}: the replay of {span_mm:.3} mm of positions at {speed_mm_per_s} mm/s takes {ticks:.3e} ticks at {:.0} Hz, more than {MAX_REPLAY_TICKS:e} (a speed in m/s? or positions in another unit?)",
+            1.0 / period_s
         );
     }
     Ok(())
