@@ -25,7 +25,7 @@ use needle_set::manifest::{read_manifest, Manifest, MANIFEST};
 use needle_set::partial;
 use needle_set::results::{content_sha256, parse_csv, Row};
 use needle_set::set_folder::{SetFolder, FAMILY_DIR};
-use needle_set::spec::family::runs::{apply, FamilyRun, REFERENCE_RUN};
+use needle_set::spec::family::runs::{apply, FamilyRun};
 use needle_set::spec::Campaign;
 use std::fmt::Write as _;
 
@@ -100,9 +100,9 @@ pub fn ratio(coeffs: &[f64; TERMS], depth_max_mm: f64, depth_mm: f64, weight: f6
     1.0 + (1.0 - weight) * sum
 }
 
-/// The family's runs of `set` that are present and current: the reference and the
-/// members, in `family.weight`'s order; `None` without a `[family]` section or without the
-/// reference's CSV.
+/// The family's runs of `set` that are present and current (complete, or the must points
+/// of a run that failed every attempt so far): the reference and the members, in
+/// `family.weight`'s order; `None` without a `[family]` section or without a reference run.
 ///
 /// # Errors
 /// An unreadable manifest or CSV, a CSV that is not the one its entry was written for,
@@ -111,10 +111,12 @@ pub fn read_runs(set: &SetFolder) -> Result<Option<(MemberRun, Vec<MemberRun>)>>
     let c = set.campaign();
     let Some(f) = &c.family else { return Ok(None) };
     let dir = set.fe_dir().join(FAMILY_DIR);
-    if !dir.join(format!("{REFERENCE_RUN}.csv")).is_file() {
-        return Ok(None);
-    }
-    let manifest = read_manifest(&dir.join(MANIFEST)).with_context(|| format!("{}", dir.join(MANIFEST).display()))?;
+    let manifest_path = dir.join(MANIFEST);
+    let manifest = if manifest_path.is_file() {
+        read_manifest(&manifest_path).with_context(|| format!("{}", manifest_path.display()))?
+    } else {
+        Manifest::default()
+    };
     let Some(reference) = read_run(c, &manifest, &dir, FamilyRun::Reference)? else { return Ok(None) };
     let mut members = Vec::new();
     for &weight in &f.weight {
