@@ -37,3 +37,7 @@ pub const UNSOLVED_BALLS: usize = crate::unsolved::tables::COUNT;
 /// The generated Rust source of the unsolved region compiled into this build (for audits
 /// and the regeneration test).
 pub const UNSOLVED_RS: &str = include_str!(concat!(env!("OUT_DIR"), "/unsolved.rs"));
+
+/// The generated Rust source of the tissue stacks compiled into this build (the set's
+/// `tissue/*.toml`; for the check that a set's files are the compiled-in ones).
+pub const TISSUE_RS: &str = include_str!(concat!(env!("OUT_DIR"), "/tissue_stacks.rs"));

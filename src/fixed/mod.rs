@@ -28,7 +28,7 @@
 //! `coeffs/<set>/golden-fixed.csv`, which this evaluator reproduces bit for bit.
 //!
 //! Its modules mirror the f32 evaluator's ([`crate::float`]) name for name: `pose`,
-//! `wrench`, `stiffness`, `depth_extension`, `insertion` (`stack`, `track`),
+//! `wrench`, `stiffness`, `depth_extension`, `family`, `insertion` (`stack`, `track`),
 //! `viscoelastic` (`identity`), `tables`, `eval`, `cross`, `eval_stiffness`. Modules of
 //! this precision alone (`host-tests/tests/precision_mirrors.rs` reads these lines):
 //!
@@ -40,6 +40,7 @@ mod cross;
 mod depth_extension;
 mod eval;
 mod eval_stiffness;
+pub mod family;
 // The module doc links the private `track` (insertion/mod.rs, line 12): left to the
 // insertion work, whose folder is being changed; remove this allow with that fix
 // (`track` in backticks, without the link).

@@ -1,7 +1,7 @@
 //! The f32 evaluator: the model in `f32`, bit for bit the contract's operation order
 //! (`coeffs/README.md`), for cores with an FPU and for the host. Its modules mirror the
 //! fixed-point evaluator's ([`crate::fixed`]) name for name: `pose`, `wrench`,
-//! `stiffness`, `depth_extension`, `insertion` (`stack`, `track`), `viscoelastic`
+//! `stiffness`, `depth_extension`, `family`, `insertion` (`stack`, `track`), `viscoelastic`
 //! (`identity`), and the evaluator's internals `tables` (the generated f32 tables),
 //! `eval` (the wrench), `cross` (the coupled form's cross terms), `eval_stiffness` (the
 //! wrench and its rates).
@@ -30,6 +30,7 @@ pub mod depth_extension;
 pub(crate) mod depth_rate;
 pub(crate) mod eval;
 pub(crate) mod eval_stiffness;
+pub mod family;
 pub(crate) mod horner;
 // The module doc's link [`extended_wrench`](crate::extended_wrench) (insertion/mod.rs,
 // line 12) names its target twice: left to the insertion work, whose folder is being

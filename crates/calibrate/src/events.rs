@@ -39,14 +39,24 @@ pub fn punctures(points: &[Point], rule: EventRule) -> Vec<Puncture> {
     let mut i = 0;
     while i < points.len() {
         let Some(peak) = points.get(i) else { break };
-        let window: Vec<(usize, &Point)> =
-            points.iter().enumerate().skip(i + 1).take_while(|(_, p)| p.position_mm - peak.position_mm <= rule.drop_within_mm).collect();
+        // only a peak above the noise of the approach can be a puncture (checked first:
+        // the window below is long on a dense curve)
+        if peak.force_n.partial_cmp(&(rule.min_peak_fraction * largest)) != Some(std::cmp::Ordering::Greater) {
+            i += 1;
+            continue;
+        }
         // the drop: the lowest point within the window, if the force never rose above the peak before it
-        let rising = window.iter().position(|(_, p)| p.force_n > peak.force_n);
-        let candidates = &window[..rising.unwrap_or(window.len())];
-        let bottom = candidates.iter().min_by(|a, b| a.1.force_n.total_cmp(&b.1.force_n)).copied();
+        let mut bottom: Option<(usize, &Point)> = None;
+        for (j, p) in points.iter().enumerate().skip(i + 1) {
+            if p.position_mm - peak.position_mm > rule.drop_within_mm || p.force_n > peak.force_n {
+                break;
+            }
+            if bottom.is_none_or(|(_, low)| p.force_n.total_cmp(&low.force_n).is_lt()) {
+                bottom = Some((j, p));
+            }
+        }
         if let Some((b, low)) = bottom {
-            let dropped = peak.force_n > rule.min_peak_fraction * largest && low.force_n <= peak.force_n * (1.0 - rule.drop_fraction);
+            let dropped = low.force_n <= peak.force_n * (1.0 - rule.drop_fraction);
             let stays = points
                 .iter()
                 .skip(b)

@@ -8,8 +8,19 @@ use crate::events::Puncture;
 use crate::lsq;
 use crate::measured::Point;
 
-/// Grid step of the onset and boundary scans, mm.
+/// Grid step of the onset and boundary scans, mm (coarser over a range longer than
+/// [`MAX_SCAN_CANDIDATES`] steps).
 pub const SCAN_STEP_MM: f64 = 0.01;
+/// Most candidates of one scan (onset, or one boundary): the step grows over a longer
+/// range, so the time of a fit is bounded whatever the curve's span.
+pub const MAX_SCAN_CANDIDATES: usize = 5_000;
+/// Most points a scan compares each candidate with (evenly thinned beyond: every k-th);
+/// the chosen candidate's coefficients are then fitted on all points. The shipped curves
+/// have fewer, so this bounds the time of a dense recording without changing them.
+pub const MAX_SCAN_POINTS: usize = 1_000;
+
+/// Progress of a fit: `(candidates scanned, candidates in all)`, called after each.
+pub type Progress<'a> = &'a mut dyn FnMut(usize, usize);
 /// The onset is the least-squares best among those whose model curve crosses the onset
 /// threshold ([`crate::replay::ONSET_FRACTION`] of the first puncture force) within this
 /// distance of the measured curve's crossing, mm (the unconstrained best when none does):
@@ -50,6 +61,12 @@ pub struct Fit {
 /// at the measured pose and needle).
 #[must_use]
 pub fn fit(points: &[Point], punctures: &[Puncture], surrogate: &dyn Fn(f64) -> f64) -> Fit {
+    fit_with_progress(points, punctures, surrogate, &mut |_, _| {})
+}
+
+/// [`fit`], telling `progress` how far the scans are.
+#[must_use]
+pub fn fit_with_progress(points: &[Point], punctures: &[Puncture], surrogate: &dyn Fn(f64) -> f64, progress: Progress<'_>) -> Fit {
     let first_peak = punctures.first().map_or(points.len() - 1, |p| p.peak);
     let pre: Vec<&Point> = points.iter().take(first_peak + 1).collect();
     let peak0 = pre.last().map_or(0.0, |p| p.position_mm);
@@ -60,9 +77,20 @@ pub fn fit(points: &[Point], punctures: &[Puncture], surrogate: &dyn Fn(f64) -> 
     // (sse, onset, scale) of the best candidate whose model crosses the onset threshold
     // within ONSET_MATCH_MM of the measured crossing, and of the best of all
     let (mut matched, mut any) = ((f64::INFINITY, start, 0.0), (f64::INFINITY, start, 0.0));
+    let total = scan(start, peak0).count()
+        + punctures
+            .iter()
+            .enumerate()
+            .filter_map(|(k, e)| {
+                let next = punctures.get(k + 1)?;
+                Some(scan(points.get(e.bottom)?.position_mm - start, points.get(next.peak)?.position_mm - start).count())
+            })
+            .sum::<usize>();
+    let mut done = 0;
+    let pre_scan = thin(&pre);
+    let rhs: Vec<f64> = pre_scan.iter().map(|p| p.force_n).collect();
     for onset in scan(start, peak0) {
-        let column: Vec<f64> = pre.iter().map(|p| indent(surrogate, p.position_mm - onset)).collect();
-        let rhs: Vec<f64> = pre.iter().map(|p| p.force_n).collect();
+        let column: Vec<f64> = pre_scan.iter().map(|p| indent(surrogate, p.position_mm - onset)).collect();
         let (x, sse) = lsq::non_negative(&[column], &rhs);
         if sse < any.0 {
             any = (sse, onset, x[0]);
@@ -72,8 +100,16 @@ pub fn fit(points: &[Point], punctures: &[Puncture], surrogate: &dyn Fn(f64) -> 
         if near && sse < matched.0 {
             matched = (sse, onset, x[0]);
         }
+        done += 1;
+        progress(done, total);
     }
-    let (_, onset, scale0) = if matched.0.is_finite() { matched } else { any };
+    let (_, onset, mut scale0) = if matched.0.is_finite() { matched } else { any };
+    if pre_scan.len() < pre.len() {
+        // the chosen onset's scale on every point
+        let column: Vec<f64> = pre.iter().map(|p| indent(surrogate, p.position_mm - onset)).collect();
+        let rhs: Vec<f64> = pre.iter().map(|p| p.force_n).collect();
+        scale0 = lsq::non_negative(&[column], &rhs).0[0];
+    }
     let mut layers = vec![LayerFit {
         boundary_mm: 0.0,
         scale: scale0,
@@ -89,7 +125,11 @@ pub fn fit(points: &[Point], punctures: &[Puncture], surrogate: &dyn Fn(f64) -> 
             (event.bottom..=end).filter_map(|i| points.get(i)).map(|p| (p.position_mm - onset, p.force_n)).collect();
         let before: f64 = layers.windows(2).map(|w| w[0].friction_n_per_mm * (w[1].boundary_mm - w[0].boundary_mm)).sum();
         let top = layers.last().map_or(0.0, |l| l.boundary_mm);
-        let fitted = interval_fit(&interval, top, before, next_peak.map(|p| (depth(event.bottom), depth(p))), surrogate);
+        let range = next_peak.map(|p| (depth(event.bottom), depth(p)));
+        let fitted = interval_fit(&interval, top, before, range, surrogate, &mut |n| {
+            done += n;
+            progress(done.min(total), total);
+        });
         if let Some(current) = layers.last_mut() {
             current.cutting_force_n = fitted.cutting_n;
             current.friction_n_per_mm = fitted.friction_n_per_mm;
@@ -129,26 +169,62 @@ fn interval_fit(
     before: f64,
     scan_range: Option<(f64, f64)>,
     surrogate: &dyn Fn(f64) -> f64,
+    scanned: &mut dyn FnMut(usize),
 ) -> IntervalFit {
-    let rhs: Vec<f64> = points.iter().map(|(_, f)| f - before).collect();
     let Some((lo, hi)) = scan_range else {
+        let rhs: Vec<f64> = points.iter().map(|(_, f)| f - before).collect();
         let columns = vec![vec![1.0; points.len()], points.iter().map(|(d, _)| d - top).collect()];
         let (x, _) = lsq::non_negative(&columns, &rhs);
         return IntervalFit { cutting_n: x[0], friction_n_per_mm: x[1], next: None };
     };
-    let mut best: Option<(f64, IntervalFit)> = None;
-    for boundary in scan(lo.max(top), hi) {
+    let with_boundary = |points: &[(f64, f64)], boundary: f64| {
+        let rhs: Vec<f64> = points.iter().map(|(_, f)| f - before).collect();
         let columns = vec![
             vec![1.0; points.len()],
             points.iter().map(|(d, _)| d.min(boundary) - top).collect(),
             points.iter().map(|(d, _)| indent(surrogate, d - boundary)).collect(),
         ];
         let (x, sse) = lsq::non_negative(&columns, &rhs);
-        if best.as_ref().is_none_or(|(s, _)| sse < *s) && x[2] > 0.0 {
-            best = Some((sse, IntervalFit { cutting_n: x[0], friction_n_per_mm: x[1], next: Some((boundary, x[2])) }));
+        (sse, IntervalFit { cutting_n: x[0], friction_n_per_mm: x[1], next: Some((boundary, x[2])) })
+    };
+    let sparse = thin(points);
+    let mut best: Option<(f64, IntervalFit)> = None;
+    let lo = lo.max(top);
+    for boundary in scan(lo, hi) {
+        let (sse, f) = with_boundary(&sparse, boundary);
+        if best.as_ref().is_none_or(|(s, _)| sse < *s) && f.next.is_some_and(|(_, s)| s > 0.0) {
+            best = Some((sse, f));
         }
+        scanned(1);
     }
-    best.map_or(IntervalFit { cutting_n: 0.0, friction_n_per_mm: 0.0, next: None }, |(_, f)| f)
+    match best {
+        // the chosen boundary's coefficients on every point
+        Some((_, f)) if sparse.len() < points.len() => {
+            let boundary = f.next.map_or(lo, |(b, _)| b);
+            let (_, full) = with_boundary(points, boundary);
+            if full.next.is_some_and(|(_, s)| s > 0.0) {
+                full
+            } else {
+                f
+            }
+        }
+        Some((_, f)) => f,
+        None => IntervalFit { cutting_n: 0.0, friction_n_per_mm: 0.0, next: None },
+    }
+}
+
+/// `points`, or every k-th of them when there are more than [`MAX_SCAN_POINTS`] (the
+/// last one kept).
+fn thin<T: Copy>(points: &[T]) -> Vec<T> {
+    let every = points.len().div_ceil(MAX_SCAN_POINTS).max(1);
+    if every == 1 {
+        return points.to_vec();
+    }
+    let mut out: Vec<T> = points.iter().step_by(every).copied().collect();
+    if !(points.len() - 1).is_multiple_of(every) {
+        out.extend(points.last().copied());
+    }
+    out
 }
 
 /// The surrogate at `depth_mm` of indentation, zero before contact.
@@ -178,8 +254,10 @@ fn crossing_depth(surrogate: &dyn Fn(f64) -> f64, threshold_n: f64, scale: f64, 
     Some(hi)
 }
 
-/// `lo, lo + step, ...` below `hi`.
-fn scan(lo: f64, hi: f64) -> impl Iterator<Item = f64> {
-    let n = ((hi - lo) / SCAN_STEP_MM).floor().max(0.0) as usize;
-    (0..n).map(move |k| lo + SCAN_STEP_MM * k as f64)
+/// `lo, lo + step, ...` below `hi`: [`SCAN_STEP_MM`], or the step of
+/// [`MAX_SCAN_CANDIDATES`] over a longer range.
+fn scan(lo: f64, hi: f64) -> impl ExactSizeIterator<Item = f64> {
+    let step = SCAN_STEP_MM.max((hi - lo) / MAX_SCAN_CANDIDATES as f64);
+    let n = if step.is_finite() { ((hi - lo) / step).floor().clamp(0.0, MAX_SCAN_CANDIDATES as f64) as usize } else { 0 };
+    (0..n).map(move |k| lo + step * k as f64)
 }

@@ -39,6 +39,22 @@ pub struct ModelOptions<'a> {
     pub fe_shear_modulus_n_per_mm2: f64,
 }
 
+/// The cheap checks of `opts`, before any file is read: every number within its range
+/// of [`crate::limits`] (the unit in the message).
+///
+/// # Errors
+/// A value outside its range.
+pub fn check_model_options(opts: &ModelOptions<'_>) -> Result<()> {
+    use crate::limits::{check_range, NEEDLE_DIAMETER_MM, SPEED_MM_PER_S};
+    check_range("--needle-diameter-mm", opts.needle_diameter_mm, &NEEDLE_DIAMETER_MM, "mm", "the needles there are")?;
+    check_range("--replay-speed-mm-per-s", opts.replay_speed_mm_per_s, &SPEED_MM_PER_S, "mm/s", "a slow robot to a fast hand")?;
+    let v = opts.fe_shear_modulus_n_per_mm2;
+    if !(v.is_finite() && v > 0.0) {
+        bail!("FE shear modulus {v} N/mm^2: must be finite and > 0");
+    }
+    Ok(())
+}
+
 /// Derives the stack of `opts` and replays it along the sampled published curve (the
 /// [`Calibration`]'s `points`).
 ///
@@ -47,15 +63,7 @@ pub struct ModelOptions<'a> {
 /// the stack has more layers than the format allows, a value is out of range, or the
 /// library has no fitted model.
 pub fn calibrate_published(opts: &ModelOptions<'_>) -> Result<Calibration> {
-    for (what, v) in [
-        ("--needle-diameter-mm", opts.needle_diameter_mm),
-        ("--replay-speed-mm-per-s", opts.replay_speed_mm_per_s),
-        ("FE shear modulus", opts.fe_shear_modulus_n_per_mm2),
-    ] {
-        if !(v.is_finite() && v > 0.0) {
-            bail!("{what} {v}: must be finite and > 0");
-        }
-    }
+    check_model_options(opts)?;
     if !needle_haptics::model_info::FITTED {
         bail!("the library was built without a fitted model: run `needle fit` first");
     }
@@ -65,6 +73,15 @@ pub fn calibrate_published(opts: &ModelOptions<'_>) -> Result<Calibration> {
     let elastic = |depth_mm: f64| f64::from(insertion::deflection(&Pose::default(), depth_mm as f32, 1.0, similarity as f32).wrench.fy_n);
     // a layer with Prony terms against its response at the replay speed (`crate::ramp`)
     let total_mm: f64 = pieces.iter().map(|p| p.thickness_mm).sum();
+    if total_mm.is_nan() || total_mm > crate::limits::MAX_SPAN_MM {
+        bail!(
+            "{}: the layers are {total_mm} mm thick in all, more than {} mm: no needle insertion is this long (thickness_mm in micrometres?)",
+            opts.pieces.display(),
+            crate::limits::MAX_SPAN_MM
+        );
+    }
+    let period_s = f64::from(insertion::InsertionConfig::DEFAULT_1KHZ.period_s);
+    crate::limits::check_replay(total_mm, opts.replay_speed_mm_per_s, period_s, "--replay-speed-mm-per-s")?;
     let responses: Vec<(String, RampResponse)> = sources
         .iter()
         .filter(|c| opts.with_prony && !c.prony.is_empty())

@@ -24,6 +24,7 @@
 pub mod events;
 pub mod fit;
 pub mod from_model;
+pub mod limits;
 mod lsq;
 pub mod measured;
 pub mod published;
@@ -87,8 +88,9 @@ pub struct Calibration {
 /// Calibrates a stack on the curve of `opts`.
 ///
 /// # Errors
-/// The curve cannot be read (with its line), it shows no contact or no puncture, the
-/// needle diameter or speed is not finite and > 0, or the library has no fitted model.
+/// The curve cannot be read (with its line) or has numbers no insertion has, it shows
+/// no contact or no puncture, an option is outside its range ([`check_options`]), or the
+/// library has no fitted model.
 pub fn calibrate(opts: &Options<'_>) -> Result<Calibration> {
     check_options(opts)?;
     calibrate_points(opts, measured::read_curve(opts.curve)?)
@@ -101,7 +103,28 @@ pub fn calibrate(opts: &Options<'_>) -> Result<Calibration> {
 /// # Errors
 /// As [`calibrate`], but for reading the curve.
 pub fn calibrate_points(opts: &Options<'_>, points: Vec<measured::Point>) -> Result<Calibration> {
+    calibrate_points_with_progress(opts, points, &mut |_, _| {})
+}
+
+/// [`calibrate_points`], telling `progress` how far the fit's scans are
+/// ([`fit::Progress`]).
+///
+/// # Errors
+/// As [`calibrate_points`].
+pub fn calibrate_points_with_progress(
+    opts: &Options<'_>,
+    points: Vec<measured::Point>,
+    progress: fit::Progress<'_>,
+) -> Result<Calibration> {
     check_options(opts)?;
+    measured::check_units(&points, None)?;
+    let (start, end) = points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.position_mm), hi.max(p.position_mm)));
+    limits::check_replay(
+        end - start,
+        opts.speed_mm_per_s,
+        f64::from(insertion::InsertionConfig::DEFAULT_1KHZ.period_s),
+        "--speed-mm-per-s",
+    )?;
     let events = events::punctures(&points, opts.rule);
     if events.is_empty() {
         bail!(
@@ -118,7 +141,7 @@ pub fn calibrate_points(opts: &Options<'_>, points: Vec<measured::Point>) -> Res
     }
     let similarity = opts.needle_diameter_mm / f64::from(insertion::FE_NEEDLE_DIAMETER_MM);
     let surrogate = |depth_mm: f64| f64::from(insertion::deflection(&Pose::default(), depth_mm as f32, 1.0, similarity as f32).wrench.fy_n);
-    let fit = fit::fit(&points, &events, &surrogate);
+    let fit = fit::fit_with_progress(&points, &events, &surrogate, progress);
     if fit.layers.len() > file::MAX_LAYERS {
         bail!(
             "{}: {} punctures would make {} layers; a stack has at most {} (raise --drop-fraction to count only the larger drops)",
@@ -135,21 +158,28 @@ pub fn calibrate_points(opts: &Options<'_>, points: Vec<measured::Point>) -> Res
         .map_err(|e| anyhow::anyhow!("the calibrated stack is refused by the tissue format: {e}"))?;
     let layers: Vec<insertion::Layer> = stack.layers.iter().map(to_layer).collect();
     let lib_stack = insertion::Stack { name: &stack.name, needle_diameter_mm: opts.needle_diameter_mm as f32, layers: &layers };
-    let (start, end) = points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.position_mm), hi.max(p.position_mm)));
     let replay = replay::replay(&lib_stack, fit.onset_mm, start, end, opts.speed_mm_per_s);
     let checks = replay::checks(&points, &events, &replay);
     Ok(Calibration { points, events, fit, stack, replay, checks, similarity })
 }
 
-fn check_options(opts: &Options<'_>) -> Result<()> {
-    if !(opts.needle_diameter_mm.is_finite() && opts.needle_diameter_mm > 0.0) {
-        bail!("--needle-diameter-mm {}: must be finite and > 0", opts.needle_diameter_mm);
-    }
+/// The cheap checks of `opts`, before any file is read: every number within its range
+/// of [`limits`] (the unit in the message).
+///
+/// # Errors
+/// A value outside its range, or the library has no fitted model.
+pub fn check_options(opts: &Options<'_>) -> Result<()> {
+    limits::check_range("--needle-diameter-mm", opts.needle_diameter_mm, &limits::NEEDLE_DIAMETER_MM, "mm", "the needles there are")?;
+    limits::check_range("--speed-mm-per-s", opts.speed_mm_per_s, &limits::SPEED_MM_PER_S, "mm/s", "a slow robot to a fast hand")?;
+    limits::check_range(
+        "--drop-fraction",
+        opts.rule.drop_fraction,
+        &limits::DROP_FRACTION,
+        "of the peak force",
+        "a fraction: 0.25 is a drop of 25 %",
+    )?;
     if !(opts.fe_shear_modulus_n_per_mm2.is_finite() && opts.fe_shear_modulus_n_per_mm2 > 0.0) {
         bail!("FE shear modulus {} N/mm^2: must be finite and > 0", opts.fe_shear_modulus_n_per_mm2);
-    }
-    if !(opts.speed_mm_per_s.is_finite() && opts.speed_mm_per_s > 0.0) {
-        bail!("--speed-mm-per-s {}: must be finite and > 0", opts.speed_mm_per_s);
     }
     if !needle_haptics::model_info::FITTED {
         bail!("the library was built without a fitted model: run `needle fit` first");

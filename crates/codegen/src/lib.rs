@@ -25,6 +25,7 @@
 pub mod contract;
 pub mod depth_extension;
 mod error;
+pub mod family;
 pub mod fixed;
 mod fixed_bound;
 mod literal;
@@ -145,7 +146,8 @@ fn write_all(model: Model, region: unsolved::Region, model_path: &Path, out_dir:
 }
 
 /// Checks the set's depth extension (`<set>/depth-extension.toml`, optional) and tissue
-/// stacks (`<set>/tissue/*.toml`) and writes [`depth_extension::RUST_FILE`] and
+/// stacks (`<set>/tissue/*.toml`) and writes [`depth_extension::RUST_FILE`],
+/// [`family::RUST_FILE`] (from `<set>/family.toml`, optional) and
 /// [`tissue::RUST_TISSUE_FILE`] into `out_dir`; returns the files to watch (for
 /// `rerun-if-changed`). A set without a `tissue/` folder gets an empty `ALL`.
 ///
@@ -156,11 +158,15 @@ pub fn generate_tissue(set_dir: &Path, out_dir: &Path) -> Result<Vec<PathBuf>, C
     let extension_path = set_dir.join(depth_extension::FILE);
     let extension = if extension_path.is_file() { Some(depth_extension::parse(&extension_path)?) } else { None };
     write_if_changed(&out_dir.join(depth_extension::RUST_FILE), &depth_extension::render(extension.as_ref()))?;
+    let family_path = set_dir.join(family::FILE);
+    let law = if family_path.is_file() { Some(family::parse(&family_path)?) } else { None };
+    write_if_changed(&out_dir.join(family::RUST_FILE), &family::render(law.as_ref()))?;
     let stacks = tissue::read_stacks(set_dir)?;
     let needle = tissue::read_fe_needle(set_dir)?;
     write_if_changed(&out_dir.join(tissue::RUST_TISSUE_FILE), &tissue::render_rust_stacks(&stacks, needle))?;
     let mut read: Vec<PathBuf> = stacks.into_iter().map(|(p, _)| p).collect();
     read.push(extension_path);
+    read.push(family_path);
     Ok(read)
 }
 

@@ -152,13 +152,8 @@ pub fn parse_stack_str(text: &str, path: &Path) -> Result<Stack, CodegenError> {
         return Err(err(raw.format.span(), format!("format = {}: this build reads tissue format {TISSUE_FORMAT}", raw.format.get_ref())));
     }
     let name = raw.name.get_ref();
-    let identifier = name.chars().next().is_some_and(|c| c.is_ascii_lowercase())
-        && name.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
-    if !identifier {
-        return Err(err(
-            raw.name.span(),
-            format!("name = {name:?}: a stack name is lower-case ASCII letters, digits and '_', starting with a letter"),
-        ));
+    if !is_stack_name(name) {
+        return Err(err(raw.name.span(), format!("name = {name:?}: {STACK_NAME_RULE}")));
     }
     check(&raw.needle_diameter_mm, "needle_diameter_mm", Bound::Positive, &err)?;
     let layers_span = raw.layers.span();
@@ -265,6 +260,16 @@ impl Stack {
 /// The tissue files of the set `set_dir` (`tissue/*.toml`, by name), checked.
 ///
 /// # Errors
+/// The rule of a stack's name, as messages say it.
+pub const STACK_NAME_RULE: &str = "a stack name is lower-case ASCII letters, digits and '_', starting with a letter";
+
+/// Whether `name` can name a stack ([`STACK_NAME_RULE`]: it becomes a Rust constant).
+#[must_use]
+pub fn is_stack_name(name: &str) -> bool {
+    name.chars().next().is_some_and(|c| c.is_ascii_lowercase())
+        && name.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
+}
+
 /// A file that [`parse_stack`] refuses, a stem that is not the stack's `name`, or an
 /// unreadable folder.
 pub fn read_stacks(set_dir: &Path) -> Result<Vec<(PathBuf, Stack)>, CodegenError> {

@@ -22,6 +22,7 @@ pub mod depth_extension;
 pub mod depth_floor;
 pub mod error_trend;
 pub mod eval;
+pub mod family;
 pub mod fixed_formats;
 pub mod golden;
 pub mod lsq;
@@ -65,9 +66,13 @@ pub struct FitOutput {
     pub golden_stiffness_fixed_csv: String,
     /// The text of `depth-extension.toml`, when the set has a deep centre run.
     pub depth_extension_toml: Option<String>,
+    /// The text of `family.toml`, when the family's law is fitted.
+    pub family_toml: Option<String>,
     /// The extension's law against the set's other deep runs (none without the
     /// extension).
     pub depth_law: Vec<depth_extension::LawCheck>,
+    /// The material family's law (`family.toml` when fitted).
+    pub family: family::FamilyFit,
     /// The unsolved region, from the set's FE records.
     pub unsolved: unsolved::Region,
     /// The text of `unsolved.toml`.
@@ -87,6 +92,9 @@ impl FitOutput {
         ];
         if let Some(text) = &self.depth_extension_toml {
             files.push((depth_extension::FILE, text));
+        }
+        if let Some(text) = &self.family_toml {
+            files.push((family::FILE, text));
         }
         files
     }
@@ -130,7 +138,14 @@ pub fn fit_set(set: &SetFolder) -> Result<FitOutput> {
         None => Vec::new(),
     };
     let depth_extension_toml = extension.as_ref().map(depth_extension::to_toml);
+    let family = family::fit(set)?;
+    let family_toml = match &family {
+        family::FamilyFit::Law(law) => Some(family::to_toml(law)),
+        _ => None,
+    };
     Ok(FitOutput {
+        family,
+        family_toml,
         model,
         model_toml,
         golden_csv,

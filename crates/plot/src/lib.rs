@@ -3,6 +3,7 @@
 //! by rendering again and comparing bytes.
 #![forbid(unsafe_code)]
 
+pub mod family;
 pub mod figures;
 pub mod panel;
 
@@ -20,7 +21,7 @@ pub const PANEL_PX: (u32, u32) = (520, 360);
 pub fn render_set(set: &SetFolder) -> Result<Vec<(&'static str, String)>> {
     let model = model_file::read(&set.file(MODEL_FILE))?;
     let mut out = Vec::new();
-    for f in figures::figures(set, &model)? {
+    for f in figures::figures(set, &model)?.into_iter().chain(family::figure(set)?) {
         let svg = panel::render(&f.caption, &f.panels, f.cols, PANEL_PX).with_context(|| f.file.to_string())?;
         out.push((f.file, svg));
     }

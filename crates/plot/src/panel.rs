@@ -62,6 +62,29 @@ pub struct Panel {
 /// model curves spans at least ([`Panel::y_min_span`]): 1 %.
 pub const MIN_SPAN_OF_SCALE: f64 = 0.01;
 
+/// A tick value as people read it: `0`, `0.6`, `2.5`, `14`, `120` (at most four
+/// significant digits, no trailing zeros); below 0.001 or from 10,000 on, `5e-4`, `1.5e4`.
+#[must_use]
+pub fn tick_label(v: f64) -> String {
+    let a = v.abs();
+    if a < 1e-12 {
+        return "0".to_string();
+    }
+    if !(1e-3..1e4).contains(&a) {
+        let s = format!("{v:.2e}");
+        let (mantissa, exponent) = s.split_once('e').unwrap_or((&s, "0"));
+        let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+        return format!("{mantissa}e{exponent}");
+    }
+    let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
 /// The axis range of `values`, padded by 6 % of their span, and at least `min_span` wide
 /// (centred on the values' midpoint).
 fn range(values: impl Iterator<Item = f64>, min_span: f64) -> std::ops::Range<f64> {
@@ -122,7 +145,8 @@ fn draw_panel(p: &Panel, area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shi
         .y_desc(&p.y_label)
         .x_labels(7)
         .y_labels(7)
-        .y_label_formatter(&|v| if v.abs() < 1e-12 { "0".to_string() } else { format!("{v:.3e}") })
+        .x_label_formatter(&|v| tick_label(*v))
+        .y_label_formatter(&|v| tick_label(*v))
         .label_style(("sans-serif", 11))
         .draw()
         .map_err(err(&p.title))?;
@@ -161,4 +185,28 @@ fn draw_panel(p: &Panel, area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shi
         .draw()
         .map_err(err(&p.title))?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::tick_label;
+
+    #[test]
+    fn tick_labels_read_as_people_write_numbers() {
+        let cases = [
+            (0.0, "0"),
+            (1e-15, "0"),
+            (0.6, "0.6"),
+            (2.5, "2.5"),
+            (5.0, "5"),
+            (14.0, "14"),
+            (-0.125, "-0.125"),
+            (0.0005, "5e-4"),
+            (15000.0, "1.5e4"),
+            (0.1 + 0.2, "0.3"),
+        ];
+        for (v, want) in cases {
+            assert_eq!(tick_label(v), want, "{v}");
+        }
+    }
 }

@@ -32,21 +32,21 @@ pub fn write_atomic_streamed<T>(path: &Path, write: impl FnOnce(&mut dyn Write) 
     refuse_special(path).context("nothing written")?;
     remove_stale_temporaries(path);
     let dir = path.parent().with_context(|| format!("{}: no parent folder", path.display()))?;
-    std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
+    create_folder(dir)?;
     let tmp = temporary_of(path)?;
     let result = (|| -> Result<T> {
-        let f = std::fs::File::create(&tmp).with_context(|| format!("{}: cannot create", tmp.display()))?;
+        let f = std::fs::File::create(&tmp).with_context(|| format!("{}: cannot create (its temporary beside it)", path.display()))?;
         let mut w = std::io::BufWriter::with_capacity(1 << 20, f);
         let value = write(&mut w)?;
-        let f = w.into_inner().map_err(|e| e.into_error()).with_context(|| format!("{}: cannot write", tmp.display()))?;
-        f.sync_all().with_context(|| format!("{}: cannot sync", tmp.display()))?;
+        let f = w.into_inner().map_err(|e| e.into_error()).with_context(|| format!("{}: cannot write", path.display()))?;
+        f.sync_all().with_context(|| format!("{}: cannot sync", path.display()))?;
         Ok(value)
     })();
     match result {
         Ok(v) => {
             if let Err(e) = std::fs::rename(&tmp, path) {
                 let _ = std::fs::remove_file(&tmp);
-                anyhow::bail!("{}: cannot rename to {}: {e}", tmp.display(), path.display());
+                anyhow::bail!("{}: cannot replace it with the new file: {e}", path.display());
             }
             Ok(v)
         }
@@ -89,10 +89,45 @@ pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<()> {
             for (t, _) in written.iter().skip(i) {
                 let _ = std::fs::remove_file(t);
             }
-            anyhow::bail!("{}: cannot rename to {}: {e}", tmp.display(), path.display());
+            anyhow::bail!("{}: cannot replace it with the new file: {e}", path.display());
         }
     }
     Ok(())
+}
+
+/// Creates folder `dir` and its parents; a file in the way is named as such (not "File
+/// exists").
+///
+/// # Errors
+/// A part of `dir` is a file, or the folder cannot be created.
+pub fn create_folder(dir: &Path) -> Result<()> {
+    if let Some(file) = dir.ancestors().find(|a| std::fs::metadata(a).is_ok_and(|m| !m.is_dir())) {
+        anyhow::bail!("{}: cannot create: {} is a file, not a folder", dir.display(), file.display());
+    }
+    std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))
+}
+
+/// Checks, before any work, that [`write_atomic`] could write `path`: it is a regular
+/// file or nothing, no file is in the way of its folder, and the folder (or the nearest
+/// one that exists) takes a new file (a probe file made and removed). Nothing is left.
+///
+/// # Errors
+/// As [`write_atomic`] would fail (the path, the reason).
+pub fn check_writable(path: &Path) -> Result<()> {
+    refuse_special(path)?;
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    if let Some(file) = dir.ancestors().find(|a| std::fs::metadata(a).is_ok_and(|m| !m.is_dir())) {
+        anyhow::bail!("{}: is a file, not a folder, so {} cannot be written", file.display(), path.display());
+    }
+    let existing = dir.ancestors().find(|a| a.is_dir()).unwrap_or(Path::new("."));
+    let probe = existing.join(format!(".needle-probe.{}.tmp", std::process::id()));
+    match std::fs::File::create(&probe) {
+        Ok(_) => {
+            let _ = std::fs::remove_file(&probe);
+            Ok(())
+        }
+        Err(e) => anyhow::bail!("{}: cannot be written: folder {}: {e}", path.display(), existing.display()),
+    }
 }
 
 /// Refuses a path where something other than a regular file is (module rule of
@@ -124,12 +159,12 @@ fn temporary_of(path: &Path) -> Result<std::path::PathBuf> {
 /// Write `bytes` to the temporary of `path` (synced); removed again on failure.
 fn write_temporary(path: &Path, bytes: &[u8]) -> Result<std::path::PathBuf> {
     let dir = path.parent().with_context(|| format!("{}: no parent folder", path.display()))?;
-    std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
+    create_folder(dir)?;
     let tmp = temporary_of(path)?;
     let written = (|| -> Result<()> {
-        let mut f = std::fs::File::create(&tmp).with_context(|| format!("{}: cannot create", tmp.display()))?;
-        f.write_all(bytes).with_context(|| format!("{}: cannot write", tmp.display()))?;
-        f.sync_all().with_context(|| format!("{}: cannot sync", tmp.display()))?;
+        let mut f = std::fs::File::create(&tmp).with_context(|| format!("{}: cannot create (its temporary beside it)", path.display()))?;
+        f.write_all(bytes).with_context(|| format!("{}: cannot write", path.display()))?;
+        f.sync_all().with_context(|| format!("{}: cannot sync", path.display()))?;
         Ok(())
     })();
     if let Err(e) = written {
@@ -160,6 +195,34 @@ pub fn remove_stale_temporaries(path: &Path) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Issue 66: an error names the file asked for, never its temporary
+    /// (`.x.toml.<pid>.tmp`): here the temporary's name is taken by a folder.
+    #[test]
+    fn message_a_failed_write_names_the_file_not_its_temporary() {
+        let d = tempfile::tempdir().expect("tempdir");
+        let path = d.path().join("x.toml");
+        std::fs::create_dir(temporary_of(&path).expect("temporary")).expect("a folder in the way");
+        let e = format!("{:#}", write_atomic(&path, b"new").expect_err("the temporary cannot be made"));
+        assert!(e.contains("x.toml: cannot create") && !e.contains(".x.toml."), "{e}");
+        let e = format!("{:#}", write_atomic_streamed(&path, |w| Ok(w.write_all(b"x")?)).expect_err("the same"));
+        assert!(e.contains("x.toml: cannot create") && !e.contains(".x.toml."), "{e}");
+    }
+
+    /// Issue 66: a file where a folder of the path must be is named as such, not "File
+    /// exists (os error 17)".
+    #[test]
+    fn message_a_file_in_the_way_of_a_folder_is_named() {
+        let d = tempfile::tempdir().expect("tempdir");
+        std::fs::write(d.path().join("plain"), "x").expect("write");
+        let path = d.path().join("plain/sub/x.svg");
+        let e = format!("{:#}", write_atomic(&path, b"new").expect_err("a file in the way"));
+        assert!(e.contains("is a file, not a folder") && !e.contains("os error 17"), "{e}");
+        let e = format!("{:#}", check_writable(&path).expect_err("a file in the way"));
+        assert!(e.contains("is a file, not a folder"), "{e}");
+        check_writable(&d.path().join("new/deeper/x.svg")).expect("a folder to be made");
+        assert!(!d.path().join("new").exists(), "the check makes nothing");
+    }
 
     /// A failure while writing the second file (its folder cannot be made: a file is in
     /// the way) leaves the first file's old content and no temporary of either.

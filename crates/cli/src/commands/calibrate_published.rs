@@ -1,7 +1,8 @@
 //! `needle calibrate-published`: a tissue stack from a published piecewise force-depth
 //! model (needle-calibrate's `published` rules), written into the set's `tissue/`, its
 //! published curve sampled into a CSV, and the stack replayed against that curve.
-use crate::compiled_set::check_compiled_set;
+use crate::compiled_set::check_compiled_set_except;
+use crate::planned_outputs::{self, Planned};
 use anyhow::{Context, Result};
 use clap::Args;
 use needle_calibrate::from_model::{calibrate_published as derive, ModelOptions};
@@ -31,12 +32,13 @@ pub struct CalibratePublishedArgs {
     /// The stack's one-line description.
     #[arg(long)]
     pub description: String,
-    /// Diameter of the stack's needle, mm (the FE needle is carried to it by geometric similarity).
-    #[arg(long)]
+    /// Diameter of the stack's needle, mm, 0.1 to 10 (the FE needle is carried to it by
+    /// geometric similarity).
+    #[arg(long, allow_negative_numbers = true)]
     pub needle_diameter_mm: f64,
-    /// Speed of the replay along the published curve, mm/s (for the comparison; with
-    /// --with-prony also the speed at which a layer with terms is fitted).
-    #[arg(long)]
+    /// Speed of the replay along the published curve, mm/s, 0.01 to 1000 (for the
+    /// comparison; with --with-prony also the speed at which a layer with terms is fitted).
+    #[arg(long, allow_negative_numbers = true)]
     pub replay_speed_mm_per_s: f64,
     /// Write the layers' published Prony terms into the stack (its boundaries then relax:
     /// the library needs its `viscoelastic` feature for it); without, they are named in
@@ -52,15 +54,34 @@ pub struct CalibratePublishedArgs {
     /// Write the figure here instead of <set>/figures/calibration-<name>.svg.
     #[arg(long)]
     pub figure: Option<PathBuf>,
+    /// Replace an existing stack, figure or sampled curve (without it, an existing one is
+    /// refused before any work).
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// Runs `needle calibrate-published`. The comparison with the published curve is printed,
-/// not held to the calibration goals: exit 0 once the files are written.
+/// not held to the calibration goals: exit 0 once the files are written. The options,
+/// the name and the outputs are checked first; the three files (sampled curve, stack,
+/// figure) are written last, all or nothing.
 ///
 /// # Errors
-/// The set is not the compiled-in one, a file is refused, or a file cannot be written.
+/// The set is not the compiled-in one, an option is out of range, an output or a file
+/// is refused, or the files cannot be written.
 pub fn run(a: CalibratePublishedArgs) -> Result<ExitCode> {
-    check_compiled_set(&a.set)?;
+    super::calibrate::check_name(&a.name)?;
+    let checked = ModelOptions {
+        pieces: &a.pieces,
+        layer_sources: &a.layer_sources,
+        name: a.name.clone(),
+        description: a.description.clone(),
+        needle_diameter_mm: a.needle_diameter_mm,
+        replay_speed_mm_per_s: a.replay_speed_mm_per_s,
+        with_prony: a.with_prony,
+        fe_shear_modulus_n_per_mm2: 1.0,
+    };
+    needle_calibrate::from_model::check_model_options(&checked)?;
+    check_compiled_set_except(&a.set, Some(&a.name))?;
     let mu0 = needle_codegen::tissue::read_fe_shear_modulus(&a.set)?
         .with_context(|| format!("{}: no campaign.toml: the FE tissue's shear modulus sets the track stiffness", a.set.display()))?;
     let opts = ModelOptions {
@@ -73,6 +94,14 @@ pub fn run(a: CalibratePublishedArgs) -> Result<ExitCode> {
         with_prony: a.with_prony,
         fe_shear_modulus_n_per_mm2: mu0,
     };
+    let out = a.out.clone().unwrap_or_else(|| a.set.join(needle_codegen::tissue::TISSUE_DIR).join(format!("{}.toml", a.name)));
+    let figure = a.figure.clone().unwrap_or_else(|| a.set.join("figures").join(format!("calibration-{}.svg", a.name)));
+    let planned = [
+        Planned { option: "--sampled-out", path: &a.sampled_out },
+        Planned { option: "--out", path: &out },
+        Planned { option: "--figure", path: &figure },
+    ];
+    planned_outputs::check(&planned, Some(&a.set), &[("--pieces", &a.pieces), ("--layer-sources", &a.layer_sources)], a.force)?;
     let c = derive(&opts)?;
     println!(
         "{} published pieces sampled every {} mm ({} points); geometric similarity: needle {} mm / FE needle {} mm = {:.4}",
@@ -94,8 +123,6 @@ pub fn run(a: CalibratePublishedArgs) -> Result<ExitCode> {
     for p in &c.points {
         sampled.push_str(&format!("{},{}\n", p.position_mm, p.force_n));
     }
-    write(&a.sampled_out, &sampled)?;
-    let out = a.out.unwrap_or_else(|| a.set.join(needle_codegen::tissue::TISSUE_DIR).join(format!("{}.toml", a.name)));
     let header = format!(
         "Tissue stack `{}`, written by `needle calibrate-published` (format: coeffs/README.md, \"Tissue stacks\"; rules: crates/calibrate/src/published.rs).\nPublished model: {} (provenance: its folder's README.md); citations per layer: {}; needle {} mm.",
         a.name,
@@ -103,18 +130,12 @@ pub fn run(a: CalibratePublishedArgs) -> Result<ExitCode> {
         a.layer_sources.display(),
         a.needle_diameter_mm
     );
-    write(&out, &c.stack.to_toml(&header))?;
-    let figure = a.figure.unwrap_or_else(|| a.set.join("figures").join(format!("calibration-{}.svg", a.name)));
-    write(&figure, &super::calibrate::figure::svg(&c, &a.name, "published model (sampled)")?)?;
+    let stack = c.stack.to_toml(&header);
+    let svg = super::calibrate::figure::svg(&c, &a.name, "published model (sampled)")?;
+    needle_stdx::fs::write_all_atomic(&[(&a.sampled_out, sampled.as_bytes()), (&out, stack.as_bytes()), (&figure, svg.as_bytes())])?;
+    for path in [&a.sampled_out, &out, &figure] {
+        println!("wrote {}", path.display());
+    }
     println!("result: stack derived by the published-model rules (the comparison above is reported, not a goal)");
     Ok(ExitCode::SUCCESS)
-}
-
-fn write(path: &std::path::Path, text: &str) -> Result<()> {
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
-    }
-    needle_stdx::fs::write_atomic(path, text.as_bytes())?;
-    println!("wrote {}", path.display());
-    Ok(())
 }

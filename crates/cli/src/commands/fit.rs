@@ -82,6 +82,11 @@ pub fn run(a: FitArgs) -> Result<ExitCode> {
     print!("{}", fit::coupled_report::to_table(&coupled));
     print!("{}", fit::unsolved::summary(&out.unsolved));
     print!("{}", fit::depth_extension::law_summary(&out.depth_law));
+    match &out.family {
+        fit::family::FamilyFit::None => {}
+        fit::family::FamilyFit::Pending(why) => println!("{why}"),
+        fit::family::FamilyFit::Law(law) => print!("{}", fit::family::summary(law)),
+    }
     for (path, text) in &files {
         if path.extension().is_some_and(|e| e == "csv") {
             println!("wrote {} ({} poses)", path.display(), text.lines().count().saturating_sub(1));

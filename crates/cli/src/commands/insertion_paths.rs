@@ -6,7 +6,8 @@
 #[path = "../../../../examples/common/insertion_paths.rs"]
 mod paths;
 
-use anyhow::{Context, Result};
+use crate::planned_outputs::Planned;
+use anyhow::Result;
 use clap::Args;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -40,17 +41,24 @@ pub fn script(path: &[paths::Waypoint], stack: &needle_haptics::insertion::Stack
     s
 }
 
-/// Runs `needle insertion-paths`.
+/// Runs `needle insertion-paths`: the scripts are written all or nothing (an existing
+/// script is replaced: they are the paths' own text).
 ///
 /// # Errors
-/// No such stack; the folder or a file cannot be written.
+/// No such stack; the folder or a file cannot be written (then none is).
 pub fn run(a: InsertionPathsArgs) -> Result<ExitCode> {
-    let stack = super::eval::insertion::stack(&a.stack)?;
-    std::fs::create_dir_all(&a.out_dir).with_context(|| format!("{}: cannot create", a.out_dir.display()))?;
-    for (i, path) in paths::PATHS.iter().enumerate() {
-        let file = a.out_dir.join(format!("{}-path{i}.csv", stack.name));
-        needle_stdx::fs::write_atomic(&file, script(path, stack).as_bytes())?;
-        println!("wrote {}", file.display());
+    let stack = super::eval::insertion::stack("--stack", &a.stack)?;
+    let files: Vec<(PathBuf, String)> = paths::PATHS
+        .iter()
+        .enumerate()
+        .map(|(i, path)| (a.out_dir.join(format!("{}-path{i}.csv", stack.name)), script(path, stack)))
+        .collect();
+    let planned: Vec<Planned<'_>> = files.iter().map(|(p, _)| Planned { option: "--out-dir", path: p }).collect();
+    crate::planned_outputs::check(&planned, None, &[], true)?;
+    let refs: Vec<(&std::path::Path, &[u8])> = files.iter().map(|(p, t)| (p.as_path(), t.as_bytes())).collect();
+    needle_stdx::fs::write_all_atomic(&refs)?;
+    for (p, _) in &files {
+        println!("wrote {}", p.display());
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -93,3 +93,43 @@ pub fn all_commands() -> Vec<Vec<String>> {
     assert!(out.len() >= 10, "found only {out:?}");
     out
 }
+
+/// A copy of the shipped set (every file: model, tissue, figures, measured curves, FE
+/// records) in a fresh temporary folder, for tests that write into a set or break one of
+/// its files: (tempdir, set dir).
+pub fn set_copy() -> (tempfile::TempDir, PathBuf) {
+    fn copy(from: &Path, to: &Path) {
+        std::fs::create_dir_all(to).expect("mkdir");
+        for e in std::fs::read_dir(from).expect("read the set").flatten() {
+            let (src, dst) = (e.path(), to.join(e.file_name()));
+            if src.is_dir() {
+                copy(&src, &dst);
+            } else {
+                std::fs::copy(&src, &dst).expect("copy");
+            }
+        }
+    }
+    let d = tempfile::tempdir().expect("tempdir");
+    let set = d.path().join("set");
+    copy(&shipped_set(), &set);
+    (d, set)
+}
+
+/// Every file under `dir` with its bytes, sorted by path: a snapshot to show that a
+/// refused command changed no file.
+pub fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    fn walk(dir: &Path, out: &mut Vec<(PathBuf, Vec<u8>)>) {
+        for e in std::fs::read_dir(dir).expect("read").flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                walk(&p, out);
+            } else {
+                out.push((p.clone(), std::fs::read(&p).unwrap_or_default()));
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(dir, &mut out);
+    out.sort();
+    out
+}

@@ -2,12 +2,14 @@
 //! written into the set's `tissue/` and checked against the curve.
 pub mod figure;
 
-use crate::compiled_set::check_compiled_set;
+use crate::compiled_set::check_compiled_set_except;
+use crate::planned_outputs::{self, Planned};
 use anyhow::{Context, Result};
 use clap::Args;
-use needle_calibrate::{calibrate as run_calibration, events::EventRule, Options};
+use needle_calibrate::{events::EventRule, Options};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::time::{Duration, Instant};
 
 /// Fit a tissue stack to a measured axial force against needle position.
 #[derive(Args)]
@@ -18,20 +20,24 @@ pub struct CalibrateArgs {
     /// The set whose FE surrogate is scaled (the one compiled in).
     #[arg(long, default_value = "coeffs/default")]
     pub set: PathBuf,
-    /// The measured curve: CSV with columns position_mm and force_n.
+    /// The measured curve: CSV with columns position_mm and force_n, in the order of the
+    /// insertion (at most 100,000 points and 16 MiB; positions spanning 1 to 500 mm;
+    /// |force| <= 500 N).
     #[arg(long)]
     pub curve: PathBuf,
-    /// Name of the stack (the tissue file is <set>/tissue/<name>.toml).
+    /// Name of the stack (the tissue file is <set>/tissue/<name>.toml): lower-case ASCII
+    /// letters, digits and '_', starting with a letter.
     #[arg(long)]
     pub name: String,
-    /// Diameter of the measured needle, mm (the FE needle is carried to it by geometric similarity).
-    #[arg(long)]
+    /// Diameter of the measured needle, mm, 0.1 to 10 (the FE needle is carried to it by
+    /// geometric similarity).
+    #[arg(long, allow_negative_numbers = true)]
     pub needle_diameter_mm: f64,
-    /// Insertion speed of the measurement, mm/s.
-    #[arg(long)]
+    /// Insertion speed of the measurement, mm/s, 0.01 to 1000.
+    #[arg(long, allow_negative_numbers = true)]
     pub speed_mm_per_s: f64,
-    /// Smallest drop that counts as a puncture, fraction of the peak force.
-    #[arg(long, default_value_t = EventRule::default().drop_fraction)]
+    /// Smallest drop that counts as a puncture, fraction of the peak force, 0.001 to 0.999.
+    #[arg(long, default_value_t = EventRule::default().drop_fraction, allow_negative_numbers = true)]
     pub drop_fraction: f64,
     /// Write the stack here instead of <set>/tissue/<name>.toml.
     #[arg(long)]
@@ -39,26 +45,48 @@ pub struct CalibrateArgs {
     /// Write the figure here instead of <set>/figures/calibration-<name>.svg.
     #[arg(long)]
     pub figure: Option<PathBuf>,
+    /// Replace an existing stack or figure (without it, an existing one is refused before
+    /// the fit).
+    #[arg(long)]
+    pub force: bool,
+    /// Write the stack and figure even when a calibration goal is missed (exit 1 still);
+    /// without it, a missed goal writes nothing.
+    #[arg(long)]
+    pub write_on_miss: bool,
 }
 
-/// Runs `needle calibrate`; exit 1 when a calibration goal is missed.
+/// Runs `needle calibrate`: the options, the name and the outputs are checked first (no
+/// fit for a run that cannot end in a file), the fit reports its progress on stderr,
+/// the stack and figure are written last, together or not at all; exit 1 when a
+/// calibration goal is missed (nothing written, unless `--write-on-miss`).
 ///
 /// # Errors
-/// The set is not the compiled-in one, the curve is refused, or the file cannot be written.
+/// The set is not the compiled-in one, an option is out of range, an output is refused,
+/// the curve is refused, or the files cannot be written.
 pub fn run(a: CalibrateArgs) -> Result<ExitCode> {
-    check_compiled_set(&a.set)?;
     let rule = EventRule { drop_fraction: a.drop_fraction, ..EventRule::default() };
-    let mu0 = needle_codegen::tissue::read_fe_shear_modulus(&a.set)?
-        .with_context(|| format!("{}: no campaign.toml: the FE tissue's shear modulus sets the track stiffness", a.set.display()))?;
-    let opts = Options {
+    let mut opts = Options {
         curve: &a.curve,
         name: a.name.clone(),
         needle_diameter_mm: a.needle_diameter_mm,
         speed_mm_per_s: a.speed_mm_per_s,
         rule,
-        fe_shear_modulus_n_per_mm2: mu0,
+        // checked below, once the set is
+        fe_shear_modulus_n_per_mm2: 1.0,
     };
-    let c = run_calibration(&opts)?;
+    // the cheap checks first: options, name, set, outputs
+    needle_calibrate::check_options(&opts)?;
+    check_name(&a.name)?;
+    check_compiled_set_except(&a.set, Some(&a.name))?;
+    opts.fe_shear_modulus_n_per_mm2 = needle_codegen::tissue::read_fe_shear_modulus(&a.set)?
+        .with_context(|| format!("{}: no campaign.toml: the FE tissue's shear modulus sets the track stiffness", a.set.display()))?;
+    let mu0 = opts.fe_shear_modulus_n_per_mm2;
+    let out = a.out.clone().unwrap_or_else(|| a.set.join(needle_codegen::tissue::TISSUE_DIR).join(format!("{}.toml", a.name)));
+    let figure = a.figure.clone().unwrap_or_else(|| a.set.join("figures").join(format!("calibration-{}.svg", a.name)));
+    let planned = [Planned { option: "--out", path: &out }, Planned { option: "--figure", path: &figure }];
+    planned_outputs::check(&planned, Some(&a.set), &[("--curve", &a.curve)], a.force)?;
+    let points = needle_calibrate::measured::read_curve(&a.curve)?;
+    let c = needle_calibrate::calibrate_points_with_progress(&opts, points, &mut progress_on_stderr())?;
     println!(
         "{} points, {} punctures; geometric similarity: measured needle {} mm / FE needle {} mm = {:.4} (lengths x {:.4}, forces x {:.4}; exact when the block scales too)",
         c.points.len(),
@@ -82,9 +110,9 @@ pub fn run(a: CalibrateArgs) -> Result<ExitCode> {
         );
     }
     let all_met = print_checks(&c.checks);
-    let out = a.out.unwrap_or_else(|| a.set.join(needle_codegen::tissue::TISSUE_DIR).join(format!("{}.toml", a.name)));
-    if let Some(dir) = out.parent() {
-        std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
+    if !all_met && !a.write_on_miss {
+        println!("result: FAIL (a goal is missed): nothing written (--write-on-miss writes the stack and figure anyway)");
+        return Ok(ExitCode::from(1));
     }
     let header = format!(
         "Tissue stack `{}`, written by `needle calibrate` (format: coeffs/README.md, \"Tissue stacks\").\nMeasured curve: {}; needle {} mm at {} mm/s.",
@@ -93,18 +121,46 @@ pub fn run(a: CalibrateArgs) -> Result<ExitCode> {
         a.needle_diameter_mm,
         a.speed_mm_per_s
     );
-    needle_stdx::fs::write_atomic(&out, c.stack.to_toml(&header).as_bytes())?;
-    println!("wrote {}", out.display());
-    let figure = a.figure.unwrap_or_else(|| a.set.join("figures").join(format!("calibration-{}.svg", a.name)));
-    if let Some(dir) = figure.parent() {
-        std::fs::create_dir_all(dir).with_context(|| format!("{}: cannot create", dir.display()))?;
-    }
+    let stack = c.stack.to_toml(&header);
     let svg = self::figure::svg(&c, &a.name, "measured")?;
-    needle_stdx::fs::write_atomic(&figure, svg.as_bytes())?;
+    needle_stdx::fs::write_all_atomic(&[(&out, stack.as_bytes()), (&figure, svg.as_bytes())])?;
+    println!("wrote {}", out.display());
     println!("wrote {}", figure.display());
-    println!("result: {}", if all_met { "every calibration goal met" } else { "FAIL (a goal is missed)" });
+    println!("result: {}", if all_met { "every calibration goal met" } else { "FAIL (a goal is missed; written with --write-on-miss)" });
     Ok(if all_met { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
+
+/// Refuses a `--name` that cannot name a stack, before any work.
+///
+/// # Errors
+/// The name breaks [`needle_codegen::tissue::STACK_NAME_RULE`].
+pub fn check_name(name: &str) -> Result<()> {
+    if !needle_codegen::tissue::is_stack_name(name) {
+        anyhow::bail!("--name {name:?}: {}", needle_codegen::tissue::STACK_NAME_RULE);
+    }
+    Ok(())
+}
+
+/// A progress callback for the fit's scans: a line on stderr at most every
+/// [`PROGRESS_EVERY`], from the first [`PROGRESS_EVERY`] on (a short fit prints nothing).
+pub fn progress_on_stderr() -> impl FnMut(usize, usize) {
+    let start = Instant::now();
+    let mut last = start;
+    move |done, total| {
+        let now = Instant::now();
+        if now.duration_since(last) >= PROGRESS_EVERY {
+            last = now;
+            eprintln!(
+                "fitting: {done} of {total} candidate depths scanned ({:.0} %, {:.0} s)",
+                100.0 * done as f64 / total.max(1) as f64,
+                now.duration_since(start).as_secs_f64()
+            );
+        }
+    }
+}
+
+/// How often a long fit reports its progress.
+pub const PROGRESS_EVERY: Duration = Duration::from_secs(1);
 
 /// Prints each check (measured, model, error, goal, met) and says whether all are met.
 pub fn print_checks(checks: &[needle_calibrate::replay::Check]) -> bool {
@@ -112,6 +168,14 @@ pub fn print_checks(checks: &[needle_calibrate::replay::Check]) -> bool {
     for check in checks {
         let met = check.met();
         all_met &= met;
+        if check.model.is_nan() {
+            // the model has no such event (a puncture it never made): no number to compare
+            println!(
+                "{:<58} measured {:>9.4}  model: none (the model does not puncture here)  (goal {} {})  MISSED",
+                check.what, check.measured, check.goal, check.unit
+            );
+            continue;
+        }
         println!(
             "{:<58} measured {:>9.4}  model {:>9.4}  error {:>+8.3} {} (goal {} {})  {}",
             check.what,

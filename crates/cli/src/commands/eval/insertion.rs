@@ -23,32 +23,52 @@ pub const OUTPUT_HEADER: &str =
     "time_s,x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm,status,phase,punctures";
 /// Largest departure of a time step from the first one, s.
 pub const PERIOD_TOLERANCE_S: f64 = 1e-6;
+/// A tick longer than this many control periods (`InsertionConfig::DEFAULT_1KHZ`,
+/// 0.001 s) is warned on stderr as a likely unit problem (time_s in ms?): 0.01 s, a
+/// haptic loop slower than 100 Hz.
+pub const WARN_TICK_PERIODS: f64 = 10.0;
+/// A tick longer than this many control periods is refused: 0.1 s, a loop slower than
+/// 10 Hz is no haptic rendering (time in ms gives ticks of 1 s).
+pub const MAX_TICK_PERIODS: f64 = 100.0;
 
-/// The stack compiled in under `name` (its file's stem).
+/// The stack compiled in under `name` (its file's stem), named by `option` (`--insertion`,
+/// `--stack`) in the message.
 ///
 /// # Errors
 /// No such stack (the compiled-in ones are listed).
-pub fn stack(name: &str) -> Result<&'static needle_haptics::insertion::Stack<'static>> {
+pub fn stack(option: &str, name: &str) -> Result<&'static needle_haptics::insertion::Stack<'static>> {
     stacks::by_name(name).with_context(|| {
         let names: Vec<&str> = stacks::ALL.iter().map(|s| s.name).collect();
-        format!("--insertion {name:?}: no such tissue stack in the compiled-in set (it has: {})", names.join(", "))
+        format!("{option} {name:?}: no such tissue stack in the compiled-in set (it has: {})", names.join(", "))
     })
 }
 
 /// The Prony terms of `--prony`: "g:tau_s" pairs, comma-separated, checked as a tissue
-/// file's are (`PronyTerms::new`).
+/// file's are (`PronyTerms::new`). At least one term: an empty value (`""`, `","`: an
+/// unset shell variable) would silently remove the stack's own terms.
 ///
 /// # Errors
-/// A pair that is not two numbers, or terms out of range (the message says which).
+/// No term, a pair that is not two numbers, a number beyond f32, or terms out of range
+/// (the message says which).
 pub fn parse_prony(text: &str) -> Result<needle_haptics::viscoelastic::PronyTerms> {
     use needle_haptics::viscoelastic::{PronyTerm, PronyTerms};
     let mut terms = Vec::new();
     for pair in text.split(',').map(str::trim).filter(|p| !p.is_empty()) {
-        let parsed = pair.split_once(':').and_then(|(g, tau)| Some((g.trim().parse::<f32>().ok()?, tau.trim().parse::<f32>().ok()?)));
+        let parsed = pair.split_once(':').and_then(|(g, tau)| Some((g.trim().parse::<f64>().ok()?, tau.trim().parse::<f64>().ok()?)));
         let Some((g, tau_s)) = parsed else {
             bail!("--prony {text:?}: {pair:?} is not g:tau_s (two numbers, e.g. 0.6:0.5)");
         };
-        terms.push(PronyTerm { g, tau_s });
+        for (name, v, rule) in [("g", g, "g is at most 9 (the weights' sum)"), ("tau_s", tau_s, "tau_s is a time constant in s")] {
+            if v.is_finite() && !(v as f32).is_finite() {
+                bail!("--prony {text:?}: {pair:?}: {name} = {v} is beyond the library's f32 numbers (|x| <= 3.4e38); {rule}");
+            }
+        }
+        terms.push(PronyTerm { g: g as f32, tau_s: tau_s as f32 });
+    }
+    if terms.is_empty() {
+        bail!(
+            "--prony {text:?}: no term (an unset shell variable?): give g:tau_s pairs (e.g. 0.6:0.5), or leave --prony out to keep the stack's own terms"
+        );
     }
     PronyTerms::new(&terms).map_err(|e| anyhow::anyhow!("--prony {text:?}: {e}"))
 }
@@ -64,6 +84,10 @@ pub fn parse_times(text: &str, path: &Path) -> Result<(Vec<f64>, f64)> {
     let col = header.iter().position(|h| h == TIME_COLUMN).with_context(|| {
         format!("{}:1: no column {TIME_COLUMN:?}: a scripted insertion needs it beside {}", path.display(), POSE_COLUMNS.join(", "))
     })?;
+    let count = header.iter().filter(|h| *h == TIME_COLUMN).count();
+    if count > 1 {
+        bail!("{}:1: column {TIME_COLUMN:?} appears {count} times: which one is the time is not clear", path.display());
+    }
     let mut times: Vec<(u64, f64)> = Vec::new();
     for rec in rdr.records() {
         let rec = rec.with_context(|| format!("{}: malformed CSV", path.display()))?;
@@ -82,6 +106,7 @@ pub fn parse_times(text: &str, path: &Path) -> Result<(Vec<f64>, f64)> {
     if period <= 0.0 {
         bail!("{}: time_s does not increase ({t0} then {t1})", path.display());
     }
+    check_tick(period, path)?;
     for pair in times.windows(2) {
         let [(_, a), (line, b)] = pair else { continue };
         if ((b - a) - period).abs() > PERIOD_TOLERANCE_S {
@@ -93,6 +118,31 @@ pub fn parse_times(text: &str, path: &Path) -> Result<(Vec<f64>, f64)> {
         }
     }
     Ok((times.into_iter().map(|(_, t)| t).collect(), period))
+}
+
+/// Warns on stderr of a tick longer than [`WARN_TICK_PERIODS`] control periods and
+/// refuses one longer than [`MAX_TICK_PERIODS`]: a unit problem (time_s in ms?), not a
+/// haptic loop.
+///
+/// # Errors
+/// The tick is longer than the limit.
+pub fn check_tick(period_s: f64, path: &Path) -> Result<()> {
+    let control = f64::from(InsertionConfig::DEFAULT_1KHZ.period_s);
+    let unit = format!("the control period is {control} s (1 kHz): time_s in milliseconds?");
+    if period_s > MAX_TICK_PERIODS * control {
+        bail!(
+            "{}: column {TIME_COLUMN}: ticks of {period_s} s, more than {} s ({MAX_TICK_PERIODS} control periods): {unit}",
+            path.display(),
+            MAX_TICK_PERIODS * control
+        );
+    }
+    if period_s > WARN_TICK_PERIODS * control {
+        eprintln!(
+            "warning: {}: ticks of {period_s} s, more than {WARN_TICK_PERIODS} control periods: {unit} (the model integrates each tick as one step)",
+            path.display()
+        );
+    }
+    Ok(())
 }
 
 /// Runs the script through `stack`: one evaluation per row.
@@ -134,7 +184,7 @@ pub fn to_csv(times: &[f64], poses: &[Pose], evals: &[InsertionEvaluation]) -> S
 /// As [`parse_poses`], [`parse_times`], [`stack`], [`parse_prony`]; the output cannot be
 /// written.
 pub fn eval_script(file: &Path, stack_name: &str, prony: Option<&str>, out: Option<&Path>) -> Result<()> {
-    let compiled = stack(stack_name)?;
+    let compiled = stack("--insertion", stack_name)?;
     let terms = prony.map(parse_prony).transpose()?;
     let layers: Vec<needle_haptics::insertion::Layer> =
         compiled.layers.iter().map(|l| needle_haptics::insertion::Layer { prony: terms.unwrap_or(l.prony), ..*l }).collect();

@@ -5,6 +5,8 @@
 //! carries the coupled model's pose dependence over to the family. The runs themselves are
 //! `needle_fe::family`'s; here the section's type and its checks.
 
+pub mod runs;
+
 use super::error::{SpecError, SpecResult};
 use super::loading::MAX_LOAD_STEPS;
 use super::pose::check_pose_in_block;
@@ -40,6 +42,10 @@ pub struct FamilySettings {
     /// The members (each one of `weight`) the off-centre poses are solved at.
     #[serde(default)]
     pub check_weight: Vec<f64>,
+    /// The members (each one of `weight`) the family's surrogate is not fitted on: `needle
+    /// fit` checks it against them (members it was not fitted on).
+    #[serde(default)]
+    pub held_out: Vec<f64>,
 }
 
 /// The run name of `pose` at the member `weight`: `centre_w0p05`, `x+04_w0p2`, `centre_w0`
@@ -55,8 +61,8 @@ pub fn member_name(pose: &str, weight: f64) -> String {
 /// No members, a weight outside `0 ..= 1` or equal to 1 (the reference), a soft exponent
 /// that is not finite, zero or beyond [`MAX_ABS_ALPHA`], a member listed twice (names collide), a depth outside the block, 0 steps or too many, an
 /// unknown mesh level or one whose fine layers stop above the depth, an unknown or
-/// repeated check pose, a check pose whose needle leaves the block, or a check member
-/// that is not one of `weight`.
+/// repeated check pose, a check pose whose needle leaves the block, or a check or
+/// held-out member that is not one of `weight`.
 pub fn validate_family(c: &Campaign, text: &str, path: &Path) -> SpecResult<()> {
     let Some(f) = &c.family else { return Ok(()) };
     let at = |key: &str| format!("{}:{}", path.display(), crate::spec::key_line(text, "family", key));
@@ -125,6 +131,12 @@ fn validate_checks(c: &Campaign, f: &FamilySettings, at: &dyn Fn(&str) -> String
             return Err(SpecError::inconsistent(at("check_weight"), "family.check_weight", message));
         }
     }
+    for &w in &f.held_out {
+        if !f.weight.contains(&w) {
+            let message = format!("family.held_out = {w}: not a member (family.weight)");
+            return Err(SpecError::inconsistent(at("held_out"), "family.held_out", message));
+        }
+    }
     Ok(())
 }
 
@@ -156,6 +168,7 @@ mod tests {
         let (_, _, mesh) = shipped_key("family", "mesh");
         let (_, check_line, check) = shipped_key("family", "check_weight");
         let (_, poses_line, poses) = shipped_key("family", "check_poses");
+        let (_, held_line, held) = shipped_key("family", "held_out");
         let cases = [
             (text.replace(&weight, "weight = []"), "family.weight", weight_line),
             (text.replace(&weight, "weight = [0.1, 1.0]"), "family.weight", weight_line),
@@ -168,6 +181,7 @@ mod tests {
             (text.replace(&mesh, "mesh = \"needle8\""), "family.mesh", shipped_key("family", "mesh").1),
             (text.replace(&check, "check_weight = [0.75]"), "family.check_weight", check_line),
             (text.replace(&poses, "check_poses = [\"nowhere\"]"), "family.check_poses", poses_line),
+            (text.replace(&held, "held_out = [0.3]"), "family.held_out", held_line),
             (text.replace(&poses, "check_poses = [\"x+04\", \"x+04\"]"), "family.check_poses", poses_line),
         ];
         for (spec, field, line) in cases {
