@@ -15,6 +15,9 @@ use std::process::ExitCode;
 tree this binary was built from, into its target/firmware/ folder: that needs the source tree, cargo and the \
 wasm32 target. Without them, give a prebuilt evaluator with --wasm FILE (the needle_wasm.wasm of that build, \
 for the same set); then nothing is built and only the set folder is read.")]
+// The fields' doc comments are the --help text, written for the terminal: <set> is a
+// placeholder there, not HTML.
+#[allow(rustdoc::invalid_html_tags)]
 pub struct ExploreArgs {
     /// Set folder holding campaign.toml, fe/ and model.toml, e.g. coeffs/default.
     #[arg(long, value_name = "DIR")]
