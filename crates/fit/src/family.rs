@@ -175,7 +175,9 @@ pub enum FamilyFit {
     Law(FamilyLaw),
 }
 
-/// The law fitted on the members of `set` that are not held out, checked on all.
+/// The law fitted on the members of `set` that are not held out and reach the model's
+/// depth (`loading.depth_mm`: a shallower run would cut the law's domain short), checked
+/// on all.
 ///
 /// # Errors
 /// A failed least squares, and [`read_runs`]'s.
@@ -187,12 +189,17 @@ pub fn fit(set: &SetFolder) -> Result<FamilyFit> {
         ));
     }
     let held_out = set.campaign().family.as_ref().map(|f| f.held_out.clone()).unwrap_or_default();
-    let fitted: Vec<&MemberRun> = members.iter().filter(|m| !held_out.contains(&m.weight)).collect();
+    let min_depth_mm = set.campaign().loading.depth_mm;
+    let deepest = |m: &MemberRun| m.fy.iter().map(|p| p.0).fold(0.0, f64::max);
+    let (fitted, shallow): (Vec<&MemberRun>, Vec<&MemberRun>) =
+        members.iter().filter(|m| !held_out.contains(&m.weight)).partition(|m| deepest(m) >= min_depth_mm - 1e-9);
     if fitted.len() < WEIGHT_DEGREE + 1 {
+        let short: Vec<String> = shallow.iter().map(|m| format!("{} to {:.2} mm", m.weight, deepest(m))).collect();
         return Ok(FamilyFit::Pending(format!(
-            "material family law: not fitted: {} fitted member run(s) in fe/{FAMILY_DIR}/ (weights {:?}), the law needs at least {}",
+            "material family law: not fitted: {} member run(s) in fe/{FAMILY_DIR}/ reach the model's depth of {min_depth_mm} mm (weights {:?}; shallower: {}), the law needs at least {}",
             fitted.len(),
             fitted.iter().map(|m| m.weight).collect::<Vec<_>>(),
+            if short.is_empty() { "none".to_string() } else { short.join(", ") },
             WEIGHT_DEGREE + 1
         )));
     }
