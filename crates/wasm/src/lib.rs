@@ -128,7 +128,7 @@ pub extern "C" fn needle_stack_thickness_mm(stack: u32, layer: u32) -> f32 {
 #[no_mangle]
 pub extern "C" fn needle_insertion_start(stack: u32, period_s: f32, velocity_time_constant_s: f32) -> i32 {
     let Some(s) = stacks::ALL.get(stack as usize) else { return -1 };
-    start_path(s, InsertionConfig { period_s, velocity_time_constant_s })
+    start_path(s, InsertionConfig { period_s, velocity_time_constant_s, ..InsertionConfig::DEFAULT_1KHZ })
 }
 
 /// Starts the page's path through `stack`: 0, or -2 for a configuration out of range.
@@ -175,7 +175,7 @@ pub extern "C" fn needle_insertion_start_prony(
         *slot = Layer { prony: terms, ..*l };
     }
     let with = Stack { layers: layers.get(..s.layers.len()).unwrap_or(&[]), ..*s };
-    start_path(&with, InsertionConfig { period_s, velocity_time_constant_s })
+    start_path(&with, InsertionConfig { period_s, velocity_time_constant_s, ..InsertionConfig::DEFAULT_1KHZ })
 }
 
 /// One tick of the started path: the wrench at [`needle_out`]; returns
