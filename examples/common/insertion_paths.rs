@@ -89,7 +89,15 @@ pub type GlitchRun = (u32, u32, u32, Glitch);
 /// cutting, and alternating every tick; NaN, infinity, poses replayed backwards; an
 /// in-domain jump of depth (to 120 mm) and of tilt (to 60 degrees).
 pub const GLITCH_PATHS: [(usize, &[GlitchRun]); 3] = [
-    (0, &[(4_000, 1, 1, Glitch::Depth(1.0e6)), (9_000, 1, 1, Glitch::NotANumber), (11_000, 3, 1, Glitch::Back(20)), (20_000, 1, 1, Glitch::X(1.0e6))]),
+    (
+        0,
+        &[
+            (4_000, 1, 1, Glitch::Depth(1.0e6)),
+            (9_000, 1, 1, Glitch::NotANumber),
+            (11_000, 3, 1, Glitch::Back(20)),
+            (20_000, 1, 1, Glitch::X(1.0e6)),
+        ],
+    ),
     (
         2,
         &[
@@ -100,7 +108,15 @@ pub const GLITCH_PATHS: [(usize, &[GlitchRun]); 3] = [
             (12_000, 10, 1, Glitch::Back(25)),
         ],
     ),
-    (3, &[(2_400, 1, 1, Glitch::Depth(120.0)), (5_100, 1, 1, Glitch::X(-1.0e9)), (8_200, 40, 1, Glitch::Depth(1.0e6)), (10_000, 1, 1, Glitch::Back(31))]),
+    (
+        3,
+        &[
+            (2_400, 1, 1, Glitch::Depth(120.0)),
+            (5_100, 1, 1, Glitch::X(-1.0e9)),
+            (8_200, 40, 1, Glitch::Depth(1.0e6)),
+            (10_000, 1, 1, Glitch::Back(31)),
+        ],
+    ),
 ];
 
 /// Every golden path: [`PATHS`], then [`GLITCH_PATHS`].

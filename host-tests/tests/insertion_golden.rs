@@ -207,7 +207,13 @@ fn c_api_fixed_lines() -> Vec<String> {
                 // SAFETY: valid pointers to local values; the state was initialised above.
                 assert_eq!(unsafe { needle_fixed_insertion_step(&mut state, &pose, &mut out) }, NEEDLE_OK);
                 let w = out.wrench;
-                digest.tick_fixed([w.fx_un, w.fy_un, w.fz_un, w.mx_unmm, w.my_unmm, w.mz_unmm], out.status, out.phase, out.punctures, out.flags);
+                digest.tick_fixed(
+                    [w.fx_un, w.fy_un, w.fz_un, w.mx_unmm, w.my_unmm, w.mz_unmm],
+                    out.status,
+                    out.phase,
+                    out.punctures,
+                    out.flags,
+                );
                 ticks += 1;
                 punctures += u64::from(out.punctures);
             });

@@ -282,6 +282,11 @@ pub mod insertion_flags {
     /// The three glitch flags: the tick was not integrated.
     pub const GLITCH: u8 = FAST_MOTION | OUT_OF_DOMAIN | NOT_FINITE;
     /// Every flag with its name, `OK` first, then in bit order.
-    pub const NAMES: [(&str, u8); 5] =
-        [("OK", OK), ("FAST_MOTION", FAST_MOTION), ("OUT_OF_DOMAIN", OUT_OF_DOMAIN), ("NOT_FINITE", NOT_FINITE), ("WRENCH_LIMITED", WRENCH_LIMITED)];
+    pub const NAMES: [(&str, u8); 5] = [
+        ("OK", OK),
+        ("FAST_MOTION", FAST_MOTION),
+        ("OUT_OF_DOMAIN", OUT_OF_DOMAIN),
+        ("NOT_FINITE", NOT_FINITE),
+        ("WRENCH_LIMITED", WRENCH_LIMITED),
+    ];
 }

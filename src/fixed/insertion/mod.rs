@@ -164,7 +164,14 @@ fn bound(w: &mut [i32; 6]) -> InsertionFlags {
     }
     // |c| <= 2^31 and a bound < 2^31: the products fit in i64; the sums are > 0 when beyond
     let scale = |c: i64, sum: i64, limit: i64| if sum <= limit { c } else { c.saturating_mul(limit).checked_div(sum).unwrap_or(0) };
-    let scaled = [scale(fx, f, FORCE_LIMIT_UN), scale(fy, f, FORCE_LIMIT_UN), scale(fz, f, FORCE_LIMIT_UN), scale(mx, m, MOMENT_LIMIT_UNMM), scale(my, m, MOMENT_LIMIT_UNMM), scale(mz, m, MOMENT_LIMIT_UNMM)];
+    let scaled = [
+        scale(fx, f, FORCE_LIMIT_UN),
+        scale(fy, f, FORCE_LIMIT_UN),
+        scale(fz, f, FORCE_LIMIT_UN),
+        scale(mx, m, MOMENT_LIMIT_UNMM),
+        scale(my, m, MOMENT_LIMIT_UNMM),
+        scale(mz, m, MOMENT_LIMIT_UNMM),
+    ];
     *w = scaled.map(saturate_i32);
     InsertionFlags::WRENCH_LIMITED
 }
@@ -356,7 +363,12 @@ impl<'a> Insertion<'a> {
     fn screen(&self, pose: &Pose) -> InsertionFlags {
         let Pose { x_mm_q16: x, z_mm_q16: z, theta_x_deg_q16: tx, theta_z_deg_q16: tz, depth_mm_q16: d } = *pose;
         let within = |v: i32, max: i64| i64::from(v).abs() <= max;
-        if !(within(x, X_MAX_Q16) && within(z, X_MAX_Q16) && within(d, DEPTH_MAX_Q16) && within(tx, TILT_MAX_Q16) && within(tz, TILT_MAX_Q16)) {
+        if !(within(x, X_MAX_Q16)
+            && within(z, X_MAX_Q16)
+            && within(d, DEPTH_MAX_Q16)
+            && within(tx, TILT_MAX_Q16)
+            && within(tz, TILT_MAX_Q16))
+        {
             return InsertionFlags::OUT_OF_DOMAIN;
         }
         let Some(last_d) = self.last_depth_q16 else { return InsertionFlags::OK };
@@ -365,7 +377,12 @@ impl<'a> Insertion<'a> {
         let [mm, deg] = self.max_step_q16.map(|s| s.saturating_mul(n));
         let moved = |a: i64, b: i64, max: i64| (a - b).abs() <= max;
         let (i, j) = (i64::from, i64::from);
-        if moved(i(d), last_d, mm) && moved(i(x), j(lx), mm) && moved(i(z), j(lz), mm) && moved(i(tx), j(ltx), deg) && moved(i(tz), j(ltz), deg) {
+        if moved(i(d), last_d, mm)
+            && moved(i(x), j(lx), mm)
+            && moved(i(z), j(lz), mm)
+            && moved(i(tx), j(ltx), deg)
+            && moved(i(tz), j(ltz), deg)
+        {
             InsertionFlags::OK
         } else {
             InsertionFlags::FAST_MOTION
@@ -373,7 +390,8 @@ impl<'a> Insertion<'a> {
     }
 
     fn filter_velocity(&mut self, step_q16: i64) {
-        let (raw, alpha) = if self.missed <= 1 { (mul_shr(step_q16, self.rate_q16, 16), self.alpha_q16) } else { self.after_glitch(step_q16) };
+        let (raw, alpha) =
+            if self.missed <= 1 { (mul_shr(step_q16, self.rate_q16, 16), self.alpha_q16) } else { self.after_glitch(step_q16) };
         self.velocity_q16 = self.velocity_q16.saturating_add(mul_shr(alpha, raw.saturating_sub(self.velocity_q16), 16));
     }
 

@@ -396,7 +396,15 @@ fn bound(w: &mut [f32; 6], dissipative_n: &mut [f32; 3]) -> InsertionFlags {
         return InsertionFlags::OK;
     }
     // the rounding of `limit / sum` may round up: the factor keeps the scaled sum below
-    let scale = |sum: f32, limit: f32| if sum <= limit { 1.0 } else if sum.is_finite() { limit * 0.999_99 / sum } else { 0.0 };
+    let scale = |sum: f32, limit: f32| {
+        if sum <= limit {
+            1.0
+        } else if sum.is_finite() {
+            limit * 0.999_99 / sum
+        } else {
+            0.0
+        }
+    };
     let (sf, sm) = (scale(f, FORCE), scale(m, MOMENT));
     *w = [fx * sf, fy * sf, fz * sf, mx * sm, my * sm, mz * sm];
     for d in dissipative_n.iter_mut() {
@@ -565,9 +573,23 @@ impl Insertion {
             self.elapsed_s += self.config.period_s;
             let (wrench, phase) = self.held;
             let e = if glitch.contains(InsertionFlags::NOT_FINITE) {
-                InsertionEvaluation { wrench: Wrench::ZERO, status: Status::ERROR, flags: glitch, phase, punctures: 0, velocity_mm_per_s: self.velocity_mm_per_s }
+                InsertionEvaluation {
+                    wrench: Wrench::ZERO,
+                    status: Status::ERROR,
+                    flags: glitch,
+                    phase,
+                    punctures: 0,
+                    velocity_mm_per_s: self.velocity_mm_per_s,
+                }
             } else {
-                InsertionEvaluation { wrench, status: Status::OK, flags: glitch, phase, punctures: 0, velocity_mm_per_s: self.velocity_mm_per_s }
+                InsertionEvaluation {
+                    wrench,
+                    status: Status::OK,
+                    flags: glitch,
+                    phase,
+                    punctures: 0,
+                    velocity_mm_per_s: self.velocity_mm_per_s,
+                }
             };
             return (e, 0.0, [0.0; 3]);
         }

@@ -127,9 +127,8 @@ pub fn flags_note(evals: &[InsertionEvaluation]) -> Option<String> {
             Some(format!("{name} in {} ticks (first at row {first})", 1 + rows.count()))
         })
         .collect();
-    (!parts.is_empty()).then(|| {
-        format!("insertion flags: {} (a glitch is not integrated: the wrench of the tick before is held)", parts.join(", "))
-    })
+    (!parts.is_empty())
+        .then(|| format!("insertion flags: {} (a glitch is not integrated: the wrench of the tick before is held)", parts.join(", ")))
 }
 
 /// The CSV form ([`OUTPUT_HEADER`]).
