@@ -284,6 +284,9 @@ pub const NEEDLE_LOOP_OUTPUT_ERROR: u16 = 0x0080;
 pub const NEEDLE_LOOP_DISABLED: u16 = 0x0100;
 /// Loop flag: the passivity guard limited the rendered stiffness.
 pub const NEEDLE_LOOP_STIFFNESS_LIMITED: u16 = 0x0200;
+/// Loop flag: the insertion rejected the pose as a glitch (`NEEDLE_INSERTION_*`); a fault
+/// that keeps the passivity guard's state.
+pub const NEEDLE_LOOP_POSE_GLITCH: u16 = 0x0400;
 
 /// A needle path through a tissue stack: initialise with `needle_insertion_init`. Plain
 /// data: it may be copied with `memcpy`.
