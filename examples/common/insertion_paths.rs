@@ -125,7 +125,8 @@ pub const PATH_COUNT: usize = PATHS.len() + GLITCH_PATHS.len();
 /// The glitch of `runs` at `tick`, if any.
 fn glitch_at(runs: &[GlitchRun], tick: u32) -> Option<Glitch> {
     for &(first, count, stride, g) in runs {
-        if tick >= first && (tick - first) % stride.max(1) == 0 && (tick - first) / stride.max(1) < count {
+        let (since, stride) = (tick.wrapping_sub(first), stride.max(1));
+        if tick >= first && since / stride * stride == since && since / stride < count {
             return Some(g);
         }
     }

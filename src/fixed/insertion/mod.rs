@@ -230,7 +230,7 @@ impl<'a> Insertion<'a> {
             return Err(InsertionError::Config);
         }
         // speed (< 2^32) times period (< 2^32) times 2^16 / 10^6: within i64 in u128
-        let per_tick = |speed: u32| i64::try_from((u128::from(speed) * u128::from(period) << 16) / 1_000_000).unwrap_or(i64::MAX);
+        let per_tick = |speed: u32| i64::try_from(((u128::from(speed) * u128::from(period)) << 16) / 1_000_000).unwrap_or(i64::MAX);
         let max_step_q16 = [per_tick(config.max_speed_mm_per_s), per_tick(config.max_turn_deg_per_s)];
         let mut insertion = Self {
             stack,
