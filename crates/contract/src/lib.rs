@@ -248,7 +248,7 @@ pub mod insertion_limits {
     /// Largest `|theta_x|` and `|theta_z|` of an insertion pose, degrees.
     pub const TILT_MAX_DEG: i32 = 89;
     /// The default largest speed of `x`, `z` and `depth`, mm/s (1 mm per tick at 1 kHz:
-    /// a hand's fast reach, about 20 times the fastest golden insertion path).
+    /// a hand's fast reach, 24 times the fastest golden insertion path's 41.7 mm/s).
     pub const SPEED_MAX_MM_PER_S: u32 = 1000;
     /// The default largest turning speed of the tilts, degrees/s (1 degree per tick at 1 kHz).
     pub const TURN_MAX_DEG_PER_S: u32 = 1000;
