@@ -50,7 +50,8 @@ impl Insertion {
             let names: Vec<&str> = stacks::ALL.iter().map(|s| s.name).collect();
             return Err(PyValueError::new_err(format!("no tissue stack {stack:?} in this build; there are: {}", names.join(", "))));
         };
-        let model = Model::new(s, InsertionConfig { period_s, velocity_time_constant_s, ..InsertionConfig::DEFAULT_1KHZ }).map_err(value_error)?;
+        let model =
+            Model::new(s, InsertionConfig { period_s, velocity_time_constant_s, ..InsertionConfig::DEFAULT_1KHZ }).map_err(value_error)?;
         Ok(Self { model, stack: s.name })
     }
 
