@@ -1,5 +1,4 @@
-//! What the bit-flag types ([`Status`](crate::Status),
-//! [`InsertionFlags`](crate::InsertionFlags) and
+//! What the two bit-flag types ([`Status`](crate::Status) and
 //! [`LoopFlags`](crate::control::LoopFlags)) share: the `|` operators and the
 //! `NAME | NAME` text.
 use core::fmt;
