@@ -77,15 +77,7 @@ pub fn fit_with_progress(points: &[Point], punctures: &[Puncture], surrogate: &d
     // (sse, onset, scale) of the best candidate whose model crosses the onset threshold
     // within ONSET_MATCH_MM of the measured crossing, and of the best of all
     let (mut matched, mut any) = ((f64::INFINITY, start, 0.0), (f64::INFINITY, start, 0.0));
-    let total = scan(start, peak0).count()
-        + punctures
-            .iter()
-            .enumerate()
-            .filter_map(|(k, e)| {
-                let next = punctures.get(k + 1)?;
-                Some(scan(points.get(e.bottom)?.position_mm - start, points.get(next.peak)?.position_mm - start).count())
-            })
-            .sum::<usize>();
+    let total = scan_count(points, punctures, start, peak0);
     let mut done = 0;
     let pre_scan = thin(&pre);
     let rhs: Vec<f64> = pre_scan.iter().map(|p| p.force_n).collect();
@@ -150,6 +142,16 @@ pub fn fit_with_progress(points: &[Point], punctures: &[Puncture], surrogate: &d
         }
     }
     Fit { onset_mm: onset, layers, last_depth_mm: depth(points.len() - 1) }
+}
+
+/// How many candidates the scans of [`fit_with_progress`] try (the onset's, then each
+/// interval's boundary), for its progress.
+fn scan_count(points: &[Point], punctures: &[Puncture], start: f64, peak0: f64) -> usize {
+    let intervals = punctures.iter().enumerate().filter_map(|(k, e)| {
+        let next = punctures.get(k + 1)?;
+        Some(scan(points.get(e.bottom)?.position_mm - start, points.get(next.peak)?.position_mm - start).count())
+    });
+    scan(start, peak0).count() + intervals.sum::<usize>()
 }
 
 struct IntervalFit {
