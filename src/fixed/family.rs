@@ -135,11 +135,13 @@ mod tests {
             inv_depth_max_q24: round_i64(inv as f64 * Q24),
             coeffs_q30: coeffs.map(|row| row.map(|a| round_i64(a as f64 * Q30))),
         };
-        for w in [0.0f32, 0.002, 0.05, 0.3, 0.9, 1.0] {
-            let m32 = f32_family::FamilyMember::new(w).expect("member");
-            let m = FamilyMember::from_f32(&m32);
+        let weights = [0.0f32, 0.002, 0.05, 0.3, 0.9, 1.0];
+        let members = weights.map(f32_family::FamilyMember::new);
+        assert!(members.iter().all(Option::is_some), "every weight in 0..=1 makes a member");
+        for (&w, m32) in weights.iter().zip(members.iter().flatten()) {
+            let m = FamilyMember::from_f32(m32);
             for d in [0.0f32, 0.1, 1.0, 4.5, 9.0, 16.0, 17.0] {
-                let (g32, r32) = f32_family::ratio_of(&law32, d, &m32);
+                let (g32, r32) = f32_family::ratio_of(&law32, d, m32);
                 let (g, r) = ratio_of(&law, round_i64(d as f64 * 65536.0) as i32, &m);
                 let (g, r) = (g as f64 / Q30, r as f64 / Q30);
                 assert!((g - g32 as f64).abs() <= 2e-6, "w {w} d {d}: {g} vs {g32}");

@@ -3,7 +3,7 @@
 //! false` (the surrogate saturates at the model's depth domain, as before).
 use crate::error::CodegenError;
 use crate::literal::f32_literal;
-use crate::model::parse_bits;
+use crate::model::nearest_f32s;
 use serde::Deserialize;
 use std::path::Path;
 use toml::Spanned;
@@ -61,26 +61,9 @@ pub fn parse(path: &Path) -> Result<Extension, CodegenError> {
     if !r.is_finite() || r < 0.0 {
         return Err(at(raw.residual_max_pct.span(), format!("residual_max_pct = {r}: must be finite and >= 0")));
     }
-    let coeffs = raw.coeffs.get_ref();
-    if coeffs.len() != 4 || !coeffs.iter().all(|c| c.is_finite() && c.abs() <= f64::from(f32::MAX)) {
-        return Err(at(raw.coeffs.span(), format!("coeffs: {} values, expected 4 finite ones", coeffs.len())));
-    }
-    let bits = raw.coeffs_f32.get_ref();
-    if bits.len() != 4 {
-        return Err(at(raw.coeffs_f32.span(), format!("coeffs_f32: {} values, expected 4", bits.len())));
-    }
-    let mut coeffs_f32 = [0.0f32; 4];
-    for ((slot, c), b) in coeffs_f32.iter_mut().zip(coeffs).zip(bits) {
-        let v = f32::from_bits(
-            parse_bits(b).ok_or_else(|| at(raw.coeffs_f32.span(), format!("coeffs_f32: {b:?} is not 0x + 8 lower-case hex digits")))?,
-        );
-        #[allow(clippy::cast_possible_truncation)]
-        let nearest = *c as f32;
-        if v.to_bits() != nearest.to_bits() {
-            return Err(at(raw.coeffs_f32.span(), format!("coeffs_f32: {b} is not the nearest f32 of {c:?}")));
-        }
-        *slot = v;
-    }
+    let coeffs_f32 = nearest_f32s::<4>(raw.coeffs.get_ref(), raw.coeffs_f32.get_ref(), &|m| at(raw.coeffs.span(), m), &|m| {
+        at(raw.coeffs_f32.span(), m)
+    })?;
     let _ = (&raw.source, &raw.csv_sha256);
     Ok(Extension { depth_max_mm: depth, coeffs_f32 })
 }

@@ -3,7 +3,7 @@
 //! 1 for every weight: the paper's tissue).
 use crate::error::CodegenError;
 use crate::literal::f32_literal;
-use crate::model::parse_bits;
+use crate::model::nearest_f32s;
 use serde::Deserialize;
 use std::path::Path;
 use toml::Spanned;
@@ -71,26 +71,9 @@ pub fn parse(path: &Path) -> Result<Family, CodegenError> {
     if !(depth.is_finite() && depth > 0.0) {
         return Err(at(raw.depth_max_mm.span(), format!("depth_max_mm = {depth}: must be finite and > 0 mm")));
     }
-    let coeffs = raw.coeffs.get_ref();
-    if coeffs.len() != TERMS || !coeffs.iter().all(|c| c.is_finite() && c.abs() <= f64::from(f32::MAX)) {
-        return Err(at(raw.coeffs.span(), format!("coeffs: {} values, expected {TERMS} finite ones", coeffs.len())));
-    }
-    let bits = raw.coeffs_f32.get_ref();
-    if bits.len() != TERMS {
-        return Err(at(raw.coeffs_f32.span(), format!("coeffs_f32: {} values, expected {TERMS}", bits.len())));
-    }
-    let mut coeffs_f32 = [0.0f32; TERMS];
-    for ((slot, c), b) in coeffs_f32.iter_mut().zip(coeffs).zip(bits) {
-        let v = f32::from_bits(
-            parse_bits(b).ok_or_else(|| at(raw.coeffs_f32.span(), format!("coeffs_f32: {b:?} is not 0x + 8 lower-case hex digits")))?,
-        );
-        #[allow(clippy::cast_possible_truncation)]
-        let nearest = *c as f32;
-        if v.to_bits() != nearest.to_bits() {
-            return Err(at(raw.coeffs_f32.span(), format!("coeffs_f32: {b} is not the nearest f32 of {c:?}")));
-        }
-        *slot = v;
-    }
+    let coeffs_f32 = nearest_f32s::<TERMS>(raw.coeffs.get_ref(), raw.coeffs_f32.get_ref(), &|m| at(raw.coeffs.span(), m), &|m| {
+        at(raw.coeffs_f32.span(), m)
+    })?;
     let _ = (&raw.reference_sha256, &raw.fitted_weights, &raw.fitted_sha256, &raw.check);
     Ok(Family { depth_max_mm: depth, coeffs_f32 })
 }

@@ -635,3 +635,32 @@ pub fn parse_bits(text: &str) -> Option<u32> {
     }
     u32::from_str_radix(digits, 16).ok()
 }
+
+/// The f32 coefficients of a generated file's `coeffs` and `coeffs_f32` keys: exactly `N`
+/// finite values within the f32 range, each bit string `0x` + 8 lower-case hex digits and
+/// the nearest f32 of its coefficient. `at_coeffs` and `at_bits` make the error of each
+/// key (its file and line).
+pub(crate) fn nearest_f32s<const N: usize>(
+    coeffs: &[f64],
+    bits: &[String],
+    at_coeffs: &dyn Fn(String) -> CodegenError,
+    at_bits: &dyn Fn(String) -> CodegenError,
+) -> Result<[f32; N], CodegenError> {
+    if coeffs.len() != N || !coeffs.iter().all(|c| c.is_finite() && c.abs() <= f64::from(f32::MAX)) {
+        return Err(at_coeffs(format!("coeffs: {} values, expected {N} finite ones", coeffs.len())));
+    }
+    if bits.len() != N {
+        return Err(at_bits(format!("coeffs_f32: {} values, expected {N}", bits.len())));
+    }
+    let mut out = [0.0f32; N];
+    for ((slot, c), b) in out.iter_mut().zip(coeffs).zip(bits) {
+        let v = f32::from_bits(parse_bits(b).ok_or_else(|| at_bits(format!("coeffs_f32: {b:?} is not 0x + 8 lower-case hex digits")))?);
+        #[allow(clippy::cast_possible_truncation)]
+        let nearest = *c as f32;
+        if v.to_bits() != nearest.to_bits() {
+            return Err(at_bits(format!("coeffs_f32: {b} is not the nearest f32 of {c:?}")));
+        }
+        *slot = v;
+    }
+    Ok(out)
+}

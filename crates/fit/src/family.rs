@@ -126,6 +126,9 @@ pub fn read_runs(set: &SetFolder) -> Result<Option<(MemberRun, Vec<MemberRun>)>>
     Ok(Some((reference, members)))
 }
 
+/// What vouches for a run's CSV bytes: its manifest entry's or its partial record's hash.
+type Vouch<'a> = Box<dyn Fn(&[u8]) -> bool + 'a>;
+
 /// The centre run of `run`: its result, or when it failed every attempt so far the must
 /// points of its furthest attempt (a current `.partial.csv`: converged FE states, only
 /// not as deep as asked); `None` when there is neither.
@@ -134,32 +137,41 @@ fn read_run(c: &Campaign, manifest: &Manifest, dir: &std::path::Path, run: Famil
     let (campaign, poses, mesh) = apply(c, f, run);
     let Some(pose) = poses.first() else { return Ok(None) };
     let path = dir.join(format!("{}.csv", pose.name));
-    if !path.is_file() {
+    // the CSV and what vouches for its bytes: its manifest entry, or its partial record
+    let (path, vouched, complete): (_, Vouch<'_>, _) = if path.is_file() {
+        let entry = manifest
+            .current_entry(&campaign, pose, &mesh)
+            .map_err(|why| anyhow::anyhow!("{}: {why}: rerun it with needle fe run --family --only {}", path.display(), pose.name))?;
+        (path, Box::new(move |b: &[u8]| entry.content_matches(b)), true)
+    } else {
         let Some(record) = partial::read_current_record(dir, &pose.name, &campaign.run_hash(pose, &mesh)) else { return Ok(None) };
-        let (csv, _) = partial::paths(dir, &pose.name);
-        let bytes = std::fs::read(&csv).with_context(|| format!("{}: cannot read", csv.display()))?;
-        if content_sha256(&bytes) != record.csv_sha256 {
-            bail!("{}: content changed since the FE run wrote it (not the csv_sha256 of its .partial.toml)", csv.display());
-        }
-        let rows: Vec<Row> = parse_csv(&String::from_utf8_lossy(&bytes), &csv)?;
-        let fy = rows.iter().map(|r| (r.depth_mm, r.wrench[FY])).collect();
-        return Ok(Some(MemberRun { weight: run.weight().unwrap_or(1.0), fy, csv_sha256: record.csv_sha256, complete: false }));
-    }
-    let entry = manifest
-        .current_entry(&campaign, pose, &mesh)
-        .map_err(|why| anyhow::anyhow!("{}: {why}: rerun it with needle fe run --family --only {}", path.display(), pose.name))?;
+        (partial::paths(dir, &pose.name).0, Box::new(move |b: &[u8]| content_sha256(b) == record.csv_sha256), false)
+    };
     let bytes = std::fs::read(&path).with_context(|| format!("{}: cannot read", path.display()))?;
-    if !entry.content_matches(&bytes) {
-        bail!("{}: content changed since the FE run wrote it (not the csv_sha256 of {MANIFEST})", path.display());
+    if !vouched(&bytes) {
+        bail!(
+            "{}: content changed since the FE run wrote it (not the csv_sha256 of its {MANIFEST} entry or .partial.toml)",
+            path.display()
+        );
     }
     let rows: Vec<Row> = parse_csv(&String::from_utf8_lossy(&bytes), &path)?;
     let fy = rows.iter().map(|r| (r.depth_mm, r.wrench[FY])).collect();
-    Ok(Some(MemberRun { weight: run.weight().unwrap_or(1.0), fy, csv_sha256: content_sha256(&bytes), complete: true }))
+    Ok(Some(MemberRun { weight: run.weight().unwrap_or(1.0), fy, csv_sha256: content_sha256(&bytes), complete }))
 }
 
-/// The reference's Fy at `depth_mm` (a must point of both runs: the same load steps).
-fn at(reference: &MemberRun, depth_mm: f64) -> Option<f64> {
-    reference.fy.iter().find(|(d, _)| (d - depth_mm).abs() < 1e-9).map(|&(_, f)| f)
+impl MemberRun {
+    /// Fy at `depth_mm`, when it is one of the run's must points (the family's runs share
+    /// their load steps).
+    #[must_use]
+    pub fn fy_at(&self, depth_mm: f64) -> Option<f64> {
+        self.fy.iter().find(|(d, _)| (d - depth_mm).abs() < 1e-9).map(|&(_, f)| f)
+    }
+
+    /// The deepest must point the run reached, mm.
+    #[must_use]
+    pub fn deepest_mm(&self) -> f64 {
+        self.fy.iter().map(|p| p.0).fold(0.0, f64::max)
+    }
 }
 
 /// What [`fit`] made of a set's family runs.
@@ -188,11 +200,10 @@ pub fn fit(set: &SetFolder) -> Result<FamilyFit> {
         ));
     }
     let held_out = set.campaign().family.as_ref().map(|f| f.held_out.clone()).unwrap_or_default();
-    let deepest = |m: &MemberRun| m.fy.iter().map(|p| p.0).fold(0.0, f64::max);
     let (fitted, partial): (Vec<&MemberRun>, Vec<&MemberRun>) =
         members.iter().filter(|m| !held_out.contains(&m.weight)).partition(|m| m.complete);
     if fitted.len() < WEIGHT_DEGREE + 1 {
-        let short: Vec<String> = partial.iter().map(|m| format!("{} to {:.2} mm", m.weight, deepest(m))).collect();
+        let short: Vec<String> = partial.iter().map(|m| format!("{} to {:.2} mm", m.weight, m.deepest_mm())).collect();
         return Ok(FamilyFit::Pending(format!(
             "material family law: not fitted: {} complete member run(s) in fe/{FAMILY_DIR}/ (weights {:?}; partial: {}), the law needs at least {}",
             fitted.len(),
@@ -201,12 +212,12 @@ pub fn fit(set: &SetFolder) -> Result<FamilyFit> {
             WEIGHT_DEGREE + 1
         )));
     }
-    let depth_max_mm = deepest(&reference);
+    let depth_max_mm = reference.deepest_mm();
     let mut rows: Vec<([f64; TERMS], f64)> = Vec::new();
     for m in &fitted {
         let peak = m.fy.iter().map(|p| p.1.abs()).fold(0.0, f64::max);
         for &(d, fw) in m.fy.iter().filter(|p| p.0 >= MIN_DEPTH_MM && p.0 <= depth_max_mm + 1e-9) {
-            let Some(fp) = at(&reference, d).filter(|f| f.abs() > 0.0) else { continue };
+            let Some(fp) = reference.fy_at(d).filter(|f| f.abs() > 0.0) else { continue };
             // (F_w - F_p) / peak = F_p (1 - w) P / peak: the row of P, weighted
             let scale = fp * (1.0 - m.weight) / peak;
             let (u, t) = (d / depth_max_mm, m.weight.sqrt());
@@ -236,7 +247,7 @@ fn check(reference: &MemberRun, m: &MemberRun, coeffs: &[f64; TERMS], depth_max_
     let peak = m.fy.iter().map(|p| p.1.abs()).fold(0.0, f64::max).max(f64::MIN_POSITIVE);
     let (mut sum, mut max, mut n, mut deepest) = (0.0, 0.0f64, 0usize, 0.0f64);
     for &(d, fw) in m.fy.iter().filter(|p| p.0 > 0.0 && p.0 <= depth_max_mm + 1e-9) {
-        let Some(fp) = at(reference, d) else { continue };
+        let Some(fp) = reference.fy_at(d) else { continue };
         let e = 100.0 * (fp * ratio(coeffs, depth_max_mm, d, m.weight) - fw) / peak;
         sum += e * e;
         max = max.max(e.abs());

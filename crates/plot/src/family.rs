@@ -4,23 +4,18 @@
 //! ratio to the paper's tissue with the fitted law `g(d, w)` of `family.toml` when there
 //! is one ([`needle_fit::family`]).
 use super::figures::Figure;
-use super::panel::{Panel, Series, Style};
+use super::panel::{Panel, Series, Style, COMPONENT_COLOURS};
 use anyhow::Result;
 use needle_fit::family::{fit, ratio, read_runs, FamilyFit, MemberRun};
 use needle_set::set_folder::SetFolder;
 use plotters::style::RGBColor;
 
-/// One colour per member, in `family.weight`'s order (the reference is black).
-const PALETTE: [RGBColor; 8] = [
-    RGBColor(31, 119, 180),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(148, 103, 189),
-    RGBColor(255, 127, 14),
-    RGBColor(23, 190, 207),
-    RGBColor(140, 86, 75),
-    RGBColor(227, 119, 194),
-];
+/// One colour per member, in `family.weight`'s order (the reference is black): the
+/// components' colours, then two more.
+const PALETTE: [RGBColor; 8] = {
+    let [a, b, c, d, e, f] = COMPONENT_COLOURS;
+    [a, b, c, d, e, f, RGBColor(140, 86, 75), RGBColor(227, 119, 194)]
+};
 const BLACK: RGBColor = RGBColor(0, 0, 0);
 
 /// Depths below this are left out of the exponent and ratio panels: forces there are
@@ -28,7 +23,7 @@ const BLACK: RGBColor = RGBColor(0, 0, 0);
 const MIN_DEPTH_MM: f64 = 0.5;
 
 fn label(m: &MemberRun) -> String {
-    let deepest = m.fy.iter().map(|p| p.0).fold(0.0, f64::max);
+    let deepest = m.deepest_mm();
     let w = if m.weight >= 1.0 { "paper (w = 1)".to_string() } else { format!("w = {}", m.weight) };
     if m.complete {
         w
@@ -75,7 +70,7 @@ pub fn figure(set: &SetFolder) -> Result<Option<Figure>> {
         let fe: Vec<(f64, f64)> =
             m.fy.iter()
                 .filter(|p| p.0 >= MIN_DEPTH_MM)
-                .filter_map(|&(d, f)| reference.fy.iter().find(|r| (r.0 - d).abs() < 1e-9).filter(|r| r.1 > 0.0).map(|r| (d, f / r.1)))
+                .filter_map(|&(d, f)| reference.fy_at(d).filter(|&r| r > 0.0).map(|r| (d, f / r)))
                 .collect();
         ratio_series.push(Series { label: format!("{} (FE)", label(m)), colour: *c, style: Style::Points, data: fe });
         if let Some(law) = &law {
