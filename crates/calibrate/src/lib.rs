@@ -30,6 +30,7 @@ pub mod measured;
 pub mod published;
 pub mod ramp;
 pub mod replay;
+pub mod shape;
 pub mod trial;
 
 use anyhow::{bail, Result};
