@@ -30,7 +30,7 @@ component by cross-validation). Writes model.toml and the four golden files all 
     InsertionPaths(needle_cli::commands::insertion_paths::InsertionPathsArgs),
     /// Fit a tissue stack (<set>/tissue/<name>.toml) to a measured force against needle position.
     Calibrate(needle_cli::commands::calibrate::CalibrateArgs),
-    /// Drive a tissue stack (a file or a compiled-in name) with a measured trial's position against time; measured and model force per row.
+    /// Drive a tissue stack with a measured trial (time, position): measured and model force per row.
     Replay(needle_cli::commands::replay::ReplayArgs),
     /// Derive a tissue stack from a published model's force polynomials per layer (no measured curve).
     CalibratePublished(needle_cli::commands::calibrate_published::CalibratePublishedArgs),
