@@ -118,6 +118,9 @@ fn combos(count: usize) -> Vec<Vec<usize>> {
     out
 }
 
+/// A scanned candidate: sum of squares, boundary, chosen time constants, unknowns.
+type Candidate = (f64, Option<f64>, Vec<usize>, Vec<f64>);
+
 /// The joint fit (module docs) over the trials with `n` punctures; `bounds` the
 /// punctured layers' upper boundaries, `friction` theirs.
 #[must_use]
@@ -134,7 +137,7 @@ pub fn fit(trials: &[Trial], n: usize, bounds: &[f64], friction: &[LayerFriction
     let hi = used.iter().map(|t| t.phases.travel_mm + t.samples.first().map_or(0.0, |s| s.position_mm) - t.onset_mm()).fold(0.0, f64::max);
     let lo = lo.max(top + BOUNDARY_STEP_MM);
     // (sse, b, choice, x)
-    let mut best: Option<(f64, Option<f64>, Vec<usize>, Vec<f64>)> = None;
+    let mut best: Option<Candidate> = None;
     let steps = ((hi - lo) / BOUNDARY_STEP_MM).floor().max(0.0) as usize;
     for i in 0..=steps {
         // the last candidate: no boundary within reach (only cutting)

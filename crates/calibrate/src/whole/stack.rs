@@ -90,39 +90,14 @@ pub fn fit(ts: &[Trial], opts: &TrialsOptions<'_>, diameter: f64, u: &dyn Fn(f64
         let cutting =
             if j + 1 == n { hold.per_trial.cutting_n.clone() } else { v.cutting.get(j).cloned().unwrap_or(Spread::of(Vec::new())) };
         let cutting_n = if j + 1 == n { hold.cutting_n } else { cutting.mean };
-        let f = fr.get(j).cloned().unwrap_or_else(|| zero_friction());
+        let f = fr.get(j).cloned().unwrap_or_else(zero_friction);
         let (l, notes) =
             layer(j, n, below - v.bounds[j], v.scale[j].clone(), v.puncture[j].clone(), (cutting_n, cutting), &f, band, opts, &source);
         layers.push(l);
         uncertainty.push(notes);
     }
     if let (Some(b), Some(f)) = (hold.boundary_mm, fr.last()) {
-        let (mut l, mut notes) = layer(
-            n,
-            n + 1,
-            last_depth - b + 1.0,
-            Spread { mean: hold.scale, ..hold.per_trial.scale.clone() },
-            Spread::of(vec![2.0 * largest]),
-            (0.0, Spread::of(Vec::new())),
-            f,
-            band,
-            opts,
-            &source,
-        );
-        l.name = "below the last puncture (deflected, never punctured)".into();
-        l.puncture_force_n = 2.0 * largest;
-        notes.retain(|(k, _)| *k != "puncture_force_n" && *k != "cutting_force_n");
-        notes.push(("puncture_force_n", format!("not punctured in any trial: twice the largest measured force, {largest:.3} N")));
-        l.prony = hold.prony.iter().map(|&(g, tau_s)| file::PronyTerm { g, tau_s }).collect();
-        if !l.prony.is_empty() {
-            l.prony_source = Some(format!(
-                "needle calibrate --trials: fitted to the holds of {} trials (the library's QLV filter, FEBio's normalisation)",
-                hold.holds
-            ));
-            let g: Vec<String> =
-                hold.per_trial.g.iter().zip(&hold.prony).map(|(s, (_, tau))| format!("g(tau {tau:.3} s) {}", s.note("-"))).collect();
-            notes.push(("prony", g.join("; ")));
-        }
+        let (l, notes) = bottom_layer(n, last_depth - b + 1.0, largest, &hold, f, band, opts, &source);
         layers.push(l);
         uncertainty.push(notes);
     }
@@ -136,6 +111,39 @@ pub fn fit(ts: &[Trial], opts: &TrialsOptions<'_>, diameter: f64, u: &dyn Fn(f64
     file::parse_stack_str(&stack.to_toml(""), Path::new(&format!("{}.toml", stack.name)))
         .map_err(|e| anyhow::anyhow!("the calibrated stack is refused by the tissue format: {e}"))?;
     Ok(Fitted { stack, uncertainty, punctures: n, friction: fr, hold, stick_band_mm_per_s: band })
+}
+
+/// The layer below the last puncture: deflected, never punctured, with the holds' Prony
+/// terms.
+#[allow(clippy::too_many_arguments)]
+fn bottom_layer(
+    n: usize,
+    thickness_mm: f64,
+    largest: f64,
+    hold: &HoldFit,
+    f: &LayerFriction,
+    band: f64,
+    opts: &TrialsOptions<'_>,
+    source: &str,
+) -> (file::Layer, Vec<(&'static str, String)>) {
+    let scale = Spread { mean: hold.scale, ..hold.per_trial.scale.clone() };
+    let (mut l, mut notes) =
+        layer(n, n + 1, thickness_mm, scale, Spread::of(vec![2.0 * largest]), (0.0, Spread::of(Vec::new())), f, band, opts, source);
+    l.name = "below the last puncture (deflected, never punctured)".into();
+    l.puncture_force_n = 2.0 * largest;
+    notes.retain(|(k, _)| *k != "puncture_force_n" && *k != "cutting_force_n");
+    notes.push(("puncture_force_n", format!("not punctured in any trial: twice the largest measured force, {largest:.3} N")));
+    l.prony = hold.prony.iter().map(|&(g, tau_s)| file::PronyTerm { g, tau_s }).collect();
+    if !l.prony.is_empty() {
+        l.prony_source = Some(format!(
+            "needle calibrate --trials: fitted to the holds of {} trials (the library's QLV filter, FEBio's normalisation)",
+            hold.holds
+        ));
+        let g: Vec<String> =
+            hold.per_trial.g.iter().zip(&hold.prony).map(|(s, (_, tau))| format!("g(tau {tau:.3} s) {}", s.note("-"))).collect();
+        notes.push(("prony", g.join("; ")));
+    }
+    (l, notes)
 }
 
 fn zero_friction() -> LayerFriction {
