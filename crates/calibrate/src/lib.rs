@@ -24,14 +24,19 @@
 pub mod events;
 pub mod fit;
 pub mod from_model;
+pub mod goals;
 pub mod limits;
 mod lsq;
 pub mod measured;
 pub mod published;
 pub mod ramp;
 pub mod replay;
+pub mod runtime_stack;
 pub mod shape;
 pub mod trial;
+pub mod trial_replay;
+pub mod trial_screen;
+pub mod whole;
 
 use anyhow::{bail, Result};
 use needle_codegen::tissue as file;
