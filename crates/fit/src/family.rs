@@ -16,7 +16,8 @@
 //! force error as a fraction of the member's peak: the figure [`MemberCheck`] reports,
 //! for the fitted members and for `family.held_out` (members it was not fitted on).
 //! The six-axis pose dependence is carried over by the same ratio (the library's wrench
-//! at a pose times `g`), checked by the half-model runs `family.check_poses`.
+//! at a pose times `g`), checked by the half-model runs `family.check_poses`
+//! ([`crate::family_poses`]).
 use crate::lsq;
 use anyhow::{bail, Context, Result};
 use nalgebra::{DMatrix, DVector};
