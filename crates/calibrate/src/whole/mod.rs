@@ -10,13 +10,14 @@
 //! 5. after the last puncture and the hold: the boundary below and its Prony terms
 //!    ([`hold`]);
 //! 6. the stack replayed along every trial through the library's insertion model
-//!    ([`crate::trial_replay`]) and held against it ([`crate::goals`]).
+//!    ([`crate::trial_replay`]) and held against it ([`goals`]).
 //!
 //! Every value's uncertainty is the standard error over the trials (their per-trial fits;
 //! for the friction's Coulomb and viscous levels the regression's), written beside it
 //! in the tissue file ([`annotate`]).
 pub mod annotate;
 pub mod friction;
+pub mod goals;
 pub mod hold;
 pub mod intervals;
 pub mod stack;
@@ -92,7 +93,7 @@ pub fn calibrate_trials(opts: &TrialsOptions<'_>) -> Result<TrialsCalibration> {
     let mut checks = Vec::with_capacity(trials.len());
     for t in &trials {
         let r = crate::trial_replay::replay(&lib, t.onset_mm(), &t.samples).map_err(|e| anyhow::anyhow!("{}: {e}", t.name()))?;
-        checks.push(crate::goals::checks(t, &r, &crate::goals::CALIBRATED));
+        checks.push(goals::checks(t, &r, &goals::CALIBRATED));
         replays.push(r);
     }
     Ok(TrialsCalibration { trials, notes, fitted, replays, checks, similarity })

@@ -4,7 +4,7 @@
 //! 10-20 mm of stage travel).
 use crate::replay::Check;
 use crate::trial_replay::TrialReplay;
-use crate::whole::trials::Trial;
+use super::trials::Trial;
 
 /// The tolerances of one kind of use.
 #[derive(Debug, Clone, Copy, PartialEq)]
