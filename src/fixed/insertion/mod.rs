@@ -12,8 +12,16 @@
 //! - Internally `i64`: path coordinates in mm Q16, the axis in Q30 ([`track`]), forces
 //!   in µN Q16; the output rounds to whole µN and saturates to `i32`.
 //!
-//! **Inputs clamped**: `x`, `z` to ±64 mm, `depth` to ±128 mm, tilts to ±89 degrees (the
-//! f32 model's); the surrogate clamps further to its own domain and reports it.
+//! **Glitches** (the f32 model's "Glitches", in integers): a pose outside the domain
+//! (`|x|, |z| <= 64` mm, `|depth| <= 128` mm, tilts `|θ| <= 89` degrees:
+//! `needle_contract::insertion_limits`) or one that moved further since the last accepted
+//! pose than [`InsertionConfig::max_speed_mm_per_s`] (tilts:
+//! [`InsertionConfig::max_turn_deg_per_s`]) allows over the ticks since it (the step per
+//! tick in Q16 computed once in [`Insertion::new`]) is not integrated: the wrench and
+//! phase are the last tick's, the flags ([`InsertionFlags`]) say why. The wrench's
+//! `|fx| + |fy| + |fz|` stays within `FORCE_LIMIT_N` (in µN) and `|mx| + |my| + |mz|`
+//! within `MOMENT_LIMIT_NMM` (in µN·mm), scaled down to the bound otherwise. The
+//! surrogate clamps further to its own domain and reports it.
 //!
 //! **Overflow.** Every product whose size depends on the stack's values or on the pose
 //! saturates (`i64::saturating_mul`); within the stacks [`Stack::from_f32`] accepts
@@ -42,7 +50,8 @@ use super::viscoelastic::identity::{QlvCoefficients, QlvState};
 use super::viscoelastic::{QlvCoefficients, QlvState};
 use super::{extended_wrench, Pose, Wrench};
 use crate::float::insertion::{InsertionError, Phase};
-use crate::Status;
+use crate::{InsertionFlags, Status};
+use needle_contract::insertion_limits as limits;
 use track::{axis, dot, mul_q30, mul_shr, HoldSums, Track, Vec3, TRACK_STIFFNESS_MAX_Q8};
 
 /// The insertion's tick settings in integers.
@@ -53,12 +62,22 @@ pub struct InsertionConfig {
     pub period_us: u32,
     /// Time constant of the velocity's low-pass filter, µs (0: unfiltered).
     pub velocity_time_constant_us: u32,
+    /// The largest speed of `x`, `z` and `depth`, mm/s (> 0; 1,000 by default): faster
+    /// is a glitch ([`InsertionFlags::FAST_MOTION`]).
+    pub max_speed_mm_per_s: u32,
+    /// The largest turning speed of the tilts, degrees/s (> 0; 1,000 by default).
+    pub max_turn_deg_per_s: u32,
 }
 
 impl InsertionConfig {
     /// 1 kHz, velocity filtered with a 5 ms time constant (the f32 model's
     /// [`DEFAULT_1KHZ`](crate::float::insertion::InsertionConfig::DEFAULT_1KHZ)).
-    pub const DEFAULT_1KHZ: Self = Self { period_us: 1000, velocity_time_constant_us: 5000 };
+    pub const DEFAULT_1KHZ: Self = Self {
+        period_us: 1000,
+        velocity_time_constant_us: 5000,
+        max_speed_mm_per_s: limits::SPEED_MAX_MM_PER_S,
+        max_turn_deg_per_s: limits::TURN_MAX_DEG_PER_S,
+    };
 }
 
 /// One tick's result.
@@ -69,7 +88,10 @@ pub struct InsertionEvaluation {
     pub wrench: Wrench,
     /// The surrogate's status while deflecting (saturation).
     pub status: Status,
-    /// The phase after this tick.
+    /// What the step did with the pose and the wrench: a glitch (not integrated, the
+    /// wrench held) or a wrench scaled down to its bound; [`InsertionFlags::OK`] otherwise.
+    pub flags: InsertionFlags,
+    /// The phase after this tick (a glitch tick's: the last tick's).
     pub phase: Phase,
     /// Boundaries punctured in this tick.
     pub punctures: u8,
@@ -93,6 +115,20 @@ pub struct Insertion<'a> {
     track: Option<Track>,
     preload_q16: [i64; 6],
     last_depth_q16: Option<i64>,
+    /// The last accepted pose's `x`, `z`, `theta_x`, `theta_z` (Q16.16).
+    accepted_q16: [i32; 4],
+    /// Ticks since the last accepted pose: 1, plus one per glitch tick since (at most
+    /// [`MISSED_MAX`]).
+    missed: u32,
+    /// The largest step per tick of `x`, `z`, `depth` (mm Q16) and of the tilts (degrees
+    /// Q16), from the configuration's speeds.
+    max_step_q16: [i64; 2],
+    /// The configuration's period and time constant, µs (the velocity's filter after a
+    /// glitch).
+    period_us: u32,
+    tau_us: u32,
+    /// The last tick's wrench and phase: what a glitch tick holds.
+    held: (Wrench, Phase),
     velocity_q16: i64,
     /// Per layer the relaxation's per-tick coefficients (computed once, in `new`).
     qlv: [QlvCoefficients; MAX_LAYERS],
@@ -107,8 +143,38 @@ struct Deflected {
     punctures: u8,
 }
 
-const X_MAX_Q16: i64 = 64 << 16;
-const DEPTH_MAX_Q16: i64 = 128 << 16;
+const X_MAX_Q16: i64 = (limits::XZ_MAX_MM as i64) << 16;
+const DEPTH_MAX_Q16: i64 = (limits::DEPTH_MAX_MM as i64) << 16;
+const TILT_MAX_Q16: i64 = (limits::TILT_MAX_DEG as i64) << 16;
+/// The force bound, µN, and the moment bound, µN·mm (`insertion_limits`).
+const FORCE_LIMIT_UN: i64 = limits::FORCE_LIMIT_N as i64 * 1_000_000;
+const MOMENT_LIMIT_UNMM: i64 = limits::MOMENT_LIMIT_NMM as i64 * 1_000_000;
+/// The most ticks since the last accepted pose counted (about 17 minutes at 1 kHz).
+const MISSED_MAX: u32 = 1 << 20;
+
+/// Scales the wrench `w` (µN, µN·mm) down to its bound when it is beyond it
+/// (`|fx| + |fy| + |fz| <= FORCE_LIMIT_UN`, `|mx| + |my| + |mz| <= MOMENT_LIMIT_UNMM`, each
+/// component times the bound over the sum, rounded toward zero);
+/// [`InsertionFlags::WRENCH_LIMITED`] when it did.
+fn bound(w: &mut [i32; 6]) -> InsertionFlags {
+    let [fx, fy, fz, mx, my, mz] = w.map(i64::from);
+    let (f, m) = (fx.abs() + fy.abs() + fz.abs(), mx.abs() + my.abs() + mz.abs());
+    if f <= FORCE_LIMIT_UN && m <= MOMENT_LIMIT_UNMM {
+        return InsertionFlags::OK;
+    }
+    // |c| <= 2^31 and a bound < 2^31: the products fit in i64; the sums are > 0 when beyond
+    let scale = |c: i64, sum: i64, limit: i64| if sum <= limit { c } else { c.saturating_mul(limit).checked_div(sum).unwrap_or(0) };
+    let scaled = [
+        scale(fx, f, FORCE_LIMIT_UN),
+        scale(fy, f, FORCE_LIMIT_UN),
+        scale(fz, f, FORCE_LIMIT_UN),
+        scale(mx, m, MOMENT_LIMIT_UNMM),
+        scale(my, m, MOMENT_LIMIT_UNMM),
+        scale(mz, m, MOMENT_LIMIT_UNMM),
+    ];
+    *w = scaled.map(saturate_i32);
+    InsertionFlags::WRENCH_LIMITED
+}
 
 fn layer_ok(l: &Layer) -> bool {
     let k = &l.friction;
@@ -160,6 +226,12 @@ impl<'a> Insertion<'a> {
         let rate_q16 = (1_000_000_u64 << 16).checked_div(period).ok_or(InsertionError::Config)?;
         let whole = period + u64::from(config.velocity_time_constant_us);
         let alpha_q16 = ((period << 16) + (whole >> 1)).checked_div(whole).ok_or(InsertionError::Config)?;
+        if config.max_speed_mm_per_s == 0 || config.max_turn_deg_per_s == 0 {
+            return Err(InsertionError::Config);
+        }
+        // speed (< 2^32) times period (< 2^32) times 2^16 / 10^6: within i64 in u128
+        let per_tick = |speed: u32| i64::try_from(((u128::from(speed) * u128::from(period)) << 16) / 1_000_000).unwrap_or(i64::MAX);
+        let max_step_q16 = [per_tick(config.max_speed_mm_per_s), per_tick(config.max_turn_deg_per_s)];
         let mut insertion = Self {
             stack,
             scales_q16,
@@ -171,6 +243,12 @@ impl<'a> Insertion<'a> {
             track: None,
             preload_q16: [0; 6],
             last_depth_q16: None,
+            accepted_q16: [0; 4],
+            missed: 1,
+            max_step_q16,
+            period_us: config.period_us,
+            tau_us: config.velocity_time_constant_us,
+            held: (Wrench::ZERO, Phase::Approach),
             velocity_q16: 0,
             qlv,
             qlv_state: QlvState::REST,
@@ -220,6 +298,8 @@ impl<'a> Insertion<'a> {
     pub fn reset(&mut self) {
         self.end_path();
         self.last_depth_q16 = None;
+        self.missed = 1;
+        self.held = (Wrench::ZERO, Phase::Approach);
         self.velocity_q16 = 0;
     }
 
@@ -240,10 +320,19 @@ impl<'a> Insertion<'a> {
     /// the 5,000-17,000 a step takes).
     #[inline(never)]
     pub fn step(&mut self, pose: &Pose) -> InsertionEvaluation {
-        let depth = i64::from(pose.depth_mm_q16).clamp(-DEPTH_MAX_Q16, DEPTH_MAX_Q16);
+        let glitch = self.screen(pose);
+        if !glitch.is_ok() {
+            self.missed = self.missed.saturating_add(1).min(MISSED_MAX);
+            let (wrench, phase) = self.held;
+            let velocity_mm_per_s_q16 = saturate_i32(self.velocity_q16);
+            return InsertionEvaluation { wrench, status: Status::OK, flags: glitch, phase, punctures: 0, velocity_mm_per_s_q16 };
+        }
+        let depth = i64::from(pose.depth_mm_q16);
         let step_q16 = self.last_depth_q16.map_or(0, |last| depth - last);
         self.filter_velocity(step_q16);
         self.last_depth_q16 = Some(depth);
+        self.accepted_q16 = [pose.x_mm_q16, pose.z_mm_q16, pose.theta_x_deg_q16, pose.theta_z_deg_q16];
+        self.missed = 1;
         // friction and cutting see the velocity only when it has the last motion's sign
         let v = if (self.velocity_q16 > 0 && step_q16 > 0) || (self.velocity_q16 < 0 && step_q16 < 0) { self.velocity_q16 } else { 0 };
         if depth <= 0 {
@@ -251,8 +340,7 @@ impl<'a> Insertion<'a> {
             return self.evaluation([0; 6], Status::OK, Phase::Approach, 0);
         }
         let a = axis(pose.theta_x_deg_q16, pose.theta_z_deg_q16);
-        let x = i64::from(pose.x_mm_q16).clamp(-X_MAX_Q16, X_MAX_Q16);
-        let z = i64::from(pose.z_mm_q16).clamp(-X_MAX_Q16, X_MAX_Q16);
+        let (x, z) = (i64::from(pose.x_mm_q16), i64::from(pose.z_mm_q16));
         let entry: Vec3 = [x, 0, z];
         let bounds = self.boundaries(a[1]);
         let Deflected { wrench_q16: mut w, status, punctures } = self.deflect(pose, depth, a, entry, &bounds);
@@ -260,14 +348,63 @@ impl<'a> Insertion<'a> {
         self.evaluation(w, status, phase, punctures)
     }
 
-    fn evaluation(&self, w_q16: [i64; 6], status: Status, phase: Phase, punctures: u8) -> InsertionEvaluation {
-        let wrench = Wrench::from_array(w_q16.map(|c| saturate_i32(c.saturating_add(1 << 15) >> 16)));
-        InsertionEvaluation { wrench, status, phase, punctures, velocity_mm_per_s_q16: saturate_i32(self.velocity_q16) }
+    /// The tick's evaluation: the wrench rounded to µN and µN·mm, saturated to `i32` and
+    /// bounded (`bound`); it is what the next glitch tick holds.
+    fn evaluation(&mut self, w_q16: [i64; 6], status: Status, phase: Phase, punctures: u8) -> InsertionEvaluation {
+        let mut w = w_q16.map(|c| saturate_i32(c.saturating_add(1 << 15) >> 16));
+        let flags = bound(&mut w);
+        let wrench = Wrench::from_array(w);
+        self.held = (wrench, phase);
+        InsertionEvaluation { wrench, status, flags, phase, punctures, velocity_mm_per_s_q16: saturate_i32(self.velocity_q16) }
+    }
+
+    /// The glitch flags of `pose` (the module's "Glitches"): [`InsertionFlags::OK`] to
+    /// integrate it.
+    fn screen(&self, pose: &Pose) -> InsertionFlags {
+        let Pose { x_mm_q16: x, z_mm_q16: z, theta_x_deg_q16: tx, theta_z_deg_q16: tz, depth_mm_q16: d } = *pose;
+        let within = |v: i32, max: i64| i64::from(v).abs() <= max;
+        if !(within(x, X_MAX_Q16)
+            && within(z, X_MAX_Q16)
+            && within(d, DEPTH_MAX_Q16)
+            && within(tx, TILT_MAX_Q16)
+            && within(tz, TILT_MAX_Q16))
+        {
+            return InsertionFlags::OUT_OF_DOMAIN;
+        }
+        let Some(last_d) = self.last_depth_q16 else { return InsertionFlags::OK };
+        let [lx, lz, ltx, ltz] = self.accepted_q16;
+        let n = i64::from(self.missed);
+        let [mm, deg] = self.max_step_q16.map(|s| s.saturating_mul(n));
+        let moved = |a: i64, b: i64, max: i64| (a - b).abs() <= max;
+        let (i, j) = (i64::from, i64::from);
+        if moved(i(d), last_d, mm)
+            && moved(i(x), j(lx), mm)
+            && moved(i(z), j(lz), mm)
+            && moved(i(tx), j(ltx), deg)
+            && moved(i(tz), j(ltz), deg)
+        {
+            InsertionFlags::OK
+        } else {
+            InsertionFlags::FAST_MOTION
+        }
     }
 
     fn filter_velocity(&mut self, step_q16: i64) {
-        let raw = mul_shr(step_q16, self.rate_q16, 16);
-        self.velocity_q16 = self.velocity_q16.saturating_add(mul_shr(self.alpha_q16, raw.saturating_sub(self.velocity_q16), 16));
+        let (raw, alpha) =
+            if self.missed <= 1 { (mul_shr(step_q16, self.rate_q16, 16), self.alpha_q16) } else { self.after_glitch(step_q16) };
+        self.velocity_q16 = self.velocity_q16.saturating_add(mul_shr(alpha, raw.saturating_sub(self.velocity_q16), 16));
+    }
+
+    /// The velocity's raw value and filter gain for a step over `missed` ticks (after a
+    /// glitch): the step over `missed` periods, `alpha = n T / (n T + tau)` in Q16.
+    fn after_glitch(&self, step_q16: i64) -> (i64, i64) {
+        let n = i64::from(self.missed);
+        let raw = mul_shr(step_q16, self.rate_q16, 16).checked_div(n).unwrap_or(0);
+        // n < 2^21, period < 2^32: t < 2^53, t 2^16 saturates (then alpha is 1 in Q16)
+        let t = i64::from(self.period_us).saturating_mul(n);
+        let whole = t.saturating_add(i64::from(self.tau_us));
+        let alpha = t.saturating_mul(1 << 16).saturating_add(whole >> 1).checked_div(whole).unwrap_or(1 << 16).min(1 << 16);
+        (raw, alpha)
     }
 
     /// Path coordinates of the layers' upper boundaries (mm Q16) for a needle of
