@@ -43,7 +43,7 @@ pub use stack::{
 };
 
 use super::arith::sat_mul;
-use super::depth_extension::saturate_i32;
+use super::depth_extension::{round_shr_i32, saturate_i32};
 #[cfg(not(feature = "viscoelastic"))]
 use super::viscoelastic::identity::{QlvCoefficients, QlvState};
 #[cfg(feature = "viscoelastic")]
@@ -114,15 +114,17 @@ pub struct Insertion<'a> {
     track_end_q16: i64,
     track: Option<Track>,
     preload_q16: [i64; 6],
-    last_depth_q16: Option<i64>,
+    /// The last accepted pose's depth (Q16.16).
+    last_depth_q16: Option<i32>,
     /// The last accepted pose's `x`, `z`, `theta_x`, `theta_z` (Q16.16).
     accepted_q16: [i32; 4],
     /// Ticks since the last accepted pose: 1, plus one per glitch tick since (at most
     /// [`MISSED_MAX`]).
     missed: u32,
     /// The largest step per tick of `x`, `z`, `depth` (mm Q16) and of the tilts (degrees
-    /// Q16), from the configuration's speeds.
-    max_step_q16: [i64; 2],
+    /// Q16), from the configuration's speeds (saturated: 65,536 mm or degrees allow any
+    /// move within the domain).
+    max_step_q16: [u32; 2],
     /// The configuration's period and time constant, µs (the velocity's filter after a
     /// glitch).
     period_us: u32,
@@ -143,38 +145,36 @@ struct Deflected {
     punctures: u8,
 }
 
-const X_MAX_Q16: i64 = (limits::XZ_MAX_MM as i64) << 16;
-const DEPTH_MAX_Q16: i64 = (limits::DEPTH_MAX_MM as i64) << 16;
-const TILT_MAX_Q16: i64 = (limits::TILT_MAX_DEG as i64) << 16;
+const X_MAX_Q16: u32 = (limits::XZ_MAX_MM as u32) << 16;
+const DEPTH_MAX_Q16: u32 = (limits::DEPTH_MAX_MM as u32) << 16;
+const TILT_MAX_Q16: u32 = (limits::TILT_MAX_DEG as u32) << 16;
 /// The force bound, µN, and the moment bound, µN·mm (`insertion_limits`).
-const FORCE_LIMIT_UN: i64 = limits::FORCE_LIMIT_N as i64 * 1_000_000;
+const FORCE_LIMIT_UN: u64 = limits::FORCE_LIMIT_N as u64 * 1_000_000;
 const MOMENT_LIMIT_UNMM: i64 = limits::MOMENT_LIMIT_NMM as i64 * 1_000_000;
 /// The most ticks since the last accepted pose counted (about 17 minutes at 1 kHz).
 const MISSED_MAX: u32 = 1 << 20;
 
-/// Scales the wrench `w` (µN, µN·mm) down to its bound when it is beyond it
-/// (`|fx| + |fy| + |fz| <= FORCE_LIMIT_UN`, `|mx| + |my| + |mz| <= MOMENT_LIMIT_UNMM`, each
-/// component times the bound over the sum, rounded toward zero);
-/// [`InsertionFlags::WRENCH_LIMITED`] when it did.
+/// Scales the force of `w` (µN) down to its bound when it is beyond it
+/// (`|fx| + |fy| + |fz| <= FORCE_LIMIT_UN`: each force component times one factor, the
+/// bound over the sum in Q32 rounded down, the product rounded toward zero, so the
+/// scaled sum is at most the bound); [`InsertionFlags::WRENCH_LIMITED`] when it did. The
+/// moments need no scaling: three `i32` are within `MOMENT_LIMIT_UNMM` (checked below).
 fn bound(w: &mut [i32; 6]) -> InsertionFlags {
-    let [fx, fy, fz, mx, my, mz] = w.map(i64::from);
-    let (f, m) = (fx.abs() + fy.abs() + fz.abs(), mx.abs() + my.abs() + mz.abs());
-    if f <= FORCE_LIMIT_UN && m <= MOMENT_LIMIT_UNMM {
+    let f: u64 = w.iter().take(3).map(|c| u64::from(c.unsigned_abs())).sum();
+    if f <= FORCE_LIMIT_UN {
         return InsertionFlags::OK;
     }
-    // |c| <= 2^31 and a bound < 2^31: the products fit in i64; the sums are > 0 when beyond
-    let scale = |c: i64, sum: i64, limit: i64| if sum <= limit { c } else { c.saturating_mul(limit).checked_div(sum).unwrap_or(0) };
-    let scaled = [
-        scale(fx, f, FORCE_LIMIT_UN),
-        scale(fy, f, FORCE_LIMIT_UN),
-        scale(fz, f, FORCE_LIMIT_UN),
-        scale(mx, m, MOMENT_LIMIT_UNMM),
-        scale(my, m, MOMENT_LIMIT_UNMM),
-        scale(mz, m, MOMENT_LIMIT_UNMM),
-    ];
-    *w = scaled.map(saturate_i32);
+    // f > FORCE_LIMIT_UN > 0: the factor is below 2^32 and `|c| factor` below 2^63
+    let factor = i64::try_from((FORCE_LIMIT_UN << 32).checked_div(f).unwrap_or(0)).unwrap_or(0);
+    for c in w.iter_mut().take(3) {
+        // |c| factor / 2^32 <= |c|: within i32
+        *c = ((i64::from(*c) * factor) / (1 << 32)) as i32;
+    }
     InsertionFlags::WRENCH_LIMITED
 }
+
+/// The fixed-point moments are `i32` µN·mm: their sum is within the moment bound.
+const _: () = assert!(3 * (i32::MAX as i64) <= MOMENT_LIMIT_UNMM);
 
 fn layer_ok(l: &Layer) -> bool {
     let k = &l.friction;
@@ -229,8 +229,8 @@ impl<'a> Insertion<'a> {
         if config.max_speed_mm_per_s == 0 || config.max_turn_deg_per_s == 0 {
             return Err(InsertionError::Config);
         }
-        // speed (< 2^32) times period (< 2^32) times 2^16 / 10^6: within i64 in u128
-        let per_tick = |speed: u32| i64::try_from(((u128::from(speed) * u128::from(period)) << 16) / 1_000_000).unwrap_or(i64::MAX);
+        // speed (mm/s) times period (µs) times 2^16 / 10^6 = 1,024 / 15,625, saturated
+        let per_tick = |speed: u32| u32::try_from(u64::from(speed).saturating_mul(period).saturating_mul(1024) / 15_625).unwrap_or(u32::MAX);
         let max_step_q16 = [per_tick(config.max_speed_mm_per_s), per_tick(config.max_turn_deg_per_s)];
         let mut insertion = Self {
             stack,
@@ -323,14 +323,18 @@ impl<'a> Insertion<'a> {
         let glitch = self.screen(pose);
         if !glitch.is_ok() {
             self.missed = self.missed.saturating_add(1).min(MISSED_MAX);
+            // the deflected boundary's filter follows time over the held input
+            if let Some(c) = self.qlv.get(self.punctured) {
+                self.qlv_state.hold(c);
+            }
             let (wrench, phase) = self.held;
             let velocity_mm_per_s_q16 = saturate_i32(self.velocity_q16);
             return InsertionEvaluation { wrench, status: Status::OK, flags: glitch, phase, punctures: 0, velocity_mm_per_s_q16 };
         }
         let depth = i64::from(pose.depth_mm_q16);
-        let step_q16 = self.last_depth_q16.map_or(0, |last| depth - last);
+        let step_q16 = self.last_depth_q16.map_or(0, |last| depth - i64::from(last));
         self.filter_velocity(step_q16);
-        self.last_depth_q16 = Some(depth);
+        self.last_depth_q16 = Some(pose.depth_mm_q16);
         self.accepted_q16 = [pose.x_mm_q16, pose.z_mm_q16, pose.theta_x_deg_q16, pose.theta_z_deg_q16];
         self.missed = 1;
         // friction and cutting see the velocity only when it has the last motion's sign
@@ -351,7 +355,7 @@ impl<'a> Insertion<'a> {
     /// The tick's evaluation: the wrench rounded to µN and µN·mm, saturated to `i32` and
     /// bounded (`bound`); it is what the next glitch tick holds.
     fn evaluation(&mut self, w_q16: [i64; 6], status: Status, phase: Phase, punctures: u8) -> InsertionEvaluation {
-        let mut w = w_q16.map(|c| saturate_i32(c.saturating_add(1 << 15) >> 16));
+        let mut w = w_q16.map(|c| round_shr_i32(c, 16));
         let flags = bound(&mut w);
         let wrench = Wrench::from_array(w);
         self.held = (wrench, phase);
@@ -359,30 +363,18 @@ impl<'a> Insertion<'a> {
     }
 
     /// The glitch flags of `pose` (the module's "Glitches"): [`InsertionFlags::OK`] to
-    /// integrate it.
+    /// integrate it. In `u32`: magnitudes and distances of `i32` never overflow there;
+    /// the largest distance of `x`, `z`, `depth` (of the tilts) against one allowance.
     fn screen(&self, pose: &Pose) -> InsertionFlags {
         let Pose { x_mm_q16: x, z_mm_q16: z, theta_x_deg_q16: tx, theta_z_deg_q16: tz, depth_mm_q16: d } = *pose;
-        let within = |v: i32, max: i64| i64::from(v).abs() <= max;
-        if !(within(x, X_MAX_Q16)
-            && within(z, X_MAX_Q16)
-            && within(d, DEPTH_MAX_Q16)
-            && within(tx, TILT_MAX_Q16)
-            && within(tz, TILT_MAX_Q16))
-        {
+        let (xz, tilt) = (x.unsigned_abs().max(z.unsigned_abs()), tx.unsigned_abs().max(tz.unsigned_abs()));
+        if xz > X_MAX_Q16 || d.unsigned_abs() > DEPTH_MAX_Q16 || tilt > TILT_MAX_Q16 {
             return InsertionFlags::OUT_OF_DOMAIN;
         }
         let Some(last_d) = self.last_depth_q16 else { return InsertionFlags::OK };
         let [lx, lz, ltx, ltz] = self.accepted_q16;
-        let n = i64::from(self.missed);
-        let [mm, deg] = self.max_step_q16.map(|s| s.saturating_mul(n));
-        let moved = |a: i64, b: i64, max: i64| (a - b).abs() <= max;
-        let (i, j) = (i64::from, i64::from);
-        if moved(i(d), last_d, mm)
-            && moved(i(x), j(lx), mm)
-            && moved(i(z), j(lz), mm)
-            && moved(i(tx), j(ltx), deg)
-            && moved(i(tz), j(ltz), deg)
-        {
+        let [mm, deg] = self.max_step_q16.map(|s| s.saturating_mul(self.missed));
+        if x.abs_diff(lx).max(z.abs_diff(lz)).max(d.abs_diff(last_d)) <= mm && tx.abs_diff(ltx).max(tz.abs_diff(ltz)) <= deg {
             InsertionFlags::OK
         } else {
             InsertionFlags::FAST_MOTION
@@ -396,15 +388,15 @@ impl<'a> Insertion<'a> {
     }
 
     /// The velocity's raw value and filter gain for a step over `missed` ticks (after a
-    /// glitch): the step over `missed` periods, `alpha = n T / (n T + tau)` in Q16.
+    /// glitch): the step over `missed` periods, `alpha = n T / (n T + tau)` in Q16, as
+    /// `2^16 - tau 2^16 / (n T + tau)` rounded (`n <= 2^20`, `T, tau < 2^32`: every value
+    /// below 2^53 in `u64`, the divisor at least `T >= 1`).
     fn after_glitch(&self, step_q16: i64) -> (i64, i64) {
-        let n = i64::from(self.missed);
-        let raw = mul_shr(step_q16, self.rate_q16, 16).checked_div(n).unwrap_or(0);
-        // n < 2^21, period < 2^32: t < 2^53, t 2^16 saturates (then alpha is 1 in Q16)
-        let t = i64::from(self.period_us).saturating_mul(n);
-        let whole = t.saturating_add(i64::from(self.tau_us));
-        let alpha = t.saturating_mul(1 << 16).saturating_add(whole >> 1).checked_div(whole).unwrap_or(1 << 16).min(1 << 16);
-        (raw, alpha)
+        let raw = mul_shr(step_q16, self.rate_q16, 16).checked_div(i64::from(self.missed)).unwrap_or(0);
+        let tau = u64::from(self.tau_us);
+        let whole = u64::from(self.period_us) * u64::from(self.missed) + tau;
+        let held = ((tau << 16) + (whole >> 1)).checked_div(whole).unwrap_or(0);
+        (raw, (1 << 16) - i64::try_from(held).unwrap_or(0))
     }
 
     /// Path coordinates of the layers' upper boundaries (mm Q16) for a needle of

@@ -571,6 +571,10 @@ impl Insertion {
         let glitch = self.screen(pose);
         if !glitch.is_ok() {
             self.elapsed_s += self.config.period_s;
+            // the deflected boundary's filter follows time over the held input
+            if let Some(c) = self.qlv.get(self.punctured) {
+                self.qlv_state.hold(c);
+            }
             let (wrench, phase) = self.held;
             let e = if glitch.contains(InsertionFlags::NOT_FINITE) {
                 InsertionEvaluation {

@@ -446,6 +446,16 @@ impl QlvState {
         coefficients.step_components(&mut self.state, w);
     }
 
+    /// One tick with the input held at the last tick's (its change zero): each term
+    /// relaxes, `h_i <- a_i h_i`, so the state follows time over a tick whose input is
+    /// not known (the insertion's glitch tick). Without terms nothing changes.
+    pub fn hold(&mut self, coefficients: &QlvCoefficients) {
+        if coefficients.is_active() {
+            let mut held = self.state.map(|s| s[0]);
+            self.filter(coefficients, &mut held);
+        }
+    }
+
     /// Back to rest.
     pub fn reset(&mut self) {
         if self.stored {
