@@ -12,9 +12,10 @@ use needle_contract::insertion_flags as bits;
 /// | [`NOT_FINITE`](Self::NOT_FINITE) | `0x04` | an input was NaN or infinite: a glitch (the status is also `ERROR`) |
 /// | [`WRENCH_LIMITED`](Self::WRENCH_LIMITED) | `0x08` | the force (or moment) was beyond its bound and was scaled down to it |
 ///
-/// A *glitch* tick is not integrated as motion: no puncture, no velocity, no track or
-/// filter change; the state stays the last accepted tick's, and the wrench and phase
-/// are held at the last tick's (zero and `ERROR` for a pose that is not finite).
+/// A *glitch* tick is not integrated as motion: no puncture, no velocity, no track
+/// change (the deflected boundary's viscoelastic filter relaxes over its held input);
+/// the state stays the last accepted tick's, and the wrench and phase are held at the
+/// last tick's (zero and `ERROR` for a pose that is not finite).
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct InsertionFlags(u8);
 

@@ -16,10 +16,12 @@ use needle_haptics::{InsertionFlags, Pose};
 
 /// The recovery (docs/insertion.md, "Glitches"): from this many ticks after a glitch the
 /// wrench is the clean run's within [`RECOVERY_N`] (the velocity filter's step over the
-/// glitch decays with its 5 ms time constant: 50 ticks are 10 of them), on a stack without Prony terms. A layer
-/// with terms sees the motion over a glitch as one tick's (its filter's coefficients are
-/// the period's): the difference decays with its time constants (the skin's 0.19 s) or
-/// goes at its puncture, and is printed, not held to the bound.
+/// glitch decays with its 5 ms time constant: 50 ticks are 10 of them). On every stack:
+/// a layer with Prony terms takes the elastic force's change over a glitch as a ramp
+/// over its ticks, exact at the constant speeds of these paths (the filter's share of
+/// the documented recovery, `insertion_glitch_property.rs`, vanishes for a force that
+/// changed at a constant rate; before the filter relaxed over held ticks the epidural
+/// differed by 3.1e-4 to 8.0e-3 N here, and by 1.40 N after x alternated).
 const RECOVERY_TICKS: usize = 50;
 /// The largest difference of a wrench component (N, N·mm for moments) from the clean
 /// run's, [`RECOVERY_TICKS`] after a glitch that was not integrated.
@@ -62,14 +64,7 @@ fn force_sum(w: [f32; 6]) -> f32 {
 /// tick flagged `want`, puncturing nothing and holding the tick before's wrench; from
 /// [`RECOVERY_TICKS`] after each glitch run the clean wrench within [`RECOVERY_N`]; the
 /// same punctures in all. Returns the largest difference after recovery.
-fn check(
-    case: &str,
-    clean: &[InsertionEvaluation],
-    glitched: &[InsertionEvaluation],
-    glitch_ticks: &[usize],
-    want: InsertionFlags,
-    elastic: bool,
-) -> f32 {
+fn check(case: &str, clean: &[InsertionEvaluation], glitched: &[InsertionEvaluation], glitch_ticks: &[usize], want: InsertionFlags) -> f32 {
     let mut worst = 0.0f32;
     for (k, (c, g)) in clean.iter().zip(glitched).enumerate() {
         let w = g.wrench.to_array();
@@ -87,12 +82,7 @@ fn check(
         if since.is_none_or(|s| s >= RECOVERY_TICKS) {
             let d = c.wrench.to_array().iter().zip(w).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
             worst = worst.max(d);
-            assert!(
-                !elastic || d <= RECOVERY_N,
-                "{case}: tick {k}: {d} N from the clean run after recovery ({:?} / {:?})",
-                c.wrench,
-                g.wrench
-            );
+            assert!(d <= RECOVERY_N, "{case}: tick {k}: {d} N from the clean run after recovery ({:?} / {:?})", c.wrench, g.wrench);
         }
     }
     let p = |r: &[InsertionEvaluation]| r.iter().map(|e| u32::from(e.punctures)).sum::<u32>();
@@ -124,14 +114,9 @@ fn case(name: &str, clean_poses: &[Pose], ticks: &[usize], glitch: impl Fn(Pose)
     }
     for (stack, fixed_stack) in stacks::ALL.iter().zip(&fixed_stacks::ALL) {
         let case = format!("{name} ({})", stack.name);
-        check(&case, &run(stack, clean_poses), &run(stack, &poses), ticks, want, is_elastic(stack));
+        check(&case, &run(stack, clean_poses), &run(stack, &poses), ticks, want);
         check_fixed(&case, &run_fixed(fixed_stack, &poses), ticks, want);
     }
-}
-
-/// Whether no layer of `stack` has Prony terms (the recovery is held to its bound).
-fn is_elastic(stack: &Stack<'_>) -> bool {
-    stack.layers.iter().all(|l| l.prony.as_slice().is_empty())
 }
 
 /// The tick of `poses` `after` ticks past the first in phase `phase` on the liver.
@@ -195,7 +180,7 @@ fn issue66_nan_and_infinity_hold_nothing_and_the_path_goes_on() {
             .flat_map(|(c, g)| c.wrench.to_array().into_iter().zip(g.wrench.to_array()).map(|(a, b)| (a - b).abs()))
             .fold(0.0, f32::max);
         println!("NaN and infinity ({}): largest difference after recovery {d:.3e} N", stack.name);
-        assert!(!is_elastic(stack) || d <= RECOVERY_N, "{}: {d} N from the clean run after recovery", stack.name);
+        assert!(d <= RECOVERY_N, "{}: {d} N from the clean run after recovery", stack.name);
     }
 }
 

@@ -18,9 +18,12 @@
 //! pose than [`InsertionConfig::max_speed_mm_per_s`] (tilts:
 //! [`InsertionConfig::max_turn_deg_per_s`]) allows over the ticks since it (the step per
 //! tick in Q16 computed once in [`Insertion::new`]) is not integrated: the wrench and
-//! phase are the last tick's, the flags ([`InsertionFlags`]) say why. The wrench's
-//! `|fx| + |fy| + |fz|` stays within `FORCE_LIMIT_N` (in µN) and `|mx| + |my| + |mz|`
-//! within `MOMENT_LIMIT_NMM` (in µN·mm), scaled down to the bound otherwise. The
+//! phase are the last tick's, the flags ([`InsertionFlags`]) say why, and the deflected
+//! boundary's filter relaxes over its held input (the next accepted tick's change taken
+//! as a ramp over the ticks since the last: `viscoelastic::QlvState::hold`). The wrench's
+//! `|fx| + |fy| + |fz|` stays within `FORCE_LIMIT_N` (in µN), scaled down to the bound
+//! otherwise; `|mx| + |my| + |mz|` is within `MOMENT_LIMIT_NMM` (in µN·mm) by its type
+//! (three `i32`, at most 6,442 N·mm). The
 //! surrogate clamps further to its own domain and reports it.
 //!
 //! **Overflow.** Every product whose size depends on the stack's values or on the pose
@@ -230,7 +233,8 @@ impl<'a> Insertion<'a> {
             return Err(InsertionError::Config);
         }
         // speed (mm/s) times period (µs) times 2^16 / 10^6 = 1,024 / 15,625, saturated
-        let per_tick = |speed: u32| u32::try_from(u64::from(speed).saturating_mul(period).saturating_mul(1024) / 15_625).unwrap_or(u32::MAX);
+        let per_tick =
+            |speed: u32| u32::try_from(u64::from(speed).saturating_mul(period).saturating_mul(1024) / 15_625).unwrap_or(u32::MAX);
         let max_step_q16 = [per_tick(config.max_speed_mm_per_s), per_tick(config.max_turn_deg_per_s)];
         let mut insertion = Self {
             stack,
@@ -527,7 +531,8 @@ impl<'a> Insertion<'a> {
             axial_q16 = axial_q16.saturating_add(cutting(v));
             Phase::Cutting(index(m - 1))
         } else {
-            let inside = (1..m).take_while(|&j| bound(j) < depth).count();
+            // the boundaries rise with j: the count of those above the tip by bisection
+            let inside = bounds.get(1..m).map_or(0, |b| b.partition_point(|&q| q < depth));
             Phase::InTrack(index(inside))
         };
         if depth > self.track_end_q16 && depth < next {

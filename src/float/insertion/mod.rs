@@ -62,12 +62,16 @@
 //! `needle_contract::insertion_limits`), not finite, or one whose `x`, `z` or `depth` moved
 //! further since the last accepted pose than [`InsertionConfig::max_speed_mm_per_s`]
 //! times the time since it (tilts: [`InsertionConfig::max_turn_deg_per_s`]) is not
-//! integrated as motion: no puncture, no velocity, no track, cutting or filter change;
-//! the tick's wrench and phase are the last tick's (zero and `ERROR` for a pose that is
-//! not finite) and its flags say why. The next pose is compared with the last accepted
-//! one over the time since it (the allowance grows by one period per glitch tick, so a
-//! real move the stream lost is accepted once it is within the speed), and the velocity
-//! filter takes that time as its step. Whatever the input, `|fx| + |fy| + |fz|` stays
+//! integrated as motion: no puncture, no velocity, no track or cutting change; the
+//! deflected boundary's viscoelastic filter relaxes over its input held at the last
+//! tick's (`QlvState::hold`: its state follows time); the tick's wrench and phase are
+//! the last tick's (zero and `ERROR` for a pose that is not finite) and its flags say
+//! why. The next pose is compared with the last accepted one over the time since it (the
+//! allowance grows by one period per glitch tick, so a real move the stream lost is
+//! accepted once it is within the speed), the velocity filter takes that time as its
+//! step, and the viscoelastic filter takes the input's change as a ramp over it (exact
+//! for a force that changed at a constant rate; docs/insertion.md, "Glitches", gives the
+//! recovery). Whatever the input, `|fx| + |fy| + |fz|` stays
 //! within `insertion_limits::FORCE_LIMIT_N` (100 N) and `|mx| + |my| + |mz|` within
 //! `MOMENT_LIMIT_NMM` (10,000 N·mm): a larger wrench is scaled down to the bound
 //! (direction kept, [`InsertionFlags::WRENCH_LIMITED`]). The model has no clock: a time
@@ -628,22 +632,26 @@ impl Insertion {
     }
 
     /// The glitch flags of `pose` (the module's "Glitches"): [`InsertionFlags::OK`] to
-    /// integrate it. The domain's tests are written `|v| <= max`, false for NaN too.
+    /// integrate it. Magnitudes compared as the bits of non-negative f32 (ordered as the
+    /// numbers, NaN above infinity, so a NaN is beyond every limit): integer comparisons,
+    /// no soft-float call on cores without an FPU, and the largest distance of `x`, `z`,
+    /// `depth` (of the tilts) against one allowance.
     fn screen(&self, pose: &Pose) -> InsertionFlags {
-        const XZ: f32 = limits::XZ_MAX_MM as f32;
-        const DEPTH: f32 = limits::DEPTH_MAX_MM as f32;
-        const TILT: f32 = limits::TILT_MAX_DEG as f32;
-        let abs = libm::fabsf;
+        const XZ: u32 = (limits::XZ_MAX_MM as f32).to_bits();
+        const DEPTH: u32 = (limits::DEPTH_MAX_MM as f32).to_bits();
+        const TILT: u32 = (limits::TILT_MAX_DEG as f32).to_bits();
+        let mag = |v: f32| v.to_bits() & 0x7fff_ffff;
         let Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, depth_mm: d } = *pose;
-        if !(abs(x) <= XZ && abs(z) <= XZ && abs(d) <= DEPTH && abs(tx) <= TILT && abs(tz) <= TILT) {
+        if mag(x).max(mag(z)) > XZ || mag(d) > DEPTH || mag(tx).max(mag(tz)) > TILT {
             let finite = [x, z, tx, tz, d].into_iter().all(f32::is_finite);
             return if finite { InsertionFlags::OUT_OF_DOMAIN } else { InsertionFlags::NOT_FINITE };
         }
         let Some(last_d) = self.last_depth_mm else { return InsertionFlags::OK };
         let [lx, lz, ltx, ltz] = self.accepted;
-        let mm = self.config.max_speed_mm_per_s * self.elapsed_s;
-        let deg = self.config.max_turn_deg_per_s * self.elapsed_s;
-        if abs(d - last_d) <= mm && abs(x - lx) <= mm && abs(z - lz) <= mm && abs(tx - ltx) <= deg && abs(tz - ltz) <= deg {
+        // finite and > 0 (or +inf): never NaN
+        let mm = mag(self.config.max_speed_mm_per_s * self.elapsed_s);
+        let deg = mag(self.config.max_turn_deg_per_s * self.elapsed_s);
+        if mag(d - last_d).max(mag(x - lx)).max(mag(z - lz)) <= mm && mag(tx - ltx).max(mag(tz - ltz)) <= deg {
             InsertionFlags::OK
         } else {
             InsertionFlags::FAST_MOTION
