@@ -632,26 +632,22 @@ impl Insertion {
     }
 
     /// The glitch flags of `pose` (the module's "Glitches"): [`InsertionFlags::OK`] to
-    /// integrate it. Magnitudes compared as the bits of non-negative f32 (ordered as the
-    /// numbers, NaN above infinity, so a NaN is beyond every limit): integer comparisons,
-    /// no soft-float call on cores without an FPU, and the largest distance of `x`, `z`,
-    /// `depth` (of the tilts) against one allowance.
+    /// integrate it. The domain's tests are written `|v| <= max`, false for NaN too.
     fn screen(&self, pose: &Pose) -> InsertionFlags {
-        const XZ: u32 = (limits::XZ_MAX_MM as f32).to_bits();
-        const DEPTH: u32 = (limits::DEPTH_MAX_MM as f32).to_bits();
-        const TILT: u32 = (limits::TILT_MAX_DEG as f32).to_bits();
-        let mag = |v: f32| v.to_bits() & 0x7fff_ffff;
+        const XZ: f32 = limits::XZ_MAX_MM as f32;
+        const DEPTH: f32 = limits::DEPTH_MAX_MM as f32;
+        const TILT: f32 = limits::TILT_MAX_DEG as f32;
+        let abs = libm::fabsf;
         let Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, depth_mm: d } = *pose;
-        if mag(x).max(mag(z)) > XZ || mag(d) > DEPTH || mag(tx).max(mag(tz)) > TILT {
+        if !(abs(x) <= XZ && abs(z) <= XZ && abs(d) <= DEPTH && abs(tx) <= TILT && abs(tz) <= TILT) {
             let finite = [x, z, tx, tz, d].into_iter().all(f32::is_finite);
             return if finite { InsertionFlags::OUT_OF_DOMAIN } else { InsertionFlags::NOT_FINITE };
         }
         let Some(last_d) = self.last_depth_mm else { return InsertionFlags::OK };
         let [lx, lz, ltx, ltz] = self.accepted;
-        // finite and > 0 (or +inf): never NaN
-        let mm = mag(self.config.max_speed_mm_per_s * self.elapsed_s);
-        let deg = mag(self.config.max_turn_deg_per_s * self.elapsed_s);
-        if mag(d - last_d).max(mag(x - lx)).max(mag(z - lz)) <= mm && mag(tx - ltx).max(mag(tz - ltz)) <= deg {
+        let mm = self.config.max_speed_mm_per_s * self.elapsed_s;
+        let deg = self.config.max_turn_deg_per_s * self.elapsed_s;
+        if abs(d - last_d) <= mm && abs(x - lx) <= mm && abs(z - lz) <= mm && abs(tx - ltx) <= deg && abs(tz - ltz) <= deg {
             InsertionFlags::OK
         } else {
             InsertionFlags::FAST_MOTION

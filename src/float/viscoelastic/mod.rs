@@ -444,32 +444,29 @@ impl QlvState {
     pub fn step(&mut self, coefficients: &QlvCoefficients, elastic: [f32; COMPONENT_COUNT]) -> [f32; COMPONENT_COUNT] {
         let mut out = elastic;
         if coefficients.is_active() {
-            self.filter(coefficients, &mut out);
+            if self.held == 0 {
+                self.filter(coefficients, &mut out);
+            } else {
+                self.after_held(coefficients, &mut out);
+            }
         }
         out
     }
 
-    /// The six components in place (after held ticks, with the ramp's `b_i`). Out of
-    /// line: inlined into the insertion's step, its registers and stack slots made every
-    /// step dearer, with or without terms (M4F: the elastic step 25-72 instructions and
-    /// 48 B of stack; docs/insertion.md).
+    /// The six components in place. Out of line: inlined into the insertion's step, its
+    /// registers and stack slots made every step dearer, with or without terms (M4F:
+    /// the elastic step 25-72 instructions and 48 B of stack; docs/insertion.md).
     #[inline(never)]
     fn filter(&mut self, coefficients: &QlvCoefficients, w: &mut [f32; COMPONENT_COUNT]) {
         self.stored = true;
-        let ramped;
-        let c = if self.held == 0 {
-            coefficients
-        } else {
-            ramped = self.ramped(coefficients);
-            &ramped
-        };
-        c.step_components(&mut self.state, w);
+        coefficients.step_components(&mut self.state, w);
     }
 
-    /// The coefficients of the step after held ticks: `b_i` times the ramp's weight
+    /// The step after held ticks: `b_i` times the ramp's weight
     /// `(1 + a_i + ... + a_i^held) / (held + 1)` (the type's "Held ticks"); no tick held
-    /// after it.
-    fn ramped(&mut self, coefficients: &QlvCoefficients) -> QlvCoefficients {
+    /// after it. Out of line: the step's usual path stays as it was.
+    #[inline(never)]
+    fn after_held(&mut self, coefficients: &QlvCoefficients, w: &mut [f32; COMPONENT_COUNT]) {
         // held >= 1: n >= 2 (as f32: exact to 2^24, then within 1e-7)
         let n = self.held as f32 + 1.0;
         self.held = 0;
@@ -477,7 +474,7 @@ impl QlvState {
         for (b, r) in ramped.b.iter_mut().zip(self.ramp) {
             *b *= r / n;
         }
-        ramped
+        self.filter(&ramped, w);
     }
 
     /// One tick with the input unknown (the type's "Held ticks"): the step's recursion
@@ -487,14 +484,12 @@ impl QlvState {
         if !coefficients.is_active() {
             return;
         }
-        let held = self.held;
-        self.held = 0;
         let mut input = self.state.map(|s| s[0]);
         self.filter(coefficients, &mut input);
-        if held == 0 {
+        if self.held == 0 {
             self.ramp = [1.0; MAX_TERMS];
         }
-        self.held = held.saturating_add(1);
+        self.held = self.held.saturating_add(1);
         for (r, a) in self.ramp.iter_mut().zip(coefficients.a) {
             *r = a * *r + 1.0;
         }
