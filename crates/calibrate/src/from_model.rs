@@ -119,6 +119,11 @@ pub fn calibrate_published(opts: &ModelOptions<'_>) -> Result<Calibration> {
                 Some(s) if !opts.with_prony && !cited.prony.is_empty() => Some(format!("{NOT_COMPILED_IN} {s}")),
                 other => other,
             },
+            family_weight: 1.0,
+            family_weight_range: None,
+            softening_fraction: 0.0,
+            softening_onset_ratio: 0.0,
+            softening_fraction_range: None,
         });
     }
     let stack = file::Stack {

@@ -13,7 +13,9 @@
 //! | friction levels | µN per mm of shaft × 2^16; the stick band's slope and the viscous term µN/mm per mm/s × 2^16 |
 //! | track stiffness | µN/mm per mm of shaft × 2^8 |
 //! | Prony terms | `g` × 2^16, `tau` µs ([`PronyTerms::from_f32`]) |
+pub use super::softening::Softening;
 use crate::fixed::depth_extension::round_i64;
+pub use crate::fixed::family::FamilyMember;
 #[cfg(feature = "viscoelastic")]
 use crate::fixed::viscoelastic::PronyTerms;
 use crate::float::insertion as f32_insertion;
@@ -89,6 +91,10 @@ pub struct Layer {
     /// the `viscoelastic` feature (an elastic build's layers carry none: flash).
     #[cfg(feature = "viscoelastic")]
     pub prony: PronyTerms,
+    /// The material family's member ([`crate::fixed::family`]).
+    pub family: FamilyMember,
+    /// The pre-puncture softening and the force that punctures.
+    pub softening: Softening,
 }
 
 /// A stack in integers: the layers and the needle's similarity to the FE needle.
@@ -164,16 +170,16 @@ impl Layer {
     #[must_use]
     pub const fn from_f32(l: &f32_insertion::Layer) -> Self {
         let band = l.friction.stick_band_mm_per_s;
+        // at least 1 (1.5e-11 N) for a positive force: a boundary that punctures at
+        // contact (the tissue format's smallest force) stays positive
+        let puncture_force_q16 =
+            if l.puncture_force_n > 0.0 && micro_q16(l.puncture_force_n) < 1 { 1 } else { micro_q16(l.puncture_force_n) };
         Self {
             thickness_q16: q16(l.thickness_mm),
             stiffness_scale_q16: q16(l.stiffness_scale),
-            // at least 1 (1.5e-11 N) for a positive force: a boundary that punctures at
-            // contact (the tissue format's smallest force) stays positive
-            puncture_force_q16: if l.puncture_force_n > 0.0 && micro_q16(l.puncture_force_n) < 1 {
-                1
-            } else {
-                micro_q16(l.puncture_force_n)
-            },
+            puncture_force_q16,
+            family: FamilyMember::from_f32(&l.family),
+            softening: Softening::from_f32(&l.softening, l.puncture_force_n, puncture_force_q16),
             cutting_force_q16: micro_q16(l.cutting_force_n),
             cutting_per_speed_q16: per_speed_q16(l.cutting_force_n, band),
             friction: Karnopp {
@@ -199,6 +205,8 @@ const EMPTY_LAYER: Layer = Layer {
     track_stiffness_q8: 0,
     #[cfg(feature = "viscoelastic")]
     prony: PronyTerms::NONE,
+    family: FamilyMember::PAPER,
+    softening: Softening { critical_q16: 0, onset_q16: 0, span_q16: 0, slope: 0, fraction_q30: 0 },
 };
 
 impl Stack {

@@ -78,10 +78,12 @@
 //! stamp going backwards reaches it as a pose out of order, a jump like any other.
 //!
 //! f32 throughout, `libm` for the trigonometry: the same bits on every target.
+mod softening;
 mod stack;
 mod track;
 
-pub use stack::{stacks, Karnopp, Layer, Stack, FE_NEEDLE_DIAMETER_MM, HUB_FROM_TIP_MM, MAX_LAYERS};
+use softening::SofteningTerms;
+pub use stack::{stacks, FamilyMember, Karnopp, Layer, Softening, Stack, FE_NEEDLE_DIAMETER_MM, HUB_FROM_TIP_MM, MAX_LAYERS};
 
 use crate::float::depth_extension::extended_wrench_and_depth_rate;
 #[cfg(not(feature = "viscoelastic"))]
@@ -272,6 +274,9 @@ pub struct Insertion {
     velocity_mm_per_s: f32,
     /// Per layer the relaxation's per-tick coefficients (computed once, in `new`).
     qlv: [QlvCoefficients; MAX_LAYERS],
+    /// Per layer the pre-puncture softening's terms and the force that punctures
+    /// (computed once, in `new`).
+    soft: [SofteningTerms; MAX_LAYERS],
     /// The viscoelastic filter of the deflected boundary's wrench.
     qlv_state: QlvState,
     /// The filter's share for a guard of the last [`Insertion::step_with_stiffness`]
@@ -431,6 +436,8 @@ fn layer_ok(l: &Layer) -> bool {
         && positive(l.stiffness_scale)
         && positive(l.puncture_force_n)
         && positive(k.stick_band_mm_per_s)
+        && l.family.is_covered()
+        && l.softening.is_valid()
         && [l.cutting_force_n, k.static_n_per_mm, k.coulomb_n_per_mm, k.viscous_n_s_per_mm2, l.track_stiffness_n_per_mm2]
             .into_iter()
             .all(non_negative)
@@ -465,6 +472,10 @@ impl Insertion {
             let terms = crate::float::viscoelastic::PronyTerms::new(l.prony.as_slice()).map_err(|_| InsertionError::Value)?;
             *k = QlvCoefficients::new(&terms, config.period_s).map_err(|_| InsertionError::Config)?;
         }
+        let mut soft = [SofteningTerms::NONE; MAX_LAYERS];
+        for (t, l) in soft.iter_mut().zip(stack.layers) {
+            *t = SofteningTerms::new(l.puncture_force_n, &l.softening).ok_or(InsertionError::Value)?;
+        }
         let mut layers = [stack.layers.first().copied().ok_or(InsertionError::LayerCount)?; MAX_LAYERS];
         for (slot, l) in layers.iter_mut().zip(stack.layers) {
             *slot = *l;
@@ -484,6 +495,7 @@ impl Insertion {
             held: (Wrench::ZERO, Phase::Approach),
             velocity_mm_per_s: 0.0,
             qlv,
+            soft,
             qlv_state: QlvState::REST,
             guard_share: FilterTerms::NONE,
         })
@@ -685,6 +697,23 @@ impl Insertion {
     /// releases the boundary's stored viscous force (the filter is reset: the lateral
     /// part kept as preload is the elastic one), as does the tip leaving the boundary
     /// (no deflected boundary in this tick): nothing stored is pushed into the hand.
+    /// [`deflection_at`] of `layer` at `indentation_mm`, times its family member's ratio
+    /// `g(δ/λ, w)` ([`crate::float::family::ratio`]; the paper's tissue: untouched, bit for
+    /// bit). The stiffness becomes `k g + |F|₁ |dg/dδ|` (`|F|₁` the sum of the unscaled
+    /// forces' magnitudes: at least the force's length, so the guard's view is not below it).
+    fn member_deflection(&self, pose: &Pose, indentation_mm: f32, layer: &Layer, rate: bool) -> (crate::Evaluation, f32) {
+        let (e, k) = deflection_at(pose, indentation_mm, layer.stiffness_scale, self.similarity, rate);
+        if layer.family.weight() >= 1.0 {
+            return (e, k);
+        }
+        // similarity > 0 (checked by `new`)
+        let (g, g_rate_per_fe_mm) = crate::float::family::ratio(indentation_mm / self.similarity, &layer.family);
+        let w = e.wrench.to_array();
+        let f1 = libm::fabsf(w[0]) + libm::fabsf(w[1]) + libm::fabsf(w[2]);
+        let k = k * g + f1 * libm::fabsf(g_rate_per_fe_mm / self.similarity);
+        (crate::Evaluation { wrench: Wrench::from_array(w.map(|x| x * g)), status: e.status }, k)
+    }
+
     fn deflect(&mut self, pose: &Pose, a: Vec3, entry: Vec3, bounds: &[f32; MAX_LAYERS + 1], rate: bool) -> Deflected {
         let mut punctures = 0u8;
         while self.punctured < self.count {
@@ -692,12 +721,27 @@ impl Insertion {
             if pose.depth_mm <= q {
                 break;
             }
-            let (Some(layer), Some(qlv)) = (self.layers.get(self.punctured).copied(), self.qlv.get(self.punctured)) else { break };
-            let (e, k) = deflection_at(pose, pose.depth_mm - q, layer.stiffness_scale, self.similarity, rate);
-            let elastic = e.wrench.to_array();
-            let w = self.qlv_state.step(qlv, elastic);
+            let (Some(layer), Some(qlv), Some(soft)) =
+                (self.layers.get(self.punctured).copied(), self.qlv.get(self.punctured), self.soft.get(self.punctured).copied())
+            else {
+                break;
+            };
+            let (e, k) = self.member_deflection(pose, pose.depth_mm - q, &layer, rate);
+            let mut elastic = e.wrench.to_array();
+            let mut w = self.qlv_state.step(qlv, elastic);
             let axial_n = dot([w[0], w[1], w[2]], a);
-            if axial_n + self.carried_cutting_n() < layer.puncture_force_n {
+            let boundary_n = axial_n + self.carried_cutting_n();
+            if boundary_n < soft.critical_n {
+                let mut k = k;
+                if soft.active() {
+                    // the tissue starting to fail: the boundary's wrench (and the guard's
+                    // view of it) loses its share; the filter's state keeps the unsoftened one
+                    let factor = soft.factor(boundary_n);
+                    for x in w.iter_mut().chain(elastic.iter_mut()) {
+                        *x *= factor;
+                    }
+                    k *= factor;
+                }
                 let mut total = self.preload;
                 for (t, x) in total.iter_mut().zip(w) {
                     *t += x;
@@ -707,7 +751,8 @@ impl Insertion {
                 }
                 return Deflected { wrench: total, status: e.status, punctures, stiffness_n_per_mm: k * qlv.effective_stiffness_ratio() };
             }
-            let w = elastic;
+            // the boundary's state at the puncture: softened to its share there
+            let w = if soft.active() { elastic.map(|x| x * soft.factor(boundary_n)) } else { elastic };
             let axial_n = dot([w[0], w[1], w[2]], a);
             self.qlv_state.reset();
             // puncture: the axial force goes, the lateral force and the moments stay
