@@ -32,7 +32,8 @@ pub(crate) fn sat_mul(a: i64, b: i64) -> i64 {
 #[cfg_attr(not(target_arch = "arm"), inline(always))]
 pub(crate) fn mul_q30_wide(x: i64, g: i64) -> i64 {
     let (hi, lo) = (x >> 30, x & ((1 << 30) - 1));
-    (hi.saturating_mul(g)).saturating_add((lo * g) >> 30)
+    // lo < 2^30 and g <= 2^31: lo g < 2^61 never wraps
+    (hi.saturating_mul(g)).saturating_add(lo.wrapping_mul(g) >> 30)
 }
 
 /// `floor(a * w / 2^15)`, for `|a| <= 2^30` and `|w| <= 2^15` (the generator proves both

@@ -55,7 +55,7 @@ fn main() -> anyhow::Result<()> {
         let missed: Vec<String> = c.checks.iter().filter(|k| !k.met()).map(|k| format!("{} {:.2}{}", k.what, k.error, k.unit)).collect();
         let l0 = &c.stack.layers[0];
         println!(
-            "{:<44} {:>7.2} {:>7.2} {:>7.2} {:>6.3} {:>6.3} {:>5.2}  {}",
+            "{:<44} {:>7.2} {:>7.2} {:>7.2} {:>6.3} {:>6.3} {:>5.2} {:>8.4} {:>8.4}  {}",
             name,
             get("pre-puncture RMS"),
             get("puncture 1 position"),
@@ -63,6 +63,8 @@ fn main() -> anyhow::Result<()> {
             l0.family_weight,
             l0.softening_fraction,
             l0.softening_onset_ratio,
+            l0.stiffness_scale,
+            c.fit.onset_mm,
             missed.join("; ")
         );
         stacks.push((name, c, speed, contact));

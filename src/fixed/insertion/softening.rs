@@ -74,7 +74,8 @@ impl Softening {
     /// `1 - D` in Q30 at the boundary's force `force_q16` (module docs).
     #[inline]
     pub(super) fn factor_q30(&self, force_q16: i64) -> i64 {
-        let over = force_q16.saturating_sub(self.onset_q16).clamp(0, self.span_q16);
+        // max then min, not clamp: a span below 0 (refused by `in_range`) must not panic
+        let over = force_q16.saturating_sub(self.onset_q16).max(0).min(self.span_q16);
         // over <= span: over * slope <= fraction 2^62 < 2^61
         let loss = (over.saturating_mul(self.slope) >> 32).min(self.fraction_q30);
         (1 << 30) - loss
