@@ -106,6 +106,17 @@ pub struct ShapeFit {
     pub fraction_range: [f64; 2],
 }
 
+impl ShapeFit {
+    /// The candidate's class, simplest first: 0 the paper's tissue without softening, 1
+    /// with softening, 2 another member without, 3 another member with softening. The
+    /// fit is the simplest class within [`RANGE_SSE_RATIO`] of the best (a term is kept
+    /// only when the data ask for it: Okamura's liver stays the paper's tissue).
+    #[must_use]
+    pub fn class(&self) -> usize {
+        usize::from(self.weight < 1.0) * 2 + usize::from(self.softening.fraction > 0.0)
+    }
+}
+
 /// A candidate whose sum of squares is within this ratio of the best's counts towards a
 /// value's fitted range (its RMS within about 5 % of the best's): the measurement's
 /// residuals are correlated over depth (the shape, not noise), so a statistical interval
@@ -184,9 +195,9 @@ fn scale_fit(b: &[f64], points: &[Point]) -> (f64, f64) {
 /// The softened candidate with the force at the puncture held to the measured peak
 /// `f_p`: with `a = s`, `b = s δ` and `s (1 - δ) S_w(d_p) = f_p`, the force is
 /// `f_p S_w / S_p + b S_w (1 - x(ρ))` (`x` the softening's ramp): one least-squares
-/// unknown `b >= 0`. `(sse, s, δ)`, `None` when `S_w(d_p)` is not positive or `δ` would
+/// unknown `b >= 0`. `(sse, s, δ, sse at δ = 0)`, `None` when `S_w(d_p)` is not positive or `δ` would
 /// not be below [`MAX_FRACTION`].
-fn softened_fit(table: &Table, points: &[Point], onset: f64, d_p: f64, onset_ratio: f64, f_p: f64) -> Option<(f64, f64, f64)> {
+fn softened_fit(table: &Table, points: &[Point], onset: f64, d_p: f64, onset_ratio: f64, f_p: f64) -> Option<(f64, f64, f64, f64)> {
     let s_p = table.at(d_p);
     if s_p <= 0.0 || f_p <= 0.0 {
         return None;
@@ -207,7 +218,7 @@ fn softened_fit(table: &Table, points: &[Point], onset: f64, d_p: f64, onset_rat
     let sse = (rr - 2.0 * b * cr + b * b * cc).max(0.0);
     let scale = b + f_p / s_p;
     let fraction = b / scale;
-    (fraction < MAX_FRACTION).then_some((sse, scale, fraction))
+    (fraction < MAX_FRACTION).then_some((sse, scale, fraction, rr))
 }
 
 /// Fits the shape of the rise `pre` (contact to the first puncture's peak, the last
@@ -231,8 +242,9 @@ pub fn fit_members(pre: &[Point], surrogate: &dyn Fn(f64) -> f64, similarity: f6
     let measured_crossing = crate::replay::measured_onset(pre, pre.len() - 1, threshold);
     // every candidate's (sse, weight, fraction), for the fitted ranges
     let mut seen: Vec<(f64, f64, f64)> = Vec::new();
-    // the best of all, and the best whose contact onset matches the measured one
-    let (mut best, mut matched): (Option<ShapeFit>, Option<ShapeFit>) = (None, None);
+    // per class (ShapeFit::class) the best of all and the best whose contact onset
+    // matches the measured one
+    let (mut best, mut matched): ([Option<ShapeFit>; 4], [Option<ShapeFit>; 4]) = ([None; 4], [None; 4]);
     for &t in sqrt_weights {
         let member = FamilyMember::new((t * t) as f32)?;
         let table = Table::new(surrogate, &member, similarity, span + PUNCTURE_LATE_MM[PUNCTURE_LATE_MM.len() - 1] + TABLE_STEP_MM);
@@ -260,33 +272,43 @@ pub fn fit_members(pre: &[Point], surrogate: &dyn Fn(f64) -> f64, similarity: f6
         for (late, onset_ratio) in PUNCTURE_LATE_MM.iter().flat_map(|l| ONSET_RATIOS.iter().map(move |r| (*l, *r))) {
             for onset in onsets(lo, hi) {
                 let d_p = peak.position_mm + late - onset;
-                let Some((sse, scale, fraction)) = softened_fit(&table, pre, onset, d_p, onset_ratio, peak.force_n) else { continue };
-                seen.push((sse, t * t, fraction));
-                let candidate = ShapeFit {
-                    onset_mm: onset,
-                    scale,
-                    weight: t * t,
-                    softening: Softening { fraction, onset_ratio },
-                    critical_force_n: scale * table.at(d_p),
-                    puncture_mm: peak.position_mm + late,
-                    sse,
-                    weight_range: [t * t; 2],
-                    fraction_range: [fraction; 2],
+                let Some((sse, scale, fraction, plain_sse)) = softened_fit(&table, pre, onset, d_p, onset_ratio, peak.force_n) else {
+                    continue;
                 };
-                if best.is_none_or(|b| sse < b.sse) {
-                    best = Some(candidate);
-                }
-                // the onset threshold is below every onset ratio: the model's crossing is elastic
-                let crossing = table.crossing(threshold / scale).map(|d| onset + d);
-                let near = matches!((crossing, measured_crossing), (Some(c), Some(m)) if (c - m).abs() <= ONSET_MATCH_MM);
-                if near && matched.is_none_or(|b| sse < b.sse) {
-                    matched = Some(candidate);
+                seen.push((sse, t * t, fraction));
+                let crossing = |scale: f64| table.crossing(threshold / scale).map(|d| onset + d);
+                let near =
+                    |scale: f64| matches!((crossing(scale), measured_crossing), (Some(c), Some(m)) if (c - m).abs() <= ONSET_MATCH_MM);
+                // the candidate and the same without softening (through the peak: s = F_p / S_w(d_p))
+                let unsoftened = (plain_sse, peak.force_n / table.at(d_p), 0.0);
+                for (sse, scale, fraction) in [(sse, scale, fraction), unsoftened] {
+                    let candidate = ShapeFit {
+                        onset_mm: onset,
+                        scale,
+                        weight: t * t,
+                        softening: if fraction > 0.0 { Softening { fraction, onset_ratio } } else { Softening::NONE },
+                        critical_force_n: scale * table.at(d_p),
+                        puncture_mm: peak.position_mm + late,
+                        sse,
+                        weight_range: [t * t; 2],
+                        fraction_range: [fraction; 2],
+                    };
+                    // the onset threshold is below every onset ratio: the model's crossing is elastic
+                    let pool = if near(scale) { &mut matched } else { &mut best };
+                    let slot = &mut pool[candidate.class()];
+                    if slot.is_none_or(|b| sse < b.sse) {
+                        *slot = Some(candidate);
+                    }
                 }
             }
         }
     }
-    let mut best = matched.or(best)?;
-    let limit = best.sse * RANGE_SSE_RATIO;
+    // the candidates whose onset matches, when any does; among them the simplest class
+    // (the paper's tissue, no softening, first) within RANGE_SSE_RATIO of the best
+    let pool = if matched.iter().any(Option::is_some) { matched } else { best };
+    let least = pool.iter().flatten().map(|c| c.sse).fold(f64::INFINITY, f64::min);
+    let limit = least * RANGE_SSE_RATIO;
+    let mut best = pool.into_iter().flatten().find(|c| c.sse <= limit)?;
     for &(_, w, fraction) in seen.iter().filter(|c| c.0 <= limit) {
         best.weight_range = [best.weight_range[0].min(w), best.weight_range[1].max(w)];
         best.fraction_range = [best.fraction_range[0].min(fraction), best.fraction_range[1].max(fraction)];

@@ -242,6 +242,32 @@ fn deflection_at(pose: &Pose, indentation_mm: f32, scale: f32, similarity: f32, 
     (crate::Evaluation { wrench: Wrench::from_array(scaled), status: e.status }, k)
 }
 
+/// The deflection `e` (stiffness `k`) of a boundary of family member `member` at
+/// `indentation_mm`: times the member's ratio `g(δ/λ, w)` ([`crate::float::family::ratio`]);
+/// the stiffness becomes `k g + |F|₁ |dg/dδ|` (`|F|₁` the sum of the forces' magnitudes
+/// before `g`: at least the force's length, so the guard's view is not below it). Out of
+/// line: a stack of the paper's tissue does not pay for it (the M4F loop tick's budget).
+#[inline(never)]
+fn apply_member(e: &mut crate::Evaluation, k: &mut f32, indentation_mm: f32, similarity: f32, member: &FamilyMember) {
+    // similarity > 0 (checked by `Insertion::new`)
+    let (g, g_rate_per_fe_mm) = crate::float::family::ratio(indentation_mm / similarity, member);
+    let w = e.wrench.to_array();
+    let f1 = libm::fabsf(w[0]) + libm::fabsf(w[1]) + libm::fabsf(w[2]);
+    *k = *k * g + f1 * libm::fabsf(g_rate_per_fe_mm / similarity);
+    e.wrench = Wrench::from_array(w.map(|x| x * g));
+}
+
+/// The softened boundary: its filtered wrench `w`, the guard's view of its elastic one and
+/// its stiffness times `factor` (the filter's state keeps the unsoftened wrench). Out of
+/// line as [`apply_member`].
+#[inline(never)]
+fn soften(w: &mut [f32; 6], elastic: &mut [f32; 6], k: &mut f32, factor: f32) {
+    for x in w.iter_mut().chain(elastic.iter_mut()) {
+        *x *= factor;
+    }
+    *k *= factor;
+}
+
 /// The needle's unit axis from tip to hub for the pose's tilts (each clamped to ±89
 /// degrees), as the insertion model computes it: `(-sin θz cos θx, cos θz cos θx, sin θx)`
 /// (the [`orientation`](crate::orientation) convention) with f32 polynomials for sine and
@@ -697,23 +723,6 @@ impl Insertion {
     /// releases the boundary's stored viscous force (the filter is reset: the lateral
     /// part kept as preload is the elastic one), as does the tip leaving the boundary
     /// (no deflected boundary in this tick): nothing stored is pushed into the hand.
-    /// [`deflection_at`] of `layer` at `indentation_mm`, times its family member's ratio
-    /// `g(δ/λ, w)` ([`crate::float::family::ratio`]; the paper's tissue: untouched, bit for
-    /// bit). The stiffness becomes `k g + |F|₁ |dg/dδ|` (`|F|₁` the sum of the unscaled
-    /// forces' magnitudes: at least the force's length, so the guard's view is not below it).
-    fn member_deflection(&self, pose: &Pose, indentation_mm: f32, layer: &Layer, rate: bool) -> (crate::Evaluation, f32) {
-        let (e, k) = deflection_at(pose, indentation_mm, layer.stiffness_scale, self.similarity, rate);
-        if layer.family.weight() >= 1.0 {
-            return (e, k);
-        }
-        // similarity > 0 (checked by `new`)
-        let (g, g_rate_per_fe_mm) = crate::float::family::ratio(indentation_mm / self.similarity, &layer.family);
-        let w = e.wrench.to_array();
-        let f1 = libm::fabsf(w[0]) + libm::fabsf(w[1]) + libm::fabsf(w[2]);
-        let k = k * g + f1 * libm::fabsf(g_rate_per_fe_mm / self.similarity);
-        (crate::Evaluation { wrench: Wrench::from_array(w.map(|x| x * g)), status: e.status }, k)
-    }
-
     fn deflect(&mut self, pose: &Pose, a: Vec3, entry: Vec3, bounds: &[f32; MAX_LAYERS + 1], rate: bool) -> Deflected {
         let mut punctures = 0u8;
         while self.punctured < self.count {
@@ -722,25 +731,23 @@ impl Insertion {
                 break;
             }
             let (Some(layer), Some(qlv), Some(soft)) =
-                (self.layers.get(self.punctured).copied(), self.qlv.get(self.punctured), self.soft.get(self.punctured).copied())
+                (self.layers.get(self.punctured).copied(), self.qlv.get(self.punctured), self.soft.get(self.punctured))
             else {
                 break;
             };
-            let (e, k) = self.member_deflection(pose, pose.depth_mm - q, &layer, rate);
+            let indentation_mm = pose.depth_mm - q;
+            let (mut e, mut k) = deflection_at(pose, indentation_mm, layer.stiffness_scale, self.similarity, rate);
+            if layer.family.weight() < 1.0 {
+                apply_member(&mut e, &mut k, indentation_mm, self.similarity, &layer.family);
+            }
             let mut elastic = e.wrench.to_array();
             let mut w = self.qlv_state.step(qlv, elastic);
             let axial_n = dot([w[0], w[1], w[2]], a);
             let boundary_n = axial_n + self.carried_cutting_n();
             if boundary_n < soft.critical_n {
-                let mut k = k;
                 if soft.active() {
-                    // the tissue starting to fail: the boundary's wrench (and the guard's
-                    // view of it) loses its share; the filter's state keeps the unsoftened one
-                    let factor = soft.factor(boundary_n);
-                    for x in w.iter_mut().chain(elastic.iter_mut()) {
-                        *x *= factor;
-                    }
-                    k *= factor;
+                    // the tissue starting to fail: the boundary's wrench loses its share
+                    soften(&mut w, &mut elastic, &mut k, soft.factor(boundary_n));
                 }
                 let mut total = self.preload;
                 for (t, x) in total.iter_mut().zip(w) {
