@@ -247,25 +247,24 @@ fn deflection_at(pose: &Pose, indentation_mm: f32, scale: f32, similarity: f32, 
 /// the stiffness becomes `k g + |F|₁ |dg/dδ|` (`|F|₁` the sum of the forces' magnitudes
 /// before `g`: at least the force's length, so the guard's view is not below it). Out of
 /// line: a stack of the paper's tissue does not pay for it (the M4F loop tick's budget).
+/// (Values in and out, no references: the caller's wrench stays in registers on the
+/// path that does not call it.)
 #[inline(never)]
-fn apply_member(e: &mut crate::Evaluation, k: &mut f32, indentation_mm: f32, similarity: f32, member: &FamilyMember) {
+fn apply_member(e: crate::Evaluation, k: f32, indentation_mm: f32, similarity: f32, member: &FamilyMember) -> (crate::Evaluation, f32) {
     // similarity > 0 (checked by `Insertion::new`)
     let (g, g_rate_per_fe_mm) = crate::float::family::ratio(indentation_mm / similarity, member);
     let w = e.wrench.to_array();
     let f1 = libm::fabsf(w[0]) + libm::fabsf(w[1]) + libm::fabsf(w[2]);
-    *k = *k * g + f1 * libm::fabsf(g_rate_per_fe_mm / similarity);
-    e.wrench = Wrench::from_array(w.map(|x| x * g));
+    let k = k * g + f1 * libm::fabsf(g_rate_per_fe_mm / similarity);
+    (crate::Evaluation { wrench: Wrench::from_array(w.map(|x| x * g)), status: e.status }, k)
 }
 
 /// The softened boundary: its filtered wrench `w`, the guard's view of its elastic one and
 /// its stiffness times `factor` (the filter's state keeps the unsoftened wrench). Out of
 /// line as [`apply_member`].
 #[inline(never)]
-fn soften(w: &mut [f32; 6], elastic: &mut [f32; 6], k: &mut f32, factor: f32) {
-    for x in w.iter_mut().chain(elastic.iter_mut()) {
-        *x *= factor;
-    }
-    *k *= factor;
+fn soften(w: [f32; 6], elastic: [f32; 6], k: f32, factor: f32) -> ([f32; 6], [f32; 6], f32) {
+    (w.map(|x| x * factor), elastic.map(|x| x * factor), k * factor)
 }
 
 /// The needle's unit axis from tip to hub for the pose's tilts (each clamped to ±89
@@ -730,15 +729,14 @@ impl Insertion {
             if pose.depth_mm <= q {
                 break;
             }
-            let (Some(layer), Some(qlv), Some(soft)) =
-                (self.layers.get(self.punctured).copied(), self.qlv.get(self.punctured), self.soft.get(self.punctured))
+            let (Some(layer), Some(qlv), Some(soft)) = (self.layers.get(self.punctured), self.qlv.get(self.punctured), self.soft.get(self.punctured))
             else {
                 break;
             };
             let indentation_mm = pose.depth_mm - q;
             let (mut e, mut k) = deflection_at(pose, indentation_mm, layer.stiffness_scale, self.similarity, rate);
             if layer.family.weight() < 1.0 {
-                apply_member(&mut e, &mut k, indentation_mm, self.similarity, &layer.family);
+                (e, k) = apply_member(e, k, indentation_mm, self.similarity, &layer.family);
             }
             let mut elastic = e.wrench.to_array();
             let mut w = self.qlv_state.step(qlv, elastic);
@@ -747,7 +745,7 @@ impl Insertion {
             if boundary_n < soft.critical_n {
                 if soft.active() {
                     // the tissue starting to fail: the boundary's wrench loses its share
-                    soften(&mut w, &mut elastic, &mut k, soft.factor(boundary_n));
+                    (w, elastic, k) = soften(w, elastic, k, soft.factor(boundary_n));
                 }
                 let mut total = self.preload;
                 for (t, x) in total.iter_mut().zip(w) {
