@@ -242,29 +242,16 @@ fn deflection_at(pose: &Pose, indentation_mm: f32, scale: f32, similarity: f32, 
     (crate::Evaluation { wrench: Wrench::from_array(scaled), status: e.status }, k)
 }
 
-/// The deflection `e` (stiffness `k`) of a boundary of family member `member` at
-/// `indentation_mm`: times the member's ratio `g(δ/λ, w)` ([`crate::float::family::ratio`]);
-/// the stiffness becomes `k g + |F|₁ |dg/dδ|` (`|F|₁` the sum of the forces' magnitudes
-/// before `g`: at least the force's length, so the guard's view is not below it). Out of
-/// line: a stack of the paper's tissue does not pay for it (the M4F loop tick's budget).
-/// (Values in and out, no references: the caller's wrench stays in registers on the
-/// path that does not call it.)
+/// The family member's ratio `g(δ/λ, w)` ([`crate::float::family::ratio`]) at
+/// `indentation_mm` and the boundary's stiffness with it, `k g + |F|₁ |dg/dδ|` (`f1_n`:
+/// `|F|₁`, the sum of the forces' magnitudes before `g`, at least the force's length, so
+/// the guard's view is not below it). Out of line, scalars in and out: a stack of the
+/// paper's tissue pays one compare (the M4F loop tick's budget).
 #[inline(never)]
-fn apply_member(e: crate::Evaluation, k: f32, indentation_mm: f32, similarity: f32, member: &FamilyMember) -> (crate::Evaluation, f32) {
+fn member_gain(f1_n: f32, k: f32, indentation_mm: f32, similarity: f32, member: &FamilyMember) -> (f32, f32) {
     // similarity > 0 (checked by `Insertion::new`)
     let (g, g_rate_per_fe_mm) = crate::float::family::ratio(indentation_mm / similarity, member);
-    let w = e.wrench.to_array();
-    let f1 = libm::fabsf(w[0]) + libm::fabsf(w[1]) + libm::fabsf(w[2]);
-    let k = k * g + f1 * libm::fabsf(g_rate_per_fe_mm / similarity);
-    (crate::Evaluation { wrench: Wrench::from_array(w.map(|x| x * g)), status: e.status }, k)
-}
-
-/// The softened boundary: its filtered wrench `w`, the guard's view of its elastic one and
-/// its stiffness times `factor` (the filter's state keeps the unsoftened wrench). Out of
-/// line as [`apply_member`].
-#[inline(never)]
-fn soften(w: [f32; 6], elastic: [f32; 6], k: f32, factor: f32) -> ([f32; 6], [f32; 6], f32) {
-    (w.map(|x| x * factor), elastic.map(|x| x * factor), k * factor)
+    (g, k * g + f1_n * libm::fabsf(g_rate_per_fe_mm / similarity))
 }
 
 /// The needle's unit axis from tip to hub for the pose's tilts (each clamped to ±89
@@ -277,10 +264,14 @@ pub fn needle_axis(pose: &Pose) -> [f32; 3] {
 }
 
 /// The state of one needle path through a stack: fixed size, no allocation.
+///
+/// `repr(C)`, the per-tick scalars first and the per-layer tables last: a Cortex-M
+/// floating-point load reaches 1,020 bytes from its base, so the fields a tick reads stay
+/// within one instruction's reach of `self` (the M4F loop tick's budget).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(C)]
 pub struct Insertion {
-    layers: [Layer; MAX_LAYERS],
     count: usize,
     similarity: f32,
     config: InsertionConfig,
@@ -297,17 +288,18 @@ pub struct Insertion {
     /// The last tick's wrench and phase: what a glitch tick holds.
     held: (Wrench, Phase),
     velocity_mm_per_s: f32,
-    /// Per layer the relaxation's per-tick coefficients (computed once, in `new`).
-    qlv: [QlvCoefficients; MAX_LAYERS],
-    /// Per layer the pre-puncture softening's terms and the force that punctures
-    /// (computed once, in `new`).
-    soft: [SofteningTerms; MAX_LAYERS],
     /// The viscoelastic filter of the deflected boundary's wrench.
     qlv_state: QlvState,
     /// The filter's share for a guard of the last [`Insertion::step_with_stiffness`]
     /// (zero-sized without the `viscoelastic` feature; written only by that call, so
     /// `step` carries none of it).
     guard_share: FilterTerms,
+    /// Per layer the pre-puncture softening's terms and the force that punctures
+    /// (computed once, in `new`).
+    soft: [SofteningTerms; MAX_LAYERS],
+    /// Per layer the relaxation's per-tick coefficients (computed once, in `new`).
+    qlv: [QlvCoefficients; MAX_LAYERS],
+    layers: [Layer; MAX_LAYERS],
 }
 
 /// What a passivity guard needs of an insertion tick beside its wrench
@@ -729,23 +721,29 @@ impl Insertion {
             if pose.depth_mm <= q {
                 break;
             }
-            let (Some(layer), Some(qlv), Some(soft)) = (self.layers.get(self.punctured), self.qlv.get(self.punctured), self.soft.get(self.punctured))
-            else {
-                break;
-            };
+            let (Some(layer), Some(qlv)) = (self.layers.get(self.punctured), self.qlv.get(self.punctured)) else { break };
             let indentation_mm = pose.depth_mm - q;
-            let (mut e, mut k) = deflection_at(pose, indentation_mm, layer.stiffness_scale, self.similarity, rate);
-            if layer.family.weight() < 1.0 {
-                (e, k) = apply_member(e, k, indentation_mm, self.similarity, &layer.family);
-            }
+            let (e, mut k) = deflection_at(pose, indentation_mm, layer.stiffness_scale, self.similarity, rate);
             let mut elastic = e.wrench.to_array();
+            if layer.family.weight() < 1.0 {
+                let f1_n = libm::fabsf(elastic[0]) + libm::fabsf(elastic[1]) + libm::fabsf(elastic[2]);
+                let g;
+                (g, k) = member_gain(f1_n, k, indentation_mm, self.similarity, &layer.family);
+                elastic = elastic.map(|x| x * g);
+            }
             let mut w = self.qlv_state.step(qlv, elastic);
             let axial_n = dot([w[0], w[1], w[2]], a);
             let boundary_n = axial_n + self.carried_cutting_n();
+            // looked up after the filter: nothing of it is live across the filter's step
+            let Some(soft) = self.soft.get(self.punctured) else { break };
             if boundary_n < soft.critical_n {
                 if soft.active() {
-                    // the tissue starting to fail: the boundary's wrench loses its share
-                    (w, elastic, k) = soften(w, elastic, k, soft.factor(boundary_n));
+                    // the tissue starting to fail: the boundary's wrench (and the guard's view
+                    // of it) loses its share; the filter's state keeps the unsoftened one
+                    let factor = soft.factor(boundary_n);
+                    w = w.map(|x| x * factor);
+                    elastic = elastic.map(|x| x * factor);
+                    k *= factor;
                 }
                 let mut total = self.preload;
                 for (t, x) in total.iter_mut().zip(w) {
