@@ -47,8 +47,12 @@ pub fn read_trial(path: &Path) -> Result<Vec<Sample>> {
     let header = reader.headers().with_context(|| format!("{}:1: cannot read the header", path.display()))?.clone();
     let mut index = [0usize; 3];
     for (slot, name) in index.iter_mut().zip(TRIAL_COLUMNS) {
-        *slot = crate::measured::column_index(&header, name, &TRIAL_COLUMNS)
-            .map_err(|problem| anyhow::anyhow!("{}:1: {problem}", path.display()))?;
+        *slot = crate::measured::column_index(&header, name, &TRIAL_COLUMNS).map_err(|problem| {
+            // a curve (position_mm,force_n) is the other format calibrate reads
+            let curve = !header.iter().any(|h| h == "time_s") && crate::measured::COLUMNS.iter().all(|c| header.iter().any(|h| h == *c));
+            let hint = if curve { ": this is a curve of one insertion (position_mm,force_n): give it with --curve" } else { "" };
+            anyhow::anyhow!("{}:1: {problem}{hint}", path.display())
+        })?;
     }
     let mut samples: Vec<Sample> = Vec::new();
     for record in reader.records() {
@@ -86,28 +90,39 @@ pub fn read_trial(path: &Path) -> Result<Vec<Sample>> {
     Ok(samples)
 }
 
-/// A trial cut into its phases (index ranges into its samples).
+/// A trial cut into its phases (index ranges into its samples). A trial without a hold
+/// or without a withdrawal has that range empty (and says so in `notes`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Phases {
     /// The stage advancing: from the last sample at the start position to the first at
     /// the furthest travel.
     pub insertion: Range<usize>,
-    /// The stage at rest at its furthest travel.
+    /// The stage at rest at its furthest travel (empty: no hold).
     pub hold: Range<usize>,
-    /// The stage returning, to the trial's end.
+    /// The stage returning, to the trial's end (empty: no withdrawal).
     pub withdrawal: Range<usize>,
     /// The first sample of the insertion where the force leaves the tare's noise band.
     pub contact: usize,
     /// The insertion's speed, mm/s (least squares of position against time over its
     /// middle 80 %).
     pub insertion_speed_mm_per_s: f64,
-    /// The withdrawal's speed, mm/s (negative: the stage returns), as the insertion's.
+    /// The withdrawal's speed, mm/s (negative: the stage returns), as the insertion's;
+    /// 0 without a withdrawal.
     pub withdrawal_speed_mm_per_s: f64,
-    /// The hold's duration, s.
+    /// The hold's duration, s (0 without a hold).
     pub hold_s: f64,
     /// The stage's furthest travel from its start, mm.
     pub travel_mm: f64,
+    /// What the trial lacks (no hold, no withdrawal), each a sentence naming the file:
+    /// the calibration fits without that phase and says so.
+    pub notes: Vec<String>,
 }
+
+/// Shortest rest at the furthest travel that counts as a hold, s.
+pub const MIN_HOLD_S: f64 = 0.5;
+
+/// Fewest samples of a withdrawal (fewer: the trial has none).
+pub const MIN_WITHDRAWAL_SAMPLES: usize = 10;
 
 /// How close to the start or furthest position the stage counts as there, as a
 /// fraction of the travel (an encoder's quantisation and the servo's settling are far
@@ -126,8 +141,9 @@ pub const CONTACT_FLOOR_N: f64 = 0.005;
 /// Cuts `s` into insertion, hold and withdrawal, and finds the contact (module docs).
 ///
 /// # Errors
-/// The stage does not advance, does not rest at its furthest travel, or does not return;
-/// no sample before the stage moves to measure the tare on; no contact.
+/// The stage does not advance; no sample before the stage moves to measure the tare on;
+/// no contact. A trial without a hold or a withdrawal is not an error: that range is
+/// empty and [`Phases::notes`] says so.
 pub fn phases(s: &[Sample], what: &str) -> Result<Phases> {
     let (Some(first), Some(max)) = (s.first(), s.iter().map(|x| x.position_mm).reduce(f64::max)) else {
         bail!("{what}: no samples");
@@ -144,19 +160,33 @@ pub fn phases(s: &[Sample], what: &str) -> Result<Phases> {
     if begin < 2 {
         bail!("{what}: the stage moves from its first sample: no tare to measure the force's noise on");
     }
-    if leave + 2 >= s.len() {
-        bail!("{what}: the stage does not return after its furthest travel ({max} mm): no withdrawal");
-    }
     let fit = |r: Range<usize>| slope(&s[r.clone()]).with_context(|| format!("{what}: samples {r:?}: too few to fit a speed"));
     let insertion = begin..top + 1;
-    let withdrawal = leave..s.len();
-    let hold = top..leave + 1;
+    let mut notes = Vec::new();
+    let withdrawal = if leave + MIN_WITHDRAWAL_SAMPLES < s.len() {
+        leave..s.len()
+    } else {
+        let line = s[leave].line;
+        notes.push(format!(
+            "{what}:{line}: the stage does not return after its furthest travel ({max} mm): no withdrawal (fitted without it)"
+        ));
+        s.len()..s.len()
+    };
     let hold_s = s[leave].time_s - s[top].time_s;
+    let (hold, hold_s) = if hold_s >= MIN_HOLD_S {
+        (top..leave + 1, hold_s)
+    } else {
+        let line = s[top].line;
+        notes.push(format!(
+            "{what}:{line}: the stage rests {hold_s:.3} s at its furthest travel ({max} mm), less than {MIN_HOLD_S} s: no hold (fitted without it)"
+        ));
+        (top..top, 0.0)
+    };
     let insertion_speed_mm_per_s = fit(middle(&insertion))?;
-    let withdrawal_speed_mm_per_s = fit(middle(&until_back(s, &withdrawal, start + tol)))?;
+    let withdrawal_speed_mm_per_s = if withdrawal.is_empty() { 0.0 } else { fit(middle(&until_back(s, &withdrawal, start + tol)))? };
     let contact =
         contact(s, begin, &insertion).with_context(|| format!("{what}: the force never leaves the tare's noise during the insertion"))?;
-    Ok(Phases { insertion, hold, withdrawal, contact, insertion_speed_mm_per_s, withdrawal_speed_mm_per_s, hold_s, travel_mm })
+    Ok(Phases { insertion, hold, withdrawal, contact, insertion_speed_mm_per_s, withdrawal_speed_mm_per_s, hold_s, travel_mm, notes })
 }
 
 /// The withdrawal up to where the stage is back at its start (`back_mm`; the trial may

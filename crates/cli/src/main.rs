@@ -30,6 +30,8 @@ component by cross-validation). Writes model.toml and the four golden files all 
     InsertionPaths(needle_cli::commands::insertion_paths::InsertionPathsArgs),
     /// Fit a tissue stack (<set>/tissue/<name>.toml) to a measured force against needle position.
     Calibrate(needle_cli::commands::calibrate::CalibrateArgs),
+    /// Drive a tissue stack with a measured trial (time, position): measured and model force per row.
+    Replay(needle_cli::commands::replay::ReplayArgs),
     /// Derive a tissue stack from a published model's force polynomials per layer (no measured curve).
     CalibratePublished(needle_cli::commands::calibrate_published::CalibratePublishedArgs),
     /// Compare the model with the FE runs it was not fitted on; exit 1 when a goal is missed.
@@ -79,6 +81,7 @@ fn main() -> ExitCode {
         Command::InsertionPaths(a) => commands::insertion_paths::run(a),
         Command::Calibrate(a) => commands::calibrate::run(a),
         Command::CalibratePublished(a) => commands::calibrate_published::run(a),
+        Command::Replay(a) => commands::replay::run(a),
         Command::Explore(a) => commands::explore::run(a),
         Command::Plot(a) => commands::plot::run(a),
         Command::Header(a) => commands::header::run(a),

@@ -34,6 +34,9 @@ struct Raw {
     /// The law against each member run (`needle fit`'s report; not read here).
     #[serde(default)]
     check: Vec<toml::Value>,
+    /// The law at the check poses (`needle fit`'s report; not read here).
+    #[serde(default)]
+    pose_check: Vec<toml::Value>,
 }
 
 /// The checked law: its depth domain and the f32 coefficients `a_jk` at
@@ -74,7 +77,7 @@ pub fn parse(path: &Path) -> Result<Family, CodegenError> {
     let coeffs_f32 = nearest_f32s::<TERMS>(raw.coeffs.get_ref(), raw.coeffs_f32.get_ref(), &|m| at(raw.coeffs.span(), m), &|m| {
         at(raw.coeffs_f32.span(), m)
     })?;
-    let _ = (&raw.reference_sha256, &raw.fitted_weights, &raw.fitted_sha256, &raw.check);
+    let _ = (&raw.reference_sha256, &raw.fitted_weights, &raw.fitted_sha256, &raw.check, &raw.pose_check);
     Ok(Family { depth_max_mm: depth, coeffs_f32 })
 }
 

@@ -16,7 +16,8 @@
 //! force error as a fraction of the member's peak: the figure [`MemberCheck`] reports,
 //! for the fitted members and for `family.held_out` (members it was not fitted on).
 //! The six-axis pose dependence is carried over by the same ratio (the library's wrench
-//! at a pose times `g`), checked by the half-model runs `family.check_poses`.
+//! at a pose times `g`), checked by the half-model runs `family.check_poses`
+//! ([`crate::family_poses`]).
 use crate::lsq;
 use anyhow::{bail, Context, Result};
 use nalgebra::{DMatrix, DVector};
@@ -26,8 +27,9 @@ use needle_set::partial;
 use needle_set::results::{content_sha256, parse_csv, Row};
 use needle_set::set_folder::{SetFolder, FAMILY_DIR};
 use needle_set::spec::family::runs::{apply, FamilyRun};
-use needle_set::spec::Campaign;
+use needle_set::spec::{Campaign, PoseSpec};
 use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
 
 /// The file's name, the law's degrees in depth and in `t = sqrt(w)`, its coefficient
 /// count (`a_jk` at `j * (WEIGHT_DEGREE + 1) + k`): the generator's, which reads the file.
@@ -109,13 +111,7 @@ pub fn ratio(coeffs: &[f64; TERMS], depth_max_mm: f64, depth_mm: f64, weight: f6
 pub fn read_runs(set: &SetFolder) -> Result<Option<(MemberRun, Vec<MemberRun>)>> {
     let c = set.campaign();
     let Some(f) = &c.family else { return Ok(None) };
-    let dir = set.fe_dir().join(FAMILY_DIR);
-    let manifest_path = dir.join(MANIFEST);
-    let manifest = if manifest_path.is_file() {
-        read_manifest(&manifest_path).with_context(|| format!("{}", manifest_path.display()))?
-    } else {
-        Manifest::default()
-    };
+    let (dir, manifest) = read_family_manifest(set)?;
     let Some(reference) = read_run(c, &manifest, &dir, FamilyRun::Reference)? else { return Ok(None) };
     let mut members = Vec::new();
     for &weight in &f.weight {
@@ -126,25 +122,59 @@ pub fn read_runs(set: &SetFolder) -> Result<Option<(MemberRun, Vec<MemberRun>)>>
     Ok(Some((reference, members)))
 }
 
+/// The family's folder `fe/family/` of `set` and its manifest (empty when there is none yet).
+///
+/// # Errors
+/// An unreadable or malformed manifest (with its path).
+pub(crate) fn read_family_manifest(set: &SetFolder) -> Result<(PathBuf, Manifest)> {
+    let dir = set.fe_dir().join(FAMILY_DIR);
+    let manifest_path = dir.join(MANIFEST);
+    let manifest = if manifest_path.is_file() {
+        read_manifest(&manifest_path).with_context(|| format!("{}", manifest_path.display()))?
+    } else {
+        Manifest::default()
+    };
+    Ok((dir, manifest))
+}
+
+/// One family run's must points as read from `fe/family/`, vouched for by their hash.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct VouchedRun {
+    /// Every row of the CSV (depth 0 first).
+    pub rows: Vec<Row>,
+    /// SHA-256 of the CSV.
+    pub csv_sha256: String,
+    /// Whether the run reached its depth (false: its `.partial.csv`).
+    pub complete: bool,
+}
+
 /// What vouches for a run's CSV bytes: its manifest entry's or its partial record's hash.
 type Vouch<'a> = Box<dyn Fn(&[u8]) -> bool + 'a>;
 
-/// The centre run of `run`: its result, or when it failed every attempt so far the must
-/// points of its furthest attempt (a current `.partial.csv`: converged FE states, only
-/// not as deep as asked); `None` when there is neither.
-fn read_run(c: &Campaign, manifest: &Manifest, dir: &std::path::Path, run: FamilyRun) -> Result<Option<MemberRun>> {
-    let Some(f) = &c.family else { return Ok(None) };
-    let (campaign, poses, mesh) = apply(c, f, run);
-    let Some(pose) = poses.first() else { return Ok(None) };
+/// The family run of `pose` (a renamed pose of [`apply`]'s, solved with `campaign` on
+/// `mesh`) in `dir`: its result, or when it failed every attempt so far the must points of
+/// its furthest attempt (a current `.partial.csv`: converged FE states, only not as deep as
+/// asked); `None` when there is neither.
+///
+/// # Errors
+/// A result whose manifest entry is missing or stale, a CSV that is not the one its entry
+/// or partial record was written for, or an unreadable CSV (each names its file).
+pub(crate) fn read_vouched(
+    campaign: &Campaign,
+    manifest: &Manifest,
+    dir: &Path,
+    pose: &PoseSpec,
+    mesh: &str,
+) -> Result<Option<VouchedRun>> {
     let path = dir.join(format!("{}.csv", pose.name));
     // the CSV and what vouches for its bytes: its manifest entry, or its partial record
     let (path, vouched, complete): (_, Vouch<'_>, _) = if path.is_file() {
         let entry = manifest
-            .current_entry(&campaign, pose, &mesh)
+            .current_entry(campaign, pose, mesh)
             .map_err(|why| anyhow::anyhow!("{}: {why}: rerun it with needle fe run --family --only {}", path.display(), pose.name))?;
         (path, Box::new(move |b: &[u8]| entry.content_matches(b)), true)
     } else {
-        let Some(record) = partial::read_current_record(dir, &pose.name, &campaign.run_hash(pose, &mesh)) else { return Ok(None) };
+        let Some(record) = partial::read_current_record(dir, &pose.name, &campaign.run_hash(pose, mesh)) else { return Ok(None) };
         (partial::paths(dir, &pose.name).0, Box::new(move |b: &[u8]| content_sha256(b) == record.csv_sha256), false)
     };
     let bytes = std::fs::read(&path).with_context(|| format!("{}: cannot read", path.display()))?;
@@ -155,8 +185,17 @@ fn read_run(c: &Campaign, manifest: &Manifest, dir: &std::path::Path, run: Famil
         );
     }
     let rows: Vec<Row> = parse_csv(&String::from_utf8_lossy(&bytes), &path)?;
-    let fy = rows.iter().map(|r| (r.depth_mm, r.wrench[FY])).collect();
-    Ok(Some(MemberRun { weight: run.weight().unwrap_or(1.0), fy, csv_sha256: content_sha256(&bytes), complete }))
+    Ok(Some(VouchedRun { rows, csv_sha256: content_sha256(&bytes), complete }))
+}
+
+/// The centre run of `run` ([`read_vouched`]), its Fy against depth.
+fn read_run(c: &Campaign, manifest: &Manifest, dir: &Path, run: FamilyRun) -> Result<Option<MemberRun>> {
+    let Some(f) = &c.family else { return Ok(None) };
+    let (campaign, poses, mesh) = apply(c, f, run);
+    let Some(pose) = poses.first() else { return Ok(None) };
+    let Some(v) = read_vouched(&campaign, manifest, dir, pose, &mesh)? else { return Ok(None) };
+    let fy = v.rows.iter().map(|r| (r.depth_mm, r.wrench[FY])).collect();
+    Ok(Some(MemberRun { weight: run.weight().unwrap_or(1.0), fy, csv_sha256: v.csv_sha256, complete: v.complete }))
 }
 
 impl MemberRun {

@@ -23,6 +23,7 @@ pub mod depth_floor;
 pub mod error_trend;
 pub mod eval;
 pub mod family;
+pub mod family_poses;
 pub mod fixed_formats;
 pub mod golden;
 pub mod lsq;
@@ -73,6 +74,8 @@ pub struct FitOutput {
     pub depth_law: Vec<depth_extension::LawCheck>,
     /// The material family's law (`family.toml` when fitted).
     pub family: family::FamilyFit,
+    /// The law at the family's check poses (empty without a fitted law).
+    pub family_poses: family_poses::PoseChecks,
     /// The unsolved region, from the set's FE records.
     pub unsolved: unsolved::Region,
     /// The text of `unsolved.toml`.
@@ -139,12 +142,17 @@ pub fn fit_set(set: &SetFolder) -> Result<FitOutput> {
     };
     let depth_extension_toml = extension.as_ref().map(depth_extension::to_toml);
     let family = family::fit(set)?;
+    let family_poses = match &family {
+        family::FamilyFit::Law(law) => family_poses::checks(set, &model, &law.coeffs, law.depth_max_mm)?,
+        _ => family_poses::PoseChecks::default(),
+    };
     let family_toml = match &family {
-        family::FamilyFit::Law(law) => Some(family::to_toml(law)),
+        family::FamilyFit::Law(law) => Some(family::to_toml(law) + &family_poses::to_toml(&family_poses)),
         _ => None,
     };
     Ok(FitOutput {
         family,
+        family_poses,
         family_toml,
         model,
         model_toml,

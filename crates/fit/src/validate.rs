@@ -206,7 +206,9 @@ fn role_name(r: Role) -> &'static str {
     }
 }
 
-fn errors(model_w: &[[f64; COMPONENT_COUNT]], run: &Run, scale: [f64; COMPONENT_COUNT]) -> [CompError; COMPONENT_COUNT] {
+/// Per component, the RMS and largest `model_w - run` over the run's rows (`model_w` row by
+/// row), in N or N·mm and in % of `scale` ([`needle_contract::error_scales`]).
+pub(crate) fn errors(model_w: &[[f64; COMPONENT_COUNT]], run: &Run, scale: [f64; COMPONENT_COUNT]) -> [CompError; COMPONENT_COUNT] {
     let mut out = [CompError::default(); COMPONENT_COUNT];
     for (c, e) in out.iter_mut().enumerate() {
         let (rms, max) = rms_max(model_w.iter().zip(&run.rows).map(|(w, r)| w[c] - r.wrench[c]));

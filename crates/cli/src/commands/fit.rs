@@ -85,7 +85,10 @@ pub fn run(a: FitArgs) -> Result<ExitCode> {
     match &out.family {
         fit::family::FamilyFit::None => {}
         fit::family::FamilyFit::Pending(why) => println!("{why}"),
-        fit::family::FamilyFit::Law(law) => print!("{}", fit::family::summary(law)),
+        fit::family::FamilyFit::Law(law) => {
+            print!("{}", fit::family::summary(law));
+            print!("{}", fit::family_poses::summary(&out.family_poses));
+        }
     }
     for (path, text) in &files {
         if path.extension().is_some_and(|e| e == "csv") {

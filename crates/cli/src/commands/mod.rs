@@ -14,4 +14,5 @@ pub mod fixed_error;
 pub mod header;
 pub mod insertion_paths;
 pub mod plot;
+pub mod replay;
 pub mod validate;

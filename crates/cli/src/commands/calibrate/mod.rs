@@ -1,6 +1,8 @@
 //! `needle calibrate`: a tissue stack fitted to a measured axial force (needle-calibrate),
 //! written into the set's `tissue/` and checked against the curve.
 pub mod figure;
+pub mod json;
+pub mod trials;
 
 use crate::compiled_set::check_compiled_set_except;
 use crate::planned_outputs::{self, Planned};
@@ -23,19 +25,26 @@ pub struct CalibrateArgs {
     /// The measured curve: CSV with columns position_mm and force_n, in the order of the
     /// insertion (at most 100,000 points and 16 MiB; positions spanning 1 to 500 mm;
     /// |force| <= 500 N).
-    #[arg(long)]
-    pub curve: PathBuf,
+    #[arg(long, required_unless_present = "trials", conflicts_with = "trials")]
+    pub curve: Option<PathBuf>,
+    /// Whole measured trials of one tissue sample and one needle, calibrated together:
+    /// CSVs with columns time_s, position_mm (stage travel) and force_n; insertion, hold
+    /// and withdrawal are found from the position against time, the contact by the fit;
+    /// any mix of speeds and repeats.
+    #[arg(long, num_args = 1.., value_name = "TRIAL")]
+    pub trials: Vec<PathBuf>,
     /// Name of the stack (the tissue file is <set>/tissue/<name>.toml): lower-case ASCII
     /// letters, digits and '_', starting with a letter.
     #[arg(long)]
     pub name: String,
     /// Diameter of the measured needle, mm, 0.1 to 10 (the FE needle is carried to it by
-    /// geometric similarity).
-    #[arg(long, allow_negative_numbers = true)]
-    pub needle_diameter_mm: f64,
-    /// Insertion speed of the measurement, mm/s, 0.01 to 1000.
-    #[arg(long, allow_negative_numbers = true)]
-    pub speed_mm_per_s: f64,
+    /// geometric similarity); with --trials one value, or one per trial (all equal).
+    #[arg(long, allow_negative_numbers = true, num_args = 1.., required = true)]
+    pub needle_diameter_mm: Vec<f64>,
+    /// Insertion speed of the measurement, mm/s, 0.01 to 1000 (--curve only: a trial's
+    /// speeds are measured from its time).
+    #[arg(long, allow_negative_numbers = true, required_unless_present = "trials", conflicts_with = "trials")]
+    pub speed_mm_per_s: Option<f64>,
     /// Smallest drop that counts as a puncture, fraction of the peak force, 0.001 to 0.999.
     #[arg(long, default_value_t = EventRule::default().drop_fraction, allow_negative_numbers = true)]
     pub drop_fraction: f64,
@@ -53,6 +62,11 @@ pub struct CalibrateArgs {
     /// without it, a missed goal writes nothing.
     #[arg(long)]
     pub write_on_miss: bool,
+    /// With --trials: print one JSON document (the fitted values with their
+    /// uncertainties, each check, the model force per measured row of each trial) instead
+    /// of the text.
+    #[arg(long, requires = "trials")]
+    pub json: bool,
 }
 
 /// Runs `needle calibrate`: the options, the name and the outputs are checked first (no
@@ -64,12 +78,16 @@ pub struct CalibrateArgs {
 /// The set is not the compiled-in one, an option is out of range, an output is refused,
 /// the curve is refused, or the files cannot be written.
 pub fn run(a: CalibrateArgs) -> Result<ExitCode> {
+    let (Some(curve), Some(speed)) = (a.curve.clone(), a.speed_mm_per_s) else { return trials::run_trials(&a) };
+    let [needle_diameter_mm] = a.needle_diameter_mm[..] else {
+        anyhow::bail!("--needle-diameter-mm: {} values: --curve is one measurement of one needle (one value)", a.needle_diameter_mm.len())
+    };
     let rule = EventRule { drop_fraction: a.drop_fraction, ..EventRule::default() };
     let mut opts = Options {
-        curve: &a.curve,
+        curve: &curve,
         name: a.name.clone(),
-        needle_diameter_mm: a.needle_diameter_mm,
-        speed_mm_per_s: a.speed_mm_per_s,
+        needle_diameter_mm,
+        speed_mm_per_s: speed,
         rule,
         // checked below, once the set is
         fe_shear_modulus_n_per_mm2: 1.0,
@@ -84,14 +102,14 @@ pub fn run(a: CalibrateArgs) -> Result<ExitCode> {
     let out = a.out.clone().unwrap_or_else(|| a.set.join(needle_codegen::tissue::TISSUE_DIR).join(format!("{}.toml", a.name)));
     let figure = a.figure.clone().unwrap_or_else(|| a.set.join("figures").join(format!("calibration-{}.svg", a.name)));
     let planned = [Planned { option: "--out", path: &out }, Planned { option: "--figure", path: &figure }];
-    planned_outputs::check(&planned, Some(&a.set), &[("--curve", &a.curve)], a.force)?;
-    let points = needle_calibrate::measured::read_curve(&a.curve)?;
+    planned_outputs::check(&planned, Some(&a.set), &[("--curve", &curve)], a.force)?;
+    let points = needle_calibrate::measured::read_curve(&curve)?;
     let c = needle_calibrate::calibrate_points_with_progress(&opts, points, &mut progress_on_stderr())?;
     println!(
         "{} points, {} punctures; geometric similarity: measured needle {} mm / FE needle {} mm = {:.4} (lengths x {:.4}, forces x {:.4}; exact when the block scales too)",
         c.points.len(),
         c.events.len(),
-        a.needle_diameter_mm,
+        needle_diameter_mm,
         needle_haptics::insertion::FE_NEEDLE_DIAMETER_MM,
         c.similarity,
         c.similarity,
@@ -117,9 +135,9 @@ pub fn run(a: CalibrateArgs) -> Result<ExitCode> {
     let header = format!(
         "Tissue stack `{}`, written by `needle calibrate` (format: coeffs/README.md, \"Tissue stacks\").\nMeasured curve: {}; needle {} mm at {} mm/s.",
         a.name,
-        a.curve.display(),
-        a.needle_diameter_mm,
-        a.speed_mm_per_s
+        curve.display(),
+        needle_diameter_mm,
+        speed
     );
     let stack = c.stack.to_toml(&header);
     let svg = self::figure::svg(&c, &a.name, "measured")?;

@@ -195,17 +195,19 @@ pub fn to_csv(times: &[f64], poses: &[Pose], evals: &[InsertionEvaluation]) -> S
     s
 }
 
-/// `needle eval --poses FILE --insertion STACK [--prony G:TAU_S,...] [--out F]`.
+/// `needle eval --poses FILE --insertion STACK [--prony G:TAU_S,...] [--out F]`; STACK a
+/// compiled-in name or a tissue file loaded at run time.
 ///
 /// # Errors
 /// As [`parse_poses`], [`parse_times`], [`stack`], [`parse_prony`]; the output cannot be
 /// written.
 pub fn eval_script(file: &Path, stack_name: &str, prony: Option<&str>, out: Option<&Path>) -> Result<()> {
-    let compiled = stack("--insertion", stack_name)?;
+    // a tissue file loaded at run time (checked as the build checks it) or a compiled-in name
+    let loaded = needle_calibrate::runtime_stack::OwnedStack::resolve("--insertion", stack_name)?;
     let terms = prony.map(parse_prony).transpose()?;
     let layers: Vec<needle_haptics::insertion::Layer> =
-        compiled.layers.iter().map(|l| needle_haptics::insertion::Layer { prony: terms.unwrap_or(l.prony), ..*l }).collect();
-    let stack = &needle_haptics::insertion::Stack { layers: &layers, ..*compiled };
+        loaded.layers.iter().map(|l| needle_haptics::insertion::Layer { prony: terms.unwrap_or(l.prony), ..*l }).collect();
+    let stack = &needle_haptics::insertion::Stack { layers: &layers, ..loaded.as_stack() };
     let text = std::fs::read_to_string(file).with_context(|| format!("{}: cannot read", file.display()))?;
     let (times, period) = parse_times(&text, file)?;
     let poses = parse_poses(&text, file)?;

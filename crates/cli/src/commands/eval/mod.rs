@@ -43,8 +43,10 @@ pub struct EvalArgs {
     /// theta_z_deg, depth_mm) instead of one pose; one output row per input row.
     #[arg(long, value_name = "FILE.csv")]
     pub poses: Option<PathBuf>,
-    /// With --poses: a scripted insertion through this compiled-in tissue stack (e.g.
-    /// liver): the file needs a time_s column, one row per tick; one wrench row per tick.
+    /// With --poses: a scripted insertion through this tissue stack, a compiled-in name
+    /// (e.g. liver) or a tissue file (e.g. my_tissue.toml, loaded at run time and checked
+    /// as the build checks one): the file needs a time_s column, one row per tick; one
+    /// wrench row per tick.
     #[arg(long, value_name = "STACK", requires = "poses", conflicts_with = "json")]
     pub insertion: Option<String>,
     /// With --insertion: these Prony terms on every layer of the stack in place of its

@@ -1,0 +1,257 @@
+//! The stack from the trials' fits (steps 2-5 of the module docs of [`super`]): the
+//! values, each with its uncertainty, and the tissue file's layers.
+use super::friction::{self, LayerFriction};
+use super::hold::{self, HoldFit};
+use super::intervals;
+use super::stats::Spread;
+use super::trials::{self, Trial};
+use super::TrialsOptions;
+use anyhow::Result;
+use needle_codegen::tissue as file;
+use std::path::Path;
+
+/// The fitted stack and what it came from.
+#[derive(Debug, Clone)]
+pub struct Fitted {
+    /// The tissue file's contents.
+    pub stack: file::Stack,
+    /// Per layer, `(key, note)`: the uncertainty written beside each value.
+    pub uncertainty: Vec<Vec<(&'static str, String)>>,
+    /// The punctures per trial the stack was fitted for.
+    pub punctures: usize,
+    /// The friction per punctured layer.
+    pub friction: Vec<LayerFriction>,
+    /// After the last puncture and the hold.
+    pub hold: HoldFit,
+    /// The stick band, mm/s.
+    pub stick_band_mm_per_s: f64,
+}
+
+/// Half the slowest measured speed, at most [`crate::STICK_BAND_MM_PER_S`]: the stick
+/// band lies below every measured speed, so each renders its fitted sliding level.
+#[must_use]
+pub fn stick_band(trials: &[Trial]) -> f64 {
+    let slowest = trials
+        .iter()
+        .flat_map(|t| [t.phases.insertion_speed_mm_per_s.abs(), t.phases.withdrawal_speed_mm_per_s.abs()])
+        .filter(|v| *v > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    (0.5 * slowest).min(crate::STICK_BAND_MM_PER_S)
+}
+
+/// The per-layer values before they become a file.
+struct Values {
+    bounds: Vec<f64>,
+    scale: Vec<Spread>,
+    puncture: Vec<Spread>,
+    cutting: Vec<Spread>,
+}
+
+/// Fits the stack (module docs of [`super`]).
+///
+/// # Errors
+/// The format refuses the stack (a value out of its range).
+pub fn fit(ts: &[Trial], opts: &TrialsOptions<'_>, diameter: f64, u: &dyn Fn(f64) -> f64, notes: &mut Vec<String>) -> Result<Fitted> {
+    let (n, count_notes) = trials::puncture_count(ts);
+    notes.extend(count_notes);
+    let used: Vec<Trial> = ts.iter().filter(|t| t.events.len() >= n).cloned().collect();
+    let mean_of = |f: &dyn Fn(&Trial) -> Option<f64>| Spread::of(used.iter().filter_map(f).collect());
+    // today's fit gives the first layer and the first guess of the boundaries
+    let mut v = Values {
+        bounds: (0..n).map(|k| if k == 0 { 0.0 } else { mean_of(&|t| t.fit.layers.get(k).map(|l| l.boundary_mm)).mean }).collect(),
+        // the first boundary's scale through each trial's first peak (today's shape, at
+        // today's onset: the model punctures where and at the force the trial did)
+        scale: vec![mean_of(&|t| t.peak(0).map(|(p, f)| f / u(p - t.onset_mm())).filter(|s| s.is_finite() && *s > 0.0))],
+        puncture: vec![mean_of(&|t| t.peak(0).map(|p| p.1))],
+        cutting: Vec::new(),
+    };
+    let mut fr = friction_or_insertion(&used, &v.bounds, f64::INFINITY, n, notes);
+    for _pass in 0..2 {
+        intervals_pass(&used, n, &mut v, &fr, u);
+        fr = friction_or_insertion(&used, &v.bounds, f64::INFINITY, n, notes);
+    }
+    let mut hold = hold::fit(&used, n, &v.bounds, &fr, u);
+    // the model has no shaft friction below the boundary it deflects: once more with it
+    if let Some(b) = hold.boundary_mm {
+        fr = friction_or_insertion(&used, &v.bounds, b, n, notes);
+        hold = hold::fit(&used, n, &v.bounds, &fr, u);
+    }
+    if hold.holds == 0 {
+        notes.push("no trial has a hold: no Prony terms fitted (the stack is elastic)".into());
+    }
+    let band = stick_band(ts);
+    let last_depth = ts.iter().flat_map(|t| t.samples.iter().map(|s| s.position_mm - t.onset_mm())).fold(0.0, f64::max);
+    let largest = ts.iter().flat_map(|t| t.samples.iter().map(|s| s.force_n)).fold(0.0, f64::max);
+    let source = source(opts, ts, band);
+    let mut layers = Vec::new();
+    let mut uncertainty = Vec::new();
+    for j in 0..n {
+        let below = v.bounds.get(j + 1).copied().or(hold.boundary_mm).unwrap_or(last_depth.max(v.bounds[j] + 1.0));
+        let cutting =
+            if j + 1 == n { hold.per_trial.cutting_n.clone() } else { v.cutting.get(j).cloned().unwrap_or(Spread::of(Vec::new())) };
+        let cutting_n = if j + 1 == n { hold.cutting_n } else { cutting.mean };
+        let f = fr.get(j).cloned().unwrap_or_else(zero_friction);
+        let (l, notes) =
+            layer(j, n, below - v.bounds[j], v.scale[j].clone(), v.puncture[j].clone(), (cutting_n, cutting), &f, band, opts, &source);
+        layers.push(l);
+        uncertainty.push(notes);
+    }
+    if let (Some(b), Some(f)) = (hold.boundary_mm, fr.last()) {
+        let (l, notes) = bottom_layer(n, last_depth - b + 1.0, largest, &hold, f, band, opts, &source);
+        layers.push(l);
+        uncertainty.push(notes);
+    }
+    let stack = file::Stack {
+        format: file::TISSUE_FORMAT,
+        name: opts.name.clone(),
+        description: format!("calibrated by needle calibrate --trials on {} trials ({} mm needle)", ts.len(), diameter),
+        needle_diameter_mm: diameter,
+        layers,
+    };
+    file::parse_stack_str(&stack.to_toml(""), Path::new(&format!("{}.toml", stack.name)))
+        .map_err(|e| anyhow::anyhow!("the calibrated stack is refused by the tissue format: {e}"))?;
+    Ok(Fitted { stack, uncertainty, punctures: n, friction: fr, hold, stick_band_mm_per_s: band })
+}
+
+/// The layer below the last puncture: deflected, never punctured, with the holds' Prony
+/// terms.
+#[allow(clippy::too_many_arguments)]
+fn bottom_layer(
+    n: usize,
+    thickness_mm: f64,
+    largest: f64,
+    hold: &HoldFit,
+    f: &LayerFriction,
+    band: f64,
+    opts: &TrialsOptions<'_>,
+    source: &str,
+) -> (file::Layer, Vec<(&'static str, String)>) {
+    let scale = Spread { mean: hold.scale, ..hold.per_trial.scale.clone() };
+    let (mut l, mut notes) =
+        layer(n, n + 1, thickness_mm, scale, Spread::of(vec![2.0 * largest]), (0.0, Spread::of(Vec::new())), f, band, opts, source);
+    l.name = "below the last puncture (deflected, never punctured)".into();
+    l.puncture_force_n = 2.0 * largest;
+    notes.retain(|(k, _)| *k != "puncture_force_n" && *k != "cutting_force_n");
+    notes.push(("puncture_force_n", format!("not punctured in any trial: twice the largest measured force, {largest:.3} N")));
+    l.prony = hold.prony.iter().map(|&(g, tau_s)| file::PronyTerm { g, tau_s }).collect();
+    if !l.prony.is_empty() {
+        l.prony_source = Some(format!(
+            "needle calibrate --trials: fitted to the holds of {} trials (the library's QLV filter, FEBio's normalisation)",
+            hold.holds
+        ));
+        let g: Vec<String> =
+            hold.per_trial.g.iter().zip(&hold.prony).map(|(s, (_, tau))| format!("g(tau {tau:.3} s) {}", s.note("-"))).collect();
+        notes.push(("prony", g.join("; ")));
+    }
+    (l, notes)
+}
+
+fn zero_friction() -> LayerFriction {
+    LayerFriction { coulomb_n_per_mm: 0.0, coulomb_se: None, viscous_n_s_per_mm2: 0.0, viscous_se: None, levels: Spread::of(Vec::new()) }
+}
+
+/// The friction from the withdrawals, or (no trial has one) today's from the insertion,
+/// said in `notes`.
+fn friction_or_insertion(used: &[Trial], bounds: &[f64], next_mm: f64, n: usize, notes: &mut Vec<String>) -> Vec<LayerFriction> {
+    if let Some(f) = friction::fit(used, bounds, next_mm) {
+        return f;
+    }
+    let msg = "no trial has a withdrawal that pulls the needle back: the friction is fitted on the insertion (all Coulomb at its speed)"
+        .to_string();
+    if !notes.contains(&msg) {
+        notes.push(msg);
+    }
+    (0..n)
+        .map(|j| {
+            let levels = Spread::of(used.iter().filter_map(|t| t.fit.layers.get(j).map(|l| l.friction_n_per_mm)).collect());
+            LayerFriction { coulomb_n_per_mm: levels.mean, coulomb_se: levels.se, viscous_n_s_per_mm2: 0.0, viscous_se: None, levels }
+        })
+        .collect()
+}
+
+/// The intervals between punctures (each layer directly under another), per trial, the
+/// boundaries, scales, puncture forces and cutting forces their means.
+fn intervals_pass(used: &[Trial], n: usize, v: &mut Values, fr: &[LayerFriction], u: &dyn Fn(f64) -> f64) {
+    v.scale.truncate(1);
+    v.puncture.truncate(1);
+    v.cutting.clear();
+    for k in 0..n.saturating_sub(1) {
+        let bounds = v.bounds[..=k].to_vec();
+        let fits: Vec<intervals::IntervalFit> =
+            used.iter().filter_map(|t| intervals::fit(t, k, &bounds, &fr[..=k.min(fr.len() - 1)], u)).collect();
+        let col = |f: &dyn Fn(&intervals::IntervalFit) -> f64| Spread::of(fits.iter().map(f).collect());
+        if let Some(b) = v.bounds.get_mut(k + 1) {
+            if !fits.is_empty() {
+                *b = col(&|f| f.boundary_mm).mean;
+            }
+        }
+        v.cutting.push(col(&|f| f.cutting_n));
+        v.scale.push(col(&|f| f.scale));
+        v.puncture.push(col(&|f| f.puncture_n));
+    }
+}
+
+/// One file layer and its uncertainty notes.
+#[allow(clippy::too_many_arguments)]
+fn layer(
+    j: usize,
+    n: usize,
+    thickness_mm: f64,
+    scale: Spread,
+    puncture: Spread,
+    cutting: (f64, Spread),
+    f: &LayerFriction,
+    band: f64,
+    opts: &TrialsOptions<'_>,
+    source: &str,
+) -> (file::Layer, Vec<(&'static str, String)>) {
+    let sliding = |v: f64| f.coulomb_n_per_mm + f.viscous_n_s_per_mm2 * v;
+    let name = if j == 0 {
+        "surface to the first internal boundary".into()
+    } else if j + 1 == n {
+        format!("below internal boundary {j}")
+    } else {
+        format!("internal boundary {j} down")
+    };
+    let l = file::Layer {
+        name,
+        thickness_mm,
+        stiffness_scale: scale.mean,
+        puncture_force_n: puncture.mean,
+        cutting_force_n: cutting.0,
+        friction_static_n_per_mm: sliding(band),
+        friction_coulomb_n_per_mm: f.coulomb_n_per_mm,
+        friction_viscous_n_s_per_mm2: f.viscous_n_s_per_mm2,
+        stick_band_mm_per_s: band,
+        track_stiffness_n_per_mm2: crate::WINKLER_E_PER_MU * scale.mean * opts.fe_shear_modulus_n_per_mm2,
+        source: source.to_string(),
+        prony: Vec::new(),
+        prony_source: None,
+    };
+    let se = |s: Option<f64>, unit: &str, k: usize| match s {
+        Some(se) => format!("+- {se:.3e} {unit} (regression over {k} trials)"),
+        None => format!("no uncertainty: fitted on {k} trial(s) or one speed"),
+    };
+    let k = f.levels.values.len();
+    let notes = vec![
+        ("stiffness_scale", scale.note("-")),
+        ("puncture_force_n", puncture.note("N")),
+        ("cutting_force_n", cutting.1.note("N")),
+        (
+            "friction_coulomb_n_per_mm",
+            if f.viscous_n_s_per_mm2 == 0.0 && f.viscous_se.is_none() { f.levels.note("N/mm") } else { se(f.coulomb_se, "N/mm", k) },
+        ),
+        ("friction_viscous_n_s_per_mm2", se(f.viscous_se, "N s/mm^2", k)),
+    ];
+    (l, notes)
+}
+
+fn source(opts: &TrialsOptions<'_>, ts: &[Trial], band: f64) -> String {
+    let speeds: Vec<String> = ts.iter().map(|t| format!("{:.2}", t.phases.insertion_speed_mm_per_s)).collect();
+    format!(
+        "needle calibrate --trials on {} trials at {} mm/s: pre-puncture shape and first puncture from each trial's insertion (today's model), friction from the withdrawals (static = sliding level at the stick band's edge, {band:.3} mm/s, assumed), each layer below a puncture and its cutting from the intervals, Prony terms from the holds; values are means or joint fits over the trials; track stiffness = E = 3 s mu0 (Winkler subgrade k ~ E, Vesic 1961); needle {} mm",
+        ts.len(),
+        speeds.join(", "),
+        opts.needle_diameter_mm.first().copied().unwrap_or(0.0)
+    )
+}

@@ -1,0 +1,72 @@
+//! `needle calibrate --trials --json` and `needle replay --json`: the results as JSON
+//! for machines (a non-finite number is `null`).
+use needle_calibrate::replay::Check;
+use needle_calibrate::trial::Sample;
+use needle_calibrate::trial_replay::TrialReplay;
+use needle_calibrate::whole::TrialsCalibration;
+use serde_json::{json, Value};
+
+fn num(x: f64) -> Value {
+    if x.is_finite() {
+        json!(x)
+    } else {
+        Value::Null
+    }
+}
+
+/// The checks, each with its numbers and whether it is met.
+#[must_use]
+pub fn checks(cs: &[Check]) -> Value {
+    cs.iter()
+        .map(|c| json!({"what": c.what, "measured": num(c.measured), "model": num(c.model), "error": num(c.error), "goal": c.goal, "unit": c.unit, "met": c.met()}))
+        .collect()
+}
+
+/// One trial's rows: time, position, measured and model force, the model's phase code
+/// (`needle_haptics::insertion::Phase::code`), and the model's punctures.
+#[must_use]
+pub fn rows(s: &[Sample], r: &TrialReplay) -> Value {
+    let rows: Vec<Value> =
+        s.iter().zip(&r.rows).map(|(x, m)| json!([x.time_s, x.position_mm, x.force_n, num(m.force_n), m.phase.code()])).collect();
+    let punctures: Vec<Value> =
+        r.punctures.iter().map(|p| json!({"time_s": p.time_s, "position_mm": p.position_mm, "force_n": num(p.force_n)})).collect();
+    json!({"columns": ["time_s", "position_mm", "force_n", "model_force_n", "model_phase"], "rows": rows, "model_punctures": punctures})
+}
+
+/// The whole calibration.
+#[must_use]
+pub fn calibration(c: &TrialsCalibration) -> Value {
+    let layers: Vec<Value> = c
+        .fitted
+        .stack
+        .layers
+        .iter()
+        .zip(&c.fitted.uncertainty)
+        .map(|(l, u)| {
+            let uncertainty: serde_json::Map<String, Value> = u.iter().map(|(k, n)| ((*k).to_string(), json!(n))).collect();
+            json!({
+                "name": l.name, "thickness_mm": l.thickness_mm, "stiffness_scale": l.stiffness_scale,
+                "puncture_force_n": l.puncture_force_n, "cutting_force_n": l.cutting_force_n,
+                "friction_static_n_per_mm": l.friction_static_n_per_mm, "friction_coulomb_n_per_mm": l.friction_coulomb_n_per_mm,
+                "friction_viscous_n_s_per_mm2": l.friction_viscous_n_s_per_mm2, "stick_band_mm_per_s": l.stick_band_mm_per_s,
+                "prony": l.prony.iter().map(|t| json!({"g": t.g, "tau_s": t.tau_s})).collect::<Vec<_>>(),
+                "uncertainty": uncertainty,
+            })
+        })
+        .collect();
+    let trials: Vec<Value> = c
+        .trials
+        .iter()
+        .zip(&c.replays)
+        .zip(&c.checks)
+        .map(|((t, r), cs)| {
+            let p = &t.phases;
+            json!({
+                "file": t.name(), "contact_mm": t.onset_mm(),
+                "insertion_speed_mm_per_s": p.insertion_speed_mm_per_s, "withdrawal_speed_mm_per_s": p.withdrawal_speed_mm_per_s,
+                "hold_s": p.hold_s, "checks": checks(cs), "model": rows(&t.samples, r),
+            })
+        })
+        .collect();
+    json!({"name": c.fitted.stack.name, "notes": c.notes, "similarity": c.similarity, "layers": layers, "trials": trials})
+}
