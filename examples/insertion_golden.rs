@@ -1,7 +1,7 @@
-//! Firmware example `insertion_golden`: every golden insertion trajectory
-//! (`common/insertion_paths.rs`) through every compiled-in tissue stack, at 1 kHz, with
+//! Firmware example `insertion_golden`: every golden insertion trajectory, the glitch
+//! paths included (`common/insertion_paths.rs`), through every compiled-in tissue stack, at 1 kHz, with
 //! the insertion model; prints per path the tick count, the punctures and the FNV-1a
-//! digest of every tick's output (six wrench bits, status, phase code, punctures), for
+//! digest of every tick's output (six wrench bits, status, phase code, punctures, flags), for
 //! the host to compare with its own run of the same ticks
 //! (host-tests/tests/insertion_golden.rs); then the same for the fixed-point insertion
 //! (`fixed::insertion`, the Q16.16 poses of the same paths), lines prefixed `fixed `.
@@ -23,7 +23,7 @@ mod common;
 
 #[cfg(target_os = "none")]
 mod firmware {
-    use crate::common::insertion_paths::{depth_scale, for_each_tick, for_each_tick_q16, Digest, PATHS};
+    use crate::common::insertion_paths::{depth_scale, for_each_path_tick, for_each_path_tick_q16, Digest, PATH_COUNT};
     use crate::common::{exit, Out};
     use needle_haptics::fixed;
     use needle_haptics::fixed::insertion::{stacks as fixed_stacks, Insertion as FixedInsertion, InsertionConfig as FixedConfig};
@@ -57,20 +57,20 @@ mod firmware {
         out.str(" stacks=");
         out.dec(stacks::ALL.len() as u64);
         out.str(" paths=");
-        out.dec(PATHS.len() as u64);
+        out.dec(PATH_COUNT as u64);
         out.nl();
         let mut ok = true;
         for stack in &stacks::ALL {
-            for (i, path) in PATHS.iter().enumerate() {
+            for i in 0..PATH_COUNT {
                 let Ok(mut insertion) = Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ) else {
                     ok = false;
                     continue;
                 };
                 let mut digest = Digest::new();
                 let (mut ticks, mut punctures) = (0u64, 0u64);
-                for_each_tick(path, depth_scale(stack), |_, p| {
+                for_each_path_tick(i, depth_scale(stack), |_, p| {
                     let e = insertion.step(&Pose { x_mm: p[0], z_mm: p[1], theta_x_deg: p[2], theta_z_deg: p[3], depth_mm: p[4] });
-                    digest.tick(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures);
+                    digest.tick(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures, e.flags.bits());
                     ticks += 1;
                     punctures += u64::from(e.punctures);
                 });
@@ -79,16 +79,16 @@ mod firmware {
         }
         // the fixed-point insertion on the same paths (Q16.16 poses, integer interpolation)
         for (stack, scale_of) in fixed_stacks::ALL.iter().zip(&stacks::ALL) {
-            for (i, path) in PATHS.iter().enumerate() {
+            for i in 0..PATH_COUNT {
                 let Ok(mut insertion) = FixedInsertion::new(stack, FixedConfig::DEFAULT_1KHZ) else {
                     ok = false;
                     continue;
                 };
                 let mut digest = Digest::new();
                 let (mut ticks, mut punctures) = (0u64, 0u64);
-                for_each_tick_q16(path, depth_scale(scale_of), |_, p| {
+                for_each_path_tick_q16(i, depth_scale(scale_of), |_, p| {
                     let e = insertion.step(&fixed::Pose::new(p[0], p[1], p[2], p[3], p[4]));
-                    digest.tick_fixed(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures);
+                    digest.tick_fixed(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures, e.flags.bits());
                     ticks += 1;
                     punctures += u64::from(e.punctures);
                 });

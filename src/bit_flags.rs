@@ -1,4 +1,5 @@
-//! What the two bit-flag types ([`Status`](crate::Status) and
+//! What the bit-flag types ([`Status`](crate::Status),
+//! [`InsertionFlags`](crate::InsertionFlags) and
 //! [`LoopFlags`](crate::control::LoopFlags)) share: the `|` operators and the
 //! `NAME | NAME` text.
 use core::fmt;

@@ -4,7 +4,7 @@
  *
  *   [wrench, status] = needle_haptics('wrench', poses)
  *   [wrench, stiffness, status] = needle_haptics('stiffness', poses)
- *   [wrench, status, phase, punctures, velocity] = needle_haptics('insertion', stack, poses [, period_s, time_constant_s])
+ *   [wrench, status, phase, punctures, velocity, flags] = needle_haptics('insertion', stack, poses [, period_s, time_constant_s])
  *   info = needle_haptics('info')
  *
  * poses: single, n x 5, one pose per row: x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm
@@ -13,7 +13,8 @@
  * library's bits, NEEDLE_STATUS_* of needle.h: saturation, FE_UNSOLVED, ERROR); stiffness: single n x 18, d wrench/d depth_mm, then d/d x_mm, then d/d z_mm
  * (six components each). The insertion steps every row once from a fresh state
  * (default 1 kHz, 5 ms velocity filter); phase uint16, punctures uint8, velocity single
- * (mm/s), n x 1 each. The library's bits: no conversion happens anywhere.
+ * (mm/s), flags uint8 (NEEDLE_INSERTION_* of needle.h: a glitch the step did not
+ * integrate, the wrench held; or the wrench scaled down to its bound), n x 1 each. The library's bits: no conversion happens anywhere.
  *
  * Errors (identifiers needle:poses, needle:args, needle:insertion) say which row and
  * column, 1-based as MATLAB counts: "poses(3, 5) (depth_mm) is NaN".
@@ -120,10 +121,10 @@ static void do_insertion(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prh
   int32_t rc = needle_insertion_init(&state, stack, period_s, tau_s);
   if (rc == NEEDLE_E_ARG) mexErrMsgIdAndTxt("needle:insertion", "no tissue stack '%s' in this build", stack);
   if (rc != NEEDLE_OK) mexErrMsgIdAndTxt("needle:insertion", "period_s must be finite and > 0, time_constant_s finite and >= 0 (code %d)", (int)rc);
-  mxArray *outs[5] = {numeric(n, 6, mxSINGLE_CLASS), numeric(n, 1, mxUINT8_CLASS), numeric(n, 1, mxUINT16_CLASS), numeric(n, 1, mxUINT8_CLASS),
-                      numeric(n, 1, mxSINGLE_CLASS)};
+  mxArray *outs[6] = {numeric(n, 6, mxSINGLE_CLASS), numeric(n, 1, mxUINT8_CLASS), numeric(n, 1, mxUINT16_CLASS), numeric(n, 1, mxUINT8_CLASS),
+                      numeric(n, 1, mxSINGLE_CLASS), numeric(n, 1, mxUINT8_CLASS)};
   float *w = (float *)mxGetData(outs[0]), *v = (float *)mxGetData(outs[4]);
-  uint8_t *s = (uint8_t *)mxGetData(outs[1]), *c = (uint8_t *)mxGetData(outs[3]);
+  uint8_t *s = (uint8_t *)mxGetData(outs[1]), *c = (uint8_t *)mxGetData(outs[3]), *f = (uint8_t *)mxGetData(outs[5]);
   uint16_t *ph = (uint16_t *)mxGetData(outs[2]);
   for (size_t r = 0; r < n; r++) {
     needle_pose_t q = pose_at(p, n, r);
@@ -134,8 +135,9 @@ static void do_insertion(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prh
     ph[r] = out.phase;
     c[r] = out.punctures;
     v[r] = out.velocity_mm_per_s;
+    f[r] = out.flags;
   }
-  for (int i = 0; i < 5; i++) {
+  for (int i = 0; i < 6; i++) {
     if (i < nlhs || i == 0) plhs[i] = outs[i];
     else mxDestroyArray(outs[i]);
   }

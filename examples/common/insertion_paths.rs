@@ -57,6 +57,136 @@ pub const PATHS: [&[Waypoint]; 5] = [
     ],
 ];
 
+/// One kind of glitch (issue 66: what a faulty encoder or pose stream gives): the tick's
+/// pose with one input replaced, or an earlier pose replayed.
+#[derive(Clone, Copy)]
+pub enum Glitch {
+    /// `depth_mm` set to this value, mm.
+    Depth(f32),
+    /// `x_mm` set to this value, mm.
+    X(f32),
+    /// `theta_x_deg` set to this value, degrees.
+    TiltX(f32),
+    /// `depth_mm` NaN (in Q16.16: `NaN as i32`, 0).
+    NotANumber,
+    /// `z_mm` infinite (in Q16.16: saturated, `i32::MAX`).
+    Infinite,
+    /// The pose of this many ticks before (time going backwards), at most
+    /// [`HISTORY`] - 1.
+    Back(u32),
+}
+
+/// How many earlier poses a [`Glitch::Back`] can reach.
+pub const HISTORY: usize = 32;
+
+/// A run of glitches: `(first tick, count, stride, glitch)`, the glitch at ticks `first +
+/// k stride` for `k < count`.
+pub type GlitchRun = (u32, u32, u32, Glitch);
+
+/// The glitch paths: a golden path of [`PATHS`] (by index) with glitches laid over it,
+/// numbered after [`PATHS`] (path 5, 6, 7). Issue 66's cases: a depth jump of 1e6 mm
+/// while deflecting and one while cutting, with the path's tilt; x jumping to 1e6 mm while
+/// cutting, and alternating every tick; NaN, infinity, poses replayed backwards; an
+/// in-domain jump of depth (to 120 mm) and of tilt (to 60 degrees).
+pub const GLITCH_PATHS: [(usize, &[GlitchRun]); 3] = [
+    (
+        0,
+        &[
+            (4_000, 1, 1, Glitch::Depth(1.0e6)),
+            (9_000, 1, 1, Glitch::NotANumber),
+            (11_000, 3, 1, Glitch::Back(20)),
+            (20_000, 1, 1, Glitch::X(1.0e6)),
+        ],
+    ),
+    (
+        2,
+        &[
+            (3_000, 1, 1, Glitch::Depth(1.0e6)),
+            (5_000, 60, 2, Glitch::X(1.0e6)),
+            (5_500, 1, 1, Glitch::TiltX(60.0)),
+            (6_500, 1, 1, Glitch::Infinite),
+            (12_000, 10, 1, Glitch::Back(25)),
+        ],
+    ),
+    (
+        3,
+        &[
+            (2_400, 1, 1, Glitch::Depth(120.0)),
+            (5_100, 1, 1, Glitch::X(-1.0e9)),
+            (8_200, 40, 1, Glitch::Depth(1.0e6)),
+            (10_000, 1, 1, Glitch::Back(31)),
+        ],
+    ),
+];
+
+/// Every golden path: [`PATHS`], then [`GLITCH_PATHS`].
+pub const PATH_COUNT: usize = PATHS.len() + GLITCH_PATHS.len();
+
+/// The glitch of `runs` at `tick`, if any.
+fn glitch_at(runs: &[GlitchRun], tick: u32) -> Option<Glitch> {
+    for &(first, count, stride, g) in runs {
+        let (since, stride) = (tick.wrapping_sub(first), stride.max(1));
+        if tick >= first && since / stride * stride == since && since / stride < count {
+            return Some(g);
+        }
+    }
+    None
+}
+
+/// Path `i` of [`PATH_COUNT`] (its waypoints and glitch runs; none for [`PATHS`]).
+fn path_and_glitches(i: usize) -> (&'static [Waypoint], &'static [GlitchRun]) {
+    match PATHS.get(i) {
+        Some(p) => (p, &[]),
+        None => match GLITCH_PATHS.get(i - PATHS.len()) {
+            Some(&(base, runs)) => (PATHS.get(base).copied().unwrap_or(&[]), runs),
+            None => (&[], &[]),
+        },
+    }
+}
+
+/// Every tick's pose of path `i` of [`PATH_COUNT`] (f32, [`for_each_tick`]), with its
+/// glitches laid over it (the clean poses are the history [`Glitch::Back`] replays).
+pub fn for_each_path_tick(i: usize, depth_scale: f32, mut f: impl FnMut(u32, [f32; 5])) {
+    let (path, runs) = path_and_glitches(i);
+    let mut history = [[0.0f32; 5]; HISTORY];
+    for_each_tick(path, depth_scale, |tick, p| {
+        history[tick as usize % HISTORY] = p;
+        let mut q = p;
+        match glitch_at(runs, tick) {
+            None => {}
+            Some(Glitch::Depth(v)) => q[4] = v,
+            Some(Glitch::X(v)) => q[0] = v,
+            Some(Glitch::TiltX(v)) => q[2] = v,
+            Some(Glitch::NotANumber) => q[4] = f32::NAN,
+            Some(Glitch::Infinite) => q[1] = f32::INFINITY,
+            Some(Glitch::Back(k)) => q = history[(tick as usize + HISTORY - (k as usize % HISTORY)) % HISTORY],
+        }
+        f(tick, q);
+    });
+}
+
+/// Every tick's Q16.16 pose of path `i` of [`PATH_COUNT`] ([`for_each_tick_q16`]), with
+/// its glitches laid over it in Q16.16 ([`q16`] of the glitch's value: saturated; NaN 0).
+pub fn for_each_path_tick_q16(i: usize, depth_scale: f32, mut f: impl FnMut(u32, [i32; 5])) {
+    let (path, runs) = path_and_glitches(i);
+    let mut history = [[0i32; 5]; HISTORY];
+    let one = |v: f32| q16([v, 0.0, 0.0, 0.0, 0.0])[0];
+    for_each_tick_q16(path, depth_scale, |tick, p| {
+        history[tick as usize % HISTORY] = p;
+        let mut q = p;
+        match glitch_at(runs, tick) {
+            None => {}
+            Some(Glitch::Depth(v)) => q[4] = one(v),
+            Some(Glitch::X(v)) => q[0] = one(v),
+            Some(Glitch::TiltX(v)) => q[2] = one(v),
+            Some(Glitch::NotANumber) => q[4] = one(f32::NAN),
+            Some(Glitch::Infinite) => q[1] = one(f32::INFINITY),
+            Some(Glitch::Back(k)) => q = history[(tick as usize + HISTORY - (k as usize % HISTORY)) % HISTORY],
+        }
+        f(tick, q);
+    });
+}
+
 /// The deepest waypoint of [`PATHS`], mm: the stack depth they were drawn for.
 pub const PATHS_DEEPEST_MM: f32 = deepest();
 
@@ -152,7 +282,7 @@ pub fn for_each_tick_q16(path: &[Waypoint], depth_scale: f32, mut f: impl FnMut(
 }
 
 /// FNV-1a over 32-bit words: the digest of a path's outputs (each tick's six wrench
-/// bits, status, phase code and punctures).
+/// bits, status, phase code, punctures and flags).
 #[derive(Clone, Copy)]
 pub struct Digest(pub u64);
 
@@ -161,25 +291,28 @@ impl Digest {
     pub const fn new() -> Self {
         Self(0xcbf2_9ce4_8422_2325)
     }
-    /// Adds one tick: the six wrench bits, the status, the phase code and the punctures.
-    pub fn tick(&mut self, wrench: [f32; 6], status: u8, phase: u16, punctures: u8) {
+    /// Adds one tick: the six wrench bits, the status, the phase code, the punctures and
+    /// the step's flags.
+    pub fn tick(&mut self, wrench: [f32; 6], status: u8, phase: u16, punctures: u8, flags: u8) {
         for c in wrench {
             self.word(c.to_bits());
         }
         self.word(u32::from(status));
         self.word(u32::from(phase));
         self.word(u32::from(punctures));
+        self.word(u32::from(flags));
     }
 
     /// Adds one fixed-point tick: the six wrench integers (µN, µN·mm), the status, the
-    /// phase code and the punctures.
-    pub fn tick_fixed(&mut self, wrench: [i32; 6], status: u8, phase: u16, punctures: u8) {
+    /// phase code, the punctures and the step's flags.
+    pub fn tick_fixed(&mut self, wrench: [i32; 6], status: u8, phase: u16, punctures: u8, flags: u8) {
         for c in wrench {
             self.word(c as u32);
         }
         self.word(u32::from(status));
         self.word(u32::from(phase));
         self.word(u32::from(punctures));
+        self.word(u32::from(flags));
     }
 
     /// Adds one word.

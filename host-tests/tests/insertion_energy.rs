@@ -369,3 +369,72 @@ fn the_guarded_loop_renders_at_half_colgates_bound_at_every_frequency() {
         }
     }
 }
+
+/// A glitch of the pose stream (issue 66), drawn per tick: with probability 2 % the
+/// hand's pose is replaced by one of a faulty encoder's (depth or x at ±1e6 mm, depth
+/// 100 mm further, a tilt of 60 degrees, NaN); the hand itself moves on as before.
+fn glitched(rng: &mut ChaCha8Rng, p: Pose) -> Pose {
+    if rng.gen_range(0..50) != 0 {
+        return p;
+    }
+    match rng.gen_range(0..6) {
+        0 => Pose { depth_mm: 1.0e6, ..p },
+        1 => Pose { depth_mm: -1.0e6, ..p },
+        2 => Pose { x_mm: 1.0e6, ..p },
+        3 => Pose { depth_mm: p.depth_mm + 100.0, ..p },
+        4 => Pose { theta_x_deg: 60.0, ..p },
+        _ => Pose { depth_mm: f32::NAN, ..p },
+    }
+}
+
+/// Issue 66: with glitches in the pose stream (2 % of the ticks, [`glitched`]) no closed
+/// cycle delivers energy either, through the insertion alone and through the guarded
+/// loop: a glitch tick holds the last wrench (or none), integrates nothing.
+#[test]
+fn with_glitches_in_the_pose_stream_no_closed_cycle_delivers_energy() {
+    use needle_haptics::control::LoopCore;
+    for stack in &stacks::ALL {
+        let mut rng = ChaCha8Rng::seed_from_u64(20261206);
+        let mut glitches = ChaCha8Rng::seed_from_u64(66);
+        let deepest: f64 = stack.layers.iter().map(|l| f64::from(l.thickness_mm)).sum::<f64>() + 5.0;
+        let (mut worst, mut worst_loop, mut punctured, mut flagged, mut fast_hand) =
+            (f64::NEG_INFINITY, f64::NEG_INFINITY, 0, 0usize, 0usize);
+        const WEAK_DAMPING_N_S_PER_MM: f64 = 0.0001;
+        let (config, guard) = guarded_loop_setup(WEAK_DAMPING_N_S_PER_MM);
+        for n in 0..300 {
+            let moves = trajectory(&mut rng, deepest);
+            let mut insertion = Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ).expect("shipped stack");
+            let (e, p) = energy_of(&moves, DAMPING_N_S_PER_MM, |pose| {
+                let g = glitched(&mut glitches, pose);
+                let e = insertion.step(&g);
+                flagged += usize::from(e.flags.is_glitch());
+                // the clean poses rejected: the hand faster than the largest speed
+                fast_hand += usize::from(e.flags.is_glitch() && g == pose);
+                (e.wrench.fy_n, e.punctures)
+            });
+            punctured += usize::from(p > 0);
+            assert!(e <= BOUND_NMM, "{}: glitched trajectory {n} delivered {e:e} N·mm to the hand: {moves:?}", stack.name);
+            let mut core = LoopCore::new(config).expect("config");
+            core.set_passivity(Some(guard)).expect("guard");
+            core.set_insertion(Some(Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ).expect("shipped stack")));
+            let (e_loop, _) = energy_of(&moves, WEAK_DAMPING_N_S_PER_MM, |pose| {
+                let s = core.step(Ok(glitched(&mut glitches, pose)));
+                (s.force_cmd_n[1], core.insertion_evaluation().map_or(0, |e| e.punctures))
+            });
+            assert!(
+                e_loop <= BOUND_NMM,
+                "{}: glitched trajectory {n} through the guarded loop delivered {e_loop:e} N·mm: {moves:?}",
+                stack.name
+            );
+            if enters(&moves) {
+                worst = worst.max(e);
+                worst_loop = worst_loop.max(e_loop);
+            }
+        }
+        println!(
+            "{}: 300 glitched trajectories ({punctured} punctured, {flagged} glitch ticks, {fast_hand} of them clean poses), most energy to the hand of those entering: {worst:e} N·mm, through the guarded loop {worst_loop:e} N·mm",
+            stack.name
+        );
+        assert!(punctured > 300 / 4 && flagged > 1000, "{}: the test must cross punctures and glitches", stack.name);
+    }
+}

@@ -120,7 +120,7 @@ fn the_compiled_stacks_convert_to_integers() {
 fn bad_configurations_and_scales_are_refused() {
     use needle_haptics::insertion::InsertionError;
     let stack = &fx::stacks::ALL[0];
-    let zero = fx::InsertionConfig { period_us: 0, velocity_time_constant_us: 0 };
+    let zero = fx::InsertionConfig { period_us: 0, velocity_time_constant_us: 0, ..fx::InsertionConfig::DEFAULT_1KHZ };
     assert_eq!(fx::Insertion::new(stack, zero).err(), Some(InsertionError::Config));
     let empty = fx::Stack { count: 0, ..*stack };
     let empty = &empty;

@@ -1,9 +1,10 @@
 //! Golden insertion sequences: the five trajectories of `examples/common/insertion_paths.rs`
-//! through every shipped tissue stack give the same bits on the host and on the
+//! and its three glitch paths (issue 66: depth and x jumping to 1e6 mm, x alternating
+//! every tick, NaN, infinity, poses replayed backwards) through every shipped tissue stack give the same bits on the host and on the
 //! emulated Cortex-M4F, M3 and M0 (the `insertion_golden` firmware under QEMU), with the
 //! f32 insertion and with the fixed-point one (`fixed::insertion`), through the C API
 //! and in wasm: every
-//! tick's six wrench components, status, phase and punctures, compared as a digest per
+//! tick's six wrench components, status, phase, punctures and flags, compared as a digest per
 //! path (FNV-1a over every tick's words; one differing bit changes it).
 #[path = "../../examples/common/insertion_paths.rs"]
 mod paths;
@@ -13,20 +14,20 @@ use needle_haptics::fixed;
 use needle_haptics::fixed::insertion::{stacks as fixed_stacks, Insertion as FixedInsertion, InsertionConfig as FixedConfig};
 use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, Phase};
 use needle_haptics::Pose;
-use paths::{depth_scale, for_each_tick, for_each_tick_q16, Digest, PATHS};
+use paths::{depth_scale, for_each_path_tick, for_each_path_tick_q16, for_each_tick, Digest, PATHS, PATH_COUNT};
 use std::time::Duration;
 
 /// The host's lines, in the firmware's format.
 fn host_lines() -> Vec<String> {
     let mut lines = Vec::new();
     for stack in &stacks::ALL {
-        for (i, path) in PATHS.iter().enumerate() {
+        for i in 0..PATH_COUNT {
             let mut insertion = Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ).expect("shipped stack");
             let mut digest = Digest::new();
             let (mut ticks, mut punctures) = (0u64, 0u64);
-            for_each_tick(path, depth_scale(stack), |_, p| {
+            for_each_path_tick(i, depth_scale(stack), |_, p| {
                 let e = insertion.step(&Pose { x_mm: p[0], z_mm: p[1], theta_x_deg: p[2], theta_z_deg: p[3], depth_mm: p[4] });
-                digest.tick(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures);
+                digest.tick(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures, e.flags.bits());
                 ticks += 1;
                 punctures += u64::from(e.punctures);
             });
@@ -50,13 +51,13 @@ fn line(prefix: &str, name: &str, i: usize, ticks: u64, punctures: u64, digest: 
 fn host_fixed_lines() -> Vec<String> {
     let mut lines = Vec::new();
     for (stack, scale_of) in fixed_stacks::ALL.iter().zip(&stacks::ALL) {
-        for (i, path) in PATHS.iter().enumerate() {
+        for i in 0..PATH_COUNT {
             let mut insertion = FixedInsertion::new(stack, FixedConfig::DEFAULT_1KHZ).expect("shipped stack");
             let mut digest = Digest::new();
             let (mut ticks, mut punctures) = (0u64, 0u64);
-            for_each_tick_q16(path, depth_scale(scale_of), |_, p| {
+            for_each_path_tick_q16(i, depth_scale(scale_of), |_, p| {
                 let e = insertion.step(&fixed::Pose::new(p[0], p[1], p[2], p[3], p[4]));
-                digest.tick_fixed(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures);
+                digest.tick_fixed(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures, e.flags.bits());
                 ticks += 1;
                 punctures += u64::from(e.punctures);
             });
@@ -143,7 +144,7 @@ fn c_api_lines() -> Vec<String> {
     let mut lines = Vec::new();
     for stack in &stacks::ALL {
         let name = std::ffi::CString::new(stack.name).expect("stack name");
-        for (i, path) in PATHS.iter().enumerate() {
+        for i in 0..PATH_COUNT {
             let mut state = needle_insertion_t { storage: [0; needle_capi::NEEDLE_INSERTION_STORAGE_WORDS], magic: 0 };
             let config = InsertionConfig::DEFAULT_1KHZ;
             // SAFETY: valid pointers to local values and a NUL-terminated name.
@@ -151,13 +152,13 @@ fn c_api_lines() -> Vec<String> {
             assert_eq!(rc, NEEDLE_OK, "needle_insertion_init({})", stack.name);
             let mut digest = Digest::new();
             let (mut ticks, mut punctures) = (0u64, 0u64);
-            for_each_tick(path, depth_scale(stack), |_, p| {
+            for_each_path_tick(i, depth_scale(stack), |_, p| {
                 let pose = needle_pose_t { x_mm: p[0], z_mm: p[1], theta_x_deg: p[2], theta_z_deg: p[3], depth_mm: p[4] };
                 let mut out = needle_insertion_result_t::default();
                 // SAFETY: valid pointers to local values; the state was initialised above.
                 assert_eq!(unsafe { needle_insertion_step(&mut state, &pose, &mut out) }, NEEDLE_OK);
                 let w = out.wrench;
-                digest.tick([w.fx_n, w.fy_n, w.fz_n, w.mx_nmm, w.my_nmm, w.mz_nmm], out.status, out.phase, out.punctures);
+                digest.tick([w.fx_n, w.fy_n, w.fz_n, w.mx_nmm, w.my_nmm, w.mz_nmm], out.status, out.phase, out.punctures, out.flags);
                 ticks += 1;
                 punctures += u64::from(out.punctures);
             });
@@ -186,7 +187,7 @@ fn c_api_fixed_lines() -> Vec<String> {
     let mut lines = Vec::new();
     for (stack, scale_of) in fixed_stacks::ALL.iter().zip(&stacks::ALL) {
         let name = std::ffi::CString::new(stack.name).expect("stack name");
-        for (i, path) in PATHS.iter().enumerate() {
+        for i in 0..PATH_COUNT {
             let mut state = needle_fixed_insertion_t { storage: [0; NEEDLE_FIXED_INSERTION_STORAGE_WORDS], magic: 0 };
             let c = FixedConfig::DEFAULT_1KHZ;
             // SAFETY: valid pointers to local values and a NUL-terminated name.
@@ -194,7 +195,7 @@ fn c_api_fixed_lines() -> Vec<String> {
             assert_eq!(rc, NEEDLE_OK, "needle_fixed_insertion_init({})", stack.name);
             let mut digest = Digest::new();
             let (mut ticks, mut punctures) = (0u64, 0u64);
-            for_each_tick_q16(path, depth_scale(scale_of), |_, p| {
+            for_each_path_tick_q16(i, depth_scale(scale_of), |_, p| {
                 let pose = needle_fixed_pose_t {
                     x_mm_q16: p[0],
                     z_mm_q16: p[1],
@@ -206,7 +207,13 @@ fn c_api_fixed_lines() -> Vec<String> {
                 // SAFETY: valid pointers to local values; the state was initialised above.
                 assert_eq!(unsafe { needle_fixed_insertion_step(&mut state, &pose, &mut out) }, NEEDLE_OK);
                 let w = out.wrench;
-                digest.tick_fixed([w.fx_un, w.fy_un, w.fz_un, w.mx_unmm, w.my_unmm, w.mz_unmm], out.status, out.phase, out.punctures);
+                digest.tick_fixed(
+                    [w.fx_un, w.fy_un, w.fz_un, w.mx_unmm, w.my_unmm, w.mz_unmm],
+                    out.status,
+                    out.phase,
+                    out.punctures,
+                    out.flags,
+                );
                 ticks += 1;
                 punctures += u64::from(out.punctures);
             });
@@ -277,8 +284,8 @@ fn golden_insertions_in_wasm_under_node() {
     let poses = dir.path().join("poses.txt");
     let mut text = String::new();
     for (s, stack) in stacks::ALL.iter().enumerate() {
-        for (i, path) in PATHS.iter().enumerate() {
-            for_each_tick(path, depth_scale(stack), |_, p| {
+        for i in 0..PATH_COUNT {
+            for_each_path_tick(i, depth_scale(stack), |_, p| {
                 text.push_str(&format!(
                     "{s} {i} {:x} {:x} {:x} {:x} {:x}\n",
                     p[0].to_bits(),
@@ -307,8 +314,8 @@ fn golden_insertions_in_wasm_under_node() {
     // the fixed-point insertion: the Q16.16 poses of the same paths
     let mut text = String::new();
     for (s, scale_of) in stacks::ALL.iter().enumerate() {
-        for (i, path) in PATHS.iter().enumerate() {
-            for_each_tick_q16(path, depth_scale(scale_of), |_, p| {
+        for i in 0..PATH_COUNT {
+            for_each_path_tick_q16(i, depth_scale(scale_of), |_, p| {
                 text.push_str(&format!(
                     "{s} {i} {:x} {:x} {:x} {:x} {:x}\n",
                     p[0] as u32, p[1] as u32, p[2] as u32, p[3] as u32, p[4] as u32

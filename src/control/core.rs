@@ -167,7 +167,9 @@ impl<const N: usize> LoopCore<N> {
     /// 2. a stale or missing pose is a fault (`POSE_STALE` / `POSE_MISSING`), the model is
     ///    not evaluated; otherwise `wrench(pose)` (or the insertion's tick:
     ///    [`set_insertion`](Self::set_insertion)), and an `ERROR` status is a fault
-    ///    (`EVAL_ERROR`);
+    ///    (`EVAL_ERROR`); a pose the insertion rejects as a glitch is a fault
+    ///    (`POSE_GLITCH`) that keeps the passivity guard's state (the insertion integrated
+    ///    nothing: the next accepted tick goes on from the last);
     /// 3. with the passivity guard on ([`set_passivity`](Self::set_passivity)), `F` is the
     ///    guarded force (`STIFFNESS_LIMITED` when the model's stiffness was above the
     ///    guard's), else the model's `(fx, fy, fz)`; then with `F`: if `fx² + fy² + fz² > limit²` (`OVER_LIMIT`),
@@ -189,7 +191,10 @@ impl<const N: usize> LoopCore<N> {
                 s.pose = pose;
                 let (wrench, status, stiffness) = self.evaluate(&pose);
                 s.model = status;
-                if status.is_error() {
+                let glitch = self.insertion.is_some() && self.insertion_last.is_some_and(|e| e.flags.is_glitch());
+                if glitch {
+                    Some(LoopFlags::POSE_GLITCH)
+                } else if status.is_error() {
                     Some(LoopFlags::EVAL_ERROR)
                 } else {
                     s.wrench = wrench;
@@ -210,7 +215,9 @@ impl<const N: usize> LoopCore<N> {
             }
         };
         if let Some(f) = fault {
-            self.guard.reset();
+            if f != LoopFlags::POSE_GLITCH {
+                self.guard.reset();
+            }
             s.flags |= f | LoopFlags::RAMPING;
             s.force_cmd_n = ramp(self.last.force_cmd_n, self.config.ramp_step_n);
             if s.force_cmd_n == [0.0; 3] {

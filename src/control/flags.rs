@@ -16,9 +16,10 @@ use core::fmt;
 /// | [`OUTPUT_ERROR`](Self::OUTPUT_ERROR) | `0x0080` | a PWM or pin write returned an error (the other outputs were still written) |
 /// | [`DISABLED`](Self::DISABLED) | `0x0100` | the enable pin is low: a fault holds and the ramp has reached zero |
 /// | [`STIFFNESS_LIMITED`](Self::STIFFNESS_LIMITED) | `0x0200` | the model's stiffness was above the passivity guard's: its force changes entered the command scaled down ([`Passivity`](super::Passivity)) |
+/// | [`POSE_GLITCH`](Self::POSE_GLITCH) | `0x0400` | the insertion rejected the pose as a glitch ([`InsertionFlags`](crate::InsertionFlags): out of its domain, too fast, not finite): not integrated; the passivity guard keeps its state |
 ///
-/// A tick is a *fault* tick when any of `POSE_STALE`, `POSE_MISSING`, `EVAL_ERROR`, or
-/// `OVER_LIMIT` with [`OverLimit::RampToZero`](super::OverLimit::RampToZero) is set.
+/// A tick is a *fault* tick when any of `POSE_STALE`, `POSE_MISSING`, `EVAL_ERROR`,
+/// `POSE_GLITCH`, or `OVER_LIMIT` with [`OverLimit::RampToZero`](super::OverLimit::RampToZero) is set.
 #[derive(Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct LoopFlags(u16);
 
@@ -45,9 +46,11 @@ impl LoopFlags {
     pub const DISABLED: Self = Self(0x0100);
     /// The passivity guard limited the rendered stiffness.
     pub const STIFFNESS_LIMITED: Self = Self(0x0200);
+    /// The insertion rejected the pose as a glitch.
+    pub const POSE_GLITCH: Self = Self(0x0400);
 
     /// Every flag with its name, in bit order.
-    pub const FLAGS: [(Self, &'static str); 10] = [
+    pub const FLAGS: [(Self, &'static str); 11] = [
         (Self::POSE_STALE, "POSE_STALE"),
         (Self::POSE_MISSING, "POSE_MISSING"),
         (Self::EVAL_ERROR, "EVAL_ERROR"),
@@ -58,6 +61,7 @@ impl LoopFlags {
         (Self::OUTPUT_ERROR, "OUTPUT_ERROR"),
         (Self::DISABLED, "DISABLED"),
         (Self::STIFFNESS_LIMITED, "STIFFNESS_LIMITED"),
+        (Self::POSE_GLITCH, "POSE_GLITCH"),
     ];
 
     /// `true` when no flag is set.

@@ -27,7 +27,7 @@
 using namespace chai3d;
 
 // The header `needle eval --poses FILE --insertion STACK` writes.
-static const char *CLI_HEADER = "time_s,x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm,status,phase,punctures";
+static const char *CLI_HEADER = "time_s,x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm,status,phase,punctures,flags";
 
 struct CliRow {
   int line;
@@ -60,8 +60,8 @@ static bool read_cli(const char *path, std::vector<CliRow> &rows) {
   }
   for (int lineno = 2; std::getline(in, line); lineno++) {
     std::stringstream ss(line);
-    std::string f[15];
-    for (int i = 0; i < 15; i++)
+    std::string f[16];
+    for (int i = 0; i < 16; i++)
       if (!std::getline(ss, f[i], ',')) {
         std::printf("%s:%d: column %d missing\n", path, lineno, i + 1);
         return false;

@@ -19,6 +19,10 @@ pub struct Trajectory {
     phase: Py<PyArray1<u16>>,
     /// uint8 (n,): boundaries punctured in that tick.
     punctures: Py<PyArray1<u8>>,
+    /// uint8 (n,): the step's `InsertionFlags` bits (`FAST_MOTION` 0x01, `OUT_OF_DOMAIN`
+    /// 0x02, `NOT_FINITE` 0x04: a glitch, not integrated, the wrench held;
+    /// `WRENCH_LIMITED` 0x08: the force or moment scaled down to its bound).
+    flags: Py<PyArray1<u8>>,
     /// float32 (n,): the filtered axial velocity, mm/s.
     velocity_mm_per_s: Py<PyArray1<f32>>,
 }
@@ -46,7 +50,8 @@ impl Insertion {
             let names: Vec<&str> = stacks::ALL.iter().map(|s| s.name).collect();
             return Err(PyValueError::new_err(format!("no tissue stack {stack:?} in this build; there are: {}", names.join(", "))));
         };
-        let model = Model::new(s, InsertionConfig { period_s, velocity_time_constant_s }).map_err(value_error)?;
+        let model =
+            Model::new(s, InsertionConfig { period_s, velocity_time_constant_s, ..InsertionConfig::DEFAULT_1KHZ }).map_err(value_error)?;
         Ok(Self { model, stack: s.name })
     }
 
@@ -80,12 +85,13 @@ impl Insertion {
         let status = PyArray1::<u8>::zeros(py, [n], false);
         let phase = PyArray1::<u16>::zeros(py, [n], false);
         let punctures = PyArray1::<u8>::zeros(py, [n], false);
+        let flags = PyArray1::<u8>::zeros(py, [n], false);
         let velocity = PyArray1::<f32>::zeros(py, [n], false);
         {
-            let (mut w, mut s, mut p, mut c, mut v) =
-                (wrench.readwrite(), status.readwrite(), phase.readwrite(), punctures.readwrite(), velocity.readwrite());
-            let (mut w, mut s, mut p, mut c, mut v) =
-                (w.as_array_mut(), s.as_array_mut(), p.as_array_mut(), c.as_array_mut(), v.as_array_mut());
+            let (mut w, mut s, mut p, mut c, mut f, mut v) =
+                (wrench.readwrite(), status.readwrite(), phase.readwrite(), punctures.readwrite(), flags.readwrite(), velocity.readwrite());
+            let (mut w, mut s, mut p, mut c, mut f, mut v) =
+                (w.as_array_mut(), s.as_array_mut(), p.as_array_mut(), c.as_array_mut(), f.as_array_mut(), v.as_array_mut());
             let model = &mut self.model;
             py.detach(|| {
                 for (row, mut w_row) in w.rows_mut().into_iter().enumerate() {
@@ -93,9 +99,12 @@ impl Insertion {
                     for (o, x) in w_row.iter_mut().zip(e.wrench.to_array()) {
                         *o = x;
                     }
-                    let (Some(s), Some(p), Some(c), Some(v)) = (s.get_mut(row), p.get_mut(row), c.get_mut(row), v.get_mut(row)) else {
+                    let (Some(s), Some(p), Some(c), Some(f), Some(v)) =
+                        (s.get_mut(row), p.get_mut(row), c.get_mut(row), f.get_mut(row), v.get_mut(row))
+                    else {
                         break;
                     };
+                    *f = e.flags.bits();
                     *s = e.status.bits();
                     *p = e.phase.code();
                     *c = e.punctures;
@@ -109,6 +118,7 @@ impl Insertion {
             status: status.unbind(),
             phase: phase.unbind(),
             punctures: punctures.unbind(),
+            flags: flags.unbind(),
             velocity_mm_per_s: velocity.unbind(),
         })
     }

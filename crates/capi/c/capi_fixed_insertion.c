@@ -9,7 +9,7 @@
  * needle_fixed_insertion_init(stack, 1000 us, 5000 us) and needle_fixed_insertion_step()
  * on each tick; prints "fixed stack=<s> path=<p> ticks=<n> punctures=<n> digest_hi=0x..
  * digest_lo=0x..", the digest FNV-1a over each tick's six wrench integers, status, phase
- * code and punctures (examples/common/insertion_paths.rs, Digest::tick_fixed).
+ * code, punctures and flags (examples/common/insertion_paths.rs, Digest::tick_fixed).
  *
  * The test compares every line with the library's own run. Exits 0 when every call
  * returned NEEDLE_OK and the refusals below hold.
@@ -56,6 +56,7 @@ static int tick(run_t *r, const needle_fixed_pose_t *p) {
   r->digest = fnv_word(r->digest, e.status);
   r->digest = fnv_word(r->digest, e.phase);
   r->digest = fnv_word(r->digest, e.punctures);
+  r->digest = fnv_word(r->digest, e.flags);
   r->ticks++;
   r->punctures += e.punctures;
   return 1;

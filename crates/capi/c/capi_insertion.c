@@ -9,8 +9,8 @@
  *
  * 1. needle_insertion_init(stack, 1 kHz, 5 ms) and needle_insertion_step() on each tick;
  *    prints "stack=<s> path=<p> ticks=<n> punctures=<n> digest_hi=0x.. digest_lo=0x..",
- *    the digest FNV-1a over each tick's six wrench bits, status, phase code and
- *    punctures (examples/common/insertion_paths.rs, Digest::tick);
+ *    the digest FNV-1a over each tick's six wrench bits, status, phase code,
+ *    punctures and flags (examples/common/insertion_paths.rs, Digest::tick);
  * 2. a loop (needle_loop_init, then needle_loop_set_insertion with a fresh insertion of
  *    the stack) ticked on the same poses; prints "loop stack=<s> path=<p> digest_hi=0x..
  *    digest_lo=0x..", the digest over each tick's commanded force bits, flags and model
@@ -90,6 +90,7 @@ static int tick(run_t *r, const needle_pose_t *p) {
   r->digest = fnv_word(r->digest, e.status);
   r->digest = fnv_word(r->digest, e.phase);
   r->digest = fnv_word(r->digest, e.punctures);
+  r->digest = fnv_word(r->digest, e.flags);
   r->ticks++;
   r->punctures += e.punctures;
   needle_tick_t t;

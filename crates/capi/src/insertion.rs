@@ -54,7 +54,7 @@ pub unsafe extern "C" fn needle_insertion_init(
     let Some(s) = core::str::from_utf8(name).ok().and_then(stacks::by_name) else {
         return NEEDLE_E_ARG;
     };
-    let config = InsertionConfig { period_s, velocity_time_constant_s };
+    let config = InsertionConfig { period_s, velocity_time_constant_s, ..InsertionConfig::DEFAULT_1KHZ };
     let Ok(state) = Insertion::new(s, config) else {
         return NEEDLE_E_CONFIG;
     };
@@ -91,6 +91,7 @@ pub unsafe extern "C" fn needle_insertion_step(
         punctures: e.punctures,
         phase: e.phase.code(),
         velocity_mm_per_s: e.velocity_mm_per_s,
+        flags: e.flags.bits(),
     };
     NEEDLE_OK
 }

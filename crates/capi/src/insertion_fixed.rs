@@ -53,7 +53,7 @@ pub unsafe extern "C" fn needle_fixed_insertion_init(
     let Some(s) = core::str::from_utf8(name).ok().and_then(stacks::by_name) else {
         return NEEDLE_E_ARG;
     };
-    let Ok(state) = Insertion::new(s, InsertionConfig { period_us, velocity_time_constant_us }) else {
+    let Ok(state) = Insertion::new(s, InsertionConfig { period_us, velocity_time_constant_us, ..InsertionConfig::DEFAULT_1KHZ }) else {
         return NEEDLE_E_CONFIG;
     };
     // SAFETY: non-NULL, valid and writable (the caller's contract).
@@ -89,6 +89,7 @@ pub unsafe extern "C" fn needle_fixed_insertion_step(
         punctures: e.punctures,
         phase: e.phase.code(),
         velocity_mm_per_s_q16: e.velocity_mm_per_s_q16,
+        flags: e.flags.bits(),
     };
     NEEDLE_OK
 }

@@ -1,4 +1,5 @@
-//! Names for C: `needle_strerror`, `needle_status_name`, `needle_loop_flag_name`.
+//! Names for C: `needle_strerror`, `needle_status_name`, `needle_insertion_flag_name`,
+//! `needle_loop_flag_name`.
 //! Static, NUL-terminated strings; the flag names are the library's (`Status::FLAGS`,
 //! `LoopFlags::FLAGS`), checked by this crate's tests.
 use core::ffi::{c_char, CStr};
@@ -37,7 +38,23 @@ pub extern "C" fn needle_status_name(bit: u8) -> *const c_char {
     s.map_or(core::ptr::null(), CStr::as_ptr)
 }
 
-/// The name of one `NEEDLE_LOOP_*` flag ("POSE_STALE", ..., "STIFFNESS_LIMITED"), "OK" for 0; NULL
+/// The name of one `NEEDLE_INSERTION_*` flag ("FAST_MOTION", "OUT_OF_DOMAIN",
+/// "NOT_FINITE", "WRENCH_LIMITED"), "OK" for 0; NULL for a value that is not 0 or
+/// exactly one known flag.
+#[no_mangle]
+pub extern "C" fn needle_insertion_flag_name(flag: u8) -> *const c_char {
+    let s: Option<&CStr> = match flag {
+        0 => Some(c"OK"),
+        crate::types::NEEDLE_INSERTION_FAST_MOTION => Some(c"FAST_MOTION"),
+        crate::types::NEEDLE_INSERTION_OUT_OF_DOMAIN => Some(c"OUT_OF_DOMAIN"),
+        crate::types::NEEDLE_INSERTION_NOT_FINITE => Some(c"NOT_FINITE"),
+        crate::types::NEEDLE_INSERTION_WRENCH_LIMITED => Some(c"WRENCH_LIMITED"),
+        _ => None,
+    };
+    s.map_or(core::ptr::null(), CStr::as_ptr)
+}
+
+/// The name of one `NEEDLE_LOOP_*` flag ("POSE_STALE", ..., "POSE_GLITCH"), "OK" for 0; NULL
 /// for a value that is not 0 or exactly one known flag.
 #[no_mangle]
 pub extern "C" fn needle_loop_flag_name(flag: u16) -> *const c_char {
@@ -53,6 +70,7 @@ pub extern "C" fn needle_loop_flag_name(flag: u16) -> *const c_char {
         crate::types::NEEDLE_LOOP_OUTPUT_ERROR => Some(c"OUTPUT_ERROR"),
         crate::types::NEEDLE_LOOP_DISABLED => Some(c"DISABLED"),
         crate::types::NEEDLE_LOOP_STIFFNESS_LIMITED => Some(c"STIFFNESS_LIMITED"),
+        crate::types::NEEDLE_LOOP_POSE_GLITCH => Some(c"POSE_GLITCH"),
         _ => None,
     };
     s.map_or(core::ptr::null(), CStr::as_ptr)
@@ -123,9 +141,14 @@ mod tests {
         for (flag, lib_name) in LoopFlags::FLAGS {
             assert_eq!(name(needle_loop_flag_name(flag.bits())).as_deref(), Some(lib_name), "loop flag {:#06x}", flag.bits());
         }
-        assert_eq!(LoopFlags::FLAGS.len(), 10, "a new loop flag needs its NEEDLE_LOOP_ constant and name");
+        assert_eq!(LoopFlags::FLAGS.len(), 11, "a new loop flag needs its NEEDLE_LOOP_ constant and name");
+        for (flag, lib_name) in needle_haptics::InsertionFlags::FLAGS {
+            assert_eq!(name(needle_insertion_flag_name(flag.bits())).as_deref(), Some(lib_name), "insertion flag {:#04x}", flag.bits());
+        }
+        assert_eq!(needle_haptics::InsertionFlags::FLAGS.len(), 4, "a new insertion flag needs its NEEDLE_INSERTION_ constant and name");
+        assert_eq!(name(needle_insertion_flag_name(0x03)), None, "two bits are not one name");
         assert_eq!(name(needle_status_name(0x11)), None, "two bits are not one name");
-        assert_eq!(name(needle_loop_flag_name(0x0400)), None, "unknown flag");
+        assert_eq!(name(needle_loop_flag_name(0x0800)), None, "unknown flag");
         assert_eq!(name(needle_strerror(crate::types::NEEDLE_E_NULL)).as_deref(), Some("NULL pointer argument"));
         assert_eq!(name(needle_strerror(-99)).as_deref(), Some("unknown needle error code"));
         for (status, want) in [(0u8, "OK"), (0x11, "SAT_X | SAT_DEPTH"), (0x30, "SAT_DEPTH | FE_UNSOLVED")] {

@@ -8,7 +8,7 @@ pub const NEEDLE_LOOP_STORAGE_WORDS: usize = 176;
 pub const NEEDLE_LOOP_MAGIC: u32 = 0x4e4c_4f50;
 
 /// 64-bit words of opaque storage in a [`needle_insertion_t`].
-pub const NEEDLE_INSERTION_STORAGE_WORDS: usize = 128;
+pub const NEEDLE_INSERTION_STORAGE_WORDS: usize = 136;
 /// [`needle_insertion_t::magic`] of an initialised insertion.
 pub const NEEDLE_INSERTION_MAGIC: u32 = 0x4e49_4e53;
 
@@ -250,6 +250,20 @@ pub const NEEDLE_STATUS_NO_MODEL: u8 = 0x40;
 /// Status bit: no wrench could be computed (NaN input, NULL pose, no model).
 pub const NEEDLE_STATUS_ERROR: u8 = 0x80;
 
+/// `needle_insertion_result_t::flags` bit (`needle_haptics::InsertionFlags::FAST_MOTION`):
+/// the pose moved further since the last accepted one than the largest speeds allow; not
+/// integrated, the wrench held. Each `NEEDLE_INSERTION_*` value is checked against the
+/// library's by `tests/c_program.rs`.
+pub const NEEDLE_INSERTION_FAST_MOTION: u8 = 0x01;
+/// Insertion flag: the pose is outside the insertion's domain (|x|, |z| <= 64 mm,
+/// |depth| <= 128 mm, tilts <= 89 degrees); not integrated, the wrench held.
+pub const NEEDLE_INSERTION_OUT_OF_DOMAIN: u8 = 0x02;
+/// Insertion flag: an input was NaN or infinite; not integrated, the wrench zero.
+pub const NEEDLE_INSERTION_NOT_FINITE: u8 = 0x04;
+/// Insertion flag: the force (|fx| + |fy| + |fz| <= 100 N) or moment (|mx| + |my| + |mz|)
+/// bound was exceeded and the wrench scaled down to it.
+pub const NEEDLE_INSERTION_WRENCH_LIMITED: u8 = 0x08;
+
 /// `needle_tick_t::flags` bit (`needle_haptics::control::LoopFlags::POSE_STALE`).
 pub const NEEDLE_LOOP_POSE_STALE: u16 = 0x0001;
 /// Loop flag: no pose this tick.
@@ -270,6 +284,9 @@ pub const NEEDLE_LOOP_OUTPUT_ERROR: u16 = 0x0080;
 pub const NEEDLE_LOOP_DISABLED: u16 = 0x0100;
 /// Loop flag: the passivity guard limited the rendered stiffness.
 pub const NEEDLE_LOOP_STIFFNESS_LIMITED: u16 = 0x0200;
+/// Loop flag: the insertion rejected the pose as a glitch (`NEEDLE_INSERTION_*`); a fault
+/// that keeps the passivity guard's state.
+pub const NEEDLE_LOOP_POSE_GLITCH: u16 = 0x0400;
 
 /// A needle path through a tissue stack: initialise with `needle_insertion_init`. Plain
 /// data: it may be copied with `memcpy`.
@@ -296,6 +313,9 @@ pub struct needle_insertion_result_t {
     pub phase: u16,
     /// Filtered axial velocity, mm/s (positive inserting).
     pub velocity_mm_per_s: f32,
+    /// `NEEDLE_INSERTION_*` flags of the step: a glitch (not integrated, the wrench held)
+    /// or a wrench scaled down to its bound; 0 otherwise.
+    pub flags: u8,
 }
 
 /// A needle path through a tissue stack in integers: initialise with
@@ -323,4 +343,6 @@ pub struct needle_fixed_insertion_result_t {
     pub phase: u16,
     /// Filtered axial velocity, mm/s × 65536 (positive inserting).
     pub velocity_mm_per_s_q16: i32,
+    /// `NEEDLE_INSERTION_*` flags, as `needle_insertion_result_t`'s.
+    pub flags: u8,
 }

@@ -16,7 +16,7 @@ use common::{manifest_dir, run, scratch, staticlib};
 use needle_haptics::control::{ChannelMap, LoopConfig, LoopCore, OverLimit};
 use needle_haptics::insertion::{stacks, Insertion, InsertionConfig};
 use needle_haptics::Pose;
-use paths::{depth_scale, for_each_tick, for_each_tick_q16, Digest, PATHS};
+use paths::{depth_scale, for_each_path_tick, for_each_path_tick_q16, Digest, PATH_COUNT};
 use std::fmt::Write as _;
 use std::process::Command;
 
@@ -42,13 +42,13 @@ fn loop_core() -> LoopCore<3> {
 fn ticks_and_expected() -> (String, Vec<String>) {
     let (mut ticks, mut want) = (String::new(), Vec::new());
     for stack in &stacks::ALL {
-        for (i, path) in PATHS.iter().enumerate() {
+        for i in 0..PATH_COUNT {
             let mut ins = Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ).expect("shipped stack");
             let mut l = loop_core();
             l.set_insertion(Some(ins));
             let (mut digest, mut loop_digest) = (Digest::new(), Digest::new());
             let (mut n, mut punctures) = (0u64, 0u64);
-            for_each_tick(path, depth_scale(stack), |_, p| {
+            for_each_path_tick(i, depth_scale(stack), |_, p| {
                 let _ = writeln!(
                     ticks,
                     "{} {i} {:x} {:x} {:x} {:x} {:x}",
@@ -61,7 +61,7 @@ fn ticks_and_expected() -> (String, Vec<String>) {
                 );
                 let pose = Pose { x_mm: p[0], z_mm: p[1], theta_x_deg: p[2], theta_z_deg: p[3], depth_mm: p[4] };
                 let e = ins.step(&pose);
-                digest.tick(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures);
+                digest.tick(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures, e.flags.bits());
                 n += 1;
                 punctures += u64::from(e.punctures);
                 let s = l.step(Ok(pose));
@@ -115,18 +115,18 @@ fn fixed_ticks_and_expected() -> (String, Vec<String>) {
     use needle_haptics::fixed::insertion::{stacks as fixed_stacks, Insertion as FixedInsertion, InsertionConfig as FixedConfig};
     let (mut ticks, mut want) = (String::new(), Vec::new());
     for (stack, scale_of) in fixed_stacks::ALL.iter().zip(&stacks::ALL) {
-        for (i, path) in PATHS.iter().enumerate() {
+        for i in 0..PATH_COUNT {
             let mut ins = FixedInsertion::new(stack, FixedConfig::DEFAULT_1KHZ).expect("shipped stack");
             let mut digest = Digest::new();
             let (mut n, mut punctures) = (0u64, 0u64);
-            for_each_tick_q16(path, depth_scale(scale_of), |_, p| {
+            for_each_path_tick_q16(i, depth_scale(scale_of), |_, p| {
                 let _ = writeln!(
                     ticks,
                     "{} {i} {:x} {:x} {:x} {:x} {:x}",
                     stack.name, p[0] as u32, p[1] as u32, p[2] as u32, p[3] as u32, p[4] as u32
                 );
                 let e = ins.step(&needle_haptics::fixed::Pose::new(p[0], p[1], p[2], p[3], p[4]));
-                digest.tick_fixed(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures);
+                digest.tick_fixed(e.wrench.to_array(), e.status.bits(), e.phase.code(), e.punctures, e.flags.bits());
                 n += 1;
                 punctures += u64::from(e.punctures);
             });

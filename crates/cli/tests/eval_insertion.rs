@@ -67,6 +67,35 @@ fn a_scripted_insertion_gives_the_librarys_ticks() {
     assert!(punctures > 0, "the script punctures");
 }
 
+/// Issue 66: a script whose depth jumps to 1e6 mm for one tick and whose x jumps 30 mm in
+/// one tick: the rows are not integrated (the wrench of the row before, 0 punctures), the
+/// `flags` column says why and stderr names the flags with their first row.
+#[test]
+fn a_glitch_in_a_script_is_flagged_and_named() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let (_, mut poses) = script();
+    poses[3000].depth_mm = 1.0e6;
+    poses[3500].x_mm += 30.0;
+    let (text, poses) = script_of(poses);
+    let out = eval_liver(dir.path(), "glitch.csv", &text, &[]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.lines().next().expect("header").ends_with(",punctures,flags"), "{stdout:.200}");
+    let rows: Vec<Vec<&str>> = stdout.lines().skip(1).map(|r| r.split(',').collect()).collect();
+    assert_eq!(rows.len(), poses.len());
+    for (k, want) in [(3000, "0x02"), (3500, "0x01")] {
+        assert_eq!(rows[k][15], want, "row {k}: the flags");
+        assert_eq!(rows[k][14], "0", "row {k}: no puncture");
+        assert_eq!(rows[k][6..12], rows[k - 1][6..12], "row {k}: the wrench of the row before");
+    }
+    assert!(rows.iter().enumerate().all(|(k, r)| k == 3000 || k == 3500 || r[15] == "0x00"), "only the glitch rows are flagged");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("FAST_MOTION in 1 ticks (first at row 3501)") && stderr.contains("OUT_OF_DOMAIN in 1 ticks (first at row 3001)"),
+        "{stderr}"
+    );
+}
+
 #[test]
 fn bad_scripts_are_refused_with_their_line() {
     let dir = tempfile::tempdir().expect("temp dir");

@@ -234,3 +234,59 @@ pub mod status {
         ("ERROR", ERROR),
     ];
 }
+
+/// The insertion model's physical limits (`needle_haptics::insertion` and
+/// `fixed::insertion`, coeffs/README.md "Insertion flags"): its domain, the default
+/// largest speeds of a tick and the bound on its wrench. A pose outside the domain, or
+/// one that moved further than the configuration's largest speeds allow since the last
+/// accepted pose, is a glitch: not integrated as motion ([`insertion_flags`]).
+pub mod insertion_limits {
+    /// Largest `|x|` and `|z|` of an insertion pose (the entry point), mm.
+    pub const XZ_MAX_MM: i32 = 64;
+    /// Largest `|depth|` of an insertion pose (the tip along the axis past the surface), mm.
+    pub const DEPTH_MAX_MM: i32 = 128;
+    /// Largest `|theta_x|` and `|theta_z|` of an insertion pose, degrees.
+    pub const TILT_MAX_DEG: i32 = 89;
+    /// The default largest speed of `x`, `z` and `depth`, mm/s (1 mm per tick at 1 kHz:
+    /// a hand's fast reach, 24 times the fastest golden insertion path's 41.7 mm/s).
+    pub const SPEED_MAX_MM_PER_S: u32 = 1000;
+    /// The default largest turning speed of the tilts, degrees/s (1 degree per tick at 1 kHz).
+    pub const TURN_MAX_DEG_PER_S: u32 = 1000;
+    /// The bound on the insertion's force: `|fx| + |fy| + |fz|` never exceeds it, N (so no
+    /// force component does); a larger force is scaled down to it, its direction kept.
+    pub const FORCE_LIMIT_N: i32 = 100;
+    /// The bound on the insertion's moment about the hub: `|mx| + |my| + |mz|` never
+    /// exceeds it, N·mm (so no moment component does); scaled down as the force.
+    pub const MOMENT_LIMIT_NMM: i32 = 10_000;
+}
+
+/// The insertion step's own flags (`needle_haptics::insertion::InsertionFlags`, the C
+/// API's `NEEDLE_INSERTION_*`, the CLI's `flags` column), beside the surrogate's
+/// [`status`] bits (whose eight bits are all taken).
+pub mod insertion_flags {
+    /// Nothing to report: the pose was accepted and the wrench was within its bound.
+    pub const OK: u8 = 0x00;
+    /// The pose moved further since the last accepted pose than the configuration's
+    /// largest speeds allow: a glitch, not integrated (the wrench held).
+    pub const FAST_MOTION: u8 = 0x01;
+    /// The pose lies outside the insertion's domain ([`super::insertion_limits`]): a
+    /// glitch, not integrated (the wrench held).
+    pub const OUT_OF_DOMAIN: u8 = 0x02;
+    /// An input was NaN or infinite: a glitch, not integrated (the wrench zero, the
+    /// status `ERROR`).
+    pub const NOT_FINITE: u8 = 0x04;
+    /// The wrench's force or moment was beyond its bound
+    /// ([`super::insertion_limits::FORCE_LIMIT_N`], [`super::insertion_limits::MOMENT_LIMIT_NMM`])
+    /// and was scaled down to it.
+    pub const WRENCH_LIMITED: u8 = 0x08;
+    /// The three glitch flags: the tick was not integrated.
+    pub const GLITCH: u8 = FAST_MOTION | OUT_OF_DOMAIN | NOT_FINITE;
+    /// Every flag with its name, `OK` first, then in bit order.
+    pub const NAMES: [(&str, u8); 5] = [
+        ("OK", OK),
+        ("FAST_MOTION", FAST_MOTION),
+        ("OUT_OF_DOMAIN", OUT_OF_DOMAIN),
+        ("NOT_FINITE", NOT_FINITE),
+        ("WRENCH_LIMITED", WRENCH_LIMITED),
+    ];
+}

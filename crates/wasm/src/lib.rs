@@ -128,7 +128,7 @@ pub extern "C" fn needle_stack_thickness_mm(stack: u32, layer: u32) -> f32 {
 #[no_mangle]
 pub extern "C" fn needle_insertion_start(stack: u32, period_s: f32, velocity_time_constant_s: f32) -> i32 {
     let Some(s) = stacks::ALL.get(stack as usize) else { return -1 };
-    start_path(s, InsertionConfig { period_s, velocity_time_constant_s })
+    start_path(s, InsertionConfig { period_s, velocity_time_constant_s, ..InsertionConfig::DEFAULT_1KHZ })
 }
 
 /// Starts the page's path through `stack`: 0, or -2 for a configuration out of range.
@@ -175,13 +175,14 @@ pub extern "C" fn needle_insertion_start_prony(
         *slot = Layer { prony: terms, ..*l };
     }
     let with = Stack { layers: layers.get(..s.layers.len()).unwrap_or(&[]), ..*s };
-    start_path(&with, InsertionConfig { period_s, velocity_time_constant_s })
+    start_path(&with, InsertionConfig { period_s, velocity_time_constant_s, ..InsertionConfig::DEFAULT_1KHZ })
 }
 
 /// One tick of the started path: the wrench at [`needle_out`]; returns
-/// `status | phase_code << 8 | punctures << 24` (phase code: 0 approach, 0x100 | layer
-/// deflecting, 0x200 | layer cutting, 0x300 | layer in the track), or `u32::MAX` when no
-/// path was started.
+/// `status | phase_code << 8 | punctures << 24 | flags << 28` (phase code: 0 approach,
+/// 0x100 | layer deflecting, 0x200 | layer cutting, 0x300 | layer in the track;
+/// punctures at most 8, four bits; flags the step's `InsertionFlags`, four bits), or
+/// `u32::MAX` when no path was started.
 #[no_mangle]
 pub extern "C" fn needle_insertion_step(x_mm: f32, z_mm: f32, theta_x_deg: f32, theta_z_deg: f32, depth_mm: f32) -> u32 {
     let mut path = PATH.0.borrow_mut();
@@ -190,7 +191,14 @@ pub extern "C" fn needle_insertion_step(x_mm: f32, z_mm: f32, theta_x_deg: f32, 
     for (slot, v) in OUT.iter().zip(e.wrench.to_array()) {
         slot.store(v.to_bits(), Ordering::Relaxed);
     }
-    u32::from(e.status.bits()) | u32::from(e.phase.code()) << 8 | u32::from(e.punctures) << 24
+    packed(e.status.bits(), e.phase.code(), e.punctures, e.flags.bits())
+}
+
+/// A tick's result in one word: `status | phase_code << 8 | punctures << 24 | flags << 28`
+/// (the phase code has 10 bits, punctures at most [`MAX_LAYERS`](needle_haptics::insertion::MAX_LAYERS) = 8 and
+/// the flags four bits).
+fn packed(status: u8, phase: u16, punctures: u8, flags: u8) -> u32 {
+    u32::from(status) | u32::from(phase) << 8 | u32::from(punctures & 0x0f) << 24 | u32::from(flags & 0x0f) << 28
 }
 
 /// The fixed-point needle path (`needle_haptics::fixed::insertion`).
@@ -207,7 +215,7 @@ static FIXED_PATH: FixedPath = FixedPath(core::cell::RefCell::new(None));
 #[no_mangle]
 pub extern "C" fn needle_fixed_insertion_start(stack: u32, period_us: u32, velocity_time_constant_us: u32) -> i32 {
     let Some(s) = fixed_stacks::ALL.get(stack as usize) else { return -1 };
-    match FixedInsertion::new(s, FixedConfig { period_us, velocity_time_constant_us }) {
+    match FixedInsertion::new(s, FixedConfig { period_us, velocity_time_constant_us, ..FixedConfig::DEFAULT_1KHZ }) {
         Ok(i) => {
             *FIXED_PATH.0.borrow_mut() = Some(i);
             0
@@ -233,7 +241,7 @@ pub extern "C" fn needle_fixed_insertion_step(
     for (slot, v) in OUT.iter().zip(e.wrench.to_array()) {
         slot.store(v as u32, Ordering::Relaxed);
     }
-    u32::from(e.status.bits()) | u32::from(e.phase.code()) << 8 | u32::from(e.punctures) << 24
+    packed(e.status.bits(), e.phase.code(), e.punctures, e.flags.bits())
 }
 
 /// A wasm module has no one to report a panic to; the library cannot panic (its

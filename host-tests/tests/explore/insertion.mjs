@@ -1,6 +1,6 @@
 // Steps the golden insertion paths through the wasm module's insertion exports and prints,
 // per path, the line the firmware prints (ticks, punctures, FNV-1a digest of every tick's
-// six wrench bits, status, phase code and punctures).
+// six wrench bits, status, phase code, punctures and the step's flags).
 // Usage: node insertion.mjs NEEDLE_WASM POSES  (POSES: lines "stack path x z tx tz depth",
 // the five inputs as f32 bits in hex, in tick order; or, with NEEDLE_FIXED=1, as Q16.16
 // integers in hex (i32 bits) for the fixed-point insertion, whose lines start "fixed ").
@@ -50,8 +50,9 @@ for (const line of readFileSync(posesPath, "utf8").split("\n")) {
   for (const v of out) digest = word(digest, v);
   digest = word(digest, r & 0xff);
   digest = word(digest, (r >>> 8) & 0xffff);
-  digest = word(digest, r >>> 24);
+  digest = word(digest, (r >>> 24) & 0xf);
+  digest = word(digest, r >>> 28);
   ticks++;
-  punctures += r >>> 24;
+  punctures += (r >>> 24) & 0xf;
 }
 finish();

@@ -12,8 +12,19 @@
 //! - Internally `i64`: path coordinates in mm Q16, the axis in Q30 ([`track`]), forces
 //!   in µN Q16; the output rounds to whole µN and saturates to `i32`.
 //!
-//! **Inputs clamped**: `x`, `z` to ±64 mm, `depth` to ±128 mm, tilts to ±89 degrees (the
-//! f32 model's); the surrogate clamps further to its own domain and reports it.
+//! **Glitches** (the f32 model's "Glitches", in integers): a pose outside the domain
+//! (`|x|, |z| <= 64` mm, `|depth| <= 128` mm, tilts `|θ| <= 89` degrees:
+//! `needle_contract::insertion_limits`) or one that moved further since the last accepted
+//! pose than [`InsertionConfig::max_speed_mm_per_s`] (tilts:
+//! [`InsertionConfig::max_turn_deg_per_s`]) allows over the ticks since it (the step per
+//! tick in Q16 computed once in [`Insertion::new`]) is not integrated: the wrench and
+//! phase are the last tick's, the flags ([`InsertionFlags`]) say why, and the deflected
+//! boundary's filter relaxes over its held input (the next accepted tick's change taken
+//! as a ramp over the ticks since the last: `viscoelastic::QlvState::hold`). The wrench's
+//! `|fx| + |fy| + |fz|` stays within `FORCE_LIMIT_N` (in µN), scaled down to the bound
+//! otherwise; `|mx| + |my| + |mz|` is within `MOMENT_LIMIT_NMM` (in µN·mm) by its type
+//! (three `i32`, at most 6,442 N·mm). The
+//! surrogate clamps further to its own domain and reports it.
 //!
 //! **Overflow.** Every product whose size depends on the stack's values or on the pose
 //! saturates (`i64::saturating_mul`); within the stacks [`Stack::from_f32`] accepts
@@ -35,14 +46,15 @@ pub use stack::{
 };
 
 use super::arith::sat_mul;
-use super::depth_extension::saturate_i32;
+use super::depth_extension::{round_shr_i32, saturate_i32};
 #[cfg(not(feature = "viscoelastic"))]
 use super::viscoelastic::identity::{QlvCoefficients, QlvState};
 #[cfg(feature = "viscoelastic")]
 use super::viscoelastic::{QlvCoefficients, QlvState};
 use super::{extended_wrench, Pose, Wrench};
 use crate::float::insertion::{InsertionError, Phase};
-use crate::Status;
+use crate::{InsertionFlags, Status};
+use needle_contract::insertion_limits as limits;
 use track::{axis, dot, mul_q30, mul_shr, HoldSums, Track, Vec3, TRACK_STIFFNESS_MAX_Q8};
 
 /// The insertion's tick settings in integers.
@@ -53,12 +65,22 @@ pub struct InsertionConfig {
     pub period_us: u32,
     /// Time constant of the velocity's low-pass filter, µs (0: unfiltered).
     pub velocity_time_constant_us: u32,
+    /// The largest speed of `x`, `z` and `depth`, mm/s (> 0; 1,000 by default): faster
+    /// is a glitch ([`InsertionFlags::FAST_MOTION`]).
+    pub max_speed_mm_per_s: u32,
+    /// The largest turning speed of the tilts, degrees/s (> 0; 1,000 by default).
+    pub max_turn_deg_per_s: u32,
 }
 
 impl InsertionConfig {
     /// 1 kHz, velocity filtered with a 5 ms time constant (the f32 model's
     /// [`DEFAULT_1KHZ`](crate::float::insertion::InsertionConfig::DEFAULT_1KHZ)).
-    pub const DEFAULT_1KHZ: Self = Self { period_us: 1000, velocity_time_constant_us: 5000 };
+    pub const DEFAULT_1KHZ: Self = Self {
+        period_us: 1000,
+        velocity_time_constant_us: 5000,
+        max_speed_mm_per_s: limits::SPEED_MAX_MM_PER_S,
+        max_turn_deg_per_s: limits::TURN_MAX_DEG_PER_S,
+    };
 }
 
 /// One tick's result.
@@ -69,7 +91,10 @@ pub struct InsertionEvaluation {
     pub wrench: Wrench,
     /// The surrogate's status while deflecting (saturation).
     pub status: Status,
-    /// The phase after this tick.
+    /// What the step did with the pose and the wrench: a glitch (not integrated, the
+    /// wrench held) or a wrench scaled down to its bound; [`InsertionFlags::OK`] otherwise.
+    pub flags: InsertionFlags,
+    /// The phase after this tick (a glitch tick's: the last tick's).
     pub phase: Phase,
     /// Boundaries punctured in this tick.
     pub punctures: u8,
@@ -92,7 +117,23 @@ pub struct Insertion<'a> {
     track_end_q16: i64,
     track: Option<Track>,
     preload_q16: [i64; 6],
-    last_depth_q16: Option<i64>,
+    /// The last accepted pose's depth (Q16.16).
+    last_depth_q16: Option<i32>,
+    /// The last accepted pose's `x`, `z`, `theta_x`, `theta_z` (Q16.16).
+    accepted_q16: [i32; 4],
+    /// Ticks since the last accepted pose: 1, plus one per glitch tick since (at most
+    /// [`MISSED_MAX`]).
+    missed: u32,
+    /// The largest step per tick of `x`, `z`, `depth` (mm Q16) and of the tilts (degrees
+    /// Q16), from the configuration's speeds (saturated: 65,536 mm or degrees allow any
+    /// move within the domain).
+    max_step_q16: [u32; 2],
+    /// The configuration's period and time constant, µs (the velocity's filter after a
+    /// glitch).
+    period_us: u32,
+    tau_us: u32,
+    /// The last tick's wrench and phase: what a glitch tick holds.
+    held: (Wrench, Phase),
     velocity_q16: i64,
     /// Per layer the relaxation's per-tick coefficients (computed once, in `new`).
     qlv: [QlvCoefficients; MAX_LAYERS],
@@ -107,8 +148,36 @@ struct Deflected {
     punctures: u8,
 }
 
-const X_MAX_Q16: i64 = 64 << 16;
-const DEPTH_MAX_Q16: i64 = 128 << 16;
+const X_MAX_Q16: u32 = (limits::XZ_MAX_MM as u32) << 16;
+const DEPTH_MAX_Q16: u32 = (limits::DEPTH_MAX_MM as u32) << 16;
+const TILT_MAX_Q16: u32 = (limits::TILT_MAX_DEG as u32) << 16;
+/// The force bound, µN, and the moment bound, µN·mm (`insertion_limits`).
+const FORCE_LIMIT_UN: u64 = limits::FORCE_LIMIT_N as u64 * 1_000_000;
+const MOMENT_LIMIT_UNMM: i64 = limits::MOMENT_LIMIT_NMM as i64 * 1_000_000;
+/// The most ticks since the last accepted pose counted (about 17 minutes at 1 kHz).
+const MISSED_MAX: u32 = 1 << 20;
+
+/// Scales the force of `w` (µN) down to its bound when it is beyond it
+/// (`|fx| + |fy| + |fz| <= FORCE_LIMIT_UN`: each force component times one factor, the
+/// bound over the sum in Q32 rounded down, the product rounded toward zero, so the
+/// scaled sum is at most the bound); [`InsertionFlags::WRENCH_LIMITED`] when it did. The
+/// moments need no scaling: three `i32` are within `MOMENT_LIMIT_UNMM` (checked below).
+fn bound(w: &mut [i32; 6]) -> InsertionFlags {
+    let f: u64 = w.iter().take(3).map(|c| u64::from(c.unsigned_abs())).sum();
+    if f <= FORCE_LIMIT_UN {
+        return InsertionFlags::OK;
+    }
+    // f > FORCE_LIMIT_UN > 0: the factor is below 2^32 and `|c| factor` below 2^63
+    let factor = i64::try_from((FORCE_LIMIT_UN << 32).checked_div(f).unwrap_or(0)).unwrap_or(0);
+    for c in w.iter_mut().take(3) {
+        // |c| factor / 2^32 <= |c|: within i32
+        *c = ((i64::from(*c) * factor) / (1 << 32)) as i32;
+    }
+    InsertionFlags::WRENCH_LIMITED
+}
+
+/// The fixed-point moments are `i32` µN·mm: their sum is within the moment bound.
+const _: () = assert!(3 * (i32::MAX as i64) <= MOMENT_LIMIT_UNMM);
 
 fn layer_ok(l: &Layer) -> bool {
     let k = &l.friction;
@@ -160,6 +229,13 @@ impl<'a> Insertion<'a> {
         let rate_q16 = (1_000_000_u64 << 16).checked_div(period).ok_or(InsertionError::Config)?;
         let whole = period + u64::from(config.velocity_time_constant_us);
         let alpha_q16 = ((period << 16) + (whole >> 1)).checked_div(whole).ok_or(InsertionError::Config)?;
+        if config.max_speed_mm_per_s == 0 || config.max_turn_deg_per_s == 0 {
+            return Err(InsertionError::Config);
+        }
+        // speed (mm/s) times period (µs) times 2^16 / 10^6 = 1,024 / 15,625, saturated
+        let per_tick =
+            |speed: u32| u32::try_from(u64::from(speed).saturating_mul(period).saturating_mul(1024) / 15_625).unwrap_or(u32::MAX);
+        let max_step_q16 = [per_tick(config.max_speed_mm_per_s), per_tick(config.max_turn_deg_per_s)];
         let mut insertion = Self {
             stack,
             scales_q16,
@@ -171,6 +247,12 @@ impl<'a> Insertion<'a> {
             track: None,
             preload_q16: [0; 6],
             last_depth_q16: None,
+            accepted_q16: [0; 4],
+            missed: 1,
+            max_step_q16,
+            period_us: config.period_us,
+            tau_us: config.velocity_time_constant_us,
+            held: (Wrench::ZERO, Phase::Approach),
             velocity_q16: 0,
             qlv,
             qlv_state: QlvState::REST,
@@ -220,6 +302,8 @@ impl<'a> Insertion<'a> {
     pub fn reset(&mut self) {
         self.end_path();
         self.last_depth_q16 = None;
+        self.missed = 1;
+        self.held = (Wrench::ZERO, Phase::Approach);
         self.velocity_q16 = 0;
     }
 
@@ -240,10 +324,23 @@ impl<'a> Insertion<'a> {
     /// the 5,000-17,000 a step takes).
     #[inline(never)]
     pub fn step(&mut self, pose: &Pose) -> InsertionEvaluation {
-        let depth = i64::from(pose.depth_mm_q16).clamp(-DEPTH_MAX_Q16, DEPTH_MAX_Q16);
-        let step_q16 = self.last_depth_q16.map_or(0, |last| depth - last);
+        let glitch = self.screen(pose);
+        if !glitch.is_ok() {
+            self.missed = self.missed.saturating_add(1).min(MISSED_MAX);
+            // the deflected boundary's filter follows time over the held input
+            if let Some(c) = self.qlv.get(self.punctured) {
+                self.qlv_state.hold(c);
+            }
+            let (wrench, phase) = self.held;
+            let velocity_mm_per_s_q16 = saturate_i32(self.velocity_q16);
+            return InsertionEvaluation { wrench, status: Status::OK, flags: glitch, phase, punctures: 0, velocity_mm_per_s_q16 };
+        }
+        let depth = i64::from(pose.depth_mm_q16);
+        let step_q16 = self.last_depth_q16.map_or(0, |last| depth - i64::from(last));
         self.filter_velocity(step_q16);
-        self.last_depth_q16 = Some(depth);
+        self.last_depth_q16 = Some(pose.depth_mm_q16);
+        self.accepted_q16 = [pose.x_mm_q16, pose.z_mm_q16, pose.theta_x_deg_q16, pose.theta_z_deg_q16];
+        self.missed = 1;
         // friction and cutting see the velocity only when it has the last motion's sign
         let v = if (self.velocity_q16 > 0 && step_q16 > 0) || (self.velocity_q16 < 0 && step_q16 < 0) { self.velocity_q16 } else { 0 };
         if depth <= 0 {
@@ -251,8 +348,7 @@ impl<'a> Insertion<'a> {
             return self.evaluation([0; 6], Status::OK, Phase::Approach, 0);
         }
         let a = axis(pose.theta_x_deg_q16, pose.theta_z_deg_q16);
-        let x = i64::from(pose.x_mm_q16).clamp(-X_MAX_Q16, X_MAX_Q16);
-        let z = i64::from(pose.z_mm_q16).clamp(-X_MAX_Q16, X_MAX_Q16);
+        let (x, z) = (i64::from(pose.x_mm_q16), i64::from(pose.z_mm_q16));
         let entry: Vec3 = [x, 0, z];
         let bounds = self.boundaries(a[1]);
         let Deflected { wrench_q16: mut w, status, punctures } = self.deflect(pose, depth, a, entry, &bounds);
@@ -260,14 +356,51 @@ impl<'a> Insertion<'a> {
         self.evaluation(w, status, phase, punctures)
     }
 
-    fn evaluation(&self, w_q16: [i64; 6], status: Status, phase: Phase, punctures: u8) -> InsertionEvaluation {
-        let wrench = Wrench::from_array(w_q16.map(|c| saturate_i32(c.saturating_add(1 << 15) >> 16)));
-        InsertionEvaluation { wrench, status, phase, punctures, velocity_mm_per_s_q16: saturate_i32(self.velocity_q16) }
+    /// The tick's evaluation: the wrench rounded to µN and µN·mm, saturated to `i32` and
+    /// bounded (`bound`); it is what the next glitch tick holds.
+    fn evaluation(&mut self, w_q16: [i64; 6], status: Status, phase: Phase, punctures: u8) -> InsertionEvaluation {
+        let mut w = w_q16.map(|c| round_shr_i32(c, 16));
+        let flags = bound(&mut w);
+        let wrench = Wrench::from_array(w);
+        self.held = (wrench, phase);
+        InsertionEvaluation { wrench, status, flags, phase, punctures, velocity_mm_per_s_q16: saturate_i32(self.velocity_q16) }
+    }
+
+    /// The glitch flags of `pose` (the module's "Glitches"): [`InsertionFlags::OK`] to
+    /// integrate it. In `u32`: magnitudes and distances of `i32` never overflow there;
+    /// the largest distance of `x`, `z`, `depth` (of the tilts) against one allowance.
+    fn screen(&self, pose: &Pose) -> InsertionFlags {
+        let Pose { x_mm_q16: x, z_mm_q16: z, theta_x_deg_q16: tx, theta_z_deg_q16: tz, depth_mm_q16: d } = *pose;
+        let (xz, tilt) = (x.unsigned_abs().max(z.unsigned_abs()), tx.unsigned_abs().max(tz.unsigned_abs()));
+        if xz > X_MAX_Q16 || d.unsigned_abs() > DEPTH_MAX_Q16 || tilt > TILT_MAX_Q16 {
+            return InsertionFlags::OUT_OF_DOMAIN;
+        }
+        let Some(last_d) = self.last_depth_q16 else { return InsertionFlags::OK };
+        let [lx, lz, ltx, ltz] = self.accepted_q16;
+        let [mm, deg] = self.max_step_q16.map(|s| s.saturating_mul(self.missed));
+        if x.abs_diff(lx).max(z.abs_diff(lz)).max(d.abs_diff(last_d)) <= mm && tx.abs_diff(ltx).max(tz.abs_diff(ltz)) <= deg {
+            InsertionFlags::OK
+        } else {
+            InsertionFlags::FAST_MOTION
+        }
     }
 
     fn filter_velocity(&mut self, step_q16: i64) {
-        let raw = mul_shr(step_q16, self.rate_q16, 16);
-        self.velocity_q16 = self.velocity_q16.saturating_add(mul_shr(self.alpha_q16, raw.saturating_sub(self.velocity_q16), 16));
+        let (raw, alpha) =
+            if self.missed <= 1 { (mul_shr(step_q16, self.rate_q16, 16), self.alpha_q16) } else { self.after_glitch(step_q16) };
+        self.velocity_q16 = self.velocity_q16.saturating_add(mul_shr(alpha, raw.saturating_sub(self.velocity_q16), 16));
+    }
+
+    /// The velocity's raw value and filter gain for a step over `missed` ticks (after a
+    /// glitch): the step over `missed` periods, `alpha = n T / (n T + tau)` in Q16, as
+    /// `2^16 - tau 2^16 / (n T + tau)` rounded (`n <= 2^20`, `T, tau < 2^32`: every value
+    /// below 2^53 in `u64`, the divisor at least `T >= 1`).
+    fn after_glitch(&self, step_q16: i64) -> (i64, i64) {
+        let raw = mul_shr(step_q16, self.rate_q16, 16).checked_div(i64::from(self.missed)).unwrap_or(0);
+        let tau = u64::from(self.tau_us);
+        let whole = u64::from(self.period_us) * u64::from(self.missed) + tau;
+        let held = ((tau << 16) + (whole >> 1)).checked_div(whole).unwrap_or(0);
+        (raw, (1 << 16) - i64::try_from(held).unwrap_or(0))
     }
 
     /// Path coordinates of the layers' upper boundaries (mm Q16) for a needle of
@@ -398,7 +531,8 @@ impl<'a> Insertion<'a> {
             axial_q16 = axial_q16.saturating_add(cutting(v));
             Phase::Cutting(index(m - 1))
         } else {
-            let inside = (1..m).take_while(|&j| bound(j) < depth).count();
+            // the boundaries rise with j: the count of those above the tip by bisection
+            let inside = bounds.get(1..m).map_or(0, |b| b.partition_point(|&q| q < depth));
             Phase::InTrack(index(inside))
         };
         if depth > self.track_end_q16 && depth < next {

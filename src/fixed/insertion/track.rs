@@ -55,7 +55,10 @@ const COS_Q30: [i64; 7] = [1_073_741_824, -536_870_912, 44_739_243, -1_491_308, 
 /// `x^2` with `x = deg π / 180` in Q30. Error against f64 below 1e-7: the `x^13`
 /// coefficient rounds to 0 in Q30 (`x^13 / 13!` is 5e-8 at 89 degrees), the rest is the
 /// constants' rounding and the products' floors (a few 2^-30); tested against
-/// `f64::sin_cos`. An axis error of 1e-7 moves a 10 N force by 1 µN.
+/// `f64::sin_cos`. An axis error of 1e-7 moves a 10 N force by 1 µN. Out of line on
+/// the Arm cores: one copy for the two tilts (on the M0 its `i64` products are library
+/// calls).
+#[cfg_attr(target_arch = "arm", inline(never))]
 pub(super) fn sin_cos_q30(deg_q16: i32) -> (i64, i64) {
     let d = i64::from(deg_q16).clamp(-TILT_MAX_Q16, TILT_MAX_Q16);
     let x = (d * RAD_PER_DEG_Q30) >> 16;

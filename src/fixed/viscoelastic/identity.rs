@@ -31,6 +31,10 @@ impl QlvState {
         elastic_q16
     }
 
+    /// Nothing to hold.
+    #[inline]
+    pub fn hold(&mut self, _coefficients: &QlvCoefficients) {}
+
     /// Nothing to reset.
     #[inline]
     pub fn reset(&mut self) {}

@@ -127,7 +127,8 @@ fn alternating_series_q32(r_q32: u64, s: u64) -> u64 {
 }
 
 /// `exp(-x)` in Q32 for `x` in Q32 (`x >= 0`): `exp(-1)^k exp(-r)` with `x = k + r`
-/// (products of two Q32 numbers at most 2^32 each: below 2^64).
+/// (each product of `e <= 2^32 + 16`, the series' rounding, and `exp(-1) < 0.37 * 2^32`
+/// is below 2^63: a plain `u64` product, no saturation test, which cost 362 B on the M0).
 fn exp_neg_q32(x_q32: u64) -> u64 {
     let k = x_q32 >> 32;
     // exp(-23) < 2^-33: zero in Q32
@@ -137,7 +138,7 @@ fn exp_neg_q32(x_q32: u64) -> u64 {
     let inv_e = alternating_series_q32(ONE_Q32, 0);
     let mut e = alternating_series_q32(x_q32 & 0xffff_ffff, 0);
     for _ in 0..k {
-        e = e.saturating_mul(inv_e) >> 32;
+        e = e.wrapping_mul(inv_e) >> 32;
     }
     e
 }
@@ -207,28 +208,77 @@ fn mul_split((hi, lo): (i64, i64), c: i64, s: u32) -> i64 {
 
 /// The filter state of a wrench's six components (`[fx, fy, fz, mx, my, mz]`, µN and
 /// µN·mm in Q16): per component `[last input, h_0, h_1, h_2]`; at rest when zero.
+///
+/// Held ticks ([`hold`](Self::hold)) as the f32 state's
+/// ([`crate::float::viscoelastic::QlvState`], "Held ticks"): each term relaxes over the
+/// held input, and the next step takes the input's change as a ramp over the `n` ticks
+/// since the last step, `b` times the ramp's weight `r = (1 + a + ... + a^(n-1)) / n`
+/// (Q30, kept per term by `r <- (a r n + 1) / (n + 1)` at each held tick, rounded down:
+/// `a r n < 2^62`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct QlvState {
     state: [[i64; 1 + MAX_TERMS]; COMPONENT_COUNT],
+    /// Ticks held since the last step.
+    held: u32,
+    /// Per term the ramp's weight `r`, Q30 (valid while `held > 0`).
+    ramp_q30: [u32; MAX_TERMS],
 }
 
 impl QlvState {
     /// At rest.
-    pub const REST: Self = Self { state: [[0; 1 + MAX_TERMS]; COMPONENT_COUNT] };
+    pub const REST: Self = Self { state: [[0; 1 + MAX_TERMS]; COMPONENT_COUNT], held: 0, ramp_q30: [0; MAX_TERMS] };
 
     /// One tick of every component: the elastic wrench (Q16) in, the viscoelastic one
-    /// out. Without terms the input is returned and the state left at rest.
-    #[inline(never)]
+    /// out (after held ticks, the input's change as a ramp over them). Without terms the
+    /// input is returned and the state left at rest.
     pub fn step(&mut self, coefficients: &QlvCoefficients, elastic_q16: [i64; COMPONENT_COUNT]) -> [i64; COMPONENT_COUNT] {
         if !coefficients.is_active() {
             return elastic_q16;
         }
+        if self.held == 0 {
+            return self.filter(coefficients, elastic_q16);
+        }
+        self.held = 0;
+        let mut ramped = *coefficients;
+        let n = usize::from(coefficients.count);
+        for (b, &r) in ramped.b_q27.iter_mut().zip(&self.ramp_q30).take(n) {
+            // b < 2^31, r <= 2^30: the product below 2^61, the result at most b
+            *b = ((i64::from(*b) * i64::from(r)) >> 30) as i32;
+        }
+        self.filter(&ramped, elastic_q16)
+    }
+
+    /// The six components' recursion.
+    #[inline(never)]
+    fn filter(&mut self, coefficients: &QlvCoefficients, elastic_q16: [i64; COMPONENT_COUNT]) -> [i64; COMPONENT_COUNT] {
         let mut out = elastic_q16;
         for (o, s) in out.iter_mut().zip(self.state.iter_mut()) {
             *o = coefficients.step_one(s, *o);
         }
         out
+    }
+
+    /// One tick with the input unknown (the type's held ticks): each term relaxes over
+    /// the input held at the last tick's, `h <- a h / 2^30` (the step's own product: its
+    /// change is zero), so the state follows time. Without terms nothing changes.
+    pub fn hold(&mut self, coefficients: &QlvCoefficients) {
+        if !coefficients.is_active() {
+            return;
+        }
+        let _ = self.filter(coefficients, self.state.map(|s| s[0]));
+        if self.held == 0 {
+            self.ramp_q30 = [1 << 30; MAX_TERMS];
+        }
+        let n = u64::from(self.held) + 1;
+        self.held = self.held.saturating_add(1);
+        let terms = usize::from(coefficients.count);
+        for (r, &a) in self.ramp_q30.iter_mut().zip(&coefficients.a_q30).take(terms) {
+            // a, r <= 2^30: a r / 2^30 <= 2^30, times n < 2^32: below 2^62; the mean of
+            // weights at most 1 stays at most 2^30
+            let ar = (u64::from(a.unsigned_abs()) * u64::from(*r)) >> 30;
+            *r = u32::try_from((ar * n + (1 << 30)).checked_div(n + 1).unwrap_or(0)).unwrap_or(1 << 30);
+        }
     }
 
     /// Back to rest.

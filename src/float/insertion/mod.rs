@@ -56,6 +56,27 @@
 //! only when it has the sign of the last tick's motion (else zero): they never push the
 //! needle the way it last moved, so they only take energy out.
 //!
+//! **Glitches** (issue 66: an encoder glitch must never become a kilonewton): before a
+//! tick is integrated its pose is screened ([`InsertionFlags`]). A pose outside the
+//! insertion's domain (`|x|, |z| <= 64` mm, `|depth| <= 128` mm, tilts `|θ| <= 89`°:
+//! `needle_contract::insertion_limits`), not finite, or one whose `x`, `z` or `depth` moved
+//! further since the last accepted pose than [`InsertionConfig::max_speed_mm_per_s`]
+//! times the time since it (tilts: [`InsertionConfig::max_turn_deg_per_s`]) is not
+//! integrated as motion: no puncture, no velocity, no track or cutting change; the
+//! deflected boundary's viscoelastic filter relaxes over its input held at the last
+//! tick's (`QlvState::hold`: its state follows time); the tick's wrench and phase are
+//! the last tick's (zero and `ERROR` for a pose that is not finite) and its flags say
+//! why. The next pose is compared with the last accepted one over the time since it (the
+//! allowance grows by one period per glitch tick, so a real move the stream lost is
+//! accepted once it is within the speed), the velocity filter takes that time as its
+//! step, and the viscoelastic filter takes the input's change as a ramp over it (exact
+//! for a force that changed at a constant rate; docs/insertion.md, "Glitches", gives the
+//! recovery). Whatever the input, `|fx| + |fy| + |fz|` stays
+//! within `insertion_limits::FORCE_LIMIT_N` (100 N) and `|mx| + |my| + |mz|` within
+//! `MOMENT_LIMIT_NMM` (10,000 N·mm): a larger wrench is scaled down to the bound
+//! (direction kept, [`InsertionFlags::WRENCH_LIMITED`]). The model has no clock: a time
+//! stamp going backwards reaches it as a pose out of order, a jump like any other.
+//!
 //! f32 throughout, `libm` for the trigonometry: the same bits on every target.
 mod stack;
 mod track;
@@ -67,7 +88,8 @@ use crate::float::depth_extension::extended_wrench_and_depth_rate;
 use crate::float::viscoelastic::identity::{QlvCoefficients, QlvState};
 #[cfg(feature = "viscoelastic")]
 use crate::float::viscoelastic::{QlvCoefficients, QlvState};
-use crate::{extended_wrench, Pose, Status, Wrench};
+use crate::{extended_wrench, InsertionFlags, Pose, Status, Wrench};
+use needle_contract::insertion_limits as limits;
 use track::{axis, dot, Track, Vec3};
 
 /// The insertion's tick settings.
@@ -78,13 +100,26 @@ pub struct InsertionConfig {
     pub period_s: f32,
     /// Time constant of the velocity's low-pass filter, s (finite, >= 0; 0: unfiltered).
     pub velocity_time_constant_s: f32,
+    /// The largest speed of `x_mm`, `z_mm` and `depth_mm`, mm/s (finite, > 0): a pose
+    /// that moved further since the last accepted one is a glitch
+    /// ([`InsertionFlags::FAST_MOTION`]); the device's fastest motion, 1,000 by default.
+    pub max_speed_mm_per_s: f32,
+    /// The largest turning speed of the tilts, degrees/s (finite, > 0; 1,000 by default).
+    pub max_turn_deg_per_s: f32,
 }
 
 impl InsertionConfig {
     /// 1 kHz, velocity filtered with a 5 ms time constant (cut-off about 32 Hz: the
     /// hand's motion passes, one tick's quantisation noise of the position is averaged
     /// over five ticks).
-    pub const DEFAULT_1KHZ: Self = Self { period_s: 0.001, velocity_time_constant_s: 0.005 };
+    /// The largest speeds are `needle_contract::insertion_limits`' defaults (1 m/s and
+    /// 1,000 degrees/s: 1 mm and 1 degree per tick).
+    pub const DEFAULT_1KHZ: Self = Self {
+        period_s: 0.001,
+        velocity_time_constant_s: 0.005,
+        max_speed_mm_per_s: limits::SPEED_MAX_MM_PER_S as f32,
+        max_turn_deg_per_s: limits::TURN_MAX_DEG_PER_S as f32,
+    };
 }
 
 /// Why an [`Insertion`] could not be made or changed.
@@ -97,7 +132,7 @@ pub enum InsertionError {
     /// A layer value is out of its range (the tissue file's checks), or the needle
     /// diameters are not finite and > 0.
     Value,
-    /// The configuration's period or time constant is out of range.
+    /// The configuration's period, time constant or largest speeds are out of range.
     Config,
     /// [`Insertion::set_scales`] got a count other than the stack's layers, or a scale
     /// that is not finite and > 0.
@@ -112,7 +147,7 @@ impl core::fmt::Display for InsertionError {
         f.write_str(match self {
             Self::LayerCount => "tissue stack: 1 to 8 layers",
             Self::Value => "tissue stack: a value out of range (thickness, scale, puncture force, stick band > 0; the rest >= 0)",
-            Self::Config => "insertion config: period_s must be finite and > 0, velocity_time_constant_s finite and >= 0",
+            Self::Config => "insertion config: period_s, max_speed_mm_per_s and max_turn_deg_per_s must be finite and > 0, velocity_time_constant_s finite and >= 0",
             Self::Scales => "stiffness scales: one per layer, each finite and > 0",
             Self::NeedsViscoelastic => "tissue stack: a layer has Prony terms; build needle-haptics with its `viscoelastic` feature",
         })
@@ -161,7 +196,10 @@ pub struct InsertionEvaluation {
     /// The surrogate's status while deflecting (saturation), `ERROR` for a pose that is
     /// not finite (then the wrench is zero and the state is unchanged).
     pub status: Status,
-    /// The phase after this tick.
+    /// What the step did with the pose and the wrench: a glitch (not integrated, the
+    /// wrench held) or a wrench scaled down to its bound; [`InsertionFlags::OK`] otherwise.
+    pub flags: InsertionFlags,
+    /// The phase after this tick (a glitch tick's: the last tick's).
     pub phase: Phase,
     /// Boundaries punctured in this tick (0 in most ticks).
     pub punctures: u8,
@@ -224,6 +262,13 @@ pub struct Insertion {
     track: Option<Track>,
     preload: [f32; 6],
     last_depth_mm: Option<f32>,
+    /// The last accepted pose's `x_mm`, `z_mm`, `theta_x_deg`, `theta_z_deg` (its depth is
+    /// `last_depth_mm`): what the next pose's motion is measured from.
+    accepted: [f32; 4],
+    /// Time since the last accepted pose, s: the period, plus one per glitch tick since.
+    elapsed_s: f32,
+    /// The last tick's wrench and phase: what a glitch tick holds.
+    held: (Wrench, Phase),
     velocity_mm_per_s: f32,
     /// Per layer the relaxation's per-tick coefficients (computed once, in `new`).
     qlv: [QlvCoefficients; MAX_LAYERS],
@@ -341,6 +386,37 @@ fn filter_terms(_j: usize, _elastic: &[f32; 6], _filtered: &[f32; 6]) -> FilterT
     FilterTerms
 }
 
+/// Scales the wrench `w` down to its bound when it is beyond it (the module's
+/// "Glitches": `|fx| + |fy| + |fz| <= FORCE_LIMIT_N`, `|mx| + |my| + |mz| <=
+/// MOMENT_LIMIT_NMM`, the direction kept; a sum that is not finite gives zero), the
+/// dissipative force with the force; [`InsertionFlags::WRENCH_LIMITED`] when it did.
+fn bound(w: &mut [f32; 6], dissipative_n: &mut [f32; 3]) -> InsertionFlags {
+    const FORCE: f32 = limits::FORCE_LIMIT_N as f32;
+    const MOMENT: f32 = limits::MOMENT_LIMIT_NMM as f32;
+    let abs = libm::fabsf;
+    let [fx, fy, fz, mx, my, mz] = *w;
+    let (f, m) = (abs(fx) + abs(fy) + abs(fz), abs(mx) + abs(my) + abs(mz));
+    if f <= FORCE && m <= MOMENT {
+        return InsertionFlags::OK;
+    }
+    // the rounding of `limit / sum` may round up: the factor keeps the scaled sum below
+    let scale = |sum: f32, limit: f32| {
+        if sum <= limit {
+            1.0
+        } else if sum.is_finite() {
+            limit * 0.999_99 / sum
+        } else {
+            0.0
+        }
+    };
+    let (sf, sm) = (scale(f, FORCE), scale(m, MOMENT));
+    *w = [fx * sf, fy * sf, fz * sf, mx * sm, my * sm, mz * sm];
+    for d in dissipative_n.iter_mut() {
+        *d = if sf > 0.0 { *d * sf } else { 0.0 };
+    }
+    InsertionFlags::WRENCH_LIMITED
+}
+
 fn positive(v: f32) -> bool {
     v.is_finite() && v > 0.0
 }
@@ -373,7 +449,11 @@ impl Insertion {
         if !stack.layers.iter().all(layer_ok) || !positive(stack.needle_diameter_mm) || !positive(FE_NEEDLE_DIAMETER_MM) {
             return Err(InsertionError::Value);
         }
-        if !positive(config.period_s) || !non_negative(config.velocity_time_constant_s) {
+        if !positive(config.period_s)
+            || !non_negative(config.velocity_time_constant_s)
+            || !positive(config.max_speed_mm_per_s)
+            || !positive(config.max_turn_deg_per_s)
+        {
             return Err(InsertionError::Config);
         }
         if cfg!(not(feature = "viscoelastic")) && stack.layers.iter().any(|l| !l.prony.as_slice().is_empty()) {
@@ -399,6 +479,9 @@ impl Insertion {
             track: None,
             preload: [0.0; 6],
             last_depth_mm: None,
+            accepted: [0.0; 4],
+            elapsed_s: config.period_s,
+            held: (Wrench::ZERO, Phase::Approach),
             velocity_mm_per_s: 0.0,
             qlv,
             qlv_state: QlvState::REST,
@@ -432,6 +515,8 @@ impl Insertion {
     pub fn reset(&mut self) {
         self.end_path();
         self.last_depth_mm = None;
+        self.elapsed_s = self.config.period_s;
+        self.held = (Wrench::ZERO, Phase::Approach);
         self.velocity_mm_per_s = 0.0;
     }
 
@@ -446,6 +531,12 @@ impl Insertion {
     /// One tick: the pose (entry point on the top surface, tilts, `depth_mm` of the tip
     /// along the axis past the surface plane, negative above it) in, the wrench out.
     /// Call it once per period of the configuration.
+    ///
+    /// A glitch (a pose outside the domain, not finite, or moving faster than the
+    /// configuration's largest speeds: the module's "Glitches") changes nothing but the
+    /// time since the last accepted pose; its evaluation holds the last tick's wrench
+    /// and phase (zero and `ERROR` when not finite) with the flags saying why. Whatever
+    /// the pose, `|fx| + |fy| + |fz| <= 100` N and `|mx| + |my| + |mz| <= 10,000` N·mm.
     pub fn step(&mut self, pose: &Pose) -> InsertionEvaluation {
         self.tick(pose, false).0
     }
@@ -481,18 +572,46 @@ impl Insertion {
         if rate {
             self.guard_share.clear();
         }
-        let finite = [pose.x_mm, pose.z_mm, pose.theta_x_deg, pose.theta_z_deg, pose.depth_mm].into_iter().all(f32::is_finite);
-        if !finite {
-            return (self.evaluation(Wrench::ZERO, Status::ERROR, Phase::Approach, 0), 0.0, [0.0; 3]);
+        let glitch = self.screen(pose);
+        if !glitch.is_ok() {
+            self.elapsed_s += self.config.period_s;
+            // the deflected boundary's filter follows time over the held input
+            if let Some(c) = self.qlv.get(self.punctured) {
+                self.qlv_state.hold(c);
+            }
+            let (wrench, phase) = self.held;
+            let e = if glitch.contains(InsertionFlags::NOT_FINITE) {
+                InsertionEvaluation {
+                    wrench: Wrench::ZERO,
+                    status: Status::ERROR,
+                    flags: glitch,
+                    phase,
+                    punctures: 0,
+                    velocity_mm_per_s: self.velocity_mm_per_s,
+                }
+            } else {
+                InsertionEvaluation {
+                    wrench,
+                    status: Status::OK,
+                    flags: glitch,
+                    phase,
+                    punctures: 0,
+                    velocity_mm_per_s: self.velocity_mm_per_s,
+                }
+            };
+            return (e, 0.0, [0.0; 3]);
         }
         let depth = pose.depth_mm;
         let step_mm = self.last_depth_mm.map_or(0.0, |last| depth - last);
         self.filter_velocity(step_mm);
         self.last_depth_mm = Some(depth);
+        self.accepted = [pose.x_mm, pose.z_mm, pose.theta_x_deg, pose.theta_z_deg];
+        self.elapsed_s = self.config.period_s;
         // friction and cutting see the velocity only when it has the last motion's sign
         let v = if self.velocity_mm_per_s * step_mm > 0.0 { self.velocity_mm_per_s } else { 0.0 };
         if depth <= 0.0 {
             self.end_path();
+            self.held = (Wrench::ZERO, Phase::Approach);
             return (self.evaluation(Wrench::ZERO, Status::OK, Phase::Approach, 0), 0.0, [0.0; 3]);
         }
         let a = axis(pose.theta_x_deg, pose.theta_z_deg);
@@ -500,18 +619,45 @@ impl Insertion {
         let bounds = self.boundaries(a[1]);
         let Deflected { wrench: mut w, status, punctures, stiffness_n_per_mm } = self.deflect(pose, a, entry, &bounds, rate);
         let (phase, axial_n) = self.shaft(pose, a, entry, v, &bounds, &mut w);
+        let mut dissipative_n = [axial_n * a[0], axial_n * a[1], axial_n * a[2]];
+        let flags = bound(&mut w, &mut dissipative_n);
         let wrench = Wrench::from_array(w);
-        let dissipative_n = [axial_n * a[0], axial_n * a[1], axial_n * a[2]];
-        (self.evaluation(wrench, status, phase, punctures), stiffness_n_per_mm, dissipative_n)
+        self.held = (wrench, phase);
+        let e = InsertionEvaluation { wrench, status, flags, phase, punctures, velocity_mm_per_s: self.velocity_mm_per_s };
+        (e, stiffness_n_per_mm, dissipative_n)
     }
 
     fn evaluation(&self, wrench: Wrench, status: Status, phase: Phase, punctures: u8) -> InsertionEvaluation {
-        InsertionEvaluation { wrench, status, phase, punctures, velocity_mm_per_s: self.velocity_mm_per_s }
+        InsertionEvaluation { wrench, status, flags: InsertionFlags::OK, phase, punctures, velocity_mm_per_s: self.velocity_mm_per_s }
+    }
+
+    /// The glitch flags of `pose` (the module's "Glitches"): [`InsertionFlags::OK`] to
+    /// integrate it. The domain's tests are written `|v| <= max`, false for NaN too.
+    fn screen(&self, pose: &Pose) -> InsertionFlags {
+        const XZ: f32 = limits::XZ_MAX_MM as f32;
+        const DEPTH: f32 = limits::DEPTH_MAX_MM as f32;
+        const TILT: f32 = limits::TILT_MAX_DEG as f32;
+        let abs = libm::fabsf;
+        let Pose { x_mm: x, z_mm: z, theta_x_deg: tx, theta_z_deg: tz, depth_mm: d } = *pose;
+        if !(abs(x) <= XZ && abs(z) <= XZ && abs(d) <= DEPTH && abs(tx) <= TILT && abs(tz) <= TILT) {
+            let finite = [x, z, tx, tz, d].into_iter().all(f32::is_finite);
+            return if finite { InsertionFlags::OUT_OF_DOMAIN } else { InsertionFlags::NOT_FINITE };
+        }
+        let Some(last_d) = self.last_depth_mm else { return InsertionFlags::OK };
+        let [lx, lz, ltx, ltz] = self.accepted;
+        let mm = self.config.max_speed_mm_per_s * self.elapsed_s;
+        let deg = self.config.max_turn_deg_per_s * self.elapsed_s;
+        if abs(d - last_d) <= mm && abs(x - lx) <= mm && abs(z - lz) <= mm && abs(tx - ltx) <= deg && abs(tz - ltz) <= deg {
+            InsertionFlags::OK
+        } else {
+            InsertionFlags::FAST_MOTION
+        }
     }
 
     fn filter_velocity(&mut self, step_mm: f32) {
-        let InsertionConfig { period_s: t, velocity_time_constant_s: tau } = self.config;
-        // t > 0 and tau >= 0 (checked in `new`): the divisions are by positive numbers
+        let (t, tau) = (self.elapsed_s, self.config.velocity_time_constant_s);
+        // t > 0 and tau >= 0 (checked in `new`; t is the period, plus periods after a
+        // glitch): the divisions are by positive numbers
         let raw = step_mm / t;
         let alpha = t / (tau + t);
         self.velocity_mm_per_s += alpha * (raw - self.velocity_mm_per_s);

@@ -61,6 +61,10 @@ impl QlvState {
         elastic
     }
 
+    /// Nothing to hold.
+    #[inline]
+    pub fn hold(&mut self, _coefficients: &QlvCoefficients) {}
+
     /// Nothing to reset.
     #[inline]
     pub fn reset(&mut self) {}

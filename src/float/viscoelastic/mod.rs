@@ -411,11 +411,22 @@ impl Qlv {
 /// The filter state of the six components of a wrench (`[fx, fy, fz, mx, my, mz]`, the
 /// [`Wrench::to_array`](crate::Wrench::to_array) order), stepped with coefficients held
 /// elsewhere: 24 f32, at rest when zero.
+///
+/// **Held ticks** ([`hold`](Self::hold)): a tick whose input is not known (the insertion's
+/// glitch tick) relaxes every term over the input held at the last one; the next
+/// [`step`](Self::step) takes its input's change as a ramp over the `n` ticks since the
+/// last step (`n - 1` held): `b_i` times `(1 + a_i + ... + a_i^(n-1)) / n`, exact for an
+/// input that changed at a constant rate over them (the module's recursion over `n` ticks
+/// of `d / n` each), and without held ticks the plain recursion.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct QlvState {
     /// Per component `[last input, h_0, h_1, h_2]`.
     state: [[f32; 1 + MAX_TERMS]; COMPONENT_COUNT],
+    /// Ticks held since the last step.
+    held: u32,
+    /// Per term `1 + a_i + ... + a_i^held` (valid while `held > 0`).
+    ramp: [f32; MAX_TERMS],
     /// Whether a step with terms ran since the last reset (when not, every value is
     /// still zero and [`reset`](Self::reset) has nothing to clear: a stack without
     /// terms pays no 24 stores a tick).
@@ -424,15 +435,20 @@ pub struct QlvState {
 
 impl QlvState {
     /// At rest.
-    pub const REST: Self = Self { state: [[0.0; 1 + MAX_TERMS]; COMPONENT_COUNT], stored: false };
+    pub const REST: Self = Self { state: [[0.0; 1 + MAX_TERMS]; COMPONENT_COUNT], held: 0, ramp: [0.0; MAX_TERMS], stored: false };
 
     /// One tick of every component with `coefficients`: the elastic wrench in, the
-    /// viscoelastic wrench out. Without terms the input is returned and the state left
+    /// viscoelastic wrench out (after held ticks, the input's change as a ramp over them:
+    /// the type's "Held ticks"). Without terms the input is returned and the state left
     /// at rest.
     pub fn step(&mut self, coefficients: &QlvCoefficients, elastic: [f32; COMPONENT_COUNT]) -> [f32; COMPONENT_COUNT] {
         let mut out = elastic;
         if coefficients.is_active() {
-            self.filter(coefficients, &mut out);
+            if self.held == 0 {
+                self.filter(coefficients, &mut out);
+            } else {
+                self.after_held(coefficients, &mut out);
+            }
         }
         out
     }
@@ -444,6 +460,39 @@ impl QlvState {
     fn filter(&mut self, coefficients: &QlvCoefficients, w: &mut [f32; COMPONENT_COUNT]) {
         self.stored = true;
         coefficients.step_components(&mut self.state, w);
+    }
+
+    /// The step after held ticks: `b_i` times the ramp's weight
+    /// `(1 + a_i + ... + a_i^held) / (held + 1)` (the type's "Held ticks"); no tick held
+    /// after it. Out of line: the step's usual path stays as it was.
+    #[inline(never)]
+    fn after_held(&mut self, coefficients: &QlvCoefficients, w: &mut [f32; COMPONENT_COUNT]) {
+        // held >= 1: n >= 2 (as f32: exact to 2^24, then within 1e-7)
+        let n = self.held as f32 + 1.0;
+        self.held = 0;
+        let mut ramped = *coefficients;
+        for (b, r) in ramped.b.iter_mut().zip(self.ramp) {
+            *b *= r / n;
+        }
+        self.filter(&ramped, w);
+    }
+
+    /// One tick with the input unknown (the type's "Held ticks"): the step's recursion
+    /// over the input held at the last tick's (its change zero: each term relaxes,
+    /// `h_i <- a_i h_i`), so the state follows time. Without terms nothing changes.
+    pub fn hold(&mut self, coefficients: &QlvCoefficients) {
+        if !coefficients.is_active() {
+            return;
+        }
+        let mut input = self.state.map(|s| s[0]);
+        self.filter(coefficients, &mut input);
+        if self.held == 0 {
+            self.ramp = [1.0; MAX_TERMS];
+        }
+        self.held = self.held.saturating_add(1);
+        for (r, a) in self.ramp.iter_mut().zip(coefficients.a) {
+            *r = a * *r + 1.0;
+        }
     }
 
     /// Back to rest.

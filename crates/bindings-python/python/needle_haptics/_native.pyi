@@ -43,6 +43,9 @@ class Trajectory:
     @property
     def punctures(self) -> npt.NDArray[np.uint8]: ...
     @property
+    def flags(self) -> npt.NDArray[np.uint8]:
+        """(n,) the step's flags: 0x01 FAST_MOTION, 0x02 OUT_OF_DOMAIN, 0x04 NOT_FINITE (a glitch: not integrated, the wrench held), 0x08 WRENCH_LIMITED."""
+    @property
     def velocity_mm_per_s(self) -> npt.NDArray[np.float32]: ...
 
 class Insertion:

@@ -62,7 +62,7 @@ export async function load(bytes) {
       return poses.map((p) => {
         const r = e.needle_insertion_step(p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg, p.depth_mm) >>> 0;
         const w = new Float32Array(Uint32Array.from(new Uint32Array(e.memory.buffer, e.needle_out(), COMPONENTS.length)).buffer);
-        return { depth_mm: p.depth_mm, fy_n: w[1], punctures: r >>> 24, phase: (r >>> 8) & 0xffff };
+        return { depth_mm: p.depth_mm, fy_n: w[1], punctures: (r >>> 24) & 0xf, phase: (r >>> 8) & 0xffff };
       });
     },
     domain: {

@@ -7,8 +7,9 @@
 //! spaced (the tick period; within 1e-6 s); rows in time order. Each row is one tick of
 //! [`Insertion::step`]: the wrench depends on the rows before it (punctures, the track,
 //! the velocity). Output: `time_s`, the pose, the wrench, the status byte, the phase
-//! (`approach`, `deflecting:<layer>`, `cutting:<layer>`, `in-track:<layer>`) and the
-//! punctures of the tick.
+//! (`approach`, `deflecting:<layer>`, `cutting:<layer>`, `in-track:<layer>`), the
+//! punctures of the tick and the step's flags byte (`InsertionFlags`: a glitch the
+//! model did not integrate, or a wrench scaled down to its bound; their names on stderr).
 use super::batch::{parse_poses, push_pose_wrench_status, POSE_COLUMNS};
 use anyhow::{bail, Context, Result};
 use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, InsertionEvaluation, Phase};
@@ -20,7 +21,7 @@ use std::path::Path;
 pub const TIME_COLUMN: &str = "time_s";
 /// Output header.
 pub const OUTPUT_HEADER: &str =
-    "time_s,x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm,status,phase,punctures";
+    "time_s,x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm,fx_n,fy_n,fz_n,mx_nmm,my_nmm,mz_nmm,status,phase,punctures,flags";
 /// Largest departure of a time step from the first one, s.
 pub const PERIOD_TOLERANCE_S: f64 = 1e-6;
 /// A tick longer than this many control periods (`InsertionConfig::DEFAULT_1KHZ`,
@@ -164,6 +165,22 @@ fn phase_name(p: Phase) -> String {
     }
 }
 
+/// What the step flagged, for stderr: per flag its name, the ticks it was set in and the
+/// first row (1-based, the header being row 0); `None` when no tick was flagged.
+#[must_use]
+pub fn flags_note(evals: &[InsertionEvaluation]) -> Option<String> {
+    let parts: Vec<String> = needle_haptics::InsertionFlags::FLAGS
+        .iter()
+        .filter_map(|&(flag, name)| {
+            let mut rows = evals.iter().enumerate().filter(|(_, e)| e.flags.contains(flag)).map(|(i, _)| i + 1);
+            let first = rows.next()?;
+            Some(format!("{name} in {} ticks (first at row {first})", 1 + rows.count()))
+        })
+        .collect();
+    (!parts.is_empty())
+        .then(|| format!("insertion flags: {} (a glitch is not integrated: the wrench of the tick before is held)", parts.join(", ")))
+}
+
 /// The CSV form ([`OUTPUT_HEADER`]).
 #[must_use]
 pub fn to_csv(times: &[f64], poses: &[Pose], evals: &[InsertionEvaluation]) -> String {
@@ -173,7 +190,7 @@ pub fn to_csv(times: &[f64], poses: &[Pose], evals: &[InsertionEvaluation]) -> S
     for ((t, p), e) in times.iter().zip(poses).zip(evals) {
         let _ = write!(s, "{t:?},");
         push_pose_wrench_status(&mut s, p, &e.wrench, e.status);
-        let _ = writeln!(s, ",{},{}", phase_name(e.phase), e.punctures);
+        let _ = writeln!(s, ",{},{},{:#04x}", phase_name(e.phase), e.punctures, e.flags.bits());
     }
     s
 }
@@ -196,6 +213,9 @@ pub fn eval_script(file: &Path, stack_name: &str, prony: Option<&str>, out: Opti
     let poses = parse_poses(&text, file)?;
     let evals = step_all(stack, &poses, period)?;
     let body = to_csv(&times, &poses, &evals);
+    if let Some(note) = flags_note(&evals) {
+        eprintln!("{}: {note}", file.display());
+    }
     match out {
         Some(path) => {
             needle_stdx::fs::write_atomic(path, body.as_bytes())?;
