@@ -68,7 +68,7 @@ def test_state_carries_over_between_calls_and_reset_forgets_it():
 def test_bad_stack_and_config_are_value_errors():
     with pytest.raises(ValueError, match='no tissue stack "kidney".*liver'):
         nh.Insertion("kidney")
-    with pytest.raises(ValueError, match="period_s must be finite and > 0"):
+    with pytest.raises(ValueError, match="period_s, max_speed_mm_per_s and max_turn_deg_per_s must be finite and > 0"):
         nh.Insertion("liver", period_s=0.0)
     with pytest.raises(ValueError, match="one per layer"):
         nh.Insertion("liver").set_scales([1.0] * 99)
