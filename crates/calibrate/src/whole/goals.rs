@@ -2,9 +2,9 @@
 //! puncture (force and position), the mean force between punctures and after the last,
 //! the hold (RMS over it, the relaxed force at its end) and the withdrawal (mean over
 //! 10-20 mm of stage travel).
+use super::trials::Trial;
 use crate::replay::Check;
 use crate::trial_replay::TrialReplay;
-use super::trials::Trial;
 
 /// The tolerances of one kind of use.
 #[derive(Debug, Clone, Copy, PartialEq)]
