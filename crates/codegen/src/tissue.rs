@@ -544,8 +544,11 @@ pub fn render_rust_stacks(stacks: &[(PathBuf, Stack)], needle: Option<FeNeedle>)
     for (path, s) in stacks {
         let file = path.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default();
         out.push_str(&format!("/// `{}` (tissue/{file}): {}\n", s.name, s.description.replace('\n', " ")));
-        if !elastic(s) {
-            out.push_str(&format!("{VISCOELASTIC_ONLY}\n"));
+        match (elastic(s), shaped(s)) {
+            (true, false) => {}
+            (false, false) => out.push_str(&format!("{VISCOELASTIC_ONLY}\n")),
+            (true, true) => out.push_str(&format!("{SHAPE_ONLY}\n")),
+            (false, true) => out.push_str("#[cfg(all(feature = \"viscoelastic\", feature = \"tissue-shape\"))]\n"),
         }
         out.push_str(&format!("pub const {}: Stack<'static> = Stack {{\n", s.name.to_uppercase()));
         out.push_str(&format!("    name: {:?},\n    needle_diameter_mm: {},\n    layers: &[\n", s.name, lit(s.needle_diameter_mm)));
@@ -574,7 +577,15 @@ pub fn render_rust_stacks(stacks: &[(PathBuf, Stack)], needle: Option<FeNeedle>)
     };
     let all = names(&|_| true);
     let all_const = |names: &[String]| format!("pub const ALL: [Stack<'static>; {}] = [{}];\n", names.len(), names.join(", "));
-    if stacks.iter().all(|(_, s)| elastic(s)) {
+    if stacks.iter().any(|(_, s)| shaped(s)) {
+        // one ALL per combination of the two features, each listing the stacks it compiles
+        out.push_str("/// Every stack of the set that this build compiles in, by file name (stacks with Prony terms need the `viscoelastic` feature, with a family member or a softening `tissue-shape`).\n");
+        for (visco, shape) in [(false, false), (false, true), (true, false), (true, true)] {
+            let on = |f: &str, yes: bool| if yes { format!("feature = \"{f}\"") } else { format!("not(feature = \"{f}\")") };
+            out.push_str(&format!("#[cfg(all({}, {}))]\n", on("viscoelastic", visco), on("tissue-shape", shape)));
+            out.push_str(&all_const(&names(&|s| (visco || elastic(s)) && (shape || !shaped(s)))));
+        }
+    } else if stacks.iter().all(|(_, s)| elastic(s)) {
         out.push_str(&format!("/// Every stack of the set, by file name.\n{}", all_const(&all)));
     } else {
         out.push_str(&format!("/// Every stack of the set, by file name.\n{VISCOELASTIC_ONLY}\n{}", all_const(&all)));
@@ -609,6 +620,16 @@ fn render_softening(fraction: f64, onset_ratio: f64) -> String {
 
 /// The attribute that compiles an item only with the library's `viscoelastic` feature.
 const VISCOELASTIC_ONLY: &str = "#[cfg(feature = \"viscoelastic\")]";
+
+/// The attribute that compiles an item only with the library's `tissue-shape` feature.
+const SHAPE_ONLY: &str = "#[cfg(feature = \"tissue-shape\")]";
+
+/// Whether a layer of `stack` has a family member other than the paper's tissue or a
+/// softening (format 2: compiled in only with the `tissue-shape` feature).
+#[allow(clippy::float_cmp)]
+fn shaped(stack: &Stack) -> bool {
+    stack.layers.iter().any(|l| l.family_weight != 1.0 || l.softening_fraction != 0.0)
+}
 
 /// Whether no layer of `stack` has a Prony term.
 fn elastic(stack: &Stack) -> bool {

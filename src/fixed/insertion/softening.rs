@@ -31,6 +31,7 @@ pub struct Softening {
     pub fraction_q30: i64,
 }
 
+#[cfg_attr(not(feature = "tissue-shape"), allow(dead_code))]
 impl Softening {
     /// The f32 layer's softening, its force that punctures from `puncture_force_q16` (the
     /// layer's, already in µN Q16). `const`: the compiled-in stacks are converted at

@@ -91,9 +91,12 @@ pub struct Layer {
     /// the `viscoelastic` feature (an elastic build's layers carry none: flash).
     #[cfg(feature = "viscoelastic")]
     pub prony: PronyTerms,
-    /// The material family's member ([`crate::fixed::family`]).
+    /// The material family's member ([`crate::fixed::family`]); only with the
+    /// `tissue-shape` feature (a default build's layers carry none: flash).
+    #[cfg(feature = "tissue-shape")]
     pub family: FamilyMember,
-    /// The pre-puncture softening and the force that punctures.
+    /// The pre-puncture softening and the force that punctures (`tissue-shape`).
+    #[cfg(feature = "tissue-shape")]
     pub softening: Softening,
 }
 
@@ -178,7 +181,9 @@ impl Layer {
             thickness_q16: q16(l.thickness_mm),
             stiffness_scale_q16: q16(l.stiffness_scale),
             puncture_force_q16,
+            #[cfg(feature = "tissue-shape")]
             family: FamilyMember::from_f32(&l.family),
+            #[cfg(feature = "tissue-shape")]
             softening: Softening::from_f32(&l.softening, l.puncture_force_n, puncture_force_q16),
             cutting_force_q16: micro_q16(l.cutting_force_n),
             cutting_per_speed_q16: per_speed_q16(l.cutting_force_n, band),
@@ -205,7 +210,9 @@ const EMPTY_LAYER: Layer = Layer {
     track_stiffness_q8: 0,
     #[cfg(feature = "viscoelastic")]
     prony: PronyTerms::NONE,
+    #[cfg(feature = "tissue-shape")]
     family: FamilyMember::PAPER,
+    #[cfg(feature = "tissue-shape")]
     softening: Softening { critical_q16: 0, onset_q16: 0, span_q16: 0, slope: 0, fraction_q30: 0 },
 };
 
@@ -236,6 +243,10 @@ impl Stack {
             }
             // an elastic build's layers carry no terms: a layer with terms is refused
             if cfg!(not(feature = "viscoelastic")) && l.prony.as_array().1 > 0 {
+                return refused;
+            }
+            // nor, without `tissue-shape`, a family member or a softening
+            if cfg!(not(feature = "tissue-shape")) && (l.family.weight() < 1.0 || l.softening.fraction != 0.0) {
                 return refused;
             }
             total += l.thickness_mm as f64;

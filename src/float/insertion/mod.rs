@@ -82,6 +82,7 @@ mod softening;
 mod stack;
 mod track;
 
+#[cfg(feature = "tissue-shape")]
 use softening::SofteningTerms;
 pub use stack::{stacks, FamilyMember, Karnopp, Layer, Softening, Stack, FE_NEEDLE_DIAMETER_MM, HUB_FROM_TIP_MM, MAX_LAYERS};
 
@@ -246,7 +247,8 @@ fn deflection_at(pose: &Pose, indentation_mm: f32, scale: f32, similarity: f32, 
 /// `indentation_mm` and the boundary's stiffness with it, `k g + |F|₁ |dg/dδ|` (`f1_n`:
 /// `|F|₁`, the sum of the forces' magnitudes before `g`, at least the force's length, so
 /// the guard's view is not below it). Out of line, scalars in and out: a stack of the
-/// paper's tissue pays one compare (the M4F loop tick's budget).
+/// paper's tissue pays one compare; without the `tissue-shape` feature nothing.
+#[cfg(feature = "tissue-shape")]
 #[inline(never)]
 fn member_gain(f1_n: f32, k: f32, indentation_mm: f32, similarity: f32, member: &FamilyMember) -> (f32, f32) {
     // similarity > 0 (checked by `Insertion::new`)
@@ -295,7 +297,8 @@ pub struct Insertion {
     /// `step` carries none of it).
     guard_share: FilterTerms,
     /// Per layer the pre-puncture softening's terms and the force that punctures
-    /// (computed once, in `new`).
+    /// (computed once, in `new`; only with the `tissue-shape` feature).
+    #[cfg(feature = "tissue-shape")]
     soft: [SofteningTerms; MAX_LAYERS],
     /// Per layer the relaxation's per-tick coefficients (computed once, in `new`).
     qlv: [QlvCoefficients; MAX_LAYERS],
@@ -447,14 +450,23 @@ fn non_negative(v: f32) -> bool {
     v.is_finite() && v >= 0.0
 }
 
+/// The layer's family member and softening: covered by the set's FE and in range with
+/// the `tissue-shape` feature; without it only the paper's tissue without softening.
+fn shape_ok(l: &Layer) -> bool {
+    if cfg!(feature = "tissue-shape") {
+        l.family.is_covered() && l.softening.is_valid()
+    } else {
+        l.family.weight() >= 1.0 && l.softening.fraction == 0.0
+    }
+}
+
 fn layer_ok(l: &Layer) -> bool {
     let k = &l.friction;
     positive(l.thickness_mm)
         && positive(l.stiffness_scale)
         && positive(l.puncture_force_n)
         && positive(k.stick_band_mm_per_s)
-        && l.family.is_covered()
-        && l.softening.is_valid()
+        && shape_ok(l)
         && [l.cutting_force_n, k.static_n_per_mm, k.coulomb_n_per_mm, k.viscous_n_s_per_mm2, l.track_stiffness_n_per_mm2]
             .into_iter()
             .all(non_negative)
@@ -489,10 +501,14 @@ impl Insertion {
             let terms = crate::float::viscoelastic::PronyTerms::new(l.prony.as_slice()).map_err(|_| InsertionError::Value)?;
             *k = QlvCoefficients::new(&terms, config.period_s).map_err(|_| InsertionError::Config)?;
         }
-        let mut soft = [SofteningTerms::NONE; MAX_LAYERS];
-        for (t, l) in soft.iter_mut().zip(stack.layers) {
-            *t = SofteningTerms::new(l.puncture_force_n, &l.softening).ok_or(InsertionError::Value)?;
-        }
+        #[cfg(feature = "tissue-shape")]
+        let soft = {
+            let mut soft = [SofteningTerms::NONE; MAX_LAYERS];
+            for (t, l) in soft.iter_mut().zip(stack.layers) {
+                *t = SofteningTerms::new(l.puncture_force_n, &l.softening).ok_or(InsertionError::Value)?;
+            }
+            soft
+        };
         let mut layers = [stack.layers.first().copied().ok_or(InsertionError::LayerCount)?; MAX_LAYERS];
         for (slot, l) in layers.iter_mut().zip(stack.layers) {
             *slot = *l;
@@ -512,6 +528,7 @@ impl Insertion {
             held: (Wrench::ZERO, Phase::Approach),
             velocity_mm_per_s: 0.0,
             qlv,
+            #[cfg(feature = "tissue-shape")]
             soft,
             qlv_state: QlvState::REST,
             guard_share: FilterTerms::NONE,
@@ -723,20 +740,32 @@ impl Insertion {
             }
             let (Some(layer), Some(qlv)) = (self.layers.get(self.punctured), self.qlv.get(self.punctured)) else { break };
             let indentation_mm = pose.depth_mm - q;
+            #[cfg_attr(not(feature = "tissue-shape"), allow(unused_mut))]
             let (e, mut k) = deflection_at(pose, indentation_mm, layer.stiffness_scale, self.similarity, rate);
+            #[cfg_attr(not(feature = "tissue-shape"), allow(unused_mut))]
             let mut elastic = e.wrench.to_array();
+            #[cfg(feature = "tissue-shape")]
             if layer.family.weight() < 1.0 {
                 let f1_n = libm::fabsf(elastic[0]) + libm::fabsf(elastic[1]) + libm::fabsf(elastic[2]);
                 let g;
                 (g, k) = member_gain(f1_n, k, indentation_mm, self.similarity, &layer.family);
                 elastic = elastic.map(|x| x * g);
             }
+            #[cfg_attr(not(feature = "tissue-shape"), allow(unused_mut))]
             let mut w = self.qlv_state.step(qlv, elastic);
             let axial_n = dot([w[0], w[1], w[2]], a);
             let boundary_n = axial_n + self.carried_cutting_n();
             // looked up after the filter: nothing of it is live across the filter's step
-            let Some(soft) = self.soft.get(self.punctured) else { break };
-            if boundary_n < soft.critical_n {
+            #[cfg(feature = "tissue-shape")]
+            let Some(soft) = self.soft.get(self.punctured) else {
+                break;
+            };
+            #[cfg(feature = "tissue-shape")]
+            let critical_n = soft.critical_n;
+            #[cfg(not(feature = "tissue-shape"))]
+            let critical_n = layer.puncture_force_n;
+            if boundary_n < critical_n {
+                #[cfg(feature = "tissue-shape")]
                 if soft.active() {
                     // the tissue starting to fail: the boundary's wrench (and the guard's view
                     // of it) loses its share; the filter's state keeps the unsoftened one
@@ -755,7 +784,10 @@ impl Insertion {
                 return Deflected { wrench: total, status: e.status, punctures, stiffness_n_per_mm: k * qlv.effective_stiffness_ratio() };
             }
             // the boundary's state at the puncture: softened to its share there
+            #[cfg(feature = "tissue-shape")]
             let w = if soft.active() { elastic.map(|x| x * soft.factor(boundary_n)) } else { elastic };
+            #[cfg(not(feature = "tissue-shape"))]
+            let w = elastic;
             let axial_n = dot([w[0], w[1], w[2]], a);
             self.qlv_state.reset();
             // puncture: the axial force goes, the lateral force and the moments stay

@@ -39,6 +39,8 @@ impl Softening {
     }
 }
 
+// Only the `tissue-shape` feature's insertion reads them (its unit tests run either way).
+#[cfg_attr(not(feature = "tissue-shape"), allow(dead_code))]
 /// A layer's softening as the tick computes it (module docs), from
 /// [`SofteningTerms::new`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -51,6 +53,7 @@ pub(crate) struct SofteningTerms {
     fraction: f32,
 }
 
+#[cfg_attr(not(feature = "tissue-shape"), allow(dead_code))]
 impl SofteningTerms {
     /// Nothing: a layer slot not in use.
     pub(crate) const NONE: Self = Self { critical_n: 0.0, onset_n: 0.0, slope_per_n: 0.0, fraction: 0.0 };
