@@ -107,7 +107,7 @@ fn a_missing_field_an_unknown_field_and_a_bad_name_are_refused() {
 
 /// GOOD as format 2 with `lines` added after the second layer's `source`.
 fn format2(lines: &str) -> String {
-    format!("{}{lines}\n", with("format", 0, "2"))
+    format!("{}\n{lines}\n", with("format", 0, "2"))
 }
 
 /// Format 2's keys (issue 64): read with their values, refused in a format 1 file, and
