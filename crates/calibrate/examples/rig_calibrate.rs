@@ -29,8 +29,8 @@ fn main() -> anyhow::Result<()> {
         std::fs::read_dir(&dir)?.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| p.extension().is_some_and(|x| x == "csv")).collect();
     files.sort();
     println!(
-        "{:<44} {:>7} {:>7} {:>7} {:>6} {:>6} {:>5}  {}",
-        "trial (self)", "rms %", "dpos mm", "dF %", "w", "delta", "r0", "checks missed"
+        "{:<44} {:>7} {:>7} {:>7} {:>6} {:>6} {:>5} {:>8} {:>8}  checks missed",
+        "trial (self)", "rms %", "dpos mm", "dF %", "w", "delta", "r0", "s", "onset"
     );
     let mut stacks = Vec::new();
     for f in &files {

@@ -254,7 +254,8 @@ pub fn fit_members(pre: &[Point], surrogate: &dyn Fn(f64) -> f64, similarity: f6
         };
         // the unsoftened scan's best onset (among those matching the measured onset, when
         // any does): the centre of the softened scan
-        let (mut plain, mut plain_matched): (Option<(f64, f64)>, Option<(f64, f64)>) = (None, None);
+        let mut plain: Option<(f64, f64)> = None;
+        let mut plain_matched: Option<(f64, f64)> = None;
         for onset in onsets(first.position_mm, peak.position_mm) {
             let (scale, sse) = scale_fit(&basis(&table, pre, onset, peak.position_mm - onset, Softening::NONE), pre);
             if plain.is_none_or(|(s, _)| sse < s) {
@@ -303,17 +304,22 @@ pub fn fit_members(pre: &[Point], surrogate: &dyn Fn(f64) -> f64, similarity: f6
             }
         }
     }
-    // the candidates whose onset matches, when any does; among them the simplest class
-    // (the paper's tissue, no softening, first) within RANGE_SSE_RATIO of the best
+    choose(matched, best, &seen)
+}
+
+/// The fit among the candidates of each class: those whose onset matches when any does;
+/// among them the simplest class within [`RANGE_SSE_RATIO`] of the best, with the fitted
+/// ranges of `seen` (every candidate's `(sse, weight, fraction)`).
+fn choose(matched: [Option<ShapeFit>; 4], best: [Option<ShapeFit>; 4], seen: &[(f64, f64, f64)]) -> Option<ShapeFit> {
     let pool = if matched.iter().any(Option::is_some) { matched } else { best };
     let least = pool.iter().flatten().map(|c| c.sse).fold(f64::INFINITY, f64::min);
     let limit = least * RANGE_SSE_RATIO;
-    let mut best = pool.into_iter().flatten().find(|c| c.sse <= limit)?;
+    let mut fit = pool.into_iter().flatten().find(|c| c.sse <= limit)?;
     for &(_, w, fraction) in seen.iter().filter(|c| c.0 <= limit) {
-        best.weight_range = [best.weight_range[0].min(w), best.weight_range[1].max(w)];
-        best.fraction_range = [best.fraction_range[0].min(fraction), best.fraction_range[1].max(fraction)];
+        fit.weight_range = [fit.weight_range[0].min(w), fit.weight_range[1].max(w)];
+        fit.fraction_range = [fit.fraction_range[0].min(fraction), fit.fraction_range[1].max(fraction)];
     }
-    Some(best)
+    Some(fit)
 }
 
 /// The fitted force at needle position `p` (N): the module's law for `fit`.

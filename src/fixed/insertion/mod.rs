@@ -462,7 +462,7 @@ impl<'a> Insertion<'a> {
             if layer.family.weight_q24() < 1 << 24 {
                 // the member's ratio at the FE depth δ/λ (the f32 model's `member_deflection`)
                 let fe_depth = saturate_i32(mul_shr(depth - q, self.stack.inv_similarity_q30, 30));
-                let g = crate::fixed::family::ratio(fe_depth, &layer.family).0.max(0).min(1 << 31);
+                let g = crate::fixed::family::ratio(fe_depth, &layer.family).0.clamp(0, 1 << 31);
                 for x in f.iter_mut().chain(moments.iter_mut()) {
                     *x = mul_q30_wide(*x, g);
                 }

@@ -61,7 +61,7 @@ impl SofteningTerms {
     /// The terms of a layer punctured at `puncture_force_n` (> 0) with `s`; `None` for a
     /// softening out of range ([`Softening::is_valid`]) or a force that is not finite and > 0.
     pub(crate) fn new(puncture_force_n: f32, s: &Softening) -> Option<Self> {
-        if !s.is_valid() || !(puncture_force_n.is_finite() && puncture_force_n > 0.0) {
+        if !(s.is_valid() && puncture_force_n.is_finite() && puncture_force_n > 0.0) {
             return None;
         }
         if s.fraction == 0.0 {
