@@ -101,8 +101,53 @@ fn a_missing_field_an_unknown_field_and_a_bad_name_are_refused() {
     let e = parse_stack_str(&with("name", 0, "\"Two Layers\""), Path::new("bad.toml")).expect_err("bad name");
     assert_eq!(e.line, Some(2), "{e}");
 
-    let e = parse_stack_str(&with("format", 0, "2"), Path::new("bad.toml")).expect_err("format");
+    let e = parse_stack_str(&with("format", 0, "3"), Path::new("bad.toml")).expect_err("format");
     assert_eq!(e.line, Some(1), "{e}");
+}
+
+/// GOOD as format 2 with `lines` added after the second layer's `source`.
+fn format2(lines: &str) -> String {
+    format!("{}\n{lines}\n", with("format", 0, "2"))
+}
+
+/// Format 2's keys (issue 64): read with their values, refused in a format 1 file, and
+/// each out of its range refused at its line; a weight below the members the set's FE
+/// covers is refused with that range.
+#[test]
+fn format_2_keys_are_read_checked_and_refused_in_format_1() {
+    let good = format2("family_weight = 0.05\nfamily_weight_range = [0.01, 0.1]\nsoftening_fraction = 0.15\nsoftening_onset_ratio = 0.6");
+    let s = parse_stack_str(&good, Path::new("two.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let l = &s.layers[1];
+    assert_eq!(
+        (l.family_weight, l.family_weight_range, l.softening_fraction, l.softening_onset_ratio),
+        (0.05, Some([0.01, 0.1]), 0.15, 0.6)
+    );
+    assert_eq!((s.layers[0].family_weight, s.layers[0].softening_fraction), (1.0, 0.0), "the defaults: the paper's tissue, no softening");
+    let again = parse_stack_str(&s.to_toml("round trip"), Path::new("two.toml")).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(again, s, "format 2 round-trips");
+
+    let in_format_1 = format!("{GOOD}family_weight = 0.05\n");
+    let e = parse_stack_str(&in_format_1, Path::new("bad.toml")).expect_err("a format 2 key in format 1");
+    assert!(e.to_string().contains("format = 2"), "{e}");
+    for (line, what) in [
+        ("family_weight = 1.5", "family_weight = 1.5"),
+        ("softening_fraction = 0.5", "softening_fraction = 0.5"),
+        ("softening_fraction = -0.1", "softening_fraction = -0.1"),
+        ("softening_onset_ratio = 1.0", "softening_onset_ratio = 1"),
+        ("family_weight = 0.2\nfamily_weight_range = [0.3, 0.5]", "family_weight_range = [0.3, 0.5]"),
+    ] {
+        let text = format2(line);
+        let e = parse_stack_str(&text, Path::new("bad.toml")).expect_err(line);
+        assert!(e.to_string().contains(what), "{line}: {e}");
+        assert!(e.line.is_some_and(|n| n > GOOD.lines().count()), "{line}: the key's own line, after GOOD's: {e}");
+    }
+    let domain = needle_codegen::tissue::FamilyDomain { weight_min: 0.01 };
+    let text = format2("family_weight = 0.005");
+    let e = needle_codegen::tissue::parse_stack_str_in(&text, Path::new("bad.toml"), &domain).expect_err("below the FE's members");
+    assert!(e.to_string().contains("0.01 to 1") && e.to_string().contains("not extrapolated"), "{e}");
+    assert_eq!(e.line, Some(text.lines().count()), "{e}");
+    needle_codegen::tissue::parse_stack_str_in(&format2("family_weight = 0.01"), Path::new("two.toml"), &domain)
+        .unwrap_or_else(|e| panic!("the softest covered member: {e}"));
 }
 
 #[test]

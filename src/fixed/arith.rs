@@ -23,6 +23,19 @@ pub(crate) fn sat_mul(a: i64, b: i64) -> i64 {
     a.saturating_mul(b)
 }
 
+/// `x g / 2^30` (floor of each part) for `|x| < 2^60` and `0 <= g <= 2^31`: `x` split at
+/// bit 30, `(x >> 30) g + ((x mod 2^30) g >> 30)`, each product below `2^61` (a wrench
+/// component of any size times a Q30 ratio such as the material family's `g` or a
+/// softening factor, where [`sat_mul`] would saturate and `insertion::track`'s `mul_q30`
+/// (`|x| < 2^47`) could wrap).
+#[cfg_attr(target_arch = "arm", inline(never))]
+#[cfg_attr(not(target_arch = "arm"), inline(always))]
+pub(crate) fn mul_q30_wide(x: i64, g: i64) -> i64 {
+    let (hi, lo) = (x >> 30, x & ((1 << 30) - 1));
+    // lo < 2^30 and g <= 2^31: lo g < 2^61 never wraps
+    (hi.saturating_mul(g)).saturating_add(lo.wrapping_mul(g) >> 30)
+}
+
 /// `floor(a * w / 2^15)`, for `|a| <= 2^30` and `|w| <= 2^15` (the generator proves both
 /// for every call): the Q15 product of a Horner step.
 ///

@@ -44,6 +44,13 @@ pub struct FamilyMember {
     sqrt_weight_q24: i64,
 }
 
+impl Default for FamilyMember {
+    /// The paper's own tissue.
+    fn default() -> Self {
+        Self::PAPER
+    }
+}
+
 impl FamilyMember {
     /// The paper's own tissue (`w = 1`).
     pub const PAPER: Self = Self { weight_q24: ONE_Q24, sqrt_weight_q24: ONE_Q24 };

@@ -38,6 +38,23 @@ impl FamilyMember {
         Self::new(weight).filter(|m| m.sqrt_weight.to_bits() == sqrt_weight.to_bits())
     }
 
+    /// The member as the generator writes it into a compiled-in stack (`const`):
+    /// `sqrt_weight` must be the f32 nearest `sqrt(weight)` (the generator's f64 root
+    /// rounded); `Insertion::new` checks it with [`FamilyMember::from_parts`] and refuses
+    /// a stack whose member is not.
+    #[doc(hidden)]
+    #[must_use]
+    pub const fn from_build(weight: f32, sqrt_weight: f32) -> Self {
+        Self { weight, sqrt_weight }
+    }
+
+    /// Whether the member is valid and within the members the set's FE covers
+    /// ([`tables::WEIGHT_MIN`] to 1): what `Insertion::new` requires of a layer's member.
+    #[must_use]
+    pub fn is_covered(&self) -> bool {
+        Self::from_parts(self.weight, self.sqrt_weight).is_some() && self.weight >= tables::WEIGHT_MIN
+    }
+
     /// The weight `w` of the paper's terms.
     #[must_use]
     pub const fn weight(&self) -> f32 {

@@ -1,12 +1,15 @@
 //! The stack's values from a measured curve: contact onset and the first boundary's
-//! stiffness scale (pre-puncture), then per interval between punctures the cutting
-//! force and friction of the layer being cut and the next boundary's depth and scale.
-//! Each scale is one linear least-squares coefficient against the FE surrogate's curve
-//! (the scaling law); a depth (onset, boundary) is scanned on a grid and the one with
-//! the smallest sum of squares kept.
+//! shape (scale, material family member, pre-puncture softening: [`crate::shape`]), then
+//! per interval between punctures the cutting force and friction of the layer being cut
+//! and the next boundary's depth and scale (as the first boundary's member). Each scale
+//! is one linear least-squares coefficient against the FE surrogate's curve (the
+//! scaling law); a depth (onset, boundary) is scanned on a grid and the one with the
+//! smallest sum of squares kept.
 use crate::events::Puncture;
 use crate::lsq;
 use crate::measured::Point;
+use crate::shape::{self, Softening};
+use needle_haptics::float::family::{ratio, FamilyMember};
 
 /// Grid step of the onset and boundary scans, mm (coarser over a range longer than
 /// [`MAX_SCAN_CANDIDATES`] steps).
@@ -21,12 +24,6 @@ pub const MAX_SCAN_POINTS: usize = 1_000;
 
 /// Progress of a fit: `(candidates scanned, candidates in all)`, called after each.
 pub type Progress<'a> = &'a mut dyn FnMut(usize, usize);
-/// The onset is the least-squares best among those whose model curve crosses the onset
-/// threshold ([`crate::replay::ONSET_FRACTION`] of the first puncture force) within this
-/// distance of the measured curve's crossing, mm (the unconstrained best when none does):
-/// contact onset is a goal of its own, which the least squares over the whole rise,
-/// weighted by the larger forces, would trade away.
-pub const ONSET_MATCH_MM: f64 = 0.25;
 
 /// The fitted values of one layer (boundary from the surface, mm of tip depth).
 #[derive(Debug, Clone, PartialEq)]
@@ -43,6 +40,32 @@ pub struct LayerFit {
     pub cutting_force_n: f64,
     /// Friction per mm of shaft in the layer at the measured speed, N/mm.
     pub friction_n_per_mm: f64,
+    /// The material family's member the boundary deflects as (1: the paper's tissue).
+    pub family_weight: f64,
+    /// Its fitted range ([`shape::ShapeFit::weight_range`]); `None`: not fitted.
+    pub family_weight_range: Option<[f64; 2]>,
+    /// The boundary's pre-puncture softening ([`Softening::NONE`]: none).
+    pub softening: Softening,
+    /// The softening fraction's fitted range; `None`: not fitted.
+    pub softening_fraction_range: Option<[f64; 2]>,
+}
+
+impl LayerFit {
+    /// A layer of the paper's tissue without softening (the shape fit's defaults).
+    #[must_use]
+    pub fn plain(boundary_mm: f64, scale: f64, puncture_force_n: f64, cutting_force_n: f64, friction_n_per_mm: f64) -> Self {
+        Self {
+            boundary_mm,
+            scale,
+            puncture_force_n,
+            cutting_force_n,
+            friction_n_per_mm,
+            family_weight: 1.0,
+            family_weight_range: None,
+            softening: Softening::NONE,
+            softening_fraction_range: None,
+        }
+    }
 }
 
 /// The whole fit.
@@ -58,56 +81,45 @@ pub struct Fit {
 
 /// Fits the stack. `surrogate(depth_mm)` is the axial force of a boundary indented by
 /// `depth_mm` with scale 1 (the library's [`deflection`](needle_haptics::insertion::deflection)
-/// at the measured pose and needle).
+/// at the measured pose and needle), `similarity` the needle's `λ`. The first boundary's
+/// shape (contact onset, scale, family member, softening) is [`shape::fit`]'s; the
+/// boundaries below deflect as the same member (one tissue), without softening.
 #[must_use]
-pub fn fit(points: &[Point], punctures: &[Puncture], surrogate: &dyn Fn(f64) -> f64) -> Fit {
-    fit_with_progress(points, punctures, surrogate, &mut |_, _| {})
+pub fn fit(points: &[Point], punctures: &[Puncture], surrogate: &dyn Fn(f64) -> f64, similarity: f64) -> Fit {
+    fit_with_progress(points, punctures, surrogate, similarity, &mut |_, _| {})
 }
 
 /// [`fit`], telling `progress` how far the scans are.
 #[must_use]
-pub fn fit_with_progress(points: &[Point], punctures: &[Puncture], surrogate: &dyn Fn(f64) -> f64, progress: Progress<'_>) -> Fit {
+pub fn fit_with_progress(
+    points: &[Point],
+    punctures: &[Puncture],
+    surrogate: &dyn Fn(f64) -> f64,
+    similarity: f64,
+    progress: Progress<'_>,
+) -> Fit {
     let first_peak = punctures.first().map_or(points.len() - 1, |p| p.peak);
-    let pre: Vec<&Point> = points.iter().take(first_peak + 1).collect();
-    let peak0 = pre.last().map_or(0.0, |p| p.position_mm);
+    let pre: Vec<Point> = points.iter().take(first_peak + 1).copied().collect();
     let start = points.iter().map(|p| p.position_mm).fold(f64::INFINITY, f64::min);
-    let peak_force = pre.last().map_or(0.0, |p| p.force_n);
-    let threshold = crate::replay::ONSET_FRACTION * peak_force;
-    let measured_crossing = crate::replay::measured_onset(points, first_peak, threshold);
-    // (sse, onset, scale) of the best candidate whose model crosses the onset threshold
-    // within ONSET_MATCH_MM of the measured crossing, and of the best of all
-    let (mut matched, mut any) = ((f64::INFINITY, start, 0.0), (f64::INFINITY, start, 0.0));
-    let total = scan_count(points, punctures, start, peak0);
+    let total = scan_count(points, punctures, start, start);
     let mut done = 0;
-    let pre_scan = thin(&pre);
-    let rhs: Vec<f64> = pre_scan.iter().map(|p| p.force_n).collect();
-    for onset in scan(start, peak0) {
-        let column: Vec<f64> = pre_scan.iter().map(|p| indent(surrogate, p.position_mm - onset)).collect();
-        let (x, sse) = lsq::non_negative(&[column], &rhs);
-        if sse < any.0 {
-            any = (sse, onset, x[0]);
-        }
-        let crossing = crossing_depth(surrogate, threshold, x[0], peak0 - onset).map(|d| onset + d);
-        let near = matches!((crossing, measured_crossing), (Some(c), Some(m)) if (c - m).abs() <= ONSET_MATCH_MM);
-        if near && sse < matched.0 {
-            matched = (sse, onset, x[0]);
-        }
-        done += 1;
-        progress(done, total);
-    }
-    let (_, onset, mut scale0) = if matched.0.is_finite() { matched } else { any };
-    if pre_scan.len() < pre.len() {
-        // the chosen onset's scale on every point
-        let column: Vec<f64> = pre.iter().map(|p| indent(surrogate, p.position_mm - onset)).collect();
-        let rhs: Vec<f64> = pre.iter().map(|p| p.force_n).collect();
-        scale0 = lsq::non_negative(&[column], &rhs).0[0];
-    }
+    let Some(first) = shape::fit(&thin(&pre), surrogate, similarity) else {
+        return Fit { onset_mm: start, layers: Vec::new(), last_depth_mm: points.last().map_or(0.0, |p| p.position_mm - start) };
+    };
+    let onset = first.onset_mm;
+    let member = FamilyMember::new(first.weight as f32);
+    // the boundaries below deflect as the same member
+    let member_surrogate = |d: f64| match &member {
+        Some(m) => surrogate(d) * f64::from(ratio((d / similarity) as f32, m).0),
+        None => surrogate(d),
+    };
+    let surrogate: &dyn Fn(f64) -> f64 = &member_surrogate;
     let mut layers = vec![LayerFit {
-        boundary_mm: 0.0,
-        scale: scale0,
-        puncture_force_n: pre.last().map_or(0.0, |p| p.force_n),
-        cutting_force_n: 0.0,
-        friction_n_per_mm: 0.0,
+        family_weight: first.weight,
+        family_weight_range: Some(first.weight_range),
+        softening: first.softening,
+        softening_fraction_range: Some(first.fraction_range),
+        ..LayerFit::plain(0.0, first.scale, pre.last().map_or(0.0, |p| p.force_n), 0.0, 0.0)
     }];
     let depth = |i: usize| points.get(i).map_or(0.0, |p| p.position_mm - onset);
     for (k, event) in punctures.iter().enumerate() {
@@ -132,20 +144,14 @@ pub fn fit_with_progress(points: &[Point], punctures: &[Puncture], surrogate: &d
             let deflection = scale * indent(surrogate, depth(end) - boundary);
             // the model punctures when deflection plus the carried cutting force reach it
             let puncture = if measured - friction > 0.0 { measured - friction } else { deflection + fitted.cutting_n };
-            layers.push(LayerFit {
-                boundary_mm: boundary,
-                scale,
-                puncture_force_n: puncture,
-                cutting_force_n: 0.0,
-                friction_n_per_mm: 0.0,
-            });
+            layers.push(LayerFit { family_weight: first.weight, ..LayerFit::plain(boundary, scale, puncture, 0.0, 0.0) });
         }
     }
     Fit { onset_mm: onset, layers, last_depth_mm: depth(points.len() - 1) }
 }
 
-/// How many candidates the scans of [`fit_with_progress`] try (the onset's, then each
-/// interval's boundary), for its progress.
+/// How many candidates the scans of [`fit_with_progress`] try (an onset scan from
+/// `start` to `peak0`, then each interval's boundary), for its progress.
 fn scan_count(points: &[Point], punctures: &[Puncture], start: f64, peak0: f64) -> usize {
     let intervals = punctures.iter().enumerate().filter_map(|(k, e)| {
         let next = punctures.get(k + 1)?;
@@ -236,24 +242,6 @@ fn indent(surrogate: &dyn Fn(f64) -> f64, depth_mm: f64) -> f64 {
     } else {
         0.0
     }
-}
-
-/// The depth (below `max_mm`) where `scale` times the surrogate first reaches
-/// `threshold_n`, by bisection on the monotone pre-puncture curve; `None` if it never does.
-fn crossing_depth(surrogate: &dyn Fn(f64) -> f64, threshold_n: f64, scale: f64, max_mm: f64) -> Option<f64> {
-    if scale <= 0.0 || max_mm <= 0.0 || scale * surrogate(max_mm) < threshold_n {
-        return None;
-    }
-    let (mut lo, mut hi) = (0.0, max_mm);
-    for _ in 0..40 {
-        let mid = 0.5 * (lo + hi);
-        if scale * indent(surrogate, mid) < threshold_n {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    Some(hi)
 }
 
 /// `lo, lo + step, ...` below `hi`: [`SCAN_STEP_MM`], or the step of

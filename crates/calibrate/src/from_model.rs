@@ -72,14 +72,7 @@ pub fn calibrate_published(opts: &ModelOptions<'_>) -> Result<Calibration> {
     let similarity = opts.needle_diameter_mm / f64::from(insertion::FE_NEEDLE_DIAMETER_MM);
     let elastic = |depth_mm: f64| f64::from(insertion::deflection(&Pose::default(), depth_mm as f32, 1.0, similarity as f32).wrench.fy_n);
     // a layer with Prony terms against its response at the replay speed (`crate::ramp`)
-    let total_mm: f64 = pieces.iter().map(|p| p.thickness_mm).sum();
-    if total_mm.is_nan() || total_mm > crate::limits::MAX_SPAN_MM {
-        bail!(
-            "{}: the layers are {total_mm} mm thick in all, more than {} mm: no needle insertion is this long (thickness_mm in micrometres?)",
-            opts.pieces.display(),
-            crate::limits::MAX_SPAN_MM
-        );
-    }
+    let total_mm = total_thickness_mm(opts, &pieces)?;
     let period_s = f64::from(insertion::InsertionConfig::DEFAULT_1KHZ.period_s);
     crate::limits::check_replay(total_mm, opts.replay_speed_mm_per_s, period_s, "--replay-speed-mm-per-s")?;
     let responses: Vec<(String, RampResponse)> = sources
@@ -119,6 +112,11 @@ pub fn calibrate_published(opts: &ModelOptions<'_>) -> Result<Calibration> {
                 Some(s) if !opts.with_prony && !cited.prony.is_empty() => Some(format!("{NOT_COMPILED_IN} {s}")),
                 other => other,
             },
+            family_weight: 1.0,
+            family_weight_range: None,
+            softening_fraction: 0.0,
+            softening_onset_ratio: 0.0,
+            softening_fraction_range: None,
         });
     }
     let stack = file::Stack {
@@ -139,6 +137,22 @@ pub fn calibrate_published(opts: &ModelOptions<'_>) -> Result<Calibration> {
     let replay = replay::replay(&lib_stack, 0.0, 0.0, end, opts.replay_speed_mm_per_s);
     let checks = replay::checks(&points, &events, &replay);
     Ok(Calibration { points, events, fit: published::as_fit(&derived), stack, replay, checks, similarity })
+}
+
+/// The layers' total thickness, mm.
+///
+/// # Errors
+/// NaN, or more than [`crate::limits::MAX_SPAN_MM`] (no needle insertion is this long).
+fn total_thickness_mm(opts: &ModelOptions<'_>, pieces: &[published::Piece]) -> Result<f64> {
+    let total_mm: f64 = pieces.iter().map(|p| p.thickness_mm).sum();
+    if total_mm.is_nan() || total_mm > crate::limits::MAX_SPAN_MM {
+        bail!(
+            "{}: the layers are {total_mm} mm thick in all, more than {} mm: no needle insertion is this long (thickness_mm in micrometres?)",
+            opts.pieces.display(),
+            crate::limits::MAX_SPAN_MM
+        );
+    }
+    Ok(total_mm)
 }
 
 /// The start of a layer's `prony_source` when its published terms are left out (without

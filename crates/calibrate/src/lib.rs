@@ -151,7 +151,7 @@ pub fn calibrate_points_with_progress(
     }
     let similarity = opts.needle_diameter_mm / f64::from(insertion::FE_NEEDLE_DIAMETER_MM);
     let surrogate = |depth_mm: f64| f64::from(insertion::deflection(&Pose::default(), depth_mm as f32, 1.0, similarity as f32).wrench.fy_n);
-    let fit = fit::fit_with_progress(&points, &events, &surrogate, progress);
+    let fit = fit::fit_with_progress(&points, &events, &surrogate, similarity, progress);
     if fit.layers.len() > file::MAX_LAYERS {
         bail!(
             "{}: {} punctures would make {} layers; a stack has at most {} (raise --drop-fraction to count only the larger drops)",
@@ -232,6 +232,11 @@ fn to_file(opts: &Options<'_>, fit: &fit::Fit) -> file::Stack {
                 source: source.clone(),
                 prony: Vec::new(),
                 prony_source: None,
+                family_weight: l.family_weight,
+                family_weight_range: l.family_weight_range,
+                softening_fraction: l.softening.fraction,
+                softening_onset_ratio: if l.softening.fraction > 0.0 { l.softening.onset_ratio } else { 0.0 },
+                softening_fraction_range: l.softening_fraction_range,
             }
         })
         .collect();
@@ -262,5 +267,8 @@ pub fn to_layer(l: &file::Layer) -> insertion::Layer {
         // the parser checked the terms with the library's rules (on the f32 weights)
         prony: PronyTerms::new(&l.prony.iter().map(|t| PronyTerm { g: t.g as f32, tau_s: t.tau_s as f32 }).collect::<Vec<_>>())
             .unwrap_or(PronyTerms::NONE),
+        // the parser checked the weight (0 ..= 1) and the softening's ranges
+        family: insertion::FamilyMember::new(l.family_weight as f32).unwrap_or(insertion::FamilyMember::PAPER),
+        softening: insertion::Softening { fraction: l.softening_fraction as f32, onset_ratio: l.softening_onset_ratio as f32 },
     }
 }

@@ -222,7 +222,7 @@ pub fn derive(pieces: &[Piece], surrogate: &dyn Fn(&str, f64) -> f64) -> Result<
         out.push(Derived {
             name: first.layer.clone(),
             thickness_mm,
-            fit: LayerFit { boundary_mm: top, scale, puncture_force_n, cutting_force_n, friction_n_per_mm },
+            fit: LayerFit::plain(top, scale, puncture_force_n, cutting_force_n, friction_n_per_mm),
             peak: drop_from,
             rises,
         });

@@ -60,6 +60,16 @@ impl Replay {
         near.min_by(|a, b| (a.0 - p).abs().total_cmp(&(b.0 - p).abs())).map_or(f64::NAN, |s| s.1)
     }
 
+    /// The model's force at the last tick at or before needle position `p` (the state
+    /// the model is in when the stage reaches `p`): the pre-puncture comparison's rule, so
+    /// that a measured point at the peak is not held against a tick just after a puncture
+    /// that lands there; the first tick's force before the first tick.
+    #[must_use]
+    pub fn before(&self, p: f64) -> f64 {
+        let i = self.samples.partition_point(|(x, _)| *x <= p);
+        self.samples.get(i.saturating_sub(1)).map_or(f64::NAN, |s| s.1)
+    }
+
     /// The first position where the force exceeds `threshold_n`.
     #[must_use]
     pub fn onset(&self, threshold_n: f64) -> Option<f64> {
@@ -125,7 +135,7 @@ pub fn checks(points: &[Point], events: &[Puncture], model: &Replay) -> Vec<Chec
     puncture_checks(points, events, model, &mut out);
     let onset = measured_onset(points, first.peak, threshold).unwrap_or(f64::NEG_INFINITY);
     let pre: Vec<&Point> = points.iter().take(first.peak + 1).filter(|p| p.position_mm >= onset).collect();
-    let rms = (pre.iter().map(|p| (model.at(p.position_mm) - p.force_n).powi(2)).sum::<f64>() / pre.len().max(1) as f64).sqrt();
+    let rms = (pre.iter().map(|p| (model.before(p.position_mm) - p.force_n).powi(2)).sum::<f64>() / pre.len().max(1) as f64).sqrt();
     out.push(Check {
         what: "pre-puncture RMS (onset to puncture 1), % of its force".into(),
         measured: 0.0,

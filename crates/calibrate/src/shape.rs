@@ -16,11 +16,15 @@
 //!   measured depth whatever `δ`, and the force there is `s S_w(d_p) (1 - δ)`.
 //!   `δ = 0` is no softening (a stack's default).
 //!
-//! For given `(w, δ, r0, onset)` the force is linear in `s` (one least-squares
-//! coefficient); `w` is scanned on [`SQRT_WEIGHTS`], the onset as
-//! [`crate::fit`] scans it (at `δ = 0`, then within [`REFINE_MM`] of that onset with the
-//! softening), `r0` on [`ONSET_RATIOS`]; `δ` follows from the force at the puncture, held to the measured peak ([`softened_fit`]). The curve of a
-//! candidate is read from a table of `S_w` at [`TABLE_STEP_MM`], linearly interpolated.
+//! For given `(w, r0, onset)` the force is linear in its unknowns, with the force at
+//! the puncture held to the measured peak (`s (1 - δ) S_w(d_p) = F_p`): one
+//! least-squares unknown `b = s δ` (the force is `F_p S_w / S_p + b S_w (1 - x(ρ))`).
+//! `w` is scanned on [`SQRT_WEIGHTS`], `r0` on [`ONSET_RATIOS`], the onset on a grid of
+//! [`ONSET_STEP_MM`] (at `δ = 0` over the whole rise, then within [`REFINE_MM`] of that
+//! onset with the softening); the fit is the best candidate whose contact onset matches
+//! the measured one within [`ONSET_MATCH_MM`] (the best of all when none does). A
+//! candidate's curve is read from a table of `S_w` at [`TABLE_STEP_MM`], linearly
+//! interpolated.
 use crate::measured::Point;
 use needle_haptics::float::family::{ratio, FamilyMember};
 
@@ -28,11 +32,22 @@ use needle_haptics::float::family::{ratio, FamilyMember};
 /// the FE covers: below 0.01 the law is not fitted).
 pub const SQRT_WEIGHTS: [f64; 19] =
     [0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4, 0.45, 0.5, 0.55, 0.6, 0.65, 0.7, 0.75, 0.8, 0.85, 0.9, 0.95, 1.0];
-/// The largest softening fraction a fit may give (the force at the puncture keeps at
-/// least half the elastic one).
-pub const MAX_FRACTION: f64 = 0.5;
+/// The largest softening fraction a fit may give (exclusive; the tissue format's and
+/// the library's bound).
+pub const MAX_FRACTION: f64 = needle_contract::SOFTENING_FRACTION_MAX;
 /// The softening's onset ratios `r0` scanned.
 pub const ONSET_RATIOS: [f64; 10] = [0.5, 0.55, 0.6, 0.65, 0.7, 0.75, 0.8, 0.85, 0.9, 0.95];
+/// The fit is the least-squares best among the candidates whose model curve crosses the
+/// onset threshold ([`crate::replay::ONSET_FRACTION`] of the puncture force) within this
+/// distance of the measured curve's crossing, mm (the best of all when none does):
+/// contact onset is a goal of its own (`needle calibrate`'s checks), which the least
+/// squares, weighted by the larger forces, would trade away.
+pub const ONSET_MATCH_MM: f64 = 0.25;
+/// How far after the measured peak the model's puncture may be placed, mm: the force at
+/// the puncture is the measured peak's, where the model punctures; a puncture a little
+/// late lets the rise follow the measured one (a digitised or noisy peak), within the
+/// puncture position's goal of 0.3 mm (issue 64).
+pub const PUNCTURE_LATE_MM: [f64; 3] = [0.0, 0.1, 0.2];
 /// Sampling of the `S_w` tables, mm of indentation.
 pub const TABLE_STEP_MM: f64 = 0.005;
 /// Half width of the onset's refinement with the softening, mm.
@@ -52,7 +67,7 @@ pub struct Softening {
 
 impl Softening {
     /// No softening.
-    pub const NONE: Self = Self { fraction: 0.0, onset_ratio: 1.0 };
+    pub const NONE: Self = Self { fraction: 0.0, onset_ratio: 0.0 };
 
     /// `1 - D(ρ)`.
     #[must_use]
@@ -79,9 +94,34 @@ pub struct ShapeFit {
     pub softening: Softening,
     /// The elastic force that punctures, `s S_w(d_p)`, N.
     pub critical_force_n: f64,
+    /// Needle position where the model punctures, mm: the measured peak's, or up to the
+    /// largest of [`PUNCTURE_LATE_MM`] after it.
+    pub puncture_mm: f64,
     /// Sum of squared residuals over the fitted points, N².
     pub sse: f64,
+    /// The weights of every candidate within [`RANGE_SSE_RATIO`] of the best's sum of
+    /// squares: the fitted range of `weight`, `[low, high]`.
+    pub weight_range: [f64; 2],
+    /// The fitted range of the softening's fraction, as `weight_range`.
+    pub fraction_range: [f64; 2],
 }
+
+impl ShapeFit {
+    /// The candidate's class, simplest first: 0 the paper's tissue without softening, 1
+    /// with softening, 2 another member without, 3 another member with softening. The
+    /// fit is the simplest class within [`RANGE_SSE_RATIO`] of the best (a term is kept
+    /// only when the data ask for it: Okamura's liver stays the paper's tissue).
+    #[must_use]
+    pub fn class(&self) -> usize {
+        usize::from(self.weight < 1.0) * 2 + usize::from(self.softening.fraction > 0.0)
+    }
+}
+
+/// A candidate whose sum of squares is within this ratio of the best's counts towards a
+/// value's fitted range (its RMS within about 5 % of the best's): the measurement's
+/// residuals are correlated over depth (the shape, not noise), so a statistical interval
+/// from the point count would be far too narrow.
+pub const RANGE_SSE_RATIO: f64 = 1.1;
 
 /// `S_w` at `TABLE_STEP_MM` from 0 to `max_mm`.
 struct Table {
@@ -99,6 +139,16 @@ impl Table {
             })
             .collect();
         Self { values }
+    }
+
+    /// The first depth where the table reaches `value` (linearly interpolated), `None`
+    /// when it never does.
+    fn crossing(&self, value: f64) -> Option<f64> {
+        let i = self.values.iter().position(|v| *v >= value)?;
+        let Some(prev) = i.checked_sub(1).and_then(|j| self.values.get(j)) else { return Some(0.0) };
+        let next = self.values.get(i)?;
+        let t = if next > prev { (value - prev) / (next - prev) } else { 0.0 };
+        Some((i as f64 - 1.0 + t) * TABLE_STEP_MM)
     }
 
     fn at(&self, d: f64) -> f64 {
@@ -145,9 +195,9 @@ fn scale_fit(b: &[f64], points: &[Point]) -> (f64, f64) {
 /// The softened candidate with the force at the puncture held to the measured peak
 /// `f_p`: with `a = s`, `b = s δ` and `s (1 - δ) S_w(d_p) = f_p`, the force is
 /// `f_p S_w / S_p + b S_w (1 - x(ρ))` (`x` the softening's ramp): one least-squares
-/// unknown `b >= 0`. `(sse, s, δ)`, `None` when `S_w(d_p)` is not positive or `δ` would
+/// unknown `b >= 0`. `(sse, s, δ, sse at δ = 0)`, `None` when `S_w(d_p)` is not positive or `δ` would
 /// not be below [`MAX_FRACTION`].
-fn softened_fit(table: &Table, points: &[Point], onset: f64, d_p: f64, onset_ratio: f64, f_p: f64) -> Option<(f64, f64, f64)> {
+fn softened_fit(table: &Table, points: &[Point], onset: f64, d_p: f64, onset_ratio: f64, f_p: f64) -> Option<(f64, f64, f64, f64)> {
     let s_p = table.at(d_p);
     if s_p <= 0.0 || f_p <= 0.0 {
         return None;
@@ -168,7 +218,7 @@ fn softened_fit(table: &Table, points: &[Point], onset: f64, d_p: f64, onset_rat
     let sse = (rr - 2.0 * b * cr + b * b * cc).max(0.0);
     let scale = b + f_p / s_p;
     let fraction = b / scale;
-    (fraction < MAX_FRACTION).then_some((sse, scale, fraction))
+    (fraction < MAX_FRACTION).then_some((sse, scale, fraction, rr))
 }
 
 /// Fits the shape of the rise `pre` (contact to the first puncture's peak, the last
@@ -188,43 +238,94 @@ pub fn fit_members(pre: &[Point], surrogate: &dyn Fn(f64) -> f64, similarity: f6
         return None;
     }
     let span = peak.position_mm - first.position_mm;
-    let mut best: Option<ShapeFit> = None;
+    let threshold = crate::replay::ONSET_FRACTION * peak.force_n;
+    let measured_crossing = crate::replay::measured_onset(pre, pre.len() - 1, threshold);
+    // every candidate's (sse, weight, fraction), for the fitted ranges
+    let mut seen: Vec<(f64, f64, f64)> = Vec::new();
+    // per class (ShapeFit::class) the best of all and the best whose contact onset
+    // matches the measured one
+    let (mut best, mut matched): ([Option<ShapeFit>; 4], [Option<ShapeFit>; 4]) = ([None; 4], [None; 4]);
     for &t in sqrt_weights {
         let member = FamilyMember::new((t * t) as f32)?;
-        let table = Table::new(surrogate, &member, similarity, span + TABLE_STEP_MM);
+        let table = Table::new(surrogate, &member, similarity, span + PUNCTURE_LATE_MM[PUNCTURE_LATE_MM.len() - 1] + TABLE_STEP_MM);
         let onsets = |lo: f64, hi: f64| {
             let n = ((hi - lo) / ONSET_STEP_MM).floor().max(0.0) as usize;
             (0..n).map(move |k| lo + ONSET_STEP_MM * k as f64)
         };
+        // the unsoftened scan's best onset (among those matching the measured onset, when
+        // any does): the centre of the softened scan
         let mut plain: Option<(f64, f64)> = None;
+        let mut plain_matched: Option<(f64, f64)> = None;
         for onset in onsets(first.position_mm, peak.position_mm) {
-            let (_, sse) = scale_fit(&basis(&table, pre, onset, peak.position_mm - onset, Softening::NONE), pre);
+            let (scale, sse) = scale_fit(&basis(&table, pre, onset, peak.position_mm - onset, Softening::NONE), pre);
             if plain.is_none_or(|(s, _)| sse < s) {
                 plain = Some((sse, onset));
             }
+            let crossing = (scale > 0.0).then(|| table.crossing(threshold / scale)).flatten().map(|d| onset + d);
+            let near = matches!((crossing, measured_crossing), (Some(c), Some(m)) if (c - m).abs() <= ONSET_MATCH_MM);
+            if near && plain_matched.is_none_or(|(s, _)| sse < s) {
+                plain_matched = Some((sse, onset));
+            }
         }
-        let (_, centre) = plain?;
+        let Some((_, centre)) = plain_matched.or(plain) else { continue };
         let lo = (centre - REFINE_MM).max(first.position_mm);
         let hi = (centre + REFINE_MM).min(peak.position_mm);
-        for onset_ratio in ONSET_RATIOS {
+        for (late, onset_ratio) in PUNCTURE_LATE_MM.iter().flat_map(|l| ONSET_RATIOS.iter().map(move |r| (*l, *r))) {
             for onset in onsets(lo, hi) {
-                let d_p = peak.position_mm - onset;
-                let Some(c) = softened_fit(&table, pre, onset, d_p, onset_ratio, peak.force_n) else { continue };
-                if best.is_none_or(|b| c.0 < b.sse) {
-                    let (sse, scale, fraction) = c;
-                    let softening = Softening { fraction, onset_ratio };
-                    let critical_force_n = scale * table.at(d_p);
-                    best = Some(ShapeFit { onset_mm: onset, scale, weight: t * t, softening, critical_force_n, sse });
+                let d_p = peak.position_mm + late - onset;
+                let Some((sse, scale, fraction, plain_sse)) = softened_fit(&table, pre, onset, d_p, onset_ratio, peak.force_n) else {
+                    continue;
+                };
+                seen.push((sse, t * t, fraction));
+                let crossing = |scale: f64| table.crossing(threshold / scale).map(|d| onset + d);
+                let near =
+                    |scale: f64| matches!((crossing(scale), measured_crossing), (Some(c), Some(m)) if (c - m).abs() <= ONSET_MATCH_MM);
+                // the candidate and the same without softening (through the peak: s = F_p / S_w(d_p))
+                let unsoftened = (plain_sse, peak.force_n / table.at(d_p), 0.0);
+                for (sse, scale, fraction) in [(sse, scale, fraction), unsoftened] {
+                    let candidate = ShapeFit {
+                        onset_mm: onset,
+                        scale,
+                        weight: t * t,
+                        softening: if fraction > 0.0 { Softening { fraction, onset_ratio } } else { Softening::NONE },
+                        critical_force_n: scale * table.at(d_p),
+                        puncture_mm: peak.position_mm + late,
+                        sse,
+                        weight_range: [t * t; 2],
+                        fraction_range: [fraction; 2],
+                    };
+                    // the onset threshold is below every onset ratio: the model's crossing is elastic
+                    let pool = if near(scale) { &mut matched } else { &mut best };
+                    let slot = &mut pool[candidate.class()];
+                    if slot.is_none_or(|b| sse < b.sse) {
+                        *slot = Some(candidate);
+                    }
                 }
             }
         }
     }
-    best
+    choose(matched, best, &seen)
+}
+
+/// The fit among the candidates of each class: those whose onset matches when any does;
+/// among them the simplest class within [`RANGE_SSE_RATIO`] of the best, with the fitted
+/// ranges of `seen` (every candidate's `(sse, weight, fraction)`).
+fn choose(matched: [Option<ShapeFit>; 4], best: [Option<ShapeFit>; 4], seen: &[(f64, f64, f64)]) -> Option<ShapeFit> {
+    let pool = if matched.iter().any(Option::is_some) { matched } else { best };
+    let least = pool.iter().flatten().map(|c| c.sse).fold(f64::INFINITY, f64::min);
+    let limit = least * RANGE_SSE_RATIO;
+    let mut fit = pool.into_iter().flatten().find(|c| c.sse <= limit)?;
+    for &(_, w, fraction) in seen.iter().filter(|c| c.0 <= limit) {
+        fit.weight_range = [fit.weight_range[0].min(w), fit.weight_range[1].max(w)];
+        fit.fraction_range = [fit.fraction_range[0].min(fraction), fit.fraction_range[1].max(fraction)];
+    }
+    Some(fit)
 }
 
 /// The fitted force at needle position `p` (N): the module's law for `fit`.
 #[must_use]
-pub fn force_at(fit: &ShapeFit, surrogate: &dyn Fn(f64) -> f64, similarity: f64, peak_mm: f64, p: f64) -> f64 {
+pub fn force_at(fit: &ShapeFit, surrogate: &dyn Fn(f64) -> f64, similarity: f64, p: f64) -> f64 {
+    let peak_mm = fit.puncture_mm;
     let Some(member) = FamilyMember::new(fit.weight as f32) else { return f64::NAN };
     let sw = |d: f64| if d > 0.0 { surrogate(d) * f64::from(ratio((d / similarity) as f32, &member).0) } else { 0.0 };
     let at_peak = sw(peak_mm - fit.onset_mm);

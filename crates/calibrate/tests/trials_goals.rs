@@ -51,7 +51,7 @@ fn predict(c: &TrialsCalibration, file: &Path, g: &Goals) -> Vec<Check> {
     let owned = OwnedStack { name: "rig".into(), needle_diameter_mm: NEEDLE_MM as f32, layers };
     let lambda = (NEEDLE_MM / f64::from(insertion::FE_NEEDLE_DIAMETER_MM)) as f32;
     let u = move |d: f64| f64::from(insertion::deflection(&Pose::default(), d as f32, 1.0, lambda).wrench.fy_n);
-    let t = trials::prepare(file, EventRule::default(), &u, false).unwrap_or_else(|e| panic!("{e:#}"));
+    let t = trials::prepare(file, EventRule::default(), &u, f64::from(lambda), false).unwrap_or_else(|e| panic!("{e:#}"));
     let r = needle_calibrate::trial_replay::replay(&owned.as_stack(), t.onset_mm(), &t.samples).unwrap_or_else(|e| panic!("{e}"));
     goals::checks(&t, &r, g)
 }

@@ -12,7 +12,9 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
-pub use needle_contract::{MAX_PRONY_TERMS, MAX_TISSUE_LAYERS as MAX_LAYERS, PRONY_G_SUM_MAX, TISSUE_FORMAT};
+pub use needle_contract::{
+    MAX_PRONY_TERMS, MAX_TISSUE_LAYERS as MAX_LAYERS, PRONY_G_SUM_MAX, SOFTENING_FRACTION_MAX, TISSUE_FORMAT, TISSUE_FORMATS_READ,
+};
 /// The folder of a set that holds its tissue stacks.
 pub const TISSUE_DIR: &str = "tissue";
 /// File name of the generated stacks in the output folder.
@@ -54,6 +56,40 @@ pub struct Layer {
     /// layer has none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub prony_source: Option<String>,
+    /// Format 2: the weight `w` of the material family's member the boundary deflects as
+    /// (`family.toml`; 1, the default: the paper's tissue), within the members the set's FE
+    /// covers.
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub family_weight: f64,
+    /// Format 2: the weights whose fit was as good within the calibration's tolerance (its
+    /// fitted range), `[low, high]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub family_weight_range: Option<[f64; 2]>,
+    /// Format 2: the share of the boundary's force lost at its puncture (the pre-puncture
+    /// softening; 0, the default: none), `0 <= fraction <` [`SOFTENING_FRACTION_MAX`].
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub softening_fraction: f64,
+    /// Format 2: where the softening starts, as a share of the force that punctures
+    /// (`0 <= ratio < 1`).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub softening_onset_ratio: f64,
+    /// Format 2: the fitted range of `softening_fraction`, `[low, high]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub softening_fraction_range: Option<[f64; 2]>,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+#[allow(clippy::trivially_copy_pass_by_ref, clippy::float_cmp)] // serde's skip_serializing_if signature; exact default
+fn is_one(v: &f64) -> bool {
+    *v == 1.0
+}
+
+#[allow(clippy::trivially_copy_pass_by_ref)] // serde's skip_serializing_if signature
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 /// One Prony term of a layer's relaxation function (long-term normalisation).
@@ -111,6 +147,11 @@ struct RawLayer {
     source: String,
     prony: Option<Spanned<Vec<Spanned<RawProny>>>>,
     prony_source: Option<Spanned<String>>,
+    family_weight: Option<Spanned<f64>>,
+    family_weight_range: Option<Spanned<[f64; 2]>>,
+    softening_fraction: Option<Spanned<f64>>,
+    softening_onset_ratio: Option<Spanned<f64>>,
+    softening_fraction_range: Option<Spanned<[f64; 2]>>,
 }
 
 #[derive(Deserialize)]
@@ -143,13 +184,48 @@ pub fn parse_stack(path: &Path) -> Result<Stack, CodegenError> {
 /// # Errors
 /// As [`parse_stack`].
 pub fn parse_stack_str(text: &str, path: &Path) -> Result<Stack, CodegenError> {
+    parse_stack_str_in(text, path, &FamilyDomain::ANY)
+}
+
+/// The members of the material family a set's FE covers (`family.toml`'s fitted
+/// weights, to the paper's tissue at 1): a layer's `family_weight` outside is refused
+/// (not extrapolated).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FamilyDomain {
+    /// The smallest weight, `0 ..= 1`.
+    pub weight_min: f64,
+}
+
+impl FamilyDomain {
+    /// Every weight `0 ..= 1` (a file read outside a set).
+    pub const ANY: Self = Self { weight_min: 0.0 };
+    /// Only the paper's tissue (a set without a family law).
+    pub const PAPER_ONLY: Self = Self { weight_min: 1.0 };
+}
+
+/// Reads and checks the tissue file at `path` as a file of a set whose family covers
+/// `domain`.
+///
+/// # Errors
+/// As [`parse_stack`], and a `family_weight` outside `domain`.
+pub fn parse_stack_in(path: &Path, domain: &FamilyDomain) -> Result<Stack, CodegenError> {
+    let text = std::fs::read_to_string(path).map_err(|e| CodegenError::file(path, format!("cannot read the tissue file: {e}")))?;
+    parse_stack_str_in(&text, path, domain)
+}
+
+/// [`parse_stack_str`] for a file of a set whose family covers `domain`.
+///
+/// # Errors
+/// As [`parse_stack_str`], and a `family_weight` outside `domain`.
+pub fn parse_stack_str_in(text: &str, path: &Path, domain: &FamilyDomain) -> Result<Stack, CodegenError> {
     let raw: RawStack = toml::from_str(text).map_err(|e| {
         let offset = e.span().map_or(text.trim_end().len(), |s| s.start);
         CodegenError::at(path, text, offset, e.message().trim_end())
     })?;
     let err = |span: Range<usize>, m: String| CodegenError::at(path, text, span.start, m);
-    if *raw.format.get_ref() != TISSUE_FORMAT {
-        return Err(err(raw.format.span(), format!("format = {}: this build reads tissue format {TISSUE_FORMAT}", raw.format.get_ref())));
+    let format = *raw.format.get_ref();
+    if !TISSUE_FORMATS_READ.contains(&format) {
+        return Err(err(raw.format.span(), format!("format = {format}: this build reads tissue formats 1 and 2")));
     }
     let name = raw.name.get_ref();
     if !is_stack_name(name) {
@@ -161,18 +237,18 @@ pub fn parse_stack_str(text: &str, path: &Path) -> Result<Stack, CodegenError> {
     if raw_layers.is_empty() || raw_layers.len() > MAX_LAYERS {
         return Err(err(layers_span, format!("{} [[layer]] entries: a stack has 1 to {MAX_LAYERS}", raw_layers.len())));
     }
-    let layers = raw_layers.into_iter().map(|l| layer(l.into_inner(), &err)).collect::<Result<Vec<_>, _>>()?;
-    Ok(Stack {
-        format: TISSUE_FORMAT,
-        name: name.clone(),
-        description: raw.description,
-        needle_diameter_mm: *raw.needle_diameter_mm.get_ref(),
-        layers,
-    })
+    let layers = raw_layers.into_iter().map(|l| layer(l.into_inner(), format, domain, &err)).collect::<Result<Vec<_>, _>>()?;
+    Ok(Stack { format, name: name.clone(), description: raw.description, needle_diameter_mm: *raw.needle_diameter_mm.get_ref(), layers })
 }
 
-fn layer(l: RawLayer, err: &dyn Fn(Range<usize>, String) -> CodegenError) -> Result<Layer, CodegenError> {
+fn layer(
+    l: RawLayer,
+    format: i64,
+    domain: &FamilyDomain,
+    err: &dyn Fn(Range<usize>, String) -> CodegenError,
+) -> Result<Layer, CodegenError> {
     use Bound::{NonNegative, Positive};
+    let shape = shape(&l, format, domain, err)?;
     let (prony, prony_span) = match l.prony {
         None => (Vec::new(), l.thickness_mm.span()),
         Some(p) => {
@@ -200,6 +276,99 @@ fn layer(l: RawLayer, err: &dyn Fn(Range<usize>, String) -> CodegenError) -> Res
         track_stiffness_n_per_mm2: check(&l.track_stiffness_n_per_mm2, "track_stiffness_n_per_mm2", NonNegative, err)?,
         name: l.name,
         source: l.source,
+        family_weight: shape.family_weight,
+        family_weight_range: shape.family_weight_range,
+        softening_fraction: shape.softening_fraction,
+        softening_onset_ratio: shape.softening_onset_ratio,
+        softening_fraction_range: shape.softening_fraction_range,
+    })
+}
+
+/// A layer's format 2 fields, checked.
+struct Shape {
+    family_weight: f64,
+    family_weight_range: Option<[f64; 2]>,
+    softening_fraction: f64,
+    softening_onset_ratio: f64,
+    softening_fraction_range: Option<[f64; 2]>,
+}
+
+/// The format 2 fields of `l`: refused in a format 1 file; the weight within `domain` and
+/// 1, the softening fraction `0 ..` [`SOFTENING_FRACTION_MAX`], its onset ratio `0 .. 1`,
+/// each range `[low, high]` with `low <= high` around its value.
+fn shape(
+    l: &RawLayer,
+    format: i64,
+    domain: &FamilyDomain,
+    err: &dyn Fn(Range<usize>, String) -> CodegenError,
+) -> Result<Shape, CodegenError> {
+    let scalars = [
+        ("family_weight", &l.family_weight),
+        ("softening_fraction", &l.softening_fraction),
+        ("softening_onset_ratio", &l.softening_onset_ratio),
+    ];
+    let ranges = [("family_weight_range", &l.family_weight_range), ("softening_fraction_range", &l.softening_fraction_range)];
+    if format < 2 {
+        let first = scalars
+            .iter()
+            .find_map(|(k, v)| v.as_ref().map(|v| (*k, v.span())))
+            .or_else(|| ranges.iter().find_map(|(k, v)| v.as_ref().map(|v| (*k, v.span()))));
+        if let Some((key, span)) = first {
+            return Err(err(
+                span,
+                format!("{key}: a format 2 field (the material family and the pre-puncture softening); write format = 2"),
+            ));
+        }
+    }
+    let within =
+        |v: &Option<Spanned<f64>>, key: &str, default: f64, lo: f64, hi: f64, hi_open: bool, what: &str| -> Result<f64, CodegenError> {
+            let Some(v) = v else { return Ok(default) };
+            let x = *v.get_ref();
+            let ok = x.is_finite() && x >= lo && if hi_open { x < hi } else { x <= hi };
+            if ok {
+                Ok(x)
+            } else {
+                Err(err(v.span(), format!("{key} = {x}: {what}")))
+            }
+        };
+    let family_weight = within(
+        &l.family_weight,
+        "family_weight",
+        1.0,
+        domain.weight_min,
+        1.0,
+        false,
+        &format!(
+            "outside the members the set's FE covers, {} to 1 (family.toml's fitted weights to the paper's tissue): not extrapolated",
+            domain.weight_min
+        ),
+    )?;
+    let softening_fraction = within(
+        &l.softening_fraction,
+        "softening_fraction",
+        0.0,
+        0.0,
+        SOFTENING_FRACTION_MAX,
+        true,
+        &format!("must be from 0 to below {SOFTENING_FRACTION_MAX}"),
+    )?;
+    let softening_onset_ratio =
+        within(&l.softening_onset_ratio, "softening_onset_ratio", 0.0, 0.0, 1.0, true, "must be from 0 to below 1")?;
+    let range = |r: &Option<Spanned<[f64; 2]>>, key: &str, value: f64| -> Result<Option<[f64; 2]>, CodegenError> {
+        let Some(r) = r else { return Ok(None) };
+        let [lo, hi] = *r.get_ref();
+        if lo.is_finite() && hi.is_finite() && lo <= value && value <= hi {
+            Ok(Some([lo, hi]))
+        } else {
+            Err(err(r.span(), format!("{key} = [{lo}, {hi}]: must be finite, low <= high, around the value {value}")))
+        }
+    };
+    Ok(Shape {
+        family_weight,
+        family_weight_range: range(&l.family_weight_range, "family_weight_range", family_weight)?,
+        softening_fraction,
+        softening_onset_ratio,
+        softening_fraction_range: range(&l.softening_fraction_range, "softening_fraction_range", softening_fraction)?,
     })
 }
 
@@ -280,9 +449,10 @@ pub fn read_stacks(set_dir: &Path) -> Result<Vec<(PathBuf, Stack)>, CodegenError
     let entries = std::fs::read_dir(&dir).map_err(|e| CodegenError::file(&dir, format!("cannot list: {e}")))?;
     let mut paths: Vec<PathBuf> = entries.flatten().map(|e| e.path()).filter(|p| p.extension().is_some_and(|x| x == "toml")).collect();
     paths.sort();
+    let domain = crate::family::domain_of_set(set_dir)?;
     let mut stacks = Vec::with_capacity(paths.len());
     for path in paths {
-        let stack = parse_stack(&path)?;
+        let stack = parse_stack_in(&path, &domain)?;
         let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
         if stem != stack.name {
             return Err(CodegenError::file(
@@ -374,14 +544,17 @@ pub fn render_rust_stacks(stacks: &[(PathBuf, Stack)], needle: Option<FeNeedle>)
     for (path, s) in stacks {
         let file = path.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default();
         out.push_str(&format!("/// `{}` (tissue/{file}): {}\n", s.name, s.description.replace('\n', " ")));
-        if !elastic(s) {
-            out.push_str(&format!("{VISCOELASTIC_ONLY}\n"));
+        match (elastic(s), shaped(s)) {
+            (true, false) => {}
+            (false, false) => out.push_str(&format!("{VISCOELASTIC_ONLY}\n")),
+            (true, true) => out.push_str(&format!("{SHAPE_ONLY}\n")),
+            (false, true) => out.push_str("#[cfg(all(feature = \"viscoelastic\", feature = \"tissue-shape\"))]\n"),
         }
         out.push_str(&format!("pub const {}: Stack<'static> = Stack {{\n", s.name.to_uppercase()));
         out.push_str(&format!("    name: {:?},\n    needle_diameter_mm: {},\n    layers: &[\n", s.name, lit(s.needle_diameter_mm)));
         for l in &s.layers {
             out.push_str(&format!(
-                "        Layer {{ thickness_mm: {}, stiffness_scale: {}, puncture_force_n: {}, cutting_force_n: {}, friction: Karnopp {{ static_n_per_mm: {}, coulomb_n_per_mm: {}, viscous_n_s_per_mm2: {}, stick_band_mm_per_s: {} }}, track_stiffness_n_per_mm2: {}, prony: {} }}, // {}\n",
+                "        Layer {{ thickness_mm: {}, stiffness_scale: {}, puncture_force_n: {}, cutting_force_n: {}, friction: Karnopp {{ static_n_per_mm: {}, coulomb_n_per_mm: {}, viscous_n_s_per_mm2: {}, stick_band_mm_per_s: {} }}, track_stiffness_n_per_mm2: {}, prony: {}, family: {}, softening: {} }}, // {}\n",
                 lit(l.thickness_mm),
                 lit(l.stiffness_scale),
                 lit(l.puncture_force_n),
@@ -392,6 +565,8 @@ pub fn render_rust_stacks(stacks: &[(PathBuf, Stack)], needle: Option<FeNeedle>)
                 lit(l.stick_band_mm_per_s),
                 lit(l.track_stiffness_n_per_mm2),
                 render_prony(&l.prony),
+                render_family(l.family_weight),
+                render_softening(l.softening_fraction, l.softening_onset_ratio),
                 l.name.replace('\n', " ")
             ));
         }
@@ -402,7 +577,15 @@ pub fn render_rust_stacks(stacks: &[(PathBuf, Stack)], needle: Option<FeNeedle>)
     };
     let all = names(&|_| true);
     let all_const = |names: &[String]| format!("pub const ALL: [Stack<'static>; {}] = [{}];\n", names.len(), names.join(", "));
-    if stacks.iter().all(|(_, s)| elastic(s)) {
+    if stacks.iter().any(|(_, s)| shaped(s)) {
+        // one ALL per combination of the two features, each listing the stacks it compiles
+        out.push_str("/// Every stack of the set that this build compiles in, by file name (stacks with Prony terms need the `viscoelastic` feature, with a family member or a softening `tissue-shape`).\n");
+        for (visco, shape) in [(false, false), (false, true), (true, false), (true, true)] {
+            let on = |f: &str, yes: bool| if yes { format!("feature = \"{f}\"") } else { format!("not(feature = \"{f}\")") };
+            out.push_str(&format!("#[cfg(all({}, {}))]\n", on("viscoelastic", visco), on("tissue-shape", shape)));
+            out.push_str(&all_const(&names(&|s| (visco || elastic(s)) && (shape || !shaped(s)))));
+        }
+    } else if stacks.iter().all(|(_, s)| elastic(s)) {
         out.push_str(&format!("/// Every stack of the set, by file name.\n{}", all_const(&all)));
     } else {
         out.push_str(&format!("/// Every stack of the set, by file name.\n{VISCOELASTIC_ONLY}\n{}", all_const(&all)));
@@ -414,8 +597,39 @@ pub fn render_rust_stacks(stacks: &[(PathBuf, Stack)], needle: Option<FeNeedle>)
     out
 }
 
+/// A layer's family member: `FamilyMember::PAPER` at 1, else the weight and its square
+/// root as f32 literals (IEEE `sqrt` is correctly rounded, so the f64 root rounded to f32
+/// is the library's `sqrtf` of the f32 weight: `FamilyMember::from_parts` holds it).
+#[allow(clippy::float_cmp, clippy::cast_possible_truncation)]
+fn render_family(weight: f64) -> String {
+    if weight == 1.0 {
+        return "FamilyMember::PAPER".into();
+    }
+    let w = weight as f32;
+    format!("FamilyMember::from_build({}, {})", f32_literal(w), f32_literal(f64::from(w).sqrt() as f32))
+}
+
+/// A layer's softening: `Softening::NONE` without one.
+#[allow(clippy::float_cmp, clippy::cast_possible_truncation)]
+fn render_softening(fraction: f64, onset_ratio: f64) -> String {
+    if fraction == 0.0 {
+        return "Softening::NONE".into();
+    }
+    format!("Softening {{ fraction: {}, onset_ratio: {} }}", f32_literal(fraction as f32), f32_literal(onset_ratio as f32))
+}
+
 /// The attribute that compiles an item only with the library's `viscoelastic` feature.
 const VISCOELASTIC_ONLY: &str = "#[cfg(feature = \"viscoelastic\")]";
+
+/// The attribute that compiles an item only with the library's `tissue-shape` feature.
+const SHAPE_ONLY: &str = "#[cfg(feature = \"tissue-shape\")]";
+
+/// Whether a layer of `stack` has a family member other than the paper's tissue or a
+/// softening (format 2: compiled in only with the `tissue-shape` feature).
+#[allow(clippy::float_cmp)]
+fn shaped(stack: &Stack) -> bool {
+    stack.layers.iter().any(|l| l.family_weight != 1.0 || l.softening_fraction != 0.0)
+}
 
 /// Whether no layer of `stack` has a Prony term.
 fn elastic(stack: &Stack) -> bool {

@@ -137,8 +137,14 @@ pub const DEPTH_MAX_MM: f64 = 6.0;
 /// Most layers a tissue stack (`coeffs/<set>/tissue/*.toml`) may have: the library's
 /// insertion state holds this many.
 pub const MAX_TISSUE_LAYERS: usize = 8;
-/// Format version of a tissue stack file.
-pub const TISSUE_FORMAT: i64 = 1;
+/// Format version of a tissue stack file that `needle calibrate` writes: 2 adds a layer's
+/// material family member and its pre-puncture softening (issue 64).
+pub const TISSUE_FORMAT: i64 = 2;
+/// The tissue formats a build reads (1: without the family and softening fields).
+pub const TISSUE_FORMATS_READ: [i64; 2] = [1, 2];
+/// The largest pre-puncture softening fraction of a layer (exclusive): the force at the
+/// puncture keeps at least half the elastic one.
+pub const SOFTENING_FRACTION_MAX: f64 = 0.5;
 
 /// Format version of a set's unsolved region (`unsolved.toml`).
 pub const UNSOLVED_FORMAT: i64 = 1;

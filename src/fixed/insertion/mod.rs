@@ -37,14 +37,17 @@
 //! `alpha = period / (period + tau)` (Q16, once): `v += floor(alpha (raw - v) / 2^16)`.
 //! No division per tick but one: the path coordinate of a boundary is its depth below
 //! the surface over the axis's vertical component (`2^60 / a_y`, once per tick).
+mod softening;
 mod stack;
 mod track;
 
 pub use stack::{
-    stacks, Karnopp, Layer, Stack, CUTTING_MAX_Q16, FRICTION_LEVEL_MAX_Q16, MAX_LAYERS, SIMILARITY_MAX, STICK_BAND_MAX_Q16,
-    STIFFNESS_SCALE_MAX, TOTAL_THICKNESS_MAX_MM, VISCOUS_MAX_Q16,
+    stacks, FamilyMember, Karnopp, Layer, Softening, Stack, CUTTING_MAX_Q16, FRICTION_LEVEL_MAX_Q16, MAX_LAYERS, SIMILARITY_MAX,
+    STICK_BAND_MAX_Q16, STIFFNESS_SCALE_MAX, TOTAL_THICKNESS_MAX_MM, VISCOUS_MAX_Q16,
 };
 
+#[cfg(feature = "tissue-shape")]
+use super::arith::mul_q30_wide;
 use super::arith::sat_mul;
 use super::depth_extension::{round_shr_i32, saturate_i32};
 #[cfg(not(feature = "viscoelastic"))]
@@ -179,6 +182,18 @@ fn bound(w: &mut [i32; 6]) -> InsertionFlags {
 /// The fixed-point moments are `i32` µN·mm: their sum is within the moment bound.
 const _: () = assert!(3 * (i32::MAX as i64) <= MOMENT_LIMIT_UNMM);
 
+/// The layer's family member and softening in range (`tissue-shape` feature; without it
+/// the layer carries neither: `Stack::from_f32` refuses a stack that has them).
+#[cfg(feature = "tissue-shape")]
+fn shape_ok(l: &Layer) -> bool {
+    l.softening.in_range() && (0..=1 << 24).contains(&l.family.weight_q24())
+}
+
+#[cfg(not(feature = "tissue-shape"))]
+fn shape_ok(_l: &Layer) -> bool {
+    true
+}
+
 fn layer_ok(l: &Layer) -> bool {
     let k = &l.friction;
     l.thickness_q16 > 0
@@ -190,6 +205,7 @@ fn layer_ok(l: &Layer) -> bool {
         && l.track_stiffness_q8 <= TRACK_STIFFNESS_MAX_Q8
         && l.cutting_force_q16 <= CUTTING_MAX_Q16
         && (l.cutting_per_speed_q16.saturating_mul(k.stick_band_q16) >> 16) <= CUTTING_MAX_Q16
+        && shape_ok(l)
 }
 
 impl<'a> Insertion<'a> {
@@ -438,17 +454,49 @@ impl<'a> Insertion<'a> {
             }
             let e = self.surrogate(pose, entry, depth - q);
             let [fx, fy, fz, mx, my, mz] = e.wrench.to_array().map(i64::from);
-            let f = [fx, fy, fz].map(|c| sat_mul(c, gf));
-            let moments = [mx, my, mz].map(|c| sat_mul(c, gm));
-            let [vfx, vfy, vfz, vmx, vmy, vmz] = self.qlv_state.step(qlv, [f[0], f[1], f[2], moments[0], moments[1], moments[2]]);
-            let [px, py, pz, pmx, pmy, pmz] = self.preload_q16;
-            if dot([vfx, vfy, vfz], a).saturating_add(self.carried_cutting_q16()) < layer.puncture_force_q16 {
+            #[cfg_attr(not(feature = "tissue-shape"), allow(unused_mut))]
+            let mut f = [fx, fy, fz].map(|c| sat_mul(c, gf));
+            #[cfg_attr(not(feature = "tissue-shape"), allow(unused_mut))]
+            let mut moments = [mx, my, mz].map(|c| sat_mul(c, gm));
+            #[cfg(feature = "tissue-shape")]
+            if layer.family.weight_q24() < 1 << 24 {
+                // the member's ratio at the FE depth δ/λ (the f32 model's `member_deflection`)
+                let fe_depth = saturate_i32(mul_shr(depth - q, self.stack.inv_similarity_q30, 30));
+                let g = crate::fixed::family::ratio(fe_depth, &layer.family).0.clamp(0, 1 << 31);
+                for x in f.iter_mut().chain(moments.iter_mut()) {
+                    *x = mul_q30_wide(*x, g);
+                }
+            }
+            #[cfg_attr(not(feature = "tissue-shape"), allow(unused_mut))]
+            let mut v = self.qlv_state.step(qlv, [f[0], f[1], f[2], moments[0], moments[1], moments[2]]);
+            let boundary = dot([v[0], v[1], v[2]], a).saturating_add(self.carried_cutting_q16());
+            #[cfg(feature = "tissue-shape")]
+            let soft = layer.softening;
+            #[cfg(feature = "tissue-shape")]
+            let critical_q16 = soft.critical_q16;
+            #[cfg(not(feature = "tissue-shape"))]
+            let critical_q16 = layer.puncture_force_q16;
+            if boundary < critical_q16 {
+                #[cfg(feature = "tissue-shape")]
+                if soft.active() {
+                    let factor = soft.factor_q30(boundary);
+                    v = v.map(|x| Softening::apply(factor, x));
+                }
+                let [vfx, vfy, vfz, vmx, vmy, vmz] = v;
+                let [px, py, pz, pmx, pmy, pmz] = self.preload_q16;
                 let sum = |p: i64, x: i64| p.saturating_add(x);
                 let total = [sum(px, vfx), sum(py, vfy), sum(pz, vfz), sum(pmx, vmx), sum(pmy, vmy), sum(pmz, vmz)];
                 return Deflected { wrench_q16: total, status: e.status, punctures };
             }
-            // the stored viscous force is released; the elastic lateral part stays
+            // the stored viscous force is released; the elastic lateral part stays,
+            // softened to its share at the puncture
             self.qlv_state.reset();
+            #[cfg(feature = "tissue-shape")]
+            if soft.active() {
+                let factor = soft.factor_q30(boundary);
+                f = f.map(|x| Softening::apply(factor, x));
+                moments = moments.map(|x| Softening::apply(factor, x));
+            }
             let axial = dot(f, a);
             let [ax, ay, az] = a;
             // puncture: the axial force goes, the lateral force and the moments stay

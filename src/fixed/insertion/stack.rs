@@ -13,7 +13,9 @@
 //! | friction levels | µN per mm of shaft × 2^16; the stick band's slope and the viscous term µN/mm per mm/s × 2^16 |
 //! | track stiffness | µN/mm per mm of shaft × 2^8 |
 //! | Prony terms | `g` × 2^16, `tau` µs ([`PronyTerms::from_f32`]) |
+pub use super::softening::Softening;
 use crate::fixed::depth_extension::round_i64;
+pub use crate::fixed::family::FamilyMember;
 #[cfg(feature = "viscoelastic")]
 use crate::fixed::viscoelastic::PronyTerms;
 use crate::float::insertion as f32_insertion;
@@ -89,6 +91,13 @@ pub struct Layer {
     /// the `viscoelastic` feature (an elastic build's layers carry none: flash).
     #[cfg(feature = "viscoelastic")]
     pub prony: PronyTerms,
+    /// The material family's member ([`crate::fixed::family`]); only with the
+    /// `tissue-shape` feature (a default build's layers carry none: flash).
+    #[cfg(feature = "tissue-shape")]
+    pub family: FamilyMember,
+    /// The pre-puncture softening and the force that punctures (`tissue-shape`).
+    #[cfg(feature = "tissue-shape")]
+    pub softening: Softening,
 }
 
 /// A stack in integers: the layers and the needle's similarity to the FE needle.
@@ -164,16 +173,18 @@ impl Layer {
     #[must_use]
     pub const fn from_f32(l: &f32_insertion::Layer) -> Self {
         let band = l.friction.stick_band_mm_per_s;
+        // at least 1 (1.5e-11 N) for a positive force: a boundary that punctures at
+        // contact (the tissue format's smallest force) stays positive
+        let puncture_force_q16 =
+            if l.puncture_force_n > 0.0 && micro_q16(l.puncture_force_n) < 1 { 1 } else { micro_q16(l.puncture_force_n) };
         Self {
             thickness_q16: q16(l.thickness_mm),
             stiffness_scale_q16: q16(l.stiffness_scale),
-            // at least 1 (1.5e-11 N) for a positive force: a boundary that punctures at
-            // contact (the tissue format's smallest force) stays positive
-            puncture_force_q16: if l.puncture_force_n > 0.0 && micro_q16(l.puncture_force_n) < 1 {
-                1
-            } else {
-                micro_q16(l.puncture_force_n)
-            },
+            puncture_force_q16,
+            #[cfg(feature = "tissue-shape")]
+            family: FamilyMember::from_f32(&l.family),
+            #[cfg(feature = "tissue-shape")]
+            softening: Softening::from_f32(&l.softening, l.puncture_force_n, puncture_force_q16),
             cutting_force_q16: micro_q16(l.cutting_force_n),
             cutting_per_speed_q16: per_speed_q16(l.cutting_force_n, band),
             friction: Karnopp {
@@ -199,6 +210,10 @@ const EMPTY_LAYER: Layer = Layer {
     track_stiffness_q8: 0,
     #[cfg(feature = "viscoelastic")]
     prony: PronyTerms::NONE,
+    #[cfg(feature = "tissue-shape")]
+    family: FamilyMember::PAPER,
+    #[cfg(feature = "tissue-shape")]
+    softening: Softening { critical_q16: 0, onset_q16: 0, span_q16: 0, slope: 0, fraction_q30: 0 },
 };
 
 impl Stack {
@@ -228,6 +243,10 @@ impl Stack {
             }
             // an elastic build's layers carry no terms: a layer with terms is refused
             if cfg!(not(feature = "viscoelastic")) && l.prony.as_array().1 > 0 {
+                return refused;
+            }
+            // nor, without `tissue-shape`, a family member or a softening
+            if cfg!(not(feature = "tissue-shape")) && (l.family.weight() < 1.0 || l.softening.fraction != 0.0) {
                 return refused;
             }
             total += l.thickness_mm as f64;

@@ -78,10 +78,13 @@
 //! stamp going backwards reaches it as a pose out of order, a jump like any other.
 //!
 //! f32 throughout, `libm` for the trigonometry: the same bits on every target.
+mod softening;
 mod stack;
 mod track;
 
-pub use stack::{stacks, Karnopp, Layer, Stack, FE_NEEDLE_DIAMETER_MM, HUB_FROM_TIP_MM, MAX_LAYERS};
+#[cfg(feature = "tissue-shape")]
+use softening::SofteningTerms;
+pub use stack::{stacks, FamilyMember, Karnopp, Layer, Softening, Stack, FE_NEEDLE_DIAMETER_MM, HUB_FROM_TIP_MM, MAX_LAYERS};
 
 use crate::float::depth_extension::extended_wrench_and_depth_rate;
 #[cfg(not(feature = "viscoelastic"))]
@@ -240,6 +243,19 @@ fn deflection_at(pose: &Pose, indentation_mm: f32, scale: f32, similarity: f32, 
     (crate::Evaluation { wrench: Wrench::from_array(scaled), status: e.status }, k)
 }
 
+/// The family member's ratio `g(δ/λ, w)` ([`crate::float::family::ratio`]) at
+/// `indentation_mm` and the boundary's stiffness with it, `k g + |F|₁ |dg/dδ|` (`f1_n`:
+/// `|F|₁`, the sum of the forces' magnitudes before `g`, at least the force's length, so
+/// the guard's view is not below it). Out of line, scalars in and out: a stack of the
+/// paper's tissue pays one compare; without the `tissue-shape` feature nothing.
+#[cfg(feature = "tissue-shape")]
+#[inline(never)]
+fn member_gain(f1_n: f32, k: f32, indentation_mm: f32, similarity: f32, member: &FamilyMember) -> (f32, f32) {
+    // similarity > 0 (checked by `Insertion::new`)
+    let (g, g_rate_per_fe_mm) = crate::float::family::ratio(indentation_mm / similarity, member);
+    (g, k * g + f1_n * libm::fabsf(g_rate_per_fe_mm / similarity))
+}
+
 /// The needle's unit axis from tip to hub for the pose's tilts (each clamped to ±89
 /// degrees), as the insertion model computes it: `(-sin θz cos θx, cos θz cos θx, sin θx)`
 /// (the [`orientation`](crate::orientation) convention) with f32 polynomials for sine and
@@ -250,10 +266,14 @@ pub fn needle_axis(pose: &Pose) -> [f32; 3] {
 }
 
 /// The state of one needle path through a stack: fixed size, no allocation.
+///
+/// `repr(C)`, the per-tick scalars first and the per-layer tables last: a Cortex-M
+/// floating-point load reaches 1,020 bytes from its base, so the fields a tick reads stay
+/// within one instruction's reach of `self` (the M4F loop tick's budget).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(C)]
 pub struct Insertion {
-    layers: [Layer; MAX_LAYERS],
     count: usize,
     similarity: f32,
     config: InsertionConfig,
@@ -270,14 +290,19 @@ pub struct Insertion {
     /// The last tick's wrench and phase: what a glitch tick holds.
     held: (Wrench, Phase),
     velocity_mm_per_s: f32,
-    /// Per layer the relaxation's per-tick coefficients (computed once, in `new`).
-    qlv: [QlvCoefficients; MAX_LAYERS],
     /// The viscoelastic filter of the deflected boundary's wrench.
     qlv_state: QlvState,
     /// The filter's share for a guard of the last [`Insertion::step_with_stiffness`]
     /// (zero-sized without the `viscoelastic` feature; written only by that call, so
     /// `step` carries none of it).
     guard_share: FilterTerms,
+    /// Per layer the pre-puncture softening's terms and the force that punctures
+    /// (computed once, in `new`; only with the `tissue-shape` feature).
+    #[cfg(feature = "tissue-shape")]
+    soft: [SofteningTerms; MAX_LAYERS],
+    /// Per layer the relaxation's per-tick coefficients (computed once, in `new`).
+    qlv: [QlvCoefficients; MAX_LAYERS],
+    layers: [Layer; MAX_LAYERS],
 }
 
 /// What a passivity guard needs of an insertion tick beside its wrench
@@ -425,12 +450,23 @@ fn non_negative(v: f32) -> bool {
     v.is_finite() && v >= 0.0
 }
 
+/// The layer's family member and softening: covered by the set's FE and in range with
+/// the `tissue-shape` feature; without it only the paper's tissue without softening.
+fn shape_ok(l: &Layer) -> bool {
+    if cfg!(feature = "tissue-shape") {
+        l.family.is_covered() && l.softening.is_valid()
+    } else {
+        l.family.weight() >= 1.0 && l.softening.fraction == 0.0
+    }
+}
+
 fn layer_ok(l: &Layer) -> bool {
     let k = &l.friction;
     positive(l.thickness_mm)
         && positive(l.stiffness_scale)
         && positive(l.puncture_force_n)
         && positive(k.stick_band_mm_per_s)
+        && shape_ok(l)
         && [l.cutting_force_n, k.static_n_per_mm, k.coulomb_n_per_mm, k.viscous_n_s_per_mm2, l.track_stiffness_n_per_mm2]
             .into_iter()
             .all(non_negative)
@@ -465,6 +501,14 @@ impl Insertion {
             let terms = crate::float::viscoelastic::PronyTerms::new(l.prony.as_slice()).map_err(|_| InsertionError::Value)?;
             *k = QlvCoefficients::new(&terms, config.period_s).map_err(|_| InsertionError::Config)?;
         }
+        #[cfg(feature = "tissue-shape")]
+        let soft = {
+            let mut soft = [SofteningTerms::NONE; MAX_LAYERS];
+            for (t, l) in soft.iter_mut().zip(stack.layers) {
+                *t = SofteningTerms::new(l.puncture_force_n, &l.softening).ok_or(InsertionError::Value)?;
+            }
+            soft
+        };
         let mut layers = [stack.layers.first().copied().ok_or(InsertionError::LayerCount)?; MAX_LAYERS];
         for (slot, l) in layers.iter_mut().zip(stack.layers) {
             *slot = *l;
@@ -484,6 +528,8 @@ impl Insertion {
             held: (Wrench::ZERO, Phase::Approach),
             velocity_mm_per_s: 0.0,
             qlv,
+            #[cfg(feature = "tissue-shape")]
+            soft,
             qlv_state: QlvState::REST,
             guard_share: FilterTerms::NONE,
         })
@@ -692,12 +738,42 @@ impl Insertion {
             if pose.depth_mm <= q {
                 break;
             }
-            let (Some(layer), Some(qlv)) = (self.layers.get(self.punctured).copied(), self.qlv.get(self.punctured)) else { break };
-            let (e, k) = deflection_at(pose, pose.depth_mm - q, layer.stiffness_scale, self.similarity, rate);
-            let elastic = e.wrench.to_array();
-            let w = self.qlv_state.step(qlv, elastic);
+            let (Some(layer), Some(qlv)) = (self.layers.get(self.punctured), self.qlv.get(self.punctured)) else { break };
+            let indentation_mm = pose.depth_mm - q;
+            #[cfg_attr(not(feature = "tissue-shape"), allow(unused_mut))]
+            let (e, mut k) = deflection_at(pose, indentation_mm, layer.stiffness_scale, self.similarity, rate);
+            #[cfg_attr(not(feature = "tissue-shape"), allow(unused_mut))]
+            let mut elastic = e.wrench.to_array();
+            #[cfg(feature = "tissue-shape")]
+            if layer.family.weight() < 1.0 {
+                let f1_n = libm::fabsf(elastic[0]) + libm::fabsf(elastic[1]) + libm::fabsf(elastic[2]);
+                let g;
+                (g, k) = member_gain(f1_n, k, indentation_mm, self.similarity, &layer.family);
+                elastic = elastic.map(|x| x * g);
+            }
+            #[cfg_attr(not(feature = "tissue-shape"), allow(unused_mut))]
+            let mut w = self.qlv_state.step(qlv, elastic);
             let axial_n = dot([w[0], w[1], w[2]], a);
-            if axial_n + self.carried_cutting_n() < layer.puncture_force_n {
+            let boundary_n = axial_n + self.carried_cutting_n();
+            // looked up after the filter: nothing of it is live across the filter's step
+            #[cfg(feature = "tissue-shape")]
+            let Some(soft) = self.soft.get(self.punctured) else {
+                break;
+            };
+            #[cfg(feature = "tissue-shape")]
+            let critical_n = soft.critical_n;
+            #[cfg(not(feature = "tissue-shape"))]
+            let critical_n = layer.puncture_force_n;
+            if boundary_n < critical_n {
+                #[cfg(feature = "tissue-shape")]
+                if soft.active() {
+                    // the tissue starting to fail: the boundary's wrench (and the guard's view
+                    // of it) loses its share; the filter's state keeps the unsoftened one
+                    let factor = soft.factor(boundary_n);
+                    w = w.map(|x| x * factor);
+                    elastic = elastic.map(|x| x * factor);
+                    k *= factor;
+                }
                 let mut total = self.preload;
                 for (t, x) in total.iter_mut().zip(w) {
                     *t += x;
@@ -707,6 +783,10 @@ impl Insertion {
                 }
                 return Deflected { wrench: total, status: e.status, punctures, stiffness_n_per_mm: k * qlv.effective_stiffness_ratio() };
             }
+            // the boundary's state at the puncture: softened to its share there
+            #[cfg(feature = "tissue-shape")]
+            let w = if soft.active() { elastic.map(|x| x * soft.factor(boundary_n)) } else { elastic };
+            #[cfg(not(feature = "tissue-shape"))]
             let w = elastic;
             let axial_n = dot([w[0], w[1], w[2]], a);
             self.qlv_state.reset();

@@ -2,6 +2,8 @@
 //! compiled in from the set's `tissue/*.toml` (format: `coeffs/README.md`, "Tissue
 //! stacks") into [`stacks`].
 
+pub use super::softening::Softening;
+pub use crate::float::family::FamilyMember;
 use crate::float::viscoelastic::{PronyTerm, PronyTerms};
 
 /// Shaft friction per mm of shaft in a layer: Karnopp's static and Coulomb levels, a
@@ -61,6 +63,12 @@ pub struct Layer {
     /// viscoelasticity, [`viscoelastic`](crate::float::viscoelastic)); [`PronyTerms::NONE`]:
     /// elastic.
     pub prony: PronyTerms,
+    /// The material family's member the boundary deflects as (the FE surrogate times the
+    /// family's ratio `g(d, w)`, [`crate::float::family`]); [`FamilyMember::PAPER`]: the
+    /// paper's tissue.
+    pub family: FamilyMember,
+    /// The boundary's pre-puncture softening; [`Softening::NONE`]: none.
+    pub softening: Softening,
 }
 
 /// A stack of layers and the needle its values belong to.
@@ -84,7 +92,7 @@ pub mod stacks {
     // `panic!` only in constant evaluation (a refused Prony set is a compile error)
     #![allow(clippy::unreadable_literal, clippy::excessive_precision, clippy::panic)]
     #[allow(unused_imports)] // a set without tissue files uses none
-    use super::{Karnopp, Layer, PronyTerm, PronyTerms, Stack};
+    use super::{FamilyMember, Karnopp, Layer, PronyTerm, PronyTerms, Softening, Stack};
     include!(concat!(env!("OUT_DIR"), "/tissue_stacks.rs"));
 
     /// The compiled-in stack named `name` (its file's stem), `None` when [`ALL`] has no

@@ -84,7 +84,8 @@ pub fn calibrate_trials(opts: &TrialsOptions<'_>) -> Result<TrialsCalibration> {
     }
     let similarity = diameter / f64::from(insertion::FE_NEEDLE_DIAMETER_MM);
     let u = move |d: f64| f64::from(insertion::deflection(&Pose::default(), d as f32, 1.0, similarity as f32).wrench.fy_n);
-    let trials: Vec<trials::Trial> = opts.trials.iter().map(|p| trials::prepare(p, opts.rule, &u, true)).collect::<Result<_>>()?;
+    let trials: Vec<trials::Trial> =
+        opts.trials.iter().map(|p| trials::prepare(p, opts.rule, &u, similarity, true)).collect::<Result<_>>()?;
     let mut notes: Vec<String> = trials.iter().flat_map(|t| t.phases.notes.clone()).collect();
     let fitted = stack::fit(&trials, opts, diameter, &u, &mut notes)?;
     let layers: Vec<insertion::Layer> = fitted.stack.layers.iter().map(crate::to_layer).collect();

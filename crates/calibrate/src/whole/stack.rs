@@ -56,12 +56,20 @@ pub fn fit(ts: &[Trial], opts: &TrialsOptions<'_>, diameter: f64, u: &dyn Fn(f64
     notes.extend(count_notes);
     let used: Vec<Trial> = ts.iter().filter(|t| t.events.len() >= n).cloned().collect();
     let mean_of = |f: &dyn Fn(&Trial) -> Option<f64>| Spread::of(used.iter().filter_map(f).collect());
+    // the first boundary's shape (issue 64): the trials' fitted member (their median) and
+    // softening (their means), the scale through each trial's first peak with it
+    let shape = first_shape(&used);
+    let lambda = diameter / f64::from(needle_haptics::insertion::FE_NEEDLE_DIAMETER_MM);
+    let member = needle_haptics::float::family::FamilyMember::new(shape.weight as f32);
+    let u0 = |d: f64| u(d) * member.map_or(1.0, |m| f64::from(needle_haptics::float::family::ratio((d / lambda) as f32, &m).0));
     // today's fit gives the first layer and the first guess of the boundaries
     let mut v = Values {
         bounds: (0..n).map(|k| if k == 0 { 0.0 } else { mean_of(&|t| t.fit.layers.get(k).map(|l| l.boundary_mm)).mean }).collect(),
         // the first boundary's scale through each trial's first peak (today's shape, at
         // today's onset: the model punctures where and at the force the trial did)
-        scale: vec![mean_of(&|t| t.peak(0).map(|(p, f)| f / u(p - t.onset_mm())).filter(|s| s.is_finite() && *s > 0.0))],
+        scale: vec![mean_of(&|t| {
+            t.peak(0).map(|(p, f)| f / (u0(p - t.onset_mm()) * (1.0 - shape.fraction))).filter(|s| s.is_finite() && *s > 0.0)
+        })],
         puncture: vec![mean_of(&|t| t.peak(0).map(|p| p.1))],
         cutting: Vec::new(),
     };
@@ -91,8 +99,13 @@ pub fn fit(ts: &[Trial], opts: &TrialsOptions<'_>, diameter: f64, u: &dyn Fn(f64
             if j + 1 == n { hold.per_trial.cutting_n.clone() } else { v.cutting.get(j).cloned().unwrap_or(Spread::of(Vec::new())) };
         let cutting_n = if j + 1 == n { hold.cutting_n } else { cutting.mean };
         let f = fr.get(j).cloned().unwrap_or_else(zero_friction);
-        let (l, notes) =
+        let (mut l, notes) =
             layer(j, n, below - v.bounds[j], v.scale[j].clone(), v.puncture[j].clone(), (cutting_n, cutting), &f, band, opts, &source);
+        if j == 0 {
+            l.family_weight = shape.weight;
+            l.softening_fraction = shape.fraction;
+            l.softening_onset_ratio = shape.onset_ratio;
+        }
         layers.push(l);
         uncertainty.push(notes);
     }
@@ -111,6 +124,27 @@ pub fn fit(ts: &[Trial], opts: &TrialsOptions<'_>, diameter: f64, u: &dyn Fn(f64
     file::parse_stack_str(&stack.to_toml(""), Path::new(&format!("{}.toml", stack.name)))
         .map_err(|e| anyhow::anyhow!("the calibrated stack is refused by the tissue format: {e}"))?;
     Ok(Fitted { stack, uncertainty, punctures: n, friction: fr, hold, stick_band_mm_per_s: band })
+}
+
+/// The first boundary's shape over the trials.
+struct FirstShape {
+    weight: f64,
+    fraction: f64,
+    onset_ratio: f64,
+}
+
+/// The median of the trials' fitted members and the means of their softenings (each
+/// trial's [`crate::shape`] fit); the paper's tissue without softening when none has one.
+fn first_shape(ts: &[Trial]) -> FirstShape {
+    let firsts: Vec<&crate::fit::LayerFit> = ts.iter().filter_map(|t| t.fit.layers.first()).collect();
+    let mut weights: Vec<f64> = firsts.iter().map(|l| l.family_weight).collect();
+    weights.sort_by(f64::total_cmp);
+    let weight = weights.get(weights.len() / 2).copied().unwrap_or(1.0);
+    let n = firsts.len().max(1) as f64;
+    let fraction = firsts.iter().map(|l| l.softening.fraction).sum::<f64>() / n;
+    let softened: Vec<f64> = firsts.iter().filter(|l| l.softening.fraction > 0.0).map(|l| l.softening.onset_ratio).collect();
+    let onset_ratio = if fraction > 0.0 && !softened.is_empty() { softened.iter().sum::<f64>() / softened.len() as f64 } else { 0.0 };
+    FirstShape { weight, fraction: if onset_ratio > 0.0 || fraction == 0.0 { fraction } else { 0.0 }, onset_ratio }
 }
 
 /// The layer below the last puncture: deflected, never punctured, with the holds' Prony
@@ -227,6 +261,11 @@ fn layer(
         source: source.to_string(),
         prony: Vec::new(),
         prony_source: None,
+        family_weight: 1.0,
+        family_weight_range: None,
+        softening_fraction: 0.0,
+        softening_onset_ratio: 0.0,
+        softening_fraction_range: None,
     };
     let se = |s: Option<f64>, unit: &str, k: usize| match s {
         Some(se) => format!("+- {se:.3e} {unit} (regression over {k} trials)"),

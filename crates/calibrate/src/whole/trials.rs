@@ -60,7 +60,7 @@ impl Trial {
 /// # Errors
 /// The reader's and the screen's refusals (`FILE:LINE`), a trial the phases cannot cut,
 /// or (with `need_puncture`) one without a puncture.
-pub fn prepare(path: &Path, rule: EventRule, surrogate: &dyn Fn(f64) -> f64, need_puncture: bool) -> Result<Trial> {
+pub fn prepare(path: &Path, rule: EventRule, surrogate: &dyn Fn(f64) -> f64, similarity: f64, need_puncture: bool) -> Result<Trial> {
     let what = path.display().to_string();
     let samples = trial::read_trial(path)?;
     crate::trial_screen::screen(&samples, &what)?;
@@ -75,7 +75,7 @@ pub fn prepare(path: &Path, rule: EventRule, surrogate: &dyn Fn(f64) -> f64, nee
             points.last().map_or(0, |p| p.line)
         );
     }
-    let fit = fit::fit(&points, &events, surrogate);
+    let fit = fit::fit(&points, &events, surrogate, similarity);
     Ok(Trial { path: path.to_path_buf(), samples, phases, points, events, fit })
 }
 

@@ -36,7 +36,7 @@ pub fn run(a: ReplayArgs) -> Result<ExitCode> {
     let stack = owned.as_stack();
     let lambda = stack.needle_diameter_mm / insertion::FE_NEEDLE_DIAMETER_MM;
     let u = move |d: f64| f64::from(insertion::deflection(&Pose::default(), d as f32, 1.0, lambda).wrench.fy_n);
-    let t = trials::prepare(&a.trial, EventRule::default(), &u, false)?;
+    let t = trials::prepare(&a.trial, EventRule::default(), &u, f64::from(lambda), false)?;
     let r = needle_calibrate::trial_replay::replay(&stack, t.onset_mm(), &t.samples).map_err(|e| anyhow::anyhow!("{}: {e}", t.name()))?;
     let checks = needle_calibrate::goals::checks(&t, &r, &needle_calibrate::goals::PREDICTED);
     if a.json {
