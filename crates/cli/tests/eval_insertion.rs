@@ -119,7 +119,11 @@ fn bad_scripts_are_refused_with_their_line() {
     let file = dir.path().join("script.csv");
     std::fs::write(&file, "time_s,x_mm,z_mm,theta_x_deg,theta_z_deg,depth_mm\n0,0,0,0,0,1\n0.001,0,0,0,0,2\n").expect("script");
     let out = needle(&["eval", "--set", &shipped_set_arg(), "--poses", file.to_str().expect("path"), "--insertion", "no_such"]);
-    assert!(String::from_utf8_lossy(&out.stderr).contains("no such tissue file, nor a stack of the compiled-in set"), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("no such tissue file, nor a stack of the compiled-in set"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 /// In at 5 mm/s to 3 mm (the liver's first boundary deflected, not punctured), held 2 s.
