@@ -87,19 +87,6 @@ pub fn parse(path: &Path) -> Result<Family, CodegenError> {
     Ok(Family { depth_max_mm: depth, coeffs_f32, weight_min })
 }
 
-/// The members the set `set_dir`'s FE covers: from the smallest fitted weight of its
-/// `family.toml` to 1, only the paper's tissue without one.
-///
-/// # Errors
-/// As [`parse`], for a set with a `family.toml`.
-pub fn domain_of_set(set_dir: &Path) -> Result<crate::tissue::FamilyDomain, CodegenError> {
-    let path = set_dir.join(FILE);
-    if !path.is_file() {
-        return Ok(crate::tissue::FamilyDomain::PAPER_ONLY);
-    }
-    Ok(crate::tissue::FamilyDomain { weight_min: parse(&path)?.weight_min })
-}
-
 /// The Rust source: `FITTED`, `WEIGHT_MIN`, `DEPTH_MAX_MM`, `INV_DEPTH_MAX_PER_MM`, `COEFFS` (rows by
 /// power of depth, each by power of `sqrt(w)`).
 #[must_use]

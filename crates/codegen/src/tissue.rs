@@ -203,6 +203,19 @@ impl FamilyDomain {
     pub const PAPER_ONLY: Self = Self { weight_min: 1.0 };
 }
 
+/// The members the set `set_dir`'s FE covers: from the smallest fitted weight of its
+/// `family.toml` to 1, only the paper's tissue without one.
+///
+/// # Errors
+/// As [`crate::family::parse`], for a set with a `family.toml`.
+pub fn domain_of_set(set_dir: &Path) -> Result<FamilyDomain, CodegenError> {
+    let path = set_dir.join(crate::family::FILE);
+    if !path.is_file() {
+        return Ok(FamilyDomain::PAPER_ONLY);
+    }
+    Ok(FamilyDomain { weight_min: crate::family::parse(&path)?.weight_min })
+}
+
 /// Reads and checks the tissue file at `path` as a file of a set whose family covers
 /// `domain`.
 ///
@@ -449,7 +462,7 @@ pub fn read_stacks(set_dir: &Path) -> Result<Vec<(PathBuf, Stack)>, CodegenError
     let entries = std::fs::read_dir(&dir).map_err(|e| CodegenError::file(&dir, format!("cannot list: {e}")))?;
     let mut paths: Vec<PathBuf> = entries.flatten().map(|e| e.path()).filter(|p| p.extension().is_some_and(|x| x == "toml")).collect();
     paths.sort();
-    let domain = crate::family::domain_of_set(set_dir)?;
+    let domain = domain_of_set(set_dir)?;
     let mut stacks = Vec::with_capacity(paths.len());
     for path in paths {
         let stack = parse_stack_in(&path, &domain)?;
