@@ -181,7 +181,7 @@ mod tests {
             (text.replace(&mesh, "mesh = \"needle8\""), "family.mesh", shipped_key("family", "mesh").1),
             (text.replace(&check, "check_weight = [0.75]"), "family.check_weight", check_line),
             (text.replace(&poses, "check_poses = [\"nowhere\"]"), "family.check_poses", poses_line),
-            (text.replace(&held, "held_out = [0.3]"), "family.held_out", held_line),
+            (text.replace(&held, "held_out = [0.4]"), "family.held_out", held_line),
             (text.replace(&poses, "check_poses = [\"x+04\", \"x+04\"]"), "family.check_poses", poses_line),
         ];
         for (spec, field, line) in cases {
