@@ -33,6 +33,10 @@ pub struct Softening {
 
 #[cfg_attr(not(feature = "tissue-shape"), allow(dead_code))]
 impl Softening {
+    /// A softening out of range (`critical_q16 = 0`, which [`Softening::in_range`] refuses;
+    /// also the empty layer's).
+    pub const REFUSED: Self = Self { critical_q16: 0, onset_q16: 0, span_q16: 0, slope: 0, fraction_q30: 0 };
+
     /// The f32 layer's softening, its force that punctures from `puncture_force_q16` (the
     /// layer's, already in µN Q16). `const`: the compiled-in stacks are converted at
     /// compile time. A softening out of range gives `critical_q16 = 0`, which
@@ -44,14 +48,14 @@ impl Softening {
             return Self { critical_q16: puncture_force_q16, onset_q16: 0, span_q16: 0, slope: 0, fraction_q30: 0 };
         }
         if !(fraction > 0.0 && fraction < f32_insertion::Softening::FRACTION_MAX as f64 && ratio >= 0.0 && ratio < 1.0) {
-            return Self { critical_q16: 0, onset_q16: 0, span_q16: 0, slope: 0, fraction_q30: 0 };
+            return Self::REFUSED;
         }
         let critical_n = puncture_force_n as f64 / (1.0 - fraction);
         let critical_q16 = round_i64(critical_n * MICRO * Q16);
         let onset_q16 = round_i64(ratio * critical_n * MICRO * Q16);
         let span_q16 = critical_q16 - onset_q16;
         if span_q16 <= 0 {
-            return Self { critical_q16: 0, onset_q16: 0, span_q16: 0, slope: 0, fraction_q30: 0 };
+            return Self::REFUSED;
         }
         let slope = round_i64(fraction * (1u64 << 62) as f64 / span_q16 as f64);
         Self { critical_q16, onset_q16, span_q16, slope, fraction_q30: round_i64(fraction * Q30) }

@@ -213,7 +213,7 @@ const EMPTY_LAYER: Layer = Layer {
     #[cfg(feature = "tissue-shape")]
     family: FamilyMember::PAPER,
     #[cfg(feature = "tissue-shape")]
-    softening: Softening { critical_q16: 0, onset_q16: 0, span_q16: 0, slope: 0, fraction_q30: 0 },
+    softening: Softening::REFUSED,
 };
 
 impl Stack {

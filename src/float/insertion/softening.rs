@@ -29,7 +29,7 @@ impl Softening {
     pub const NONE: Self = Self { fraction: 0.0, onset_ratio: 0.0 };
     /// The largest fraction a stack may give (the force at the puncture keeps at least
     /// half the elastic one).
-    pub const FRACTION_MAX: f32 = 0.5;
+    pub const FRACTION_MAX: f32 = needle_contract::SOFTENING_FRACTION_MAX as f32;
 
     /// Whether the values are in range (the tissue file's check, for a stack built at run
     /// time).
