@@ -117,6 +117,8 @@ pub fn calibrate_published(opts: &ModelOptions<'_>) -> Result<Calibration> {
             softening_fraction: 0.0,
             softening_onset_ratio: 0.0,
             softening_fraction_range: None,
+            presliding_mm: None,
+            shaft_prony: Vec::new(),
         });
     }
     let stack = file::Stack {

@@ -237,6 +237,8 @@ fn to_file(opts: &Options<'_>, fit: &fit::Fit) -> file::Stack {
                 softening_fraction: l.softening.fraction,
                 softening_onset_ratio: if l.softening.fraction > 0.0 { l.softening.onset_ratio } else { 0.0 },
                 softening_fraction_range: l.softening_fraction_range,
+                presliding_mm: None,
+                shaft_prony: Vec::new(),
             }
         })
         .collect();
@@ -270,5 +272,11 @@ pub fn to_layer(l: &file::Layer) -> insertion::Layer {
         // the parser checked the weight (0 ..= 1) and the softening's ranges
         family: insertion::FamilyMember::new(l.family_weight as f32).unwrap_or(insertion::FamilyMember::PAPER),
         softening: insertion::Softening { fraction: l.softening_fraction as f32, onset_ratio: l.softening_onset_ratio as f32 },
+        // the parser checked the distance's range and the terms
+        presliding: l.presliding_mm.map_or(insertion::Presliding::NONE, |d| insertion::Presliding {
+            distance_mm: d as f32,
+            shaft_prony: PronyTerms::new(&l.shaft_prony.iter().map(|t| PronyTerm { g: t.g as f32, tau_s: t.tau_s as f32 }).collect::<Vec<_>>())
+                .unwrap_or(PronyTerms::NONE),
+        }),
     }
 }

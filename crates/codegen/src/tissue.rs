@@ -13,7 +13,8 @@ use std::path::{Path, PathBuf};
 use toml::Spanned;
 
 pub use needle_contract::{
-    MAX_PRONY_TERMS, MAX_TISSUE_LAYERS as MAX_LAYERS, PRONY_G_SUM_MAX, SOFTENING_FRACTION_MAX, TISSUE_FORMAT, TISSUE_FORMATS_READ,
+    MAX_PRONY_TERMS, MAX_TISSUE_LAYERS as MAX_LAYERS, PRESLIDING_MM_RANGE, PRONY_G_SUM_MAX, SOFTENING_FRACTION_MAX, TISSUE_FORMAT,
+    TISSUE_FORMATS_READ,
 };
 /// The folder of a set that holds its tissue stacks.
 pub const TISSUE_DIR: &str = "tissue";
@@ -76,6 +77,16 @@ pub struct Layer {
     /// Format 2: the fitted range of `softening_fraction`, `[low, high]`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub softening_fraction_range: Option<[f64; 2]>,
+    /// Format 2: the shaft's presliding distance, mm, within [`PRESLIDING_MM_RANGE`]
+    /// (none, the default: the Karnopp friction, zero at rest): a needle at rest keeps
+    /// its shaft friction and cutting force, a reversal turns them over within twice it
+    /// (compiled in only with the library's `shaft-presliding` feature).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub presliding_mm: Option<f64>,
+    /// Format 2: the relaxation of the held shaft force and cutting (0 to
+    /// [`MAX_PRONY_TERMS`], long-term normalisation; needs `presliding_mm`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub shaft_prony: Vec<PronyTerm>,
 }
 
 fn one() -> f64 {
@@ -152,9 +163,11 @@ struct RawLayer {
     softening_fraction: Option<Spanned<f64>>,
     softening_onset_ratio: Option<Spanned<f64>>,
     softening_fraction_range: Option<Spanned<[f64; 2]>>,
+    presliding_mm: Option<Spanned<f64>>,
+    shaft_prony: Option<Spanned<Vec<Spanned<RawProny>>>>,
 }
 
-#[derive(Deserialize)]
+#[derive(Deserialize, Clone)]
 #[serde(deny_unknown_fields)]
 struct RawProny {
     g: Spanned<f64>,
@@ -262,6 +275,7 @@ fn layer(
 ) -> Result<Layer, CodegenError> {
     use Bound::{NonNegative, Positive};
     let shape = shape(&l, format, domain, err)?;
+    let (presliding_mm, shaft_prony) = presliding_fields(&l, format, err)?;
     let (prony, prony_span) = match l.prony {
         None => (Vec::new(), l.thickness_mm.span()),
         Some(p) => {
@@ -277,6 +291,8 @@ fn layer(
     }
     Ok(Layer {
         prony,
+        presliding_mm,
+        shaft_prony,
         prony_source: l.prony_source.map(Spanned::into_inner),
         thickness_mm: check(&l.thickness_mm, "thickness_mm", Positive, err)?,
         stiffness_scale: check(&l.stiffness_scale, "stiffness_scale", Positive, err)?,
@@ -383,6 +399,39 @@ fn shape(
         softening_onset_ratio,
         softening_fraction_range: range(&l.softening_fraction_range, "softening_fraction_range", softening_fraction)?,
     })
+}
+
+/// The presliding fields of `l` (format 2): the distance within [`PRESLIDING_MM_RANGE`],
+/// the shaft's Prony terms checked as a layer's and only with a distance.
+fn presliding_fields(l: &RawLayer, format: i64, err: &dyn Fn(Range<usize>, String) -> CodegenError) -> Result<(Option<f64>, Vec<PronyTerm>), CodegenError> {
+    if format < 2 {
+        if let Some(span) = l.presliding_mm.as_ref().map(Spanned::span).or_else(|| l.shaft_prony.as_ref().map(Spanned::span)) {
+            return Err(err(span, "presliding_mm, shaft_prony: format 2 fields (the shaft's presliding); write format = 2".into()));
+        }
+    }
+    let distance = match &l.presliding_mm {
+        None => None,
+        Some(v) => {
+            let (lo, hi) = PRESLIDING_MM_RANGE;
+            let x = *v.get_ref();
+            if !(x.is_finite() && (lo..=hi).contains(&x)) {
+                return Err(err(v.span(), format!("presliding_mm = {x}: must be from {lo} to {hi} mm (leave it out for none)")));
+            }
+            Some(x)
+        }
+    };
+    let terms = match l.shaft_prony.clone() {
+        None => Vec::new(),
+        Some(p) => {
+            let span = p.span();
+            let terms = prony(p, err)?;
+            if distance.is_none() && !terms.is_empty() {
+                return Err(err(span, format!("layer {:?}: shaft_prony needs presliding_mm (the held force it relaxes)", l.name)));
+            }
+            terms
+        }
+    };
+    Ok((distance, terms))
 }
 
 /// The Prony terms: at most [`MAX_PRONY_TERMS`], each `g >= 0` and `tau_s > 0`, the sum
@@ -557,17 +606,12 @@ pub fn render_rust_stacks(stacks: &[(PathBuf, Stack)], needle: Option<FeNeedle>)
     for (path, s) in stacks {
         let file = path.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default();
         out.push_str(&format!("/// `{}` (tissue/{file}): {}\n", s.name, s.description.replace('\n', " ")));
-        match (elastic(s), shaped(s)) {
-            (true, false) => {}
-            (false, false) => out.push_str(&format!("{VISCOELASTIC_ONLY}\n")),
-            (true, true) => out.push_str(&format!("{SHAPE_ONLY}\n")),
-            (false, true) => out.push_str("#[cfg(all(feature = \"viscoelastic\", feature = \"tissue-shape\"))]\n"),
-        }
+        out.push_str(&gate(&needs(s)));
         out.push_str(&format!("pub const {}: Stack<'static> = Stack {{\n", s.name.to_uppercase()));
         out.push_str(&format!("    name: {:?},\n    needle_diameter_mm: {},\n    layers: &[\n", s.name, lit(s.needle_diameter_mm)));
         for l in &s.layers {
             out.push_str(&format!(
-                "        Layer {{ thickness_mm: {}, stiffness_scale: {}, puncture_force_n: {}, cutting_force_n: {}, friction: Karnopp {{ static_n_per_mm: {}, coulomb_n_per_mm: {}, viscous_n_s_per_mm2: {}, stick_band_mm_per_s: {} }}, track_stiffness_n_per_mm2: {}, prony: {}, family: {}, softening: {} }}, // {}\n",
+                "        Layer {{ thickness_mm: {}, stiffness_scale: {}, puncture_force_n: {}, cutting_force_n: {}, friction: Karnopp {{ static_n_per_mm: {}, coulomb_n_per_mm: {}, viscous_n_s_per_mm2: {}, stick_band_mm_per_s: {} }}, track_stiffness_n_per_mm2: {}, prony: {}, family: {}, softening: {}, {PRESLIDING_ONLY} presliding: {} }}, // {}\n",
                 lit(l.thickness_mm),
                 lit(l.stiffness_scale),
                 lit(l.puncture_force_n),
@@ -580,6 +624,7 @@ pub fn render_rust_stacks(stacks: &[(PathBuf, Stack)], needle: Option<FeNeedle>)
                 render_prony(&l.prony),
                 render_family(l.family_weight),
                 render_softening(l.softening_fraction, l.softening_onset_ratio),
+                render_presliding(l.presliding_mm, &l.shaft_prony),
                 l.name.replace('\n', " ")
             ));
         }
@@ -590,13 +635,25 @@ pub fn render_rust_stacks(stacks: &[(PathBuf, Stack)], needle: Option<FeNeedle>)
     };
     let all = names(&|_| true);
     let all_const = |names: &[String]| format!("pub const ALL: [Stack<'static>; {}] = [{}];\n", names.len(), names.join(", "));
-    if stacks.iter().any(|(_, s)| shaped(s)) {
-        // one ALL per combination of the two features, each listing the stacks it compiles
-        out.push_str("/// Every stack of the set that this build compiles in, by file name (stacks with Prony terms need the `viscoelastic` feature, with a family member or a softening `tissue-shape`).\n");
-        for (visco, shape) in [(false, false), (false, true), (true, false), (true, true)] {
-            let on = |f: &str, yes: bool| if yes { format!("feature = \"{f}\"") } else { format!("not(feature = \"{f}\")") };
-            out.push_str(&format!("#[cfg(all({}, {}))]\n", on("viscoelastic", visco), on("tissue-shape", shape)));
-            out.push_str(&all_const(&names(&|s| (visco || elastic(s)) && (shape || !shaped(s)))));
+    let shape_used = stacks.iter().any(|(_, s)| shaped(s));
+    let presliding_used = stacks.iter().any(|(_, s)| has_presliding(s));
+    if shape_used || presliding_used {
+        // one ALL per combination of the features that gate a stack, each listing the
+        // stacks it compiles (the `viscoelastic` feature always among them with `tissue-shape`)
+        let gating: Vec<usize> =
+            (0..FEATURES.len()).filter(|&k| [shape_used || stacks.iter().any(|(_, s)| !elastic(s)), shape_used, presliding_used][k]).collect();
+        out.push_str("/// Every stack of the set that this build compiles in, by file name (stacks with Prony terms need the `viscoelastic` feature, with a family member or a softening `tissue-shape`");
+        out.push_str(if presliding_used { ", with a presliding `shaft-presliding`).\n" } else { ").\n" });
+        for combination in 0..1usize << gating.len() {
+            let on = |i: usize| combination >> (gating.len() - 1 - i) & 1 == 1;
+            let cfgs: Vec<String> = gating
+                .iter()
+                .enumerate()
+                .map(|(i, &k)| if on(i) { format!("feature = \"{}\"", FEATURES[k]) } else { format!("not(feature = \"{}\")", FEATURES[k]) })
+                .collect();
+            out.push_str(&format!("#[cfg(all({}))]\n", cfgs.join(", ")));
+            let compiled = |s: &Stack| gating.iter().enumerate().all(|(i, &k)| on(i) || !needs(s)[k]);
+            out.push_str(&all_const(&names(&compiled)));
         }
     } else if stacks.iter().all(|(_, s)| elastic(s)) {
         out.push_str(&format!("/// Every stack of the set, by file name.\n{}", all_const(&all)));
@@ -634,8 +691,42 @@ fn render_softening(fraction: f64, onset_ratio: f64) -> String {
 /// The attribute that compiles an item only with the library's `viscoelastic` feature.
 const VISCOELASTIC_ONLY: &str = "#[cfg(feature = \"viscoelastic\")]";
 
-/// The attribute that compiles an item only with the library's `tissue-shape` feature.
-const SHAPE_ONLY: &str = "#[cfg(feature = \"tissue-shape\")]";
+/// The attribute that compiles a layer's presliding field (a field of the library's
+/// layer only with its `shaft-presliding` feature).
+const PRESLIDING_ONLY: &str = "#[cfg(feature = \"shaft-presliding\")]";
+
+/// The library features that gate a stack, in the order of [`needs`].
+const FEATURES: [&str; 3] = ["viscoelastic", "tissue-shape", "shaft-presliding"];
+
+/// Which of [`FEATURES`] `stack` needs compiled in: Prony terms, a family member or a
+/// softening, a presliding.
+fn needs(stack: &Stack) -> [bool; 3] {
+    [!elastic(stack), shaped(stack), has_presliding(stack)]
+}
+
+/// The attribute that compiles a stack needing `needs` (nothing when it needs none).
+fn gate(needs: &[bool; 3]) -> String {
+    let on: Vec<String> = FEATURES.iter().zip(needs).filter(|(_, n)| **n).map(|(f, _)| format!("feature = \"{f}\"")).collect();
+    match on.len() {
+        0 => String::new(),
+        1 => format!("#[cfg({})]\n", on.join("")),
+        _ => format!("#[cfg(all({}))]\n", on.join(", ")),
+    }
+}
+
+/// Whether a layer of `stack` has a presliding (compiled in only with the
+/// `shaft-presliding` feature).
+fn has_presliding(stack: &Stack) -> bool {
+    stack.layers.iter().any(|l| l.presliding_mm.is_some())
+}
+
+/// A layer's presliding: `Presliding::NONE` without one.
+fn render_presliding(distance_mm: Option<f64>, terms: &[PronyTerm]) -> String {
+    match distance_mm {
+        None => "Presliding::NONE".into(),
+        Some(d) => format!("Presliding {{ distance_mm: {}, shaft_prony: {} }}", lit(d), render_prony(terms)),
+    }
+}
 
 /// Whether a layer of `stack` has a family member other than the paper's tissue or a
 /// softening (format 2: compiled in only with the `tissue-shape` feature).

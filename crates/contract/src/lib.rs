@@ -145,6 +145,9 @@ pub const TISSUE_FORMATS_READ: [i64; 2] = [1, 2];
 /// The largest pre-puncture softening fraction of a layer (exclusive): the force at the
 /// puncture keeps at least half the elastic one.
 pub const SOFTENING_FRACTION_MAX: f64 = 0.5;
+/// The range of a layer's presliding distance (tissue format 2's `presliding_mm`, the
+/// `shaft-presliding` feature), mm: the shaft's stuck state turns over within twice it.
+pub const PRESLIDING_MM_RANGE: (f64, f64) = (0.01, 50.0);
 
 /// Format version of a set's unsolved region (`unsolved.toml`).
 pub const UNSOLVED_FORMAT: i64 = 1;

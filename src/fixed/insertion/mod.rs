@@ -212,12 +212,17 @@ impl<'a> Insertion<'a> {
     /// A path through `stack`, the needle above the surface.
     ///
     /// # Errors
+    /// [`InsertionError::FloatOnly`] (a stack with a presliding layer: `shaft-presliding`),
     /// [`InsertionError::LayerCount`] (also for a stack [`Stack::from_f32`] refused),
     /// [`InsertionError::Value`] (a value out of the tissue file's ranges after
     /// rounding, e.g. a thickness below 2^-17 mm, or beyond the integer ranges: a
     /// stiffness scale above [`STIFFNESS_SCALE_MAX`], a track stiffness above 8.4 N/mm
     /// per mm), [`InsertionError::Config`] (a zero period).
     pub fn new(stack: &'a Stack, config: InsertionConfig) -> Result<Self, InsertionError> {
+        #[cfg(feature = "shaft-presliding")]
+        if stack.float_only {
+            return Err(InsertionError::FloatOnly);
+        }
         if stack.count == 0 || stack.count > MAX_LAYERS {
             return Err(InsertionError::LayerCount);
         }

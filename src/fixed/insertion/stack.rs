@@ -116,6 +116,11 @@ pub struct Stack {
     pub similarity_pow_q16: [i64; 2],
     /// The hub's distance from the tip for this needle (`λ` times the FE needle's), mm, Q16.
     pub hub_from_tip_q16: i64,
+    /// Whether [`Stack::from_f32`] refused the stack for a layer with a presliding (the
+    /// f32 insertion's alone: [`InsertionError::FloatOnly`](crate::float::insertion::InsertionError::FloatOnly));
+    /// only with the `shaft-presliding` feature.
+    #[cfg(feature = "shaft-presliding")]
+    pub float_only: bool,
 }
 
 /// Largest friction level (static or Coulomb), µN per mm of shaft in Q16 (2^38: 4.2 N/mm).
@@ -249,6 +254,11 @@ impl Stack {
             if cfg!(not(feature = "tissue-shape")) && (l.family.weight() < 1.0 || l.softening.fraction != 0.0) {
                 return refused;
             }
+            // nor a presliding: the fixed-point insertion has none (the f32 one's alone)
+            #[cfg(feature = "shaft-presliding")]
+            if l.presliding.distance_mm != 0.0 {
+                return Self { float_only: true, ..refused };
+            }
             total += l.thickness_mm as f64;
             *slot = Layer::from_f32(l);
             slots = free;
@@ -264,6 +274,8 @@ impl Stack {
             inv_similarity_q30: round_i64((1u64 << 30) as f64 / lambda),
             similarity_pow_q16: [round_i64(lambda * lambda * Q16), round_i64(lambda * lambda * lambda * Q16)],
             hub_from_tip_q16: round_i64(f32_insertion::HUB_FROM_TIP_MM as f64 * lambda * Q16),
+            #[cfg(feature = "shaft-presliding")]
+            float_only: false,
         }
     }
 
@@ -299,5 +311,13 @@ pub mod stacks {
     }
 }
 
-const EMPTY_STACK: Stack =
-    Stack { name: "", layers: [EMPTY_LAYER; MAX_LAYERS], count: 0, inv_similarity_q30: 0, similarity_pow_q16: [0, 0], hub_from_tip_q16: 0 };
+const EMPTY_STACK: Stack = Stack {
+    name: "",
+    layers: [EMPTY_LAYER; MAX_LAYERS],
+    count: 0,
+    inv_similarity_q30: 0,
+    similarity_pow_q16: [0, 0],
+    hub_from_tip_q16: 0,
+    #[cfg(feature = "shaft-presliding")]
+    float_only: false,
+};

@@ -78,12 +78,16 @@
 //! stamp going backwards reaches it as a pose out of order, a jump like any other.
 //!
 //! f32 throughout, `libm` for the trigonometry: the same bits on every target.
+#[cfg(feature = "shaft-presliding")]
+mod presliding;
 mod softening;
 mod stack;
 mod track;
 
 #[cfg(feature = "tissue-shape")]
 use softening::SofteningTerms;
+#[cfg(feature = "shaft-presliding")]
+pub use stack::Presliding;
 pub use stack::{stacks, FamilyMember, Karnopp, Layer, Softening, Stack, FE_NEEDLE_DIAMETER_MM, HUB_FROM_TIP_MM, MAX_LAYERS};
 
 use crate::float::depth_extension::extended_wrench_and_depth_rate;
@@ -143,6 +147,10 @@ pub enum InsertionError {
     /// A layer has Prony terms and the library was built without its `viscoelastic`
     /// feature.
     NeedsViscoelastic,
+    /// A layer has a presliding ([`Presliding`]), which the fixed-point insertion does
+    /// not have (the f32 insertion's alone); only with the `shaft-presliding` feature.
+    #[cfg(feature = "shaft-presliding")]
+    FloatOnly,
 }
 
 impl core::fmt::Display for InsertionError {
@@ -153,6 +161,8 @@ impl core::fmt::Display for InsertionError {
             Self::Config => "insertion config: period_s, max_speed_mm_per_s and max_turn_deg_per_s must be finite and > 0, velocity_time_constant_s finite and >= 0",
             Self::Scales => "stiffness scales: one per layer, each finite and > 0",
             Self::NeedsViscoelastic => "tissue stack: a layer has Prony terms; build needle-haptics with its `viscoelastic` feature",
+            #[cfg(feature = "shaft-presliding")]
+            Self::FloatOnly => "tissue stack: a layer has a presliding (presliding_mm); the fixed-point insertion has none: use the f32 insertion",
         })
     }
 }
@@ -300,6 +310,10 @@ pub struct Insertion {
     /// (computed once, in `new`; only with the `tissue-shape` feature).
     #[cfg(feature = "tissue-shape")]
     soft: [SofteningTerms; MAX_LAYERS],
+    /// The shaft's presliding: per layer its coefficients and state (only with the
+    /// `shaft-presliding` feature).
+    #[cfg(feature = "shaft-presliding")]
+    shaft: presliding::Shaft,
     /// Per layer the relaxation's per-tick coefficients (computed once, in `new`).
     qlv: [QlvCoefficients; MAX_LAYERS],
     layers: [Layer; MAX_LAYERS],
@@ -462,6 +476,10 @@ fn shape_ok(l: &Layer) -> bool {
 
 fn layer_ok(l: &Layer) -> bool {
     let k = &l.friction;
+    #[cfg(feature = "shaft-presliding")]
+    if !l.presliding.is_valid() {
+        return false;
+    }
     positive(l.thickness_mm)
         && positive(l.stiffness_scale)
         && positive(l.puncture_force_n)
@@ -509,6 +527,8 @@ impl Insertion {
             }
             soft
         };
+        #[cfg(feature = "shaft-presliding")]
+        let shaft = presliding::Shaft::new(stack.layers, config.period_s).ok_or(InsertionError::Value)?;
         let mut layers = [stack.layers.first().copied().ok_or(InsertionError::LayerCount)?; MAX_LAYERS];
         for (slot, l) in layers.iter_mut().zip(stack.layers) {
             *slot = *l;
@@ -528,6 +548,8 @@ impl Insertion {
             held: (Wrench::ZERO, Phase::Approach),
             velocity_mm_per_s: 0.0,
             qlv,
+            #[cfg(feature = "shaft-presliding")]
+            shaft,
             #[cfg(feature = "tissue-shape")]
             soft,
             qlv_state: QlvState::REST,
@@ -572,6 +594,8 @@ impl Insertion {
         self.track = None;
         self.preload = [0.0; 6];
         self.qlv_state.reset();
+        #[cfg(feature = "shaft-presliding")]
+        self.shaft.reset();
     }
 
     /// One tick: the pose (entry point on the top surface, tilts, `depth_mm` of the tip
@@ -625,6 +649,9 @@ impl Insertion {
             if let Some(c) = self.qlv.get(self.punctured) {
                 self.qlv_state.hold(c);
             }
+            // and so does the shaft's held force
+            #[cfg(feature = "shaft-presliding")]
+            self.shaft.advance(0.0);
             let (wrench, phase) = self.held;
             let e = if glitch.contains(InsertionFlags::NOT_FINITE) {
                 InsertionEvaluation {
@@ -650,6 +677,8 @@ impl Insertion {
         let depth = pose.depth_mm;
         let step_mm = self.last_depth_mm.map_or(0.0, |last| depth - last);
         self.filter_velocity(step_mm);
+        #[cfg(feature = "shaft-presliding")]
+        self.shaft.advance(step_mm);
         self.last_depth_mm = Some(depth);
         self.accepted = [pose.x_mm, pose.z_mm, pose.theta_x_deg, pose.theta_z_deg];
         self.elapsed_s = self.config.period_s;
@@ -664,7 +693,8 @@ impl Insertion {
         let entry: Vec3 = [pose.x_mm, 0.0, pose.z_mm];
         let bounds = self.boundaries(a[1]);
         let Deflected { wrench: mut w, status, punctures, stiffness_n_per_mm } = self.deflect(pose, a, entry, &bounds, rate);
-        let (phase, axial_n) = self.shaft(pose, a, entry, v, &bounds, &mut w);
+        let (phase, axial_n, shaft_stiffness) = self.shaft(pose, a, entry, v, &bounds, &mut w);
+        let stiffness_n_per_mm = stiffness_n_per_mm + shaft_stiffness;
         let mut dissipative_n = [axial_n * a[0], axial_n * a[1], axial_n * a[2]];
         let flags = bound(&mut w, &mut dissipative_n);
         let wrench = Wrench::from_array(w);
@@ -812,21 +842,23 @@ impl Insertion {
         self.punctured.checked_sub(1).and_then(|j| self.layers.get(j)).map_or(0.0, |l| l.cutting_force_n)
     }
 
-    /// Friction, cutting and the track's hold on the shaft, added to `w`; the phase and
-    /// the axial force of friction and cutting (N, along `+a`).
-    fn shaft(&mut self, pose: &Pose, a: Vec3, entry: Vec3, v: f32, bounds: &[f32; MAX_LAYERS + 1], w: &mut [f32; 6]) -> (Phase, f32) {
+    /// Friction, cutting and the track's hold on the shaft, added to `w`; the phase, the
+    /// axial force of Karnopp friction and ramped cutting (N, along `+a`: dissipative)
+    /// and the stiffness of the presliding's held force (N/mm; 0 without it).
+    fn shaft(&mut self, pose: &Pose, a: Vec3, entry: Vec3, v: f32, bounds: &[f32; MAX_LAYERS + 1], w: &mut [f32; 6]) -> (Phase, f32, f32) {
         let depth = pose.depth_mm;
         let m = self.punctured;
         let index = |j: usize| u8::try_from(j).unwrap_or(u8::MAX);
         let bound = |j: usize| bounds.get(j).copied().unwrap_or(f32::INFINITY);
         if m == 0 {
-            return (if depth > bound(0) { Phase::Deflecting(0) } else { Phase::Approach }, 0.0);
+            return (if depth > bound(0) { Phase::Deflecting(0) } else { Phase::Approach }, 0.0, 0.0);
         }
         let next = bound(m);
         let top = if depth < next { depth } else { next };
         let hub_q = depth - HUB_FROM_TIP_MM * self.similarity;
         let deviation = self.track.map(|t| t.deviation(entry, a, hub_q));
-        let mut axial_n = 0.0f32;
+        // (dissipative, held, held stiffness)
+        let mut axial = (0.0f32, 0.0f32, 0.0f32);
         for j in 0..m {
             let (Some(layer), lo) = (self.layers.get(j), bound(j)) else { break };
             let hi = bound(j + 1);
@@ -834,37 +866,76 @@ impl Insertion {
             if q2 <= q1 {
                 continue;
             }
-            axial_n += (q2 - q1) * layer.friction.per_mm(v);
+            let (f, held, k) = self.friction_in(j, layer, v, q2 - q1);
+            axial = (axial.0 + f, axial.1 + held, axial.2 + k);
             if let Some(d) = &deviation {
                 d.add_hold(layer.track_stiffness_n_per_mm2, q1, q2, w);
             }
         }
-        // cutting layer m - 1, or carrying its cutting force onto boundary m
+        // cutting layer m - 1, or carrying its cutting force onto boundary m: ramped in
+        // over the stick band, or held at the tip (presliding)
+        let held_cutting = self.held_cutting(m, depth);
         let cutting = |v: f32| {
-            self.layers.get(m - 1).map_or(0.0, |l| {
+            self.layers.get(m - 1).filter(|_| held_cutting.is_none()).map_or(0.0, |l| {
                 let ramp = v / l.friction.stick_band_mm_per_s;
                 l.cutting_force_n * if ramp < 1.0 { ramp } else { 1.0 }
             })
         };
         let phase = if depth >= next {
             if v > 0.0 {
-                axial_n += cutting(v);
+                axial.0 += cutting(v);
             }
             Phase::Deflecting(index(m))
         } else if depth >= self.track_end_mm && v > 0.0 {
-            axial_n += cutting(v);
+            axial.0 += cutting(v);
             Phase::Cutting(index(m - 1))
         } else {
             let inside = (1..m).take_while(|&j| bound(j) < depth).count();
             Phase::InTrack(index(inside))
         };
+        if let Some((c, k)) = held_cutting {
+            axial = (axial.0, axial.1 + c, axial.2 + k);
+        }
         if depth > self.track_end_mm && depth < next {
             self.track_end_mm = depth;
         }
         // the force on the needle opposes the motion: along +a (towards the hub) inserting
-        w[0] += axial_n * a[0];
-        w[1] += axial_n * a[1];
-        w[2] += axial_n * a[2];
-        (phase, axial_n)
+        let total = axial.0 + axial.1;
+        w[0] += total * a[0];
+        w[1] += total * a[1];
+        w[2] += total * a[2];
+        (phase, axial.0, axial.2)
+    }
+
+    /// Layer `j`'s shaft friction over `length_mm` of shaft in it at speed `v`: the
+    /// Karnopp friction (dissipative), or the presliding's held force and its stiffness,
+    /// N, N, N/mm.
+    #[allow(clippy::unused_self)] // reads the shaft's state with `shaft-presliding` only
+    fn friction_in(&self, j: usize, layer: &Layer, v: f32, length_mm: f32) -> (f32, f32, f32) {
+        #[cfg(feature = "shaft-presliding")]
+        if let Some(f) = self.shaft.friction_per_mm(j, layer, v) {
+            return (0.0, length_mm * f, self.shaft.stiffness(j, layer, length_mm));
+        }
+        #[cfg(not(feature = "shaft-presliding"))]
+        let _ = j;
+        (length_mm * layer.friction.per_mm(v), 0.0, 0.0)
+    }
+
+    /// The cutting force of layer `m - 1` held at the tip at `depth_mm` and its stiffness
+    /// (N, N/mm), `None` when the layer has no presliding (its cutting is ramped).
+    #[allow(clippy::unused_self)] // reads the shaft's state with `shaft-presliding` only
+    fn held_cutting(&self, m: usize, depth_mm: f32) -> Option<(f32, f32)> {
+        #[cfg(feature = "shaft-presliding")]
+        {
+            let j = m.checked_sub(1)?;
+            let l = self.layers.get(j)?;
+            let c = self.shaft.cutting(j, l, depth_mm, self.track_end_mm)?;
+            Some((c, self.shaft.cutting_stiffness(j, l)))
+        }
+        #[cfg(not(feature = "shaft-presliding"))]
+        {
+            let _ = (m, depth_mm);
+            None
+        }
     }
 }

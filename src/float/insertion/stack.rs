@@ -2,6 +2,8 @@
 //! compiled in from the set's `tissue/*.toml` (format: `coeffs/README.md`, "Tissue
 //! stacks") into [`stacks`].
 
+#[cfg(feature = "shaft-presliding")]
+pub use super::presliding::Presliding;
 pub use super::softening::Softening;
 pub use crate::float::family::FamilyMember;
 use crate::float::viscoelastic::{PronyTerm, PronyTerms};
@@ -69,6 +71,11 @@ pub struct Layer {
     pub family: FamilyMember,
     /// The boundary's pre-puncture softening; [`Softening::NONE`]: none.
     pub softening: Softening,
+    /// The shaft's presliding (stuck) friction and held cutting in the layer
+    /// ([`Presliding::NONE`]: the Karnopp friction, zero at rest); only with the
+    /// `shaft-presliding` feature (a default build's layers carry none: flash).
+    #[cfg(feature = "shaft-presliding")]
+    pub presliding: Presliding,
 }
 
 /// A stack of layers and the needle its values belong to.
@@ -93,6 +100,9 @@ pub mod stacks {
     #![allow(clippy::unreadable_literal, clippy::excessive_precision, clippy::panic)]
     #[allow(unused_imports)] // a set without tissue files uses none
     use super::{FamilyMember, Karnopp, Layer, PronyTerm, PronyTerms, Softening, Stack};
+    #[cfg(feature = "shaft-presliding")]
+    #[allow(unused_imports)] // a set without presliding stacks uses none
+    use super::Presliding;
     include!(concat!(env!("OUT_DIR"), "/tissue_stacks.rs"));
 
     /// The compiled-in stack named `name` (its file's stem), `None` when [`ALL`] has no

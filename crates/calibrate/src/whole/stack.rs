@@ -266,6 +266,8 @@ fn layer(
         softening_fraction: 0.0,
         softening_onset_ratio: 0.0,
         softening_fraction_range: None,
+        presliding_mm: None,
+        shaft_prony: Vec::new(),
     };
     let se = |s: Option<f64>, unit: &str, k: usize| match s {
         Some(se) => format!("+- {se:.3e} {unit} (regression over {k} trials)"),

@@ -1,0 +1,195 @@
+//! The shaft's presliding (stuck) state: shaft friction and the tip's cutting force that
+//! a needle at rest keeps, relaxing, and that turns over within twice a presliding
+//! distance when the motion reverses (issue 65; the `shaft-presliding` feature).
+//!
+//! **The bristle** (an elasto-plastic, Dahl-like state per layer): `z` in `[-1, 1]`,
+//! advanced by the tick's axial step over the layer's presliding distance `p`
+//! (`z <- clamp(z + Δd / p, -1, 1)`); at rest it stays, reversing it crosses zero
+//! within `p` and turns over within `2 p`.
+//!
+//! **Relaxation** (the shaft's own Prony terms, [`Presliding::shaft_prony`], FEBio's
+//! long-term normalisation `G(t) = 1 + sum g_i exp(-t / tau_i)`, at most three terms):
+//! each term is a bristle of its own, `z_i <- clamp(a_i z_i + Δd / p, -1, 1)` with the
+//! QLV recursion's decay `a_i = exp(-dt / tau_i)` (the library's viscoelastic filter's
+//! coefficient), a Maxwell arm that slips at its share. Sliding, every `z_i` is at ±1;
+//! at rest each decays with its time constant, so a held force relaxes as
+//! `G(t) / G(0)` to `1 / (1 + sum g_i)` of the sliding one.
+//!
+//! **Forces** (the tissue file's levels are the sliding ones, as the Karnopp friction's):
+//! per mm of shaft in the layer
+//! `f = coulomb (z + sum g_i z_i) / (1 + sum g_i) + viscous |v| z` (the viscous part only
+//! while `z` has the motion's sign: it never pushes the needle the way it moves); the
+//! tip's cutting force while the tip sits in its cut,
+//! `cutting w (1 + sum g_i max(z_i, 0)) / (1 + sum g_i)` with
+//! `w = clamp(1 + (depth - track end) / p, 0, 1)` (full at the track's end, gone `p`
+//! behind it).
+//!
+//! **Passive**: each bristle is a spring (stiffness `level / p`) that slips at its level,
+//! each arm a spring and slider in series with a dashpot; the stored energy of a state is
+//! `level ∫ (shaft length) (s - d0) / p ds >= 0` over its elastic stretch, slipping and
+//! relaxing only lower it, and `w` is a function of the depth for a fixed track end
+//! (which moves only while the tip cuts at full force). A closed cycle gives nothing back
+//! (`host-tests/tests/insertion_energy.rs` holds it).
+use super::stack::{Layer, MAX_LAYERS};
+use crate::float::viscoelastic::{PronyTerms, MAX_TERMS};
+use needle_contract::PRESLIDING_MM_RANGE;
+
+/// A layer's presliding; [`Presliding::NONE`]: today's Karnopp friction, zero at rest.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Presliding {
+    /// The presliding distance `p`, mm (0: none; else within
+    /// `needle_contract::PRESLIDING_MM_RANGE`).
+    pub distance_mm: f32,
+    /// The relaxation of the held shaft force and cutting (none: no relaxation).
+    pub shaft_prony: PronyTerms,
+}
+
+impl Presliding {
+    /// No presliding: the layer's Karnopp friction and ramped cutting.
+    pub const NONE: Self = Self { distance_mm: 0.0, shaft_prony: PronyTerms::NONE };
+
+    /// Whether the layer has a presliding state.
+    #[must_use]
+    pub fn is_active(&self) -> bool {
+        self.distance_mm > 0.0
+    }
+
+    /// [`Presliding::NONE`], or a distance within its range and checked terms (the
+    /// tissue file's checks).
+    #[must_use]
+    #[allow(clippy::cast_possible_truncation)] // the range's bounds are exact in f32 to their use
+    pub fn is_valid(&self) -> bool {
+        let checked = PronyTerms::new(self.shaft_prony.as_slice()).is_ok();
+        if !self.is_active() {
+            return self.distance_mm == 0.0 && self.shaft_prony.is_empty();
+        }
+        let (lo, hi) = PRESLIDING_MM_RANGE;
+        self.distance_mm.is_finite() && self.distance_mm >= lo as f32 && self.distance_mm <= hi as f32 && checked
+    }
+}
+
+/// A layer's per-tick coefficients (computed once, in `Insertion::new`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct Coefficients {
+    /// `1 / p`, 1/mm (0: the layer has no presliding).
+    per_mm: f32,
+    /// Each term's decay per tick, `exp(-dt / tau_i)` (0 for an unused term).
+    decay: [f32; MAX_TERMS],
+    /// Each term's share of the sliding force, `g_i / (1 + sum g)` (0 unused).
+    share: [f32; MAX_TERMS],
+    /// The long-term share, `1 / (1 + sum g)`.
+    long_term: f32,
+}
+
+impl Coefficients {
+    const NONE: Self = Self { per_mm: 0.0, decay: [0.0; MAX_TERMS], share: [0.0; MAX_TERMS], long_term: 1.0 };
+
+    /// The layer's coefficients for ticks of `period_s` (> 0); `None` for a presliding
+    /// out of range.
+    fn new(p: &Presliding, period_s: f32) -> Option<Self> {
+        if !p.is_valid() || !(period_s.is_finite() && period_s > 0.0) {
+            return None;
+        }
+        if !p.is_active() {
+            return Some(Self::NONE);
+        }
+        let terms = p.shaft_prony.as_slice();
+        let total = 1.0 + terms.iter().map(|t| t.g).sum::<f32>();
+        // total >= 1 (every g >= 0, checked) and tau_s > 0, distance_mm > 0: no division by zero
+        let mut out = Self { per_mm: 1.0 / p.distance_mm, long_term: 1.0 / total, ..Self::NONE };
+        for ((a, s), t) in out.decay.iter_mut().zip(out.share.iter_mut()).zip(terms) {
+            *a = libm::expf(-period_s / t.tau_s);
+            *s = t.g / total;
+        }
+        Some(out)
+    }
+}
+
+/// The shaft's presliding for a whole stack: each layer's coefficients and state.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub(super) struct Shaft {
+    coefficients: [Coefficients; MAX_LAYERS],
+    /// Each layer's bristle `z`.
+    z: [f32; MAX_LAYERS],
+    /// Each layer's arms `z_i`.
+    arms: [[f32; MAX_TERMS]; MAX_LAYERS],
+}
+
+fn clamp_unit(x: f32) -> f32 {
+    x.clamp(-1.0, 1.0)
+}
+
+impl Shaft {
+    /// The coefficients of `layers` for ticks of `period_s`, every state at rest; `None`
+    /// for a layer whose presliding is out of range.
+    pub(super) fn new(layers: &[Layer], period_s: f32) -> Option<Self> {
+        let mut coefficients = [Coefficients::NONE; MAX_LAYERS];
+        for (c, l) in coefficients.iter_mut().zip(layers) {
+            *c = Coefficients::new(&l.presliding, period_s)?;
+        }
+        Some(Self { coefficients, z: [0.0; MAX_LAYERS], arms: [[0.0; MAX_TERMS]; MAX_LAYERS] })
+    }
+
+    /// One tick of `step_mm` along the axis (0: at rest, or a glitch tick: the arms relax).
+    pub(super) fn advance(&mut self, step_mm: f32) {
+        for ((c, z), arms) in self.coefficients.iter().zip(self.z.iter_mut()).zip(self.arms.iter_mut()) {
+            if c.per_mm > 0.0 {
+                let s = step_mm * c.per_mm;
+                *z = clamp_unit(*z + s);
+                for (arm, a) in arms.iter_mut().zip(c.decay) {
+                    *arm = clamp_unit(a * *arm + s);
+                }
+            }
+        }
+    }
+
+    /// Every state at rest (the path ended).
+    pub(super) fn reset(&mut self) {
+        self.z = [0.0; MAX_LAYERS];
+        self.arms = [[0.0; MAX_TERMS]; MAX_LAYERS];
+    }
+
+    /// Layer `j`'s friction per mm of shaft at speed `v` (mm/s, zero when against the
+    /// last motion), N/mm, of the force's sign along the axis; `None` when the layer
+    /// has no presliding.
+    pub(super) fn friction_per_mm(&self, j: usize, layer: &Layer, v: f32) -> Option<f32> {
+        let (c, z, arms) = self.layer(j)?;
+        let mut held = c.long_term * z;
+        for (s, arm) in c.share.iter().zip(arms) {
+            held += s * arm;
+        }
+        let viscous = if z * v > 0.0 { layer.friction.viscous_n_s_per_mm2 * libm::fabsf(v) * z } else { 0.0 };
+        Some(layer.friction.coulomb_n_per_mm * held + viscous)
+    }
+
+    /// Layer `j`'s cutting force held at the tip, N, with the tip at `depth_mm` and the
+    /// track's end at `track_end_mm`; `None` when the layer has no presliding.
+    pub(super) fn cutting(&self, j: usize, layer: &Layer, depth_mm: f32, track_end_mm: f32) -> Option<f32> {
+        let (c, _, arms) = self.layer(j)?;
+        let w = (1.0 + (depth_mm - track_end_mm) * c.per_mm).clamp(0.0, 1.0);
+        let mut held = c.long_term;
+        for (s, arm) in c.share.iter().zip(arms) {
+            held += s * if *arm > 0.0 { *arm } else { 0.0 };
+        }
+        Some(layer.cutting_force_n * w * held)
+    }
+
+    /// The stiffness of layer `j`'s bristles along the axis for `length_mm` of shaft in
+    /// it, N/mm (its sliding level over `p`); 0 without presliding.
+    pub(super) fn stiffness(&self, j: usize, layer: &Layer, length_mm: f32) -> f32 {
+        self.coefficients.get(j).map_or(0.0, |c| layer.friction.coulomb_n_per_mm * length_mm * c.per_mm)
+    }
+
+    /// The stiffness of layer `j`'s held cutting, N/mm (0 without presliding).
+    pub(super) fn cutting_stiffness(&self, j: usize, layer: &Layer) -> f32 {
+        self.coefficients.get(j).map_or(0.0, |c| layer.cutting_force_n * c.per_mm)
+    }
+
+    fn layer(&self, j: usize) -> Option<(&Coefficients, f32, &[f32; MAX_TERMS])> {
+        let c = self.coefficients.get(j).filter(|c| c.per_mm > 0.0)?;
+        Some((c, self.z.get(j).copied()?, self.arms.get(j)?))
+    }
+}
