@@ -205,6 +205,32 @@ fn with_the_viscoelastic_filter_no_closed_cycle_delivers_energy() {
     }
 }
 
+/// The passivity test with the shaft's presliding (issue 65) on every layer of every
+/// shipped stack, with and without the moderate shaft terms: held friction and cutting
+/// are springs that slip (`insertion::presliding`), so a closed cycle must give nothing
+/// back. The presliding distance of each stack is set from Colgate's condition of this
+/// test's device, not from a tissue: the zero-order hold delivers `(K / 2) Σ Δd²` for a
+/// rendered stiffness `K` and the device's damping takes `(b / T) Σ Δd²`, so the held
+/// force's stiffness (the stack's largest cutting force plus all its shaft friction,
+/// over `p`) is kept at half of `b / T` (`p = 2 (cutting + friction) T / b`, at least
+/// 0.5 mm); a stiffer bristle is the guard's to render (`control::passivity`).
+#[test]
+fn with_the_shaft_presliding_no_closed_cycle_delivers_energy() {
+    use needle_haptics::insertion::Presliding;
+    for stack in &stacks::ALL {
+        let held_n: f64 = stack.layers.iter().map(|l| f64::from(l.cutting_force_n)).fold(0.0, f64::max)
+            + stack.layers.iter().map(|l| f64::from(l.friction.coulomb_n_per_mm * l.thickness_mm)).sum::<f64>();
+        let p_mm = (2.0 * held_n * PERIOD_S / DAMPING_N_S_PER_MM).max(0.5) as f32;
+        for (label, shaft_prony) in [("no", PronyTerms::NONE), test_terms()[0]] {
+            let layers: Vec<Layer> =
+                stack.layers.iter().map(|l| Layer { presliding: Presliding { distance_mm: p_mm, shaft_prony }, ..*l }).collect();
+            let name = format!("{} with presliding {p_mm} mm and {label} shaft terms", stack.name);
+            let held = Stack { name: &name, layers: &layers, ..*stack };
+            no_closed_cycle_delivers_energy(&held, TRAJECTORIES / 3);
+        }
+    }
+}
+
 fn no_closed_cycle_delivers_energy(stack: &Stack<'_>, trajectories: usize) {
     {
         // one generator per stack: a stack added does not change another's trajectories

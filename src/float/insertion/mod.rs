@@ -830,6 +830,8 @@ impl Insertion {
             }
             self.punctured += 1;
             self.track_end_mm = pose.depth_mm;
+            #[cfg(feature = "shaft-presliding")]
+            self.shaft.punctured(pose.depth_mm);
             punctures = punctures.saturating_add(1);
         }
         self.qlv_state.reset();

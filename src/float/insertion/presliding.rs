@@ -20,15 +20,17 @@
 //! `f = coulomb (z + sum g_i z_i) / (1 + sum g_i) + viscous |v| z` (the viscous part only
 //! while `z` has the motion's sign: it never pushes the needle the way it moves); the
 //! tip's cutting force while the tip sits in its cut,
-//! `cutting w (1 + sum g_i max(z_i, 0)) / (1 + sum g_i)` with
-//! `w = clamp(1 + (depth - track end) / p, 0, 1)` (full at the track's end, gone `p`
-//! behind it).
+//! `cutting w (1 + sum g_i max(z_i, 0)) / (1 + sum g_i)` with `w` 1 at and past the
+//! track's end `e`, falling linearly to 0 at `a = max(e - p, c)` behind it, `c` the depth
+//! where the tip began to cut the layer (its puncture): the tissue ahead of the tip is
+//! loaded over the first `p` of the cut, never at once.
 //!
 //! **Passive**: each bristle is a spring (stiffness `level / p`) that slips at its level,
 //! each arm a spring and slider in series with a dashpot; the stored energy of a state is
 //! `level ∫ (shaft length) (s - d0) / p ds >= 0` over its elastic stretch, slipping and
 //! relaxing only lower it, and `w` is a function of the depth for a fixed track end
-//! (which moves only while the tip cuts at full force). A closed cycle gives nothing back
+//! (which moves only while the tip cuts at full force, storing at most half the work:
+//! `cutting (e - a) / 2`). A closed cycle gives nothing back
 //! (`host-tests/tests/insertion_energy.rs` holds it).
 use super::stack::{Layer, MAX_LAYERS};
 use crate::float::viscoelastic::{PronyTerms, MAX_TERMS};
@@ -116,6 +118,8 @@ pub(super) struct Shaft {
     z: [f32; MAX_LAYERS],
     /// Each layer's arms `z_i`.
     arms: [[f32; MAX_TERMS]; MAX_LAYERS],
+    /// Where the tip began to cut its present layer (its puncture's depth), mm.
+    cut_from_mm: f32,
 }
 
 fn clamp_unit(x: f32) -> f32 {
@@ -130,7 +134,7 @@ impl Shaft {
         for (c, l) in coefficients.iter_mut().zip(layers) {
             *c = Coefficients::new(&l.presliding, period_s)?;
         }
-        Some(Self { coefficients, z: [0.0; MAX_LAYERS], arms: [[0.0; MAX_TERMS]; MAX_LAYERS] })
+        Some(Self { coefficients, z: [0.0; MAX_LAYERS], arms: [[0.0; MAX_TERMS]; MAX_LAYERS], cut_from_mm: 0.0 })
     }
 
     /// One tick of `step_mm` along the axis (0: at rest, or a glitch tick: the arms relax).
@@ -150,6 +154,12 @@ impl Shaft {
     pub(super) fn reset(&mut self) {
         self.z = [0.0; MAX_LAYERS];
         self.arms = [[0.0; MAX_TERMS]; MAX_LAYERS];
+        self.cut_from_mm = 0.0;
+    }
+
+    /// A boundary punctured with the tip at `depth_mm`: the tip begins to cut there.
+    pub(super) fn punctured(&mut self, depth_mm: f32) {
+        self.cut_from_mm = depth_mm;
     }
 
     /// Layer `j`'s friction per mm of shaft at speed `v` (mm/s, zero when against the
@@ -169,7 +179,17 @@ impl Shaft {
     /// track's end at `track_end_mm`; `None` when the layer has no presliding.
     pub(super) fn cutting(&self, j: usize, layer: &Layer, depth_mm: f32, track_end_mm: f32) -> Option<f32> {
         let (c, _, arms) = self.layer(j)?;
-        let w = (1.0 + (depth_mm - track_end_mm) * c.per_mm).clamp(0.0, 1.0);
+        // per_mm > 0 (`layer`): the distance is finite and > 0
+        let behind = track_end_mm - 1.0 / c.per_mm;
+        let from = if behind > self.cut_from_mm { behind } else { self.cut_from_mm };
+        let span = track_end_mm - from;
+        let w = if depth_mm >= track_end_mm {
+            1.0
+        } else if span > 0.0 {
+            ((depth_mm - from) / span).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
         let mut held = c.long_term;
         for (s, arm) in c.share.iter().zip(arms) {
             held += s * if *arm > 0.0 { *arm } else { 0.0 };

@@ -12,6 +12,15 @@
 //! linear between samples: the library's). The boundary `b` is scanned, the time
 //! constants chosen among [`TAU_COUNT`] log-spaced values from three sampling periods to
 //! three holds, and `x >= 0` is the least squares of all the trials together.
+//!
+//! **With the shaft's presliding** ([`ShaftGuess`]: the library's `shaft-presliding`),
+//! at rest the shaft keeps its friction and the tip its cutting force, relaxing through
+//! the shaft's own Prony terms: the friction is subtracted in the hold too (at rest: its
+//! Coulomb level), the cutting column covers the hold, and per time constant a column
+//! `(friction at rest + c) (z_i - 1)` with `z_i` the library's arm along the trial
+//! ([`super::presliding::arms`]) takes the weight `beta_i = g_i / (1 + sum g)` of the
+//! shaft's relaxation (`g_i = beta_i / (1 - sum beta)`); the boundary is the one found
+//! without it, the time constants shared by both sets of terms.
 use super::friction::LayerFriction;
 use super::intervals::{friction_n, indent, BOUNDARY_STEP_MM};
 use super::stats::{Normal, Spread};
@@ -23,6 +32,16 @@ pub const TAU_COUNT: usize = 7;
 /// How far above the last puncture the boundary below may lie, mm (it deflects at once
 /// when it lies above the depth where the layer above punctures).
 pub const ABOVE_LAST_PUNCTURE_MM: f64 = 3.0;
+
+/// The shaft's presliding for a joint fit: its distance and the cutting force of the fit
+/// before (the relaxation's column carries it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShaftGuess {
+    /// The presliding distance, mm.
+    pub presliding_mm: f64,
+    /// The cutting force of the last punctured layer, N.
+    pub cutting_n: f64,
+}
 
 /// What the joint fit gave.
 #[derive(Debug, Clone, PartialEq)]
@@ -40,6 +59,11 @@ pub struct HoldFit {
     pub per_trial: PerTrial,
     /// How many trials had a hold.
     pub holds: usize,
+    /// The shaft's Prony terms `(g, tau_s)` (with a [`ShaftGuess`]; else empty), and
+    /// each term's weight per trial.
+    pub shaft_prony: Vec<(f64, f64)>,
+    /// The shaft terms' per-trial weights.
+    pub shaft_g: Vec<Spread>,
 }
 
 /// The per-trial refits of [`HoldFit`].
@@ -63,6 +87,7 @@ pub fn tau_grid(dt_s: f64, hold_s: f64) -> Vec<f64> {
 
 /// The normal equations of trial `t` for the boundary at `b_mm` (columns: cutting,
 /// deflection, one per `taus`).
+#[allow(clippy::too_many_arguments)]
 fn normal(
     t: &Trial,
     n: usize,
@@ -71,15 +96,18 @@ fn normal(
     b_mm: f64,
     taus: &[f64],
     u: &dyn Fn(f64) -> f64,
+    shaft: Option<&ShaftGuess>,
 ) -> Option<Normal> {
     let e = t.events.get(n.checked_sub(1)?)?;
     let start = t.sample_of(e.bottom);
     let end = if t.phases.hold.is_empty() { t.phases.insertion.end } else { t.phases.hold.end };
     let v = t.phases.insertion_speed_mm_per_s;
-    let mut out = Normal::new(2 + taus.len());
+    let columns = if shaft.is_some() { 2 + 2 * taus.len() } else { 2 + taus.len() };
+    let arms = shaft.map(|g| super::presliding::arms(t, taus, g.presliding_mm));
+    let mut out = Normal::new(columns);
     let mut h = vec![0.0; taus.len()];
     let mut last: Option<(f64, f64)> = None;
-    let mut row = vec![0.0; 2 + taus.len()];
+    let mut row = vec![0.0; columns];
     for i in start..end {
         let s = t.samples.get(i)?;
         let d = s.position_mm - t.onset_mm();
@@ -93,10 +121,20 @@ fn normal(
             }
         }
         last = Some((s.time_s, ue));
-        let r = s.force_n - if moving { friction_n(friction, bounds, b_mm, d, v) } else { 0.0 };
-        row[0] = if moving { 1.0 } else { 0.0 };
         row[1] = ue;
-        row[2..].copy_from_slice(&h);
+        row[2..2 + taus.len()].copy_from_slice(&h);
+        let r = if let (Some(g), Some(z)) = (shaft, arms.as_ref().and_then(|a| a.get(i))) {
+            // held at rest: the friction's Coulomb level, the cutting; both relax
+            let at_rest = friction_n(friction, bounds, b_mm, d, 0.0);
+            row[0] = 1.0;
+            for (c, zi) in row[2 + taus.len()..].iter_mut().zip(z) {
+                *c = (at_rest + g.cutting_n) * (zi - 1.0);
+            }
+            s.force_n - if moving { friction_n(friction, bounds, b_mm, d, v) } else { at_rest }
+        } else {
+            row[0] = if moving { 1.0 } else { 0.0 };
+            s.force_n - if moving { friction_n(friction, bounds, b_mm, d, v) } else { 0.0 }
+        };
         out.add(&row, r);
     }
     Some(out)
@@ -144,7 +182,7 @@ pub fn fit(trials: &[Trial], n: usize, bounds: &[f64], friction: &[LayerFriction
         let b = if i == steps { None } else { Some(lo + BOUNDARY_STEP_MM * i as f64) };
         let mut all = Normal::new(2 + taus.len());
         for t in &used {
-            if let Some(nm) = normal(t, n, bounds, friction, b.unwrap_or(f64::INFINITY), &taus, u) {
+            if let Some(nm) = normal(t, n, bounds, friction, b.unwrap_or(f64::INFINITY), &taus, u, None) {
                 all.merge(&nm);
             }
         }
@@ -175,7 +213,99 @@ pub fn fit(trials: &[Trial], n: usize, bounds: &[f64], friction: &[LayerFriction
     let chosen: Vec<f64> = kept.iter().map(|k| k.1).collect();
     let per_trial = refit(&used, n, bounds, friction, b, &chosen, u);
     let prony = kept;
-    HoldFit { boundary_mm: b, scale, cutting_n: x.first().copied().unwrap_or(0.0), prony, per_trial, holds }
+    HoldFit {
+        boundary_mm: b,
+        scale,
+        cutting_n: x.first().copied().unwrap_or(0.0),
+        prony,
+        per_trial,
+        holds,
+        shaft_prony: Vec::new(),
+        shaft_g: Vec::new(),
+    }
+}
+
+/// The joint fit with the shaft's presliding (module docs) at the boundary of `before`
+/// (the fit without it): the time constants chosen again, with the shaft's terms beside
+/// the boundary's; `before` when no trial has a hold.
+#[must_use]
+pub fn fit_with_shaft(
+    trials: &[Trial],
+    n: usize,
+    bounds: &[f64],
+    friction: &[LayerFriction],
+    u: &dyn Fn(f64) -> f64,
+    before: &HoldFit,
+    guess: &ShaftGuess,
+) -> HoldFit {
+    let used: Vec<&Trial> = trials.iter().filter(|t| t.events.len() >= n).collect();
+    if before.holds == 0 {
+        return before.clone();
+    }
+    let dt = used.iter().flat_map(|t| t.samples.windows(2).map(|w| w[1].time_s - w[0].time_s)).fold(f64::INFINITY, f64::min);
+    let longest = used.iter().map(|t| t.phases.hold_s).fold(0.0, f64::max);
+    let taus = tau_grid(dt, longest);
+    let m = taus.len();
+    let b = before.boundary_mm;
+    let normals: Vec<Normal> =
+        used.iter().filter_map(|t| normal(t, n, bounds, friction, b.unwrap_or(f64::INFINITY), &taus, u, Some(guess))).collect();
+    let mut all = Normal::new(2 + 2 * m);
+    for nm in &normals {
+        all.merge(nm);
+    }
+    let keep_of = |choice: &[usize]| -> Vec<usize> {
+        [0, 1].into_iter().chain(choice.iter().map(|k| k + 2)).chain(choice.iter().map(|k| k + 2 + m)).collect()
+    };
+    let mut best: Option<(f64, Vec<usize>, Vec<f64>)> = None;
+    for choice in combos(m) {
+        let (x, sse) = all.select(&keep_of(&choice)).non_negative();
+        let scale = x.get(1).copied().unwrap_or(0.0);
+        let k = choice.len();
+        let g_sum: f64 = x.iter().skip(2).take(k).map(|c| c / scale.max(f64::MIN_POSITIVE)).sum();
+        let beta_sum: f64 = x.iter().skip(2 + k).sum();
+        if (b.is_some() && scale <= 0.0) || g_sum > needle_codegen::tissue::PRONY_G_SUM_MAX || beta_sum >= SHAFT_BETA_SUM_MAX {
+            continue;
+        }
+        if best.as_ref().is_none_or(|(s, ..)| sse < *s) {
+            best = Some((sse, choice, x));
+        }
+    }
+    let Some((_, choice, x)) = best else { return before.clone() };
+    let k = choice.len();
+    let scale = x.get(1).copied().unwrap_or(0.0);
+    let chosen: Vec<f64> = choice.iter().filter_map(|&c| taus.get(c).copied()).collect();
+    let prony: Vec<(f64, f64)> =
+        chosen.iter().zip(x.iter().skip(2)).filter(|(_, c)| **c > 0.0 && scale > 0.0).map(|(tau, c)| (c / scale, *tau)).collect();
+    let betas: Vec<f64> = x.iter().skip(2 + k).copied().collect();
+    let shaft_prony = shaft_terms(&betas, &chosen);
+    // per trial: each alone at the chosen terms
+    let per: Vec<Vec<f64>> = normals.iter().map(|nm| nm.select(&keep_of(&choice)).non_negative().0).collect();
+    let shaft_g = (0..k)
+        .map(|i| {
+            Spread::of(
+                per.iter()
+                    .map(|x| {
+                        let b: Vec<f64> = x.iter().skip(2 + k).copied().collect();
+                        let total = 1.0 - b.iter().sum::<f64>();
+                        b.get(i).copied().unwrap_or(0.0) / total.max(1.0 - SHAFT_BETA_SUM_MAX)
+                    })
+                    .collect(),
+            )
+        })
+        .collect();
+    let per_trial = refit(&used, n, bounds, friction, b, &prony.iter().map(|p| p.1).collect::<Vec<_>>(), u);
+    HoldFit { boundary_mm: b, scale, cutting_n: x.first().copied().unwrap_or(0.0), prony, per_trial, holds: before.holds, shaft_prony, shaft_g }
+}
+
+/// The largest sum of the shaft's relaxation weights `beta` (`1 - 1 / (1 + 9)`: the
+/// format's largest sum of `g`, 9).
+pub const SHAFT_BETA_SUM_MAX: f64 = 0.9;
+
+/// The shaft's terms `(g, tau_s)` from the weights `beta` (`g_i = beta_i / (1 - sum beta)`),
+/// the zero ones left out.
+fn shaft_terms(betas: &[f64], taus: &[f64]) -> Vec<(f64, f64)> {
+    let total = 1.0 - betas.iter().sum::<f64>();
+    betas.iter().zip(taus).filter(|(b, _)| **b > 0.0 && total > 0.0).map(|(b, tau)| (b / total, *tau)).collect()
 }
 
 /// Each trial alone at the chosen boundary and time constants.
@@ -190,7 +320,7 @@ fn refit(
 ) -> PerTrial {
     let fits: Vec<Vec<f64>> = used
         .iter()
-        .filter_map(|t| normal(t, n, bounds, friction, b.unwrap_or(f64::INFINITY), taus, u))
+        .filter_map(|t| normal(t, n, bounds, friction, b.unwrap_or(f64::INFINITY), taus, u, None))
         .map(|nm| nm.non_negative().0)
         .collect();
     let col = |k: usize| fits.iter().map(|x| x.get(k).copied().unwrap_or(0.0)).collect::<Vec<f64>>();

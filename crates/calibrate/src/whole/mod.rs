@@ -8,7 +8,8 @@
 //! 3. the shaft friction per layer from the withdrawals ([`friction`]);
 //! 4. each layer directly under another, deflecting after its puncture ([`intervals`]);
 //! 5. after the last puncture and the hold: the boundary below and its Prony terms
-//!    ([`hold`]);
+//!    ([`hold`]); then the shaft's presliding, its distance from the withdrawals' onsets
+//!    and its relaxation from the holds ([`presliding`], [`hold::fit_with_shaft`]);
 //! 6. the stack replayed along every trial through the library's insertion model
 //!    ([`crate::trial_replay`]) and held against it ([`goals`]).
 //!
@@ -20,6 +21,7 @@ pub mod friction;
 pub mod goals;
 pub mod hold;
 pub mod intervals;
+pub mod presliding;
 pub mod stack;
 pub mod stats;
 pub mod trials;

@@ -25,6 +25,9 @@ pub struct Fitted {
     pub hold: HoldFit,
     /// The stick band, mm/s.
     pub stick_band_mm_per_s: f64,
+    /// The shaft's presliding distance over the trials (mm; `None`: no withdrawal shows
+    /// one, the stack keeps the Karnopp friction).
+    pub presliding_mm: Option<Spread>,
 }
 
 /// Half the slowest measured speed, at most [`crate::STICK_BAND_MM_PER_S`]: the stick
@@ -87,6 +90,16 @@ pub fn fit(ts: &[Trial], opts: &TrialsOptions<'_>, diameter: f64, u: &dyn Fn(f64
     if hold.holds == 0 {
         notes.push("no trial has a hold: no Prony terms fitted (the stack is elastic)".into());
     }
+    let presliding = super::presliding::distance(&used);
+    if let Some(p) = &presliding {
+        // twice: the relaxation's columns carry the cutting force of the fit before
+        for _pass in 0..2 {
+            let guess = hold::ShaftGuess { presliding_mm: p.mean, cutting_n: hold.cutting_n };
+            hold = hold::fit_with_shaft(&used, n, &v.bounds, &fr, u, &hold, &guess);
+        }
+    } else {
+        notes.push("no trial has a withdrawal that turns the force over: no presliding fitted (the shaft's friction is zero at rest)".into());
+    }
     let band = stick_band(ts);
     let last_depth = ts.iter().flat_map(|t| t.samples.iter().map(|s| s.position_mm - t.onset_mm())).fold(0.0, f64::max);
     let largest = ts.iter().flat_map(|t| t.samples.iter().map(|s| s.force_n)).fold(0.0, f64::max);
@@ -99,8 +112,11 @@ pub fn fit(ts: &[Trial], opts: &TrialsOptions<'_>, diameter: f64, u: &dyn Fn(f64
             if j + 1 == n { hold.per_trial.cutting_n.clone() } else { v.cutting.get(j).cloned().unwrap_or(Spread::of(Vec::new())) };
         let cutting_n = if j + 1 == n { hold.cutting_n } else { cutting.mean };
         let f = fr.get(j).cloned().unwrap_or_else(zero_friction);
-        let (mut l, notes) =
+        let (mut l, mut notes) =
             layer(j, n, below - v.bounds[j], v.scale[j].clone(), v.puncture[j].clone(), (cutting_n, cutting), &f, band, opts, &source);
+        if let Some(p) = &presliding {
+            with_presliding(&mut l, &mut notes, p, &hold);
+        }
         if j == 0 {
             l.family_weight = shape.weight;
             l.softening_fraction = shape.fraction;
@@ -123,7 +139,19 @@ pub fn fit(ts: &[Trial], opts: &TrialsOptions<'_>, diameter: f64, u: &dyn Fn(f64
     };
     file::parse_stack_str(&stack.to_toml(""), Path::new(&format!("{}.toml", stack.name)))
         .map_err(|e| anyhow::anyhow!("the calibrated stack is refused by the tissue format: {e}"))?;
-    Ok(Fitted { stack, uncertainty, punctures: n, friction: fr, hold, stick_band_mm_per_s: band })
+    Ok(Fitted { stack, uncertainty, punctures: n, friction: fr, hold, stick_band_mm_per_s: band, presliding_mm: presliding })
+}
+
+/// A punctured layer's presliding: the distance over the trials and the shaft's terms of
+/// the hold's fit, each with its uncertainty.
+fn with_presliding(l: &mut file::Layer, notes: &mut Vec<(&'static str, String)>, p: &Spread, hold: &HoldFit) {
+    l.presliding_mm = Some(p.mean);
+    l.shaft_prony = hold.shaft_prony.iter().map(|&(g, tau_s)| file::PronyTerm { g, tau_s }).collect();
+    notes.push(("presliding_mm", format!("{} (the withdrawals' onsets: travel to the midpoint of the turn-over)", p.note("mm"))));
+    if !l.shaft_prony.is_empty() {
+        let g: Vec<String> = hold.shaft_g.iter().zip(&hold.shaft_prony).map(|(s, (_, tau))| format!("g(tau {tau:.3} s) {}", s.note("-"))).collect();
+        notes.push(("shaft_prony", format!("{} (the holds, with the boundary's terms)", g.join("; "))));
+    }
 }
 
 /// The first boundary's shape over the trials.

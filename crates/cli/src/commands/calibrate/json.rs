@@ -50,6 +50,8 @@ pub fn calibration(c: &TrialsCalibration) -> Value {
                 "friction_static_n_per_mm": l.friction_static_n_per_mm, "friction_coulomb_n_per_mm": l.friction_coulomb_n_per_mm,
                 "friction_viscous_n_s_per_mm2": l.friction_viscous_n_s_per_mm2, "stick_band_mm_per_s": l.stick_band_mm_per_s,
                 "prony": l.prony.iter().map(|t| json!({"g": t.g, "tau_s": t.tau_s})).collect::<Vec<_>>(),
+                "presliding_mm": l.presliding_mm,
+                "shaft_prony": l.shaft_prony.iter().map(|t| json!({"g": t.g, "tau_s": t.tau_s})).collect::<Vec<_>>(),
                 "uncertainty": uncertainty,
             })
         })

@@ -91,6 +91,15 @@ fn print_text(c: &TrialsCalibration) {
         if !l.prony.is_empty() {
             println!("  {}", note("prony").trim());
         }
+        if let Some(p) = l.presliding_mm {
+            println!("  presliding {p:.3} mm{}", note("presliding_mm"));
+            for t in &l.shaft_prony {
+                println!("  shaft Prony term g {:.4}, tau {:.4} s", t.g, t.tau_s);
+            }
+            if !l.shaft_prony.is_empty() {
+                println!("  {}", note("shaft_prony").trim());
+            }
+        }
     }
     for (t, checks) in c.trials.iter().zip(&c.checks) {
         println!("trial {} (contact at {:.3} mm of travel, {:.3} mm/s):", t.name(), t.onset_mm(), t.phases.insertion_speed_mm_per_s);
