@@ -118,6 +118,7 @@ pub fn calibrate_published(opts: &ModelOptions<'_>) -> Result<Calibration> {
             softening_onset_ratio: 0.0,
             softening_fraction_range: None,
             presliding_mm: None,
+            relaxation_slip_mm: None,
             shaft_prony: Vec::new(),
         });
     }

@@ -238,6 +238,7 @@ fn to_file(opts: &Options<'_>, fit: &fit::Fit) -> file::Stack {
                 softening_onset_ratio: if l.softening.fraction > 0.0 { l.softening.onset_ratio } else { 0.0 },
                 softening_fraction_range: l.softening_fraction_range,
                 presliding_mm: None,
+                relaxation_slip_mm: None,
                 shaft_prony: Vec::new(),
             }
         })
@@ -275,6 +276,7 @@ pub fn to_layer(l: &file::Layer) -> insertion::Layer {
         // the parser checked the distance's range and the terms
         presliding: l.presliding_mm.map_or(insertion::Presliding::NONE, |d| insertion::Presliding {
             distance_mm: d as f32,
+            relaxation_slip_mm: l.relaxation_slip_mm.unwrap_or(d) as f32,
             shaft_prony: PronyTerms::new(&l.shaft_prony.iter().map(|t| PronyTerm { g: t.g as f32, tau_s: t.tau_s as f32 }).collect::<Vec<_>>())
                 .unwrap_or(PronyTerms::NONE),
         }),

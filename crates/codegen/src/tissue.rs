@@ -83,6 +83,12 @@ pub struct Layer {
     /// (compiled in only with the library's `shaft-presliding` feature).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub presliding_mm: Option<f64>,
+    /// Format 2: the distance within which the relaxing part of the held force (each
+    /// `shaft_prony` term) is loaded, mm, within [`PRESLIDING_MM_RANGE`] (default:
+    /// `presliding_mm`; needs it): sliding faster than it over a term's time constant keeps
+    /// the term at its slip, so the held force relaxes by the same share at any such speed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub relaxation_slip_mm: Option<f64>,
     /// Format 2: the relaxation of the held shaft force and cutting (0 to
     /// [`MAX_PRONY_TERMS`], long-term normalisation; needs `presliding_mm`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -164,6 +170,7 @@ struct RawLayer {
     softening_onset_ratio: Option<Spanned<f64>>,
     softening_fraction_range: Option<Spanned<[f64; 2]>>,
     presliding_mm: Option<Spanned<f64>>,
+    relaxation_slip_mm: Option<Spanned<f64>>,
     shaft_prony: Option<Spanned<Vec<Spanned<RawProny>>>>,
 }
 
@@ -275,7 +282,7 @@ fn layer(
 ) -> Result<Layer, CodegenError> {
     use Bound::{NonNegative, Positive};
     let shape = shape(&l, format, domain, err)?;
-    let (presliding_mm, shaft_prony) = presliding_fields(&l, format, err)?;
+    let (presliding_mm, relaxation_slip_mm, shaft_prony) = presliding_fields(&l, format, err)?;
     let (prony, prony_span) = match l.prony {
         None => (Vec::new(), l.thickness_mm.span()),
         Some(p) => {
@@ -292,6 +299,7 @@ fn layer(
     Ok(Layer {
         prony,
         presliding_mm,
+        relaxation_slip_mm,
         shaft_prony,
         prony_source: l.prony_source.map(Spanned::into_inner),
         thickness_mm: check(&l.thickness_mm, "thickness_mm", Positive, err)?,
@@ -401,25 +409,33 @@ fn shape(
     })
 }
 
-/// The presliding fields of `l` (format 2): the distance within [`PRESLIDING_MM_RANGE`],
-/// the shaft's Prony terms checked as a layer's and only with a distance.
-fn presliding_fields(l: &RawLayer, format: i64, err: &dyn Fn(Range<usize>, String) -> CodegenError) -> Result<(Option<f64>, Vec<PronyTerm>), CodegenError> {
+/// A layer's presliding fields, checked: the distance, the relaxation's slip distance,
+/// the shaft's terms.
+type PreslidingFields = (Option<f64>, Option<f64>, Vec<PronyTerm>);
+
+/// The presliding fields of `l` (format 2): the distances within [`PRESLIDING_MM_RANGE`],
+/// the shaft's Prony terms checked as a layer's, both only with a presliding distance.
+fn presliding_fields(l: &RawLayer, format: i64, err: &dyn Fn(Range<usize>, String) -> CodegenError) -> Result<PreslidingFields, CodegenError> {
+    let spans = [l.presliding_mm.as_ref().map(Spanned::span), l.relaxation_slip_mm.as_ref().map(Spanned::span), l.shaft_prony.as_ref().map(Spanned::span)];
     if format < 2 {
-        if let Some(span) = l.presliding_mm.as_ref().map(Spanned::span).or_else(|| l.shaft_prony.as_ref().map(Spanned::span)) {
-            return Err(err(span, "presliding_mm, shaft_prony: format 2 fields (the shaft's presliding); write format = 2".into()));
+        if let Some(span) = spans.into_iter().flatten().next() {
+            return Err(err(span, "presliding_mm, relaxation_slip_mm, shaft_prony: format 2 fields (the shaft's presliding); write format = 2".into()));
         }
     }
-    let distance = match &l.presliding_mm {
-        None => None,
-        Some(v) => {
-            let (lo, hi) = PRESLIDING_MM_RANGE;
-            let x = *v.get_ref();
-            if !(x.is_finite() && (lo..=hi).contains(&x)) {
-                return Err(err(v.span(), format!("presliding_mm = {x}: must be from {lo} to {hi} mm (leave it out for none)")));
-            }
-            Some(x)
+    let in_range = |v: &Spanned<f64>, key: &str| -> Result<f64, CodegenError> {
+        let (lo, hi) = PRESLIDING_MM_RANGE;
+        let x = *v.get_ref();
+        if x.is_finite() && (lo..=hi).contains(&x) {
+            Ok(x)
+        } else {
+            Err(err(v.span(), format!("{key} = {x}: must be from {lo} to {hi} mm (leave it out for none)")))
         }
     };
+    let distance = l.presliding_mm.as_ref().map(|v| in_range(v, "presliding_mm")).transpose()?;
+    let slip = l.relaxation_slip_mm.as_ref().map(|v| in_range(v, "relaxation_slip_mm")).transpose()?;
+    if let (None, Some(v)) = (distance, &l.relaxation_slip_mm) {
+        return Err(err(v.span(), format!("layer {:?}: relaxation_slip_mm needs presliding_mm", l.name)));
+    }
     let terms = match l.shaft_prony.clone() {
         None => Vec::new(),
         Some(p) => {
@@ -431,7 +447,7 @@ fn presliding_fields(l: &RawLayer, format: i64, err: &dyn Fn(Range<usize>, Strin
             terms
         }
     };
-    Ok((distance, terms))
+    Ok((distance, slip, terms))
 }
 
 /// The Prony terms: at most [`MAX_PRONY_TERMS`], each `g >= 0` and `tau_s > 0`, the sum
@@ -624,7 +640,7 @@ pub fn render_rust_stacks(stacks: &[(PathBuf, Stack)], needle: Option<FeNeedle>)
                 render_prony(&l.prony),
                 render_family(l.family_weight),
                 render_softening(l.softening_fraction, l.softening_onset_ratio),
-                render_presliding(l.presliding_mm, &l.shaft_prony),
+                render_presliding(l.presliding_mm, l.relaxation_slip_mm, &l.shaft_prony),
                 l.name.replace('\n', " ")
             ));
         }
@@ -721,10 +737,15 @@ fn has_presliding(stack: &Stack) -> bool {
 }
 
 /// A layer's presliding: `Presliding::NONE` without one.
-fn render_presliding(distance_mm: Option<f64>, terms: &[PronyTerm]) -> String {
+fn render_presliding(distance_mm: Option<f64>, slip_mm: Option<f64>, terms: &[PronyTerm]) -> String {
     match distance_mm {
         None => "Presliding::NONE".into(),
-        Some(d) => format!("Presliding {{ distance_mm: {}, shaft_prony: {} }}", lit(d), render_prony(terms)),
+        Some(d) => format!(
+            "Presliding {{ distance_mm: {}, relaxation_slip_mm: {}, shaft_prony: {} }}",
+            lit(d),
+            lit(slip_mm.unwrap_or(d)),
+            render_prony(terms)
+        ),
     }
 }
 

@@ -9,11 +9,13 @@
 //!
 //! **Relaxation** (the shaft's own Prony terms, [`Presliding::shaft_prony`], FEBio's
 //! long-term normalisation `G(t) = 1 + sum g_i exp(-t / tau_i)`, at most three terms):
-//! each term is a bristle of its own, `z_i <- clamp(a_i z_i + Δd / p, -1, 1)` with the
+//! each term is a bristle of its own, `z_i <- clamp(a_i z_i + Δd / p_r, -1, 1)` with the
 //! QLV recursion's decay `a_i = exp(-dt / tau_i)` (the library's viscoelastic filter's
-//! coefficient), a Maxwell arm that slips at its share. Sliding, every `z_i` is at ±1;
-//! at rest each decays with its time constant, so a held force relaxes as
-//! `G(t) / G(0)` to `1 / (1 + sum g_i)` of the sliding one.
+//! coefficient) and the relaxation's slip distance `p_r`
+//! ([`Presliding::relaxation_slip_mm`]): a Maxwell arm that slips at its share. Sliding
+//! faster than `p_r / tau_i`, every `z_i` is at ±1; at rest each decays with its time
+//! constant, so a held force relaxes as `G(t) / G(0)` to `1 / (1 + sum g_i)` of the
+//! sliding one, by the same share whatever the speed it slid at.
 //!
 //! **Forces** (the tissue file's levels are the sliding ones, as the Karnopp friction's):
 //! per mm of shaft in the layer
@@ -43,13 +45,17 @@ pub struct Presliding {
     /// The presliding distance `p`, mm (0: none; else within
     /// `needle_contract::PRESLIDING_MM_RANGE`).
     pub distance_mm: f32,
+    /// The distance within which the relaxing part of the held force (each Prony term's
+    /// arm) is loaded, mm (within the same range as `distance_mm`; with no terms, any
+    /// value in range).
+    pub relaxation_slip_mm: f32,
     /// The relaxation of the held shaft force and cutting (none: no relaxation).
     pub shaft_prony: PronyTerms,
 }
 
 impl Presliding {
     /// No presliding: the layer's Karnopp friction and ramped cutting.
-    pub const NONE: Self = Self { distance_mm: 0.0, shaft_prony: PronyTerms::NONE };
+    pub const NONE: Self = Self { distance_mm: 0.0, relaxation_slip_mm: 0.0, shaft_prony: PronyTerms::NONE };
 
     /// Whether the layer has a presliding state.
     #[must_use]
@@ -64,10 +70,11 @@ impl Presliding {
     pub fn is_valid(&self) -> bool {
         let checked = PronyTerms::new(self.shaft_prony.as_slice()).is_ok();
         if !self.is_active() {
-            return self.distance_mm == 0.0 && self.shaft_prony.is_empty();
+            return self.distance_mm == 0.0 && self.relaxation_slip_mm == 0.0 && self.shaft_prony.is_empty();
         }
         let (lo, hi) = PRESLIDING_MM_RANGE;
-        self.distance_mm.is_finite() && self.distance_mm >= lo as f32 && self.distance_mm <= hi as f32 && checked
+        let in_range = |d: f32| d.is_finite() && d >= lo as f32 && d <= hi as f32;
+        in_range(self.distance_mm) && in_range(self.relaxation_slip_mm) && checked
     }
 }
 
@@ -77,6 +84,8 @@ impl Presliding {
 struct Coefficients {
     /// `1 / p`, 1/mm (0: the layer has no presliding).
     per_mm: f32,
+    /// `1 / p_r`, 1/mm.
+    arm_per_mm: f32,
     /// Each term's decay per tick, `exp(-dt / tau_i)` (0 for an unused term).
     decay: [f32; MAX_TERMS],
     /// Each term's share of the sliding force, `g_i / (1 + sum g)` (0 unused).
@@ -86,7 +95,7 @@ struct Coefficients {
 }
 
 impl Coefficients {
-    const NONE: Self = Self { per_mm: 0.0, decay: [0.0; MAX_TERMS], share: [0.0; MAX_TERMS], long_term: 1.0 };
+    const NONE: Self = Self { per_mm: 0.0, arm_per_mm: 0.0, decay: [0.0; MAX_TERMS], share: [0.0; MAX_TERMS], long_term: 1.0 };
 
     /// The layer's coefficients for ticks of `period_s` (> 0); `None` for a presliding
     /// out of range.
@@ -99,8 +108,9 @@ impl Coefficients {
         }
         let terms = p.shaft_prony.as_slice();
         let total = 1.0 + terms.iter().map(|t| t.g).sum::<f32>();
-        // total >= 1 (every g >= 0, checked) and tau_s > 0, distance_mm > 0: no division by zero
-        let mut out = Self { per_mm: 1.0 / p.distance_mm, long_term: 1.0 / total, ..Self::NONE };
+        // total >= 1 (every g >= 0, checked), tau_s > 0 and both distances > 0 (checked):
+        // no division by zero
+        let mut out = Self { per_mm: 1.0 / p.distance_mm, arm_per_mm: 1.0 / p.relaxation_slip_mm, long_term: 1.0 / total, ..Self::NONE };
         for ((a, s), t) in out.decay.iter_mut().zip(out.share.iter_mut()).zip(terms) {
             *a = libm::expf(-period_s / t.tau_s);
             *s = t.g / total;
@@ -141,8 +151,8 @@ impl Shaft {
     pub(super) fn advance(&mut self, step_mm: f32) {
         for ((c, z), arms) in self.coefficients.iter().zip(self.z.iter_mut()).zip(self.arms.iter_mut()) {
             if c.per_mm > 0.0 {
-                let s = step_mm * c.per_mm;
-                *z = clamp_unit(*z + s);
+                *z = clamp_unit(*z + step_mm * c.per_mm);
+                let s = step_mm * c.arm_per_mm;
                 for (arm, a) in arms.iter_mut().zip(c.decay) {
                     *arm = clamp_unit(a * *arm + s);
                 }
@@ -198,14 +208,20 @@ impl Shaft {
     }
 
     /// The stiffness of layer `j`'s bristles along the axis for `length_mm` of shaft in
-    /// it, N/mm (its sliding level over `p`); 0 without presliding.
+    /// it, N/mm (its long-term share over `p`, each arm's share over `p_r`); 0 without
+    /// presliding.
     pub(super) fn stiffness(&self, j: usize, layer: &Layer, length_mm: f32) -> f32 {
-        self.coefficients.get(j).map_or(0.0, |c| layer.friction.coulomb_n_per_mm * length_mm * c.per_mm)
+        layer.friction.coulomb_n_per_mm * length_mm * self.gain(j)
     }
 
     /// The stiffness of layer `j`'s held cutting, N/mm (0 without presliding).
     pub(super) fn cutting_stiffness(&self, j: usize, layer: &Layer) -> f32 {
-        self.coefficients.get(j).map_or(0.0, |c| layer.cutting_force_n * c.per_mm)
+        layer.cutting_force_n * self.gain(j)
+    }
+
+    /// The bristles' stiffness per unit level, 1/mm.
+    fn gain(&self, j: usize) -> f32 {
+        self.coefficients.get(j).map_or(0.0, |c| c.long_term * c.per_mm + c.share.iter().sum::<f32>() * c.arm_per_mm)
     }
 
     fn layer(&self, j: usize) -> Option<(&Coefficients, f32, &[f32; MAX_TERMS])> {

@@ -5,6 +5,12 @@
 //! speeds give Coulomb and viscous levels (`f = C + V |v|`, least squares over the
 //! trials); one speed gives the level at that speed, all Coulomb. The static level is the
 //! sliding level at the stick band's edge (continuous: the data cannot show a break).
+//! With the shaft's presliding ([`Turnover`]) the model's shaft force turns over after the
+//! stage reverses: its relaxing share (`1 - long`, the arms) at once, its long-term share
+//! linearly over twice the presliding distance `p`, so at travel `Δ` it pulls
+//! `s(Δ) = (1 - long) + long clamp(Δ / p - 1, -1, 1)` of its sliding level: each
+//! pulled-back row's lengths are weighted by it (rows where the model does not pull yet,
+//! `s <= 0`, left out).
 use super::stats::{Normal, Spread};
 use super::trials::Trial;
 
@@ -50,21 +56,43 @@ impl LayerFriction {
 /// viscous term from a Coulomb level.
 pub const SPEED_RATIO_FOR_VISCOUS: f64 = 1.2;
 
+/// The shaft's presliding as the withdrawal's fit needs it (module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Turnover {
+    /// The presliding distance `p`, mm (> 0).
+    pub presliding_mm: f64,
+    /// The long-term share of the held force, `1 / (1 + sum g)` of the shaft's terms.
+    pub long_term: f64,
+}
+
+impl Turnover {
+    /// The share of its sliding pull the model's shaft has reached at `travel_mm` after
+    /// the reversal.
+    #[must_use]
+    pub fn share(&self, travel_mm: f64) -> f64 {
+        (1.0 - self.long_term) + self.long_term * (travel_mm / self.presliding_mm - 1.0).clamp(-1.0, 1.0)
+    }
+}
+
 /// The friction of the `bounds.len()` punctured layers from the trials' withdrawals (the
 /// trials' onsets; no shaft below `next_mm`, the boundary the model deflects there and
-/// never punctures); `None` when no trial has a withdrawal with the needle pulled back.
+/// never punctures; with `turnover`, each row weighted by the model's turn-over); `None`
+/// when no trial has a withdrawal with the needle pulled back.
 #[must_use]
-pub fn fit(trials: &[Trial], bounds: &[f64], next_mm: f64) -> Option<Vec<LayerFriction>> {
+pub fn fit(trials: &[Trial], bounds: &[f64], next_mm: f64, turnover: Option<&Turnover>) -> Option<Vec<LayerFriction>> {
     let n = bounds.len();
     // per trial: (speed, levels of each layer)
     let mut per_trial: Vec<(f64, Vec<f64>)> = Vec::new();
     for t in trials {
         let mut normal = Normal::new(n);
         let mut rows = 0;
+        let reversal = t.samples.get(t.phases.withdrawal.start).map_or(f64::INFINITY, |s| s.position_mm);
         for s in &t.samples[t.phases.withdrawal.clone()] {
             let d = s.position_mm - t.onset_mm();
-            if s.force_n < 0.0 && d > 0.0 {
-                normal.add(&lengths(bounds, next_mm, d), -s.force_n);
+            let share = turnover.map_or(1.0, |tv| tv.share(reversal - s.position_mm));
+            if s.force_n < 0.0 && d > 0.0 && share > 0.0 {
+                let row: Vec<f64> = lengths(bounds, next_mm, d).iter().map(|l| l * share).collect();
+                normal.add(&row, -s.force_n);
                 rows += 1;
             }
         }

@@ -20,7 +20,12 @@
 //! `(friction at rest + c) (z_i - 1)` with `z_i` the library's arm along the trial
 //! ([`super::presliding::arms`]) takes the weight `beta_i = g_i / (1 + sum g)` of the
 //! shaft's relaxation (`g_i = beta_i / (1 - sum beta)`); the boundary is the one found
-//! without it, the time constants shared by both sets of terms.
+//! without it, the time constants shared by both sets of terms. Each arm is loaded within
+//! `v tau_i` of travel (`v` the slowest insertion, at most the presliding distance), so it
+//! slips while the needle slides at any measured speed: the held force relaxes by the
+//! same share at every speed (as the rig's trials do) and the sliding force is the
+//! friction and cutting the trials show. The stack's relaxation slip distance is the
+//! smallest of the chosen terms'.
 use super::friction::LayerFriction;
 use super::intervals::{friction_n, indent, BOUNDARY_STEP_MM};
 use super::stats::{Normal, Spread};
@@ -41,6 +46,17 @@ pub struct ShaftGuess {
     pub presliding_mm: f64,
     /// The cutting force of the last punctured layer, N.
     pub cutting_n: f64,
+    /// The slowest insertion speed of the trials, mm/s.
+    pub slowest_mm_per_s: f64,
+}
+
+impl ShaftGuess {
+    /// The slip distance of an arm of time constant `tau_s` (module docs), mm.
+    #[must_use]
+    pub fn slip_mm(&self, tau_s: f64) -> f64 {
+        let (lo, _) = needle_codegen::tissue::PRESLIDING_MM_RANGE;
+        (self.slowest_mm_per_s * tau_s).clamp(lo, self.presliding_mm.max(lo))
+    }
 }
 
 /// What the joint fit gave.
@@ -64,6 +80,9 @@ pub struct HoldFit {
     pub shaft_prony: Vec<(f64, f64)>,
     /// The shaft terms' per-trial weights.
     pub shaft_g: Vec<Spread>,
+    /// The relaxation's slip distance, mm (the smallest of the shaft terms'; `None`
+    /// without terms).
+    pub shaft_slip_mm: Option<f64>,
 }
 
 /// The per-trial refits of [`HoldFit`].
@@ -103,7 +122,7 @@ fn normal(
     let end = if t.phases.hold.is_empty() { t.phases.insertion.end } else { t.phases.hold.end };
     let v = t.phases.insertion_speed_mm_per_s;
     let columns = if shaft.is_some() { 2 + 2 * taus.len() } else { 2 + taus.len() };
-    let arms = shaft.map(|g| super::presliding::arms(t, taus, g.presliding_mm));
+    let arms = shaft.map(|g| super::presliding::arms(t, taus, &taus.iter().map(|tau| g.slip_mm(*tau)).collect::<Vec<_>>()));
     let mut out = Normal::new(columns);
     let mut h = vec![0.0; taus.len()];
     let mut last: Option<(f64, f64)> = None;
@@ -222,6 +241,7 @@ pub fn fit(trials: &[Trial], n: usize, bounds: &[f64], friction: &[LayerFriction
         holds,
         shaft_prony: Vec::new(),
         shaft_g: Vec::new(),
+        shaft_slip_mm: None,
     }
 }
 
@@ -253,34 +273,70 @@ pub fn fit_with_shaft(
     for nm in &normals {
         all.merge(nm);
     }
-    let keep_of = |choice: &[usize]| -> Vec<usize> {
-        [0, 1].into_iter().chain(choice.iter().map(|k| k + 2)).chain(choice.iter().map(|k| k + 2 + m)).collect()
+    // the boundary's and the shaft's terms at the chosen time constants, or either alone
+    // (a column left out is a zero weight: the unknowns keep their places)
+    let keep_of = |choice: &[usize], which: (bool, bool)| -> Vec<usize> {
+        let boundary = choice.iter().filter(|_| which.0).map(|k| k + 2);
+        let shaft = choice.iter().filter(|_| which.1).map(|k| k + 2 + m);
+        [0, 1].into_iter().chain(boundary).chain(shaft).collect()
     };
-    let mut best: Option<(f64, Vec<usize>, Vec<f64>)> = None;
+    let mut best: Option<(f64, Vec<usize>, (bool, bool), Vec<f64>)> = None;
     for choice in combos(m) {
-        let (x, sse) = all.select(&keep_of(&choice)).non_negative();
-        let scale = x.get(1).copied().unwrap_or(0.0);
-        let k = choice.len();
-        let g_sum: f64 = x.iter().skip(2).take(k).map(|c| c / scale.max(f64::MIN_POSITIVE)).sum();
-        let beta_sum: f64 = x.iter().skip(2 + k).sum();
-        if (b.is_some() && scale <= 0.0) || g_sum > needle_codegen::tissue::PRONY_G_SUM_MAX || beta_sum >= SHAFT_BETA_SUM_MAX {
-            continue;
-        }
-        if best.as_ref().is_none_or(|(s, ..)| sse < *s) {
-            best = Some((sse, choice, x));
+        for which in [(true, true), (true, false), (false, true)] {
+            let keep = keep_of(&choice, which);
+            let (y, sse) = all.select(&keep).non_negative();
+            let k = choice.len();
+            // back in the places of both sets
+            let mut x = vec![0.0; 2 + 2 * k];
+            for (slot, v) in [0, 1]
+                .into_iter()
+                .chain((0..k).filter(|_| which.0).map(|i| 2 + i))
+                .chain((0..k).filter(|_| which.1).map(|i| 2 + k + i))
+                .zip(y)
+            {
+                x[slot] = v;
+            }
+            let scale = x[1];
+            let g_sum: f64 = x.iter().skip(2).take(k).map(|c| c / scale.max(f64::MIN_POSITIVE)).sum();
+            let beta_sum: f64 = x.iter().skip(2 + k).sum();
+            // a zero scale: the held shaft explains the force, no boundary deflects
+            if g_sum > needle_codegen::tissue::PRONY_G_SUM_MAX || beta_sum >= SHAFT_BETA_SUM_MAX {
+                continue;
+            }
+            if best.as_ref().is_none_or(|(s, ..)| sse < *s) {
+                best = Some((sse, choice.clone(), which, x));
+            }
         }
     }
-    let Some((_, choice, x)) = best else { return before.clone() };
+    let Some((_, choice, which, x)) = best else { return before.clone() };
     let k = choice.len();
     let scale = x.get(1).copied().unwrap_or(0.0);
+    let b = b.filter(|_| scale > 0.0);
     let chosen: Vec<f64> = choice.iter().filter_map(|&c| taus.get(c).copied()).collect();
     let prony: Vec<(f64, f64)> =
         chosen.iter().zip(x.iter().skip(2)).filter(|(_, c)| **c > 0.0 && scale > 0.0).map(|(tau, c)| (c / scale, *tau)).collect();
     let betas: Vec<f64> = x.iter().skip(2 + k).copied().collect();
     let shaft_prony = shaft_terms(&betas, &chosen);
+    let shaft_slip_mm = shaft_prony.iter().map(|(_, tau)| guess.slip_mm(*tau)).reduce(f64::min);
     // per trial: each alone at the chosen terms
-    let per: Vec<Vec<f64>> = normals.iter().map(|nm| nm.select(&keep_of(&choice)).non_negative().0).collect();
+    let per: Vec<Vec<f64>> = normals
+        .iter()
+        .map(|nm| {
+            let y = nm.select(&keep_of(&choice, which)).non_negative().0;
+            let mut x = vec![0.0; 2 + 2 * k];
+            for (slot, v) in [0, 1]
+                .into_iter()
+                .chain((0..k).filter(|_| which.0).map(|i| 2 + i))
+                .chain((0..k).filter(|_| which.1).map(|i| 2 + k + i))
+                .zip(y)
+            {
+                x[slot] = v;
+            }
+            x
+        })
+        .collect();
     let shaft_g = (0..k)
+        .filter(|&i| betas.get(i).is_some_and(|b| *b > 0.0))
         .map(|i| {
             Spread::of(
                 per.iter()
@@ -294,7 +350,17 @@ pub fn fit_with_shaft(
         })
         .collect();
     let per_trial = refit(&used, n, bounds, friction, b, &prony.iter().map(|p| p.1).collect::<Vec<_>>(), u);
-    HoldFit { boundary_mm: b, scale, cutting_n: x.first().copied().unwrap_or(0.0), prony, per_trial, holds: before.holds, shaft_prony, shaft_g }
+    HoldFit {
+        boundary_mm: b,
+        scale,
+        cutting_n: x.first().copied().unwrap_or(0.0),
+        prony,
+        per_trial,
+        holds: before.holds,
+        shaft_prony,
+        shaft_g,
+        shaft_slip_mm,
+    }
 }
 
 /// The largest sum of the shaft's relaxation weights `beta` (`1 - 1 / (1 + 9)`: the

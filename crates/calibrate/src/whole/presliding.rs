@@ -58,11 +58,12 @@ pub fn distance(trials: &[Trial]) -> Option<Spread> {
     Some(s)
 }
 
-/// The library's arms `z_i` (time constants `taus`, distance `p_mm`) along trial `t`'s
-/// measured position, one row per sample: stepped at the library's tick between samples
-/// (the position linear between them), `z_i <- clamp(exp(-dt / tau_i) z_i + Δd / p)`.
+/// The library's arms `z_i` (time constants `taus`, slip distances `slip_mm`) along trial
+/// `t`'s measured position, one row per sample: stepped at the library's tick between
+/// samples (the position linear between them), `z_i <- clamp(exp(-dt / tau_i) z_i + Δd /
+/// p_i)`.
 #[must_use]
-pub fn arms(t: &Trial, taus: &[f64], p_mm: f64) -> Vec<Vec<f64>> {
+pub fn arms(t: &Trial, taus: &[f64], slip_mm: &[f64]) -> Vec<Vec<f64>> {
     let decay: Vec<f64> = taus.iter().map(|tau| (-TICK_S / tau).exp()).collect();
     let mut z = vec![0.0; taus.len()];
     let mut out = Vec::with_capacity(t.samples.len());
@@ -70,10 +71,10 @@ pub fn arms(t: &Trial, taus: &[f64], p_mm: f64) -> Vec<Vec<f64>> {
     for s in &t.samples {
         if let Some((t0, x0)) = last {
             let ticks = ((s.time_s - t0) / TICK_S).round().max(1.0);
-            let step = (s.position_mm - x0) / ticks / p_mm;
+            let step = (s.position_mm - x0) / ticks;
             for _ in 0..ticks as usize {
-                for (zi, a) in z.iter_mut().zip(&decay) {
-                    *zi = (a * *zi + step).clamp(-1.0, 1.0);
+                for ((zi, a), p) in z.iter_mut().zip(&decay).zip(slip_mm) {
+                    *zi = (a * *zi + step / p).clamp(-1.0, 1.0);
                 }
             }
         }

@@ -76,27 +76,36 @@ pub fn fit(ts: &[Trial], opts: &TrialsOptions<'_>, diameter: f64, u: &dyn Fn(f64
         puncture: vec![mean_of(&|t| t.peak(0).map(|p| p.1))],
         cutting: Vec::new(),
     };
-    let mut fr = friction_or_insertion(&used, &v.bounds, f64::INFINITY, n, notes);
+    let presliding = super::presliding::distance(&used);
+    let turnover = None;
+    let mut fr = friction_or_insertion(&used, &v.bounds, f64::INFINITY, turnover, n, notes);
     for _pass in 0..2 {
         intervals_pass(&used, n, &mut v, &fr, u);
-        fr = friction_or_insertion(&used, &v.bounds, f64::INFINITY, n, notes);
+        fr = friction_or_insertion(&used, &v.bounds, f64::INFINITY, turnover, n, notes);
     }
     let mut hold = hold::fit(&used, n, &v.bounds, &fr, u);
     // the model has no shaft friction below the boundary it deflects: once more with it
     if let Some(b) = hold.boundary_mm {
-        fr = friction_or_insertion(&used, &v.bounds, b, n, notes);
+        fr = friction_or_insertion(&used, &v.bounds, b, turnover, n, notes);
         hold = hold::fit(&used, n, &v.bounds, &fr, u);
     }
     if hold.holds == 0 {
         notes.push("no trial has a hold: no Prony terms fitted (the stack is elastic)".into());
     }
-    let presliding = super::presliding::distance(&used);
     if let Some(p) = &presliding {
         // twice: the relaxation's columns carry the cutting force of the fit before
+        let slowest = used.iter().map(|t| t.phases.insertion_speed_mm_per_s.abs()).fold(f64::INFINITY, f64::min);
         for _pass in 0..2 {
-            let guess = hold::ShaftGuess { presliding_mm: p.mean, cutting_n: hold.cutting_n };
+            let guess = hold::ShaftGuess { presliding_mm: p.mean, cutting_n: hold.cutting_n, slowest_mm_per_s: slowest };
             hold = hold::fit_with_shaft(&used, n, &v.bounds, &fr, u, &hold, &guess);
+            // the withdrawals' friction with the model's turn-over (and, when no boundary
+            // deflects, the shaft reaching the stage's depth)
+            let long_term = 1.0 / (1.0 + hold.shaft_prony.iter().map(|t| t.0).sum::<f64>());
+            let tv = friction::Turnover { presliding_mm: p.mean, long_term };
+            fr = friction_or_insertion(&used, &v.bounds, hold.boundary_mm.unwrap_or(f64::INFINITY), Some(&tv), n, notes);
         }
+        let guess = hold::ShaftGuess { presliding_mm: p.mean, cutting_n: hold.cutting_n, slowest_mm_per_s: slowest };
+        hold = hold::fit_with_shaft(&used, n, &v.bounds, &fr, u, &hold, &guess);
     } else {
         notes.push("no trial has a withdrawal that turns the force over: no presliding fitted (the shaft's friction is zero at rest)".into());
     }
@@ -146,8 +155,15 @@ pub fn fit(ts: &[Trial], opts: &TrialsOptions<'_>, diameter: f64, u: &dyn Fn(f64
 /// the hold's fit, each with its uncertainty.
 fn with_presliding(l: &mut file::Layer, notes: &mut Vec<(&'static str, String)>, p: &Spread, hold: &HoldFit) {
     l.presliding_mm = Some(p.mean);
+    l.relaxation_slip_mm = hold.shaft_slip_mm;
     l.shaft_prony = hold.shaft_prony.iter().map(|&(g, tau_s)| file::PronyTerm { g, tau_s }).collect();
-    notes.push(("presliding_mm", format!("{} (the withdrawals' onsets: travel to the midpoint of the turn-over)", p.note("mm"))));
+    notes.push((
+        "presliding_mm",
+        format!(
+            "{} (the withdrawals' onsets: travel to the midpoint of the turn-over); relaxation_slip_mm: the slowest insertion speed times the shortest shaft time constant",
+            p.note("mm")
+        ),
+    ));
     if !l.shaft_prony.is_empty() {
         let g: Vec<String> = hold.shaft_g.iter().zip(&hold.shaft_prony).map(|(s, (_, tau))| format!("g(tau {tau:.3} s) {}", s.note("-"))).collect();
         notes.push(("shaft_prony", format!("{} (the holds, with the boundary's terms)", g.join("; "))));
@@ -214,8 +230,15 @@ fn zero_friction() -> LayerFriction {
 
 /// The friction from the withdrawals, or (no trial has one) today's from the insertion,
 /// said in `notes`.
-fn friction_or_insertion(used: &[Trial], bounds: &[f64], next_mm: f64, n: usize, notes: &mut Vec<String>) -> Vec<LayerFriction> {
-    if let Some(f) = friction::fit(used, bounds, next_mm) {
+fn friction_or_insertion(
+    used: &[Trial],
+    bounds: &[f64],
+    next_mm: f64,
+    turnover: Option<&friction::Turnover>,
+    n: usize,
+    notes: &mut Vec<String>,
+) -> Vec<LayerFriction> {
+    if let Some(f) = friction::fit(used, bounds, next_mm, turnover) {
         return f;
     }
     let msg = "no trial has a withdrawal that pulls the needle back: the friction is fitted on the insertion (all Coulomb at its speed)"
@@ -295,6 +318,7 @@ fn layer(
         softening_onset_ratio: 0.0,
         softening_fraction_range: None,
         presliding_mm: None,
+        relaxation_slip_mm: None,
         shaft_prony: Vec::new(),
     };
     let se = |s: Option<f64>, unit: &str, k: usize| match s {
