@@ -90,14 +90,6 @@ fn calibrated_at_2_mm_per_s_and_predicted() {
         let started = std::time::Instant::now();
         let c = calibrate(&files);
         eprintln!("{sample}: calibrated on {} trials in {:.2} s; notes: {:?}", files.len(), started.elapsed().as_secs_f64(), c.notes);
-        if std::env::var_os("DEBUG_STACK").is_some() {
-            eprintln!("{}", c.fitted.stack.to_toml(""));
-            eprintln!("HOLD {:?} PRESLIDING {:?}", c.fitted.hold, c.fitted.presliding_mm);
-            let (t, r) = (&c.trials[0], &c.replays[0]);
-            for i in (t.phases.insertion.end.saturating_sub(150)..t.phases.withdrawal.start + 300).step_by(10) {
-                eprintln!("DBG {:.2} {:.3} {:.3} {:.3} {:?}", t.samples[i].time_s, t.samples[i].position_mm, t.samples[i].force_n, r.rows[i].force_n, r.rows[i].phase);
-            }
-        }
         for (t, checks) in c.trials.iter().zip(&c.checks) {
             let (m, n) = show("calibrated", &t.path, checks);
             totals = (totals.0 + m, totals.1 + n);

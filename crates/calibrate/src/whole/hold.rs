@@ -20,7 +20,7 @@
 //! `(friction at rest + c) (z_i - 1)` with `z_i` the library's arm along the trial
 //! ([`super::presliding::arms`]) takes the weight `beta_i = g_i / (1 + sum g)` of the
 //! shaft's relaxation (`g_i = beta_i / (1 - sum beta)`); the boundary is the one found
-//! without it, the time constants shared by both sets of terms. Each arm is loaded within
+//! without it (its scale fitted again, elastic: [`fit_with_shaft`]). Each arm is loaded within
 //! `v tau_i` of travel (`v` the slowest insertion, at most the presliding distance), so it
 //! slips while the needle slides at any measured speed: the held force relaxes by the
 //! same share at every speed (as the rig's trials do) and the sliding force is the
@@ -246,8 +246,10 @@ pub fn fit(trials: &[Trial], n: usize, bounds: &[f64], friction: &[LayerFriction
 }
 
 /// The joint fit with the shaft's presliding (module docs) at the boundary of `before`
-/// (the fit without it): the time constants chosen again, with the shaft's terms beside
-/// the boundary's; `before` when no trial has a hold.
+/// (the fit without it): the time constants chosen again for the shaft's terms, the
+/// boundary elastic (the rig's holds relax by the same share at every speed, as the
+/// shaft's terms do, the boundary's quasi-linear terms by a share that grows with the
+/// speed); `before` when no trial has a hold.
 #[must_use]
 pub fn fit_with_shaft(
     trials: &[Trial],
@@ -273,88 +275,44 @@ pub fn fit_with_shaft(
     for nm in &normals {
         all.merge(nm);
     }
-    // the boundary's and the shaft's terms at the chosen time constants, or either alone
-    // (a column left out is a zero weight: the unknowns keep their places)
-    let keep_of = |choice: &[usize], which: (bool, bool)| -> Vec<usize> {
-        let boundary = choice.iter().filter(|_| which.0).map(|k| k + 2);
-        let shaft = choice.iter().filter(|_| which.1).map(|k| k + 2 + m);
-        [0, 1].into_iter().chain(boundary).chain(shaft).collect()
-    };
-    let mut best: Option<(f64, Vec<usize>, (bool, bool), Vec<f64>)> = None;
+    // unknowns: cutting, the boundary's scale, each chosen term's beta
+    let keep_of = |choice: &[usize]| -> Vec<usize> { [0, 1].into_iter().chain(choice.iter().map(|k| k + 2 + m)).collect() };
+    let mut best: Option<(f64, Vec<usize>, Vec<f64>)> = None;
     for choice in combos(m) {
-        for which in [(true, true), (true, false), (false, true)] {
-            let keep = keep_of(&choice, which);
-            let (y, sse) = all.select(&keep).non_negative();
-            let k = choice.len();
-            // back in the places of both sets
-            let mut x = vec![0.0; 2 + 2 * k];
-            for (slot, v) in [0, 1]
-                .into_iter()
-                .chain((0..k).filter(|_| which.0).map(|i| 2 + i))
-                .chain((0..k).filter(|_| which.1).map(|i| 2 + k + i))
-                .zip(y)
-            {
-                x[slot] = v;
-            }
-            let scale = x[1];
-            let g_sum: f64 = x.iter().skip(2).take(k).map(|c| c / scale.max(f64::MIN_POSITIVE)).sum();
-            let beta_sum: f64 = x.iter().skip(2 + k).sum();
-            // a zero scale: the held shaft explains the force, no boundary deflects
-            if g_sum > needle_codegen::tissue::PRONY_G_SUM_MAX || beta_sum >= SHAFT_BETA_SUM_MAX {
-                continue;
-            }
-            if best.as_ref().is_none_or(|(s, ..)| sse < *s) {
-                best = Some((sse, choice.clone(), which, x));
-            }
+        let (x, sse) = all.select(&keep_of(&choice)).non_negative();
+        if x.iter().skip(2).sum::<f64>() >= SHAFT_BETA_SUM_MAX {
+            continue;
+        }
+        if best.as_ref().is_none_or(|(s, ..)| sse < *s) {
+            best = Some((sse, choice, x));
         }
     }
-    let Some((_, choice, which, x)) = best else { return before.clone() };
-    let k = choice.len();
+    let Some((_, choice, x)) = best else { return before.clone() };
     let scale = x.get(1).copied().unwrap_or(0.0);
+    // a zero scale: the held shaft explains the force, no boundary deflects
     let b = b.filter(|_| scale > 0.0);
     let chosen: Vec<f64> = choice.iter().filter_map(|&c| taus.get(c).copied()).collect();
-    let prony: Vec<(f64, f64)> =
-        chosen.iter().zip(x.iter().skip(2)).filter(|(_, c)| **c > 0.0 && scale > 0.0).map(|(tau, c)| (c / scale, *tau)).collect();
-    let betas: Vec<f64> = x.iter().skip(2 + k).copied().collect();
+    let betas: Vec<f64> = x.iter().skip(2).copied().collect();
     let shaft_prony = shaft_terms(&betas, &chosen);
     let shaft_slip_mm = shaft_prony.iter().map(|(_, tau)| guess.slip_mm(*tau)).reduce(f64::min);
-    // per trial: each alone at the chosen terms
-    let per: Vec<Vec<f64>> = normals
-        .iter()
-        .map(|nm| {
-            let y = nm.select(&keep_of(&choice, which)).non_negative().0;
-            let mut x = vec![0.0; 2 + 2 * k];
-            for (slot, v) in [0, 1]
-                .into_iter()
-                .chain((0..k).filter(|_| which.0).map(|i| 2 + i))
-                .chain((0..k).filter(|_| which.1).map(|i| 2 + k + i))
-                .zip(y)
-            {
-                x[slot] = v;
-            }
-            x
-        })
-        .collect();
-    let shaft_g = (0..k)
+    // per trial: each alone at the chosen terms, each kept term's weight g
+    let per: Vec<Vec<f64>> = normals.iter().map(|nm| nm.select(&keep_of(&choice)).non_negative().0).collect();
+    let shaft_g = (0..choice.len())
         .filter(|&i| betas.get(i).is_some_and(|b| *b > 0.0))
         .map(|i| {
-            Spread::of(
-                per.iter()
-                    .map(|x| {
-                        let b: Vec<f64> = x.iter().skip(2 + k).copied().collect();
-                        let total = 1.0 - b.iter().sum::<f64>();
-                        b.get(i).copied().unwrap_or(0.0) / total.max(1.0 - SHAFT_BETA_SUM_MAX)
-                    })
-                    .collect(),
-            )
+            let g = |x: &Vec<f64>| {
+                let total = 1.0 - x.iter().skip(2).sum::<f64>();
+                x.get(2 + i).copied().unwrap_or(0.0) / total.max(1.0 - SHAFT_BETA_SUM_MAX)
+            };
+            Spread::of(per.iter().map(g).collect())
         })
         .collect();
-    let per_trial = refit(&used, n, bounds, friction, b, &prony.iter().map(|p| p.1).collect::<Vec<_>>(), u);
+    let per_trial = refit(&used, n, bounds, friction, b, &[], u);
     HoldFit {
         boundary_mm: b,
         scale,
         cutting_n: x.first().copied().unwrap_or(0.0),
-        prony,
+        prony: Vec::new(),
         per_trial,
         holds: before.holds,
         shaft_prony,
