@@ -222,8 +222,11 @@ fn with_the_shaft_presliding_no_closed_cycle_delivers_energy() {
             + stack.layers.iter().map(|l| f64::from(l.friction.coulomb_n_per_mm * l.thickness_mm)).sum::<f64>();
         let p_mm = (2.0 * held_n * PERIOD_S / DAMPING_N_S_PER_MM).max(0.5) as f32;
         for (label, shaft_prony) in [("no", PronyTerms::NONE), test_terms()[0]] {
-            let layers: Vec<Layer> =
-                stack.layers.iter().map(|l| Layer { presliding: Presliding { distance_mm: p_mm, relaxation_slip_mm: p_mm, shaft_prony }, ..*l }).collect();
+            let layers: Vec<Layer> = stack
+                .layers
+                .iter()
+                .map(|l| Layer { presliding: Presliding { distance_mm: p_mm, relaxation_slip_mm: p_mm, shaft_prony }, ..*l })
+                .collect();
             let name = format!("{} with presliding {p_mm} mm and {label} shaft terms", stack.name);
             let held = Stack { name: &name, layers: &layers, ..*stack };
             no_closed_cycle_delivers_energy(&held, TRAJECTORIES / 3);

@@ -96,7 +96,8 @@ fn the_fixed_point_insertion_refuses_a_presliding_layer() {
     let layers: &'static [Layer] =
         Box::leak(with(Presliding { distance_mm: P_MM, relaxation_slip_mm: P_MM, shaft_prony: PronyTerms::NONE }).into_boxed_slice());
     let stack: &'static Stack<'static> = Box::leak(Box::new(Stack { layers, ..*liver() }));
-    let fixed: &'static needle_haptics::fixed::insertion::Stack = Box::leak(Box::new(needle_haptics::fixed::insertion::Stack::from_f32(stack)));
+    let fixed: &'static needle_haptics::fixed::insertion::Stack =
+        Box::leak(Box::new(needle_haptics::fixed::insertion::Stack::from_f32(stack)));
     let e = needle_haptics::fixed::insertion::Insertion::new(fixed, needle_haptics::fixed::insertion::InsertionConfig::DEFAULT_1KHZ)
         .expect_err("a presliding layer");
     assert_eq!(e, InsertionError::FloatOnly);

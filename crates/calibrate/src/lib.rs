@@ -277,8 +277,10 @@ pub fn to_layer(l: &file::Layer) -> insertion::Layer {
         presliding: l.presliding_mm.map_or(insertion::Presliding::NONE, |d| insertion::Presliding {
             distance_mm: d as f32,
             relaxation_slip_mm: l.relaxation_slip_mm.unwrap_or(d) as f32,
-            shaft_prony: PronyTerms::new(&l.shaft_prony.iter().map(|t| PronyTerm { g: t.g as f32, tau_s: t.tau_s as f32 }).collect::<Vec<_>>())
-                .unwrap_or(PronyTerms::NONE),
+            shaft_prony: PronyTerms::new(
+                &l.shaft_prony.iter().map(|t| PronyTerm { g: t.g as f32, tau_s: t.tau_s as f32 }).collect::<Vec<_>>(),
+            )
+            .unwrap_or(PronyTerms::NONE),
         }),
     }
 }

@@ -415,11 +415,22 @@ type PreslidingFields = (Option<f64>, Option<f64>, Vec<PronyTerm>);
 
 /// The presliding fields of `l` (format 2): the distances within [`PRESLIDING_MM_RANGE`],
 /// the shaft's Prony terms checked as a layer's, both only with a presliding distance.
-fn presliding_fields(l: &RawLayer, format: i64, err: &dyn Fn(Range<usize>, String) -> CodegenError) -> Result<PreslidingFields, CodegenError> {
-    let spans = [l.presliding_mm.as_ref().map(Spanned::span), l.relaxation_slip_mm.as_ref().map(Spanned::span), l.shaft_prony.as_ref().map(Spanned::span)];
+fn presliding_fields(
+    l: &RawLayer,
+    format: i64,
+    err: &dyn Fn(Range<usize>, String) -> CodegenError,
+) -> Result<PreslidingFields, CodegenError> {
+    let spans = [
+        l.presliding_mm.as_ref().map(Spanned::span),
+        l.relaxation_slip_mm.as_ref().map(Spanned::span),
+        l.shaft_prony.as_ref().map(Spanned::span),
+    ];
     if format < 2 {
         if let Some(span) = spans.into_iter().flatten().next() {
-            return Err(err(span, "presliding_mm, relaxation_slip_mm, shaft_prony: format 2 fields (the shaft's presliding); write format = 2".into()));
+            return Err(err(
+                span,
+                "presliding_mm, relaxation_slip_mm, shaft_prony: format 2 fields (the shaft's presliding); write format = 2".into(),
+            ));
         }
     }
     let in_range = |v: &Spanned<f64>, key: &str| -> Result<f64, CodegenError> {
@@ -656,8 +667,9 @@ pub fn render_rust_stacks(stacks: &[(PathBuf, Stack)], needle: Option<FeNeedle>)
     if shape_used || presliding_used {
         // one ALL per combination of the features that gate a stack, each listing the
         // stacks it compiles (the `viscoelastic` feature always among them with `tissue-shape`)
-        let gating: Vec<usize> =
-            (0..FEATURES.len()).filter(|&k| [shape_used || stacks.iter().any(|(_, s)| !elastic(s)), shape_used, presliding_used][k]).collect();
+        let gating: Vec<usize> = (0..FEATURES.len())
+            .filter(|&k| [shape_used || stacks.iter().any(|(_, s)| !elastic(s)), shape_used, presliding_used][k])
+            .collect();
         out.push_str("/// Every stack of the set that this build compiles in, by file name (stacks with Prony terms need the `viscoelastic` feature, with a family member or a softening `tissue-shape`");
         out.push_str(if presliding_used { ", with a presliding `shaft-presliding`).\n" } else { ").\n" });
         for combination in 0..1usize << gating.len() {

@@ -98,11 +98,11 @@ pub const MAX_LAYERS: usize = needle_contract::MAX_TISSUE_LAYERS;
 pub mod stacks {
     // `panic!` only in constant evaluation (a refused Prony set is a compile error)
     #![allow(clippy::unreadable_literal, clippy::excessive_precision, clippy::panic)]
-    #[allow(unused_imports)] // a set without tissue files uses none
-    use super::{FamilyMember, Karnopp, Layer, PronyTerm, PronyTerms, Softening, Stack};
     #[cfg(feature = "shaft-presliding")]
     #[allow(unused_imports)] // a set without presliding stacks uses none
     use super::Presliding;
+    #[allow(unused_imports)] // a set without tissue files uses none
+    use super::{FamilyMember, Karnopp, Layer, PronyTerm, PronyTerms, Softening, Stack};
     include!(concat!(env!("OUT_DIR"), "/tissue_stacks.rs"));
 
     /// The compiled-in stack named `name` (its file's stem), `None` when [`ALL`] has no

@@ -21,8 +21,8 @@
 //! ([`super::presliding::arms`]) takes the weight `beta_i = g_i / (1 + sum g)` of the
 //! shaft's relaxation (`g_i = beta_i / (1 - sum beta)`); the boundary is the one found
 //! without it (its scale fitted again, elastic: [`fit_with_shaft`]). Each arm is loaded within
-//! `v tau_i` of travel (`v` the slowest insertion, at most the presliding distance), so it
-//! slips while the needle slides at any measured speed: the held force relaxes by the
+//! `v tau_i` of travel (`v` the slowest insertion speed; at most the presliding
+//! distance), so it slips while the needle slides at any measured speed: the held force relaxes by the
 //! same share at every speed (as the rig's trials do) and the sliding force is the
 //! friction and cutting the trials show. The stack's relaxation slip distance is the
 //! smallest of the chosen terms'.
@@ -46,7 +46,7 @@ pub struct ShaftGuess {
     pub presliding_mm: f64,
     /// The cutting force of the last punctured layer, N.
     pub cutting_n: f64,
-    /// The slowest insertion speed of the trials, mm/s.
+    /// The slowest insertion speed of the trials, mm/s: the arms slip at it.
     pub slowest_mm_per_s: f64,
 }
 
@@ -307,7 +307,8 @@ pub fn fit_with_shaft(
             Spread::of(per.iter().map(g).collect())
         })
         .collect();
-    let per_trial = refit(&used, n, bounds, friction, b, &[], u);
+    let spread = |k: usize| Spread::of(per.iter().map(|x| x.get(k).copied().unwrap_or(0.0)).collect());
+    let per_trial = PerTrial { scale: spread(1), cutting_n: spread(0), g: Vec::new() };
     HoldFit {
         boundary_mm: b,
         scale,

@@ -76,39 +76,22 @@ pub fn fit(ts: &[Trial], opts: &TrialsOptions<'_>, diameter: f64, u: &dyn Fn(f64
         puncture: vec![mean_of(&|t| t.peak(0).map(|p| p.1))],
         cutting: Vec::new(),
     };
-    let presliding = super::presliding::distance(&used);
-    let turnover = None;
-    let mut fr = friction_or_insertion(&used, &v.bounds, f64::INFINITY, turnover, n, notes);
+    let mut fr = friction_or_insertion(&used, &v.bounds, f64::INFINITY, None, n, notes);
     for _pass in 0..2 {
         intervals_pass(&used, n, &mut v, &fr, u);
-        fr = friction_or_insertion(&used, &v.bounds, f64::INFINITY, turnover, n, notes);
+        fr = friction_or_insertion(&used, &v.bounds, f64::INFINITY, None, n, notes);
     }
     let mut hold = hold::fit(&used, n, &v.bounds, &fr, u);
     // the model has no shaft friction below the boundary it deflects: once more with it
     if let Some(b) = hold.boundary_mm {
-        fr = friction_or_insertion(&used, &v.bounds, b, turnover, n, notes);
+        fr = friction_or_insertion(&used, &v.bounds, b, None, n, notes);
         hold = hold::fit(&used, n, &v.bounds, &fr, u);
     }
     if hold.holds == 0 {
         notes.push("no trial has a hold: no Prony terms fitted (the stack is elastic)".into());
     }
-    if let Some(p) = &presliding {
-        // twice: the relaxation's columns carry the cutting force of the fit before
-        let slowest = used.iter().map(|t| t.phases.insertion_speed_mm_per_s.abs()).fold(f64::INFINITY, f64::min);
-        for _pass in 0..2 {
-            let guess = hold::ShaftGuess { presliding_mm: p.mean, cutting_n: hold.cutting_n, slowest_mm_per_s: slowest };
-            hold = hold::fit_with_shaft(&used, n, &v.bounds, &fr, u, &hold, &guess);
-            // the withdrawals' friction with the model's turn-over (and, when no boundary
-            // deflects, the shaft reaching the stage's depth)
-            let long_term = 1.0 / (1.0 + hold.shaft_prony.iter().map(|t| t.0).sum::<f64>());
-            let tv = friction::Turnover { presliding_mm: p.mean, long_term };
-            fr = friction_or_insertion(&used, &v.bounds, hold.boundary_mm.unwrap_or(f64::INFINITY), Some(&tv), n, notes);
-        }
-        let guess = hold::ShaftGuess { presliding_mm: p.mean, cutting_n: hold.cutting_n, slowest_mm_per_s: slowest };
-        hold = hold::fit_with_shaft(&used, n, &v.bounds, &fr, u, &hold, &guess);
-    } else {
-        notes.push("no trial has a withdrawal that turns the force over: no presliding fitted (the shaft's friction is zero at rest)".into());
-    }
+    let slowest = used.iter().map(|t| t.phases.insertion_speed_mm_per_s.abs()).fold(f64::INFINITY, f64::min);
+    let presliding = shaft_fit(&used, n, &v.bounds, slowest, u, (&mut hold, &mut fr), notes);
     let band = stick_band(ts);
     let last_depth = ts.iter().flat_map(|t| t.samples.iter().map(|s| s.position_mm - t.onset_mm())).fold(0.0, f64::max);
     let largest = ts.iter().flat_map(|t| t.samples.iter().map(|s| s.force_n)).fold(0.0, f64::max);
@@ -151,6 +134,41 @@ pub fn fit(ts: &[Trial], opts: &TrialsOptions<'_>, diameter: f64, u: &dyn Fn(f64
     Ok(Fitted { stack, uncertainty, punctures: n, friction: fr, hold, stick_band_mm_per_s: band, presliding_mm: presliding })
 }
 
+/// The shaft's presliding (the `hold` and `presliding` modules): its distance from the
+/// withdrawals' onsets, then twice the shaft's terms from the holds (the relaxation's
+/// columns carry the cutting force of the fit before; the arms slip at the slowest
+/// insertion speed `slowest`, so the held force relaxes by the same share at every
+/// measured speed) and the
+/// withdrawals' friction with the model's turn-over (and, when no boundary deflects, the
+/// shaft reaching the stage's depth), then the terms once more; `None` (said in `notes`)
+/// when no withdrawal turns the force over.
+fn shaft_fit(
+    used: &[Trial],
+    n: usize,
+    bounds: &[f64],
+    slowest: f64,
+    u: &dyn Fn(f64) -> f64,
+    (hold, fr): (&mut HoldFit, &mut Vec<LayerFriction>),
+    notes: &mut Vec<String>,
+) -> Option<Spread> {
+    let Some(p) = super::presliding::distance(used) else {
+        notes.push(
+            "no trial has a withdrawal that turns the force over: no presliding fitted (the shaft's friction is zero at rest)".into(),
+        );
+        return None;
+    };
+    for pass in 0..3 {
+        let guess = hold::ShaftGuess { presliding_mm: p.mean, cutting_n: hold.cutting_n, slowest_mm_per_s: slowest };
+        *hold = hold::fit_with_shaft(used, n, bounds, fr, u, hold, &guess);
+        if pass < 2 {
+            let long_term = 1.0 / (1.0 + hold.shaft_prony.iter().map(|t| t.0).sum::<f64>());
+            let tv = friction::Turnover { presliding_mm: p.mean, long_term };
+            *fr = friction_or_insertion(used, bounds, hold.boundary_mm.unwrap_or(f64::INFINITY), Some(&tv), n, notes);
+        }
+    }
+    Some(p)
+}
+
 /// A punctured layer's presliding: the distance over the trials and the shaft's terms of
 /// the hold's fit, each with its uncertainty.
 fn with_presliding(l: &mut file::Layer, notes: &mut Vec<(&'static str, String)>, p: &Spread, hold: &HoldFit) {
@@ -165,7 +183,8 @@ fn with_presliding(l: &mut file::Layer, notes: &mut Vec<(&'static str, String)>,
         ),
     ));
     if !l.shaft_prony.is_empty() {
-        let g: Vec<String> = hold.shaft_g.iter().zip(&hold.shaft_prony).map(|(s, (_, tau))| format!("g(tau {tau:.3} s) {}", s.note("-"))).collect();
+        let g: Vec<String> =
+            hold.shaft_g.iter().zip(&hold.shaft_prony).map(|(s, (_, tau))| format!("g(tau {tau:.3} s) {}", s.note("-"))).collect();
         notes.push(("shaft_prony", format!("{} (the holds, with the boundary's terms)", g.join("; "))));
     }
 }
