@@ -818,6 +818,32 @@ mod tests {
         assert!(rust.contains(&format!("{VISCOELASTIC_ONLY}\npub const ALL: [Stack<'static>; 2] = [LIVER, VISCO];")), "{rust}");
         assert!(rust.contains("#[cfg(not(feature = \"viscoelastic\"))]\npub const ALL: [Stack<'static>; 1] = [LIVER];"), "{rust}");
         let all_elastic = render_rust_stacks(&[elastic_stack], None);
-        assert!(!all_elastic.contains("cfg("), "an elastic set needs no feature gate:\n{all_elastic}");
+        // (every layer's presliding field is the feature's: a field, not a gate of the stack)
+        let stacks_only = all_elastic.replace(&format!("{PRESLIDING_ONLY} presliding:"), "");
+        assert!(!stacks_only.contains("cfg("), "an elastic set needs no feature gate:\n{all_elastic}");
+    }
+
+    #[test]
+    fn a_stack_with_a_presliding_is_compiled_only_with_the_shaft_presliding_feature() {
+        let plain = shipped("liver");
+        let mut held = shipped("liver");
+        held.1.name = "held".to_string();
+        held.1.format = 2;
+        held.1.layers.iter_mut().for_each(|l| l.presliding_mm = Some(1.5));
+        let rust = render_rust_stacks(&[plain.clone(), held], None);
+        assert!(rust.contains("#[cfg(feature = \"shaft-presliding\")]\npub const HELD:"), "the presliding stack is not gated:\n{rust}");
+        assert!(!rust.contains("#[cfg(feature = \"shaft-presliding\")]\npub const LIVER:"), "the plain stack is gated:\n{rust}");
+        assert!(
+            rust.contains("#[cfg(all(feature = \"shaft-presliding\"))]\npub const ALL: [Stack<'static>; 2] = [LIVER, HELD];"),
+            "{rust}"
+        );
+        assert!(rust.contains("#[cfg(all(not(feature = \"shaft-presliding\")))]\npub const ALL: [Stack<'static>; 1] = [LIVER];"), "{rust}");
+        assert!(
+            rust.contains("#[cfg(feature = \"shaft-presliding\")] presliding: Presliding { distance_mm: 1.5, relaxation_slip_mm: 1.5, shaft_prony: PronyTerms::NONE }"),
+            "the layer's field, its slip distance defaulting to the distance:\n{rust}"
+        );
+        let plain_only = render_rust_stacks(&[plain], None);
+        assert!(plain_only.contains("#[cfg(feature = \"shaft-presliding\")] presliding: Presliding::NONE"), "{plain_only}");
+        assert!(!plain_only.contains("#[cfg(all("), "a set without presliding needs no ALL per feature:\n{plain_only}");
     }
 }

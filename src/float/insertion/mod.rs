@@ -528,7 +528,7 @@ impl Insertion {
             soft
         };
         #[cfg(feature = "shaft-presliding")]
-        let shaft = presliding::Shaft::new(stack.layers, config.period_s).ok_or(InsertionError::Value)?;
+        let shaft = presliding::Shaft::new(stack.layers.iter().map(|l| &l.presliding), config.period_s).ok_or(InsertionError::Value)?;
         let mut layers = [stack.layers.first().copied().ok_or(InsertionError::LayerCount)?; MAX_LAYERS];
         for (slot, l) in layers.iter_mut().zip(stack.layers) {
             *slot = *l;
@@ -915,8 +915,9 @@ impl Insertion {
     #[allow(clippy::unused_self)] // reads the shaft's state with `shaft-presliding` only
     fn friction_in(&self, j: usize, layer: &Layer, v: f32, length_mm: f32) -> (f32, f32, f32) {
         #[cfg(feature = "shaft-presliding")]
-        if let Some(f) = self.shaft.friction_per_mm(j, layer, v) {
-            return (0.0, length_mm * f, self.shaft.stiffness(j, layer, length_mm));
+        let k = &layer.friction;
+        if let Some(f) = self.shaft.friction_per_mm(j, k.coulomb_n_per_mm, k.viscous_n_s_per_mm2, v) {
+            return (0.0, length_mm * f, self.shaft.stiffness(j, k.coulomb_n_per_mm * length_mm));
         }
         #[cfg(not(feature = "shaft-presliding"))]
         let _ = j;
@@ -931,8 +932,8 @@ impl Insertion {
         {
             let j = m.checked_sub(1)?;
             let l = self.layers.get(j)?;
-            let c = self.shaft.cutting(j, l, depth_mm, self.track_end_mm)?;
-            Some((c, self.shaft.cutting_stiffness(j, l)))
+            let c = self.shaft.cutting(j, l.cutting_force_n, depth_mm, self.track_end_mm)?;
+            Some((c, self.shaft.stiffness(j, l.cutting_force_n)))
         }
         #[cfg(not(feature = "shaft-presliding"))]
         {

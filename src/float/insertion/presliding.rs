@@ -34,9 +34,8 @@
 //! (which moves only while the tip cuts at full force, storing at most half the work:
 //! `cutting (e - a) / 2`). A closed cycle gives nothing back
 //! (`host-tests/tests/insertion_energy.rs` holds it).
-use super::stack::{Layer, MAX_LAYERS};
 use crate::float::viscoelastic::{PronyTerms, MAX_TERMS};
-use needle_contract::PRESLIDING_MM_RANGE;
+use needle_contract::{MAX_TISSUE_LAYERS as MAX_LAYERS, PRESLIDING_MM_RANGE};
 
 /// A layer's presliding; [`Presliding::NONE`]: today's Karnopp friction, zero at rest.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -137,12 +136,12 @@ fn clamp_unit(x: f32) -> f32 {
 }
 
 impl Shaft {
-    /// The coefficients of `layers` for ticks of `period_s`, every state at rest; `None`
-    /// for a layer whose presliding is out of range.
-    pub(super) fn new(layers: &[Layer], period_s: f32) -> Option<Self> {
+    /// The coefficients of the layers' `presliding` for ticks of `period_s`, every state
+    /// at rest; `None` for a presliding out of range.
+    pub(super) fn new<'a>(presliding: impl Iterator<Item = &'a Presliding>, period_s: f32) -> Option<Self> {
         let mut coefficients = [Coefficients::NONE; MAX_LAYERS];
-        for (c, l) in coefficients.iter_mut().zip(layers) {
-            *c = Coefficients::new(&l.presliding, period_s)?;
+        for (c, p) in coefficients.iter_mut().zip(presliding) {
+            *c = Coefficients::new(p, period_s)?;
         }
         Some(Self { coefficients, z: [0.0; MAX_LAYERS], arms: [[0.0; MAX_TERMS]; MAX_LAYERS], cut_from_mm: 0.0 })
     }
@@ -173,21 +172,22 @@ impl Shaft {
     }
 
     /// Layer `j`'s friction per mm of shaft at speed `v` (mm/s, zero when against the
-    /// last motion), N/mm, of the force's sign along the axis; `None` when the layer
-    /// has no presliding.
-    pub(super) fn friction_per_mm(&self, j: usize, layer: &Layer, v: f32) -> Option<f32> {
+    /// last motion) with its sliding levels `coulomb_n_per_mm` and `viscous_n_s_per_mm2`,
+    /// N/mm, of the force's sign along the axis; `None` when the layer has no presliding.
+    pub(super) fn friction_per_mm(&self, j: usize, coulomb_n_per_mm: f32, viscous_n_s_per_mm2: f32, v: f32) -> Option<f32> {
         let (c, z, arms) = self.layer(j)?;
         let mut held = c.long_term * z;
         for (s, arm) in c.share.iter().zip(arms) {
             held += s * arm;
         }
-        let viscous = if z * v > 0.0 { layer.friction.viscous_n_s_per_mm2 * libm::fabsf(v) * z } else { 0.0 };
-        Some(layer.friction.coulomb_n_per_mm * held + viscous)
+        let viscous = if z * v > 0.0 { viscous_n_s_per_mm2 * libm::fabsf(v) * z } else { 0.0 };
+        Some(coulomb_n_per_mm * held + viscous)
     }
 
-    /// Layer `j`'s cutting force held at the tip, N, with the tip at `depth_mm` and the
-    /// track's end at `track_end_mm`; `None` when the layer has no presliding.
-    pub(super) fn cutting(&self, j: usize, layer: &Layer, depth_mm: f32, track_end_mm: f32) -> Option<f32> {
+    /// Layer `j`'s cutting force `cutting_n` held at the tip, N, with the tip at
+    /// `depth_mm` and the track's end at `track_end_mm`; `None` when the layer has no
+    /// presliding.
+    pub(super) fn cutting(&self, j: usize, cutting_n: f32, depth_mm: f32, track_end_mm: f32) -> Option<f32> {
         let (c, _, arms) = self.layer(j)?;
         // per_mm > 0 (`layer`): the distance is finite and > 0
         let behind = track_end_mm - 1.0 / c.per_mm;
@@ -204,19 +204,14 @@ impl Shaft {
         for (s, arm) in c.share.iter().zip(arms) {
             held += s * if *arm > 0.0 { *arm } else { 0.0 };
         }
-        Some(layer.cutting_force_n * w * held)
+        Some(cutting_n * w * held)
     }
 
-    /// The stiffness of layer `j`'s bristles along the axis for `length_mm` of shaft in
-    /// it, N/mm (its long-term share over `p`, each arm's share over `p_r`); 0 without
-    /// presliding.
-    pub(super) fn stiffness(&self, j: usize, layer: &Layer, length_mm: f32) -> f32 {
-        layer.friction.coulomb_n_per_mm * length_mm * self.gain(j)
-    }
-
-    /// The stiffness of layer `j`'s held cutting, N/mm (0 without presliding).
-    pub(super) fn cutting_stiffness(&self, j: usize, layer: &Layer) -> f32 {
-        layer.cutting_force_n * self.gain(j)
+    /// The stiffness along the axis of layer `j`'s bristles holding `level_n` (its shaft
+    /// friction or its cutting at their sliding level), N/mm: the long-term share over
+    /// `p`, each arm's share over `p_r`; 0 without presliding.
+    pub(super) fn stiffness(&self, j: usize, level_n: f32) -> f32 {
+        level_n * self.gain(j)
     }
 
     /// The bristles' stiffness per unit level, 1/mm.
