@@ -693,8 +693,12 @@ impl Insertion {
         let entry: Vec3 = [pose.x_mm, 0.0, pose.z_mm];
         let bounds = self.boundaries(a[1]);
         let Deflected { wrench: mut w, status, punctures, stiffness_n_per_mm } = self.deflect(pose, a, entry, &bounds, rate);
-        let (phase, axial_n, shaft_stiffness) = self.shaft(pose, a, entry, v, &bounds, &mut w);
-        let stiffness_n_per_mm = stiffness_n_per_mm + shaft_stiffness;
+        let (phase, axial_n, held_stiffness) = self.shaft(pose, a, entry, v, &bounds, &mut w);
+        // the presliding's held force is elastic to a guard: its stiffness with the boundary's
+        #[cfg(feature = "shaft-presliding")]
+        let stiffness_n_per_mm = stiffness_n_per_mm + held_stiffness;
+        #[cfg(not(feature = "shaft-presliding"))]
+        let () = held_stiffness;
         let mut dissipative_n = [axial_n * a[0], axial_n * a[1], axial_n * a[2]];
         let flags = bound(&mut w, &mut dissipative_n);
         let wrench = Wrench::from_array(w);
@@ -846,21 +850,23 @@ impl Insertion {
 
     /// Friction, cutting and the track's hold on the shaft, added to `w`; the phase, the
     /// axial force of Karnopp friction and ramped cutting (N, along `+a`: dissipative)
-    /// and the stiffness of the presliding's held force (N/mm; 0 without it).
-    fn shaft(&mut self, pose: &Pose, a: Vec3, entry: Vec3, v: f32, bounds: &[f32; MAX_LAYERS + 1], w: &mut [f32; 6]) -> (Phase, f32, f32) {
+    /// and, with `shaft-presliding`, the stiffness of the presliding's held force (N/mm).
+    fn shaft(&mut self, pose: &Pose, a: Vec3, entry: Vec3, v: f32, bounds: &[f32; MAX_LAYERS + 1], w: &mut [f32; 6]) -> (Phase, f32, Held) {
         let depth = pose.depth_mm;
         let m = self.punctured;
         let index = |j: usize| u8::try_from(j).unwrap_or(u8::MAX);
         let bound = |j: usize| bounds.get(j).copied().unwrap_or(f32::INFINITY);
         if m == 0 {
-            return (if depth > bound(0) { Phase::Deflecting(0) } else { Phase::Approach }, 0.0, 0.0);
+            return (if depth > bound(0) { Phase::Deflecting(0) } else { Phase::Approach }, 0.0, NO_HELD);
         }
         let next = bound(m);
         let top = if depth < next { depth } else { next };
         let hub_q = depth - HUB_FROM_TIP_MM * self.similarity;
         let deviation = self.track.map(|t| t.deviation(entry, a, hub_q));
-        // (dissipative, held, held stiffness)
-        let mut axial = (0.0f32, 0.0f32, 0.0f32);
+        let mut axial_n = 0.0f32;
+        // the presliding's held force and its stiffness
+        #[cfg(feature = "shaft-presliding")]
+        let mut held = (0.0f32, 0.0f32);
         for j in 0..m {
             let (Some(layer), lo) = (self.layers.get(j), bound(j)) else { break };
             let hi = bound(j + 1);
@@ -868,77 +874,90 @@ impl Insertion {
             if q2 <= q1 {
                 continue;
             }
-            let (f, held, k) = self.friction_in(j, layer, v, q2 - q1);
-            axial = (axial.0 + f, axial.1 + held, axial.2 + k);
+            #[cfg(feature = "shaft-presliding")]
+            if let Some((f, k)) = self.held_friction(j, layer, v, q2 - q1) {
+                held = (held.0 + f, held.1 + k);
+            } else {
+                axial_n += (q2 - q1) * layer.friction.per_mm(v);
+            }
+            #[cfg(not(feature = "shaft-presliding"))]
+            {
+                axial_n += (q2 - q1) * layer.friction.per_mm(v);
+            }
             if let Some(d) = &deviation {
                 d.add_hold(layer.track_stiffness_n_per_mm2, q1, q2, w);
             }
         }
         // cutting layer m - 1, or carrying its cutting force onto boundary m: ramped in
-        // over the stick band, or held at the tip (presliding)
+        // over the stick band (or, with a presliding, held at the tip)
+        #[cfg(feature = "shaft-presliding")]
         let held_cutting = self.held_cutting(m, depth);
         let cutting = |v: f32| {
-            self.layers.get(m - 1).filter(|_| held_cutting.is_none()).map_or(0.0, |l| {
+            let layer = self.layers.get(m - 1);
+            #[cfg(feature = "shaft-presliding")]
+            let layer = layer.filter(|_| held_cutting.is_none());
+            layer.map_or(0.0, |l| {
                 let ramp = v / l.friction.stick_band_mm_per_s;
                 l.cutting_force_n * if ramp < 1.0 { ramp } else { 1.0 }
             })
         };
         let phase = if depth >= next {
             if v > 0.0 {
-                axial.0 += cutting(v);
+                axial_n += cutting(v);
             }
             Phase::Deflecting(index(m))
         } else if depth >= self.track_end_mm && v > 0.0 {
-            axial.0 += cutting(v);
+            axial_n += cutting(v);
             Phase::Cutting(index(m - 1))
         } else {
             let inside = (1..m).take_while(|&j| bound(j) < depth).count();
             Phase::InTrack(index(inside))
         };
-        if let Some((c, k)) = held_cutting {
-            axial = (axial.0, axial.1 + c, axial.2 + k);
-        }
+        #[cfg(feature = "shaft-presliding")]
+        let (total, held_k) = {
+            let (c, k) = held_cutting.unwrap_or((0.0, 0.0));
+            (axial_n + held.0 + c, held.1 + k)
+        };
+        #[cfg(not(feature = "shaft-presliding"))]
+        let (total, held_k) = (axial_n, NO_HELD);
         if depth > self.track_end_mm && depth < next {
             self.track_end_mm = depth;
         }
         // the force on the needle opposes the motion: along +a (towards the hub) inserting
-        let total = axial.0 + axial.1;
         w[0] += total * a[0];
         w[1] += total * a[1];
         w[2] += total * a[2];
-        (phase, axial.0, axial.2)
+        (phase, axial_n, held_k)
     }
 
-    /// Layer `j`'s shaft friction over `length_mm` of shaft in it at speed `v`: the
-    /// Karnopp friction (dissipative), or the presliding's held force and its stiffness,
-    /// N, N, N/mm.
-    #[allow(clippy::unused_self)] // reads the shaft's state with `shaft-presliding` only
-    fn friction_in(&self, j: usize, layer: &Layer, v: f32, length_mm: f32) -> (f32, f32, f32) {
-        #[cfg(feature = "shaft-presliding")]
+    /// Layer `j`'s presliding friction over `length_mm` of shaft in it at speed `v` and
+    /// its stiffness (N, N/mm); `None` when the layer has none (its Karnopp friction).
+    #[cfg(feature = "shaft-presliding")]
+    fn held_friction(&self, j: usize, layer: &Layer, v: f32, length_mm: f32) -> Option<(f32, f32)> {
         let k = &layer.friction;
-        if let Some(f) = self.shaft.friction_per_mm(j, k.coulomb_n_per_mm, k.viscous_n_s_per_mm2, v) {
-            return (0.0, length_mm * f, self.shaft.stiffness(j, k.coulomb_n_per_mm * length_mm));
-        }
-        #[cfg(not(feature = "shaft-presliding"))]
-        let _ = j;
-        (length_mm * layer.friction.per_mm(v), 0.0, 0.0)
+        let f = self.shaft.friction_per_mm(j, k.coulomb_n_per_mm, k.viscous_n_s_per_mm2, v)?;
+        Some((length_mm * f, self.shaft.stiffness(j, k.coulomb_n_per_mm * length_mm)))
     }
 
     /// The cutting force of layer `m - 1` held at the tip at `depth_mm` and its stiffness
     /// (N, N/mm), `None` when the layer has no presliding (its cutting is ramped).
-    #[allow(clippy::unused_self)] // reads the shaft's state with `shaft-presliding` only
+    #[cfg(feature = "shaft-presliding")]
     fn held_cutting(&self, m: usize, depth_mm: f32) -> Option<(f32, f32)> {
-        #[cfg(feature = "shaft-presliding")]
-        {
-            let j = m.checked_sub(1)?;
-            let l = self.layers.get(j)?;
-            let c = self.shaft.cutting(j, l.cutting_force_n, depth_mm, self.track_end_mm)?;
-            Some((c, self.shaft.stiffness(j, l.cutting_force_n)))
-        }
-        #[cfg(not(feature = "shaft-presliding"))]
-        {
-            let _ = (m, depth_mm);
-            None
-        }
+        let j = m.checked_sub(1)?;
+        let l = self.layers.get(j)?;
+        let c = self.shaft.cutting(j, l.cutting_force_n, depth_mm, self.track_end_mm)?;
+        Some((c, self.shaft.stiffness(j, l.cutting_force_n)))
     }
 }
+
+/// The presliding's held-force stiffness a shaft step reports (N/mm; nothing without the
+/// `shaft-presliding` feature).
+#[cfg(feature = "shaft-presliding")]
+type Held = f32;
+#[cfg(feature = "shaft-presliding")]
+const NO_HELD: Held = 0.0;
+/// Nothing without the `shaft-presliding` feature.
+#[cfg(not(feature = "shaft-presliding"))]
+type Held = ();
+#[cfg(not(feature = "shaft-presliding"))]
+const NO_HELD: Held = ();

@@ -99,7 +99,7 @@ impl Coefficients {
     /// The layer's coefficients for ticks of `period_s` (> 0); `None` for a presliding
     /// out of range.
     fn new(p: &Presliding, period_s: f32) -> Option<Self> {
-        if !p.is_valid() || !(period_s.is_finite() && period_s > 0.0) {
+        if !(p.is_valid() && period_s.is_finite() && period_s > 0.0) {
             return None;
         }
         if !p.is_active() {
