@@ -212,7 +212,7 @@ impl<'a> Insertion<'a> {
     /// A path through `stack`, the needle above the surface.
     ///
     /// # Errors
-    /// [`InsertionError::FloatOnly`] (a stack with a presliding layer: `shaft-presliding`),
+    /// `InsertionError::FloatOnly` (a stack with a presliding layer: `shaft-presliding`),
     /// [`InsertionError::LayerCount`] (also for a stack [`Stack::from_f32`] refused),
     /// [`InsertionError::Value`] (a value out of the tissue file's ranges after
     /// rounding, e.g. a thickness below 2^-17 mm, or beyond the integer ranges: a
