@@ -175,17 +175,17 @@ fn with_presliding(l: &mut file::Layer, notes: &mut Vec<(&'static str, String)>,
     l.presliding_mm = Some(p.mean);
     l.relaxation_slip_mm = hold.shaft_slip_mm;
     l.shaft_prony = hold.shaft_prony.iter().map(|&(g, tau_s)| file::PronyTerm { g, tau_s }).collect();
-    notes.push((
-        "presliding_mm",
-        format!(
-            "{} (the withdrawals' onsets: travel to the midpoint of the turn-over); relaxation_slip_mm: the slowest insertion speed times the shortest shaft time constant",
-            p.note("mm")
-        ),
-    ));
+    notes.push(("presliding_mm", format!("{} (the withdrawals' onsets: travel to the midpoint of the turn-over)", p.note("mm"))));
+    if l.relaxation_slip_mm.is_some() {
+        notes.push((
+            "relaxation_slip_mm",
+            "the slowest insertion speed times the shortest shaft time constant: each term slips at every measured speed".into(),
+        ));
+    }
     if !l.shaft_prony.is_empty() {
         let g: Vec<String> =
             hold.shaft_g.iter().zip(&hold.shaft_prony).map(|(s, (_, tau))| format!("g(tau {tau:.3} s) {}", s.note("-"))).collect();
-        notes.push(("shaft_prony", format!("{} (the holds, with the boundary's terms)", g.join("; "))));
+        notes.push(("shaft_prony", format!("{} (the holds; the boundary below elastic)", g.join("; "))));
     }
 }
 
