@@ -20,12 +20,13 @@
 //! `(friction at rest + c) (z_i - 1)` with `z_i` the library's arm along the trial
 //! ([`super::presliding::arms`]) takes the weight `beta_i = g_i / (1 + sum g)` of the
 //! shaft's relaxation (`g_i = beta_i / (1 - sum beta)`); the boundary is the one found
-//! without it (its scale fitted again, elastic: [`fit_with_shaft`]). Each arm is loaded within
-//! `v tau_i` of travel (`v` the slowest insertion speed; at most the presliding
-//! distance), so it slips while the needle slides at any measured speed: the held force relaxes by the
-//! same share at every speed (as the rig's trials do) and the sliding force is the
-//! friction and cutting the trials show. The stack's relaxation slip distance is the
-//! smallest of the chosen terms'.
+//! without it (its scale fitted again, elastic: [`fit_with_shaft`]). Each arm is loaded
+//! within `v tau_i` of travel (`v` the slowest insertion speed; at most the presliding
+//! distance), so it slips while the needle slides at any measured speed: the held force
+//! relaxes by the same share at every speed (as the rig's trials do) and the sliding
+//! force is the friction and cutting the trials show. The stack's relaxation slip
+//! distance is the smallest of the chosen terms' (each arm then slips sooner, the same
+//! while sliding and at rest).
 use super::friction::LayerFriction;
 use super::intervals::{friction_n, indent, BOUNDARY_STEP_MM};
 use super::stats::{Normal, Spread};
@@ -38,8 +39,8 @@ pub const TAU_COUNT: usize = 7;
 /// when it lies above the depth where the layer above punctures).
 pub const ABOVE_LAST_PUNCTURE_MM: f64 = 3.0;
 
-/// The shaft's presliding for a joint fit: its distance and the cutting force of the fit
-/// before (the relaxation's column carries it).
+/// The shaft's presliding for a joint fit: its distance, the cutting force of the fit
+/// before (the relaxation's column carries it) and the speed its arms slip at.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ShaftGuess {
     /// The presliding distance, mm.
@@ -75,10 +76,9 @@ pub struct HoldFit {
     pub per_trial: PerTrial,
     /// How many trials had a hold.
     pub holds: usize,
-    /// The shaft's Prony terms `(g, tau_s)` (with a [`ShaftGuess`]; else empty), and
-    /// each term's weight per trial.
+    /// The shaft's Prony terms `(g, tau_s)` (with a [`ShaftGuess`]; else empty).
     pub shaft_prony: Vec<(f64, f64)>,
-    /// The shaft terms' per-trial weights.
+    /// Each shaft term's weight `g` refitted on each trial alone.
     pub shaft_g: Vec<Spread>,
     /// The relaxation's slip distance, mm (the smallest of the shaft terms'; `None`
     /// without terms).
