@@ -333,7 +333,9 @@ pub struct GuardTerms {
     pub stiffness_n_per_mm: f32,
     /// The force of shaft friction and cutting in the wrench, N (block frame): it only
     /// takes energy out, so a guard leaves it as it is and limits the rest (the
-    /// boundary's deflection, the preload and the track's hold: the elastic part).
+    /// boundary's deflection, the preload and the track's hold: the elastic part). A
+    /// presliding's held force is not in it (it is elastic, its stiffness in
+    /// `stiffness_n_per_mm`).
     pub dissipative_n: [f32; 3],
 }
 
