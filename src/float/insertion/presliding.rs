@@ -32,8 +32,9 @@
 //! `level ∫ (shaft length) (s - d0) / p ds >= 0` over its elastic stretch, slipping and
 //! relaxing only lower it, and `w` is a function of the depth for a fixed track end
 //! (which moves only while the tip cuts at full force, storing at most half the work:
-//! `cutting (e - a) / 2`). A closed cycle gives nothing back
-//! (`host-tests/tests/insertion_energy.rs` holds it).
+//! `cutting (e - a) / 2`). A closed cycle of the insertion alone gives nothing back
+//! (`host-tests/tests/insertion_energy.rs` holds it); the control loop's passivity guard
+//! does not render the held force passively yet (`docs/insertion.md`, "Presliding").
 use crate::float::viscoelastic::{PronyTerms, MAX_TERMS};
 use needle_contract::{MAX_TISSUE_LAYERS as MAX_LAYERS, PRESLIDING_MM_RANGE};
 
