@@ -21,6 +21,7 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+pub mod edges;
 pub mod events;
 pub mod fit;
 pub mod from_model;

@@ -1,5 +1,6 @@
 //! `needle calibrate --trials --json` and `needle replay --json`: the results as JSON
 //! for machines (a non-finite number is `null`).
+use needle_calibrate::edges::EdgeWarning;
 use needle_calibrate::replay::Check;
 use needle_calibrate::trial::Sample;
 use needle_calibrate::trial_replay::TrialReplay;
@@ -31,6 +32,20 @@ pub fn rows(s: &[Sample], r: &TrialReplay) -> Value {
     let punctures: Vec<Value> =
         r.punctures.iter().map(|p| json!({"time_s": p.time_s, "position_mm": p.position_mm, "force_n": num(p.force_n)})).collect();
     json!({"columns": ["time_s", "position_mm", "force_n", "model_force_n", "model_phase"], "rows": rows, "model_punctures": punctures})
+}
+
+/// The fitted values on their range's edge, each with its numbers and its sentence.
+#[must_use]
+pub fn edges(es: &[EdgeWarning]) -> Value {
+    es.iter()
+        .map(|e| {
+            json!({
+                "key": e.key, "parameter": e.parameter, "value": num(e.value), "range": [num(e.range[0]), num(e.range[1])],
+                "unit": e.unit, "grid_step": num(e.step), "edge": e.edge.word(),
+                "trials_on_edge": e.trials_on_edge.map(|(k, n)| json!({"trials": k, "of": n})), "text": e.to_string(),
+            })
+        })
+        .collect()
 }
 
 /// The whole calibration.
@@ -68,5 +83,5 @@ pub fn calibration(c: &TrialsCalibration) -> Value {
             })
         })
         .collect();
-    json!({"name": c.fitted.stack.name, "notes": c.notes, "similarity": c.similarity, "layers": layers, "trials": trials})
+    json!({"name": c.fitted.stack.name, "notes": c.notes, "warnings": edges(&c.edges), "similarity": c.similarity, "layers": layers, "trials": trials})
 }

@@ -127,6 +127,18 @@ pub fn run(a: CalibrateArgs) -> Result<ExitCode> {
             needle_calibrate::WINKLER_E_PER_MU * l.scale * mu0
         );
     }
+    if let Some(l) = c.fit.layers.first() {
+        println!(
+            "layer 0 shape: family member w = {} (fitted range {}), softening fraction {:.4}{}",
+            l.family_weight,
+            l.family_weight_range.map_or("not fitted".into(), |[lo, hi]| format!("{lo:.4} to {hi:.4}")),
+            l.softening.fraction,
+            if l.softening.fraction > 0.0 { format!(" from {:.2} of the puncture's elastic force", l.softening.onset_ratio) } else { String::new() }
+        );
+    }
+    for e in &c.fit.edges {
+        println!("warning: {e}");
+    }
     let all_met = print_checks(&c.checks);
     if !all_met && !a.write_on_miss {
         println!("result: FAIL (a goal is missed): nothing written (--write-on-miss writes the stack and figure anyway)");

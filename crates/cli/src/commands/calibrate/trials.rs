@@ -36,6 +36,9 @@ pub fn run_trials(a: &CalibrateArgs) -> Result<ExitCode> {
     let all_met = c.checks.iter().flatten().all(needle_calibrate::replay::Check::met);
     if a.json {
         println!("{}", serde_json::to_string_pretty(&super::json::calibration(&c))?);
+        for e in &c.edges {
+            eprintln!("warning: {e}");
+        }
     } else {
         print_text(&c);
     }
@@ -63,6 +66,9 @@ pub fn run_trials(a: &CalibrateArgs) -> Result<ExitCode> {
 fn print_text(c: &TrialsCalibration) {
     for note in &c.notes {
         println!("note: {note}");
+    }
+    for e in &c.edges {
+        println!("warning: {e}");
     }
     println!(
         "{} trials, {} punctures each; geometric similarity {:.4}; stick band {:.3} mm/s (half the slowest speed, at most 1)",
