@@ -3,6 +3,7 @@
 pub mod figure;
 pub mod json;
 pub mod trials;
+pub mod trials_figure;
 
 use crate::compiled_set::check_compiled_set_except;
 use crate::planned_outputs::{self, Planned};
@@ -51,7 +52,10 @@ pub struct CalibrateArgs {
     /// Write the stack here instead of <set>/tissue/<name>.toml.
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Write the figure here instead of <set>/figures/calibration-<name>.svg.
+    /// Write the figure here instead of <set>/figures/calibration-<name>.svg (--curve:
+    /// the curve, the model and the residual against position, and before the first
+    /// puncture against depth; --trials: per trial the measured and the model force
+    /// against time over insertion, hold and withdrawal, the punctures, the residual).
     #[arg(long)]
     pub figure: Option<PathBuf>,
     /// Replace an existing stack or figure (without it, an existing one is refused before

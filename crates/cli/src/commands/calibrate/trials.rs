@@ -9,10 +9,10 @@ use needle_calibrate::events::EventRule;
 use needle_calibrate::whole::{annotate::annotate, calibrate_trials, TrialsCalibration, TrialsOptions};
 use std::process::ExitCode;
 
-/// Runs the `--trials` form: the name, set and output are checked first, the trials
-/// read and fitted, the text (or `--json`) printed, the stack written last (nothing on
-/// an error; on a missed goal only with `--write-on-miss`); exit 1 when a goal is
-/// missed.
+/// Runs the `--trials` form: the name, set and outputs are checked first, the trials
+/// read and fitted, the text (or `--json`) printed, the stack and its figure
+/// ([`super::trials_figure`]) written last, together (nothing on an error; on a missed
+/// goal only with `--write-on-miss`); exit 1 when a goal is missed.
 ///
 /// # Errors
 /// The set is not the compiled-in one, an output is refused, a trial is refused (its
@@ -24,7 +24,9 @@ pub fn run_trials(a: &CalibrateArgs) -> Result<ExitCode> {
         .with_context(|| format!("{}: no campaign.toml: the FE tissue's shear modulus sets the track stiffness", a.set.display()))?;
     let out = a.out.clone().unwrap_or_else(|| a.set.join(needle_codegen::tissue::TISSUE_DIR).join(format!("{}.toml", a.name)));
     let inputs: Vec<(&str, &std::path::Path)> = a.trials.iter().map(|p| ("--trials", p.as_path())).collect();
-    planned_outputs::check(&[Planned { option: "--out", path: &out }], Some(&a.set), &inputs, a.force)?;
+    let figure = a.figure.clone().unwrap_or_else(|| a.set.join("figures").join(format!("calibration-{}.svg", a.name)));
+    let planned = [Planned { option: "--out", path: &out }, Planned { option: "--figure", path: &figure }];
+    planned_outputs::check(&planned, Some(&a.set), &inputs, a.force)?;
     let opts = TrialsOptions {
         trials: &a.trials,
         name: a.name.clone(),
@@ -44,7 +46,7 @@ pub fn run_trials(a: &CalibrateArgs) -> Result<ExitCode> {
     }
     let say = |s: String| if a.json { eprintln!("{s}") } else { println!("{s}") };
     if !all_met && !a.write_on_miss {
-        say("result: FAIL (a goal is missed): nothing written (--write-on-miss writes the stack anyway)".into());
+        say("result: FAIL (a goal is missed): nothing written (--write-on-miss writes the stack and figure anyway)".into());
         return Ok(ExitCode::from(1));
     }
     let names: Vec<String> = a.trials.iter().map(|p| p.display().to_string()).collect();
@@ -54,8 +56,12 @@ pub fn run_trials(a: &CalibrateArgs) -> Result<ExitCode> {
         names.join(", ")
     );
     let text = annotate(&c.fitted.stack.to_toml(&header), &c.fitted.uncertainty);
-    needle_stdx::fs::write_all_atomic(&[(&out, text.as_bytes())])?;
+    let shown: Vec<_> = c.trials.iter().zip(&c.replays).collect();
+    let caption = format!("needle calibrate --trials: {} on {} trials, measured and model", a.name, c.trials.len());
+    let svg = super::trials_figure::svg(&caption, &shown)?;
+    needle_stdx::fs::write_all_atomic(&[(&out, text.as_bytes()), (&figure, svg.as_bytes())])?;
     say(format!("wrote {}", out.display()));
+    say(format!("wrote {}", figure.display()));
     say(format!(
         "result: {}",
         if all_met { "every calibration goal met" } else { "FAIL (a goal is missed; written with --write-on-miss)" }
