@@ -100,8 +100,10 @@ pub fn calibrate_trials(opts: &TrialsOptions<'_>) -> Result<TrialsCalibration> {
         replays.push(r);
     }
     let fits: Vec<&crate::fit::Fit> = trials.iter().map(|t| &t.fit).collect();
-    let edges = fitted.stack.layers.first().map_or_else(Vec::new, |l| {
-        crate::edges::of_trials(l.family_weight, l.softening_fraction, l.softening_onset_ratio, &fits)
-    });
+    let edges = fitted
+        .stack
+        .layers
+        .first()
+        .map_or_else(Vec::new, |l| crate::edges::of_trials(l.family_weight, l.softening_fraction, l.softening_onset_ratio, &fits));
     Ok(TrialsCalibration { trials, notes, fitted, replays, checks, similarity, edges })
 }

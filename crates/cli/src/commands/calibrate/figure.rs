@@ -82,7 +82,11 @@ fn pre_puncture(c: &Calibration, reference: &str) -> Vec<Panel> {
     };
     let grey = RGBColor(90, 90, 90);
     let shape = Panel {
-        title: format!("before the first puncture: member w = {}, scale s = {}, {softening}", tick_label(layer.family_weight), tick_label(layer.scale)),
+        title: format!(
+            "before the first puncture: member w = {}, scale s = {}, {softening}",
+            tick_label(layer.family_weight),
+            tick_label(layer.scale)
+        ),
         x_label: "depth from the fitted contact, mm".into(),
         y_label: "axial force, N".into(),
         series: vec![

@@ -137,7 +137,11 @@ pub fn run(a: CalibrateArgs) -> Result<ExitCode> {
             l.family_weight,
             l.family_weight_range.map_or("not fitted".into(), |[lo, hi]| format!("{lo:.4} to {hi:.4}")),
             l.softening.fraction,
-            if l.softening.fraction > 0.0 { format!(" from {:.2} of the puncture's elastic force", l.softening.onset_ratio) } else { String::new() }
+            if l.softening.fraction > 0.0 {
+                format!(" from {:.2} of the puncture's elastic force", l.softening.onset_ratio)
+            } else {
+                String::new()
+            }
         );
     }
     for e in &c.fit.edges {
