@@ -38,7 +38,7 @@ component by cross-validation). Writes model.toml and the four golden files all 
     Validate(needle_cli::commands::validate::ValidateArgs),
     /// Serve the model explorer (the library compiled to wasm) to a browser on a local port.
     Explore(needle_cli::commands::explore::ExploreArgs),
-    /// Draw the set's figures as SVG (Figs 4, 6, 7, 8, parity, FE verification).
+    /// Draw the set's figures as SVG (Figs 4, 6, 7, 8, parity, FE verification, the material family).
     Plot(needle_cli::commands::plot::PlotArgs),
     /// The fixed-point evaluator's largest error against f64 on a grid and random poses, beside its bound.
     FixedError(needle_cli::commands::fixed_error::FixedErrorArgs),
