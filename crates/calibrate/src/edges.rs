@@ -199,11 +199,11 @@ pub fn of_shape(fit: &ShapeFit) -> Vec<EdgeWarning> {
 
 /// The warnings of a stack fitted on several trials: its first layer's member `w` and
 /// softening (`fraction`, `r0`: the trials' median and means), each with how many of the
-/// trials' own fits (`fits`, [`crate::fit::Fit::edges`]) lie on the same edge. The
-/// paper's tissue warns when one of the trials' fits is pinned to it.
+/// trials' own fits lie on the same edge (`fits`: each trial's warnings, its fit's
+/// `edges`). The paper's tissue warns when one of the trials' fits is pinned to it.
 #[must_use]
-pub fn of_trials(w: f64, fraction: f64, r0: f64, fits: &[&crate::fit::Fit]) -> Vec<EdgeWarning> {
-    let count = |key: &str, edge: Edge| fits.iter().filter(|f| f.edges.iter().any(|e| e.key == key && e.edge == edge)).count();
+pub fn of_trials(w: f64, fraction: f64, r0: f64, fits: &[&[EdgeWarning]]) -> Vec<EdgeWarning> {
+    let count = |key: &str, edge: Edge| fits.iter().filter(|f| f.iter().any(|e| e.key == key && e.edge == edge)).count();
     let pinned = count("family_weight", Edge::Upper) > 0;
     weight_warning(w, pinned)
         .into_iter()

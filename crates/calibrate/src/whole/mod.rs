@@ -99,7 +99,7 @@ pub fn calibrate_trials(opts: &TrialsOptions<'_>) -> Result<TrialsCalibration> {
         checks.push(goals::checks(t, &r, &goals::CALIBRATED));
         replays.push(r);
     }
-    let fits: Vec<&crate::fit::Fit> = trials.iter().map(|t| &t.fit).collect();
+    let fits: Vec<&[crate::edges::EdgeWarning]> = trials.iter().map(|t| t.fit.edges.as_slice()).collect();
     let edges = fitted
         .stack
         .layers

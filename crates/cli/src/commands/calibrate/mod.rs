@@ -109,6 +109,31 @@ pub fn run(a: CalibrateArgs) -> Result<ExitCode> {
     planned_outputs::check(&planned, Some(&a.set), &[("--curve", &curve)], a.force)?;
     let points = needle_calibrate::measured::read_curve(&curve)?;
     let c = needle_calibrate::calibrate_points_with_progress(&opts, points, &mut progress_on_stderr())?;
+    print_fit(&c, needle_diameter_mm, mu0);
+    let all_met = print_checks(&c.checks);
+    if !all_met && !a.write_on_miss {
+        println!("result: FAIL (a goal is missed): nothing written (--write-on-miss writes the stack and figure anyway)");
+        return Ok(ExitCode::from(1));
+    }
+    let header = format!(
+        "Tissue stack `{}`, written by `needle calibrate` (format: coeffs/README.md, \"Tissue stacks\").\nMeasured curve: {}; needle {} mm at {} mm/s.",
+        a.name,
+        curve.display(),
+        needle_diameter_mm,
+        speed
+    );
+    let stack = c.stack.to_toml(&header);
+    let svg = self::figure::svg(&c, &a.name, "measured")?;
+    needle_stdx::fs::write_all_atomic(&[(&out, stack.as_bytes()), (&figure, svg.as_bytes())])?;
+    println!("wrote {}", out.display());
+    println!("wrote {}", figure.display());
+    println!("result: {}", if all_met { "every calibration goal met" } else { "FAIL (a goal is missed; written with --write-on-miss)" });
+    Ok(if all_met { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}
+
+/// Prints the fitted values of a `--curve` calibration: the similarity, the contact,
+/// each layer, the first boundary's shape and the values on their range's edge.
+fn print_fit(c: &needle_calibrate::Calibration, needle_diameter_mm: f64, mu0: f64) {
     println!(
         "{} points, {} punctures; geometric similarity: measured needle {} mm / FE needle {} mm = {:.4} (lengths x {:.4}, forces x {:.4}; exact when the block scales too)",
         c.points.len(),
@@ -133,7 +158,7 @@ pub fn run(a: CalibrateArgs) -> Result<ExitCode> {
     }
     if let Some(l) = c.fit.layers.first() {
         println!(
-            "layer 0 shape: family member w = {} (fitted range {}), softening fraction {:.4}{}",
+            "layer 0 shape: family member w = {:.4} (fitted range {}), softening fraction {:.4}{}",
             l.family_weight,
             l.family_weight_range.map_or("not fitted".into(), |[lo, hi]| format!("{lo:.4} to {hi:.4}")),
             l.softening.fraction,
@@ -147,25 +172,6 @@ pub fn run(a: CalibrateArgs) -> Result<ExitCode> {
     for e in &c.fit.edges {
         println!("warning: {e}");
     }
-    let all_met = print_checks(&c.checks);
-    if !all_met && !a.write_on_miss {
-        println!("result: FAIL (a goal is missed): nothing written (--write-on-miss writes the stack and figure anyway)");
-        return Ok(ExitCode::from(1));
-    }
-    let header = format!(
-        "Tissue stack `{}`, written by `needle calibrate` (format: coeffs/README.md, \"Tissue stacks\").\nMeasured curve: {}; needle {} mm at {} mm/s.",
-        a.name,
-        curve.display(),
-        needle_diameter_mm,
-        speed
-    );
-    let stack = c.stack.to_toml(&header);
-    let svg = self::figure::svg(&c, &a.name, "measured")?;
-    needle_stdx::fs::write_all_atomic(&[(&out, stack.as_bytes()), (&figure, svg.as_bytes())])?;
-    println!("wrote {}", out.display());
-    println!("wrote {}", figure.display());
-    println!("result: {}", if all_met { "every calibration goal met" } else { "FAIL (a goal is missed; written with --write-on-miss)" });
-    Ok(if all_met { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
 
 /// Refuses a `--name` that cannot name a stack, before any work.
