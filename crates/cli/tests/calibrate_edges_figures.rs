@@ -71,7 +71,7 @@ fn a_rig_trial_fitted_on_the_softest_member_is_warned_about() {
     let d = tempfile::tempdir().expect("tempdir");
     let trial = rig("skin_2mmps_0deg_needle2_trial1.csv");
     let lo = softest_fitted_member();
-    let o = calibrate_trials(d.path(), &[trial.clone()], &[]);
+    let o = calibrate_trials(d.path(), std::slice::from_ref(&trial), &[]);
     let stdout = String::from_utf8_lossy(&o.stdout);
     let w = warnings(&stdout);
     let member = w.iter().find(|l| l.contains("family_weight = ")).unwrap_or_else(|| panic!("no member warning:\n{}", show(&o)));
@@ -96,7 +96,7 @@ fn a_rig_trial_fitted_on_the_softest_member_is_warned_about() {
 fn a_rig_trial_fitted_inside_the_range_has_no_warning() {
     let d = tempfile::tempdir().expect("tempdir");
     let trial = rig("muscle_2mmps_0deg_needle2_trial1.csv");
-    let o = calibrate_trials(d.path(), &[trial.clone()], &[]);
+    let o = calibrate_trials(d.path(), std::slice::from_ref(&trial), &[]);
     assert!(String::from_utf8_lossy(&o.stdout).contains("wrote "), "a stack was fitted and written: {}", show(&o));
     assert_eq!(warnings(&String::from_utf8_lossy(&o.stdout)), Vec::<&str>::new(), "{}", show(&o));
     let j = calibrate_trials(d.path(), &[trial], &["--json", "--force"]);
