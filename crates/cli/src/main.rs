@@ -44,6 +44,9 @@ component by cross-validation). Writes model.toml and the four golden files all 
     FixedError(needle_cli::commands::fixed_error::FixedErrorArgs),
     /// Write the C headers: needle.h (the C API) and needle_coeffs.h (the model's tables).
     Header(needle_cli::commands::header::HeaderArgs),
+    /// Tissue stack files: draw a plausible tissue within a stack's spread over its trials.
+    #[command(subcommand)]
+    Stack(needle_cli::commands::stack::StackCommand),
     /// The library on Cortex-M under QEMU: size, bench, golden, check.
     #[command(subcommand)]
     Firmware(needle_cli::commands::firmware::FirmwareCommand),
@@ -86,6 +89,7 @@ fn main() -> ExitCode {
         Command::Plot(a) => commands::plot::run(a),
         Command::Header(a) => commands::header::run(a),
         Command::FixedError(a) => commands::fixed_error::run(a),
+        Command::Stack(c) => commands::stack::run(c),
         Command::Firmware(c) => commands::firmware::run(c),
     };
     match result {

@@ -25,7 +25,9 @@ pub fn run_trials(a: &CalibrateArgs) -> Result<ExitCode> {
     let out = a.out.clone().unwrap_or_else(|| a.set.join(needle_codegen::tissue::TISSUE_DIR).join(format!("{}.toml", a.name)));
     let inputs: Vec<(&str, &std::path::Path)> = a.trials.iter().map(|p| ("--trials", p.as_path())).collect();
     let figure = a.figure.clone().unwrap_or_else(|| a.set.join("figures").join(format!("calibration-{}.svg", a.name)));
-    let planned = [Planned { option: "--out", path: &out }, Planned { option: "--figure", path: &figure }];
+    let spread_out = needle_calibrate::spread::beside(&out);
+    let planned =
+        [Planned { option: "--out", path: &out }, Planned { option: "--figure", path: &figure }, Planned { option: "--out (its spread)", path: &spread_out }];
     planned_outputs::check(&planned, Some(&a.set), &inputs, a.force)?;
     let opts = TrialsOptions {
         trials: &a.trials,
@@ -59,8 +61,10 @@ pub fn run_trials(a: &CalibrateArgs) -> Result<ExitCode> {
     let shown: Vec<_> = c.trials.iter().zip(&c.replays).collect();
     let caption = format!("needle calibrate --trials: {} on {} trials, measured and model", a.name, c.trials.len());
     let svg = super::trials_figure::svg(&caption, &shown)?;
-    needle_stdx::fs::write_all_atomic(&[(&out, text.as_bytes()), (&figure, svg.as_bytes())])?;
+    let spread = needle_calibrate::spread::to_csv(&c.fitted.spread);
+    needle_stdx::fs::write_all_atomic(&[(&out, text.as_bytes()), (&spread_out, spread.as_bytes()), (&figure, svg.as_bytes())])?;
     say(format!("wrote {}", out.display()));
+    say(format!("wrote {} (the values' spread over the trials: needle stack sample)", spread_out.display()));
     say(format!("wrote {}", figure.display()));
     say(format!(
         "result: {}",
