@@ -27,7 +27,14 @@ pub fn sample(stack: &file::Stack, rows: &[Row], spread_path: &Path, normal: &mu
     let n = out.layers.len();
     for r in rows {
         let Some(l) = out.layers.get_mut(r.layer) else {
-            bail!("{}:{}: layer {}: the stack {:?} has {n} layers (0 to {})", spread_path.display(), r.line, r.layer, stack.name, n.saturating_sub(1))
+            bail!(
+                "{}:{}: layer {}: the stack {:?} has {n} layers (0 to {})",
+                spread_path.display(),
+                r.line,
+                r.layer,
+                stack.name,
+                n.saturating_sub(1)
+            )
         };
         let z = normal().clamp(-MAX_SDS, MAX_SDS);
         let value = match r.key {

@@ -77,16 +77,18 @@ pub fn parse(text: &str, path: &Path) -> Result<Vec<Row>> {
     let mut rows: Vec<Row> = Vec::new();
     for (n, l) in lines.filter(|(_, l)| !l.trim().is_empty()) {
         let cols: Vec<&str> = l.split(',').map(str::trim).collect();
-        let [layer, key, trials, mean, sd] = cols[..] else {
-            bail!("{file}:{n}: {} columns: a row has 5 ({HEADER})", cols.len())
-        };
+        let [layer, key, trials, mean, sd] = cols[..] else { bail!("{file}:{n}: {} columns: a row has 5 ({HEADER})", cols.len()) };
         let layer: usize = layer.parse().map_err(|_| anyhow::anyhow!("{file}:{n}: layer {layer:?}: not a layer index (0, 1, ...)"))?;
         let Some(key) = KEYS.iter().copied().find(|k| *k == key) else {
             bail!("{file}:{n}: key {key:?}: not one of the values fitted per trial ({})", KEYS.join(", "))
         };
-        let trials: usize = trials.parse().ok().filter(|t| *t >= 1).ok_or_else(|| anyhow::anyhow!("{file}:{n}: trials {trials:?}: a count, at least 1"))?;
+        let trials: usize =
+            trials.parse().ok().filter(|t| *t >= 1).ok_or_else(|| anyhow::anyhow!("{file}:{n}: trials {trials:?}: a count, at least 1"))?;
         let number = |name: &str, v: &str| -> Result<f64> {
-            v.parse::<f64>().ok().filter(|x| x.is_finite()).ok_or_else(|| anyhow::anyhow!("{file}:{n}: {name} {v:?}: not a finite number (the key's unit)"))
+            v.parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| anyhow::anyhow!("{file}:{n}: {name} {v:?}: not a finite number (the key's unit)"))
         };
         let (mean, sd) = (number("mean", mean)?, number("sd", sd)?);
         if sd < 0.0 {

@@ -137,10 +137,15 @@ pub fn fit(ts: &[Trial], opts: &TrialsOptions<'_>, diameter: f64, u: &dyn Fn(f64
 /// friction has no viscous term (the per-trial levels are then Coulomb levels).
 fn spreads(scale: Spread, puncture: Spread, cutting: Option<Spread>, f: &LayerFriction) -> Vec<(&'static str, Spread)> {
     let friction = (f.viscous_n_s_per_mm2 == 0.0).then(|| f.levels.clone());
-    [("stiffness_scale", Some(scale)), ("puncture_force_n", Some(puncture)), ("cutting_force_n", cutting), ("friction_coulomb_n_per_mm", friction)]
-        .into_iter()
-        .filter_map(|(k, s)| s.filter(|s| !s.values.is_empty()).map(|s| (k, s)))
-        .collect()
+    [
+        ("stiffness_scale", Some(scale)),
+        ("puncture_force_n", Some(puncture)),
+        ("cutting_force_n", cutting),
+        ("friction_coulomb_n_per_mm", friction),
+    ]
+    .into_iter()
+    .filter_map(|(k, s)| s.filter(|s| !s.values.is_empty()).map(|s| (k, s)))
+    .collect()
 }
 
 /// The first boundary's shape over the trials.

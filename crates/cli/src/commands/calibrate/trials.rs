@@ -26,8 +26,11 @@ pub fn run_trials(a: &CalibrateArgs) -> Result<ExitCode> {
     let inputs: Vec<(&str, &std::path::Path)> = a.trials.iter().map(|p| ("--trials", p.as_path())).collect();
     let figure = a.figure.clone().unwrap_or_else(|| a.set.join("figures").join(format!("calibration-{}.svg", a.name)));
     let spread_out = needle_calibrate::spread::beside(&out);
-    let planned =
-        [Planned { option: "--out", path: &out }, Planned { option: "--figure", path: &figure }, Planned { option: "--out (its spread)", path: &spread_out }];
+    let planned = [
+        Planned { option: "--out", path: &out },
+        Planned { option: "--figure", path: &figure },
+        Planned { option: "--out (its spread)", path: &spread_out },
+    ];
     planned_outputs::check(&planned, Some(&a.set), &inputs, a.force)?;
     let opts = TrialsOptions {
         trials: &a.trials,

@@ -37,7 +37,8 @@ pub struct SampleArgs {
 /// output is refused or cannot be written (nothing written).
 pub fn run(a: SampleArgs) -> Result<ExitCode> {
     let name = a.out.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-    crate::commands::calibrate::check_name(&name).with_context(|| format!("--out {}: the file's stem is the stack's name", a.out.display()))?;
+    crate::commands::calibrate::check_name(&name)
+        .with_context(|| format!("--out {}: the file's stem is the stack's name", a.out.display()))?;
     let spread_path = a.spread.clone().unwrap_or_else(|| spread::beside(&a.stack));
     let inputs = [("--stack", a.stack.as_path()), ("--spread", spread_path.as_path())];
     planned_outputs::check(&[Planned { option: "--out", path: &a.out }], None, &inputs, a.force)?;
