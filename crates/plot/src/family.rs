@@ -27,7 +27,7 @@ pub const MEASURED_FILE: &str = "family-measured.svg";
 
 /// Depths below this are left out of the exponent and ratio panels: forces there are
 /// below 1 % of the peak and their ratios are the solver's noise.
-const MIN_DEPTH_MM: f64 = 0.5;
+pub const MIN_DEPTH_MM: f64 = 0.5;
 
 fn label(m: &MemberRun) -> String {
     let deepest = m.deepest_mm();

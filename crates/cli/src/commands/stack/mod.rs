@@ -6,6 +6,8 @@ use std::process::ExitCode;
 
 /// The `needle stack` subcommands.
 #[derive(Subcommand)]
+// The doc comments and after_help are the --help text: <name> is a placeholder there.
+#[allow(rustdoc::invalid_html_tags)]
 pub enum StackCommand {
     /// Draw a plausible tissue within the spread over the trials a stack was fitted on.
     #[command(after_help = "The spread is the file `needle calibrate --trials` writes beside the stack \

@@ -11,6 +11,9 @@ use std::process::ExitCode;
 
 /// Arguments of `needle stack sample`.
 #[derive(Args)]
+// The fields' doc comments are the --help text, written for the terminal: <name> is a
+// placeholder there, not HTML.
+#[allow(rustdoc::invalid_html_tags)]
 pub struct SampleArgs {
     /// The stack: a tissue file written by `needle calibrate --trials`.
     #[arg(long, value_name = "FILE")]
