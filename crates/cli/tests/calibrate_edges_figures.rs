@@ -151,8 +151,9 @@ fn okamura_s_curve_on_the_paper_s_tissue_says_it_is_the_upper_edge() {
     assert!(assert_human_ticks(&svg, "liver figure") >= 16, "four panels with their ticks");
 }
 
-/// A whole-trial calibration's figure: per trial the force against time and the
-/// residual, the phases and punctures in the legend; `needle replay --figure` draws one
+/// A whole-trial calibration's figure: per trial the force against time, the residual,
+/// and the rise before the first puncture against depth; the phases and punctures in
+/// the legend; `needle replay --figure` draws one
 /// trial through a stack file the same way.
 #[test]
 fn a_whole_trial_calibration_writes_its_figure() {
@@ -165,11 +166,13 @@ fn a_whole_trial_calibration_writes_its_figure() {
     let texts = svg_texts(&svg);
     let count = |s: &str| texts.iter().filter(|x| x.contains(s)).count();
     assert_eq!(count("axial force against time (insertion, hold, withdrawal)"), 2, "{texts:?}");
-    assert_eq!(count("residual, measured - model"), 2, "{texts:?}");
+    assert_eq!(texts.iter().filter(|x| x.ends_with(".csv: residual, measured - model")).count(), 2, "{texts:?}");
+    assert_eq!(count("before the first puncture, against depth"), 2, "{texts:?}");
+    assert_eq!(count("first layer: member w = "), 1, "the caption names the shape: {texts:?}");
     for legend in ["measured punctures", "model punctures", "hold starts", "withdrawal starts", "model (calibrated stack)"] {
         assert_eq!(count(legend), 2, "{legend} in each trial's panel: {texts:?}");
     }
-    assert!(assert_human_ticks(&svg, "trials figure") >= 20, "four panels with their ticks");
+    assert!(assert_human_ticks(&svg, "trials figure") >= 30, "six panels with their ticks");
     // the stack just written, replayed on a third repeat, with its figure
     let replayed = d.path().join("replay.svg");
     let r = needle(&[

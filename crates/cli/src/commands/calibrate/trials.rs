@@ -62,7 +62,25 @@ pub fn run_trials(a: &CalibrateArgs) -> Result<ExitCode> {
     );
     let text = annotate(&c.fitted.stack.to_toml(&header), &c.fitted.uncertainty);
     let shown: Vec<_> = c.trials.iter().zip(&c.replays).collect();
-    let caption = format!("needle calibrate --trials: {} on {} trials, measured and model", a.name, c.trials.len());
+    let caption = match c.fitted.stack.layers.first() {
+        Some(l) => format!(
+            "needle calibrate --trials: {} on {} trials; first layer: member w = {}, scale s = {}, softening {}",
+            a.name,
+            c.trials.len(),
+            needle_plot::panel::tick_label(l.family_weight),
+            needle_plot::panel::tick_label(l.stiffness_scale),
+            if l.softening_fraction > 0.0 {
+                format!(
+                    "{} from {}",
+                    needle_plot::panel::tick_label(l.softening_fraction),
+                    needle_plot::panel::tick_label(l.softening_onset_ratio)
+                )
+            } else {
+                "none".into()
+            }
+        ),
+        None => format!("needle calibrate --trials: {} on {} trials", a.name, c.trials.len()),
+    };
     let svg = super::trials_figure::svg(&caption, &shown)?;
     let spread = needle_calibrate::spread::to_csv(&c.fitted.spread);
     needle_stdx::fs::write_all_atomic(&[(&out, text.as_bytes()), (&spread_out, spread.as_bytes()), (&figure, svg.as_bytes())])?;
