@@ -149,6 +149,10 @@ fn okamura_s_curve_on_the_paper_s_tissue_says_it_is_the_upper_edge() {
         assert_eq!(texts.iter().filter(|x| x.contains(t)).count(), 1, "panel {t:?} once: {texts:?}");
     }
     assert!(assert_human_ticks(&svg, "liver figure") >= 16, "four panels with their ticks");
+    // the figure docs/insertion.md shows is this one (regenerate it with the command
+    // there, `--figure coeffs/default/figures/calibration-liver.svg`)
+    let committed = std::fs::read_to_string(shipped_set().join("figures/calibration-liver.svg")).expect("committed figure");
+    assert!(committed == svg, "coeffs/default/figures/calibration-liver.svg is stale: rerun docs/insertion.md's needle calibrate");
 }
 
 /// A whole-trial calibration's figure: per trial the force against time, the residual,
