@@ -153,6 +153,31 @@ fn okamura_s_curve_on_the_paper_s_tissue_says_it_is_the_upper_edge() {
     // there, `--figure coeffs/default/figures/calibration-liver.svg`)
     let committed = std::fs::read_to_string(shipped_set().join("figures/calibration-liver.svg")).expect("committed figure");
     assert!(committed == svg, "coeffs/default/figures/calibration-liver.svg is stale: rerun docs/insertion.md's needle calibrate");
+    // --json: the same warning with its numbers, the model per measured point
+    let j = needle(&[
+        "calibrate",
+        "--curve",
+        &okamura().to_string_lossy(),
+        "--name",
+        "liver",
+        "--needle-diameter-mm",
+        "1.27",
+        "--speed-mm-per-s",
+        "3",
+        "--set",
+        &shipped_set_arg(),
+        "--out",
+        &out.to_string_lossy(),
+        "--figure",
+        &fig.to_string_lossy(),
+        "--force",
+        "--json",
+    ]);
+    let doc: serde_json::Value = serde_json::from_slice(&j.stdout).unwrap_or_else(|e| panic!("{e}\n{}", show(&j)));
+    let ws = doc["warnings"].as_array().expect("warnings");
+    assert!(ws.len() == 1 && ws[0]["key"] == "family_weight" && ws[0]["edge"] == "upper" && ws[0]["value"] == 1.0, "{ws:?}");
+    let points = std::fs::read_to_string(okamura()).expect("curve").lines().skip(1).filter(|l| !l.trim().is_empty()).count();
+    assert_eq!(doc["model"]["rows"].as_array().map(Vec::len), Some(points), "one model row per measured point");
 }
 
 /// A whole-trial calibration's figure: per trial the force against time, the residual,

@@ -1,5 +1,5 @@
-//! `needle calibrate --trials --json` and `needle replay --json`: the results as JSON
-//! for machines (a non-finite number is `null`).
+//! `needle calibrate --json` (`--curve` and `--trials`) and `needle replay --json`: the
+//! results as JSON for machines (a non-finite number is `null`).
 use needle_calibrate::edges::EdgeWarning;
 use needle_calibrate::replay::Check;
 use needle_calibrate::trial::Sample;
@@ -48,6 +48,39 @@ pub fn edges(es: &[EdgeWarning]) -> Value {
         .collect()
 }
 
+/// One layer of a tissue file: its values (the file's keys) and its shape.
+#[must_use]
+pub fn layer(l: &needle_codegen::tissue::Layer) -> Value {
+    let range = |r: Option<[f64; 2]>| r.map(|[lo, hi]| json!([num(lo), num(hi)]));
+    json!({
+        "name": l.name, "thickness_mm": l.thickness_mm, "stiffness_scale": l.stiffness_scale,
+        "puncture_force_n": l.puncture_force_n, "cutting_force_n": l.cutting_force_n,
+        "friction_static_n_per_mm": l.friction_static_n_per_mm, "friction_coulomb_n_per_mm": l.friction_coulomb_n_per_mm,
+        "friction_viscous_n_s_per_mm2": l.friction_viscous_n_s_per_mm2, "stick_band_mm_per_s": l.stick_band_mm_per_s,
+        "prony": l.prony.iter().map(|t| json!({"g": t.g, "tau_s": t.tau_s})).collect::<Vec<_>>(),
+        "family_weight": l.family_weight, "family_weight_range": range(l.family_weight_range),
+        "softening_fraction": l.softening_fraction, "softening_onset_ratio": l.softening_onset_ratio,
+        "softening_fraction_range": range(l.softening_fraction_range),
+    })
+}
+
+/// A single-curve calibration (`needle calibrate --curve --json`): the layers, the
+/// values on their range's edge, the checks, and per measured point the model's force
+/// (the state the model is in when the stage reaches the point).
+#[must_use]
+pub fn curve_calibration(c: &needle_calibrate::Calibration) -> Value {
+    let rows: Vec<Value> = c.points.iter().map(|p| json!([p.position_mm, p.force_n, num(c.replay.before(p.position_mm))])).collect();
+    let measured: Vec<Value> =
+        c.events.iter().filter_map(|e| c.points.get(e.peak)).map(|p| json!({"position_mm": p.position_mm, "force_n": p.force_n})).collect();
+    let model: Vec<Value> = c.replay.punctures.iter().map(|&(p, f)| json!({"position_mm": p, "force_n": num(f)})).collect();
+    json!({
+        "name": c.stack.name, "warnings": edges(&c.fit.edges), "similarity": c.similarity, "contact_mm": c.fit.onset_mm,
+        "layers": c.stack.layers.iter().map(layer).collect::<Vec<_>>(), "checks": checks(&c.checks),
+        "measured_punctures": measured,
+        "model": {"columns": ["position_mm", "force_n", "model_force_n"], "rows": rows, "model_punctures": model},
+    })
+}
+
 /// The whole calibration.
 #[must_use]
 pub fn calibration(c: &TrialsCalibration) -> Value {
@@ -59,14 +92,9 @@ pub fn calibration(c: &TrialsCalibration) -> Value {
         .zip(&c.fitted.uncertainty)
         .map(|(l, u)| {
             let uncertainty: serde_json::Map<String, Value> = u.iter().map(|(k, n)| ((*k).to_string(), json!(n))).collect();
-            json!({
-                "name": l.name, "thickness_mm": l.thickness_mm, "stiffness_scale": l.stiffness_scale,
-                "puncture_force_n": l.puncture_force_n, "cutting_force_n": l.cutting_force_n,
-                "friction_static_n_per_mm": l.friction_static_n_per_mm, "friction_coulomb_n_per_mm": l.friction_coulomb_n_per_mm,
-                "friction_viscous_n_s_per_mm2": l.friction_viscous_n_s_per_mm2, "stick_band_mm_per_s": l.stick_band_mm_per_s,
-                "prony": l.prony.iter().map(|t| json!({"g": t.g, "tau_s": t.tau_s})).collect::<Vec<_>>(),
-                "uncertainty": uncertainty,
-            })
+            let mut v = layer(l);
+            v["uncertainty"] = Value::Object(uncertainty);
+            v
         })
         .collect();
     let trials: Vec<Value> = c

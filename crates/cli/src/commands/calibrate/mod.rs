@@ -66,10 +66,10 @@ pub struct CalibrateArgs {
     /// without it, a missed goal writes nothing.
     #[arg(long)]
     pub write_on_miss: bool,
-    /// With --trials: print one JSON document (the fitted values with their
-    /// uncertainties, each check, the model force per measured row of each trial) instead
-    /// of the text.
-    #[arg(long, requires = "trials")]
+    /// Print one JSON document instead of the text: the fitted values (with --trials their
+    /// uncertainties), the values on their range's edge (warnings), each check, the model
+    /// force per measured row (of each trial).
+    #[arg(long)]
     pub json: bool,
 }
 
@@ -109,10 +109,19 @@ pub fn run(a: CalibrateArgs) -> Result<ExitCode> {
     planned_outputs::check(&planned, Some(&a.set), &[("--curve", &curve)], a.force)?;
     let points = needle_calibrate::measured::read_curve(&curve)?;
     let c = needle_calibrate::calibrate_points_with_progress(&opts, points, &mut progress_on_stderr())?;
-    print_fit(&c, needle_diameter_mm, mu0);
-    let all_met = print_checks(&c.checks);
+    let all_met = c.checks.iter().all(needle_calibrate::replay::Check::met);
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&self::json::curve_calibration(&c))?);
+        for e in &c.fit.edges {
+            eprintln!("warning: {e}");
+        }
+    } else {
+        print_fit(&c, needle_diameter_mm, mu0);
+        print_checks(&c.checks);
+    }
+    let say = |s: String| if a.json { eprintln!("{s}") } else { println!("{s}") };
     if !all_met && !a.write_on_miss {
-        println!("result: FAIL (a goal is missed): nothing written (--write-on-miss writes the stack and figure anyway)");
+        say("result: FAIL (a goal is missed): nothing written (--write-on-miss writes the stack and figure anyway)".into());
         return Ok(ExitCode::from(1));
     }
     let header = format!(
@@ -125,9 +134,12 @@ pub fn run(a: CalibrateArgs) -> Result<ExitCode> {
     let stack = c.stack.to_toml(&header);
     let svg = self::figure::svg(&c, &a.name, "measured")?;
     needle_stdx::fs::write_all_atomic(&[(&out, stack.as_bytes()), (&figure, svg.as_bytes())])?;
-    println!("wrote {}", out.display());
-    println!("wrote {}", figure.display());
-    println!("result: {}", if all_met { "every calibration goal met" } else { "FAIL (a goal is missed; written with --write-on-miss)" });
+    say(format!("wrote {}", out.display()));
+    say(format!("wrote {}", figure.display()));
+    say(format!(
+        "result: {}",
+        if all_met { "every calibration goal met" } else { "FAIL (a goal is missed; written with --write-on-miss)" }
+    ));
     Ok(if all_met { ExitCode::SUCCESS } else { ExitCode::from(1) })
 }
 
