@@ -22,6 +22,7 @@
 #![deny(missing_docs)]
 
 pub mod events;
+pub mod fe_loop;
 pub mod fit;
 pub mod from_model;
 
