@@ -23,6 +23,7 @@
 
 pub mod edges;
 pub mod events;
+pub mod fe_loop;
 pub mod fit;
 pub mod from_model;
 
