@@ -230,3 +230,42 @@ fn a_whole_trial_calibration_writes_its_figure() {
     ]);
     assert_eq!(again.status.code(), Some(2), "{}", show(&again));
 }
+
+/// The shipped rig-derived stack (`coeffs/default/calibrated/rig_skin_2mmps_t1.toml`,
+/// coeffs/README.md) and its committed spread and figure are what its command writes.
+#[test]
+fn the_shipped_rig_stack_s_spread_and_figure_are_up_to_date() {
+    let d = tempfile::tempdir().expect("tempdir");
+    let out = d.path().join("rig_skin_2mmps_t1.toml");
+    let fig = d.path().join("fig.svg");
+    let trial = rig("skin_2mmps_0deg_needle2_trial1.csv");
+    let o = needle(&[
+        "calibrate",
+        "--trials",
+        &trial.to_string_lossy(),
+        "--name",
+        "rig_skin_2mmps_t1",
+        "--needle-diameter-mm",
+        "1.27",
+        "--write-on-miss",
+        "--set",
+        &shipped_set_arg(),
+        "--out",
+        &out.to_string_lossy(),
+        "--figure",
+        &fig.to_string_lossy(),
+    ]);
+    let set = shipped_set();
+    let pairs = [
+        (out.clone(), set.join("calibrated/rig_skin_2mmps_t1.toml")),
+        (d.path().join("rig_skin_2mmps_t1.spread.csv"), set.join("calibrated/rig_skin_2mmps_t1.spread.csv")),
+        (fig, set.join("figures/calibration-rig_skin_2mmps_t1.svg")),
+    ];
+    for (fresh, committed) in pairs {
+        let a = std::fs::read_to_string(&fresh).unwrap_or_else(|e| panic!("{}: {e}\n{}", fresh.display(), show(&o)));
+        let b = std::fs::read_to_string(&committed).unwrap_or_else(|e| panic!("{}: {e}", committed.display()));
+        // the stack's header names the trial as given; compare from its first value on
+        let body = |t: &str| t.lines().filter(|l| !l.starts_with("# Trials:")).collect::<Vec<_>>().join("\n");
+        assert!(body(&a) == body(&b), "{} is stale: rerun coeffs/README.md's command for it", committed.display());
+    }
+}
