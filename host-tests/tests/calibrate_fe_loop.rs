@@ -55,13 +55,16 @@ fn febio_of_the_fitted_skin_meets_the_measured_pre_puncture_curve() {
     let c = calibrate_points(&opts, points).expect("the trial calibrates");
     let l0 = c.fit.layers.first().expect("a first layer");
     // the FE run is of this calibration's material: the same member and scale as the stack
+    // (`--trials` refits the first layer's scale with the trial's friction beside it: the
+    // two agree to 2e-7; 1e-6 is far below what the FE resolves)
     assert!((l0.family_weight - layer.family_weight).abs() <= 1e-12, "member {} vs the stack's {}", l0.family_weight, layer.family_weight);
-    assert!((l0.scale / layer.stiffness_scale - 1.0).abs() <= 1e-9, "scale {} vs the stack's {}", l0.scale, layer.stiffness_scale);
+    assert!((l0.scale / layer.stiffness_scale - 1.0).abs() <= 1e-6, "scale {} vs the stack's {}", l0.scale, layer.stiffness_scale);
 
     let k = fe_loop::compare(&c, &run.fy).expect("the FE run reaches the measured puncture");
     println!(
         "{TRIAL}: FEBio of w = {}, moduli x {:.4} (run {}), needle x {:.4}: RMS {:.2} % of the puncture force {:.3} N over {} points \
-         (max {:.2} %); below the softening's onset {:.2} % over {} points; FE depth needed {:.2} mm",
+         (max {:.2} %); below the softening's onset {:.2} % over {} points; with the layer's softening on the FE force {:.2} %; \
+         FE depth needed {:.2} mm",
         layer.family_weight,
         layer.stiffness_scale,
         fitted.run_name(),
@@ -72,6 +75,7 @@ fn febio_of_the_fitted_skin_meets_the_measured_pre_puncture_curve() {
         k.max_pct,
         k.rms_below_softening_pct,
         k.points_below_softening,
+        k.rms_softened_pct,
         k.fe_depth_needed_mm
     );
     assert!(k.points > 100, "the rise has {} points", k.points);

@@ -25,6 +25,10 @@ pub struct LoopCheck {
     pub rms_below_softening_pct: f64,
     /// Their count.
     pub points_below_softening: usize,
+    /// RMS over every point of the rise with the layer's fitted softening applied to the
+    /// FE force (`1 - D(ρ)`, ρ = FE force over the FE force at the peak: the calibrated
+    /// failure law on top of the FE material), % of the puncture force.
+    pub rms_softened_pct: f64,
     /// The measured force at the first puncture, N.
     pub puncture_force_n: f64,
     /// The FE depth the comparison needs, mm of the FE needle (the peak's).
@@ -56,11 +60,14 @@ pub fn compare(c: &Calibration, fe: &[(f64, f64)]) -> Result<LoopCheck> {
     }
     let fe_at = |d: f64| interpolate(fe, d) * lambda * lambda;
     let at_peak = fe_at(needed);
-    let r0 = c.fit.layers.first().map_or(0.0, |l| if l.softening.fraction > 0.0 { l.softening.onset_ratio } else { 1.0 });
+    let softening = c.fit.layers.first().map_or(crate::shape::Softening::NONE, |l| l.softening);
+    let r0 = if softening.fraction > 0.0 { softening.onset_ratio } else { 1.0 };
     let f_p = peak.force_n;
-    let (mut sum, mut sum_below, mut below, mut max) = (0.0, 0.0, 0usize, 0.0f64);
+    let (mut sum, mut sum_below, mut below, mut max, mut sum_soft) = (0.0, 0.0, 0usize, 0.0f64, 0.0);
     for p in &rise {
         let model = fe_at((p.position_mm - onset) / lambda);
+        let rho = if at_peak > 0.0 { model / at_peak } else { 0.0 };
+        sum_soft += (model * softening.factor(rho) - p.force_n).powi(2);
         let e = model - p.force_n;
         sum += e * e;
         max = max.max(e.abs());
@@ -76,6 +83,7 @@ pub fn compare(c: &Calibration, fe: &[(f64, f64)]) -> Result<LoopCheck> {
         points: rise.len(),
         rms_below_softening_pct: pct(sum_below, below),
         points_below_softening: below,
+        rms_softened_pct: pct(sum_soft, rise.len()),
         puncture_force_n: f_p,
         fe_depth_needed_mm: needed,
     })
