@@ -91,6 +91,15 @@ pub fn ratio(depth_mm_q16: i32, member: &FamilyMember) -> (i64, i64) {
     ratio_of(&law, depth_mm_q16, member)
 }
 
+/// Bytes of the law's constants in integers (the coefficients, the depth and its two
+/// inverses): the fixed-point family's tables, at most what they put in flash (issue 64's
+/// goal for the family's tables, f32 and integer together: <= 1 KiB;
+/// host-tests/tests/firmware_no_panic.rs).
+pub const TABLE_BYTES: usize = core::mem::size_of_val(&COEFFS_Q30)
+    + core::mem::size_of_val(&DEPTH_MAX_MM_Q16)
+    + core::mem::size_of_val(&INV_DEPTH_MAX_Q30)
+    + core::mem::size_of_val(&INV_DEPTH_MAX_Q24);
+
 /// A law's constants in integers (the generated ones, or a test's).
 struct Law {
     depth_max_mm_q16: i32,
