@@ -116,7 +116,8 @@ fn loop_tick_instructions_with_tissue_shape_on_cortex_m4f() {
         assert!(phase.starts_with(want), "{what}: phase {phase}, want {want}..");
         let goal = if *terms == 0 { 1600.0 } else { 1600.0 + 120.0 };
         if *n > goal {
-            missed.push(format!("{what}: {n} instructions per loop tick with {terms} Prony term(s) on the deflected layer (goal <= {goal})"));
+            missed
+                .push(format!("{what}: {n} instructions per loop tick with {terms} Prony term(s) on the deflected layer (goal <= {goal})"));
         }
     }
     assert!(missed.is_empty(), "with tissue-shape:\n{}", missed.join("\n"));

@@ -193,7 +193,11 @@ fn shaped_insertion_firmware_links_runs_and_fits_in_24_kib_on_every_core() {
                     report.model_flash().saturating_sub(before.model_flash()),
                     report.static_ram()
                 );
-                assert!(report.model_flash() > before.model_flash(), "{}: {name} {features:?} holds no more than without the feature", core.core);
+                assert!(
+                    report.model_flash() > before.model_flash(),
+                    "{}: {name} {features:?} holds no more than without the feature",
+                    core.core
+                );
                 if report.model_flash() > 24 * 1024 {
                     missed.push(format!("{}: {name} {features:?}: {} B > 24 KiB", core.core, report.model_flash()));
                 }

@@ -706,12 +706,15 @@ mod tests {
         let both = "#[cfg(all(feature = \"viscoelastic\", feature = \"tissue-shape\"))]\npub const RIG_SKIN:";
         assert!(rust.contains(both), "rig_skin is not gated by both features:\n{rust}");
         let alls: Vec<&str> = rust.lines().filter(|l| l.starts_with("pub const ALL")).collect();
-        assert_eq!(alls, [
-            "pub const ALL: [Stack<'static>; 1] = [LIVER];",
-            "pub const ALL: [Stack<'static>; 1] = [LIVER];",
-            "pub const ALL: [Stack<'static>; 2] = [EPIDURAL, LIVER];",
-            "pub const ALL: [Stack<'static>; 3] = [EPIDURAL, LIVER, RIG_SKIN];",
-        ]);
+        assert_eq!(
+            alls,
+            [
+                "pub const ALL: [Stack<'static>; 1] = [LIVER];",
+                "pub const ALL: [Stack<'static>; 1] = [LIVER];",
+                "pub const ALL: [Stack<'static>; 2] = [EPIDURAL, LIVER];",
+                "pub const ALL: [Stack<'static>; 3] = [EPIDURAL, LIVER, RIG_SKIN];",
+            ]
+        );
         let lines: Vec<&str> = rust.lines().collect();
         for (i, l) in lines.iter().enumerate().filter(|(_, l)| l.starts_with("pub const ALL")) {
             assert!(lines.get(i.wrapping_sub(2)).is_some_and(|d| d.starts_with("///")), "ALL at line {} has no doc:\n{rust}", i + 1);
