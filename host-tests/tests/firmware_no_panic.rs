@@ -218,6 +218,10 @@ fn the_family_tables_fit_in_1_kib() {
         + std::mem::size_of_val(&t::FITTED);
     let fixed_bytes = needle_haptics::fixed::family::TABLE_BYTES;
     println!("family tables: f32 {f32_bytes} B, fixed point {fixed_bytes} B, together {} B (goal <= 1,024 B)", f32_bytes + fixed_bytes);
-    assert!(t::FITTED, "the set has no family law: nothing measured");
+    // at run time, not in a `const` block: a set without the law fails this test alone
+    #[allow(clippy::assertions_on_constants)]
+    {
+        assert!(t::FITTED, "the set has no family law: nothing measured");
+    }
     assert!(f32_bytes + fixed_bytes <= 1024, "the family's tables take {} B > 1 KiB", f32_bytes + fixed_bytes);
 }

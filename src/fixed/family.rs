@@ -87,14 +87,11 @@ const fn rows_of(coeffs_q30: &[[i64; 3]; 5], t: i64) -> [i64; 5] {
     const fn m(a: i64, m: i64) -> i64 {
         a.saturating_mul(m) >> 24
     }
-    let mut c = [0i64; 5];
-    let mut j = 0;
-    while j < 5 {
-        let [a0, a1, a2] = coeffs_q30[j];
-        c[j] = m(m(a2, t).saturating_add(a1), t).saturating_add(a0);
-        j += 1;
+    const fn row([a0, a1, a2]: [i64; 3], t: i64) -> i64 {
+        m(m(a2, t).saturating_add(a1), t).saturating_add(a0)
     }
-    c
+    let [r0, r1, r2, r3, r4] = *coeffs_q30;
+    [row(r0, t), row(r1, t), row(r2, t), row(r3, t), row(r4, t)]
 }
 
 /// `g(d, w)` in Q30 and its rate by depth, 1/mm in Q30, at `depth_mm_q16` (the module's
@@ -112,10 +109,14 @@ pub fn ratio(depth_mm_q16: i32, member: &FamilyMember) -> (i64, i64) {
 /// inverses): the fixed-point family's tables, at most what they put in flash (issue 64's
 /// goal for the family's tables, f32 and integer together: <= 1 KiB;
 /// host-tests/tests/firmware_no_panic.rs).
-pub const TABLE_BYTES: usize = core::mem::size_of_val(&COEFFS_Q30)
-    + core::mem::size_of_val(&DEPTH_MAX_MM_Q16)
-    + core::mem::size_of_val(&INV_DEPTH_MAX_Q30)
-    + core::mem::size_of_val(&INV_DEPTH_MAX_Q24);
+pub const TABLE_BYTES: usize =
+    bytes_of(&COEFFS_Q30) + bytes_of(&DEPTH_MAX_MM_Q16) + bytes_of(&INV_DEPTH_MAX_Q30) + bytes_of(&INV_DEPTH_MAX_Q24);
+
+/// The size of `value`'s type, bytes (`size_of_val` in a `const` needs a newer Rust than
+/// the crate's MSRV).
+const fn bytes_of<T>(_value: &T) -> usize {
+    core::mem::size_of::<T>()
+}
 
 /// A law's depth constants in integers (the generated ones, or a test's; its rows at a
 /// member are the member's, [`rows_of`]).

@@ -716,7 +716,7 @@ mod tests {
             ]
         );
         let lines: Vec<&str> = rust.lines().collect();
-        for (i, l) in lines.iter().enumerate().filter(|(_, l)| l.starts_with("pub const ALL")) {
+        for (i, _) in lines.iter().enumerate().filter(|(_, l)| l.starts_with("pub const ALL")) {
             assert!(lines.get(i.wrapping_sub(2)).is_some_and(|d| d.starts_with("///")), "ALL at line {} has no doc:\n{rust}", i + 1);
         }
     }
