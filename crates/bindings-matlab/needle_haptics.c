@@ -110,15 +110,23 @@ static float scalar_arg(const mxArray *a, const char *what) {
 
 static void do_insertion(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[]) {
   if (nrhs != 3 && nrhs != 5) mexErrMsgIdAndTxt("needle:args", "usage: needle_haptics('insertion', stack, poses [, period_s, time_constant_s])");
-  char stack[64];
-  if (!mxIsChar(prhs[1]) || mxGetString(prhs[1], stack, sizeof stack) != 0) mexErrMsgIdAndTxt("needle:args", "stack must be a name (char), e.g. 'liver'");
+  char stack[4096];
+  if (!mxIsChar(prhs[1]) || mxGetString(prhs[1], stack, sizeof stack) != 0)
+    mexErrMsgIdAndTxt("needle:args", "stack must be a name (char), e.g. 'liver', or a tissue file's path ending in .toml");
   float period_s = nrhs == 5 ? scalar_arg(prhs[3], "period_s") : 0.001f;
   float tau_s = nrhs == 5 ? scalar_arg(prhs[4], "time_constant_s") : 0.005f;
   size_t n;
   const float *p = check_poses(prhs[2], &n);
   needle_insertion_t state;
   memset(&state, 0, sizeof state);
-  int32_t rc = needle_insertion_init(&state, stack, period_s, tau_s);
+  /* a name ending in .toml is a tissue file, loaded now and checked as the build checks a
+   * compiled-in stack (its refusal names FILE:LINE) */
+  size_t len = strlen(stack);
+  int is_file = len > 5 && strcmp(stack + len - 5, ".toml") == 0;
+  char why[1024] = "";
+  int32_t rc = is_file ? needle_insertion_init_file(&state, stack, period_s, tau_s, why, sizeof why)
+                       : needle_insertion_init(&state, stack, period_s, tau_s);
+  if (rc == NEEDLE_E_ARG && is_file) mexErrMsgIdAndTxt("needle:insertion", "%s", why);
   if (rc == NEEDLE_E_ARG) mexErrMsgIdAndTxt("needle:insertion", "no tissue stack '%s' in this build", stack);
   if (rc != NEEDLE_OK) mexErrMsgIdAndTxt("needle:insertion", "period_s must be finite and > 0, time_constant_s finite and >= 0 (code %d)", (int)rc);
   mxArray *outs[6] = {numeric(n, 6, mxSINGLE_CLASS), numeric(n, 1, mxUINT8_CLASS), numeric(n, 1, mxUINT16_CLASS), numeric(n, 1, mxUINT8_CLASS),

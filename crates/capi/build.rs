@@ -5,7 +5,16 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Watched for changes; cbindgen parses `src/lib.rs` and follows its `mod` items.
-const SOURCES: [&str; 6] = ["src/lib.rs", "src/types.rs", "src/eval.rs", "src/control.rs", "src/command.rs", "src/names.rs"];
+const SOURCES: [&str; 8] = [
+    "src/lib.rs",
+    "src/types.rs",
+    "src/eval.rs",
+    "src/control.rs",
+    "src/command.rs",
+    "src/names.rs",
+    "src/insertion.rs",
+    "src/insertion_file.rs",
+];
 
 fn main() -> ExitCode {
     let dir = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").unwrap_or_default());

@@ -66,7 +66,7 @@ fn fixed_point_insertion_follows_the_f32_one_on_every_golden_path() {
             for_each_tick_q16(path, depth_scale(stack), |_, p| fixed_out.push(fins.step(&fixed::Pose::new(p[0], p[1], p[2], p[3], p[4]))));
             assert_eq!(f32_out.len(), fixed_out.len());
             let peak: f64 = f32_out.iter().flat_map(|e| e.wrench.to_array()).map(|c| f64::from(c).abs() * 1e6).fold(0.0, f64::max);
-            let (mut phase_differs, mut worst, mut worst_rel) = (0usize, [0.0f64; 6], 0.0f64);
+            let (mut phase_differs, mut worst, mut worst_rel, mut saturated) = (0usize, [0.0f64; 6], 0.0f64, 0usize);
             let punctures = |v: &dyn Fn(usize) -> u8| (0..f32_out.len()).map(|k| u64::from(v(k))).sum::<u64>();
             let (pf, px) = (punctures(&|k| f32_out[k].punctures), punctures(&|k| fixed_out[k].punctures));
             for (k, (a, b)) in f32_out.iter().zip(&fixed_out).enumerate() {
@@ -75,7 +75,14 @@ fn fixed_point_insertion_follows_the_f32_one_on_every_golden_path() {
                     continue;
                 }
                 for (c, (x, y)) in a.wrench.to_array().iter().zip(b.wrench.to_array()).enumerate() {
-                    let d = (f64::from(*x) * 1e6 - f64::from(y)).abs();
+                    // a fixed-point component is an i32 (µN, µN·mm): a moment beyond
+                    // ±2,147 N·mm saturates by its type (`fixed::insertion`'s module docs),
+                    // where the f32 one is bounded only by the sum's 10,000 N·mm; the
+                    // shipped `rig_skin` reaches -2,150.7 N·mm on path 2 (a tilted needle
+                    // drifting sideways in its stiff bottom layer): compared in the type's range
+                    let want = (f64::from(*x) * 1e6).clamp(f64::from(i32::MIN), f64::from(i32::MAX));
+                    saturated += usize::from(want != f64::from(*x) * 1e6);
+                    let d = (want - f64::from(y)).abs();
                     worst[c] = worst[c].max(d);
                     let allowed = bound[c] + 1e-6 * peak;
                     worst_rel = worst_rel.max(d / allowed);
@@ -87,7 +94,7 @@ fn fixed_point_insertion_follows_the_f32_one_on_every_golden_path() {
                 }
             }
             println!(
-                "{} path {i}: {} ticks, punctures f32 {pf} fixed {px}, phase differs in {phase_differs} ticks, largest difference {:?} µN(mm) (bound {:?}), worst/bound {worst_rel:.3}",
+                "{} path {i}: {} ticks, punctures f32 {pf} fixed {px}, phase differs in {phase_differs} ticks, largest difference {:?} µN(mm) (bound {:?}), worst/bound {worst_rel:.3}, f32 components beyond i32 {saturated}",
                 stack.name,
                 f32_out.len(),
                 worst.map(|w| w.round()),

@@ -5,22 +5,32 @@
 //! f32 insertion and with the fixed-point one (`fixed::insertion`), through the C API
 //! and in wasm: every
 //! tick's six wrench components, status, phase, punctures and flags, compared as a digest per
-//! path (FNV-1a over every tick's words; one differing bit changes it).
+//! path (FNV-1a over every tick's words; one differing bit changes it). The firmware is
+//! built twice: the product's features (`viscoelastic`: the stacks without a family member
+//! or a softening) and with `tissue-shape` too (every stack, the shaped ones: issue 64);
+//! the host, the C API and wasm have both features and run every stack.
 #[path = "../../examples/common/insertion_paths.rs"]
 mod paths;
 
+use needle_firmware_host::build::Features;
 use needle_firmware_host::{build, core, qemu};
 use needle_haptics::fixed;
 use needle_haptics::fixed::insertion::{stacks as fixed_stacks, Insertion as FixedInsertion, InsertionConfig as FixedConfig};
-use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, Phase};
+use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, Phase, Stack};
 use needle_haptics::Pose;
 use paths::{depth_scale, for_each_path_tick, for_each_path_tick_q16, for_each_tick, Digest, PATHS, PATH_COUNT};
 use std::time::Duration;
 
-/// The host's lines, in the firmware's format.
+/// The host's lines, in the firmware's format: every stack (the host crates have every
+/// library feature).
 fn host_lines() -> Vec<String> {
+    host_lines_of(|_| true)
+}
+
+/// The host's lines of the stacks `keep` takes (those a firmware build compiles in).
+fn host_lines_of(keep: impl Fn(&Stack<'_>) -> bool) -> Vec<String> {
     let mut lines = Vec::new();
-    for stack in &stacks::ALL {
+    for stack in stacks::ALL.iter().filter(|s| keep(s)) {
         for i in 0..PATH_COUNT {
             let mut insertion = Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ).expect("shipped stack");
             let mut digest = Digest::new();
@@ -47,10 +57,15 @@ fn line(prefix: &str, name: &str, i: usize, ticks: u64, punctures: u64, digest: 
 }
 
 /// The host's lines of the fixed-point insertion (`fixed::insertion`, the paths' Q16.16
-/// poses), in the firmware's format.
+/// poses), in the firmware's format: every stack.
 fn host_fixed_lines() -> Vec<String> {
+    host_fixed_lines_of(|_| true)
+}
+
+/// The host's fixed-point lines of the stacks `keep` takes (by their f32 form).
+fn host_fixed_lines_of(keep: impl Fn(&Stack<'_>) -> bool) -> Vec<String> {
     let mut lines = Vec::new();
-    for (stack, scale_of) in fixed_stacks::ALL.iter().zip(&stacks::ALL) {
+    for (stack, scale_of) in fixed_stacks::ALL.iter().zip(&stacks::ALL).filter(|(_, s)| keep(s)) {
         for i in 0..PATH_COUNT {
             let mut insertion = FixedInsertion::new(stack, FixedConfig::DEFAULT_1KHZ).expect("shipped stack");
             let mut digest = Digest::new();
@@ -104,35 +119,66 @@ fn the_golden_paths_reach_the_deepest_layer_of_every_stack() {
     }
 }
 
-fn on(core_name: &str) {
+/// The `insertion_golden` firmware built with `features` on `core_name` under QEMU against
+/// the host's lines of the stacks that build compiles in.
+fn on(core_name: &str, features: Features) {
     let core = core(core_name).unwrap_or_else(|e| panic!("{e:#}"));
     let set = needle_firmware_host::compiled_set();
-    let elf = build::build_examples(&core, &["insertion_golden"], &set).unwrap_or_else(|e| panic!("{e:#}")).remove(0);
+    let elf = build::build_examples_with(&core, &["insertion_golden"], &set, features).unwrap_or_else(|e| panic!("{e:#}")).remove(0);
     let run = qemu::run(&core, &elf, false, Duration::from_secs(900)).unwrap_or_else(|e| panic!("{e:#}"));
     assert!(run.status.success(), "{core_name}: exit {}: {}\n{}", run.status, run.stdout, run.stderr);
     let got: Vec<&str> = run.stdout.lines().filter(|l| l.starts_with("stack=") || l.starts_with("fixed stack=")).collect();
-    let want: Vec<String> = host_lines().into_iter().chain(host_fixed_lines()).collect();
+    let keep = |s: &Stack<'_>| features.compiles(s);
+    let want: Vec<String> = host_lines_of(keep).into_iter().chain(host_fixed_lines_of(keep)).collect();
     assert_eq!(got.len(), want.len(), "{core_name}: {} paths printed, the host has {}:\n{}", got.len(), want.len(), run.stdout);
     for (g, w) in got.iter().zip(&want) {
         assert_eq!(g, w, "{core_name}: the firmware's path differs from the host's");
     }
     assert!(run.stdout.lines().any(|l| l == "needle-insertion-golden end"), "{core_name}: no end line");
-    println!("{core_name}: {} golden insertion paths bit-exact ({:.1} s under QEMU)", got.len(), run.elapsed.as_secs_f64());
+    println!("{core_name} ({features:?}): {} golden insertion paths bit-exact ({:.1} s under QEMU)", got.len(), run.elapsed.as_secs_f64());
 }
 
 #[test]
 fn golden_insertions_on_cortex_m4f_mps2_an386() {
-    on("m4f");
+    on("m4f", Features::Viscoelastic);
 }
 
 #[test]
 fn golden_insertions_on_cortex_m3_mps2_an385() {
-    on("m3");
+    on("m3", Features::Viscoelastic);
 }
 
 #[test]
 fn golden_insertions_on_cortex_m0_microbit() {
-    on("m0");
+    on("m0", Features::Viscoelastic);
+}
+
+/// The shipped stacks that only a build with `tissue-shape` compiles in (a family member or
+/// a softening): the shaped goldens below run them, so they cannot pass without one.
+fn shaped_stacks() -> Vec<&'static str> {
+    stacks::ALL.iter().filter(|s| Features::Shape.compiles(s) && !Features::Viscoelastic.compiles(s)).map(|s| s.name).collect()
+}
+
+/// The same paths with the `tissue-shape` feature (and `viscoelastic`): every stack, the
+/// shaped ones too, f32 and fixed point (issue 64).
+fn shaped_on(core_name: &str) {
+    assert!(!shaped_stacks().is_empty(), "the set ships no stack with a family member or a softening");
+    on(core_name, Features::Shape);
+}
+
+#[test]
+fn golden_shaped_insertions_on_cortex_m4f_mps2_an386() {
+    shaped_on("m4f");
+}
+
+#[test]
+fn golden_shaped_insertions_on_cortex_m3_mps2_an385() {
+    shaped_on("m3");
+}
+
+#[test]
+fn golden_shaped_insertions_on_cortex_m0_microbit() {
+    shaped_on("m0");
 }
 
 /// The C API's run of the paths (`needle_insertion_*` through their C ABI), in the

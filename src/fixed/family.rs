@@ -36,12 +36,17 @@ const COEFFS_Q30: [[i64; 3]; 5] = {
     [row(r0), row(r1), row(r2), row(r3), row(r4)]
 };
 
-/// A member of the family in integers: `w` and `sqrt(w)` in Q24.
+/// A member of the family in integers: `w` and `sqrt(w)` in Q24, and the law's rows at
+/// this member.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FamilyMember {
     weight_q24: i64,
     sqrt_weight_q24: i64,
+    /// `c_j = (a_j2 t + a_j1) t + a_j0` in Q30, `t = sqrt(w)`: a layer's constants,
+    /// computed once with the member (on the build host for a compiled-in stack), not per
+    /// tick (10 of a tick's 25 saturating products: the M0's fixed-point step, issue 64).
+    rows_q30: [i64; 5],
 }
 
 impl Default for FamilyMember {
@@ -53,13 +58,14 @@ impl Default for FamilyMember {
 
 impl FamilyMember {
     /// The paper's own tissue (`w = 1`).
-    pub const PAPER: Self = Self { weight_q24: ONE_Q24, sqrt_weight_q24: ONE_Q24 };
+    pub const PAPER: Self = Self { weight_q24: ONE_Q24, sqrt_weight_q24: ONE_Q24, rows_q30: rows_of(&COEFFS_Q30, ONE_Q24) };
 
     /// The f32 member's values rounded to Q24 (`const`: compiled-in stacks convert on the
     /// build host).
     #[must_use]
     pub const fn from_f32(m: &FamilyMember32) -> Self {
-        Self { weight_q24: round_i64(m.weight() as f64 * Q24), sqrt_weight_q24: round_i64(m.sqrt_weight() as f64 * Q24) }
+        let t = round_i64(m.sqrt_weight() as f64 * Q24);
+        Self { weight_q24: round_i64(m.weight() as f64 * Q24), sqrt_weight_q24: t, rows_q30: rows_of(&COEFFS_Q30, t) }
     }
 
     /// `w` in Q24.
@@ -75,6 +81,19 @@ fn mul_m(a: i64, m: i64) -> i64 {
     sat_mul(a, m) >> 24
 }
 
+/// The law's rows at `t` (Q24): `c_j = (a_j2 t + a_j1) t + a_j0` in Q30, each product
+/// [`mul_m`]'s (`const`, the same integers).
+const fn rows_of(coeffs_q30: &[[i64; 3]; 5], t: i64) -> [i64; 5] {
+    const fn m(a: i64, m: i64) -> i64 {
+        a.saturating_mul(m) >> 24
+    }
+    const fn row([a0, a1, a2]: [i64; 3], t: i64) -> i64 {
+        m(m(a2, t).saturating_add(a1), t).saturating_add(a0)
+    }
+    let [r0, r1, r2, r3, r4] = *coeffs_q30;
+    [row(r0, t), row(r1, t), row(r2, t), row(r3, t), row(r4, t)]
+}
+
 /// `g(d, w)` in Q30 and its rate by depth, 1/mm in Q30, at `depth_mm_q16` (the module's
 /// law). Never panics.
 #[must_use]
@@ -82,25 +101,33 @@ pub fn ratio(depth_mm_q16: i32, member: &FamilyMember) -> (i64, i64) {
     if !f32_tables::FITTED {
         return (ONE_Q30, 0);
     }
-    let law = Law {
-        depth_max_mm_q16: DEPTH_MAX_MM_Q16,
-        inv_depth_max_q30: INV_DEPTH_MAX_Q30,
-        inv_depth_max_q24: INV_DEPTH_MAX_Q24,
-        coeffs_q30: COEFFS_Q30,
-    };
-    ratio_of(&law, depth_mm_q16, member)
+    let law = Law { depth_max_mm_q16: DEPTH_MAX_MM_Q16, inv_depth_max_q30: INV_DEPTH_MAX_Q30, inv_depth_max_q24: INV_DEPTH_MAX_Q24 };
+    ratio_of(&law, depth_mm_q16, member, &member.rows_q30)
 }
 
-/// A law's constants in integers (the generated ones, or a test's).
+/// Bytes of the law's constants in integers (the coefficients, the depth and its two
+/// inverses): the fixed-point family's tables, at most what they put in flash (issue 64's
+/// goal for the family's tables, f32 and integer together: <= 1 KiB;
+/// host-tests/tests/firmware_no_panic.rs).
+pub const TABLE_BYTES: usize =
+    bytes_of(&COEFFS_Q30) + bytes_of(&DEPTH_MAX_MM_Q16) + bytes_of(&INV_DEPTH_MAX_Q30) + bytes_of(&INV_DEPTH_MAX_Q24);
+
+/// The size of `value`'s type, bytes (`size_of_val` in a `const` needs a newer Rust than
+/// the crate's MSRV).
+const fn bytes_of<T>(_value: &T) -> usize {
+    core::mem::size_of::<T>()
+}
+
+/// A law's depth constants in integers (the generated ones, or a test's; its rows at a
+/// member are the member's, [`rows_of`]).
 struct Law {
     depth_max_mm_q16: i32,
     inv_depth_max_q30: i64,
     inv_depth_max_q24: i64,
-    coeffs_q30: [[i64; 3]; 5],
 }
 
-/// [`ratio`] of `law`.
-fn ratio_of(law: &Law, depth_mm_q16: i32, member: &FamilyMember) -> (i64, i64) {
+/// [`ratio`] of `law`, its rows at `member` being `rows_q30`.
+fn ratio_of(law: &Law, depth_mm_q16: i32, member: &FamilyMember, rows_q30: &[i64; 5]) -> (i64, i64) {
     if member.weight_q24 >= ONE_Q24 {
         return (ONE_Q30, 0);
     }
@@ -113,9 +140,7 @@ fn ratio_of(law: &Law, depth_mm_q16: i32, member: &FamilyMember) -> (i64, i64) {
     };
     // mm in Q16 times 1/mm in Q30 is Q46; over 2^22: u in Q24
     let u = sat_mul(i64::from(d), law.inv_depth_max_q30) >> 22;
-    let t = member.sqrt_weight_q24;
-    let c = law.coeffs_q30.map(|[a0, a1, a2]| mul_m(mul_m(a2, t).saturating_add(a1), t).saturating_add(a0));
-    let [c0, c1, c2, c3, c4] = c;
+    let [c0, c1, c2, c3, c4] = *rows_q30;
     let p = mul_m(mul_m(mul_m(mul_m(c4, u).saturating_add(c3), u).saturating_add(c2), u).saturating_add(c1), u).saturating_add(c0);
     let dp = mul_m(mul_m(mul_m(sat_mul(4, c4), u).saturating_add(sat_mul(3, c3)), u).saturating_add(sat_mul(2, c2)), u).saturating_add(c1);
     let soft = ONE_Q24 - member.weight_q24;
@@ -140,8 +165,8 @@ mod tests {
             depth_max_mm_q16: round_i64(16.2f32 as f64 * 65536.0) as i32,
             inv_depth_max_q30: round_i64(inv as f64 * Q30),
             inv_depth_max_q24: round_i64(inv as f64 * Q24),
-            coeffs_q30: coeffs.map(|row| row.map(|a| round_i64(a as f64 * Q30))),
         };
+        let coeffs_q30 = coeffs.map(|row| row.map(|a| round_i64(a as f64 * Q30)));
         let weights = [0.0f32, 0.002, 0.05, 0.3, 0.9, 1.0];
         let members = weights.map(f32_family::FamilyMember::new);
         assert!(members.iter().all(Option::is_some), "every weight in 0..=1 makes a member");
@@ -149,12 +174,27 @@ mod tests {
             let m = FamilyMember::from_f32(m32);
             for d in [0.0f32, 0.1, 1.0, 4.5, 9.0, 16.0, 17.0] {
                 let (g32, r32) = f32_family::ratio_of(&law32, d, m32);
-                let (g, r) = ratio_of(&law, round_i64(d as f64 * 65536.0) as i32, &m);
+                let (g, r) = ratio_of(&law, round_i64(d as f64 * 65536.0) as i32, &m, &rows_of(&coeffs_q30, m.sqrt_weight_q24));
                 let (g, r) = (g as f64 / Q30, r as f64 / Q30);
                 assert!((g - g32 as f64).abs() <= 2e-6, "w {w} d {d}: {g} vs {g32}");
                 assert!((r - r32 as f64).abs() <= 2e-6, "w {w} d {d}: rate {r} vs {r32}; g {g} vs {g32}");
             }
         }
-        assert_eq!(ratio_of(&law, 5 << 16, &FamilyMember::PAPER), (ONE_Q30, 0));
+        assert_eq!(ratio_of(&law, 5 << 16, &FamilyMember::PAPER, &rows_of(&coeffs_q30, ONE_Q24)), (ONE_Q30, 0));
+    }
+
+    /// The rows computed once with the member are the ones the tick computed from the
+    /// generated law before (issue 64's M0 cost): the same integers, so the same ratio, bit
+    /// for bit, at every weight and depth tried.
+    #[test]
+    fn the_members_rows_are_the_per_tick_rows() {
+        let per_tick = |t: i64| COEFFS_Q30.map(|[a0, a1, a2]| mul_m(mul_m(a2, t).saturating_add(a1), t).saturating_add(a0));
+        for k in 0..=200 {
+            let w = k as f32 / 200.0;
+            let Some(m32) = f32_family::FamilyMember::new(w) else { continue };
+            let m = FamilyMember::from_f32(&m32);
+            assert_eq!(m.rows_q30, per_tick(m.sqrt_weight_q24), "w {w}");
+        }
+        assert_eq!(FamilyMember::PAPER.rows_q30, per_tick(ONE_Q24));
     }
 }

@@ -10,8 +10,17 @@ namespace needle_chai3d {
 
 cNeedleTissue::cNeedleTissue() : m_hubFromTipMm(needle_hub_from_tip_mm()), m_insertion(false) { std::memset(&m_state, 0, sizeof m_state); }
 
-bool cNeedleTissue::useInsertion(const std::string &stack, float period_s) {
-  m_insertion = needle_insertion_init(&m_state, stack.c_str(), period_s, 0.005f) == NEEDLE_OK;
+bool cNeedleTissue::useInsertion(const std::string &stack, float period_s, std::string *why) {
+  const std::string toml = ".toml";
+  bool is_file = stack.size() > toml.size() && stack.compare(stack.size() - toml.size(), toml.size(), toml) == 0;
+  char message[1024] = "";
+  int32_t rc = is_file ? needle_insertion_init_file(&m_state, stack.c_str(), period_s, 0.005f, message, sizeof message)
+                       : needle_insertion_init(&m_state, stack.c_str(), period_s, 0.005f);
+  m_insertion = rc == NEEDLE_OK;
+  if (why != nullptr) {
+    if (is_file || rc == NEEDLE_OK) *why = message;
+    else *why = rc == NEEDLE_E_ARG ? "no tissue stack '" + stack + "' in this build" : "period_s must be finite and > 0";
+  }
   return m_insertion;
 }
 

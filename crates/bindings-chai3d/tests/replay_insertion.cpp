@@ -12,6 +12,8 @@
 // distribution.
 //
 //   replay_insertion STACK <eval-output.csv>...
+//
+// STACK is a compiled-in name or a tissue file's path (.toml), loaded at run time.
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -88,8 +90,9 @@ static void replay(const char *stack, const char *path, const std::vector<CliRow
   needle_chai3d::cNeedleTissue *tissue = new needle_chai3d::cNeedleTissue();
   world->addChild(tissue);
   world->computeGlobalPositions(true);
-  if (!tissue->useInsertion(stack)) {
-    std::printf("no tissue stack %s in this build\n", stack);
+  std::string why;
+  if (!tissue->useInsertion(stack, 0.001f, &why)) {
+    std::printf("useInsertion(%s): %s\n", stack, why.c_str());
     std::exit(2);
   }
   std::vector<ScriptedPose> script;

@@ -8,10 +8,14 @@ root = fullfile(here, '..', '..', '..');
 addpath(here);
 set_dir = fullfile(root, 'coeffs', 'default');
 tests = {@() t_wrench_golden(set_dir), @() t_stiffness_golden(set_dir), @() t_nan_rows(set_dir), ...
-         @t_shape_and_class_errors, @() t_insertion_cli(root, set_dir), @() t_readme(root), @() t_fig8_example(root)};
+         @t_shape_and_class_errors, @() t_insertion_cli(set_dir, 'liver'), ...
+         @() t_insertion_cli(set_dir, fullfile(set_dir, 'calibrated', 'rig_skin_2mmps_t1.toml')), @() t_bad_tissue_file(set_dir), ...
+         @() t_readme(root), @() t_fig8_example(root)};
 names = {'wrench is bit-exact on every finite golden row', 'stiffness is bit-exact on every finite golden row', ...
          'every non-finite golden row names its row and column', 'shape and class errors name the column', ...
-         'insertion equals needle eval --insertion tick by tick', 'the README example prints its line', ...
+         'insertion equals needle eval --insertion tick by tick', ...
+         'a tissue file loaded at run time equals needle eval --insertion FILE tick by tick', ...
+         'a refused tissue file names its line', 'the README example prints its line', ...
          'the Fig. 8-style example draws its PNG'};
 passed = 0; failed = 0;
 for i = 1:numel(tests)
@@ -94,10 +98,25 @@ expect_error(@() needle_haptics('insertion', 'kidney', single([0 0 0 0 3])), 'no
 expect_error(@() needle_haptics('insertion', 'liver', single([0 0 0 0 3; -Inf 0 0 0 3])), 'poses\(2, 1\) \(x_mm\) is -Inf');
 end
 
-function t_insertion_cli(root, set_dir)
+function t_bad_tissue_file(set_dir)
+text = fileread(fullfile(set_dir, 'calibrated', 'rig_skin_2mmps_t1.toml'));
+bad = [tempname() '.toml'];
+fid = fopen(bad, 'w');
+fprintf(fid, '%s', regexprep(text, 'stiffness_scale = ', 'stiffness_scale = -', 'once'));
+fclose(fid);
+lines = strsplit(fileread(bad), "\n", "CollapseDelimiters", false);
+line = find(strncmp(lines, 'stiffness_scale = -', 19), 1);
+[~, name, ext] = fileparts(bad);
+expect_error(@() needle_haptics('insertion', bad, single([0 0 0 0 3])), sprintf('%s%s:%d:.*stiffness_scale', name, ext, line));
+delete(bad);
+end
+
+% The insertion through `stack` (a compiled-in name or a tissue file's path) against the
+% library's command line, tick by tick.
+function t_insertion_cli(set_dir, stack)
 depth = [linspace(-1, 30, 6000), linspace(30, 12, 2000), linspace(12, 35, 3000), linspace(35, -1, 4000)]';
 poses = single([repmat([1.5 -0.5 4 -2], numel(depth), 1), depth]);
-[w, s, phase, punctures] = needle_haptics('insertion', 'liver', poses);
+[w, s, phase, punctures] = needle_haptics('insertion', stack, poses);
 check(sum(punctures) >= 1, 'the path punctures');
 csv_in = [tempname() '.csv'];
 fid = fopen(csv_in, 'w');
@@ -106,7 +125,7 @@ fprintf(fid, '%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n', [(0:numel(depth) - 1)' * 0.001, 
 fclose(fid);
 exe = getenv('NEEDLE_BIN');
 check(~isempty(exe), 'NEEDLE_BIN must name the needle binary (.ci/test-octave sets it)');
-[status, text] = system(sprintf('"%s" eval --set "%s" --poses "%s" --insertion liver', exe, set_dir, csv_in));
+[status, text] = system(sprintf('"%s" eval --set "%s" --poses "%s" --insertion "%s"', exe, set_dir, csv_in, stack));
 delete(csv_in);
 check(status == 0, 'needle eval failed: %s', text);
 lines = strsplit(strtrim(text), "\n");

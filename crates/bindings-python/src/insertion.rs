@@ -1,7 +1,9 @@
 //! `Insertion`: the library's whole-insertion model (`needle_haptics::insertion`) through
-//! a compiled-in tissue stack, one tick per pose row.
+//! a compiled-in tissue stack or a tissue file loaded at run time (checked as the build
+//! checks a compiled-in one: `needle_calibrate::runtime_stack`), one tick per pose row.
 use crate::poses::{borrow, not_finite, pose_at};
-use needle_haptics::insertion::{stacks, Insertion as Model, InsertionConfig};
+use needle_calibrate::runtime_stack::OwnedStack;
+use needle_haptics::insertion::{Insertion as Model, InsertionConfig};
 use needle_haptics::Status;
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -31,7 +33,7 @@ pub struct Trajectory {
 #[pyclass(module = "needle_haptics._native")]
 pub struct Insertion {
     model: Model,
-    stack: &'static str,
+    stack: String,
 }
 
 fn value_error(e: impl std::fmt::Display) -> PyErr {
@@ -40,25 +42,23 @@ fn value_error(e: impl std::fmt::Display) -> PyErr {
 
 #[pymethods]
 impl Insertion {
-    /// A path through the compiled-in stack `stack` (see `stacks()`), the needle above
-    /// the surface; `period_s` is the tick period, `velocity_time_constant_s` the
-    /// velocity filter's.
+    /// A path through the stack `stack`: the name of a compiled-in stack (see `stacks()`)
+    /// or the path of a tissue file (`.toml`, loaded now and checked with the build's
+    /// messages, `FILE:LINE`), the needle above the surface; `period_s` is the tick period,
+    /// `velocity_time_constant_s` the velocity filter's.
     #[new]
     #[pyo3(signature = (stack, period_s = InsertionConfig::DEFAULT_1KHZ.period_s, velocity_time_constant_s = InsertionConfig::DEFAULT_1KHZ.velocity_time_constant_s))]
     fn new(stack: &str, period_s: f32, velocity_time_constant_s: f32) -> PyResult<Self> {
-        let Some(s) = stacks::by_name(stack) else {
-            let names: Vec<&str> = stacks::ALL.iter().map(|s| s.name).collect();
-            return Err(PyValueError::new_err(format!("no tissue stack {stack:?} in this build; there are: {}", names.join(", "))));
-        };
-        let model =
-            Model::new(s, InsertionConfig { period_s, velocity_time_constant_s, ..InsertionConfig::DEFAULT_1KHZ }).map_err(value_error)?;
-        Ok(Self { model, stack: s.name })
+        let owned = OwnedStack::resolve("stack", stack).map_err(|e| PyValueError::new_err(format!("{e:#}")))?;
+        let config = InsertionConfig { period_s, velocity_time_constant_s, ..InsertionConfig::DEFAULT_1KHZ };
+        let model = Model::new(&owned.as_stack(), config).map_err(value_error)?;
+        Ok(Self { model, stack: owned.name })
     }
 
-    /// The stack's name.
+    /// The stack's name (a tissue file's `name`).
     #[getter]
-    fn stack(&self) -> &'static str {
-        self.stack
+    fn stack(&self) -> &str {
+        &self.stack
     }
 
     /// Replaces the layers' stiffness scales (one per layer, each finite and > 0).

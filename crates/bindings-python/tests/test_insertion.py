@@ -39,7 +39,12 @@ def phase_code(text: str) -> int:
     return kinds[kind] | (int(layer) if layer else 0)
 
 
-@pytest.mark.parametrize("stack", nh.stack_names())
+# A tissue file loaded at run time (issue 65): a stack calibrated by `needle calibrate
+# --trials` on a rig trial, with a family member, a softening and Prony terms.
+CALIBRATED = os.path.join(nh.SET_DIR, "calibrated", "rig_skin_2mmps_t1.toml")
+
+
+@pytest.mark.parametrize("stack", nh.stack_names() + [CALIBRATED])
 def test_insertion_matches_the_library_cli_tick_by_tick(stack, tmp_path):
     poses = trajectory()
     got = nh.Insertion(stack).run(poses)
@@ -66,8 +71,20 @@ def test_state_carries_over_between_calls_and_reset_forgets_it():
 
 
 def test_bad_stack_and_config_are_value_errors():
-    with pytest.raises(ValueError, match='no tissue stack "kidney".*liver'):
+    with pytest.raises(ValueError, match='stack "kidney": no such tissue file, nor a stack of the compiled-in set.*liver'):
         nh.Insertion("kidney")
+    with pytest.raises(ValueError, match="cannot read the tissue file"):
+        nh.Insertion("/nonexistent/kidney.toml")
+
+
+def test_a_bad_tissue_file_is_refused_with_its_line(tmp_path):
+    with open(CALIBRATED, encoding="utf-8") as f:
+        text = f.read()
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text.replace("stiffness_scale = ", "stiffness_scale = -", 1), encoding="utf-8")
+    line = next(i for i, l in enumerate(bad.read_text(encoding="utf-8").splitlines(), 1) if l.startswith("stiffness_scale = -"))
+    with pytest.raises(ValueError, match=f"bad.toml:{line}:.*stiffness_scale"):
+        nh.Insertion(str(bad))
     with pytest.raises(ValueError, match="period_s, max_speed_mm_per_s and max_turn_deg_per_s must be finite and > 0"):
         nh.Insertion("liver", period_s=0.0)
     with pytest.raises(ValueError, match="one per layer"):

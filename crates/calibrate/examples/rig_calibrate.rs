@@ -70,9 +70,9 @@ fn main() -> anyhow::Result<()> {
         stacks.push((name, c, speed, contact));
     }
     // repeats: each trial's stack replayed on the other trials of its group (same sample and speed)
-    println!("\n{:<44} {:>9} {:>9} {:>9}", "calibrated on -> replayed on", "rms %", "dpos mm", "dF %");
+    println!("\n{:<44} {:>9} {:>9} {:>9} {:>12}", "calibrated on -> replayed on", "rms %", "dpos mm", "dF %", "floor rms %");
     let group = |n: &str| n.rsplit_once("_trial").map_or(n.to_string(), |(g, _)| g.to_string());
-    let mut worst = 0.0f64;
+    let (mut worst, mut all, mut floors) = (0.0f64, Vec::new(), Vec::new());
     for (a, ca, _, contact_a) in &stacks {
         let layers: Vec<_> = ca.stack.layers.iter().map(to_layer).collect();
         let stack = Stack { name: "rig", needle_diameter_mm: ca.stack.needle_diameter_mm as f32, layers: &layers };
@@ -95,20 +95,57 @@ fn main() -> anyhow::Result<()> {
                 ca.fit.onset_mm + (contact_b - contact_a)
             };
             let model = replay::replay(&stack, onset, start, end, *speed_b);
+            // the repeats' own floor: trial a's measured curve, shifted as the model is, as the
+            // model of trial b over the same window (b's onset to its first puncture)
+            let floor = measured_as_model(&ca.points, &cb.points, cb.events.first().map_or(0, |e| e.peak), onset - ca.fit.onset_mm);
             let checks = replay::checks(pts, &cb.events, &model);
             let get = |w: &str| checks.iter().find(|k| k.what.starts_with(w)).map_or(f64::NAN, |k| k.error);
             worst = worst.max(get("pre-puncture RMS"));
+            all.push(get("pre-puncture RMS"));
+            floors.push(floor);
             println!(
-                "{:<44} {:>9.2} {:>9.2} {:>9.2}",
+                "{:<44} {:>9.2} {:>9.2} {:>9.2} {:>12.2}",
                 format!("{} -> {}", short(a), short(b)),
                 get("pre-puncture RMS"),
                 get("puncture 1 position"),
-                get("puncture 1 force")
+                get("puncture 1 force"),
+                floor
             );
         }
     }
     println!("worst replayed pre-puncture RMS: {worst:.2} %");
+    let summary = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        let at = |q: f64| v.get(((v.len() as f64 - 1.0) * q).round() as usize).copied().unwrap_or(f64::NAN);
+        format!("median {:.2} %, 90th percentile {:.2} %, worst {:.2} % ({} pairs)", at(0.5), at(0.9), at(1.0), v.len())
+    };
+    println!("replayed stacks: {}", summary(&mut all));
+    println!("floor (the calibrated trial's measured curve as the model): {}", summary(&mut floors));
     Ok(())
+}
+
+/// The pre-puncture RMS (% of `b`'s first puncture force, over `b`'s points from its 5 %
+/// onset to that puncture, as `replay::checks` measures a model) of `a`'s measured curve
+/// shifted by `shift_mm` (linear between its points; `a`'s insertion, its punctures too)
+/// as the model of `b`.
+fn measured_as_model(a: &[Point], b: &[Point], b_peak: usize, shift_mm: f64) -> f64 {
+    let peak = b.get(b_peak).map_or(f64::NAN, |p| p.force_n);
+    let onset = replay::measured_onset(b, b_peak, replay::ONSET_FRACTION * peak).unwrap_or(f64::NEG_INFINITY);
+    let at = |p: f64| {
+        let x = p - shift_mm;
+        let i = a.partition_point(|q| q.position_mm < x);
+        match (i.checked_sub(1).and_then(|k| a.get(k)), a.get(i)) {
+            (Some(l), Some(r)) if r.position_mm > l.position_mm => {
+                l.force_n + (r.force_n - l.force_n) * (x - l.position_mm) / (r.position_mm - l.position_mm)
+            }
+            (_, Some(r)) => r.force_n,
+            (Some(l), None) => l.force_n,
+            (None, None) => f64::NAN,
+        }
+    };
+    let pre: Vec<&Point> = b.iter().take(b_peak + 1).filter(|p| p.position_mm >= onset).collect();
+    let ss: f64 = pre.iter().map(|p| (at(p.position_mm) - p.force_n).powi(2)).sum();
+    100.0 * (ss / pre.len().max(1) as f64).sqrt() / peak
 }
 
 fn short(n: &str) -> String {

@@ -77,6 +77,9 @@ pub struct Fit {
     pub layers: Vec<LayerFit>,
     /// Depth of the last point, mm (the last layer's thickness reaches it).
     pub last_depth_mm: f64,
+    /// The first boundary's shape values that lie on their range's edge
+    /// ([`crate::edges::of_shape`]).
+    pub edges: Vec<crate::edges::EdgeWarning>,
 }
 
 /// Fits the stack. `surrogate(depth_mm)` is the axial force of a boundary indented by
@@ -104,7 +107,8 @@ pub fn fit_with_progress(
     let total = scan_count(points, punctures, start, start);
     let mut done = 0;
     let Some(first) = shape::fit(&thin(&pre), surrogate, similarity) else {
-        return Fit { onset_mm: start, layers: Vec::new(), last_depth_mm: points.last().map_or(0.0, |p| p.position_mm - start) };
+        let last_depth_mm = points.last().map_or(0.0, |p| p.position_mm - start);
+        return Fit { onset_mm: start, layers: Vec::new(), last_depth_mm, edges: Vec::new() };
     };
     let onset = first.onset_mm;
     let member = FamilyMember::new(first.weight as f32);
@@ -147,7 +151,7 @@ pub fn fit_with_progress(
             layers.push(LayerFit { family_weight: first.weight, ..LayerFit::plain(boundary, scale, puncture, 0.0, 0.0) });
         }
     }
-    Fit { onset_mm: onset, layers, last_depth_mm: depth(points.len() - 1) }
+    Fit { onset_mm: onset, layers, last_depth_mm: depth(points.len() - 1), edges: crate::edges::of_shape(&first) }
 }
 
 /// How many candidates the scans of [`fit_with_progress`] try (an onset scan from

@@ -21,7 +21,9 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+pub mod edges;
 pub mod events;
+pub mod fe_loop;
 pub mod fit;
 pub mod from_model;
 
@@ -32,7 +34,9 @@ pub mod published;
 pub mod ramp;
 pub mod replay;
 pub mod runtime_stack;
+pub mod sample;
 pub mod shape;
+pub mod spread;
 pub mod trial;
 pub mod trial_replay;
 pub mod trial_screen;

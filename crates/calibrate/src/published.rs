@@ -237,7 +237,7 @@ pub fn derive(pieces: &[Piece], surrogate: &dyn Fn(&str, f64) -> f64) -> Result<
 #[must_use]
 pub fn as_fit(layers: &[Derived]) -> Fit {
     let last_depth_mm = layers.iter().map(|l| l.thickness_mm).sum();
-    Fit { onset_mm: 0.0, layers: layers.iter().map(|l| l.fit.clone()).collect(), last_depth_mm }
+    Fit { onset_mm: 0.0, layers: layers.iter().map(|l| l.fit.clone()).collect(), last_depth_mm, edges: Vec::new() }
 }
 
 /// The published punctures among [`sample`]'s points: each layer's `peak`, the next

@@ -104,6 +104,10 @@ pub struct ShapeFit {
     pub weight_range: [f64; 2],
     /// The fitted range of the softening's fraction, as `weight_range`.
     pub fraction_range: [f64; 2],
+    /// The weight of the candidate with the least sum of squares, whatever its class
+    /// (the fit keeps a simpler class within [`RANGE_SSE_RATIO`]): whether the data pin
+    /// the paper's tissue (`w = 1`, the range's edge: [`crate::edges`]).
+    pub least_squares_weight: f64,
 }
 
 impl ShapeFit {
@@ -293,6 +297,7 @@ pub fn fit_members(pre: &[Point], surrogate: &dyn Fn(f64) -> f64, similarity: f6
                         sse,
                         weight_range: [t * t; 2],
                         fraction_range: [fraction; 2],
+                        least_squares_weight: t * t,
                     };
                     // the onset threshold is below every onset ratio: the model's crossing is elastic
                     let pool = if near(scale) { &mut matched } else { &mut best };
@@ -314,7 +319,9 @@ fn choose(matched: [Option<ShapeFit>; 4], best: [Option<ShapeFit>; 4], seen: &[(
     let pool = if matched.iter().any(Option::is_some) { matched } else { best };
     let least = pool.iter().flatten().map(|c| c.sse).fold(f64::INFINITY, f64::min);
     let limit = least * RANGE_SSE_RATIO;
+    let least_squares_weight = pool.iter().flatten().find(|c| c.sse <= least).map_or(1.0, |c| c.weight);
     let mut fit = pool.into_iter().flatten().find(|c| c.sse <= limit)?;
+    fit.least_squares_weight = least_squares_weight;
     for &(_, w, fraction) in seen.iter().filter(|c| c.0 <= limit) {
         fit.weight_range = [fit.weight_range[0].min(w), fit.weight_range[1].max(w)];
         fit.fraction_range = [fit.fraction_range[0].min(fraction), fit.fraction_range[1].max(fraction)];

@@ -3,7 +3,8 @@
 //! (the control loop renders an insertion).
 //!
 //! The state is `needle_haptics::insertion::Insertion` kept in the opaque storage of a
-//! [`needle_insertion_t`]; the stack is one of the compiled-in ones, by name.
+//! [`needle_insertion_t`]; the stack is one of the compiled-in ones, by name (on a host, a
+//! tissue file loaded at run time: `needle_insertion_init_file`).
 use crate::control::loop_core;
 use crate::eval::{pose_in, wrench_out_of};
 use crate::types::*;
@@ -59,11 +60,20 @@ pub unsafe extern "C" fn needle_insertion_init(
         return NEEDLE_E_CONFIG;
     };
     // SAFETY: non-NULL, valid and writable (the caller's contract).
+    unsafe { install(insertion, state) };
+    NEEDLE_OK
+}
+
+/// Writes `state` into `insertion`'s storage and marks it set up.
+///
+/// # Safety
+/// `insertion` is non-NULL, valid and writable.
+pub(crate) unsafe fn install(insertion: *mut needle_insertion_t, state: Insertion) {
+    // SAFETY: non-NULL, valid and writable (the caller's contract).
     let i = unsafe { &mut *insertion };
     // SAFETY: size and alignment checked at compile time; the storage is plain u64s.
     unsafe { i.storage.as_mut_ptr().cast::<Insertion>().write(state) };
     i.magic = NEEDLE_INSERTION_MAGIC;
-    NEEDLE_OK
 }
 
 /// One tick: the pose in, the wrench, status, phase code (`0` approach, `0x100 | layer`

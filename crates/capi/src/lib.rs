@@ -22,6 +22,8 @@ mod control;
 mod eval;
 mod eval_fixed;
 mod insertion;
+#[cfg(not(target_os = "none"))]
+mod insertion_file;
 mod insertion_fixed;
 mod names;
 mod types;
@@ -31,6 +33,8 @@ pub use control::{needle_loop_init, needle_loop_set_force_limit_n, needle_loop_t
 pub use eval::{needle_model_info, needle_wrench, needle_wrench_and_stiffness};
 pub use eval_fixed::{needle_fixed_wrench, needle_fixed_wrench_and_stiffness};
 pub use insertion::{needle_insertion_init, needle_insertion_reset, needle_insertion_set_scales, needle_insertion_step};
+#[cfg(not(target_os = "none"))]
+pub use insertion_file::needle_insertion_init_file;
 pub use insertion_fixed::{
     needle_fixed_insertion_init, needle_fixed_insertion_reset, needle_fixed_insertion_set_scales, needle_fixed_insertion_step,
 };

@@ -38,12 +38,15 @@ component by cross-validation). Writes model.toml and the four golden files all 
     Validate(needle_cli::commands::validate::ValidateArgs),
     /// Serve the model explorer (the library compiled to wasm) to a browser on a local port.
     Explore(needle_cli::commands::explore::ExploreArgs),
-    /// Draw the set's figures as SVG (Figs 4, 6, 7, 8, parity, FE verification).
+    /// Draw the set's figures as SVG (Figs 4, 6, 7, 8, parity, FE verification, the material family).
     Plot(needle_cli::commands::plot::PlotArgs),
     /// The fixed-point evaluator's largest error against f64 on a grid and random poses, beside its bound.
     FixedError(needle_cli::commands::fixed_error::FixedErrorArgs),
     /// Write the C headers: needle.h (the C API) and needle_coeffs.h (the model's tables).
     Header(needle_cli::commands::header::HeaderArgs),
+    /// Tissue stack files: draw a plausible tissue within a stack's spread over its trials.
+    #[command(subcommand)]
+    Stack(needle_cli::commands::stack::StackCommand),
     /// The library on Cortex-M under QEMU: size, bench, golden, check.
     #[command(subcommand)]
     Firmware(needle_cli::commands::firmware::FirmwareCommand),
@@ -86,6 +89,7 @@ fn main() -> ExitCode {
         Command::Plot(a) => commands::plot::run(a),
         Command::Header(a) => commands::header::run(a),
         Command::FixedError(a) => commands::fixed_error::run(a),
+        Command::Stack(c) => commands::stack::run(c),
         Command::Firmware(c) => commands::firmware::run(c),
     };
     match result {

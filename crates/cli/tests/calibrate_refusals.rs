@@ -260,7 +260,7 @@ fn message_a_missing_model_puncture_says_none_not_nan() {
 fn message_insertion_paths_with_an_unknown_stack_names_stack() {
     let d = tempfile::tempdir().expect("tempdir");
     let o = needle(&["insertion-paths", "--stack", "kidney", "--out-dir", d.path().to_str().expect("utf-8")]);
-    let err = refused(&o, &["--stack \"kidney\": no such tissue stack"]);
+    let err = refused(&o, &["--stack \"kidney\": no such tissue file, nor a stack of the compiled-in set"]);
     assert!(!err.contains("--insertion"), "{err}");
 }
 

@@ -38,6 +38,36 @@ fn committed_figures_are_up_to_date() {
     }
 }
 
+/// The family figure with measured curves placed among its members
+/// (`family-measured.svg`, issue 64 item 6) is what the command draws from Okamura's
+/// curve and one rig trial of each sample (read in place from
+/// `../shared/data/stokes-needle-rig/`: derived figures are committed, the data not),
+/// with the command docs/usage.md gives.
+#[test]
+fn the_committed_family_figure_with_measured_shapes_is_up_to_date() {
+    let set = shipped_set();
+    let rig = needle_stdx::workspace_root().join("../shared/data/stokes-needle-rig");
+    let files = [
+        set.join("measured/okamura2004-bovine-liver/position_force.csv"),
+        rig.join("skin_2mmps_0deg_needle2_trial1.csv"),
+        rig.join("muscle_2mmps_0deg_needle2_trial1.csv"),
+        rig.join("skin-on-muscle_2mmps_0deg_needle2_trial2.csv"),
+    ];
+    let mut args: Vec<String> = vec!["--set".into(), set.to_string_lossy().into_owned(), "--check".into(), "--measured".into()];
+    args.extend(files.iter().map(|p| p.to_string_lossy().into_owned()));
+    args.extend(["--needle-diameter-mm".into(), "1.27".into()]);
+    let o = plot(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(o.status.success(), "{}", show(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("family-measured.svg: up to date"), "{out}");
+    let svg = std::fs::read_to_string(set.join("figures/family-measured.svg")).expect("committed");
+    for f in &files {
+        let tail: Vec<String> = f.iter().rev().take(2).map(|c| c.to_string_lossy().into_owned()).collect();
+        let label = format!("measured: {}/{}", tail[1], tail[0]);
+        assert!(svg.contains(&label), "{label}: placed among the members");
+    }
+}
+
 /// Changing one coefficient of model.toml changes the model curves: --check fails and
 /// names the figure.
 #[test]

@@ -92,7 +92,15 @@ pub fn parse(core: &Core, output: &str) -> anyhow::Result<CoreFigures> {
 /// # Errors
 /// Build or run failed, or the output is malformed.
 pub fn run(core: &Core, set: &Path) -> anyhow::Result<CoreFigures> {
-    let elf = build::build_examples(core, &["bench"], set)?.remove(0);
+    run_with(core, set, build::Features::Viscoelastic)
+}
+
+/// [`run`] on the `bench` firmware built with the library's `features`.
+///
+/// # Errors
+/// As [`run`].
+pub fn run_with(core: &Core, set: &Path, features: build::Features) -> anyhow::Result<CoreFigures> {
+    let elf = build::build_examples_with(core, &["bench"], set, features)?.remove(0);
     let run = qemu::run(core, &elf, true, Duration::from_secs(600))?;
     if !run.status.success() {
         bail!("bench firmware on {} exited with {}:\n{}{}", core.core, run.status, run.stdout, run.stderr);

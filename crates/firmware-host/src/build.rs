@@ -61,6 +61,13 @@ pub enum Features {
     /// (`firmware-elastic/` beside [`target_dir`]), so the two builds do not replace
     /// each other's files.
     Elastic,
+    /// `viscoelastic` and `tissue-shape` (a layer's material family member and its
+    /// pre-puncture softening, issue 64): the shaped stacks compiled in. Its own target
+    /// folder (`firmware-shape/`).
+    Shape,
+    /// `tissue-shape` alone: the elastic insertions with the shaped stacks (the flash
+    /// budget's build with the feature). Its own target folder (`firmware-shape-elastic/`).
+    ShapeElastic,
 }
 
 impl Features {
@@ -70,6 +77,8 @@ impl Features {
         match self {
             Self::Viscoelastic => target_dir(),
             Self::Elastic => target_dir().with_file_name("firmware-elastic"),
+            Self::Shape => target_dir().with_file_name("firmware-shape"),
+            Self::ShapeElastic => target_dir().with_file_name("firmware-shape-elastic"),
         }
     }
 
@@ -77,7 +86,34 @@ impl Features {
         match self {
             Self::Viscoelastic => &["--features", "viscoelastic"],
             Self::Elastic => &[],
+            Self::Shape => &["--features", "viscoelastic,tissue-shape"],
+            Self::ShapeElastic => &["--features", "tissue-shape"],
         }
+    }
+
+    /// Whether this build has the `viscoelastic` feature.
+    #[must_use]
+    pub fn viscoelastic(self) -> bool {
+        matches!(self, Self::Viscoelastic | Self::Shape)
+    }
+
+    /// Whether this build has the `tissue-shape` feature.
+    #[must_use]
+    pub fn tissue_shape(self) -> bool {
+        matches!(self, Self::Shape | Self::ShapeElastic)
+    }
+
+    /// Whether this build compiles `stack` in (the generator's rule,
+    /// `needle_codegen::tissue::render_rust_stacks`): a stack with a Prony term needs
+    /// `viscoelastic`, one with a family member other than the paper's tissue or a
+    /// softening needs `tissue-shape`. For a host that lists the stacks of a firmware
+    /// build from its own `stacks::ALL` (the host crates turn both features on).
+    #[must_use]
+    #[allow(clippy::float_cmp)]
+    pub fn compiles(self, stack: &needle_haptics::insertion::Stack<'_>) -> bool {
+        let prony = stack.layers.iter().any(|l| !l.prony.is_empty());
+        let shaped = stack.layers.iter().any(|l| l.family.weight() != 1.0 || l.softening.fraction != 0.0);
+        (self.viscoelastic() || !prony) && (self.tissue_shape() || !shaped)
     }
 }
 

@@ -122,6 +122,21 @@ pub fn read_runs(set: &SetFolder) -> Result<Option<(MemberRun, Vec<MemberRun>)>>
     Ok(Some((reference, members)))
 }
 
+/// The run of `[family.fitted]` (`FamilyRun::fitted`: the calibrated layer's member and
+/// scale read from its stack), its Fy against depth, as [`read_runs`] reads a member's:
+/// vouched by its manifest entry's hash (the stack's values are in it), or its
+/// `.partial.csv` when it failed; `None` without the section or a result.
+///
+/// # Errors
+/// The stack cannot be read ([`FamilyRun::fitted`]), and [`read_runs`]'s.
+pub fn read_fitted_run(set: &SetFolder) -> Result<Option<MemberRun>> {
+    let c = set.campaign();
+    let Some(f) = &c.family else { return Ok(None) };
+    let Some(run) = FamilyRun::fitted(f, set.dir())? else { return Ok(None) };
+    let (dir, manifest) = read_family_manifest(set)?;
+    read_run(c, &manifest, &dir, run)
+}
+
 /// The family's folder `fe/family/` of `set` and its manifest (empty when there is none yet).
 ///
 /// # Errors

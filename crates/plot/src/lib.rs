@@ -27,3 +27,15 @@ pub fn render_set(set: &SetFolder) -> Result<Vec<(&'static str, String)>> {
     }
     Ok(out)
 }
+
+/// The family figure with `measured` curves placed among its members
+/// ([`family::figure_with`]): (file name, SVG text), `None` when the set has no family
+/// runs.
+///
+/// # Errors
+/// The family's runs cannot be read; the chart cannot be laid out.
+pub fn render_family_measured(set: &SetFolder, measured: &[family::MeasuredShape]) -> Result<Option<(&'static str, String)>> {
+    let Some(f) = family::figure_with(set, measured)? else { return Ok(None) };
+    let svg = panel::render(&f.caption, &f.panels, f.cols, PANEL_PX).with_context(|| f.file.to_string())?;
+    Ok(Some((f.file, svg)))
+}

@@ -29,9 +29,12 @@ struct TissueTick {
 class cNeedleTissue : public chai3d::cGenericObject {
  public:
   cNeedleTissue();
-  // The whole insertion through the compiled-in stack `stack` at `period_s` per tick;
-  // returns false (and keeps the surrogate alone) for an unknown stack or a bad period.
-  bool useInsertion(const std::string &stack, float period_s = 0.001f);
+  // The whole insertion through the stack `stack` at `period_s` per tick: a compiled-in
+  // name, or a tissue file's path ending in ".toml" (loaded now, checked as the build
+  // checks a compiled-in stack: needle_insertion_init_file). Returns false (and keeps the
+  // surrogate alone) for an unknown stack, a refused file or a bad period; then `why`
+  // (when given) says so, a refused file with FILE:LINE.
+  bool useInsertion(const std::string &stack, float period_s = 0.001f, std::string *why = nullptr);
   // One haptic tick: reads the device, evaluates, applies the force and torque.
   TissueTick update(chai3d::cGenericHapticDevice &device);
   // The tick without a device: the hub and the rotation in world coordinates.

@@ -65,6 +65,8 @@ pub struct TrialsCalibration {
     pub checks: Vec<Vec<Check>>,
     /// Geometric similarity, measured needle over the FE needle.
     pub similarity: f64,
+    /// The first layer's shape values on their range's edge ([`crate::edges::of_trials`]).
+    pub edges: Vec<crate::edges::EdgeWarning>,
 }
 
 /// Calibrates a stack on the trials of `opts` (module docs).
@@ -99,5 +101,11 @@ pub fn calibrate_trials(opts: &TrialsOptions<'_>) -> Result<TrialsCalibration> {
         checks.push(goals::checks(t, &r, &goals::CALIBRATED));
         replays.push(r);
     }
-    Ok(TrialsCalibration { trials, notes, fitted, replays, checks, similarity })
+    let fits: Vec<&[crate::edges::EdgeWarning]> = trials.iter().map(|t| t.fit.edges.as_slice()).collect();
+    let edges = fitted
+        .stack
+        .layers
+        .first()
+        .map_or_else(Vec::new, |l| crate::edges::of_trials(l.family_weight, l.softening_fraction, l.softening_onset_ratio, &fits));
+    Ok(TrialsCalibration { trials, notes, fitted, replays, checks, similarity, edges })
 }

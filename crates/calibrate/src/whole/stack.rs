@@ -28,6 +28,9 @@ pub struct Fitted {
     /// The shaft's presliding distance over the trials (mm; `None`: no withdrawal shows
     /// one, the stack keeps the Karnopp friction).
     pub presliding_mm: Option<Spread>,
+    /// Per layer, `(key, spread over the trials)` of the values fitted per trial: what
+    /// `needle stack sample` draws within ([`crate::spread`]).
+    pub spread: Vec<Vec<(&'static str, Spread)>>,
 }
 
 /// Half the slowest measured speed, at most [`crate::STICK_BAND_MM_PER_S`]: the stick
@@ -97,13 +100,14 @@ pub fn fit(ts: &[Trial], opts: &TrialsOptions<'_>, diameter: f64, u: &dyn Fn(f64
     let largest = ts.iter().flat_map(|t| t.samples.iter().map(|s| s.force_n)).fold(0.0, f64::max);
     let source = source(opts, ts, band);
     let mut layers = Vec::new();
-    let mut uncertainty = Vec::new();
+    let (mut uncertainty, mut spread) = (Vec::new(), Vec::new());
     for j in 0..n {
         let below = v.bounds.get(j + 1).copied().or(hold.boundary_mm).unwrap_or(last_depth.max(v.bounds[j] + 1.0));
         let cutting =
             if j + 1 == n { hold.per_trial.cutting_n.clone() } else { v.cutting.get(j).cloned().unwrap_or(Spread::of(Vec::new())) };
         let cutting_n = if j + 1 == n { hold.cutting_n } else { cutting.mean };
         let f = fr.get(j).cloned().unwrap_or_else(zero_friction);
+        spread.push(spreads(v.scale[j].clone(), v.puncture[j].clone(), Some(cutting.clone()), &f));
         let (mut l, mut notes) =
             layer(j, n, below - v.bounds[j], v.scale[j].clone(), v.puncture[j].clone(), (cutting_n, cutting), &f, band, opts, &source);
         if let Some(p) = &presliding {
@@ -119,6 +123,8 @@ pub fn fit(ts: &[Trial], opts: &TrialsOptions<'_>, diameter: f64, u: &dyn Fn(f64
     }
     if let (Some(b), Some(f)) = (hold.boundary_mm, fr.last()) {
         let (l, notes) = bottom_layer(n, last_depth - b + 1.0, largest, &hold, f, band, opts, &source);
+        let scale = Spread { mean: hold.scale, ..hold.per_trial.scale.clone() };
+        spread.push(spreads(scale, Spread::of(Vec::new()), None, f));
         layers.push(l);
         uncertainty.push(notes);
     }
@@ -131,7 +137,7 @@ pub fn fit(ts: &[Trial], opts: &TrialsOptions<'_>, diameter: f64, u: &dyn Fn(f64
     };
     file::parse_stack_str(&stack.to_toml(""), Path::new(&format!("{}.toml", stack.name)))
         .map_err(|e| anyhow::anyhow!("the calibrated stack is refused by the tissue format: {e}"))?;
-    Ok(Fitted { stack, uncertainty, punctures: n, friction: fr, hold, stick_band_mm_per_s: band, presliding_mm: presliding })
+    Ok(Fitted { stack, uncertainty, punctures: n, friction: fr, hold, stick_band_mm_per_s: band, presliding_mm: presliding, spread })
 }
 
 /// The shaft's presliding (the `hold` and `presliding` modules): its distance from the
@@ -187,6 +193,22 @@ fn with_presliding(l: &mut file::Layer, notes: &mut Vec<(&'static str, String)>,
             hold.shaft_g.iter().zip(&hold.shaft_prony).map(|(s, (_, tau))| format!("g(tau {tau:.3} s) {}", s.note("-"))).collect();
         notes.push(("shaft_prony", format!("{} (the holds; the boundary below elastic)", g.join("; "))));
     }
+}
+
+/// A layer's spreads over the trials: its scale, puncture force and cutting force (those
+/// fitted per trial: an empty spread is left out) and its Coulomb friction when the
+/// friction has no viscous term (the per-trial levels are then Coulomb levels).
+fn spreads(scale: Spread, puncture: Spread, cutting: Option<Spread>, f: &LayerFriction) -> Vec<(&'static str, Spread)> {
+    let friction = (f.viscous_n_s_per_mm2 == 0.0).then(|| f.levels.clone());
+    [
+        ("stiffness_scale", Some(scale)),
+        ("puncture_force_n", Some(puncture)),
+        ("cutting_force_n", cutting),
+        ("friction_coulomb_n_per_mm", friction),
+    ]
+    .into_iter()
+    .filter_map(|(k, s)| s.filter(|s| !s.values.is_empty()).map(|s| (k, s)))
+    .collect()
 }
 
 /// The first boundary's shape over the trials.

@@ -19,7 +19,8 @@ use std::process::ExitCode;
 // and [section] are placeholders and campaign.toml sections there, not HTML or links.
 #[allow(rustdoc::invalid_html_tags, rustdoc::broken_intra_doc_links)]
 pub struct InsertionPathsArgs {
-    /// The compiled-in tissue stack whose depth the paths are scaled to (e.g. liver).
+    /// The tissue stack whose depth the paths are scaled to: a compiled-in name (e.g. liver)
+    /// or a tissue file (.toml, checked as the build checks a compiled-in one).
     #[arg(long)]
     pub stack: String,
     /// Folder for the scripts: <stack>-path<i>.csv, i = 0..4.
@@ -47,7 +48,8 @@ pub fn script(path: &[paths::Waypoint], stack: &needle_haptics::insertion::Stack
 /// # Errors
 /// No such stack; the folder or a file cannot be written (then none is).
 pub fn run(a: InsertionPathsArgs) -> Result<ExitCode> {
-    let stack = super::eval::insertion::stack("--stack", &a.stack)?;
+    let owned = needle_calibrate::runtime_stack::OwnedStack::resolve("--stack", &a.stack)?;
+    let stack = &owned.as_stack();
     let files: Vec<(PathBuf, String)> = paths::PATHS
         .iter()
         .enumerate()

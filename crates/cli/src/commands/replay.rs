@@ -25,13 +25,25 @@ pub struct ReplayArgs {
     /// Print one JSON document (rows, punctures, checks) instead of the text.
     #[arg(long)]
     pub json: bool,
+    /// Also write the figure here (SVG): the measured and the model force against time
+    /// over insertion, hold and withdrawal, the punctures, the residual.
+    #[arg(long, value_name = "SVG")]
+    pub figure: Option<PathBuf>,
+    /// Replace an existing figure (without it, an existing one is refused before the run).
+    #[arg(long)]
+    pub force: bool,
 }
 
-/// Runs `needle replay`: exit 0 whether or not the checks are met (they are printed).
+/// Runs `needle replay`: exit 0 whether or not the checks are met (they are printed);
+/// with `--figure`, the figure written ([`super::calibrate::trials_figure`]).
 ///
 /// # Errors
 /// The stack or the trial is refused (file:line).
 pub fn run(a: ReplayArgs) -> Result<ExitCode> {
+    if let Some(figure) = &a.figure {
+        let planned = [crate::planned_outputs::Planned { option: "--figure", path: figure }];
+        crate::planned_outputs::check(&planned, None, &[("--trial", &a.trial), ("--stack", std::path::Path::new(&a.stack))], a.force)?;
+    }
     let owned = OwnedStack::resolve("--stack", &a.stack)?;
     let stack = owned.as_stack();
     let lambda = stack.needle_diameter_mm / insertion::FE_NEEDLE_DIAMETER_MM;
@@ -39,6 +51,17 @@ pub fn run(a: ReplayArgs) -> Result<ExitCode> {
     let t = trials::prepare(&a.trial, EventRule::default(), &u, f64::from(lambda), false)?;
     let r = needle_calibrate::trial_replay::replay(&stack, t.onset_mm(), &t.samples).map_err(|e| anyhow::anyhow!("{}: {e}", t.name()))?;
     let checks = needle_calibrate::goals::checks(&t, &r, &needle_calibrate::goals::PREDICTED);
+    if let Some(figure) = &a.figure {
+        let caption = format!("needle replay: stack {} on {}, measured and model", stack.name, t.name());
+        let svg = super::calibrate::trials_figure::svg(&caption, &[(&t, &r)])?;
+        needle_stdx::fs::write_all_atomic(&[(figure.as_path(), svg.as_bytes())])?;
+        let say = format!("wrote {}", figure.display());
+        if a.json {
+            eprintln!("{say}");
+        } else {
+            println!("{say}");
+        }
+    }
     if a.json {
         let doc = serde_json::json!({
             "stack": stack.name, "trial": t.name(), "contact_mm": t.onset_mm(),

@@ -1,7 +1,10 @@
-//! The calibration figure of `needle calibrate`: the measured curve, the calibrated
-//! stack's force through the library's insertion model, the punctures, the residuals.
+//! The calibration figure of `needle calibrate --curve`: the measured curve, the
+//! calibrated stack's force through the library's insertion model, the punctures, the
+//! residuals; and the first boundary's shape (issue 64): the measured rise before the
+//! first puncture, the model with its family member, scale and softening, and the
+//! residual, against depth from the fitted contact.
 use needle_calibrate::Calibration;
-use needle_plot::panel::{render, Panel, RGBColor, Series, Style, COMPONENT_COLOURS};
+use needle_plot::panel::{render, tick_label, Panel, RGBColor, Series, Style, COMPONENT_COLOURS};
 
 /// Most reference points the figure draws.
 const FIGURE_POINTS: usize = 600;
@@ -46,5 +49,58 @@ pub fn svg(c: &Calibration, name: &str, reference: &str) -> anyhow::Result<Strin
         series: vec![Series { label: "residual".into(), colour: grey, style: Style::Points, data: residuals }],
         y_min_span: 0.0,
     };
-    render(&format!("needle calibrate: {name}"), &[force, residual], 1, (900, 420))
+    let mut panels = vec![force, residual];
+    panels.extend(pre_puncture(c, reference));
+    let cols = if panels.len() > 2 { 2 } else { 1 };
+    render(&format!("needle calibrate: {name}"), &panels, cols, (900, 420))
+}
+
+/// The first boundary's shape, when the calibration fitted it (`needle calibrate`; a
+/// published model's layers have none): the measured rise from contact to the first
+/// puncture and the calibrated model (its member, scale and softening in the title)
+/// against depth from the fitted contact, and their residual.
+fn pre_puncture(c: &Calibration, reference: &str) -> Vec<Panel> {
+    let (Some(layer), Some(first)) = (c.fit.layers.first(), c.events.first()) else { return Vec::new() };
+    if layer.family_weight_range.is_none() {
+        return Vec::new();
+    }
+    let onset = c.fit.onset_mm;
+    let Some(peak) = c.points.get(first.peak).map(|p| p.position_mm) else { return Vec::new() };
+    let pre: Vec<_> = c.points.iter().take(first.peak + 1).filter(|p| p.position_mm >= onset).collect();
+    let every = pre.len().div_ceil(FIGURE_POINTS).max(1);
+    let measured: Vec<(f64, f64)> = pre.iter().step_by(every).map(|p| (p.position_mm - onset, p.force_n)).collect();
+    let model: Vec<(f64, f64)> =
+        c.replay.samples.iter().filter(|(x, _)| *x >= onset && *x <= peak).step_by(10).map(|&(x, f)| (x - onset, f)).collect();
+    // the pre-puncture comparison's rule (the model's state when the stage reaches the point)
+    let residuals: Vec<(f64, f64)> =
+        pre.iter().step_by(every).map(|p| (p.position_mm - onset, p.force_n - c.replay.before(p.position_mm))).collect();
+    let soft = &layer.softening;
+    let softening = if soft.fraction > 0.0 {
+        format!("softening {} from {} of the puncture's elastic force", tick_label(soft.fraction), tick_label(soft.onset_ratio))
+    } else {
+        "no softening".into()
+    };
+    let grey = RGBColor(90, 90, 90);
+    let shape = Panel {
+        title: format!(
+            "before the first puncture: member w = {}, scale s = {}, {softening}",
+            tick_label(layer.family_weight),
+            tick_label(layer.scale)
+        ),
+        x_label: "depth from the fitted contact, mm".into(),
+        y_label: "axial force, N".into(),
+        series: vec![
+            Series { label: reference.into(), colour: grey, style: Style::Points, data: measured },
+            Series { label: "calibrated model".into(), colour: COMPONENT_COLOURS[1], style: Style::Line, data: model },
+        ],
+        y_min_span: 0.0,
+    };
+    let residual = Panel {
+        title: format!("before the first puncture: residual, {reference} - model"),
+        x_label: "depth from the fitted contact, mm".into(),
+        y_label: "residual, N".into(),
+        series: vec![Series { label: "residual".into(), colour: grey, style: Style::Points, data: residuals }],
+        y_min_span: 0.0,
+    };
+    vec![shape, residual]
 }

@@ -3,6 +3,7 @@
 pub mod figure;
 pub mod json;
 pub mod trials;
+pub mod trials_figure;
 
 use crate::compiled_set::check_compiled_set_except;
 use crate::planned_outputs::{self, Planned};
@@ -51,7 +52,10 @@ pub struct CalibrateArgs {
     /// Write the stack here instead of <set>/tissue/<name>.toml.
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Write the figure here instead of <set>/figures/calibration-<name>.svg.
+    /// Write the figure here instead of <set>/figures/calibration-<name>.svg (--curve:
+    /// the curve, the model and the residual against position, and before the first
+    /// puncture against depth; --trials: per trial the measured and the model force
+    /// against time over insertion, hold and withdrawal, the punctures, the residual).
     #[arg(long)]
     pub figure: Option<PathBuf>,
     /// Replace an existing stack or figure (without it, an existing one is refused before
@@ -62,10 +66,10 @@ pub struct CalibrateArgs {
     /// without it, a missed goal writes nothing.
     #[arg(long)]
     pub write_on_miss: bool,
-    /// With --trials: print one JSON document (the fitted values with their
-    /// uncertainties, each check, the model force per measured row of each trial) instead
-    /// of the text.
-    #[arg(long, requires = "trials")]
+    /// Print one JSON document instead of the text: the fitted values (with --trials their
+    /// uncertainties), the values on their range's edge (warnings), each check, the model
+    /// force per measured row (of each trial).
+    #[arg(long)]
     pub json: bool,
 }
 
@@ -105,6 +109,43 @@ pub fn run(a: CalibrateArgs) -> Result<ExitCode> {
     planned_outputs::check(&planned, Some(&a.set), &[("--curve", &curve)], a.force)?;
     let points = needle_calibrate::measured::read_curve(&curve)?;
     let c = needle_calibrate::calibrate_points_with_progress(&opts, points, &mut progress_on_stderr())?;
+    let all_met = c.checks.iter().all(needle_calibrate::replay::Check::met);
+    if a.json {
+        println!("{}", serde_json::to_string_pretty(&self::json::curve_calibration(&c))?);
+        for e in &c.fit.edges {
+            eprintln!("warning: {e}");
+        }
+    } else {
+        print_fit(&c, needle_diameter_mm, mu0);
+        print_checks(&c.checks);
+    }
+    let say = |s: String| if a.json { eprintln!("{s}") } else { println!("{s}") };
+    if !all_met && !a.write_on_miss {
+        say("result: FAIL (a goal is missed): nothing written (--write-on-miss writes the stack and figure anyway)".into());
+        return Ok(ExitCode::from(1));
+    }
+    let header = format!(
+        "Tissue stack `{}`, written by `needle calibrate` (format: coeffs/README.md, \"Tissue stacks\").\nMeasured curve: {}; needle {} mm at {} mm/s.",
+        a.name,
+        curve.display(),
+        needle_diameter_mm,
+        speed
+    );
+    let stack = c.stack.to_toml(&header);
+    let svg = self::figure::svg(&c, &a.name, "measured")?;
+    needle_stdx::fs::write_all_atomic(&[(&out, stack.as_bytes()), (&figure, svg.as_bytes())])?;
+    say(format!("wrote {}", out.display()));
+    say(format!("wrote {}", figure.display()));
+    say(format!(
+        "result: {}",
+        if all_met { "every calibration goal met" } else { "FAIL (a goal is missed; written with --write-on-miss)" }
+    ));
+    Ok(if all_met { ExitCode::SUCCESS } else { ExitCode::from(1) })
+}
+
+/// Prints the fitted values of a `--curve` calibration: the similarity, the contact,
+/// each layer, the first boundary's shape and the values on their range's edge.
+fn print_fit(c: &needle_calibrate::Calibration, needle_diameter_mm: f64, mu0: f64) {
     println!(
         "{} points, {} punctures; geometric similarity: measured needle {} mm / FE needle {} mm = {:.4} (lengths x {:.4}, forces x {:.4}; exact when the block scales too)",
         c.points.len(),
@@ -127,25 +168,22 @@ pub fn run(a: CalibrateArgs) -> Result<ExitCode> {
             needle_calibrate::WINKLER_E_PER_MU * l.scale * mu0
         );
     }
-    let all_met = print_checks(&c.checks);
-    if !all_met && !a.write_on_miss {
-        println!("result: FAIL (a goal is missed): nothing written (--write-on-miss writes the stack and figure anyway)");
-        return Ok(ExitCode::from(1));
+    if let Some(l) = c.fit.layers.first() {
+        println!(
+            "layer 0 shape: family member w = {:.4} (fitted range {}), softening fraction {:.4}{}",
+            l.family_weight,
+            l.family_weight_range.map_or("not fitted".into(), |[lo, hi]| format!("{lo:.4} to {hi:.4}")),
+            l.softening.fraction,
+            if l.softening.fraction > 0.0 {
+                format!(" from {:.2} of the puncture's elastic force", l.softening.onset_ratio)
+            } else {
+                String::new()
+            }
+        );
     }
-    let header = format!(
-        "Tissue stack `{}`, written by `needle calibrate` (format: coeffs/README.md, \"Tissue stacks\").\nMeasured curve: {}; needle {} mm at {} mm/s.",
-        a.name,
-        curve.display(),
-        needle_diameter_mm,
-        speed
-    );
-    let stack = c.stack.to_toml(&header);
-    let svg = self::figure::svg(&c, &a.name, "measured")?;
-    needle_stdx::fs::write_all_atomic(&[(&out, stack.as_bytes()), (&figure, svg.as_bytes())])?;
-    println!("wrote {}", out.display());
-    println!("wrote {}", figure.display());
-    println!("result: {}", if all_met { "every calibration goal met" } else { "FAIL (a goal is missed; written with --write-on-miss)" });
-    Ok(if all_met { ExitCode::SUCCESS } else { ExitCode::from(1) })
+    for e in &c.fit.edges {
+        println!("warning: {e}");
+    }
 }
 
 /// Refuses a `--name` that cannot name a stack, before any work.

@@ -9,10 +9,10 @@ use needle_calibrate::events::EventRule;
 use needle_calibrate::whole::{annotate::annotate, calibrate_trials, TrialsCalibration, TrialsOptions};
 use std::process::ExitCode;
 
-/// Runs the `--trials` form: the name, set and output are checked first, the trials
-/// read and fitted, the text (or `--json`) printed, the stack written last (nothing on
-/// an error; on a missed goal only with `--write-on-miss`); exit 1 when a goal is
-/// missed.
+/// Runs the `--trials` form: the name, set and outputs are checked first, the trials
+/// read and fitted, the text (or `--json`) printed, the stack and its figure
+/// ([`super::trials_figure`]) written last, together (nothing on an error; on a missed
+/// goal only with `--write-on-miss`); exit 1 when a goal is missed.
 ///
 /// # Errors
 /// The set is not the compiled-in one, an output is refused, a trial is refused (its
@@ -24,7 +24,14 @@ pub fn run_trials(a: &CalibrateArgs) -> Result<ExitCode> {
         .with_context(|| format!("{}: no campaign.toml: the FE tissue's shear modulus sets the track stiffness", a.set.display()))?;
     let out = a.out.clone().unwrap_or_else(|| a.set.join(needle_codegen::tissue::TISSUE_DIR).join(format!("{}.toml", a.name)));
     let inputs: Vec<(&str, &std::path::Path)> = a.trials.iter().map(|p| ("--trials", p.as_path())).collect();
-    planned_outputs::check(&[Planned { option: "--out", path: &out }], Some(&a.set), &inputs, a.force)?;
+    let figure = a.figure.clone().unwrap_or_else(|| a.set.join("figures").join(format!("calibration-{}.svg", a.name)));
+    let spread_out = needle_calibrate::spread::beside(&out);
+    let planned = [
+        Planned { option: "--out", path: &out },
+        Planned { option: "--figure", path: &figure },
+        Planned { option: "--out (its spread)", path: &spread_out },
+    ];
+    planned_outputs::check(&planned, Some(&a.set), &inputs, a.force)?;
     let opts = TrialsOptions {
         trials: &a.trials,
         name: a.name.clone(),
@@ -36,12 +43,15 @@ pub fn run_trials(a: &CalibrateArgs) -> Result<ExitCode> {
     let all_met = c.checks.iter().flatten().all(needle_calibrate::replay::Check::met);
     if a.json {
         println!("{}", serde_json::to_string_pretty(&super::json::calibration(&c))?);
+        for e in &c.edges {
+            eprintln!("warning: {e}");
+        }
     } else {
         print_text(&c);
     }
     let say = |s: String| if a.json { eprintln!("{s}") } else { println!("{s}") };
     if !all_met && !a.write_on_miss {
-        say("result: FAIL (a goal is missed): nothing written (--write-on-miss writes the stack anyway)".into());
+        say("result: FAIL (a goal is missed): nothing written (--write-on-miss writes the stack and figure anyway)".into());
         return Ok(ExitCode::from(1));
     }
     let names: Vec<String> = a.trials.iter().map(|p| p.display().to_string()).collect();
@@ -51,8 +61,32 @@ pub fn run_trials(a: &CalibrateArgs) -> Result<ExitCode> {
         names.join(", ")
     );
     let text = annotate(&c.fitted.stack.to_toml(&header), &c.fitted.uncertainty);
-    needle_stdx::fs::write_all_atomic(&[(&out, text.as_bytes())])?;
+    let shown: Vec<_> = c.trials.iter().zip(&c.replays).collect();
+    let caption = match c.fitted.stack.layers.first() {
+        Some(l) => format!(
+            "needle calibrate --trials: {} on {} trials; first layer: member w = {}, scale s = {}, softening {}",
+            a.name,
+            c.trials.len(),
+            needle_plot::panel::tick_label(l.family_weight),
+            needle_plot::panel::tick_label(l.stiffness_scale),
+            if l.softening_fraction > 0.0 {
+                format!(
+                    "{} from {}",
+                    needle_plot::panel::tick_label(l.softening_fraction),
+                    needle_plot::panel::tick_label(l.softening_onset_ratio)
+                )
+            } else {
+                "none".into()
+            }
+        ),
+        None => format!("needle calibrate --trials: {} on {} trials", a.name, c.trials.len()),
+    };
+    let svg = super::trials_figure::svg(&caption, &shown)?;
+    let spread = needle_calibrate::spread::to_csv(&c.fitted.spread);
+    needle_stdx::fs::write_all_atomic(&[(&out, text.as_bytes()), (&spread_out, spread.as_bytes()), (&figure, svg.as_bytes())])?;
     say(format!("wrote {}", out.display()));
+    say(format!("wrote {} (the values' spread over the trials: needle stack sample)", spread_out.display()));
+    say(format!("wrote {}", figure.display()));
     say(format!(
         "result: {}",
         if all_met { "every calibration goal met" } else { "FAIL (a goal is missed; written with --write-on-miss)" }
@@ -63,6 +97,9 @@ pub fn run_trials(a: &CalibrateArgs) -> Result<ExitCode> {
 fn print_text(c: &TrialsCalibration) {
     for note in &c.notes {
         println!("note: {note}");
+    }
+    for e in &c.edges {
+        println!("warning: {e}");
     }
     println!(
         "{} trials, {} punctures each; geometric similarity {:.4}; stick band {:.3} mm/s (half the slowest speed, at most 1)",

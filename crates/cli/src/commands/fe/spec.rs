@@ -72,13 +72,15 @@ pub fn variants(set: &SetFolder, opts: RunOptions) -> anyhow::Result<Vec<RunOpti
     }
 }
 
-/// One run per run of `[family]` (`needle_fe::family::FamilyRun::all`), in order; the
-/// runs `--only` selects nothing of are left out.
+/// One run per run of `[family]` (`needle_fe::family::FamilyRun::all`), in order, then
+/// `[family.fitted]`'s (`FamilyRun::fitted`); the runs `--only` selects nothing of are left
+/// out.
 fn family_variants(set: &SetFolder, opts: RunOptions) -> anyhow::Result<Vec<RunOptions>> {
     let (c, path) = (set.campaign(), set.spec_path());
     let f = c.family.clone().ok_or_else(|| anyhow::anyhow!("{}: --family: the spec has no [family] section", path.display()))?;
     let mut out = Vec::new();
-    for run in needle_fe::family::FamilyRun::all(&f) {
+    let fitted = needle_fe::family::FamilyRun::fitted(&f, set.dir())?;
+    for run in needle_fe::family::FamilyRun::all(&f).into_iter().chain(fitted) {
         let (_, runs, _) = needle_fe::family::apply(c, &f, run);
         if needle_set::spec::select(&runs, opts.only.as_deref()).is_ok_and(|r| !r.is_empty()) {
             out.push(RunOptions { family_run: Some(run), ..opts.clone() });
@@ -86,7 +88,7 @@ fn family_variants(set: &SetFolder, opts: RunOptions) -> anyhow::Result<Vec<RunO
     }
     if out.is_empty() {
         anyhow::bail!(
-            "--family --only {:?}: matches no run (names: centre_paper, the paper's tissue; <pose>_w<weight>, e.g. centre_w0p05, x+04_w0p2)",
+            "--family --only {:?}: matches no run (names: centre_paper, the paper's tissue; <pose>_w<weight>, e.g. centre_w0p05, x+04_w0p2; fitted_<stack>_l<layer>)",
             opts.only.as_deref().unwrap_or("")
         );
     }

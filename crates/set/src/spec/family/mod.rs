@@ -46,6 +46,39 @@ pub struct FamilySettings {
     /// fit` checks it against them (members it was not fitted on).
     #[serde(default)]
     pub held_out: Vec<f64>,
+    /// `[family.fitted]`: the FEBio run of a calibrated layer's material (issue 64, item 5);
+    /// absent: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fitted: Option<FittedMaterial>,
+}
+
+/// `[family.fitted]`: a calibrated layer's material solved by FEBio at the centre (the
+/// member `family_weight` of the layer with every modulus times its `stiffness_scale`,
+/// both read from the stack file when the run is made: [`runs::FamilyRun::fitted`]) on
+/// `family.mesh`, to `depth_mm` in `steps` load steps: the check that a fitted tissue is a
+/// material and not a curve (its force against the measured curve, by geometric
+/// similarity, in `needle_calibrate::fe_loop`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FittedMaterial {
+    /// The stack file, relative to the set's folder (`calibrated/<name>.toml`).
+    pub stack: String,
+    /// The layer (0: the surface's) whose material is solved.
+    pub layer: usize,
+    /// Final depth along the needle axis, mm (the FE needle's: the measured depth over the
+    /// geometric similarity).
+    pub depth_mm: f64,
+    /// Number of equal load steps to `depth_mm`.
+    pub steps: u32,
+}
+
+impl FittedMaterial {
+    /// The run's name: `fitted_<stack file stem>_l<layer>` (`fitted_rig_skin_2mmps_t1_l0`).
+    #[must_use]
+    pub fn run_name(&self) -> String {
+        let stem = std::path::Path::new(&self.stack).file_stem().map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+        format!("fitted_{stem}_l{}", self.layer)
+    }
 }
 
 /// The run name of `pose` at the member `weight`: `centre_w0p05`, `x+04_w0p2`, `centre_w0`
@@ -104,7 +137,33 @@ pub fn validate_family(c: &Campaign, text: &str, path: &Path) -> SpecResult<()> 
         );
         return Err(SpecError::inconsistent(at("mesh"), "family.mesh", message));
     }
-    validate_checks(c, f, &at)
+    validate_checks(c, f, &at)?;
+    validate_fitted(c, f, text, path)
+}
+
+/// `[family.fitted]`: a stack path inside the set, a depth inside the block and the
+/// family mesh's fine layers, 1 ..= [`MAX_LOAD_STEPS`] steps.
+fn validate_fitted(c: &Campaign, f: &FamilySettings, text: &str, path: &Path) -> SpecResult<()> {
+    let Some(m) = &f.fitted else { return Ok(()) };
+    let at = |key: &str| format!("{}:{}", path.display(), crate::spec::key_line(text, "family.fitted", key));
+    let stack = std::path::Path::new(&m.stack);
+    if m.stack.is_empty() || stack.is_absolute() || stack.components().any(|c| matches!(c, std::path::Component::ParentDir)) {
+        let message = format!("family.fitted.stack = {:?}: must be a path inside the set's folder (calibrated/<name>.toml)", m.stack);
+        return Err(SpecError::range(at("stack"), "family.fitted.stack", message));
+    }
+    let fine = c.mesh.get(&f.mesh).map_or(0.0, |l| l.fine_depth_mm);
+    if !(m.depth_mm.is_finite() && m.depth_mm > 0.0 && m.depth_mm <= fine) {
+        let message = format!(
+            "family.fitted.depth_mm = {}: must be > 0 and within the family mesh's fine layers (fine_depth_mm = {fine} mm)",
+            m.depth_mm
+        );
+        return Err(SpecError::range(at("depth_mm"), "family.fitted.depth_mm", message));
+    }
+    if m.steps == 0 || m.steps > MAX_LOAD_STEPS {
+        let message = format!("family.fitted.steps = {}: must be 1 ..= {MAX_LOAD_STEPS}", m.steps);
+        return Err(SpecError::range(at("steps"), "family.fitted.steps", message));
+    }
+    Ok(())
 }
 
 /// The off-centre check runs: known poses inside the block, listed once; members of the family.
@@ -169,6 +228,9 @@ mod tests {
         let (_, check_line, check) = shipped_key("family", "check_weight");
         let (_, poses_line, poses) = shipped_key("family", "check_poses");
         let (_, held_line, held) = shipped_key("family", "held_out");
+        let (_, stack_line, stack) = shipped_key("family.fitted", "stack");
+        let (_, fitted_depth_line, fitted_depth) = shipped_key("family.fitted", "depth_mm");
+        let (_, fitted_steps_line, fitted_steps) = shipped_key("family.fitted", "steps");
         let cases = [
             (text.replace(&weight, "weight = []"), "family.weight", weight_line),
             (text.replace(&weight, "weight = [0.1, 1.0]"), "family.weight", weight_line),
@@ -183,6 +245,9 @@ mod tests {
             (text.replace(&poses, "check_poses = [\"nowhere\"]"), "family.check_poses", poses_line),
             (text.replace(&held, "held_out = [0.4]"), "family.held_out", held_line),
             (text.replace(&poses, "check_poses = [\"x+04\", \"x+04\"]"), "family.check_poses", poses_line),
+            (text.replace(&stack, "stack = \"../elsewhere.toml\""), "family.fitted.stack", stack_line),
+            (text.replace(&fitted_depth, "depth_mm = 40.0"), "family.fitted.depth_mm", fitted_depth_line),
+            (text.replace(&fitted_steps, "steps = 0"), "family.fitted.steps", fitted_steps_line),
         ];
         for (spec, field, line) in cases {
             assert_ne!(spec, text, "the test's edit did not apply ({field})");

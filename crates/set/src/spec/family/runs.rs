@@ -13,6 +13,9 @@
 //!   the campaign's mesh level (half models, as the campaign solves them), named
 //!   `<pose>_w<weight>`: the check of the ratio law that carries the coupled model's pose
 //!   dependence over to the family;
+//! - with `[family.fitted]`, the centre of a calibrated layer's material (its member, every
+//!   modulus times its stiffness scale, both read from the stack file: [`FamilyRun::fitted`])
+//!   to `family.fitted.depth_mm` on `family.mesh`, named `fitted_<stack>_l<layer>`;
 //!
 //! into `<set>/fe/family/<run>.csv` with one `<set>/fe/family/manifest.toml`.
 //!
@@ -29,6 +32,7 @@
 
 use super::{member_name, FamilySettings};
 use crate::spec::{Campaign, PoseSpec, Tissue};
+use std::path::Path;
 
 /// One run variant of the family: a campaign run of its own (its tissue, loading, mesh
 /// and poses).
@@ -46,6 +50,14 @@ pub enum FamilyRun {
         /// The member's weight of the paper's terms.
         weight: f64,
     },
+    /// The centre of `[family.fitted]`'s calibrated layer: the member `weight` with every
+    /// modulus times `scale` (both from the stack file).
+    Fitted {
+        /// The layer's `family_weight`.
+        weight: f64,
+        /// The layer's `stiffness_scale` (> 0).
+        scale: f64,
+    },
 }
 
 impl FamilyRun {
@@ -57,18 +69,46 @@ impl FamilyRun {
         std::iter::once(FamilyRun::Reference).chain(centres).chain(checks).collect()
     }
 
+    /// The run of `[family.fitted]` of `f` (none without it), its member and scale read from
+    /// the stack file in `set_dir` (checked as `needle calibrate` writes it, `file:line`).
+    ///
+    /// # Errors
+    /// The stack cannot be read or is refused, it has no layer `family.fitted.layer`, or
+    /// that layer's scale is not > 0 or its weight not in `0 ..= 1`.
+    pub fn fitted(f: &FamilySettings, set_dir: &Path) -> anyhow::Result<Option<FamilyRun>> {
+        let Some(m) = &f.fitted else { return Ok(None) };
+        let path = set_dir.join(&m.stack);
+        let stack = needle_codegen::tissue::parse_stack(&path).map_err(|e| anyhow::anyhow!("family.fitted.stack: {e}"))?;
+        let Some(layer) = stack.layers.get(m.layer) else {
+            anyhow::bail!("{}: family.fitted.layer = {}: the stack has {} layer(s)", path.display(), m.layer, stack.layers.len());
+        };
+        let (weight, scale) = (layer.family_weight, layer.stiffness_scale);
+        if !(scale.is_finite() && scale > 0.0 && (0.0..=1.0).contains(&weight)) {
+            anyhow::bail!(
+                "{}: layer {}: stiffness_scale = {scale} and family_weight = {weight}: not a member to solve",
+                path.display(),
+                m.layer
+            );
+        }
+        Ok(Some(FamilyRun::Fitted { weight, scale }))
+    }
+
     /// The member's weight of the paper's terms; `None` for the reference (the paper's
     /// tissue itself, weight 1).
     pub fn weight(self) -> Option<f64> {
         match self {
             FamilyRun::Reference => None,
-            FamilyRun::Centre { weight } | FamilyRun::Check { weight } => Some(weight),
+            FamilyRun::Centre { weight } | FamilyRun::Check { weight } | FamilyRun::Fitted { weight, .. } => Some(weight),
         }
     }
 
-    /// What the run solves, for messages: `weight = 0.05` or `the paper's tissue`.
+    /// What the run solves, for messages: `weight = 0.05`, `the paper's tissue` or the
+    /// fitted layer's `weight = 0.01, moduli x 30.3`.
     pub fn label(self) -> String {
-        self.weight().map_or_else(|| "the paper's tissue".to_string(), |w| format!("weight = {w}"))
+        match self {
+            FamilyRun::Fitted { weight, scale } => format!("the fitted layer: weight = {weight}, moduli x {scale}"),
+            _ => self.weight().map_or_else(|| "the paper's tissue".to_string(), |w| format!("weight = {w}")),
+        }
     }
 }
 
@@ -102,6 +142,16 @@ pub fn apply(c: &Campaign, f: &FamilySettings, run: FamilyRun) -> (Campaign, Vec
             .collect()
     };
     match run {
+        FamilyRun::Fitted { scale, .. } => {
+            // the stack's scale on every modulus (the bulk modulus follows mu0: bulk_to_shear)
+            out.tissue.mu_n_per_mm2.iter_mut().for_each(|mu| *mu *= scale);
+            out.loading.ramp_hold = None;
+            let Some(m) = &f.fitted else { return (out, Vec::new(), f.mesh.clone()) };
+            out.loading.depth_mm = m.depth_mm;
+            out.loading.steps = m.steps;
+            let poses = named(&["centre".to_string()]).into_iter().map(|p| PoseSpec { name: m.run_name(), ..p }).collect();
+            (out, poses, f.mesh.clone())
+        }
         FamilyRun::Reference | FamilyRun::Centre { .. } => {
             out.loading.depth_mm = f.depth_mm;
             out.loading.steps = f.steps;
@@ -148,18 +198,29 @@ mod tests {
         let f = c.family.clone().expect("[family]");
         let runs = FamilyRun::all(&f);
         assert_eq!(runs.len(), 1 + f.weight.len() + f.check_weight.len());
+        let set_dir = needle_stdx::workspace_root().join("coeffs/default");
+        let fitted = FamilyRun::fitted(&f, &set_dir).expect("the shipped [family.fitted] stack");
+        assert_eq!(fitted.is_some(), f.fitted.is_some());
         let mut hashes = std::collections::BTreeSet::new();
-        for run in runs {
+        for run in runs.into_iter().chain(fitted) {
             let (campaign, poses, mesh) = apply(&c, &f, run);
             assert!(!poses.is_empty(), "{run:?}");
             for p in &poses {
-                match run.weight() {
-                    Some(w) => assert!(p.name.ends_with(&format!("_w{}", format!("{w}").replace('.', "p"))), "{}", p.name),
-                    None => assert_eq!(p.name, REFERENCE_RUN),
+                match (run, run.weight(), &f.fitted) {
+                    (FamilyRun::Fitted { .. }, _, Some(m)) => assert_eq!(p.name, m.run_name()),
+                    (_, Some(w), _) => assert!(p.name.ends_with(&format!("_w{}", format!("{w}").replace('.', "p"))), "{}", p.name),
+                    _ => assert_eq!(p.name, REFERENCE_RUN),
                 }
                 assert!(hashes.insert(campaign.run_hash(p, &mesh)), "{} repeats a hash", p.name);
             }
             match run {
+                FamilyRun::Fitted { weight, scale } => {
+                    let member = member_tissue(&c.tissue, weight, f.soft_alpha);
+                    let ratio = campaign.tissue.mu0_n_per_mm2() / member.mu0_n_per_mm2();
+                    assert!((ratio / scale - 1.0).abs() < 1e-12, "every modulus times the stack's scale: {ratio} vs {scale}");
+                    let m = f.fitted.as_ref().expect("a fitted run comes from [family.fitted]");
+                    assert_eq!((campaign.loading.depth_mm, campaign.loading.steps, mesh.as_str()), (m.depth_mm, m.steps, f.mesh.as_str()));
+                }
                 FamilyRun::Reference | FamilyRun::Centre { .. } => {
                     assert_eq!((campaign.loading.depth_mm, mesh.as_str()), (f.depth_mm, f.mesh.as_str()))
                 }
