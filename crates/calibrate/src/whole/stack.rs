@@ -128,16 +128,22 @@ pub fn fit(ts: &[Trial], opts: &TrialsOptions<'_>, diameter: f64, u: &dyn Fn(f64
         layers.push(l);
         uncertainty.push(notes);
     }
+    let stack = checked_stack(opts, ts.len(), diameter, layers)?;
+    Ok(Fitted { stack, uncertainty, punctures: n, friction: fr, hold, stick_band_mm_per_s: band, presliding_mm: presliding, spread })
+}
+
+/// The stack of `layers`, checked by the tissue format's reader as the file will be read.
+fn checked_stack(opts: &TrialsOptions<'_>, trials: usize, diameter: f64, layers: Vec<file::Layer>) -> Result<file::Stack> {
     let stack = file::Stack {
         format: file::TISSUE_FORMAT,
         name: opts.name.clone(),
-        description: format!("calibrated by needle calibrate --trials on {} trials ({} mm needle)", ts.len(), diameter),
+        description: format!("calibrated by needle calibrate --trials on {trials} trials ({diameter} mm needle)"),
         needle_diameter_mm: diameter,
         layers,
     };
     file::parse_stack_str(&stack.to_toml(""), Path::new(&format!("{}.toml", stack.name)))
         .map_err(|e| anyhow::anyhow!("the calibrated stack is refused by the tissue format: {e}"))?;
-    Ok(Fitted { stack, uncertainty, punctures: n, friction: fr, hold, stick_band_mm_per_s: band, presliding_mm: presliding, spread })
+    Ok(stack)
 }
 
 /// The shaft's presliding (the `hold` and `presliding` modules): its distance from the
