@@ -99,7 +99,7 @@ fn insertion_cases(out: &str) -> Vec<(String, f64, usize, String)> {
 }
 
 /// The cases of the `tissue-shape` build that miss issue 64's loop-tick goal, as measured
-/// (2026-12-07; the issue stays open for them, the closing note has the figures and what
+/// (the issue stays open for them, the closing note has the figures and what
 /// was tried): the epidural's surface with the guard 1,735.0 (budget 1,720; 1,713.1
 /// without the feature) and the rig skin's surface with the guard 1,718.9 (1,600). Not a
 /// tolerance: every other case must meet its goal, and these are still printed.

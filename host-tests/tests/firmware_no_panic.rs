@@ -169,7 +169,7 @@ fn insertion_flash_within_24_kib([model_example, insertion_example]: [&str; 2], 
 /// f32 and fixed point, elastic and with the viscoelastic filter. The feature must cost
 /// flash (or its code is not in the image) and the shaped stack must be in the build.
 /// The images of the build with both `viscoelastic` and `tissue-shape` that miss issue
-/// 64's 24 KiB, as measured (2026-12-07; the issue stays open for them, the closing note
+/// 64's 24 KiB, as measured (the issue stays open for them, the closing note
 /// has the figures): f32 M3 25,720 and M0 24,914 B, fixed point M4F 25,820, M3 25,806 and
 /// M0 26,764 B (every compiled-in stack, the QLV filter and the family in one image).
 /// Not a tolerance: `tissue-shape` alone (at most 21,046 B) and every other image must

@@ -14,7 +14,7 @@
 use needle_firmware_host::build::Features;
 use needle_firmware_host::{self as firmware, bench, CORES};
 
-/// The cases that miss their goal, as measured (2026-12-07; issue 64 stays open for
+/// The cases that miss their goal, as measured (issue 64 stays open for
 /// them, the closing note has the figures and what was tried): the M0's fixed-point step
 /// deflecting the rig skin's surface, 20,114.0 instructions (goal 20,000; 22,244.1 before
 /// a member's law rows were computed once with it). Not a tolerance: every other case
