@@ -13,6 +13,9 @@
 //!   the exact `+0.0` steps) is float arithmetic; the fixed evaluator's is `fixed::arith`.
 //! - precision-only: `depth_rate` because the forces' rate by depth feeds the passivity
 //!   guard of the control loop (`crate::control`), which runs the f32 insertion only.
+//! - precision-only: `insertion::presliding` because the shaft's presliding (the
+//!   `shaft-presliding` feature) is f32 only: the fixed-point insertion refuses a presliding
+//!   layer (`InsertionError::FloatOnly`).
 //!
 //! The whole API is also at the crate's root (`needle_haptics::wrench`,
 //! `needle_haptics::Pose`, `needle_haptics::insertion`...), re-exported from here.
