@@ -191,7 +191,7 @@ fn apply_variant(opts: &RunOptions, campaign: &mut Campaign, spec_path: &Path) -
         if !(s.is_finite() && s > 0.0) || opts.out_dir.is_none() {
             bail!("tissue scale {s}: must be finite and > 0, with its own output folder (never <set>/fe)");
         }
-        campaign.tissue.mu_n_per_mm2.iter_mut().for_each(|mu| *mu *= s);
+        campaign.tissue.scale_moduli(s);
     }
     if let Some(r) = opts.edge_radius_mm {
         if !campaign.needle.fits_edge_radius(r) || opts.out_dir.is_none() {

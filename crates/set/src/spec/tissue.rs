@@ -30,6 +30,11 @@ impl Tissue {
     pub fn mu0_n_per_mm2(&self) -> f64 {
         self.mu_n_per_mm2.iter().sum()
     }
+    /// Every modulus times `s` (the bulk modulus follows: `bulk_to_shear` is kept): the
+    /// same material `s` times as stiff.
+    pub fn scale_moduli(&mut self, s: f64) {
+        self.mu_n_per_mm2.iter_mut().for_each(|mu| *mu *= s);
+    }
     /// Initial bulk modulus K0 = bulk_to_shear * mu0, N/mm^2.
     pub fn k0_n_per_mm2(&self) -> f64 {
         self.bulk_to_shear * self.mu0_n_per_mm2()

@@ -9,6 +9,20 @@ use needle_plot::panel::{render, tick_label, Panel, RGBColor, Series, Style, COM
 /// Most reference points the figure draws.
 const FIGURE_POINTS: usize = 600;
 
+/// The colour of the measured points and the residuals in the calibration figures.
+pub(super) const MEASURED_GREY: RGBColor = RGBColor(90, 90, 90);
+
+/// A residual panel of the calibration figures: `data` as grey points against `x_label`.
+pub(super) fn residual_panel(title: String, x_label: &str, data: Vec<(f64, f64)>) -> Panel {
+    Panel {
+        title,
+        x_label: x_label.into(),
+        y_label: "residual, N".into(),
+        series: vec![Series { label: "residual".into(), colour: MEASURED_GREY, style: Style::Points, data }],
+        y_min_span: 0.0,
+    }
+}
+
 /// The SVG text of the figure for `c` (stack `name`), its curve labelled `reference`
 /// ("measured", or "published model (sampled)" for `needle calibrate-published`).
 ///
@@ -24,7 +38,7 @@ pub fn svg(c: &Calibration, name: &str, reference: &str) -> anyhow::Result<Strin
         c.events.iter().filter_map(|e| c.points.get(e.peak)).map(|p| (p.position_mm, p.force_n)).collect();
     let residuals: Vec<(f64, f64)> =
         c.points.iter().step_by(every).map(|p| (p.position_mm, p.force_n - c.replay.at(p.position_mm))).collect();
-    let grey = RGBColor(90, 90, 90);
+    let grey = MEASURED_GREY;
     let force = Panel {
         title: format!("{name}: axial force against needle position"),
         x_label: "needle position, mm".into(),
@@ -42,13 +56,7 @@ pub fn svg(c: &Calibration, name: &str, reference: &str) -> anyhow::Result<Strin
         ],
         y_min_span: 0.0,
     };
-    let residual = Panel {
-        title: format!("residual: {reference} - model"),
-        x_label: "needle position, mm".into(),
-        y_label: "residual, N".into(),
-        series: vec![Series { label: "residual".into(), colour: grey, style: Style::Points, data: residuals }],
-        y_min_span: 0.0,
-    };
+    let residual = residual_panel(format!("residual: {reference} - model"), "needle position, mm", residuals);
     let mut panels = vec![force, residual];
     panels.extend(pre_puncture(c, reference));
     let cols = if panels.len() > 2 { 2 } else { 1 };
@@ -80,7 +88,7 @@ fn pre_puncture(c: &Calibration, reference: &str) -> Vec<Panel> {
     } else {
         "no softening".into()
     };
-    let grey = RGBColor(90, 90, 90);
+    let grey = MEASURED_GREY;
     let shape = Panel {
         title: format!(
             "before the first puncture: member w = {}, scale s = {}, {softening}",
@@ -95,12 +103,7 @@ fn pre_puncture(c: &Calibration, reference: &str) -> Vec<Panel> {
         ],
         y_min_span: 0.0,
     };
-    let residual = Panel {
-        title: format!("before the first puncture: residual, {reference} - model"),
-        x_label: "depth from the fitted contact, mm".into(),
-        y_label: "residual, N".into(),
-        series: vec![Series { label: "residual".into(), colour: grey, style: Style::Points, data: residuals }],
-        y_min_span: 0.0,
-    };
+    let residual =
+        residual_panel(format!("before the first puncture: residual, {reference} - model"), "depth from the fitted contact, mm", residuals);
     vec![shape, residual]
 }

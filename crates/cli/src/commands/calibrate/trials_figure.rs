@@ -7,7 +7,7 @@
 //! ([`needle_calibrate::trial_replay`]): the same numbers `--json` prints.
 use needle_calibrate::trial_replay::TrialReplay;
 use needle_calibrate::whole::trials::Trial;
-use needle_plot::panel::{render, Panel, RGBColor, Series, Style, COMPONENT_COLOURS};
+use needle_plot::panel::{render, Panel, Series, Style, COMPONENT_COLOURS};
 
 /// Most points of one measured series (the rows are thinned evenly beyond).
 const MEASURED_POINTS: usize = 600;
@@ -37,7 +37,7 @@ pub fn panels(t: &Trial, r: &TrialReplay) -> [Panel; 3] {
         .map(|(x, m)| (x.time_s, x.force_n - m.force_n))
         .collect();
     let (lo, hi) = measured.iter().chain(&model).fold((0.0f64, 0.0f64), |(a, b), p| (a.min(p.1), b.max(p.1)));
-    let grey = RGBColor(90, 90, 90);
+    let grey = super::figure::MEASURED_GREY;
     let mut series = vec![
         Series { label: "measured".into(), colour: grey, style: Style::Points, data: measured },
         Series { label: "model (calibrated stack)".into(), colour: COMPONENT_COLOURS[1], style: Style::Line, data: model },
@@ -60,13 +60,7 @@ pub fn panels(t: &Trial, r: &TrialReplay) -> [Panel; 3] {
         series,
         y_min_span: 0.0,
     };
-    let residual = Panel {
-        title: format!("{name}: residual, measured - model"),
-        x_label: "time, s".into(),
-        y_label: "residual, N".into(),
-        series: vec![Series { label: "residual".into(), colour: grey, style: Style::Points, data: residual }],
-        y_min_span: 0.0,
-    };
+    let residual = super::figure::residual_panel(format!("{name}: residual, measured - model"), "time, s", residual);
     [force, residual, pre_puncture(t, r, &name)]
 }
 
@@ -81,7 +75,7 @@ fn pre_puncture(t: &Trial, r: &TrialReplay, name: &str) -> Panel {
         .map(|(x, m)| (x.position_mm - onset, x.force_n, m.force_n))
         .collect();
     let every = rows.len().div_ceil(MEASURED_POINTS).max(1);
-    let grey = RGBColor(90, 90, 90);
+    let grey = super::figure::MEASURED_GREY;
     Panel {
         title: format!("{name}: before the first puncture, against depth"),
         x_label: "depth from the fitted contact, mm".into(),

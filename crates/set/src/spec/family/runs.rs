@@ -143,8 +143,7 @@ pub fn apply(c: &Campaign, f: &FamilySettings, run: FamilyRun) -> (Campaign, Vec
     };
     match run {
         FamilyRun::Fitted { scale, .. } => {
-            // the stack's scale on every modulus (the bulk modulus follows mu0: bulk_to_shear)
-            out.tissue.mu_n_per_mm2.iter_mut().for_each(|mu| *mu *= scale);
+            out.tissue.scale_moduli(scale);
             out.loading.ramp_hold = None;
             let Some(m) = &f.fitted else { return (out, Vec::new(), f.mesh.clone()) };
             out.loading.depth_mm = m.depth_mm;
