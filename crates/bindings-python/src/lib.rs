@@ -15,6 +15,7 @@ mod info;
 mod insertion;
 mod poses;
 mod rows;
+mod sample;
 mod toml_py;
 
 #[pymodule]
@@ -26,6 +27,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("CurveError", m.py().get_type::<calibrate::CurveError>())?;
     m.add_function(wrap_pyfunction!(calibrate::calibrate, m)?)?;
     m.add_class::<calibration::Calibration>()?;
+    m.add_function(wrap_pyfunction!(sample::sample_stack, m)?)?;
     info::add(m)?;
     Ok(())
 }

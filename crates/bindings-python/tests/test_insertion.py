@@ -89,3 +89,46 @@ def test_a_bad_tissue_file_is_refused_with_its_line(tmp_path):
         nh.Insertion("liver", period_s=0.0)
     with pytest.raises(ValueError, match="one per layer"):
         nh.Insertion("liver").set_scales([1.0] * 99)
+
+
+def calibrated_on_three_skin_trials(exe: str, tmp_path) -> str:
+    """`needle calibrate --trials` on three skin repeats (read in place from the shared
+    rig data): a stack with a spread over its trials."""
+    rig = os.path.join(nh.SET_DIR, "..", "..", "..", "shared", "data", "stokes-needle-rig")
+    trials = [os.path.join(rig, f"skin_2mmps_0deg_needle2_trial{k}.csv") for k in (1, 2, 3)]
+    assert all(os.path.isfile(t) for t in trials), f"the measured rig trials live beside the checkout: {rig}"
+    out = tmp_path / "skin.toml"
+    args = [exe, "calibrate", "--trials", *trials, "--name", "skin", "--needle-diameter-mm", "1.27", "--write-on-miss"]
+    # exit 1 when a goal is missed; --write-on-miss writes the stack all the same
+    done = subprocess.run(args + ["--set", nh.SET_DIR, "--out", str(out), "--figure", str(tmp_path / "skin.svg")], capture_output=True, text=True)
+    assert done.returncode in (0, 1) and out.is_file(), done.stderr
+    return str(out)
+
+
+def test_a_stack_drawn_in_python_is_the_cli_draw_and_loads(tmp_path):
+    """issue 65 item 3: Python draws the tissue `needle stack sample` draws (the same
+    stack, spread and seed: the same file, byte for byte), within the spread, and the
+    drawn file loads and punctures."""
+    exe = os.environ.get("NEEDLE_BIN")
+    assert exe and os.path.isfile(exe), "NEEDLE_BIN must name the needle binary (.ci/test-python builds it)"
+    stack = calibrated_on_three_skin_trials(exe, tmp_path)
+    cli_out, py_out = tmp_path / "cli" / "drawn.toml", tmp_path / "drawn.toml"
+    cli_out.parent.mkdir()
+    subprocess.run([exe, "stack", "sample", "--stack", stack, "--seed", "7", "--out", str(cli_out)], check=True, capture_output=True)
+    text = nh.sample_stack(stack, seed=7, out=py_out)
+    assert text == cli_out.read_text(encoding="utf-8")
+    assert py_out.read_text(encoding="utf-8") == text
+    values = lambda t: [line for line in t.splitlines() if line.startswith("stiffness_scale")]
+    assert values(text) != values(open(stack, encoding="utf-8").read()), "the draw moves the fitted scale"
+    assert values(text) != values(nh.sample_stack(stack, seed=8, name="drawn")), "another seed draws another tissue"
+    got = nh.Insertion(str(py_out)).run(trajectory())
+    assert got.punctures.sum() >= 1, "the drawn tissue punctures on the scripted path"
+
+
+def test_a_bad_spread_is_refused_with_its_line(tmp_path):
+    bad = tmp_path / "bad.spread.csv"
+    bad.write_text("layer,key,trials,mean,sd\n0,stiffness_scale,3,1.0,-0.5\n", encoding="utf-8")
+    out = tmp_path / "never.toml"
+    with pytest.raises(ValueError, match="bad.spread.csv:2:"):
+        nh.sample_stack(CALIBRATED, seed=1, spread=bad, out=out)
+    assert not out.exists(), "nothing written on error"

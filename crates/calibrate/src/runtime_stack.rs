@@ -27,13 +27,22 @@ impl OwnedStack {
     /// The format's refusal (`FILE:LINE: ...`, as the build says it), or the library's.
     pub fn load(path: &Path) -> Result<Self> {
         let file = needle_codegen::tissue::parse_stack(path)?;
+        Self::from_file(&file).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+    }
+
+    /// The stack of a tissue file's values already read (a stack drawn within a
+    /// spread, `crate::sample`), converted as the build compiles them.
+    ///
+    /// # Errors
+    /// The library's refusal ([`Insertion::new`]).
+    pub fn from_file(file: &needle_codegen::tissue::Stack) -> Result<Self> {
         let out = Self {
             name: file.name.clone(),
             needle_diameter_mm: file.needle_diameter_mm as f32,
             layers: file.layers.iter().map(crate::to_layer).collect(),
         };
         if let Err(e) = Insertion::new(&out.as_stack(), InsertionConfig::DEFAULT_1KHZ) {
-            bail!("{}: {e}", path.display());
+            bail!("{e}");
         }
         Ok(out)
     }

@@ -42,6 +42,9 @@ pub struct Content {
     pub wasm: Vec<u8>,
     /// The set's data (`/set.json`, [`super::set_json::set_json`]).
     pub set_json: String,
+    /// Tissue files and tissues drawn within their spread (`/stacks.json`,
+    /// [`super::stacks_json::stacks_json`]; `[]` without `--stack`).
+    pub stacks_json: String,
 }
 
 /// A bound, not yet serving, explorer server.
@@ -69,8 +72,8 @@ impl Explorer {
         }
     }
 
-    /// Answers requests until the process ends: GET of the page's files, `/needle.wasm`
-    /// and `/set.json`; 404 for any other path, 405 for other methods, 421 for a `Host`
+    /// Answers requests until the process ends: GET of the page's files, `/needle.wasm`,
+    /// `/set.json` and `/stacks.json`; 404 for any other path, 405 for other methods, 421 for a `Host`
     /// that is not this server ([`host_is_local`]). A failed answer (the browser went
     /// away) is reported on stderr and the server goes on.
     pub fn serve(self) {
@@ -173,6 +176,8 @@ fn answer(request: Request, content: &Content, port: u16, over_limit: bool) {
         (200, "application/wasm", &content.wasm)
     } else if path == "/set.json" {
         (200, "application/json", content.set_json.as_bytes())
+    } else if path == "/stacks.json" {
+        (200, "application/json", content.stacks_json.as_bytes())
     } else {
         (404, "text/plain; charset=utf-8", b"not found\n")
     };

@@ -8,7 +8,8 @@ use std::net::{SocketAddr, TcpStream};
 use std::time::Duration;
 
 fn start(wasm: Vec<u8>) -> SocketAddr {
-    let e = Explorer::bind("127.0.0.1:0".parse().expect("addr"), Content { wasm, set_json: "{}".into() }).expect("bind");
+    let e = Explorer::bind("127.0.0.1:0".parse().expect("addr"), Content { wasm, set_json: "{}".into(), stacks_json: "[]".into() })
+        .expect("bind");
     let addr: SocketAddr = e.url().trim_start_matches("http://").trim_end_matches('/').parse().expect("url");
     std::thread::spawn(move || e.serve());
     addr

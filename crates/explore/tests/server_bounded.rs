@@ -9,7 +9,11 @@ use std::net::{SocketAddr, TcpStream};
 use std::time::Duration;
 
 fn start() -> SocketAddr {
-    let e = Explorer::bind("127.0.0.1:0".parse().expect("addr"), Content { wasm: vec![7; 1 << 20], set_json: "{}".into() }).expect("bind");
+    let e = Explorer::bind(
+        "127.0.0.1:0".parse().expect("addr"),
+        Content { wasm: vec![7; 1 << 20], set_json: "{}".into(), stacks_json: "[]".into() },
+    )
+    .expect("bind");
     let addr: SocketAddr = e.url().trim_start_matches("http://").trim_end_matches('/').parse().expect("url");
     std::thread::spawn(move || e.serve());
     addr

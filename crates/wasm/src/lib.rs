@@ -15,7 +15,10 @@
 //!   with Prony terms tried on every layer) and [`needle_insertion_step`], whose
 //!   wrench is left at [`needle_out`] as [`needle_eval`]'s is; the fixed-point insertion
 //!   the same way ([`needle_fixed_insertion_start`], [`needle_fixed_insertion_step`]:
-//!   Q16.16 poses, the wrench in µN and µN·mm as `i32` bits).
+//!   Q16.16 poses, the wrench in µN and µN·mm as `i32` bits);
+//! - a stack given by the page instead of a compiled-in one (a tissue file the host
+//!   loaded, or one drawn within its spread: `needle explore --stack`): its layers as
+//!   [`layer_words`] at [`needle_layers_in`], then [`needle_insertion_start_layers`].
 #![cfg_attr(target_arch = "wasm32", no_std)]
 #![deny(missing_docs)]
 
@@ -23,8 +26,10 @@ use core::sync::atomic::{AtomicU32, Ordering};
 use needle_contract::COMPONENT_COUNT;
 use needle_haptics::fixed;
 use needle_haptics::fixed::insertion::{stacks as fixed_stacks, Insertion as FixedInsertion, InsertionConfig as FixedConfig};
-use needle_haptics::insertion::{stacks, Insertion, InsertionConfig};
+use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, MAX_LAYERS};
 use needle_haptics::{model_info, wrench, Pose};
+
+pub mod layer_words;
 
 /// The last evaluation: fx, fy, fz (N), mx, my, mz (N*mm) as f32 bits.
 static OUT: [AtomicU32; COMPONENT_COUNT] = [const { AtomicU32::new(0) }; COMPONENT_COUNT];
@@ -34,7 +39,7 @@ static OUT: [AtomicU32; COMPONENT_COUNT] = [const { AtomicU32::new(0) }; COMPONE
 /// at [`needle_out`] and returns the status bits (`Status`: saturation flags 0x1f,
 /// `FE_UNSOLVED` 0x20 (the pose lies where the set's FE could not solve; the wrench is
 /// still the model's), `NO_MODEL` 0x40, `ERROR` 0x80).
-#[no_mangle]
+#[cfg_attr(target_arch = "wasm32", no_mangle)]
 pub extern "C" fn needle_eval(x_mm: f32, z_mm: f32, theta_x_deg: f32, theta_z_deg: f32, depth_mm: f32) -> u32 {
     let e = wrench(&Pose::new(x_mm, z_mm, theta_x_deg, theta_z_deg, depth_mm));
     for (slot, v) in OUT.iter().zip(e.wrench.to_array()) {
@@ -45,13 +50,13 @@ pub extern "C" fn needle_eval(x_mm: f32, z_mm: f32, theta_x_deg: f32, theta_z_de
 
 /// Number of wrench components, the words at [`needle_out`] (the contract's
 /// `COMPONENT_COUNT`; the page checks its component list against it).
-#[no_mangle]
+#[cfg_attr(target_arch = "wasm32", no_mangle)]
 pub extern "C" fn needle_component_count() -> u32 {
     COMPONENT_COUNT as u32
 }
 
 /// Address of the result buffer of [`needle_eval`] in the module's memory.
-#[no_mangle]
+#[cfg_attr(target_arch = "wasm32", no_mangle)]
 pub extern "C" fn needle_out() -> *const AtomicU32 {
     OUT.as_ptr()
 }
@@ -59,7 +64,7 @@ pub extern "C" fn needle_out() -> *const AtomicU32 {
 /// The model's domain: `k` = 0 `X_MAX_MM`, 1 `Z_MAX_MM`, 2 `THETA_MAX_DEG` (both tilts),
 /// 3 `DEPTH_MAX_MM`; positions and tilts range over [-max, max], depth over [0, max].
 /// Any other `k`: NaN.
-#[no_mangle]
+#[cfg_attr(target_arch = "wasm32", no_mangle)]
 pub extern "C" fn needle_domain(k: u32) -> f32 {
     match k {
         0 => model_info::X_MAX_MM,
@@ -72,7 +77,7 @@ pub extern "C" fn needle_domain(k: u32) -> f32 {
 
 /// 1 when the compiled model is the coupled form (cross terms), 0 for the paper's
 /// superposition; 2 when no model is fitted (every evaluation returns `NO_MODEL`).
-#[no_mangle]
+#[cfg_attr(target_arch = "wasm32", no_mangle)]
 pub extern "C" fn needle_coupled() -> u32 {
     if !model_info::FITTED {
         2
@@ -92,32 +97,32 @@ unsafe impl Sync for Path {}
 static PATH: Path = Path(core::cell::RefCell::new(None));
 
 /// Number of compiled-in tissue stacks (indices for [`needle_insertion_start`]).
-#[no_mangle]
+#[cfg_attr(target_arch = "wasm32", no_mangle)]
 pub extern "C" fn needle_stack_count() -> u32 {
     stacks::ALL.len() as u32
 }
 
 /// Address of stack `stack`'s name (UTF-8, [`needle_stack_name_len`] bytes) in the
 /// module's memory; null for an unknown stack.
-#[no_mangle]
+#[cfg_attr(target_arch = "wasm32", no_mangle)]
 pub extern "C" fn needle_stack_name(stack: u32) -> *const u8 {
     stacks::ALL.get(stack as usize).map_or(core::ptr::null(), |s| s.name.as_ptr())
 }
 
 /// Length of stack `stack`'s name in bytes (0 for an unknown stack).
-#[no_mangle]
+#[cfg_attr(target_arch = "wasm32", no_mangle)]
 pub extern "C" fn needle_stack_name_len(stack: u32) -> u32 {
     stacks::ALL.get(stack as usize).map_or(0, |s| s.name.len() as u32)
 }
 
 /// Number of layers of stack `stack` (0 for an unknown stack).
-#[no_mangle]
+#[cfg_attr(target_arch = "wasm32", no_mangle)]
 pub extern "C" fn needle_stack_layer_count(stack: u32) -> u32 {
     stacks::ALL.get(stack as usize).map_or(0, |s| s.layers.len() as u32)
 }
 
 /// Thickness of layer `layer` of stack `stack`, mm (NaN for an unknown one).
-#[no_mangle]
+#[cfg_attr(target_arch = "wasm32", no_mangle)]
 pub extern "C" fn needle_stack_thickness_mm(stack: u32, layer: u32) -> f32 {
     stacks::ALL.get(stack as usize).and_then(|s| s.layers.get(layer as usize)).map_or(f32::NAN, |l| l.thickness_mm)
 }
@@ -125,7 +130,7 @@ pub extern "C" fn needle_stack_thickness_mm(stack: u32, layer: u32) -> f32 {
 /// Starts a needle path through stack `stack` (an index below [`needle_stack_count`]),
 /// ticked every `period_s` s, the velocity low-passed with `velocity_time_constant_s` s.
 /// Returns 0, or -1 for an unknown stack, -2 for a period or time constant out of range.
-#[no_mangle]
+#[cfg_attr(target_arch = "wasm32", no_mangle)]
 pub extern "C" fn needle_insertion_start(stack: u32, period_s: f32, velocity_time_constant_s: f32) -> i32 {
     let Some(s) = stacks::ALL.get(stack as usize) else { return -1 };
     start_path(s, InsertionConfig { period_s, velocity_time_constant_s, ..InsertionConfig::DEFAULT_1KHZ })
@@ -149,7 +154,7 @@ fn start_path(stack: &needle_haptics::insertion::Stack<'_>, config: InsertionCon
 /// user tries terms on a compiled-in stack. Returns 0, -1 for an unknown stack, -2 for a
 /// period or time constant out of range, -3 for terms the tissue files would refuse
 /// (`PronyTerms::new`: g >= 0, tau > 0 s, sum of g <= 9).
-#[no_mangle]
+#[cfg_attr(target_arch = "wasm32", no_mangle)]
 #[allow(clippy::too_many_arguments)] // numbers only: the module has no allocator or bindings
 pub extern "C" fn needle_insertion_start_prony(
     stack: u32,
@@ -178,12 +183,58 @@ pub extern "C" fn needle_insertion_start_prony(
     start_path(&with, InsertionConfig { period_s, velocity_time_constant_s, ..InsertionConfig::DEFAULT_1KHZ })
 }
 
+/// The page's layers for [`needle_insertion_start_layers`]: [`MAX_LAYERS`] layers of
+/// [`layer_words::LAYER_WORDS`] f32 words each, as bits.
+static LAYERS_IN: [AtomicU32; MAX_LAYERS * layer_words::LAYER_WORDS] = [const { AtomicU32::new(0) }; MAX_LAYERS * layer_words::LAYER_WORDS];
+
+/// Words per layer at [`needle_layers_in`] ([`layer_words::LAYER_WORDS`]).
+#[cfg_attr(target_arch = "wasm32", no_mangle)]
+pub extern "C" fn needle_layer_words() -> u32 {
+    layer_words::LAYER_WORDS as u32
+}
+
+/// Address of the buffer the page writes a stack's layers to (f32 words, layer after
+/// layer, [`needle_layer_words`] each, at most `MAX_LAYERS` = 8 layers).
+#[cfg_attr(target_arch = "wasm32", no_mangle)]
+pub extern "C" fn needle_layers_in() -> *const AtomicU32 {
+    LAYERS_IN.as_ptr()
+}
+
+/// Starts a needle path through the `count` layers at [`needle_layers_in`] (a stack of
+/// a needle of `needle_diameter_mm`), as [`needle_insertion_start`] does for a
+/// compiled-in one. Returns 0, -1 for a count of 0 or above `MAX_LAYERS`, -3 for a layer
+/// whose words are refused ([`layer_words::from_words`]), -2 for a stack or
+/// configuration the insertion refuses (`Insertion::new`: the checks a compiled-in stack
+/// passed at build time).
+#[cfg_attr(target_arch = "wasm32", no_mangle)]
+pub extern "C" fn needle_insertion_start_layers(count: u32, needle_diameter_mm: f32, period_s: f32, velocity_time_constant_s: f32) -> i32 {
+    use needle_haptics::insertion::{Layer, Stack};
+    let n = count as usize;
+    if n == 0 || n > MAX_LAYERS {
+        return -1;
+    }
+    let words: [f32; MAX_LAYERS * layer_words::LAYER_WORDS] =
+        core::array::from_fn(|i| LAYERS_IN.get(i).map_or(0.0, |w| f32::from_bits(w.load(Ordering::Relaxed))));
+    let mut layers: [Option<Layer>; MAX_LAYERS] = [None; MAX_LAYERS];
+    for (slot, w) in layers.iter_mut().zip(words.chunks_exact(layer_words::LAYER_WORDS)).take(n) {
+        *slot = layer_words::from_words(w);
+    }
+    let Some(Some(first)) = layers.first().copied() else { return -3 };
+    let mut out: [Layer; MAX_LAYERS] = [first; MAX_LAYERS];
+    for (o, l) in out.iter_mut().zip(&layers).take(n) {
+        let Some(l) = l else { return -3 };
+        *o = *l;
+    }
+    let stack = Stack { name: "page", needle_diameter_mm, layers: out.get(..n).unwrap_or(&[]) };
+    start_path(&stack, InsertionConfig { period_s, velocity_time_constant_s, ..InsertionConfig::DEFAULT_1KHZ })
+}
+
 /// One tick of the started path: the wrench at [`needle_out`]; returns
 /// `status | phase_code << 8 | punctures << 24 | flags << 28` (phase code: 0 approach,
 /// 0x100 | layer deflecting, 0x200 | layer cutting, 0x300 | layer in the track;
 /// punctures at most 8, four bits; flags the step's `InsertionFlags`, four bits), or
 /// `u32::MAX` when no path was started.
-#[no_mangle]
+#[cfg_attr(target_arch = "wasm32", no_mangle)]
 pub extern "C" fn needle_insertion_step(x_mm: f32, z_mm: f32, theta_x_deg: f32, theta_z_deg: f32, depth_mm: f32) -> u32 {
     let mut path = PATH.0.borrow_mut();
     let Some(ins) = path.as_mut() else { return u32::MAX };
@@ -212,7 +263,7 @@ static FIXED_PATH: FixedPath = FixedPath(core::cell::RefCell::new(None));
 /// Starts a fixed-point needle path through stack `stack`, ticked every `period_us` µs,
 /// the velocity low-passed with `velocity_time_constant_us` µs. Returns 0, or -1 for an
 /// unknown stack, -2 for a zero period.
-#[no_mangle]
+#[cfg_attr(target_arch = "wasm32", no_mangle)]
 pub extern "C" fn needle_fixed_insertion_start(stack: u32, period_us: u32, velocity_time_constant_us: u32) -> i32 {
     let Some(s) = fixed_stacks::ALL.get(stack as usize) else { return -1 };
     match FixedInsertion::new(s, FixedConfig { period_us, velocity_time_constant_us, ..FixedConfig::DEFAULT_1KHZ }) {
@@ -227,7 +278,7 @@ pub extern "C" fn needle_fixed_insertion_start(stack: u32, period_us: u32, veloc
 /// One tick of the started fixed-point path, the pose in Q16.16 (mm, degrees × 65536):
 /// the wrench (µN, µN·mm, as `i32` bits) at [`needle_out`]; returns what
 /// [`needle_insertion_step`] returns, or `u32::MAX` when no path was started.
-#[no_mangle]
+#[cfg_attr(target_arch = "wasm32", no_mangle)]
 pub extern "C" fn needle_fixed_insertion_step(
     x_mm_q16: i32,
     z_mm_q16: i32,

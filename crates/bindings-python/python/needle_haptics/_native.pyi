@@ -124,3 +124,18 @@ def calibrate(
     force_n) float64 arrays, against the set compiled in. `label` names the curve in the
     stack's description and source (default: the path, or "arrays"). Raises CurveError
     (row, column, line) for a bad curve, ValueError when it cannot calibrate."""
+
+def sample_stack(
+    stack: Union[str, "os.PathLike[str]"],
+    /,
+    *,
+    seed: int,
+    name: Optional[str] = None,
+    spread: Optional[Union[str, "os.PathLike[str]"]] = None,
+    out: Optional[Union[str, "os.PathLike[str]"]] = None,
+) -> str:
+    """`needle stack sample`: a tissue drawn within the spread `stack` was fitted with
+    (`spread`, default `<stem>.spread.csv` beside it), the same draw as the command (the
+    same files and seed, the same text). Returns the tissue file's text, named `name`
+    (default: `out`'s stem, else `<stack's stem>_seed<seed>`); with `out` also writes it
+    (atomically). Raises ValueError naming the file and line of a refused input."""

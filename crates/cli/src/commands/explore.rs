@@ -32,6 +32,15 @@ pub struct ExploreArgs {
     /// instead of building one with cargo (see below).
     #[arg(long, value_name = "FILE")]
     pub wasm: Option<PathBuf>,
+    /// A tissue file to play in the insertion player besides the compiled-in stacks
+    /// (repeatable). With its spread beside it (<name>.spread.csv, written by `needle
+    /// calibrate --trials`), the page also offers tissues drawn within that spread.
+    #[arg(long, value_name = "FILE")]
+    pub stack: Vec<PathBuf>,
+    /// Tissues drawn per --stack with a spread: seeds 1 to N, each the tissue `needle
+    /// stack sample --seed K` writes.
+    #[arg(long, value_name = "N", default_value_t = 5)]
+    pub draws: u64,
 }
 
 /// Run `needle explore`: build the set's wasm evaluator (or take `--wasm`), print the
@@ -44,6 +53,15 @@ pub fn run(a: ExploreArgs) -> Result<ExitCode> {
     let set = std::path::absolute(&a.set).with_context(|| format!("{}: not a usable path", a.set.display()))?;
     let set_json = explore::set_json::set_json(&needle_set::set_folder::SetFolder::open(&a.set)?)?;
     let runs = set_json["runs"].as_array().map_or(0, Vec::len);
+    let stacks_json = explore::stacks_json::stacks_json(&a.stack, a.draws)?;
+    for s in stacks_json.as_array().into_iter().flatten() {
+        let drawn = s["drawn"].as_array().map_or(0, Vec::len);
+        println!(
+            "needle explore: tissue file {} ({} layers), {drawn} tissue(s) drawn within its spread",
+            s["file"],
+            s["stack"]["words"].as_array().map_or(0, Vec::len)
+        );
+    }
     let wasm_path = match &a.wasm {
         Some(prebuilt) => prebuilt.clone(),
         None => {
@@ -59,7 +77,10 @@ pub fn run(a: ExploreArgs) -> Result<ExitCode> {
     if !wasm.starts_with(b"\0asm") {
         anyhow::bail!("--wasm {}: not a WebAssembly module (it does not start with \\0asm)", wasm_path.display());
     }
-    let explorer = Explorer::bind(SocketAddr::new(a.host, a.port), Content { wasm, set_json: set_json.to_string() })?;
+    let explorer = Explorer::bind(
+        SocketAddr::new(a.host, a.port),
+        Content { wasm, set_json: set_json.to_string(), stacks_json: stacks_json.to_string() },
+    )?;
     println!(
         "needle explore: set {} ({runs} FE runs), evaluator {} ({} bytes)",
         a.set.display(),

@@ -9,9 +9,10 @@ const UNITS = Object.fromEntries(COMPONENTS.map((c) => [c, c.endsWith("_nmm") ? 
 const CURVE_POINTS = 61; // depths 0 .. depth_max for the plot and the CSV
 const $ = (id) => document.getElementById(id);
 
-const [model, set] = await Promise.all([
+const [model, set, files] = await Promise.all([
   fetch("needle.wasm").then((r) => r.arrayBuffer()).then(load),
   fetch("set.json").then((r) => r.json()),
+  fetch("stacks.json").then((r) => r.json()),
 ]);
 const d = model.domain;
 const INPUTS = [
@@ -225,9 +226,23 @@ function script(step, deepest, stop_mm, hold_ticks) {
   return depths;
 }
 
+// the chosen stack: "c:i" the compiled-in stack i; "f:j" tissue file j of /stacks.json,
+// "f:j:k" its draw k (needle explore --stack): { thickness_mm, run(poses, terms), values }
+function chosenStack() {
+  const [kind, j, k] = $("stack").value.split(":");
+  if (kind === "c") {
+    const s = Number(j);
+    const st = model.stacks[s];
+    return st && { thickness_mm: st.thickness_mm, run: (poses, terms) => model.insert(s, poses, terms), values: [] };
+  }
+  const file = files[Number(j)];
+  const drawn = k === undefined ? null : file?.drawn[Number(k)];
+  const st = drawn ? drawn.stack : file?.stack;
+  return st && { thickness_mm: st.thickness_mm, run: (poses) => model.insertLayers(st, poses), values: drawn ? drawn.values : [], file: true };
+}
+
 function playInsertion() {
-  const s = Number($("stack").value);
-  const stack = model.stacks[s];
+  const stack = chosenStack();
   if (!stack) return;
   const total = stack.thickness_mm.reduce((a, b) => a + b, 0);
   const deepest = total + 5;
@@ -243,11 +258,11 @@ function playInsertion() {
   try {
     if (stop === null) {
       // stop at 80 % of the depth of the first puncture of the same insertion unstopped
-      const dry = model.insert(s, script(step, deepest, null, 0).map(at), terms);
+      const dry = stack.run(script(step, deepest, null, 0).map(at), terms);
       const first = dry.findIndex((t) => t.punctures > 0);
       stop = first > 0 ? 0.8 * dry[first].depth_mm : null;
     }
-    ticks = model.insert(s, script(step, deepest, stop, hold_ticks).map(at), terms);
+    ticks = stack.run(script(step, deepest, stop, hold_ticks).map(at), terms);
   } catch (err) {
     $("insertion-summary").textContent = String(err.message);
     return;
@@ -259,7 +274,11 @@ function playInsertion() {
     ? `; stopped at ${held[0].depth_mm.toFixed(2)} mm for ${(hold_ticks / 1000).toFixed(1)} s: Fy ${held[0].fy_n.toPrecision(3)} -> ${held[1].fy_n.toPrecision(3)} N` +
       (held[0].fy_n !== 0 ? ` (${(100 * (held[1].fy_n / held[0].fy_n - 1)).toFixed(1)} %)` : "")
     : "";
-  $("insertion-summary").textContent = `${ticks.length} ticks, ${punctures.length} puncture(s), largest Fy ${Math.max(...ticks.map((t) => t.fy_n)).toPrecision(3)} N${relax}`;
+  // a drawn tissue: each drawn value beside the file's (needle stack sample's draw)
+  const drawnText = stack.values.map((v) => `layer ${v.layer} ${v.key} ${v.from.toPrecision(4)} -> ${v.to.toPrecision(4)}`).join("; ");
+  const own = stack.file ? "; the file's own Prony terms" : "";
+  $("insertion-summary").textContent = `${ticks.length} ticks, ${punctures.length} puncture(s), largest Fy ${Math.max(...ticks.map((t) => t.fy_n)).toPrecision(3)} N${relax}${own}` +
+    (drawnText ? `. Drawn: ${drawnText}` : "");
   if (held) {
     document.body.dataset.holdFyStart = String(held[0].fy_n);
     document.body.dataset.holdFyEnd = String(held[1].fy_n);
@@ -299,11 +318,16 @@ function playInsertion() {
 if (set.viscoelastic) {
   $("prony").value = set.viscoelastic.g.map((g, i) => `${g}:${set.viscoelastic.tau_s[i]}`).join(", ");
 }
-model.stacks.forEach((st, i) => {
+const option = (value, text) => {
   const o = document.createElement("option");
-  o.value = String(i);
-  o.textContent = `${st.name} (${st.thickness_mm.length} layers)`;
+  o.value = value;
+  o.textContent = text;
   $("stack").appendChild(o);
+};
+model.stacks.forEach((st, i) => option(`c:${i}`, `${st.name} (${st.thickness_mm.length} layers)`));
+files.forEach((f, j) => {
+  option(`f:${j}`, `${f.name} (file ${f.file}, ${f.stack.thickness_mm.length} layers)`);
+  f.drawn.forEach((d, k) => option(`f:${j}:${k}`, `${f.name} drawn within its spread, seed ${d.seed}`));
 });
-if (model.stacks.length === 0) $("insertion-section").hidden = true;
+if (model.stacks.length === 0 && files.length === 0) $("insertion-section").hidden = true;
 $("play").addEventListener("click", playInsertion);

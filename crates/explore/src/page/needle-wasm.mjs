@@ -45,6 +45,12 @@ export async function load(bytes) {
     for (let l = 0; l < e.needle_stack_layer_count(s); l++) thickness_mm.push(e.needle_stack_thickness_mm(s, l));
     stacks.push({ name, thickness_mm });
   }
+  // the started path stepped through `poses`: per tick the depth, fy and the punctures
+  const steps = (poses) => poses.map((p) => {
+    const r = e.needle_insertion_step(p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg, p.depth_mm) >>> 0;
+    const w = new Float32Array(Uint32Array.from(new Uint32Array(e.memory.buffer, e.needle_out(), COMPONENTS.length)).buffer);
+    return { depth_mm: p.depth_mm, fy_n: w[1], punctures: (r >>> 24) & 0xf, phase: (r >>> 8) & 0xffff };
+  });
   return {
     form,
     stacks,
@@ -59,11 +65,20 @@ export async function load(bytes) {
         : e.needle_insertion_start_prony(s, 0.001, 0.005, t.length, ...term(0), ...term(1), ...term(2));
       if (started === -3) throw new Error("Prony terms refused: at most 3, each g >= 0 and tau_s > 0 s, sum of g <= 9");
       if (started !== 0) throw new Error(`stack ${s}: cannot start`);
-      return poses.map((p) => {
-        const r = e.needle_insertion_step(p.x_mm, p.z_mm, p.theta_x_deg, p.theta_z_deg, p.depth_mm) >>> 0;
-        const w = new Float32Array(Uint32Array.from(new Uint32Array(e.memory.buffer, e.needle_out(), COMPONENTS.length)).buffer);
-        return { depth_mm: p.depth_mm, fy_n: w[1], punctures: (r >>> 24) & 0xf, phase: (r >>> 8) & 0xffff };
-      });
+      return steps(poses);
+    },
+    // the same through a stack given as layers (a tissue file the server loaded, or one
+    // drawn within its spread: /stacks.json): { needle_diameter_mm, words: one array of
+    // needle_layer_words() numbers per layer (crates/wasm/src/layer_words.rs) }
+    insertLayers(stack, poses) {
+      if (!("needle_insertion_start_layers" in e)) throw new Error("needle.wasm plays no tissue files: rebuild it with needle explore");
+      const n = e.needle_layer_words();
+      const words = new Float32Array(e.memory.buffer, e.needle_layers_in(), 8 * n);
+      words.fill(0);
+      stack.words.forEach((w, l) => words.set(w, l * n));
+      const started = e.needle_insertion_start_layers(stack.words.length, stack.needle_diameter_mm, 0.001, 0.005);
+      if (started !== 0) throw new Error(`the tissue file's layers are refused (${started})`);
+      return steps(poses);
     },
     domain: {
       x_max_mm: e.needle_domain(0),

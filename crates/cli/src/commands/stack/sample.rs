@@ -4,8 +4,6 @@ use crate::planned_outputs::{self, Planned};
 use anyhow::{Context, Result};
 use clap::Args;
 use needle_calibrate::{sample, spread};
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -45,42 +43,12 @@ pub fn run(a: SampleArgs) -> Result<ExitCode> {
     let spread_path = a.spread.clone().unwrap_or_else(|| spread::beside(&a.stack));
     let inputs = [("--stack", a.stack.as_path()), ("--spread", spread_path.as_path())];
     planned_outputs::check(&[Planned { option: "--out", path: &a.out }], None, &inputs, a.force)?;
-    let text = std::fs::read_to_string(&a.stack).with_context(|| format!("--stack {}: cannot read", a.stack.display()))?;
-    let stack = needle_codegen::tissue::parse_stack_str(&text, &a.stack).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let rows = spread::read(&spread_path)?;
-    let mut rng = ChaCha8Rng::seed_from_u64(a.seed);
-    let mut normal = || standard_normal(&mut rng);
-    let renamed = needle_codegen::tissue::Stack { name: name.clone(), ..stack.clone() };
-    let drawn = sample::sample(&renamed, &rows, &spread_path, &mut normal)?;
-    for r in &rows {
-        let (old, new) = (value(&stack, r), value(&drawn, r));
+    let d = sample::sample_file(&a.stack, Some(&spread_path), &name, a.seed).with_context(|| format!("--stack {}", a.stack.display()))?;
+    for r in &d.rows {
+        let (old, new) = (sample::value(&d.stack, r), sample::value(&d.drawn, r));
         println!("layer {} {}: {old:.6} -> {new:.6} (sd {:.3e} over {} trials)", r.layer, r.key, r.sd, r.trials);
     }
-    let header = format!(
-        "Tissue stack `{name}`, written by `needle stack sample` (format: coeffs/README.md, \"Tissue stacks\").\nDrawn from {} within {} (seed {}).",
-        a.stack.display(),
-        spread_path.display(),
-        a.seed
-    );
-    needle_stdx::fs::write_all_atomic(&[(a.out.as_path(), drawn.to_toml(&header).as_bytes())])?;
+    needle_stdx::fs::write_all_atomic(&[(a.out.as_path(), d.to_toml(&a.stack).as_bytes())])?;
     println!("wrote {}", a.out.display());
     Ok(ExitCode::SUCCESS)
-}
-
-/// The value of row `r`'s key in `s` (NaN when the layer is missing).
-fn value(s: &needle_codegen::tissue::Stack, r: &spread::Row) -> f64 {
-    s.layers.get(r.layer).map_or(f64::NAN, |l| match r.key {
-        "stiffness_scale" => l.stiffness_scale,
-        "puncture_force_n" => l.puncture_force_n,
-        "cutting_force_n" => l.cutting_force_n,
-        _ => l.friction_coulomb_n_per_mm,
-    })
-}
-
-/// A standard normal draw (Box-Muller on two uniform draws in (0, 1]).
-fn standard_normal(rng: &mut ChaCha8Rng) -> f64 {
-    use rand::Rng;
-    let u1: f64 = 1.0 - rng.gen::<f64>();
-    let u2: f64 = rng.gen::<f64>();
-    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
 }
