@@ -196,7 +196,8 @@ fn with_presliding(l: &mut file::Layer, notes: &mut Vec<(&'static str, String)>,
     if !l.shaft_prony.is_empty() {
         let g: Vec<String> =
             hold.shaft_g.iter().zip(&hold.shaft_prony).map(|(s, (_, tau))| format!("g(tau {tau:.3} s) {}", s.note("-"))).collect();
-        notes.push(("shaft_prony", format!("{} (the holds; the boundary below elastic)", g.join("; "))));
+        let below = if hold.prony.is_empty() { "no boundary below" } else { "the boundary below relaxes through the same terms" };
+        notes.push(("shaft_prony", format!("{} (the holds; {below})", g.join("; "))));
     }
 }
 
