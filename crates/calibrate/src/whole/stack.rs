@@ -98,37 +98,63 @@ pub fn fit(ts: &[Trial], opts: &TrialsOptions<'_>, diameter: f64, u: &dyn Fn(f64
     let last_depth = ts.iter().flat_map(|t| t.samples.iter().map(|s| s.position_mm - t.onset_mm())).fold(0.0, f64::max);
     let largest = ts.iter().flat_map(|t| t.samples.iter().map(|s| s.force_n)).fold(0.0, f64::max);
     let source = source(opts, ts, band);
+    let parts = Parts { n, v: &v, presliding: presliding.as_ref(), shape: &shape, band, last_depth, largest, opts, source: &source };
+    let (layers, uncertainty, spread) = build(&parts, &fr, &hold);
+    let stack = checked_stack(opts, ts.len(), diameter, layers)?;
+    Ok(Fitted { stack, uncertainty, punctures: n, friction: fr, hold, stick_band_mm_per_s: band, presliding_mm: presliding, spread })
+}
+
+/// What the file's layers are made of.
+struct Parts<'a> {
+    n: usize,
+    v: &'a Values,
+    presliding: Option<&'a Spread>,
+    shape: &'a FirstShape,
+    band: f64,
+    last_depth: f64,
+    largest: f64,
+    opts: &'a TrialsOptions<'a>,
+    source: &'a str,
+}
+
+/// The file's layers of `p`, each value's uncertainty notes and the spreads.
+#[allow(clippy::type_complexity)]
+fn build(
+    p: &Parts<'_>,
+    fr: &[LayerFriction],
+    hold: &HoldFit,
+) -> (Vec<file::Layer>, Vec<Vec<(&'static str, String)>>, Vec<Vec<(&'static str, Spread)>>) {
+    let (n, v) = (p.n, p.v);
     let mut layers = Vec::new();
     let (mut uncertainty, mut spread) = (Vec::new(), Vec::new());
     for j in 0..n {
-        let below = v.bounds.get(j + 1).copied().or(hold.boundary_mm).unwrap_or(last_depth.max(v.bounds[j] + 1.0));
+        let below = v.bounds.get(j + 1).copied().or(hold.boundary_mm).unwrap_or(p.last_depth.max(v.bounds[j] + 1.0));
         let cutting =
             if j + 1 == n { hold.per_trial.cutting_n.clone() } else { v.cutting.get(j).cloned().unwrap_or(Spread::of(Vec::new())) };
         let cutting_n = if j + 1 == n { hold.cutting_n } else { cutting.mean };
         let f = fr.get(j).cloned().unwrap_or_else(zero_friction);
         spread.push(spreads(v.scale[j].clone(), v.puncture[j].clone(), Some(cutting.clone()), &f));
         let (mut l, mut notes) =
-            layer(j, n, below - v.bounds[j], v.scale[j].clone(), v.puncture[j].clone(), (cutting_n, cutting), &f, band, opts, &source);
-        if let Some(p) = &presliding {
-            with_presliding(&mut l, &mut notes, p, &hold);
+            layer(j, n, below - v.bounds[j], v.scale[j].clone(), v.puncture[j].clone(), (cutting_n, cutting), &f, p.band, p.opts, p.source);
+        if let Some(pre) = p.presliding {
+            with_presliding(&mut l, &mut notes, pre, hold);
         }
         if j == 0 {
-            l.family_weight = shape.weight;
-            l.softening_fraction = shape.fraction;
-            l.softening_onset_ratio = shape.onset_ratio;
+            l.family_weight = p.shape.weight;
+            l.softening_fraction = p.shape.fraction;
+            l.softening_onset_ratio = p.shape.onset_ratio;
         }
         layers.push(l);
         uncertainty.push(notes);
     }
     if let (Some(b), Some(f)) = (hold.boundary_mm, fr.last()) {
-        let (l, notes) = bottom_layer(n, last_depth - b + 1.0, largest, &hold, f, band, opts, &source);
+        let (l, notes) = bottom_layer(n, p.last_depth - b + 1.0, p.largest, hold, f, p.band, p.opts, p.source);
         let scale = Spread { mean: hold.scale, ..hold.per_trial.scale.clone() };
         spread.push(spreads(scale, Spread::of(Vec::new()), None, f));
         layers.push(l);
         uncertainty.push(notes);
     }
-    let stack = checked_stack(opts, ts.len(), diameter, layers)?;
-    Ok(Fitted { stack, uncertainty, punctures: n, friction: fr, hold, stick_band_mm_per_s: band, presliding_mm: presliding, spread })
+    (layers, uncertainty, spread)
 }
 
 /// The stack of `layers`, checked by the tissue format's reader as the file will be read.
