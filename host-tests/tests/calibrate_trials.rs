@@ -68,6 +68,13 @@ fn every_rig_trial_is_cut_into_its_phases_at_its_named_speed() {
         let after = s[p.insertion.clone()].iter().find(|x| x.position_mm >= at + 3.0).map_or(f64::NAN, |x| x.force_n - tare);
         assert!(after > 0.1, "{what}: 3 mm past the contact at {at} mm the force is {after} N");
         assert!(p.insertion.end <= p.hold.end && p.hold.start < p.withdrawal.start, "{what}: phases in order: {p:?}");
+        // the hold ends before the stage starts back: its last sample is not below the
+        // one before it, and the withdrawal's first move is (the stage's servo takes
+        // several samples to leave the at-rest tolerance: those are the withdrawal's)
+        let at = |i: usize| s.get(i).map_or(f64::NAN, |x| x.position_mm);
+        let last = p.hold.end - 1;
+        assert!(at(last) >= at(last - 1), "{what}: the hold's last sample (line {}) is already moving back", s[last].line);
+        assert!(at(last + 1) < at(last), "{what}: the sample after the hold (line {}) has not moved back", s[last + 1].line);
     }
 }
 

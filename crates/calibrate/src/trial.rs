@@ -97,7 +97,8 @@ pub struct Phases {
     /// The stage advancing: from the last sample at the start position to the first at
     /// the furthest travel.
     pub insertion: Range<usize>,
-    /// The stage at rest at its furthest travel (empty: no hold).
+    /// The stage at rest at its furthest travel, to the last sample before it starts
+    /// back (empty: no hold).
     pub hold: Range<usize>,
     /// The stage returning, to the trial's end (empty: no withdrawal).
     pub withdrawal: Range<usize>,
@@ -155,7 +156,7 @@ pub fn phases(s: &[Sample], what: &str) -> Result<Phases> {
     }
     let tol = AT_REST_FRACTION * travel_mm;
     let top = s.iter().position(|x| x.position_mm >= max - tol).unwrap_or(0);
-    let leave = s.iter().rposition(|x| x.position_mm >= max - tol).unwrap_or(top);
+    let leave = rest_end(s, top, s.iter().rposition(|x| x.position_mm >= max - tol).unwrap_or(top));
     let begin = s[..top].iter().rposition(|x| x.position_mm <= start + tol).unwrap_or(0);
     if begin < 2 {
         bail!("{what}: the stage moves from its first sample: no tare to measure the force's noise on");
@@ -187,6 +188,18 @@ pub fn phases(s: &[Sample], what: &str) -> Result<Phases> {
     let contact =
         contact(s, begin, &insertion).with_context(|| format!("{what}: the force never leaves the tare's noise during the insertion"))?;
     Ok(Phases { insertion, hold, withdrawal, contact, insertion_speed_mm_per_s, withdrawal_speed_mm_per_s, hold_s, travel_mm, notes })
+}
+
+/// The last sample at rest at the furthest travel: `last` (the last within the at-rest
+/// tolerance) moved back over the stage's final run of falling positions, which is the
+/// withdrawal already under way (a servo accelerates the stage through the tolerance
+/// over several samples); not before `top`.
+fn rest_end(s: &[Sample], top: usize, last: usize) -> usize {
+    let mut k = last;
+    while k > top && s[k].position_mm < s[k - 1].position_mm {
+        k -= 1;
+    }
+    k
 }
 
 /// The withdrawal up to where the stage is back at its start (`back_mm`; the trial may

@@ -20,13 +20,18 @@
 //! `(friction at rest + c) (z_i - 1)` with `z_i` the library's arm along the trial
 //! ([`super::presliding::arms`]) takes the weight `beta_i = g_i / (1 + sum g)` of the
 //! shaft's relaxation (`g_i = beta_i / (1 - sum beta)`); the boundary is the one found
-//! without it (its scale fitted again, elastic: [`fit_with_shaft`]). Each arm is loaded
-//! within `v tau_i` of travel (`v` the slowest insertion speed; at most the presliding
-//! distance), so it slips while the needle slides at any measured speed: the held force
-//! relaxes by the same share at every speed (as the rig's trials do) and the sliding
-//! force is the friction and cutting the trials show. The stack's relaxation slip
-//! distance is the smallest of the chosen terms' (each arm then slips sooner, the same
-//! while sliding and at rest).
+//! without it, its scale fitted again and its terms the shaft's ([`super::tied`]: one
+//! relaxation function for the tissue; [`fit_with_shaft`]). Each arm is loaded within
+//! `v tau_i` of travel (`v` the stick band's edge, below every measured speed; at most
+//! the presliding distance), so it slips while the needle slides at any speed above the
+//! stick band: the held force relaxes by the same share at every sliding speed (as the
+//! rig's trials do, at 1, 2 and 3 mm/s) and the sliding force is the friction and
+//! cutting the trials show. The stack's relaxation slip distance is the smallest of the
+//! chosen terms' (each arm then slips sooner, the same while sliding and at rest).
+//!
+//! The boundary's filter starts from rest at the last puncture's peak (the library
+//! resets it there and steps it to the deflection at once when the boundary lies above
+//! the tip).
 use super::friction::LayerFriction;
 use super::intervals::{friction_n, indent, BOUNDARY_STEP_MM};
 use super::stats::{Normal, Spread};
@@ -47,8 +52,9 @@ pub struct ShaftGuess {
     pub presliding_mm: f64,
     /// The cutting force of the last punctured layer, N.
     pub cutting_n: f64,
-    /// The slowest insertion speed of the trials, mm/s: the arms slip at it.
-    pub slowest_mm_per_s: f64,
+    /// The speed the arms slip at, mm/s: the stick band's edge (below every measured
+    /// speed, [`super::stack::stick_band`]).
+    pub slip_speed_mm_per_s: f64,
 }
 
 impl ShaftGuess {
@@ -56,7 +62,7 @@ impl ShaftGuess {
     #[must_use]
     pub fn slip_mm(&self, tau_s: f64) -> f64 {
         let (lo, _) = needle_codegen::tissue::PRESLIDING_MM_RANGE;
-        (self.slowest_mm_per_s * tau_s).clamp(lo, self.presliding_mm.max(lo))
+        (self.slip_speed_mm_per_s * tau_s).clamp(lo, self.presliding_mm.max(lo))
     }
 }
 
@@ -125,7 +131,9 @@ fn normal(
     let arms = shaft.map(|g| super::presliding::arms(t, taus, &taus.iter().map(|tau| g.slip_mm(*tau)).collect::<Vec<_>>()));
     let mut out = Normal::new(columns);
     let mut h = vec![0.0; taus.len()];
-    let mut last: Option<(f64, f64)> = None;
+    // the library resets the filter at the puncture and steps it to the boundary's
+    // deflection there: the filter starts from rest at the puncture's peak
+    let mut last: Option<(f64, f64)> = t.samples.get(t.sample_of(e.peak)).map(|s| (s.time_s, 0.0));
     let mut row = vec![0.0; columns];
     for i in start..end {
         let s = t.samples.get(i)?;
@@ -246,10 +254,9 @@ pub fn fit(trials: &[Trial], n: usize, bounds: &[f64], friction: &[LayerFriction
 }
 
 /// The joint fit with the shaft's presliding (module docs) at the boundary of `before`
-/// (the fit without it): the time constants chosen again for the shaft's terms, the
-/// boundary elastic (the rig's holds relax by the same share at every speed, as the
-/// shaft's terms do, the boundary's quasi-linear terms by a share that grows with the
-/// speed); `before` when no trial has a hold.
+/// (the fit without it): the time constants chosen again, one set for the shaft and the
+/// boundary ([`super::tied`]; the boundary's terms are this fit's `prony`); `before`
+/// when no trial has a hold.
 #[must_use]
 pub fn fit_with_shaft(
     trials: &[Trial],
@@ -277,9 +284,18 @@ pub fn fit_with_shaft(
     }
     // unknowns: cutting, the boundary's scale, each chosen term's beta
     let keep_of = |choice: &[usize]| -> Vec<usize> { [0, 1].into_iter().chain(choice.iter().map(|k| k + 2 + m)).collect() };
+    // one relaxation function: the boundary below relaxes through the shaft's terms
+    let tie = b.is_some();
+    let terms = |nm: &Normal, choice: &[usize]| {
+        if tie {
+            super::tied::fit(nm, choice, m)
+        } else {
+            nm.select(&keep_of(choice)).non_negative()
+        }
+    };
     let mut best: Option<(f64, Vec<usize>, Vec<f64>)> = None;
     for choice in combos(m) {
-        let (x, sse) = all.select(&keep_of(&choice)).non_negative();
+        let (x, sse) = terms(&all, &choice);
         if x.iter().skip(2).sum::<f64>() >= SHAFT_BETA_SUM_MAX {
             continue;
         }
@@ -296,7 +312,7 @@ pub fn fit_with_shaft(
     let shaft_prony = shaft_terms(&betas, &chosen);
     let shaft_slip_mm = shaft_prony.iter().map(|(_, tau)| guess.slip_mm(*tau)).reduce(f64::min);
     // per trial: each alone at the chosen terms, each kept term's weight g
-    let per: Vec<Vec<f64>> = normals.iter().map(|nm| nm.select(&keep_of(&choice)).non_negative().0).collect();
+    let per: Vec<Vec<f64>> = normals.iter().map(|nm| terms(nm, &choice).0).collect();
     let shaft_g = (0..choice.len())
         .filter(|&i| betas.get(i).is_some_and(|b| *b > 0.0))
         .map(|i| {
@@ -309,11 +325,12 @@ pub fn fit_with_shaft(
         .collect();
     let spread = |k: usize| Spread::of(per.iter().map(|x| x.get(k).copied().unwrap_or(0.0)).collect());
     let per_trial = PerTrial { scale: spread(1), cutting_n: spread(0), g: Vec::new() };
+    let prony = if b.is_some() { shaft_prony.clone() } else { Vec::new() };
     HoldFit {
         boundary_mm: b,
         scale,
         cutting_n: x.first().copied().unwrap_or(0.0),
-        prony: Vec::new(),
+        prony,
         per_trial,
         holds: before.holds,
         shaft_prony,

@@ -22,6 +22,8 @@ pub struct IntervalFit {
     pub cutting_n: f64,
     /// The next layer's puncture threshold (the peak less the friction), N.
     pub puncture_n: f64,
+    /// The depth of the next puncture's peak, mm.
+    pub peak_mm: f64,
 }
 
 /// The friction force at depth `d` for the punctured layers' `bounds` (the next boundary
@@ -60,7 +62,7 @@ pub fn fit(t: &Trial, k: usize, bounds: &[f64], friction: &[LayerFriction], u: &
         let r: Vec<(f64, f64)> = rows.iter().map(|&(d, f)| (indent(u, d - b), f - friction_n(friction, bounds, b, d, v))).collect();
         let Some((sse, scale, cutting)) = constrained(&r, indent(u, d_peak - b), p) else { continue };
         if best.as_ref().is_none_or(|(s, _)| sse < *s) {
-            best = Some((sse, IntervalFit { boundary_mm: b, scale, cutting_n: cutting, puncture_n: p }));
+            best = Some((sse, IntervalFit { boundary_mm: b, scale, cutting_n: cutting, puncture_n: p, peak_mm: d_peak }));
         }
     }
     best.map(|(_, f)| f)

@@ -24,6 +24,7 @@ pub mod intervals;
 pub mod presliding;
 pub mod stack;
 pub mod stats;
+pub mod tied;
 pub mod trials;
 
 use crate::events::EventRule;

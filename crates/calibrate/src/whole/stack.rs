@@ -93,43 +93,68 @@ pub fn fit(ts: &[Trial], opts: &TrialsOptions<'_>, diameter: f64, u: &dyn Fn(f64
     if hold.holds == 0 {
         notes.push("no trial has a hold: no Prony terms fitted (the stack is elastic)".into());
     }
-    let slowest = used.iter().map(|t| t.phases.insertion_speed_mm_per_s.abs()).fold(f64::INFINITY, f64::min);
-    let presliding = shaft_fit(&used, n, &v.bounds, slowest, u, (&mut hold, &mut fr), notes);
     let band = stick_band(ts);
+    let presliding = shaft_fit(&used, n, &v.bounds, band, u, (&mut hold, &mut fr), notes);
     let last_depth = ts.iter().flat_map(|t| t.samples.iter().map(|s| s.position_mm - t.onset_mm())).fold(0.0, f64::max);
     let largest = ts.iter().flat_map(|t| t.samples.iter().map(|s| s.force_n)).fold(0.0, f64::max);
     let source = source(opts, ts, band);
+    let parts = Parts { n, v: &v, presliding: presliding.as_ref(), shape: &shape, band, last_depth, largest, opts, source: &source };
+    let (layers, uncertainty, spread) = build(&parts, &fr, &hold);
+    let stack = checked_stack(opts, ts.len(), diameter, layers)?;
+    Ok(Fitted { stack, uncertainty, punctures: n, friction: fr, hold, stick_band_mm_per_s: band, presliding_mm: presliding, spread })
+}
+
+/// What the file's layers are made of.
+struct Parts<'a> {
+    n: usize,
+    v: &'a Values,
+    presliding: Option<&'a Spread>,
+    shape: &'a FirstShape,
+    band: f64,
+    last_depth: f64,
+    largest: f64,
+    opts: &'a TrialsOptions<'a>,
+    source: &'a str,
+}
+
+/// The file's layers of `p`, each value's uncertainty notes and the spreads.
+#[allow(clippy::type_complexity)]
+fn build(
+    p: &Parts<'_>,
+    fr: &[LayerFriction],
+    hold: &HoldFit,
+) -> (Vec<file::Layer>, Vec<Vec<(&'static str, String)>>, Vec<Vec<(&'static str, Spread)>>) {
+    let (n, v) = (p.n, p.v);
     let mut layers = Vec::new();
     let (mut uncertainty, mut spread) = (Vec::new(), Vec::new());
     for j in 0..n {
-        let below = v.bounds.get(j + 1).copied().or(hold.boundary_mm).unwrap_or(last_depth.max(v.bounds[j] + 1.0));
+        let below = v.bounds.get(j + 1).copied().or(hold.boundary_mm).unwrap_or(p.last_depth.max(v.bounds[j] + 1.0));
         let cutting =
             if j + 1 == n { hold.per_trial.cutting_n.clone() } else { v.cutting.get(j).cloned().unwrap_or(Spread::of(Vec::new())) };
         let cutting_n = if j + 1 == n { hold.cutting_n } else { cutting.mean };
         let f = fr.get(j).cloned().unwrap_or_else(zero_friction);
         spread.push(spreads(v.scale[j].clone(), v.puncture[j].clone(), Some(cutting.clone()), &f));
         let (mut l, mut notes) =
-            layer(j, n, below - v.bounds[j], v.scale[j].clone(), v.puncture[j].clone(), (cutting_n, cutting), &f, band, opts, &source);
-        if let Some(p) = &presliding {
-            with_presliding(&mut l, &mut notes, p, &hold);
+            layer(j, n, below - v.bounds[j], v.scale[j].clone(), v.puncture[j].clone(), (cutting_n, cutting), &f, p.band, p.opts, p.source);
+        if let Some(pre) = p.presliding {
+            with_presliding(&mut l, &mut notes, pre, hold);
         }
         if j == 0 {
-            l.family_weight = shape.weight;
-            l.softening_fraction = shape.fraction;
-            l.softening_onset_ratio = shape.onset_ratio;
+            l.family_weight = p.shape.weight;
+            l.softening_fraction = p.shape.fraction;
+            l.softening_onset_ratio = p.shape.onset_ratio;
         }
         layers.push(l);
         uncertainty.push(notes);
     }
     if let (Some(b), Some(f)) = (hold.boundary_mm, fr.last()) {
-        let (l, notes) = bottom_layer(n, last_depth - b + 1.0, largest, &hold, f, band, opts, &source);
+        let (l, notes) = bottom_layer(n, p.last_depth - b + 1.0, p.largest, hold, f, p.band, p.opts, p.source);
         let scale = Spread { mean: hold.scale, ..hold.per_trial.scale.clone() };
         spread.push(spreads(scale, Spread::of(Vec::new()), None, f));
         layers.push(l);
         uncertainty.push(notes);
     }
-    let stack = checked_stack(opts, ts.len(), diameter, layers)?;
-    Ok(Fitted { stack, uncertainty, punctures: n, friction: fr, hold, stick_band_mm_per_s: band, presliding_mm: presliding, spread })
+    (layers, uncertainty, spread)
 }
 
 /// The stack of `layers`, checked by the tissue format's reader as the file will be read.
@@ -148,9 +173,9 @@ fn checked_stack(opts: &TrialsOptions<'_>, trials: usize, diameter: f64, layers:
 
 /// The shaft's presliding (the `hold` and `presliding` modules): its distance from the
 /// withdrawals' onsets, then twice the shaft's terms from the holds (the relaxation's
-/// columns carry the cutting force of the fit before; the arms slip at the slowest
-/// insertion speed `slowest`, so the held force relaxes by the same share at every
-/// measured speed) and the
+/// columns carry the cutting force of the fit before; the arms slip at the stick band's
+/// edge `band`, so the held force relaxes by the same share at every sliding speed)
+/// and the
 /// withdrawals' friction with the model's turn-over (and, when no boundary deflects, the
 /// shaft reaching the stage's depth), then the terms once more; `None` (said in `notes`)
 /// when no withdrawal turns the force over.
@@ -158,7 +183,7 @@ fn shaft_fit(
     used: &[Trial],
     n: usize,
     bounds: &[f64],
-    slowest: f64,
+    band: f64,
     u: &dyn Fn(f64) -> f64,
     (hold, fr): (&mut HoldFit, &mut Vec<LayerFriction>),
     notes: &mut Vec<String>,
@@ -170,7 +195,7 @@ fn shaft_fit(
         return None;
     };
     for pass in 0..3 {
-        let guess = hold::ShaftGuess { presliding_mm: p.mean, cutting_n: hold.cutting_n, slowest_mm_per_s: slowest };
+        let guess = hold::ShaftGuess { presliding_mm: p.mean, cutting_n: hold.cutting_n, slip_speed_mm_per_s: band };
         *hold = hold::fit_with_shaft(used, n, bounds, fr, u, hold, &guess);
         if pass < 2 {
             let long_term = 1.0 / (1.0 + hold.shaft_prony.iter().map(|t| t.0).sum::<f64>());
@@ -191,13 +216,14 @@ fn with_presliding(l: &mut file::Layer, notes: &mut Vec<(&'static str, String)>,
     if l.relaxation_slip_mm.is_some() {
         notes.push((
             "relaxation_slip_mm",
-            "the slowest insertion speed times the shortest shaft time constant: each term slips at every measured speed".into(),
+            "the stick band's edge times the shortest shaft time constant: each term slips at every speed above the stick band".into(),
         ));
     }
     if !l.shaft_prony.is_empty() {
         let g: Vec<String> =
             hold.shaft_g.iter().zip(&hold.shaft_prony).map(|(s, (_, tau))| format!("g(tau {tau:.3} s) {}", s.note("-"))).collect();
-        notes.push(("shaft_prony", format!("{} (the holds; the boundary below elastic)", g.join("; "))));
+        let below = if hold.prony.is_empty() { "no boundary below" } else { "the boundary below relaxes through the same terms" };
+        notes.push(("shaft_prony", format!("{} (the holds; {below})", g.join("; "))));
     }
 }
 
@@ -260,12 +286,14 @@ fn bottom_layer(
     notes.push(("puncture_force_n", format!("not punctured in any trial: twice the largest measured force, {largest:.3} N")));
     l.prony = hold.prony.iter().map(|&(g, tau_s)| file::PronyTerm { g, tau_s }).collect();
     if !l.prony.is_empty() {
+        let tied = hold.prony == hold.shaft_prony;
         l.prony_source = Some(format!(
-            "needle calibrate --trials: fitted to the holds of {} trials (the library's QLV filter, FEBio's normalisation)",
-            hold.holds
+            "needle calibrate --trials: fitted to the holds of {} trials (the library's QLV filter, FEBio's normalisation){}",
+            hold.holds,
+            if tied { "; the shaft's terms: one relaxation function for the tissue" } else { "" }
         ));
-        let g: Vec<String> =
-            hold.per_trial.g.iter().zip(&hold.prony).map(|(s, (_, tau))| format!("g(tau {tau:.3} s) {}", s.note("-"))).collect();
+        let per = if tied { &hold.shaft_g } else { &hold.per_trial.g };
+        let g: Vec<String> = per.iter().zip(&hold.prony).map(|(s, (_, tau))| format!("g(tau {tau:.3} s) {}", s.note("-"))).collect();
         notes.push(("prony", g.join("; ")));
     }
     (l, notes)
@@ -301,8 +329,9 @@ fn friction_or_insertion(
         .collect()
 }
 
-/// The intervals between punctures (each layer directly under another), per trial, the
-/// boundaries, scales, puncture forces and cutting forces their means.
+/// The intervals between punctures (each layer directly under another), per trial: the
+/// boundaries, puncture forces and cutting forces their means, the scale the one with
+/// which the model reaches the mean puncture force at the trials' mean puncture depth.
 fn intervals_pass(used: &[Trial], n: usize, v: &mut Values, fr: &[LayerFriction], u: &dyn Fn(f64) -> f64) {
     v.scale.truncate(1);
     v.puncture.truncate(1);
@@ -317,9 +346,17 @@ fn intervals_pass(used: &[Trial], n: usize, v: &mut Values, fr: &[LayerFriction]
                 *b = col(&|f| f.boundary_mm).mean;
             }
         }
-        v.cutting.push(col(&|f| f.cutting_n));
-        v.scale.push(col(&|f| f.scale));
-        v.puncture.push(col(&|f| f.puncture_n));
+        let (cutting, mut scale, puncture) = (col(&|f| f.cutting_n), col(&|f| f.scale), col(&|f| f.puncture_n));
+        // the scale through the trials' mean peak: the model punctures at their mean
+        // depth (the mean of the per-trial scales does not, the surrogate being curved)
+        let peak = col(&|f| f.peak_mm).mean;
+        let through = (puncture.mean - cutting.mean) / intervals::indent(u, peak - v.bounds[k + 1]);
+        if !fits.is_empty() && through.is_finite() && through > 0.0 {
+            scale.mean = through;
+        }
+        v.cutting.push(cutting);
+        v.scale.push(scale);
+        v.puncture.push(puncture);
     }
 }
 

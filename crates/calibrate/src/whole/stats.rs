@@ -95,6 +95,49 @@ impl Normal {
         out
     }
 
+    /// The normal equations of new columns, each a combination of these: new column `k`
+    /// is `sum_i m[k][i]` times column `i`.
+    #[must_use]
+    pub fn combine(&self, m: &[Vec<f64>]) -> Self {
+        let n = m.len();
+        let mut out = Self::new(n);
+        for (a, ma) in m.iter().enumerate() {
+            for (b, mb) in m.iter().enumerate() {
+                let mut q = 0.0;
+                for (i, x) in ma.iter().enumerate().filter(|(_, x)| **x != 0.0) {
+                    for (j, y) in mb.iter().enumerate().filter(|(_, y)| **y != 0.0) {
+                        q += x * self.ata.get(i * self.n + j).copied().unwrap_or(0.0) * y;
+                    }
+                }
+                out.ata[a * n + b] = q;
+            }
+            out.atb[a] = ma.iter().enumerate().map(|(i, x)| x * self.atb.get(i).copied().unwrap_or(0.0)).sum();
+        }
+        out.btb = self.btb;
+        out
+    }
+
+    /// The first `n - 1` unknowns `>= 0` minimising `|A x - b|²` with the last fixed at 1,
+    /// and the sum of squares.
+    #[must_use]
+    pub fn with_last_fixed(&self) -> (Vec<f64>, f64) {
+        let n = self.n;
+        if n == 0 {
+            return (Vec::new(), self.btb);
+        }
+        let k = n - 1;
+        let mut reduced = Self::new(k);
+        for i in 0..k {
+            for j in 0..k {
+                reduced.ata[i * k + j] = self.ata[i * n + j];
+            }
+            reduced.atb[i] = self.atb[i] - self.ata[i * n + k];
+        }
+        reduced.btb = self.btb - 2.0 * self.atb[k] + self.ata[k * n + k];
+        let (x, sse) = reduced.non_negative();
+        (x, sse)
+    }
+
     /// `x >= 0` minimising `|A x - b|²` (every subset of free columns tried: exact for the
     /// few columns of a layer) and the sum of squares.
     #[must_use]
