@@ -62,6 +62,15 @@
 //!   feature take the rule above bit for bit (the feature's state is zero-sized without
 //!   it). Measured: `host-tests/tests/insertion_energy.rs` (random closed cycles and
 //!   Colgate's ratio at `wT` from `0.2 pi` to `pi`).
+//! - **with the shaft's presliding** (feature `shaft-presliding`, a layer with a
+//!   presliding distance): the insertion's held friction and cutting `H` (a spring that
+//!   slips: a function of the path's history, which the rule above would ratchet into
+//!   its offset) is neither in `D` nor in the elastic part: the guard renders it through
+//!   a bristle of its own (`control::held_bristle`, which states why it is passive) of
+//!   stiffness `κ <= HELD_SHARE k_g`, runs the rule above on `F - H` with the deflected
+//!   boundary's stiffness charged against `k_g - κ`, and adds the bristle's force along
+//!   the axis. A tick with nothing held and the bristle at rest is the rule above bit
+//!   for bit.
 #[cfg(feature = "shaft-presliding")]
 use super::held_bristle::HeldBristle;
 use super::ConfigError;
