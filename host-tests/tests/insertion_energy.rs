@@ -471,8 +471,24 @@ fn glitched(rng: &mut ChaCha8Rng, p: Pose) -> Pose {
 /// loop: a glitch tick holds the last wrench (or none), integrates nothing.
 #[test]
 fn with_glitches_in_the_pose_stream_no_closed_cycle_delivers_energy() {
-    use needle_haptics::control::LoopCore;
     for stack in &stacks::ALL {
+        glitched_cycles_deliver_no_energy(stack, 300);
+    }
+}
+
+/// The glitch test with the shaft's presliding on every layer
+/// ([`for_each_presliding_stack`]): a glitch tick advances no bristle (the arms relax),
+/// and the guard's bristle keeps its state over it.
+#[test]
+fn with_the_shaft_presliding_and_glitches_no_closed_cycle_delivers_energy() {
+    for_each_presliding_stack(|held| glitched_cycles_deliver_no_energy(held, 100));
+}
+
+/// `trajectories` random trajectories through `stack` with glitches in the pose stream,
+/// through the insertion alone and through the guarded loop.
+fn glitched_cycles_deliver_no_energy(stack: &Stack<'_>, trajectories: usize) {
+    use needle_haptics::control::LoopCore;
+    {
         let mut rng = ChaCha8Rng::seed_from_u64(20261206);
         let mut glitches = ChaCha8Rng::seed_from_u64(66);
         let deepest: f64 = stack.layers.iter().map(|l| f64::from(l.thickness_mm)).sum::<f64>() + 5.0;
@@ -480,7 +496,7 @@ fn with_glitches_in_the_pose_stream_no_closed_cycle_delivers_energy() {
             (f64::NEG_INFINITY, f64::NEG_INFINITY, 0, 0usize, 0usize);
         const WEAK_DAMPING_N_S_PER_MM: f64 = 0.0001;
         let (config, guard) = guarded_loop_setup(WEAK_DAMPING_N_S_PER_MM);
-        for n in 0..300 {
+        for n in 0..trajectories {
             let moves = trajectory(&mut rng, deepest);
             let mut insertion = Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ).expect("shipped stack");
             let (e, p) = energy_of(&moves, DAMPING_N_S_PER_MM, |pose| {
@@ -511,9 +527,14 @@ fn with_glitches_in_the_pose_stream_no_closed_cycle_delivers_energy() {
             }
         }
         println!(
-            "{}: 300 glitched trajectories ({punctured} punctured, {flagged} glitch ticks, {fast_hand} of them clean poses), most energy to the hand of those entering: {worst:e} N·mm, through the guarded loop {worst_loop:e} N·mm",
+            "{}: {trajectories} glitched trajectories ({punctured} punctured, {flagged} glitch ticks, {fast_hand} of them clean poses), most energy to the hand of those entering: {worst:e} N·mm, through the guarded loop {worst_loop:e} N·mm",
             stack.name
         );
-        assert!(punctured > 300 / 4 && flagged > 1000, "{}: the test must cross punctures and glitches", stack.name);
+        // about 2 % of some 2,000 ticks a trajectory are glitches
+        assert!(
+            punctured > trajectories / 4 && flagged > 10 * trajectories / 3,
+            "{}: the test must cross punctures and glitches",
+            stack.name
+        );
     }
 }
