@@ -305,7 +305,7 @@ fn the_guarded_loop_delivers_no_energy(stack: &Stack<'_>, loop_trajectories: usi
         // one generator per stack: a stack added does not change another's trajectories
         let mut rng = ChaCha8Rng::seed_from_u64(20261127);
         let deepest: f64 = stack.layers.iter().map(|l| f64::from(l.thickness_mm)).sum::<f64>() + 5.0;
-        let (mut worst, mut limited, mut punctured) = (f64::NEG_INFINITY, 0, 0);
+        let (mut worst, mut worst_punctured, mut limited, mut punctured) = (f64::NEG_INFINITY, f64::NEG_INFINITY, 0, 0);
         for n in 0..loop_trajectories {
             let moves = trajectory(&mut rng, deepest);
             let mut core = LoopCore::new(config).expect("config");
@@ -323,9 +323,12 @@ fn the_guarded_loop_delivers_no_energy(stack: &Stack<'_>, loop_trajectories: usi
             if enters(&moves) {
                 worst = worst.max(e);
             }
+            if p > 0 {
+                worst_punctured = worst_punctured.max(e);
+            }
         }
         println!(
-            "{}: {loop_trajectories} trajectories through the guarded loop ({limited} stiffness-limited, {punctured} punctured), most energy to the hand of those entering the tissue {worst:e} N·mm",
+            "{}: {loop_trajectories} trajectories through the guarded loop ({limited} stiffness-limited, {punctured} punctured), most energy to the hand of those entering the tissue {worst:e} N·mm, of those puncturing {worst_punctured:e} N·mm",
             stack.name
         );
         assert!(limited > loop_trajectories / 4, "{}: the guard acted in only {limited} trajectories", stack.name);
