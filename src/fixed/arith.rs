@@ -20,7 +20,11 @@ use needle_contract::TERMS;
 #[cfg_attr(target_arch = "arm", inline(never))]
 #[cfg_attr(not(target_arch = "arm"), inline(always))]
 pub(crate) fn sat_mul(a: i64, b: i64) -> i64 {
-    a.saturating_mul(b)
+    match (i32::try_from(a), i32::try_from(b)) {
+        // both within `i32`: `|a b| <= 2^62` never saturates, one widening product
+        (Ok(a), Ok(b)) => i64::from(a).wrapping_mul(i64::from(b)),
+        _ => a.saturating_mul(b),
+    }
 }
 
 /// `x g / 2^30` (floor of each part) for `|x| < 2^60` and `0 <= g <= 2^31`: `x` split at
@@ -32,6 +36,13 @@ pub(crate) fn sat_mul(a: i64, b: i64) -> i64 {
 #[cfg_attr(not(target_arch = "arm"), inline(always))]
 pub(crate) fn mul_q30_wide(x: i64, g: i64) -> i64 {
     let (hi, lo) = (x >> 30, x & ((1 << 30) - 1));
+    if let (Ok(hi), Ok(g), Ok(lo)) = (i32::try_from(hi), u32::try_from(g), u32::try_from(lo)) {
+        if g <= 1 << 31 {
+            // |hi g| <= 2^62 and lo g < 2^61: neither the product nor the sum saturates
+            let low = (u64::from(lo) * u64::from(g)) >> 30;
+            return (i64::from(hi) * i64::from(g)).wrapping_add(low as i64);
+        }
+    }
     // lo < 2^30 and g <= 2^31: lo g < 2^61 never wraps
     (hi.saturating_mul(g)).saturating_add(lo.wrapping_mul(g) >> 30)
 }
