@@ -47,6 +47,19 @@ pub(crate) fn mul_q30_wide(x: i64, g: i64) -> i64 {
     (hi.saturating_mul(g)).saturating_add(lo.wrapping_mul(g) >> 30)
 }
 
+/// Each of the six components of a wrench (µN Q16, any size) times the Q30 ratio `g`
+/// (`0 <= g <= 2^31`: the material family's `g`, a softening factor): [`mul_q30_wide`]
+/// per component. Out of line on every Arm core: one copy for the insertion's three
+/// uses (flash, issue 64; only the `tissue-shape` feature's insertion calls it).
+#[cfg_attr(target_arch = "arm", inline(never))]
+#[cfg_attr(not(target_arch = "arm"), inline(always))]
+#[cfg_attr(not(feature = "tissue-shape"), allow(dead_code))]
+pub(crate) fn scale_q30(w: &mut [i64; 6], g: i64) {
+    for x in w.iter_mut() {
+        *x = mul_q30_wide(*x, g);
+    }
+}
+
 /// `floor(a * w / 2^15)`, for `|a| <= 2^30` and `|w| <= 2^15` (the generator proves both
 /// for every call): the Q15 product of a Horner step.
 ///

@@ -46,9 +46,9 @@ pub use stack::{
     STICK_BAND_MAX_Q16, STIFFNESS_SCALE_MAX, TOTAL_THICKNESS_MAX_MM, VISCOUS_MAX_Q16,
 };
 
-#[cfg(feature = "tissue-shape")]
-use super::arith::mul_q30_wide;
 use super::arith::sat_mul;
+#[cfg(feature = "tissue-shape")]
+use super::arith::scale_q30;
 use super::depth_extension::{round_shr_i32, saturate_i32};
 #[cfg(not(feature = "viscoelastic"))]
 use super::viscoelastic::identity::{QlvCoefficients, QlvState};
@@ -459,21 +459,18 @@ impl<'a> Insertion<'a> {
             }
             let e = self.surrogate(pose, entry, depth - q);
             let [fx, fy, fz, mx, my, mz] = e.wrench.to_array().map(i64::from);
+            // the forces times `s λ²`, the moments times `s λ³`
             #[cfg_attr(not(feature = "tissue-shape"), allow(unused_mut))]
-            let mut f = [fx, fy, fz].map(|c| sat_mul(c, gf));
-            #[cfg_attr(not(feature = "tissue-shape"), allow(unused_mut))]
-            let mut moments = [mx, my, mz].map(|c| sat_mul(c, gm));
+            let mut fm = [sat_mul(fx, gf), sat_mul(fy, gf), sat_mul(fz, gf), sat_mul(mx, gm), sat_mul(my, gm), sat_mul(mz, gm)];
             #[cfg(feature = "tissue-shape")]
             if layer.family.weight_q24() < 1 << 24 {
                 // the member's ratio at the FE depth δ/λ (the f32 model's `member_deflection`)
                 let fe_depth = saturate_i32(mul_shr(depth - q, self.stack.inv_similarity_q30, 30));
                 let g = crate::fixed::family::ratio(fe_depth, &layer.family).0.clamp(0, 1 << 31);
-                for x in f.iter_mut().chain(moments.iter_mut()) {
-                    *x = mul_q30_wide(*x, g);
-                }
+                scale_q30(&mut fm, g);
             }
             #[cfg_attr(not(feature = "tissue-shape"), allow(unused_mut))]
-            let mut v = self.qlv_state.step(qlv, [f[0], f[1], f[2], moments[0], moments[1], moments[2]]);
+            let mut v = self.qlv_state.step(qlv, fm);
             let boundary = dot([v[0], v[1], v[2]], a).saturating_add(self.carried_cutting_q16());
             #[cfg(feature = "tissue-shape")]
             let soft = layer.softening;
@@ -481,11 +478,13 @@ impl<'a> Insertion<'a> {
             let critical_q16 = soft.critical_q16;
             #[cfg(not(feature = "tissue-shape"))]
             let critical_q16 = layer.puncture_force_q16;
+            // the softening's factor at this force (1 without softening), for either branch
+            #[cfg(feature = "tissue-shape")]
+            let factor = soft.active().then(|| soft.factor_q30(boundary));
             if boundary < critical_q16 {
                 #[cfg(feature = "tissue-shape")]
-                if soft.active() {
-                    let factor = soft.factor_q30(boundary);
-                    v = v.map(|x| Softening::apply(factor, x));
+                if let Some(factor) = factor {
+                    Softening::apply(factor, &mut v);
                 }
                 let [vfx, vfy, vfz, vmx, vmy, vmz] = v;
                 let [px, py, pz, pmx, pmy, pmz] = self.preload_q16;
@@ -497,11 +496,11 @@ impl<'a> Insertion<'a> {
             // softened to its share at the puncture
             self.qlv_state.reset();
             #[cfg(feature = "tissue-shape")]
-            if soft.active() {
-                let factor = soft.factor_q30(boundary);
-                f = f.map(|x| Softening::apply(factor, x));
-                moments = moments.map(|x| Softening::apply(factor, x));
+            if let Some(factor) = factor {
+                Softening::apply(factor, &mut fm);
             }
+            let [fx, fy, fz, mx, my, mz] = fm;
+            let (f, moments) = ([fx, fy, fz], [mx, my, mz]);
             let axial = dot(f, a);
             let [ax, ay, az] = a;
             // puncture: the axial force goes, the lateral force and the moments stay

@@ -6,7 +6,7 @@
 //! force `F` is `min(max(F - onset, 0), span) * slope >> 32` in Q30 (`span = (1 - r0)
 //! F_crit`, `slope = fraction 2^62 / span`: the product stays below `fraction 2^62 <
 //! 2^61`), at most `fraction` (Q30); the wrench is multiplied by `2^30 - loss` (Q30).
-use crate::fixed::arith::mul_q30_wide;
+use crate::fixed::arith::scale_q30;
 use crate::fixed::depth_extension::round_i64;
 use crate::float::insertion as f32_insertion;
 
@@ -86,9 +86,10 @@ impl Softening {
         (1 << 30) - loss
     }
 
-    /// `x` times `factor_q30` (a Q16 force or moment of any size: [`mul_q30_wide`]).
+    /// Each component of `w` (Q16 forces and moments of any size) times `factor_q30`
+    /// ([`scale_q30`]).
     #[inline]
-    pub(super) fn apply(factor_q30: i64, x: i64) -> i64 {
-        mul_q30_wide(x, factor_q30)
+    pub(super) fn apply(factor_q30: i64, w: &mut [i64; 6]) {
+        scale_q30(w, factor_q30);
     }
 }
