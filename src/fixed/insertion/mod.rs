@@ -46,9 +46,9 @@ pub use stack::{
     STICK_BAND_MAX_Q16, STIFFNESS_SCALE_MAX, TOTAL_THICKNESS_MAX_MM, VISCOUS_MAX_Q16,
 };
 
-use super::arith::sat_mul;
 #[cfg(feature = "tissue-shape")]
 use super::arith::scale_q30;
+use super::arith::{div_i64, div_u64, sat_mul};
 use super::depth_extension::{round_shr_i32, saturate_i32};
 #[cfg(not(feature = "viscoelastic"))]
 use super::viscoelastic::identity::{QlvCoefficients, QlvState};
@@ -171,7 +171,7 @@ fn bound(w: &mut [i32; 6]) -> InsertionFlags {
         return InsertionFlags::OK;
     }
     // f > FORCE_LIMIT_UN > 0: the factor is below 2^32 and `|c| factor` below 2^63
-    let factor = i64::try_from((FORCE_LIMIT_UN << 32).checked_div(f).unwrap_or(0)).unwrap_or(0);
+    let factor = i64::try_from(div_u64(FORCE_LIMIT_UN << 32, f).unwrap_or(0)).unwrap_or(0);
     for c in w.iter_mut().take(3) {
         // |c| factor / 2^32 <= |c|: within i32
         *c = ((i64::from(*c) * factor) / (1 << 32)) as i32;
@@ -247,15 +247,16 @@ impl<'a> Insertion<'a> {
             *s = l.stiffness_scale_q16 as i32;
         }
         let period = u64::from(config.period_us);
-        let rate_q16 = (1_000_000_u64 << 16).checked_div(period).ok_or(InsertionError::Config)?;
+        let rate_q16 = div_u64(1_000_000_u64 << 16, period).ok_or(InsertionError::Config)?;
         let whole = period + u64::from(config.velocity_time_constant_us);
-        let alpha_q16 = ((period << 16) + (whole >> 1)).checked_div(whole).ok_or(InsertionError::Config)?;
+        let alpha_q16 = div_u64((period << 16) + (whole >> 1), whole).ok_or(InsertionError::Config)?;
         if config.max_speed_mm_per_s == 0 || config.max_turn_deg_per_s == 0 {
             return Err(InsertionError::Config);
         }
         // speed (mm/s) times period (µs) times 2^16 / 10^6 = 1,024 / 15,625, saturated
-        let per_tick =
-            |speed: u32| u32::try_from(u64::from(speed).saturating_mul(period).saturating_mul(1024) / 15_625).unwrap_or(u32::MAX);
+        let per_tick = |speed: u32| {
+            u32::try_from(div_u64(u64::from(speed).saturating_mul(period).saturating_mul(1024), 15_625).unwrap_or(0)).unwrap_or(u32::MAX)
+        };
         let max_step_q16 = [per_tick(config.max_speed_mm_per_s), per_tick(config.max_turn_deg_per_s)];
         let mut insertion = Self {
             stack,
@@ -284,7 +285,9 @@ impl<'a> Insertion<'a> {
 
     fn update_gains(&mut self) {
         let [l2, l3] = self.stack.similarity_pow_q16;
-        for (g, &s) in self.gains_q16.iter_mut().zip(&self.scales_q16) {
+        // the layers in use (a slot past them keeps its zero scale and gains); a loop of
+        // the stack's count, not unrolled into the eight slots (flash)
+        for (g, &s) in self.gains_q16.iter_mut().zip(&self.scales_q16).take(self.stack.count) {
             *g = [mul_shr(i64::from(s), l2, 16), mul_shr(i64::from(s), l3, 16)];
         }
     }
@@ -417,10 +420,10 @@ impl<'a> Insertion<'a> {
     /// `2^16 - tau 2^16 / (n T + tau)` rounded (`n <= 2^20`, `T, tau < 2^32`: every value
     /// below 2^53 in `u64`, the divisor at least `T >= 1`).
     fn after_glitch(&self, step_q16: i64) -> (i64, i64) {
-        let raw = mul_shr(step_q16, self.rate_q16, 16).checked_div(i64::from(self.missed)).unwrap_or(0);
+        let raw = div_i64(mul_shr(step_q16, self.rate_q16, 16), i64::from(self.missed)).unwrap_or(0);
         let tau = u64::from(self.tau_us);
         let whole = u64::from(self.period_us) * u64::from(self.missed) + tau;
-        let held = ((tau << 16) + (whole >> 1)).checked_div(whole).unwrap_or(0);
+        let held = div_u64((tau << 16) + (whole >> 1), whole).unwrap_or(0);
         (raw, (1 << 16) - i64::try_from(held).unwrap_or(0))
     }
 
@@ -430,7 +433,7 @@ impl<'a> Insertion<'a> {
     fn boundaries(&self, a_y_q30: i64) -> [i64; MAX_LAYERS + 1] {
         // cos(89°)^2 2^30 > 327,000: the division is by a positive number; `checked_div`
         // keeps the no-panic proof without relying on it
-        let inv_ay_q30 = (1_i64 << 60).checked_div(a_y_q30).unwrap_or(i64::MAX);
+        let inv_ay_q30 = div_i64(1_i64 << 60, a_y_q30).unwrap_or(i64::MAX);
         let mut q = [i64::MAX; MAX_LAYERS + 1];
         let mut above = 0_i64;
         for (slot, l) in q.iter_mut().zip(self.stack.layers()) {
