@@ -82,7 +82,6 @@ fn at(v: Vec3, i: usize) -> i64 {
 }
 
 /// `v · a` for a direction `a` in Q30, in `v`'s format ([`mul_q30`] per term).
-#[cfg_attr(target_arch = "arm", inline(never))]
 pub(super) fn dot(v: Vec3, a: Vec3) -> i64 {
     mul_q30(v[0], a[0]).saturating_add(mul_q30(v[1], a[1])).saturating_add(mul_q30(v[2], a[2]))
 }
