@@ -1,8 +1,10 @@
 //! The wrench and its stiffness in f32: the evaluation algorithm of `coeffs/README.md`
 //! ("Stiffness") bit for bit, sharing the wrench's operations.
 use crate::float::cross::{add_cross, add_cross_rates, COUPLED, CROSS_SCALES};
-use crate::float::eval::{clamp_to_domain, skip_sweep, sweep_t, unsolved_flag, BASELINE_STARTS, ODD, ONE_THIRD, STARTS, SWEEP_SCALES};
-use crate::float::horner::{horner_from, horner_with_rate_from, MatrixStarts, Start};
+use crate::float::eval::{
+    clamp_to_domain, skip_sweep, sweep_t, unsolved_flag, BASELINE_STARTS, DEVIATION_MATS, ODD, ONE_THIRD, STARTS, SWEEP_SCALES,
+};
+use crate::float::horner::{horner_from_shared as horner_from, horner_with_rate_from_shared as horner_with_rate_from, MatrixStarts, Start};
 use crate::float::stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
 use crate::float::tables::{BASELINE, DEVIATION, FITTED};
 use crate::{Pose, Status, Wrench};
@@ -145,7 +147,9 @@ pub(crate) struct ComponentTables {
     baseline: [f32; TERMS],
     /// Where its Horner starts (`float::eval::BASELINE_STARTS`).
     baseline_start: Start,
-    mats: [[[f32; TERMS]; TERMS]; 4],
+    /// Per sweep its matrix in [`DEVIATION_MATS`] (a reference: one copy of the
+    /// matrices for every user; constants to the optimiser all the same).
+    mats: [&'static [[f32; TERMS]; TERMS]; 4],
     starts: [MatrixStarts; 4],
     odd: [bool; 4],
     skip: [bool; 4],
@@ -157,7 +161,7 @@ const fn component_tables(c: usize) -> ComponentTables {
     ComponentTables {
         baseline: BASELINE[c],
         baseline_start: BASELINE_STARTS[c],
-        mats: [DEVIATION[0][c], DEVIATION[1][c], DEVIATION[2][c], DEVIATION[3][c]],
+        mats: [&DEVIATION_MATS[0][c], &DEVIATION_MATS[1][c], &DEVIATION_MATS[2][c], &DEVIATION_MATS[3][c]],
         starts: [STARTS[0][c], STARTS[1][c], STARTS[2][c], STARTS[3][c]],
         odd: [ODD[0][c], ODD[1][c], ODD[2][c], ODD[3][c]],
         skip: [SKIP[0][c], SKIP[1][c], SKIP[2][c], SKIP[3][c]],
@@ -214,8 +218,11 @@ pub(crate) fn component(tables: &ComponentTables, at: &At) -> Component {
     c
 }
 
-/// A theta sweep: `w ± D`, `a ± dD/du`.
-#[inline(always)]
+/// A theta sweep: `w ± D`, `a ± dD/du`. Inlined into each component on hard-float cores
+/// (its tables and starts constants there); one out-of-line copy on soft-float cores, where
+/// every f32 operation is a call into the float runtime anyway (flash, issue 64).
+#[cfg_attr(target_abi = "eabihf", inline(always))]
+#[cfg_attr(not(target_abi = "eabihf"), inline(never))]
 fn add_across(c: &mut Component, m: &[[f32; TERMS]; TERMS], s: &MatrixStarts, odd: bool, sign: f32, t: f32, u: f32) {
     let [m0, m1, m2, m3, m4] = m;
     let [s0, s1, s2, s3, s4] = s.rows;
@@ -232,8 +239,9 @@ fn add_across(c: &mut Component, m: &[[f32; TERMS]; TERMS], s: &MatrixStarts, od
 
 /// The x or z sweep: as [`add_across`], and `±dD/dt` returned (the caller adds it to the
 /// rate by t, `g = g ± dD/dt`), each row evaluated once with its t-rate
-/// ([`horner_with_rate_from`]).
-#[inline(always)]
+/// ([`horner_with_rate_from`]). Out of line on soft-float cores, as [`add_across`].
+#[cfg_attr(target_abi = "eabihf", inline(always))]
+#[cfg_attr(not(target_abi = "eabihf"), inline(never))]
 fn add_along(c: &mut Component, m: &[[f32; TERMS]; TERMS], s: &MatrixStarts, odd: bool, sign: f32, t: f32, u: f32) -> f32 {
     let [m0, m1, m2, m3, m4] = m;
     let [s0, s1, s2, s3, s4] = s.rows;
