@@ -1,7 +1,7 @@
 //! The integer primitives of the fixed-point contract: the Q15 product and the
-//! normalisation, and the saturating `i64` product of the insertion and the depth
-//! extension. All are exact (the same integer on every core); only how they are computed
-//! differs, for speed or flash.
+//! normalisation, the saturating `i64` product of the insertion and the depth extension,
+//! and the 64-bit division (on the M0 a bitwise one of its own). All are exact (the same
+//! integer on every core); only how they are computed differs, for speed or flash.
 use needle_contract::TERMS;
 
 /// `a b` saturated to the `i64` range (the insertion's and the depth extension's
@@ -17,6 +17,12 @@ use needle_contract::TERMS;
 /// products out of line as well (`insertion::track`): 22,838 -> 20,150 B and 22,798 ->
 /// 20,184 B (with the `viscoelastic` feature 25,824 -> 22,924 B and 25,984 -> 22,968 B),
 /// for about 3 % more instructions per surface tick (docs/insertion.md, "Cost").
+///
+/// Two factors within `i32` (a wrench component in µN and a gain, a depth and an
+/// inverse) take one widening product, which cannot saturate; only the others take the
+/// saturating one, which on the M0 is four library multiplies and its overflow tests
+/// (about 220 instructions): the M0's fixed-point step deflecting rig_skin's surface
+/// 20,125 -> 15,145 instructions with this and `mul_q30_wide`'s fast path (issue 64).
 #[cfg_attr(target_arch = "arm", inline(never))]
 #[cfg_attr(not(target_arch = "arm"), inline(always))]
 pub(crate) fn sat_mul(a: i64, b: i64) -> i64 {
@@ -31,7 +37,8 @@ pub(crate) fn sat_mul(a: i64, b: i64) -> i64 {
 /// bit 30, `(x >> 30) g + ((x mod 2^30) g >> 30)`, each product below `2^61` (a wrench
 /// component of any size times a Q30 ratio such as the material family's `g` or a
 /// softening factor, where [`sat_mul`] would saturate and `insertion::track`'s `mul_q30`
-/// (`|x| < 2^47`) could wrap).
+/// (`|x| < 2^47`) could wrap). Saturating for any `x` and `g`; where neither product can
+/// (`x >> 30` within `i32`, `0 <= g <= 2^31`), two widening products without the tests.
 #[cfg_attr(target_arch = "arm", inline(never))]
 #[cfg_attr(not(target_arch = "arm"), inline(always))]
 pub(crate) fn mul_q30_wide(x: i64, g: i64) -> i64 {

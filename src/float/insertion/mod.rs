@@ -781,7 +781,9 @@ impl Insertion {
             #[cfg_attr(not(feature = "tissue-shape"), allow(unused_mut))]
             let mut elastic = e.wrench.to_array();
             #[cfg(feature = "tissue-shape")]
-            if layer.family.weight() < 1.0 {
+            // `w < 1` on the bits (`new` checked `0 < w <= 1`): an integer test, not a float
+            // compare, for every layer of every stack (the M4F's loop tick)
+            if layer.family.weight().to_bits() < 1.0f32.to_bits() {
                 let f1_n = libm::fabsf(elastic[0]) + libm::fabsf(elastic[1]) + libm::fabsf(elastic[2]);
                 let g;
                 (g, k) = member_gain(f1_n, k, indentation_mm, self.similarity, &layer.family);
@@ -793,7 +795,9 @@ impl Insertion {
             let boundary_n = axial_n + self.carried_cutting_n();
             // looked up after the filter: nothing of it is live across the filter's step
             #[cfg(feature = "tissue-shape")]
-            let Some(soft) = self.soft.get(self.punctured) else {
+            // `punctured < count <= MAX_LAYERS` (the loop's condition): the index is
+            // `punctured`, and the compiler sees it in range (no test per tick)
+            let Some(soft) = self.soft.get(self.punctured % MAX_LAYERS) else {
                 break;
             };
             #[cfg(feature = "tissue-shape")]

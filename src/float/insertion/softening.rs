@@ -80,7 +80,10 @@ impl SofteningTerms {
     /// Whether the layer softens at all.
     #[inline]
     pub(crate) fn active(&self) -> bool {
-        self.fraction > 0.0
+        // `fraction > 0.0` on the bits: `new` stores `+0.0` or a positive fraction, so a
+        // positive fraction is exactly nonzero bits (an integer test, not a float compare:
+        // the M4F's loop tick)
+        self.fraction.to_bits() != 0
     }
 
     /// `1 - D` at the boundary's axial force `force_n` (below `critical_n`): the loss
