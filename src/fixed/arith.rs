@@ -50,8 +50,9 @@ pub(crate) fn mul_q30_wide(x: i64, g: i64) -> i64 {
             return (i64::from(hi) * i64::from(g)).wrapping_add(low as i64);
         }
     }
-    // lo < 2^30 and g <= 2^31: lo g < 2^61 never wraps
-    (hi.saturating_mul(g)).saturating_add(lo.wrapping_mul(g) >> 30)
+    // lo < 2^30 and g <= 2^31: lo g < 2^61 never wraps; `sat_mul` is `hi g` saturated
+    // (its own copy of the saturating product: flash)
+    sat_mul(hi, g).saturating_add(lo.wrapping_mul(g) >> 30)
 }
 
 /// Each of the six components of a wrench (µN Q16, any size) times the Q30 ratio `g`
