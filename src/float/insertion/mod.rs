@@ -306,10 +306,6 @@ pub struct Insertion {
     /// (zero-sized without the `viscoelastic` feature; written only by that call, so
     /// `step` carries none of it).
     guard_share: FilterTerms,
-    /// Per layer the pre-puncture softening's terms and the force that punctures
-    /// (computed once, in `new`; only with the `tissue-shape` feature).
-    #[cfg(feature = "tissue-shape")]
-    soft: [SofteningTerms; MAX_LAYERS],
     /// The shaft's presliding: per layer its coefficients and state (only with the
     /// `shaft-presliding` feature).
     #[cfg(feature = "shaft-presliding")]
@@ -317,6 +313,11 @@ pub struct Insertion {
     /// Per layer the relaxation's per-tick coefficients (computed once, in `new`).
     qlv: [QlvCoefficients; MAX_LAYERS],
     layers: [Layer; MAX_LAYERS],
+    /// Per layer the pre-puncture softening's terms and the force that punctures
+    /// (computed once, in `new`; only with the `tissue-shape` feature). Last: read once
+    /// per tick, through the layer's index.
+    #[cfg(feature = "tissue-shape")]
+    soft: [SofteningTerms; MAX_LAYERS],
 }
 
 /// What a passivity guard needs of an insertion tick beside its wrench
@@ -819,7 +820,14 @@ impl Insertion {
                     *t += x;
                 }
                 if rate && qlv.is_active() {
-                    self.guard_share = filter_terms(self.punctured, &elastic, &w);
+                    // with `tissue-shape` the layer's index below MAX_LAYERS as the compiler
+                    // sees it (`punctured < count`: the same index), so `filter_terms` tests no
+                    // range; the default build's code as it was (there it moved other ticks by 1)
+                    #[cfg(feature = "tissue-shape")]
+                    let j = self.punctured % MAX_LAYERS;
+                    #[cfg(not(feature = "tissue-shape"))]
+                    let j = self.punctured;
+                    self.guard_share = filter_terms(j, &elastic, &w);
                 }
                 return Deflected { wrench: total, status: e.status, punctures, stiffness_n_per_mm: k * qlv.effective_stiffness_ratio() };
             }
