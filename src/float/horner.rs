@@ -149,11 +149,11 @@ pub(crate) fn horner_with_rate_from(p: &[f32; TERMS], w: f32, start: Start) -> (
     (b * w + p0, d)
 }
 
-/// [`horner_from`] for the stiffness's evaluators (`float::eval_stiffness`,
-/// `float::depth_rate`): inlined on hard-float cores (their starts constants there), one
-/// out-of-line copy on soft-float cores, where each of its operations is a call into the
-/// float runtime anyway (flash per image, issue 64; the wrench's own evaluation keeps
-/// [`horner_from`] inline).
+/// [`horner_from`] for the passivity guard's depth rates (`float::depth_rate`, through
+/// `float::eval_stiffness::component::<true>`): inlined on hard-float cores (their starts
+/// constants there), one out-of-line copy on soft-float cores, where each of its
+/// operations is a call into the float runtime anyway (flash per image, issue 64; the
+/// wrench and `wrench_and_stiffness` keep [`horner_from`] inline).
 #[cfg_attr(target_abi = "eabihf", inline(always))]
 #[cfg_attr(not(target_abi = "eabihf"), inline(never))]
 pub(crate) fn horner_from_shared(p: &[f32; TERMS], w: f32, start: Start) -> f32 {
