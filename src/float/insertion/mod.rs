@@ -768,6 +768,13 @@ impl Insertion {
     /// releases the boundary's stored viscous force (the filter is reset: the lateral
     /// part kept as preload is the elastic one), as does the tip leaving the boundary
     /// (no deflected boundary in this tick): nothing stored is pushed into the hand.
+    ///
+    /// With `tissue-shape` (the M4F's loop tick, issue 64): a member other than the
+    /// paper's tissue is `w < 1` on the bits (`new` checked `0 < w <= 1`: an integer test,
+    /// not a float compare, for every layer of every stack); the softening is looked up
+    /// after the filter (nothing of it is live across the filter's step) at
+    /// `punctured % MAX_LAYERS`, which is `punctured` (`punctured < count <= MAX_LAYERS`,
+    /// the loop's condition) and which the compiler sees in range (no test per tick).
     fn deflect(&mut self, pose: &Pose, a: Vec3, entry: Vec3, bounds: &[f32; MAX_LAYERS + 1], rate: bool) -> Deflected {
         let mut punctures = 0u8;
         while self.punctured < self.count {
@@ -782,8 +789,6 @@ impl Insertion {
             #[cfg_attr(not(feature = "tissue-shape"), allow(unused_mut))]
             let mut elastic = e.wrench.to_array();
             #[cfg(feature = "tissue-shape")]
-            // `w < 1` on the bits (`new` checked `0 < w <= 1`): an integer test, not a float
-            // compare, for every layer of every stack (the M4F's loop tick)
             if layer.family.weight().to_bits() < 1.0f32.to_bits() {
                 let f1_n = libm::fabsf(elastic[0]) + libm::fabsf(elastic[1]) + libm::fabsf(elastic[2]);
                 let g;
@@ -794,10 +799,7 @@ impl Insertion {
             let mut w = self.qlv_state.step(qlv, elastic);
             let axial_n = dot([w[0], w[1], w[2]], a);
             let boundary_n = axial_n + self.carried_cutting_n();
-            // looked up after the filter: nothing of it is live across the filter's step
             #[cfg(feature = "tissue-shape")]
-            // `punctured < count <= MAX_LAYERS` (the loop's condition): the index is
-            // `punctured`, and the compiler sees it in range (no test per tick)
             let Some(soft) = self.soft.get(self.punctured % MAX_LAYERS) else {
                 break;
             };
@@ -820,14 +822,7 @@ impl Insertion {
                     *t += x;
                 }
                 if rate && qlv.is_active() {
-                    // with `tissue-shape` the layer's index below MAX_LAYERS as the compiler
-                    // sees it (`punctured < count`: the same index), so `filter_terms` tests no
-                    // range; the default build's code as it was (there it moved other ticks by 1)
-                    #[cfg(feature = "tissue-shape")]
-                    let j = self.punctured % MAX_LAYERS;
-                    #[cfg(not(feature = "tissue-shape"))]
-                    let j = self.punctured;
-                    self.guard_share = filter_terms(j, &elastic, &w);
+                    self.guard_share = filter_terms(self.deflected_index(), &elastic, &w);
                 }
                 return Deflected { wrench: total, status: e.status, punctures, stiffness_n_per_mm: k * qlv.effective_stiffness_ratio() };
             }
@@ -854,6 +849,20 @@ impl Insertion {
         }
         self.qlv_state.reset();
         Deflected { wrench: self.preload, status: Status::OK, punctures, stiffness_n_per_mm: 0.0 }
+    }
+
+    /// The deflected boundary's layer, `punctured`, for the guard's filter share: with
+    /// `tissue-shape` as `punctured % MAX_LAYERS` (the same index, `punctured < count <=
+    /// MAX_LAYERS`), which the compiler sees in range, so `filter_terms` tests no range
+    /// (the epidural's guarded surface tick 1,725.9 -> 1,718.9); the default build's code
+    /// as it was (there the same change moved other ticks by one instruction).
+    #[inline(always)]
+    fn deflected_index(&self) -> usize {
+        if cfg!(feature = "tissue-shape") {
+            self.punctured % MAX_LAYERS
+        } else {
+            self.punctured
+        }
     }
 
     /// The cutting force of the last punctured layer (N; 0 before the first puncture):
