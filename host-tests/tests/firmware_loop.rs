@@ -99,11 +99,13 @@ fn insertion_cases(out: &str) -> Vec<(String, f64, usize, String)> {
 }
 
 /// The cases of the `tissue-shape` build that miss issue 64's loop-tick goal, as measured
-/// (the issue stays open for them, the closing note has the figures and what
-/// was tried): the epidural's surface with the guard 1,735.0 (budget 1,720; 1,713.1
-/// without the feature) and the rig skin's surface with the guard 1,718.9 (1,600). Not a
-/// tolerance: every other case must meet its goal, and these are still printed.
-const LOOP_TICK_MISSED_WITH_SHAPE: [&str; 2] = ["insertion-epidural-surface+guard", "insertion-rig_skin-surface+guard"];
+/// (the issue stays open for them, the closing note has the figures and what was tried):
+/// the rig skin's surface with the guard, 1,685.2 (goal 1,600; 1,718.9 before the
+/// softening's factor took two compares instead of the M4F's library `fminf`/`fmaxf`; the
+/// liver's tick, the same but for the member's law and the softening, 1,570.2). Not a
+/// tolerance: every other case must meet its goal (the epidural's surface with the guard
+/// now does: 1,718.9 against 1,720, 1,735.0 before), and this one is still printed.
+const LOOP_TICK_MISSED_WITH_SHAPE: [&str; 1] = ["insertion-rig_skin-surface+guard"];
 
 /// Issue 64's cost goal with the `tissue-shape` feature: the loop rendering the whole
 /// insertion, every stack of the build (the shaped one too) at the surface and deep, with

@@ -36,17 +36,13 @@ const COEFFS_Q30: [[i64; 3]; 5] = {
     [row(r0), row(r1), row(r2), row(r3), row(r4)]
 };
 
-/// A member of the family in integers: `w` and `sqrt(w)` in Q24, and the law's rows at
-/// this member.
+/// A member of the family in integers: `w` and `sqrt(w)` in Q24 (8 bytes: a compiled-in
+/// stack holds one per layer slot).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FamilyMember {
-    weight_q24: i64,
-    sqrt_weight_q24: i64,
-    /// `c_j = (a_j2 t + a_j1) t + a_j0` in Q30, `t = sqrt(w)`: a layer's constants,
-    /// computed once with the member (on the build host for a compiled-in stack), not per
-    /// tick (10 of a tick's 25 saturating products: the M0's fixed-point step, issue 64).
-    rows_q30: [i64; 5],
+    weight_q24: i32,
+    sqrt_weight_q24: i32,
 }
 
 impl Default for FamilyMember {
@@ -58,40 +54,39 @@ impl Default for FamilyMember {
 
 impl FamilyMember {
     /// The paper's own tissue (`w = 1`).
-    pub const PAPER: Self = Self { weight_q24: ONE_Q24, sqrt_weight_q24: ONE_Q24, rows_q30: rows_of(&COEFFS_Q30, ONE_Q24) };
+    pub const PAPER: Self = Self { weight_q24: ONE_Q24 as i32, sqrt_weight_q24: ONE_Q24 as i32 };
 
     /// The f32 member's values rounded to Q24 (`const`: compiled-in stacks convert on the
-    /// build host).
+    /// build host). A weight and its root are within `0 ..= 1` (`float::family::FamilyMember`),
+    /// so both fit `i32`; anything else is refused as out of range (`weight_q24` -1).
     #[must_use]
     pub const fn from_f32(m: &FamilyMember32) -> Self {
-        let t = round_i64(m.sqrt_weight() as f64 * Q24);
-        Self { weight_q24: round_i64(m.weight() as f64 * Q24), sqrt_weight_q24: t, rows_q30: rows_of(&COEFFS_Q30, t) }
+        let (w, t) = (round_i64(m.weight() as f64 * Q24), round_i64(m.sqrt_weight() as f64 * Q24));
+        if w < 0 || w > ONE_Q24 || t < 0 || t > ONE_Q24 {
+            return Self { weight_q24: -1, sqrt_weight_q24: 0 };
+        }
+        Self { weight_q24: w as i32, sqrt_weight_q24: t as i32 }
     }
 
     /// `w` in Q24.
     #[must_use]
     pub const fn weight_q24(&self) -> i64 {
-        self.weight_q24
+        self.weight_q24 as i64
     }
 }
 
-/// `floor(a m / 2^24)` of a Q30 value `a` and a Q24 multiplier `m`, saturating.
-#[inline(always)]
+/// `floor(a m / 2^24)` of a Q30 value `a` and a Q24 multiplier `m`, saturating: the
+/// product of [`sat_mul`], with one widening product where it cannot saturate (`|a| <
+/// 2^37` and `0 <= m < 2^25`, as every multiplier of the law is: `|a m| < 2^63`), so the
+/// same integers on every core. Out of line on the Arm cores (one copy for the law's 15
+/// products: flash).
+#[cfg_attr(target_arch = "arm", inline(never))]
+#[cfg_attr(not(target_arch = "arm"), inline(always))]
 fn mul_m(a: i64, m: i64) -> i64 {
-    sat_mul(a, m) >> 24
-}
-
-/// The law's rows at `t` (Q24): `c_j = (a_j2 t + a_j1) t + a_j0` in Q30, each product
-/// [`mul_m`]'s (`const`, the same integers).
-const fn rows_of(coeffs_q30: &[[i64; 3]; 5], t: i64) -> [i64; 5] {
-    const fn m(a: i64, m: i64) -> i64 {
-        a.saturating_mul(m) >> 24
+    match (i32::try_from(a >> 6), u32::try_from(m)) {
+        (Ok(_), Ok(m32)) if m32 < 1 << 25 => a.wrapping_mul(i64::from(m32)) >> 24,
+        _ => sat_mul(a, m) >> 24,
     }
-    const fn row([a0, a1, a2]: [i64; 3], t: i64) -> i64 {
-        m(m(a2, t).saturating_add(a1), t).saturating_add(a0)
-    }
-    let [r0, r1, r2, r3, r4] = *coeffs_q30;
-    [row(r0, t), row(r1, t), row(r2, t), row(r3, t), row(r4, t)]
 }
 
 /// `g(d, w)` in Q30 and its rate by depth, 1/mm in Q30, at `depth_mm_q16` (the module's
@@ -102,7 +97,7 @@ pub fn ratio(depth_mm_q16: i32, member: &FamilyMember) -> (i64, i64) {
         return (ONE_Q30, 0);
     }
     let law = Law { depth_max_mm_q16: DEPTH_MAX_MM_Q16, inv_depth_max_q30: INV_DEPTH_MAX_Q30, inv_depth_max_q24: INV_DEPTH_MAX_Q24 };
-    ratio_of(&law, depth_mm_q16, member, &member.rows_q30)
+    ratio_of(&law, depth_mm_q16, member, &COEFFS_Q30)
 }
 
 /// Bytes of the law's constants in integers (the coefficients, the depth and its two
@@ -118,17 +113,17 @@ const fn bytes_of<T>(_value: &T) -> usize {
     core::mem::size_of::<T>()
 }
 
-/// A law's depth constants in integers (the generated ones, or a test's; its rows at a
-/// member are the member's, [`rows_of`]).
+/// A law's depth constants in integers (the generated ones, or a test's).
 struct Law {
     depth_max_mm_q16: i32,
     inv_depth_max_q30: i64,
     inv_depth_max_q24: i64,
 }
 
-/// [`ratio`] of `law`, its rows at `member` being `rows_q30`.
-fn ratio_of(law: &Law, depth_mm_q16: i32, member: &FamilyMember, rows_q30: &[i64; 5]) -> (i64, i64) {
-    if member.weight_q24 >= ONE_Q24 {
+/// [`ratio`] of `law`, whose coefficients `a_jk` are `coeffs_q30`.
+fn ratio_of(law: &Law, depth_mm_q16: i32, member: &FamilyMember, coeffs_q30: &[[i64; 3]; 5]) -> (i64, i64) {
+    let (w, t) = (i64::from(member.weight_q24), i64::from(member.sqrt_weight_q24));
+    if w >= ONE_Q24 {
         return (ONE_Q30, 0);
     }
     let (d, clamped) = if depth_mm_q16 <= 0 {
@@ -140,10 +135,11 @@ fn ratio_of(law: &Law, depth_mm_q16: i32, member: &FamilyMember, rows_q30: &[i64
     };
     // mm in Q16 times 1/mm in Q30 is Q46; over 2^22: u in Q24
     let u = sat_mul(i64::from(d), law.inv_depth_max_q30) >> 22;
-    let [c0, c1, c2, c3, c4] = *rows_q30;
+    // the rows at the member: the integers of `rows_of`
+    let [c0, c1, c2, c3, c4] = coeffs_q30.map(|[a0, a1, a2]| mul_m(mul_m(a2, t).saturating_add(a1), t).saturating_add(a0));
     let p = mul_m(mul_m(mul_m(mul_m(c4, u).saturating_add(c3), u).saturating_add(c2), u).saturating_add(c1), u).saturating_add(c0);
     let dp = mul_m(mul_m(mul_m(sat_mul(4, c4), u).saturating_add(sat_mul(3, c3)), u).saturating_add(sat_mul(2, c2)), u).saturating_add(c1);
-    let soft = ONE_Q24 - member.weight_q24;
+    let soft = ONE_Q24 - w;
     let rate = if clamped { 0 } else { mul_m(mul_m(dp, soft), law.inv_depth_max_q24) };
     (ONE_Q30.saturating_add(mul_m(p, soft)), rate)
 }
@@ -174,27 +170,29 @@ mod tests {
             let m = FamilyMember::from_f32(m32);
             for d in [0.0f32, 0.1, 1.0, 4.5, 9.0, 16.0, 17.0] {
                 let (g32, r32) = f32_family::ratio_of(&law32, d, m32);
-                let (g, r) = ratio_of(&law, round_i64(d as f64 * 65536.0) as i32, &m, &rows_of(&coeffs_q30, m.sqrt_weight_q24));
+                let (g, r) = ratio_of(&law, round_i64(d as f64 * 65536.0) as i32, &m, &coeffs_q30);
                 let (g, r) = (g as f64 / Q30, r as f64 / Q30);
                 assert!((g - g32 as f64).abs() <= 2e-6, "w {w} d {d}: {g} vs {g32}");
                 assert!((r - r32 as f64).abs() <= 2e-6, "w {w} d {d}: rate {r} vs {r32}; g {g} vs {g32}");
             }
         }
-        assert_eq!(ratio_of(&law, 5 << 16, &FamilyMember::PAPER, &rows_of(&coeffs_q30, ONE_Q24)), (ONE_Q30, 0));
+        assert_eq!(ratio_of(&law, 5 << 16, &FamilyMember::PAPER, &coeffs_q30), (ONE_Q30, 0));
     }
 
-    /// The rows computed once with the member are the ones the tick computed from the
-    /// generated law before (issue 64's M0 cost): the same integers, so the same ratio, bit
-    /// for bit, at every weight and depth tried.
+    /// The law's product with one widening multiply where it cannot saturate is the
+    /// saturating product's integer (issue 64's M0 cost), at and around its fast path's
+    /// edges: `|a|` near 2^37, `m` near 2^25, and the signs.
     #[test]
-    fn the_members_rows_are_the_per_tick_rows() {
-        let per_tick = |t: i64| COEFFS_Q30.map(|[a0, a1, a2]| mul_m(mul_m(a2, t).saturating_add(a1), t).saturating_add(a0));
-        for k in 0..=200 {
-            let w = k as f32 / 200.0;
-            let Some(m32) = f32_family::FamilyMember::new(w) else { continue };
-            let m = FamilyMember::from_f32(&m32);
-            assert_eq!(m.rows_q30, per_tick(m.sqrt_weight_q24), "w {w}");
+    fn the_laws_product_is_the_saturating_product() {
+        let edges = [24_u32, 25, 30, 31, 32, 36, 37, 38, 40, 62].map(|e| [(1_i64 << e) - 1, 1 << e, (1 << e) + 1]);
+        let special = [0_i64, 1, 3, i64::MAX, i64::MIN, i64::MAX / 3];
+        let values = || special.into_iter().chain(edges.into_iter().flatten()).flat_map(|v| [v, v.wrapping_neg()]);
+        for a in values() {
+            for m in values() {
+                assert_eq!(mul_m(a, m), a.saturating_mul(m) >> 24, "a {a} m {m}");
+            }
         }
-        assert_eq!(FamilyMember::PAPER.rows_q30, per_tick(ONE_Q24));
+        let t = i64::from(FamilyMember::from_f32(&f32_family::FamilyMember::new(0.3).expect("a member")).sqrt_weight_q24);
+        assert!(t > 0 && t < ONE_Q24, "sqrt(0.3) in Q24: {t}");
     }
 }

@@ -59,6 +59,6 @@ pub fn wrench_and_depth_rate(pose: &Pose) -> (Evaluation, [f32; 3]) {
 /// compiler drops the rate's operations); not inlined, as in `float::eval_stiffness`.
 #[inline(never)]
 fn column<const C: usize, const RATE: bool>(at: &At) -> (f32, f32) {
-    let c = component(&Column::<C>::TABLES, at);
+    let c = component::<true>(&Column::<C>::TABLES, at);
     (c.w, if RATE { c.a } else { 0.0 })
 }

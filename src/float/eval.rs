@@ -16,6 +16,12 @@ pub(crate) const SWEEP_SCALES: [f32; 4] = needle_contract::SWEEP_SCALES_F32;
 /// (the contract's table, `needle_contract::ODD`).
 pub(crate) const ODD: [[bool; COMPONENT_COUNT]; 4] = needle_contract::ODD;
 
+/// The deviation matrices `D_kc` as one `static` (the generated `DEVIATION`'s values): the
+/// soft-float wrench's loop and the stiffness's component tables
+/// (`float::eval_stiffness::ComponentTables`) read the same copy, so a soft-float image
+/// holds them once (issue 64's flash per image).
+pub(crate) static DEVIATION_MATS: [[[[f32; TERMS]; TERMS]; COMPONENT_COUNT]; 4] = DEVIATION;
+
 /// `|v|`, exactly (clears the sign bit).
 #[inline(always)]
 fn abs(v: f32) -> f32 {
@@ -164,7 +170,8 @@ fn superpose(sweeps: [f32; 4], u: f32) -> [f32; COMPONENT_COUNT] {
     for ((wc, b), &start) in w.iter_mut().zip(BASELINE.iter()).zip(BASELINE_STARTS.iter()) {
         *wc = baseline(b, start, u);
     }
-    let sweeps = sweeps.iter().zip(SWEEP_SCALES.iter()).zip(DEVIATION.iter()).zip(ODD.iter()).zip(SKIP_DEVIATION.iter()).zip(STARTS.iter());
+    let sweeps =
+        sweeps.iter().zip(SWEEP_SCALES.iter()).zip(DEVIATION_MATS.iter()).zip(ODD.iter()).zip(SKIP_DEVIATION.iter()).zip(STARTS.iter());
     for (((((v, s), mats), odd), skip), starts) in sweeps {
         let t = sweep_t(*v, *s);
         let negative = *v < 0.0;

@@ -1,8 +1,10 @@
 //! The wrench and its stiffness in f32: the evaluation algorithm of `coeffs/README.md`
 //! ("Stiffness") bit for bit, sharing the wrench's operations.
 use crate::float::cross::{add_cross, add_cross_rates, COUPLED, CROSS_SCALES};
-use crate::float::eval::{clamp_to_domain, skip_sweep, sweep_t, unsolved_flag, BASELINE_STARTS, ODD, ONE_THIRD, STARTS, SWEEP_SCALES};
-use crate::float::horner::{horner_from, horner_with_rate_from, MatrixStarts, Start};
+use crate::float::eval::{
+    clamp_to_domain, skip_sweep, sweep_t, unsolved_flag, BASELINE_STARTS, DEVIATION_MATS, ODD, ONE_THIRD, STARTS, SWEEP_SCALES,
+};
+use crate::float::horner::{horner_from, horner_from_shared, horner_with_rate_from, horner_with_rate_from_shared, MatrixStarts, Start};
 use crate::float::stiffness::{Stiffness, StiffnessEvaluation, WrenchRate};
 use crate::float::tables::{BASELINE, DEVIATION, FITTED};
 use crate::{Pose, Status, Wrench};
@@ -145,7 +147,9 @@ pub(crate) struct ComponentTables {
     baseline: [f32; TERMS],
     /// Where its Horner starts (`float::eval::BASELINE_STARTS`).
     baseline_start: Start,
-    mats: [[[f32; TERMS]; TERMS]; 4],
+    /// Per sweep its matrix in [`DEVIATION_MATS`] (a reference: one copy of the
+    /// matrices for every user; constants to the optimiser all the same).
+    mats: [&'static [[f32; TERMS]; TERMS]; 4],
     starts: [MatrixStarts; 4],
     odd: [bool; 4],
     skip: [bool; 4],
@@ -157,7 +161,7 @@ const fn component_tables(c: usize) -> ComponentTables {
     ComponentTables {
         baseline: BASELINE[c],
         baseline_start: BASELINE_STARTS[c],
-        mats: [DEVIATION[0][c], DEVIATION[1][c], DEVIATION[2][c], DEVIATION[3][c]],
+        mats: [&DEVIATION_MATS[0][c], &DEVIATION_MATS[1][c], &DEVIATION_MATS[2][c], &DEVIATION_MATS[3][c]],
         starts: [STARTS[0][c], STARTS[1][c], STARTS[2][c], STARTS[3][c]],
         odd: [ODD[0][c], ODD[1][c], ODD[2][c], ODD[3][c]],
         skip: [SKIP[0][c], SKIP[1][c], SKIP[2][c], SKIP[3][c]],
@@ -180,18 +184,28 @@ impl<const C: usize> Column<C> {
 /// the result, +121; two components in one function: no gain, 1,117.0 either way).
 #[inline(never)]
 fn component_of<const C: usize>(at: &At) -> Component {
-    component(&Column::<C>::TABLES, at)
+    component::<false>(&Column::<C>::TABLES, at)
 }
 
 /// One component: the baseline and its rate, then per sweep `w ± D`, `a ± dD/du`, and for
 /// x and z `g ± dD/dt`. `w + sign * D` is `w - D` for `sign = -1` (the product is exact,
 /// and `w + (-D)` is `w - D` by definition; `+0 + -0 = +0 = +0 - +0`): one multiply-add
 /// on the FPU and no branch. Every Horner starts where the tables say (`crate::float::horner`).
+///
+/// `SHARED`: the sweeps and their Horner evaluations through one out-of-line copy each on
+/// soft-float cores ([`add_along_shared`], [`add_across_shared`]: the passivity guard's
+/// `float::depth_rate`, whose image has a flash budget, issue 64), else written out per
+/// component with the tables' starts as constants (`wrench_and_stiffness`, as fast as
+/// before). The same operations either way; on hard-float cores the same code.
 #[inline(always)]
-pub(crate) fn component(tables: &ComponentTables, at: &At) -> Component {
+pub(crate) fn component<const SHARED: bool>(tables: &ComponentTables, at: &At) -> Component {
     let ComponentTables { baseline, baseline_start, mats, starts, odd, skip } = tables;
     let u = at.u;
-    let (w, a) = horner_with_rate_from(baseline, u, *baseline_start);
+    let (w, a) = if SHARED {
+        horner_with_rate_from_shared(baseline, u, *baseline_start)
+    } else {
+        horner_with_rate_from(baseline, u, *baseline_start)
+    };
     let mut c = Component { w, a, gx: 0.0, gz: 0.0 };
     let [mx, mz, mtx, mtz] = mats;
     let [sx, sz, stx, stz] = starts;
@@ -200,27 +214,59 @@ pub(crate) fn component(tables: &ComponentTables, at: &At) -> Component {
     let [tx, tz, ttx, ttz] = at.t;
     let [nx, nz, ntx, ntz] = at.sign;
     if !kx {
-        c.gx += add_along(&mut c, mx, sx, ox, nx, tx, u);
+        c.gx += if SHARED { add_along_shared(&mut c, mx, sx, ox, nx, tx, u) } else { add_along::<false>(&mut c, mx, sx, ox, nx, tx, u) };
     }
     if !kz {
-        c.gz += add_along(&mut c, mz, sz, oz, nz, tz, u);
+        c.gz += if SHARED { add_along_shared(&mut c, mz, sz, oz, nz, tz, u) } else { add_along::<false>(&mut c, mz, sz, oz, nz, tz, u) };
     }
     if !ktx {
-        add_across(&mut c, mtx, stx, otx, ntx, ttx, u);
+        if SHARED {
+            add_across_shared(&mut c, mtx, stx, otx, ntx, ttx, u);
+        } else {
+            add_across::<false>(&mut c, mtx, stx, otx, ntx, ttx, u);
+        }
     }
     if !ktz {
-        add_across(&mut c, mtz, stz, otz, ntz, ttz, u);
+        if SHARED {
+            add_across_shared(&mut c, mtz, stz, otz, ntz, ttz, u);
+        } else {
+            add_across::<false>(&mut c, mtz, stz, otz, ntz, ttz, u);
+        }
     }
     c
 }
 
-/// A theta sweep: `w ± D`, `a ± dD/du`.
+/// [`add_across`] with its Horner evaluations shared: one out-of-line copy on soft-float
+/// cores, where every f32 operation is a call into the float runtime anyway (flash, issue
+/// 64); inlined on hard-float cores (the same code as [`add_across`] there).
+#[cfg_attr(target_abi = "eabihf", inline(always))]
+#[cfg_attr(not(target_abi = "eabihf"), inline(never))]
+fn add_across_shared(c: &mut Component, m: &[[f32; TERMS]; TERMS], s: &MatrixStarts, odd: bool, sign: f32, t: f32, u: f32) {
+    add_across::<true>(c, m, s, odd, sign, t, u);
+}
+
+/// [`add_along`] as [`add_across_shared`].
+#[cfg_attr(target_abi = "eabihf", inline(always))]
+#[cfg_attr(not(target_abi = "eabihf"), inline(never))]
+fn add_along_shared(c: &mut Component, m: &[[f32; TERMS]; TERMS], s: &MatrixStarts, odd: bool, sign: f32, t: f32, u: f32) -> f32 {
+    add_along::<true>(c, m, s, odd, sign, t, u)
+}
+
+/// A theta sweep: `w ± D`, `a ± dD/du` (`SHARED`: through the shared Horner).
 #[inline(always)]
-fn add_across(c: &mut Component, m: &[[f32; TERMS]; TERMS], s: &MatrixStarts, odd: bool, sign: f32, t: f32, u: f32) {
+fn add_across<const SHARED: bool>(c: &mut Component, m: &[[f32; TERMS]; TERMS], s: &MatrixStarts, odd: bool, sign: f32, t: f32, u: f32) {
+    let h = |p: &[f32; TERMS], w: f32, start: Start| if SHARED { horner_from_shared(p, w, start) } else { horner_from(p, w, start) };
+    let hr = |p: &[f32; TERMS], w: f32, start: Start| {
+        if SHARED {
+            horner_with_rate_from_shared(p, w, start)
+        } else {
+            horner_with_rate_from(p, w, start)
+        }
+    };
     let [m0, m1, m2, m3, m4] = m;
     let [s0, s1, s2, s3, s4] = s.rows;
-    let rows = [horner_from(m0, t, s0), horner_from(m1, t, s1), horner_from(m2, t, s2), horner_from(m3, t, s3), horner_from(m4, t, s4)];
-    let (dev, du) = horner_with_rate_from(&rows, u, s.outer);
+    let rows = [h(m0, t, s0), h(m1, t, s1), h(m2, t, s2), h(m3, t, s3), h(m4, t, s4)];
+    let (dev, du) = hr(&rows, u, s.outer);
     if odd {
         c.w += sign * dev;
         c.a += sign * du;
@@ -234,16 +280,32 @@ fn add_across(c: &mut Component, m: &[[f32; TERMS]; TERMS], s: &MatrixStarts, od
 /// rate by t, `g = g ± dD/dt`), each row evaluated once with its t-rate
 /// ([`horner_with_rate_from`]).
 #[inline(always)]
-fn add_along(c: &mut Component, m: &[[f32; TERMS]; TERMS], s: &MatrixStarts, odd: bool, sign: f32, t: f32, u: f32) -> f32 {
+fn add_along<const SHARED: bool>(
+    c: &mut Component,
+    m: &[[f32; TERMS]; TERMS],
+    s: &MatrixStarts,
+    odd: bool,
+    sign: f32,
+    t: f32,
+    u: f32,
+) -> f32 {
+    let h = |p: &[f32; TERMS], w: f32, start: Start| if SHARED { horner_from_shared(p, w, start) } else { horner_from(p, w, start) };
+    let hr = |p: &[f32; TERMS], w: f32, start: Start| {
+        if SHARED {
+            horner_with_rate_from_shared(p, w, start)
+        } else {
+            horner_with_rate_from(p, w, start)
+        }
+    };
     let [m0, m1, m2, m3, m4] = m;
     let [s0, s1, s2, s3, s4] = s.rows;
-    let (r0, q0) = horner_with_rate_from(m0, t, s0);
-    let (r1, q1) = horner_with_rate_from(m1, t, s1);
-    let (r2, q2) = horner_with_rate_from(m2, t, s2);
-    let (r3, q3) = horner_with_rate_from(m3, t, s3);
-    let (r4, q4) = horner_with_rate_from(m4, t, s4);
-    let (dev, du) = horner_with_rate_from(&[r0, r1, r2, r3, r4], u, s.outer);
-    let dt = horner_from(&[q0, q1, q2, q3, q4], u, s.outer_rate);
+    let (r0, q0) = hr(m0, t, s0);
+    let (r1, q1) = hr(m1, t, s1);
+    let (r2, q2) = hr(m2, t, s2);
+    let (r3, q3) = hr(m3, t, s3);
+    let (r4, q4) = hr(m4, t, s4);
+    let (dev, du) = hr(&[r0, r1, r2, r3, r4], u, s.outer);
+    let dt = h(&[q0, q1, q2, q3, q4], u, s.outer_rate);
     if odd {
         c.w += sign * dev;
         c.a += sign * du;

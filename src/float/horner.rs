@@ -148,3 +148,21 @@ pub(crate) fn horner_with_rate_from(p: &[f32; TERMS], w: f32, start: Start) -> (
     };
     (b * w + p0, d)
 }
+
+/// [`horner_from`] for the passivity guard's depth rates (`float::depth_rate`, through
+/// `float::eval_stiffness::component::<true>`): inlined on hard-float cores (their starts
+/// constants there), one out-of-line copy on soft-float cores, where each of its
+/// operations is a call into the float runtime anyway (flash per image, issue 64; the
+/// wrench and `wrench_and_stiffness` keep [`horner_from`] inline).
+#[cfg_attr(target_abi = "eabihf", inline(always))]
+#[cfg_attr(not(target_abi = "eabihf"), inline(never))]
+pub(crate) fn horner_from_shared(p: &[f32; TERMS], w: f32, start: Start) -> f32 {
+    horner_from(p, w, start)
+}
+
+/// [`horner_with_rate_from`] as [`horner_from_shared`].
+#[cfg_attr(target_abi = "eabihf", inline(always))]
+#[cfg_attr(not(target_abi = "eabihf"), inline(never))]
+pub(crate) fn horner_with_rate_from_shared(p: &[f32; TERMS], w: f32, start: Start) -> (f32, f32) {
+    horner_with_rate_from(p, w, start)
+}

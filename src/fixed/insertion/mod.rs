@@ -47,8 +47,8 @@ pub use stack::{
 };
 
 #[cfg(feature = "tissue-shape")]
-use super::arith::mul_q30_wide;
-use super::arith::sat_mul;
+use super::arith::scale_q30;
+use super::arith::{div_i64, div_u64, sat_mul};
 use super::depth_extension::{round_shr_i32, saturate_i32};
 #[cfg(not(feature = "viscoelastic"))]
 use super::viscoelastic::identity::{QlvCoefficients, QlvState};
@@ -171,12 +171,21 @@ fn bound(w: &mut [i32; 6]) -> InsertionFlags {
         return InsertionFlags::OK;
     }
     // f > FORCE_LIMIT_UN > 0: the factor is below 2^32 and `|c| factor` below 2^63
-    let factor = i64::try_from((FORCE_LIMIT_UN << 32).checked_div(f).unwrap_or(0)).unwrap_or(0);
+    let factor = i64::try_from(div_u64(FORCE_LIMIT_UN << 32, f).unwrap_or(0)).unwrap_or(0);
     for c in w.iter_mut().take(3) {
         // |c| factor / 2^32 <= |c|: within i32
         *c = ((i64::from(*c) * factor) / (1 << 32)) as i32;
     }
     InsertionFlags::WRENCH_LIMITED
+}
+
+/// A layer's gains `[s λ², s λ³]` (Q16) into `g` from its scale `s` (Q16) and `[λ², λ³]`
+/// (Q16). Out of line on the Arm cores: the eight slots' loop is unrolled, and each copy
+/// is then a call with pointers (the products written out eight times took 570-620 B;
+/// once per configuration, not per tick).
+#[cfg_attr(target_arch = "arm", inline(never))]
+fn gains_of(g: &mut [i64; 2], s: i32, &[l2, l3]: &[i64; 2]) {
+    *g = [mul_shr(i64::from(s), l2, 16), mul_shr(i64::from(s), l3, 16)];
 }
 
 /// The fixed-point moments are `i32` µN·mm: their sum is within the moment bound.
@@ -247,15 +256,16 @@ impl<'a> Insertion<'a> {
             *s = l.stiffness_scale_q16 as i32;
         }
         let period = u64::from(config.period_us);
-        let rate_q16 = (1_000_000_u64 << 16).checked_div(period).ok_or(InsertionError::Config)?;
+        let rate_q16 = div_u64(1_000_000_u64 << 16, period).ok_or(InsertionError::Config)?;
         let whole = period + u64::from(config.velocity_time_constant_us);
-        let alpha_q16 = ((period << 16) + (whole >> 1)).checked_div(whole).ok_or(InsertionError::Config)?;
+        let alpha_q16 = div_u64((period << 16) + (whole >> 1), whole).ok_or(InsertionError::Config)?;
         if config.max_speed_mm_per_s == 0 || config.max_turn_deg_per_s == 0 {
             return Err(InsertionError::Config);
         }
         // speed (mm/s) times period (µs) times 2^16 / 10^6 = 1,024 / 15,625, saturated
-        let per_tick =
-            |speed: u32| u32::try_from(u64::from(speed).saturating_mul(period).saturating_mul(1024) / 15_625).unwrap_or(u32::MAX);
+        let per_tick = |speed: u32| {
+            u32::try_from(div_u64(u64::from(speed).saturating_mul(period).saturating_mul(1024), 15_625).unwrap_or(0)).unwrap_or(u32::MAX)
+        };
         let max_step_q16 = [per_tick(config.max_speed_mm_per_s), per_tick(config.max_turn_deg_per_s)];
         let mut insertion = Self {
             stack,
@@ -282,10 +292,12 @@ impl<'a> Insertion<'a> {
         Ok(insertion)
     }
 
+    /// `gains_q16` from `scales_q16` and the stack's `λ` powers (a slot past the layers
+    /// keeps its zero scale and gains: the same products).
     fn update_gains(&mut self) {
-        let [l2, l3] = self.stack.similarity_pow_q16;
+        let pow = &self.stack.similarity_pow_q16;
         for (g, &s) in self.gains_q16.iter_mut().zip(&self.scales_q16) {
-            *g = [mul_shr(i64::from(s), l2, 16), mul_shr(i64::from(s), l3, 16)];
+            gains_of(g, s, pow);
         }
     }
 
@@ -417,10 +429,10 @@ impl<'a> Insertion<'a> {
     /// `2^16 - tau 2^16 / (n T + tau)` rounded (`n <= 2^20`, `T, tau < 2^32`: every value
     /// below 2^53 in `u64`, the divisor at least `T >= 1`).
     fn after_glitch(&self, step_q16: i64) -> (i64, i64) {
-        let raw = mul_shr(step_q16, self.rate_q16, 16).checked_div(i64::from(self.missed)).unwrap_or(0);
+        let raw = div_i64(mul_shr(step_q16, self.rate_q16, 16), i64::from(self.missed)).unwrap_or(0);
         let tau = u64::from(self.tau_us);
         let whole = u64::from(self.period_us) * u64::from(self.missed) + tau;
-        let held = ((tau << 16) + (whole >> 1)).checked_div(whole).unwrap_or(0);
+        let held = div_u64((tau << 16) + (whole >> 1), whole).unwrap_or(0);
         (raw, (1 << 16) - i64::try_from(held).unwrap_or(0))
     }
 
@@ -430,7 +442,7 @@ impl<'a> Insertion<'a> {
     fn boundaries(&self, a_y_q30: i64) -> [i64; MAX_LAYERS + 1] {
         // cos(89°)^2 2^30 > 327,000: the division is by a positive number; `checked_div`
         // keeps the no-panic proof without relying on it
-        let inv_ay_q30 = (1_i64 << 60).checked_div(a_y_q30).unwrap_or(i64::MAX);
+        let inv_ay_q30 = div_i64(1_i64 << 60, a_y_q30).unwrap_or(i64::MAX);
         let mut q = [i64::MAX; MAX_LAYERS + 1];
         let mut above = 0_i64;
         for (slot, l) in q.iter_mut().zip(self.stack.layers()) {
@@ -459,21 +471,18 @@ impl<'a> Insertion<'a> {
             }
             let e = self.surrogate(pose, entry, depth - q);
             let [fx, fy, fz, mx, my, mz] = e.wrench.to_array().map(i64::from);
+            // the forces times `s λ²`, the moments times `s λ³`
             #[cfg_attr(not(feature = "tissue-shape"), allow(unused_mut))]
-            let mut f = [fx, fy, fz].map(|c| sat_mul(c, gf));
-            #[cfg_attr(not(feature = "tissue-shape"), allow(unused_mut))]
-            let mut moments = [mx, my, mz].map(|c| sat_mul(c, gm));
+            let mut fm = [sat_mul(fx, gf), sat_mul(fy, gf), sat_mul(fz, gf), sat_mul(mx, gm), sat_mul(my, gm), sat_mul(mz, gm)];
             #[cfg(feature = "tissue-shape")]
             if layer.family.weight_q24() < 1 << 24 {
                 // the member's ratio at the FE depth δ/λ (the f32 model's `member_deflection`)
                 let fe_depth = saturate_i32(mul_shr(depth - q, self.stack.inv_similarity_q30, 30));
                 let g = crate::fixed::family::ratio(fe_depth, &layer.family).0.clamp(0, 1 << 31);
-                for x in f.iter_mut().chain(moments.iter_mut()) {
-                    *x = mul_q30_wide(*x, g);
-                }
+                scale_q30(&mut fm, g);
             }
             #[cfg_attr(not(feature = "tissue-shape"), allow(unused_mut))]
-            let mut v = self.qlv_state.step(qlv, [f[0], f[1], f[2], moments[0], moments[1], moments[2]]);
+            let mut v = self.qlv_state.step(qlv, fm);
             let boundary = dot([v[0], v[1], v[2]], a).saturating_add(self.carried_cutting_q16());
             #[cfg(feature = "tissue-shape")]
             let soft = layer.softening;
@@ -481,11 +490,13 @@ impl<'a> Insertion<'a> {
             let critical_q16 = soft.critical_q16;
             #[cfg(not(feature = "tissue-shape"))]
             let critical_q16 = layer.puncture_force_q16;
+            // the softening's factor at this force (1 without softening), for either branch
+            #[cfg(feature = "tissue-shape")]
+            let factor = soft.active().then(|| soft.factor_q30(boundary));
             if boundary < critical_q16 {
                 #[cfg(feature = "tissue-shape")]
-                if soft.active() {
-                    let factor = soft.factor_q30(boundary);
-                    v = v.map(|x| Softening::apply(factor, x));
+                if let Some(factor) = factor {
+                    Softening::apply(factor, &mut v);
                 }
                 let [vfx, vfy, vfz, vmx, vmy, vmz] = v;
                 let [px, py, pz, pmx, pmy, pmz] = self.preload_q16;
@@ -497,11 +508,11 @@ impl<'a> Insertion<'a> {
             // softened to its share at the puncture
             self.qlv_state.reset();
             #[cfg(feature = "tissue-shape")]
-            if soft.active() {
-                let factor = soft.factor_q30(boundary);
-                f = f.map(|x| Softening::apply(factor, x));
-                moments = moments.map(|x| Softening::apply(factor, x));
+            if let Some(factor) = factor {
+                Softening::apply(factor, &mut fm);
             }
+            let [fx, fy, fz, mx, my, mz] = fm;
+            let (f, moments) = ([fx, fy, fz], [mx, my, mz]);
             let axial = dot(f, a);
             let [ax, ay, az] = a;
             // puncture: the axial force goes, the lateral force and the moments stay

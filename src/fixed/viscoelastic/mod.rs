@@ -19,6 +19,7 @@
 
 use needle_contract::COMPONENT_COUNT;
 
+use super::arith::div_u64;
 use super::depth_extension::round_i64;
 
 #[cfg(not(feature = "viscoelastic"))]
@@ -116,7 +117,7 @@ fn alternating_series_q32(r_q32: u64, s: u64) -> u64 {
     let (mut term, mut plus, mut minus) = (ONE_Q32, ONE_Q32, 0_u64);
     for n in 1..=16_u64 {
         // term <= 2^32 and r <= 2^32: the product at most 2^64 (saturating there: 1 unit)
-        term = (term.saturating_mul(r_q32) >> 32).checked_div(n + s).unwrap_or(0);
+        term = div_u64(term.saturating_mul(r_q32) >> 32, n + s).unwrap_or(0);
         if n % 2 == 1 {
             minus += term;
         } else {
@@ -159,14 +160,14 @@ impl QlvCoefficients {
         let n = usize::from(terms.count);
         for (((a, b), &g), &tau) in out.a_q30.iter_mut().zip(out.b_q27.iter_mut()).zip(&terms.g_q16).zip(&terms.tau_us).take(n) {
             // tau >= 1 (in_range): x = period / tau in Q32, below 2^64
-            let x_q32 = (u64::from(period_us) << 32).checked_div(u64::from(tau))?;
+            let x_q32 = div_u64(u64::from(period_us) << 32, u64::from(tau))?;
             let e = exp_neg_q32(x_q32);
             // a <= 2^30 (e <= 2^32): fits i32
             *a = i32::try_from((e + 2) >> 2).ok()?;
             // phi = (1 - e) / x in Q32: its series below x = 1 (no cancellation), else the
             // quotient (1 - e >= 0.63; (1 - e) 2^32 below 2^64, x >= 2^32)
             let phi_q32 =
-                if x_q32 < ONE_Q32 { alternating_series_q32(x_q32, 1) } else { ((ONE_Q32 - e.min(ONE_Q32)) << 32).checked_div(x_q32)? };
+                if x_q32 < ONE_Q32 { alternating_series_q32(x_q32, 1) } else { div_u64((ONE_Q32 - e.min(ONE_Q32)) << 32, x_q32)? };
             // b = g phi in Q27: g (Q16, <= 9 * 2^16) times phi (<= 2^32) below 2^52
             let g = u64::try_from(g).ok()?;
             *b = i32::try_from((g * phi_q32 + (1 << 20)) >> 21).ok()?;
@@ -277,7 +278,7 @@ impl QlvState {
             // a, r <= 2^30: a r / 2^30 <= 2^30, times n < 2^32: below 2^62; the mean of
             // weights at most 1 stays at most 2^30
             let ar = (u64::from(a.unsigned_abs()) * u64::from(*r)) >> 30;
-            *r = u32::try_from((ar * n + (1 << 30)).checked_div(n + 1).unwrap_or(0)).unwrap_or(1 << 30);
+            *r = u32::try_from(div_u64(ar * n + (1 << 30), n + 1).unwrap_or(0)).unwrap_or(1 << 30);
         }
     }
 

@@ -308,10 +308,6 @@ pub struct Insertion {
     /// (zero-sized without the `viscoelastic` feature; written only by that call, so
     /// `step` carries none of it).
     guard_share: FilterTerms,
-    /// Per layer the pre-puncture softening's terms and the force that punctures
-    /// (computed once, in `new`; only with the `tissue-shape` feature).
-    #[cfg(feature = "tissue-shape")]
-    soft: [SofteningTerms; MAX_LAYERS],
     /// The shaft's presliding: per layer its coefficients and state (only with the
     /// `shaft-presliding` feature).
     #[cfg(feature = "shaft-presliding")]
@@ -319,6 +315,11 @@ pub struct Insertion {
     /// Per layer the relaxation's per-tick coefficients (computed once, in `new`).
     qlv: [QlvCoefficients; MAX_LAYERS],
     layers: [Layer; MAX_LAYERS],
+    /// Per layer the pre-puncture softening's terms and the force that punctures
+    /// (computed once, in `new`; only with the `tissue-shape` feature). Last: read once
+    /// per tick, through the layer's index.
+    #[cfg(feature = "tissue-shape")]
+    soft: [SofteningTerms; MAX_LAYERS],
 }
 
 /// What a passivity guard needs of an insertion tick beside its wrench
@@ -801,6 +802,13 @@ impl Insertion {
     /// releases the boundary's stored viscous force (the filter is reset: the lateral
     /// part kept as preload is the elastic one), as does the tip leaving the boundary
     /// (no deflected boundary in this tick): nothing stored is pushed into the hand.
+    ///
+    /// With `tissue-shape` (the M4F's loop tick, issue 64): a member other than the
+    /// paper's tissue is `w < 1` on the bits (`new` checked `0 < w <= 1`: an integer test,
+    /// not a float compare, for every layer of every stack); the softening is looked up
+    /// after the filter (nothing of it is live across the filter's step) at
+    /// `punctured % MAX_LAYERS`, which is `punctured` (`punctured < count <= MAX_LAYERS`,
+    /// the loop's condition) and which the compiler sees in range (no test per tick).
     fn deflect(&mut self, pose: &Pose, a: Vec3, entry: Vec3, bounds: &[f32; MAX_LAYERS + 1], rate: bool) -> Deflected {
         let mut punctures = 0u8;
         while self.punctured < self.count {
@@ -815,7 +823,7 @@ impl Insertion {
             #[cfg_attr(not(feature = "tissue-shape"), allow(unused_mut))]
             let mut elastic = e.wrench.to_array();
             #[cfg(feature = "tissue-shape")]
-            if layer.family.weight() < 1.0 {
+            if layer.family.weight().to_bits() < 1.0f32.to_bits() {
                 let f1_n = libm::fabsf(elastic[0]) + libm::fabsf(elastic[1]) + libm::fabsf(elastic[2]);
                 let g;
                 (g, k) = member_gain(f1_n, k, indentation_mm, self.similarity, &layer.family);
@@ -825,9 +833,8 @@ impl Insertion {
             let mut w = self.qlv_state.step(qlv, elastic);
             let axial_n = dot([w[0], w[1], w[2]], a);
             let boundary_n = axial_n + self.carried_cutting_n();
-            // looked up after the filter: nothing of it is live across the filter's step
             #[cfg(feature = "tissue-shape")]
-            let Some(soft) = self.soft.get(self.punctured) else {
+            let Some(soft) = self.soft.get(self.punctured % MAX_LAYERS) else {
                 break;
             };
             #[cfg(feature = "tissue-shape")]
@@ -849,7 +856,7 @@ impl Insertion {
                     *t += x;
                 }
                 if rate && qlv.is_active() {
-                    self.guard_share = filter_terms(self.punctured, &elastic, &w);
+                    self.guard_share = filter_terms(self.deflected_index(), &elastic, &w);
                 }
                 return Deflected { wrench: total, status: e.status, punctures, stiffness_n_per_mm: k * qlv.effective_stiffness_ratio() };
             }
@@ -876,6 +883,20 @@ impl Insertion {
         }
         self.qlv_state.reset();
         Deflected { wrench: self.preload, status: Status::OK, punctures, stiffness_n_per_mm: 0.0 }
+    }
+
+    /// The deflected boundary's layer, `punctured`, for the guard's filter share: with
+    /// `tissue-shape` as `punctured % MAX_LAYERS` (the same index, `punctured < count <=
+    /// MAX_LAYERS`), which the compiler sees in range, so `filter_terms` tests no range
+    /// (the epidural's guarded surface tick 1,725.9 -> 1,718.9); the default build's code
+    /// as it was (there the same change moved other ticks by one instruction).
+    #[inline(always)]
+    fn deflected_index(&self) -> usize {
+        if cfg!(feature = "tissue-shape") {
+            self.punctured % MAX_LAYERS
+        } else {
+            self.punctured
+        }
     }
 
     /// The cutting force of the last punctured layer (N; 0 before the first puncture):

@@ -80,13 +80,30 @@ impl SofteningTerms {
     /// Whether the layer softens at all.
     #[inline]
     pub(crate) fn active(&self) -> bool {
-        self.fraction > 0.0
+        // `fraction > 0.0` on the bits: `new` stores `+0.0` or a positive fraction, so a
+        // positive fraction is exactly nonzero bits (an integer test, not a float compare:
+        // the M4F's loop tick)
+        self.fraction.to_bits() != 0
     }
 
-    /// `1 - D` at the boundary's axial force `force_n` (below `critical_n`).
+    /// `1 - D` at the boundary's axial force `force_n` (below `critical_n`): the loss
+    /// `min(max(x, 0), fraction)` of `x = (F - onset) slope`, written as two compares
+    /// (`f32::max` and `min` are calls into the float library on the Cortex-M4F, whose
+    /// FPU has no min or max: about 25 instructions of a loop tick, issue 64). The same
+    /// factor for every `x`: a NaN or `x <= 0` loses nothing (`1 - 0`, whatever the sign
+    /// of a zero), above `fraction` the loss is `fraction`.
     #[inline]
     pub(crate) fn factor(&self, force_n: f32) -> f32 {
-        let loss = ((force_n - self.onset_n) * self.slope_per_n).max(0.0).min(self.fraction);
+        let x = (force_n - self.onset_n) * self.slope_per_n;
+        let loss = if x > 0.0 {
+            if x < self.fraction {
+                x
+            } else {
+                self.fraction
+            }
+        } else {
+            0.0
+        };
         1.0 - loss
     }
 }
@@ -116,5 +133,20 @@ mod tests {
         assert!(SofteningTerms::new(1.0, &Softening { fraction: 0.1, onset_ratio: 1.0 }).is_none(), "onset at the puncture");
         assert!(SofteningTerms::new(1.0, &Softening { fraction: f32::NAN, onset_ratio: 0.5 }).is_none(), "NaN");
         assert_eq!(SofteningTerms::new(1.5, &Softening::NONE).map(|t| (t.critical_n, t.active())), Some((1.5, false)));
+    }
+
+    /// The factor's compares give the bits of `1 - min(max(x, 0), fraction)` for every
+    /// kind of `x`: NaN, the infinities, both zeros, below and above the fraction.
+    #[test]
+    fn the_factor_is_the_min_max_form_bit_for_bit() {
+        let Some(t) = SofteningTerms::new(2.0, &Softening { fraction: 0.2, onset_ratio: 0.6 }) else {
+            panic!("a valid softening has terms")
+        };
+        let forces = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 0.0, -0.0, 1.5, t.onset_n, 2.0, 2.4, t.critical_n, 3.0, 1e30, -1e30];
+        let steps = (0..=1000).map(|k| k as f32 * 0.003);
+        for f in forces.into_iter().chain(steps) {
+            let want = 1.0 - ((f - t.onset_n) * t.slope_per_n).max(0.0).min(t.fraction);
+            assert_eq!(t.factor(f).to_bits(), want.to_bits(), "F {f}");
+        }
     }
 }
