@@ -155,6 +155,28 @@ pub struct Rms {
     pub all_pct: f64,
     /// Over the rows of each phase, in [`STAGES`]' order (NaN: no rows).
     pub stage_pct: [f64; 3],
+    /// The rows of each phase.
+    pub stage_rows: [usize; 3],
+}
+
+impl Rms {
+    /// The RMS over the rows of the phases `keep` says (in [`STAGES`]' order), %; NaN
+    /// without rows.
+    #[must_use]
+    pub fn over(&self, keep: [bool; 3]) -> f64 {
+        let (mut s, mut n) = (0.0, 0usize);
+        for ((pct, rows), k) in self.stage_pct.iter().zip(self.stage_rows).zip(keep) {
+            if k && rows > 0 {
+                s += pct * pct * rows as f64;
+                n += rows;
+            }
+        }
+        if n == 0 {
+            f64::NAN
+        } else {
+            (s / n as f64).sqrt()
+        }
+    }
 }
 
 /// Sums of squares and counts, per stage.
@@ -183,7 +205,7 @@ impl Sums {
     /// The RMS, % of `peak`.
     fn rms(&self, peak: f64) -> Rms {
         let pct = |(s, n): (f64, usize)| if n == 0 { f64::NAN } else { 100.0 * (s / n as f64).sqrt() / peak };
-        Rms { all_pct: pct(self.total()), stage_pct: self.0.map(pct) }
+        Rms { all_pct: pct(self.total()), stage_pct: self.0.map(pct), stage_rows: self.0.map(|x| x.1) }
     }
 }
 
