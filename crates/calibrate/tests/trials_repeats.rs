@@ -13,8 +13,12 @@ use common::{calibrate, name, prepare, replay};
 use needle_calibrate::whole::repeats::{GroupSpread, Rms, RATIO_GOAL};
 use std::path::PathBuf;
 
-/// The cases that miss the goal today (`group: calibrated on -> predicted`; their
-/// figures are printed). Not a tolerance: every other case must meet the goal.
+/// The cases that miss the goal today (`group: calibrated on -> predicted`; each one's
+/// figures are printed): every muscle prediction (ratio 1.90-3.78), skin 29 of 30
+/// (1.59-2.19), skin on muscle at 1 mm/s 5 of 12 (1.50-1.78), at 2 mm/s 6 of 12
+/// (1.51-1.61), at 3 mm/s 8 of 30 (1.51-1.70). Where they come from (the withdrawal's
+/// pull, growing as the needle leaves, beyond the library's friction per mm of shaft):
+/// `docs/insertion.md`, "Repeats". Not a tolerance: every other case must meet the goal.
 const MISSED: &[&str] = &[
     "muscle_2mmps_0deg_needle2: trial1+trial2 -> trial3",
     "muscle_2mmps_0deg_needle2: trial1+trial2 -> trial4",
@@ -181,7 +185,7 @@ fn group_cases(key: &str, files: &[PathBuf]) -> Vec<Case> {
                 let no_withdrawal = rms.over(NO_WITHDRAWAL) / spread.rms.over(NO_WITHDRAWAL);
                 let name = format!("{key}: {}+{} -> {}", short(&files[a]), short(&files[b]), short(&files[k]));
                 let line = format!(
-                    "{name}: model RMS {} / spread {:.2} % = {ratio:.2} (goal <= {RATIO_GOAL}; without the withdrawal {no_withdrawal:.2}; calibrated in {secs:.2} s)",
+                    "{name}: model RMS {} / spread {:.2} % = {ratio:.3} (goal <= {RATIO_GOAL}; without the withdrawal {no_withdrawal:.3}; calibrated in {secs:.2} s)",
                     show(&rms),
                     spread.rms.all_pct
                 );
