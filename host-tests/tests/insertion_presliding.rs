@@ -106,3 +106,104 @@ fn the_fixed_point_insertion_refuses_a_presliding_layer() {
     let bad = with(Presliding { distance_mm: 0.001, relaxation_slip_mm: 0.001, shaft_prony: PronyTerms::NONE });
     assert_eq!(Insertion::new(&Stack { layers: &bad, ..*liver() }, InsertionConfig::DEFAULT_1KHZ).err(), Some(InsertionError::Value));
 }
+
+/// The depths of `run`'s path: insert to `deep_mm` at the speed, hold `hold_s`,
+/// withdraw `back_mm`.
+fn path(deep_mm: f64, hold_s: f64, back_mm: f64) -> Vec<f64> {
+    let dt = 0.001;
+    let mut depths = Vec::new();
+    let mut d = -1.0;
+    while d < deep_mm {
+        d = (d + SPEED_MM_PER_S * dt).min(deep_mm);
+        depths.push(d);
+    }
+    depths.extend(std::iter::repeat_n(deep_mm, (hold_s / dt) as usize));
+    let end = deep_mm - back_mm;
+    while d > end {
+        d = (d - SPEED_MM_PER_S * dt).max(end);
+        depths.push(d);
+    }
+    depths
+}
+
+/// Per tick of `depths` through the control loop with the passivity guard for a device
+/// of damping `damping_n_s_per_mm` at 1 kHz: the depth, the insertion's fy and the
+/// commanded fy.
+fn guarded(stack: &Stack<'_>, depths: &[f64], damping_n_s_per_mm: f32) -> Vec<(f64, f32, f32)> {
+    use needle_haptics::control::{ChannelMap, LoopConfig, LoopCore, OverLimit, Passivity};
+    let config = LoopConfig {
+        channels: [ChannelMap { gains_per_n: [0.0, 0.01, 0.0], direction_inverted: false }],
+        force_limit_n: 100.0,
+        force_limit_max_n: 100.0,
+        over_limit: OverLimit::Saturate,
+        ramp_step_n: 0.01,
+    };
+    let mut core = LoopCore::new(config).expect("config");
+    core.set_passivity(Some(Passivity { damping_n_s_per_mm, period_s: 0.001 })).expect("guard");
+    core.set_insertion(Some(Insertion::new(stack, InsertionConfig::DEFAULT_1KHZ).expect("a valid stack")));
+    depths
+        .iter()
+        .map(|&d| {
+            let s = core.step(Ok(Pose { depth_mm: d as f32, ..Pose::default() }));
+            (d, s.wrench.fy_n, s.force_cmd_n[1])
+        })
+        .collect()
+}
+
+/// Through the control loop's passivity guard (`control::held_bristle`), the liver with a
+/// presliding and a shaft term on every layer along `run`'s path (insert, hold 1 s,
+/// withdraw 12 mm), in the last layer (from the stop on: no boundary deflects, and on the
+/// vertical axis the track holds nothing, so the command is the held force alone).
+///
+/// On a device whose guard leaves the held stiffness alone (10 N·s/m: `HELD_SHARE k_g` =
+/// 5 N/mm against the bristles' `level / p` of about 1.5 N/mm) the command is the
+/// insertion's force: sliding, relaxing at rest, pulling back past the reversal (within
+/// 1e-5 of it: f32 rounding of the force taken apart and put together again), and it
+/// turns over within twice the presliding distance. On the weakly damped device of the
+/// energy tests (0.1 N·s/m: 0.05 N/mm) it holds a force at rest, never more than the
+/// insertion's nor of the other sign, and grows away from zero no faster than its
+/// stiffness allows.
+#[test]
+fn the_guarded_loop_renders_the_held_force_within_its_stiffness() {
+    use needle_haptics::control::{Passivity, HELD_SHARE};
+    let layers = with(Presliding { distance_mm: P_MM, relaxation_slip_mm: P_MM, shaft_prony: terms() });
+    let stack = Stack { layers: &layers, ..*liver() };
+    let depths = path(DEEP_MM, 1.0, 12.0);
+    let stop = depths.iter().position(|d| *d >= DEEP_MM).expect("the stop");
+    let reversal = depths.iter().rposition(|d| *d >= DEEP_MM).expect("the reversal");
+    let close = |a: f32, b: f32| (a - b).abs() <= 1e-5 * b.abs().max(1e-3);
+    let ticks = guarded(&stack, &depths, 0.01);
+    for k in [stop - 1, reversal] {
+        let (_, model, cmd) = ticks[k];
+        assert!(model > 0.5 && close(cmd, model), "tick {k}: command {cmd} N, insertion {model} N");
+    }
+    let (_, relaxed, _) = ticks[reversal];
+    assert!(relaxed < 0.9 * ticks[stop].1, "the held force relaxes at rest: {relaxed} N");
+    let crossing = ticks[reversal..].iter().find(|(_, _, c)| *c < 0.0).map(|(d, _, _)| DEEP_MM - d).expect("the command turns over");
+    assert!(crossing <= 2.0 * f64::from(P_MM), "the command crosses zero after {crossing} mm, presliding {P_MM} mm");
+    let back = ticks[reversal..].iter().find(|(d, _, _)| *d <= DEEP_MM - 3.0 * f64::from(P_MM)).expect("withdrawn");
+    assert!(back.1 < -0.5 && close(back.2, back.1), "pulling back: command {} N, insertion {} N", back.2, back.1);
+
+    let weak = Passivity { damping_n_s_per_mm: 0.0001, period_s: 0.001 };
+    let ticks = guarded(&stack, &depths, weak.damping_n_s_per_mm);
+    let held_at_rest = ticks[reversal].2;
+    assert!(held_at_rest > 0.5, "the weak device's command holds at rest: {held_at_rest} N");
+    let kappa = f64::from(HELD_SHARE * weak.guard_stiffness_n_per_mm());
+    let mut turned = 0.0f64;
+    for (k, w) in ticks[stop..].windows(2).enumerate() {
+        let [(d0, _, c0), (d1, model, c1)] = [w[0], w[1]];
+        assert!(c1 * model >= 0.0 && c1.abs() <= model.abs(), "tick {}: command {c1} N, insertion {model} N", stop + k + 1);
+        // away from zero it grows by at most its stiffness times the step (towards zero it
+        // may fall at once: a slip, the insertion's relaxation or its turning over)
+        let from = if c0 * c1 > 0.0 { f64::from(c0.abs()) } else { 0.0 };
+        let grown = f64::from(c1.abs()) - from;
+        assert!(
+            grown <= kappa * (d1 - d0).abs() * (1.0 + 1e-4) + 1e-6,
+            "tick {}: the command grew {grown} N over {} mm",
+            stop + k + 1,
+            d1 - d0
+        );
+        turned = turned.max(f64::from(held_at_rest - c1));
+    }
+    assert!(turned > 0.5, "the weak device's command turns over on the way out: by {turned} N");
+}

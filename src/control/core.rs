@@ -202,6 +202,9 @@ impl<const N: usize> LoopCore<N> {
                     let f = match stiffness {
                         Some((p, terms)) => {
                             let filter = self.insertion.as_ref().and_then(Insertion::guard_filter);
+                            #[cfg(feature = "shaft-presliding")]
+                            let (guarded, limited) = self.guard.apply_held(&p, f, &terms, filter);
+                            #[cfg(not(feature = "shaft-presliding"))]
                             let (guarded, limited) = self.guard.apply(&p, f, &terms, filter);
                             if limited {
                                 s.flags |= LoopFlags::STIFFNESS_LIMITED;
@@ -271,7 +274,7 @@ impl<const N: usize> LoopCore<N> {
             self.insertion_last = Some(e);
             if e.punctures > 0 {
                 // nothing the guard stored while the boundary deflected is given back
-                self.guard.reset();
+                self.guard.punctured();
             }
             return (e.wrench, e.status, guarded);
         }

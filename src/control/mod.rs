@@ -52,6 +52,8 @@ mod config;
 mod core;
 mod flags;
 mod hal_loop;
+#[cfg(feature = "shaft-presliding")]
+mod held_bristle;
 mod passivity;
 mod pose_source;
 mod sample;
@@ -60,6 +62,8 @@ pub use self::core::{ChannelCommand, LoopCore};
 pub use config::{ChannelMap, ConfigError, LoopConfig, OverLimit};
 pub use flags::LoopFlags;
 pub use hal_loop::{Channel, ControlLoop};
+#[cfg(feature = "shaft-presliding")]
+pub use held_bristle::HELD_SHARE;
 pub use passivity::{Passivity, GUARD_FRACTION};
 pub use pose_source::{PoseFault, PoseSource};
 pub use sample::Sample;

@@ -62,6 +62,17 @@
 //!   feature take the rule above bit for bit (the feature's state is zero-sized without
 //!   it). Measured: `host-tests/tests/insertion_energy.rs` (random closed cycles and
 //!   Colgate's ratio at `wT` from `0.2 pi` to `pi`).
+//! - **with the shaft's presliding** (feature `shaft-presliding`, a layer with a
+//!   presliding distance): the insertion's held friction and cutting `H` (a spring that
+//!   slips: a function of the path's history, which the rule above would ratchet into
+//!   its offset) is neither in `D` nor in the elastic part: the guard renders it through
+//!   a bristle of its own (`control::held_bristle`, which states why it is passive) of
+//!   stiffness `κ <= HELD_SHARE k_g`, runs the rule above on `F - H` with the deflected
+//!   boundary's stiffness charged against `k_g - κ`, and adds the bristle's force along
+//!   the axis. A tick with nothing held and the bristle at rest is the rule above bit
+//!   for bit.
+#[cfg(feature = "shaft-presliding")]
+use super::held_bristle::HeldBristle;
 use super::ConfigError;
 #[cfg(feature = "viscoelastic")]
 use crate::float::insertion::FilterTerms;
@@ -118,12 +129,52 @@ pub(crate) struct Guard {
     offset_n: [f32; 3],
     last_model_n: Option<[f32; 3]>,
     filter: GuardFilter,
+    /// The bristle of the shaft's held force (`control::held_bristle`).
+    #[cfg(feature = "shaft-presliding")]
+    held: HeldBristle,
 }
 
 impl Guard {
     /// Forget the history (after a fault): the next tick follows the model.
     pub(crate) fn reset(&mut self) {
         *self = Self::default();
+    }
+
+    /// A puncture: forget the deflected boundary's history (the next tick follows the
+    /// model), keep the held force's bristle (the shaft still holds).
+    #[cfg(feature = "shaft-presliding")]
+    pub(crate) fn punctured(&mut self) {
+        *self = Self { held: self.held, ..Self::default() };
+    }
+
+    /// A puncture: [`reset`](Self::reset) (no held force without the `shaft-presliding`
+    /// feature).
+    #[cfg(not(feature = "shaft-presliding"))]
+    #[inline]
+    pub(crate) fn punctured(&mut self) {
+        self.reset();
+    }
+
+    /// [`apply`](Self::apply) with the shaft's held force `terms.held` rendered by the guard's
+    /// bristle (`control::held_bristle`): the rule runs on the rest of the force, with the
+    /// deflected boundary's stiffness charged against `k_g - κ` (`κ` the bristle's), and
+    /// the bristle's force is added along the axis. A tick with nothing held and the
+    /// bristle at rest is [`apply`](Self::apply) bit for bit.
+    #[cfg(feature = "shaft-presliding")]
+    pub(crate) fn apply_held(&mut self, p: &Passivity, f_n: [f32; 3], terms: &GuardTerms, filter: FilterShare<'_>) -> ([f32; 3], bool) {
+        let h = &terms.held;
+        if h.force_n == 0.0 && h.stiffness_n_per_mm == 0.0 && self.held.is_at_rest() {
+            return self.apply(p, f_n, terms, filter);
+        }
+        let k_g = p.guard_stiffness_n_per_mm();
+        let (r, kappa) = self.held.step(h, k_g);
+        let a = h.axis;
+        let rest = [f_n[0] - h.force_n * a[0], f_n[1] - h.force_n * a[1], f_n[2] - h.force_n * a[2]];
+        // the rule limits the boundary to `k_g - kappa` when it sees its stiffness times
+        // `k_g / (k_g - kappa)`; `kappa <= HELD_SHARE k_g < k_g`: a positive divisor
+        let boundary = GuardTerms { stiffness_n_per_mm: terms.stiffness_n_per_mm * (k_g / (k_g - kappa)), ..*terms };
+        let (g, limited) = self.apply(p, rest, &boundary, filter);
+        ([g[0] + r * a[0], g[1] + r * a[1], g[2] + r * a[2]], limited || kappa < h.stiffness_n_per_mm)
     }
 
     /// The guarded force for the model force `f_n` with its stiffness and dissipative

@@ -3,11 +3,13 @@
 //! gives from the shipped `model.toml`, the law's coefficients in `family.toml` and the
 //! check runs in `fe/family/` (every run present there, complete or partial, has its
 //! table); a complete run's Fy error is recomputed here from the CSV on its own; every
-//! complete check run meets the must (5 %). The goal (3 %) is printed, not asserted: the
-//! complete run x+04_w0p01 misses it (worst 3.35 %, its Fx and Mz, from two must points
-//! where the member's lateral force jumps: contact stick-slip).
+//! complete check run meets the must (5 %). The goal (3 %) is held per pose (the issue's
+//! "two family members far from the paper's"): every check pose has at least two complete
+//! members within it. Not every member meets it: x+04_w0p01 (worst 3.35 %, its Fx and
+//! Mz, from two must points where the member's lateral force jumps: contact stick-slip),
+//! x+04_w0p03 and z+02_w0p03 (4.2-4.5 %) and z+02_w0p01 (3.01 %) are within the must only.
 use needle_fit::family::{ratio, TERMS};
-use needle_fit::family_poses::{checks, PoseCheck, MUST_PCT};
+use needle_fit::family_poses::{checks, PoseCheck, GOAL_PCT, MUST_PCT};
 use needle_set::set_folder::SetFolder;
 use std::path::PathBuf;
 
@@ -122,5 +124,26 @@ fn the_shipped_pose_checks_are_a_fresh_computation_and_a_complete_run_meets_the_
         assert_eq!(c.worst_pct, c.rms_pct.iter().copied().fold(0.0, f64::max));
         assert!(c.worst_pct.is_finite() && c.worst_pct > 0.0, "{} w {}: worst {}", c.pose, c.weight, c.worst_pct);
         assert!(c.worst_pct <= MUST_PCT, "{} w {}: the law misses the must: worst {:.3} % > {MUST_PCT} %", c.pose, c.weight, c.worst_pct);
+    }
+}
+
+#[test]
+fn every_check_pose_has_two_complete_members_within_the_goal() {
+    let set = SetFolder::open(&set_dir()).unwrap_or_else(|e| panic!("{e:#}"));
+    let path = set.file(needle_fit::family::FILE);
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let file: toml::Value = toml::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let tables = file.get("pose_check").and_then(toml::Value::as_array).cloned().unwrap_or_default();
+    let family = set.campaign().family.clone().expect("coeffs/default has a [family] section");
+    for pose in &family.check_poses {
+        let within: Vec<f64> = tables
+            .iter()
+            .filter(|t| t.get("pose").and_then(toml::Value::as_str) == Some(pose.as_str()))
+            .filter(|t| t.get("complete").and_then(toml::Value::as_bool) == Some(true))
+            .filter(|t| float(t, "worst_pct").is_some_and(|w| w <= GOAL_PCT))
+            .filter_map(|t| float(t, "weight"))
+            .collect();
+        eprintln!("{pose}: complete members within {GOAL_PCT} %: {within:?}");
+        assert!(within.len() >= 2, "{pose}: {} complete member(s) within the goal {GOAL_PCT} % ({within:?}); two wanted", within.len());
     }
 }

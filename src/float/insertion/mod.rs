@@ -84,6 +84,8 @@ mod softening;
 mod stack;
 mod track;
 
+#[cfg(feature = "shaft-presliding")]
+pub use presliding::HeldTerms;
 #[cfg(feature = "tissue-shape")]
 use softening::SofteningTerms;
 #[cfg(feature = "shaft-presliding")]
@@ -334,14 +336,23 @@ pub struct GuardTerms {
     /// The force of shaft friction and cutting in the wrench, N (block frame): it only
     /// takes energy out, so a guard leaves it as it is and limits the rest (the
     /// boundary's deflection, the preload and the track's hold: the elastic part). A
-    /// presliding's held force is not in it (it is elastic, its stiffness in
-    /// `stiffness_n_per_mm`).
+    /// presliding's held force is in neither: a spring that slips, its force and
+    /// stiffness are the guard's to read apart (`held`).
     pub dissipative_n: [f32; 3],
+    /// The shaft's presliding's held force, its stiffness, axis and the tick's step
+    /// (only with the `shaft-presliding` feature; [`HeldTerms::NONE`] when nothing is
+    /// held): elastic and slipping, rendered by the guard's own bristle.
+    #[cfg(feature = "shaft-presliding")]
+    pub held: HeldTerms,
 }
 
 impl GuardTerms {
-    /// No stiffness, no dissipative force.
+    /// No stiffness, no dissipative force (nothing held).
+    #[cfg(not(feature = "shaft-presliding"))]
     pub const NONE: Self = Self { stiffness_n_per_mm: 0.0, dissipative_n: [0.0; 3] };
+    /// No stiffness, no dissipative force, nothing held.
+    #[cfg(feature = "shaft-presliding")]
+    pub const NONE: Self = Self { stiffness_n_per_mm: 0.0, dissipative_n: [0.0; 3], held: HeldTerms::NONE };
 }
 
 /// What a guard needs of the deflected boundary's viscoelastic filter: the deflected
@@ -610,6 +621,9 @@ impl Insertion {
     /// and phase (zero and `ERROR` when not finite) with the flags saying why. Whatever
     /// the pose, `|fx| + |fy| + |fz| <= 100` N and `|mx| + |my| + |mz| <= 10,000` N·mm.
     pub fn step(&mut self, pose: &Pose) -> InsertionEvaluation {
+        #[cfg(feature = "shaft-presliding")]
+        return self.tick(pose, false, &mut { HeldTerms::NONE }).0;
+        #[cfg(not(feature = "shaft-presliding"))]
         self.tick(pose, false).0
     }
 
@@ -618,8 +632,17 @@ impl Insertion {
     /// stiffness and the dissipative part of the force. The control loop's guard takes
     /// them ([`LoopCore::set_insertion`](crate::control::LoopCore::set_insertion)).
     pub fn step_with_stiffness(&mut self, pose: &Pose) -> (InsertionEvaluation, GuardTerms) {
-        let (e, stiffness_n_per_mm, dissipative_n) = self.tick(pose, true);
-        (e, GuardTerms { stiffness_n_per_mm, dissipative_n })
+        #[cfg(feature = "shaft-presliding")]
+        {
+            let mut held = HeldTerms::NONE;
+            let (e, stiffness_n_per_mm, dissipative_n) = self.tick(pose, true, &mut held);
+            (e, GuardTerms { stiffness_n_per_mm, dissipative_n, held })
+        }
+        #[cfg(not(feature = "shaft-presliding"))]
+        {
+            let (e, stiffness_n_per_mm, dissipative_n) = self.tick(pose, true);
+            (e, GuardTerms { stiffness_n_per_mm, dissipative_n })
+        }
     }
 
     /// The deflected boundary's filter of the last
@@ -639,8 +662,14 @@ impl Insertion {
     #[inline(never)]
     /// The tick's evaluation, and (with `rate`; else 0) the deflected boundary's
     /// stiffness and the dissipative force of [`GuardTerms`], whose filter share it
-    /// leaves in `guard_share` (with `rate` only).
-    fn tick(&mut self, pose: &Pose, rate: bool) -> (InsertionEvaluation, f32, [f32; 3]) {
+    /// leaves in `guard_share` and (with `shaft-presliding`) its held force in
+    /// `held_out` (with `rate` only; left as it is in a tick that holds nothing).
+    fn tick(
+        &mut self,
+        pose: &Pose,
+        rate: bool,
+        #[cfg(feature = "shaft-presliding")] held_out: &mut HeldTerms,
+    ) -> (InsertionEvaluation, f32, [f32; 3]) {
         if rate {
             self.guard_share.clear();
         }
@@ -695,14 +724,19 @@ impl Insertion {
         let entry: Vec3 = [pose.x_mm, 0.0, pose.z_mm];
         let bounds = self.boundaries(a[1]);
         let Deflected { wrench: mut w, status, punctures, stiffness_n_per_mm } = self.deflect(pose, a, entry, &bounds, rate);
-        let (phase, axial_n, held_stiffness) = self.shaft(pose, a, entry, v, &bounds, &mut w);
-        // the presliding's held force is elastic to a guard: its stiffness with the boundary's
-        #[cfg(feature = "shaft-presliding")]
-        let stiffness_n_per_mm = stiffness_n_per_mm + held_stiffness;
+        let (phase, axial_n, held) = self.shaft(pose, a, entry, v, &bounds, &mut w);
         #[cfg(not(feature = "shaft-presliding"))]
-        let () = held_stiffness;
+        let () = held;
         let mut dissipative_n = [axial_n * a[0], axial_n * a[1], axial_n * a[2]];
+        #[cfg(feature = "shaft-presliding")]
+        let sum_before_n = libm::fabsf(w[0]) + libm::fabsf(w[1]) + libm::fabsf(w[2]);
         let flags = bound(&mut w, &mut dissipative_n);
+        // the presliding's held force, read apart by a guard (`HeldTerms`)
+        #[cfg(feature = "shaft-presliding")]
+        if rate {
+            let sum_after_n = libm::fabsf(w[0]) + libm::fabsf(w[1]) + libm::fabsf(w[2]);
+            *held_out = HeldTerms::new(held, a, step_mm, sum_before_n, sum_after_n);
+        }
         let wrench = Wrench::from_array(w);
         self.held = (wrench, phase);
         let e = InsertionEvaluation { wrench, status, flags, phase, punctures, velocity_mm_per_s: self.velocity_mm_per_s };
@@ -852,7 +886,8 @@ impl Insertion {
 
     /// Friction, cutting and the track's hold on the shaft, added to `w`; the phase, the
     /// axial force of Karnopp friction and ramped cutting (N, along `+a`: dissipative)
-    /// and, with `shaft-presliding`, the stiffness of the presliding's held force (N/mm).
+    /// and, with `shaft-presliding`, the presliding's held force and its stiffness (N
+    /// along `+a`, N/mm).
     fn shaft(&mut self, pose: &Pose, a: Vec3, entry: Vec3, v: f32, bounds: &[f32; MAX_LAYERS + 1], w: &mut [f32; 6]) -> (Phase, f32, Held) {
         let depth = pose.depth_mm;
         let m = self.punctured;
@@ -916,12 +951,12 @@ impl Insertion {
             Phase::InTrack(index(inside))
         };
         #[cfg(feature = "shaft-presliding")]
-        let (total, held_k) = {
+        let (total, held) = {
             let (c, k) = held_cutting.unwrap_or((0.0, 0.0));
-            (axial_n + held.0 + c, held.1 + k)
+            (axial_n + held.0 + c, (held.0 + c, held.1 + k))
         };
         #[cfg(not(feature = "shaft-presliding"))]
-        let (total, held_k) = (axial_n, NO_HELD);
+        let (total, held) = (axial_n, NO_HELD);
         if depth > self.track_end_mm && depth < next {
             self.track_end_mm = depth;
         }
@@ -929,7 +964,7 @@ impl Insertion {
         w[0] += total * a[0];
         w[1] += total * a[1];
         w[2] += total * a[2];
-        (phase, axial_n, held_k)
+        (phase, axial_n, held)
     }
 
     /// Layer `j`'s presliding friction over `length_mm` of shaft in it at speed `v` and
@@ -952,12 +987,12 @@ impl Insertion {
     }
 }
 
-/// The presliding's held-force stiffness a shaft step reports (N/mm; nothing without the
-/// `shaft-presliding` feature).
+/// The presliding's held force and its stiffness a shaft step reports (N along `+a`,
+/// N/mm; nothing without the `shaft-presliding` feature).
 #[cfg(feature = "shaft-presliding")]
-type Held = f32;
+type Held = (f32, f32);
 #[cfg(feature = "shaft-presliding")]
-const NO_HELD: Held = 0.0;
+const NO_HELD: Held = (0.0, 0.0);
 /// Nothing without the `shaft-presliding` feature.
 #[cfg(not(feature = "shaft-presliding"))]
 type Held = ();

@@ -33,8 +33,9 @@
 //! relaxing only lower it, and `w` is a function of the depth for a fixed track end
 //! (which moves only while the tip cuts at full force, storing at most half the work:
 //! `cutting (e - a) / 2`). A closed cycle of the insertion alone gives nothing back
-//! (`host-tests/tests/insertion_energy.rs` holds it); the control loop's passivity guard
-//! does not render the held force passively yet (`docs/insertion.md`, "Presliding").
+//! (`host-tests/tests/insertion_energy.rs` holds it). The control loop's passivity guard
+//! renders the held force through a bristle of its own ([`HeldTerms`] is what it reads
+//! of a tick; `control::held_bristle`, `docs/insertion.md`, "Presliding").
 use crate::float::viscoelastic::{PronyTerms, MAX_TERMS};
 use needle_contract::{MAX_TISSUE_LAYERS as MAX_LAYERS, PRESLIDING_MM_RANGE};
 
@@ -75,6 +76,48 @@ impl Presliding {
         let (lo, hi) = PRESLIDING_MM_RANGE;
         let in_range = |d: f32| d.is_finite() && d >= lo as f32 && d <= hi as f32;
         in_range(self.distance_mm) && in_range(self.relaxation_slip_mm) && checked
+    }
+}
+
+/// What a passivity guard needs of a tick's presliding beside the rest of
+/// [`GuardTerms`](super::GuardTerms) (`Insertion::step_with_stiffness`): the held force,
+/// its stiffness, the axis it acts along and the step the bristles advanced by (the
+/// control loop's guard renders it through a bristle of its own:
+/// `control::held_bristle`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct HeldTerms {
+    /// The held friction and cutting of every layer with a presliding, N, along the
+    /// axis `+a` (towards the hub: resisting a deeper needle when positive); in the
+    /// wrench (scaled with it when it was bounded), not in the guard's dissipative force.
+    pub force_n: f32,
+    /// Its stiffness along the axis, N/mm: the bristles' `level / p` (each arm's share
+    /// over `p_r`) summed over the shaft in the layers and the held cutting.
+    pub stiffness_n_per_mm: f32,
+    /// The needle's axis `a` (unit, block frame).
+    pub axis: [f32; 3],
+    /// The tick's step along the axis, mm (the depth's change the bristles advanced by).
+    pub step_mm: f32,
+}
+
+impl HeldTerms {
+    /// Nothing held (no presliding layer in the tissue, the needle above the surface,
+    /// or a tick without `step_with_stiffness`).
+    pub const NONE: Self = Self { force_n: 0.0, stiffness_n_per_mm: 0.0, axis: [0.0; 3], step_mm: 0.0 };
+
+    /// The held force `held` (N, N/mm) of a tick of `step_mm` along the axis `a`, in a
+    /// wrench whose force was scaled from `sum_before_n` to `sum_after_n` (the sums of
+    /// its components' magnitudes; the same when it was not bounded).
+    pub(super) fn new(held: (f32, f32), a: [f32; 3], step_mm: f32, sum_before_n: f32, sum_after_n: f32) -> Self {
+        // a bounded wrench (its sum above the bound, > 0) scales the held force with it
+        let scale = if sum_after_n == sum_before_n {
+            1.0
+        } else if sum_before_n.is_finite() && sum_before_n > 0.0 {
+            sum_after_n / sum_before_n
+        } else {
+            0.0
+        };
+        Self { force_n: held.0 * scale, stiffness_n_per_mm: held.1, axis: a, step_mm }
     }
 }
 
