@@ -5,55 +5,17 @@
 //! and each 2 mm/s trial held out: calibrated on the others of its group, predicted.
 //! Every check's numbers are printed (`--nocapture`); what is asserted is said at each
 //! assertion.
-use needle_calibrate::events::EventRule;
+mod common;
+
+use common::{calibrate, group, prepare, replay};
 use needle_calibrate::goals::{self, Goals};
 use needle_calibrate::replay::Check;
-use needle_calibrate::runtime_stack::OwnedStack;
-use needle_calibrate::whole::{calibrate_trials, trials, TrialsCalibration, TrialsOptions};
-use needle_haptics::{insertion, Pose};
+use needle_calibrate::whole::TrialsCalibration;
 use std::path::{Path, PathBuf};
 
-/// The rig does not state its needle's gauge: the shipped liver's 1.27 mm (18 G) is
-/// assumed (it scales the FE surrogate's depth; the fitted scales absorb the rest).
-const NEEDLE_MM: f64 = 1.27;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn group(prefix: &str) -> Vec<PathBuf> {
-    let dir = root().join("../shared/data/stokes-needle-rig");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap_or_else(|e| panic!("{}: {e} (the measured rig trials live beside the checkout)", dir.display()))
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with(prefix) && n.ends_with(".csv")))
-        .collect();
-    files.sort();
-    assert!(!files.is_empty(), "{}: no trials {prefix}*", dir.display());
-    files
-}
-
-fn calibrate(files: &[PathBuf]) -> TrialsCalibration {
-    let mu0 = needle_codegen::tissue::read_fe_shear_modulus(&root().join("coeffs/default")).ok().flatten().unwrap_or(f64::NAN);
-    let opts = TrialsOptions {
-        trials: files,
-        name: "rig".into(),
-        needle_diameter_mm: &[NEEDLE_MM],
-        rule: EventRule::default(),
-        fe_shear_modulus_n_per_mm2: mu0,
-    };
-    calibrate_trials(&opts).unwrap_or_else(|e| panic!("{e:#}"))
-}
-
 fn predict(c: &TrialsCalibration, file: &Path, g: &Goals) -> Vec<Check> {
-    let layers: Vec<insertion::Layer> = c.fitted.stack.layers.iter().map(needle_calibrate::to_layer).collect();
-    let owned = OwnedStack { name: "rig".into(), needle_diameter_mm: NEEDLE_MM as f32, layers };
-    let lambda = (NEEDLE_MM / f64::from(insertion::FE_NEEDLE_DIAMETER_MM)) as f32;
-    let u = move |d: f64| f64::from(insertion::deflection(&Pose::default(), d as f32, 1.0, lambda).wrench.fy_n);
-    let t = trials::prepare(file, EventRule::default(), &u, f64::from(lambda), false).unwrap_or_else(|e| panic!("{e:#}"));
-    let r = needle_calibrate::trial_replay::replay(&owned.as_stack(), t.onset_mm(), &t.samples).unwrap_or_else(|e| panic!("{e}"));
-    goals::checks(&t, &r, g)
+    let t = prepare(file);
+    goals::checks(&t, &replay(c, &t), g)
 }
 
 fn show(label: &str, file: &Path, checks: &[Check]) -> (usize, usize) {

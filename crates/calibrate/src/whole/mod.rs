@@ -11,7 +11,8 @@
 //!    ([`hold`]); then the shaft's presliding, its distance from the withdrawals' onsets
 //!    and its relaxation from the holds ([`presliding`], [`hold::fit_with_shaft`]);
 //! 6. the stack replayed along every trial through the library's insertion model
-//!    ([`crate::trial_replay`]) and held against it ([`goals`]).
+//!    ([`crate::trial_replay`]) and held against it ([`goals`]); a group's repeats and
+//!    a prediction's error against their spread: [`repeats`].
 //!
 //! Every value's uncertainty is the standard error over the trials (their per-trial fits;
 //! for the friction's Coulomb and viscous levels the regression's), written beside it
@@ -22,6 +23,7 @@ pub mod goals;
 pub mod hold;
 pub mod intervals;
 pub mod presliding;
+pub mod repeats;
 pub mod stack;
 pub mod stats;
 pub mod tied;
