@@ -14,13 +14,7 @@ use std::path::PathBuf;
 /// Raises ValueError naming the file and line of a refused stack or spread.
 #[pyfunction]
 #[pyo3(signature = (stack, /, *, seed, name = None, spread = None, out = None))]
-pub fn sample_stack(
-    stack: PathBuf,
-    seed: u64,
-    name: Option<String>,
-    spread: Option<PathBuf>,
-    out: Option<PathBuf>,
-) -> PyResult<String> {
+pub fn sample_stack(stack: PathBuf, seed: u64, name: Option<String>, spread: Option<PathBuf>, out: Option<PathBuf>) -> PyResult<String> {
     let name = name
         .or_else(|| out.as_ref().and_then(|o| o.file_stem()).map(|s| s.to_string_lossy().into_owned()))
         .unwrap_or_else(|| format!("{}_seed{seed}", stack.file_stem().map_or_else(String::new, |s| s.to_string_lossy().into_owned())));
