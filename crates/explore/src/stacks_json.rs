@@ -26,7 +26,8 @@ fn layers(s: &OwnedStack) -> Value {
 }
 
 /// One tissue file and, when its spread file lies beside it, `draws` tissues drawn
-/// within the spread: name, file, layers ([`layers`]), and per draw its seed, its layers
+/// within the spread: name, file, layers (needle diameter, thicknesses and
+/// each layer's wasm words), and per draw its seed, its layers
 /// and each drawn value beside the stack's (layer, key, from, to, sd).
 ///
 /// # Errors
