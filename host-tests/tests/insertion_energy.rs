@@ -223,7 +223,7 @@ fn for_each_presliding_stack(mut check: impl FnMut(&Stack<'_>)) {
             let layers: Vec<Layer> = stack
                 .layers
                 .iter()
-                .map(|l| Layer { presliding: Presliding { distance_mm: p_mm, relaxation_slip_mm: p_mm, shaft_prony }, ..*l })
+                .map(|l| Layer { presliding: Presliding { distance_mm: p_mm, relaxation_slip_mm: p_mm, shaft_prony, tent_n_per_mm: 0.0 }, ..*l })
                 .collect();
             let name = format!("{} with presliding {p_mm} mm and {label} shaft terms", stack.name);
             check(&Stack { name: &name, layers: &layers, ..*stack });
@@ -384,7 +384,7 @@ fn the_guarded_loop_renders_at_half_colgates_bound_at_every_frequency() {
 fn with_the_shaft_presliding_the_guarded_loop_renders_at_half_colgates_bound() {
     use needle_haptics::control::GUARD_FRACTION;
     use needle_haptics::insertion::Presliding;
-    let presliding = Presliding { distance_mm: 1.0, relaxation_slip_mm: 1.0, shaft_prony: PronyTerms::NONE };
+    let presliding = Presliding { distance_mm: 1.0, relaxation_slip_mm: 1.0, shaft_prony: PronyTerms::NONE, tent_n_per_mm: 0.0 };
     for stack in &stacks::ALL {
         let (first, second) = (stack.layers[0], stack.layers[1]);
         let held = Layer { presliding, ..first };

@@ -51,9 +51,9 @@ const HOLD_S: f64 = 5.0;
 #[test]
 fn at_rest_the_shaft_keeps_its_force_and_relaxes_to_its_long_term_share() {
     let karnopp = run(liver(), DEEP_MM, HOLD_S, 0.0);
-    let held_layers = with(Presliding { distance_mm: P_MM, relaxation_slip_mm: 0.1, shaft_prony: PronyTerms::NONE });
+    let held_layers = with(Presliding { distance_mm: P_MM, relaxation_slip_mm: 0.1, shaft_prony: PronyTerms::NONE, tent_n_per_mm: 0.0 });
     let held = run(&Stack { layers: &held_layers, ..*liver() }, DEEP_MM, HOLD_S, 0.0);
-    let relaxing_layers = with(Presliding { distance_mm: P_MM, relaxation_slip_mm: 0.1, shaft_prony: terms() });
+    let relaxing_layers = with(Presliding { distance_mm: P_MM, relaxation_slip_mm: 0.1, shaft_prony: terms(), tent_n_per_mm: 0.0 });
     let relaxing = run(&Stack { layers: &relaxing_layers, ..*liver() }, DEEP_MM, HOLD_S, 0.0);
     let stop = karnopp.iter().position(|(d, _)| *d >= DEEP_MM).expect("the stop");
     let (moving, end) = (stop - 1, karnopp.len() - 1);
@@ -74,7 +74,7 @@ fn at_rest_the_shaft_keeps_its_force_and_relaxes_to_its_long_term_share() {
 
 #[test]
 fn a_reversal_turns_the_held_force_over_within_twice_the_presliding_distance() {
-    let layers = with(Presliding { distance_mm: P_MM, relaxation_slip_mm: P_MM, shaft_prony: PronyTerms::NONE });
+    let layers = with(Presliding { distance_mm: P_MM, relaxation_slip_mm: P_MM, shaft_prony: PronyTerms::NONE, tent_n_per_mm: 0.0 });
     let stack = Stack { layers: &layers, ..*liver() };
     let back_mm = 4.0 * f64::from(P_MM);
     let ticks = run(&stack, DEEP_MM, 0.5, back_mm);
@@ -94,7 +94,7 @@ fn a_reversal_turns_the_held_force_over_within_twice_the_presliding_distance() {
 #[test]
 fn the_fixed_point_insertion_refuses_a_presliding_layer() {
     let layers: &'static [Layer] =
-        Box::leak(with(Presliding { distance_mm: P_MM, relaxation_slip_mm: P_MM, shaft_prony: PronyTerms::NONE }).into_boxed_slice());
+        Box::leak(with(Presliding { distance_mm: P_MM, relaxation_slip_mm: P_MM, shaft_prony: PronyTerms::NONE, tent_n_per_mm: 0.0 }).into_boxed_slice());
     let stack: &'static Stack<'static> = Box::leak(Box::new(Stack { layers, ..*liver() }));
     let fixed: &'static needle_haptics::fixed::insertion::Stack =
         Box::leak(Box::new(needle_haptics::fixed::insertion::Stack::from_f32(stack)));
@@ -103,7 +103,7 @@ fn the_fixed_point_insertion_refuses_a_presliding_layer() {
     assert_eq!(e, InsertionError::FloatOnly);
     assert!(e.to_string().contains("f32 insertion"), "{e}");
     // and the f32 insertion refuses a presliding out of its range
-    let bad = with(Presliding { distance_mm: 0.001, relaxation_slip_mm: 0.001, shaft_prony: PronyTerms::NONE });
+    let bad = with(Presliding { distance_mm: 0.001, relaxation_slip_mm: 0.001, shaft_prony: PronyTerms::NONE, tent_n_per_mm: 0.0 });
     assert_eq!(Insertion::new(&Stack { layers: &bad, ..*liver() }, InsertionConfig::DEFAULT_1KHZ).err(), Some(InsertionError::Value));
 }
 
@@ -166,7 +166,7 @@ fn guarded(stack: &Stack<'_>, depths: &[f64], damping_n_s_per_mm: f32) -> Vec<(f
 #[test]
 fn the_guarded_loop_renders_the_held_force_within_its_stiffness() {
     use needle_haptics::control::{Passivity, HELD_SHARE};
-    let layers = with(Presliding { distance_mm: P_MM, relaxation_slip_mm: P_MM, shaft_prony: terms() });
+    let layers = with(Presliding { distance_mm: P_MM, relaxation_slip_mm: P_MM, shaft_prony: terms(), tent_n_per_mm: 0.0 });
     let stack = Stack { layers: &layers, ..*liver() };
     let depths = path(DEEP_MM, 1.0, 12.0);
     let stop = depths.iter().position(|d| *d >= DEEP_MM).expect("the stop");

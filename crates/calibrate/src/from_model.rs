@@ -119,6 +119,7 @@ pub fn calibrate_published(opts: &ModelOptions<'_>) -> Result<Calibration> {
             softening_fraction_range: None,
             presliding_mm: None,
             relaxation_slip_mm: None,
+            tent_n_per_mm: None,
             shaft_prony: Vec::new(),
         });
     }

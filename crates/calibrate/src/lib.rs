@@ -243,6 +243,7 @@ fn to_file(opts: &Options<'_>, fit: &fit::Fit) -> file::Stack {
                 softening_fraction_range: l.softening_fraction_range,
                 presliding_mm: None,
                 relaxation_slip_mm: None,
+                tent_n_per_mm: None,
                 shaft_prony: Vec::new(),
             }
         })
@@ -285,6 +286,7 @@ pub fn to_layer(l: &file::Layer) -> insertion::Layer {
                 &l.shaft_prony.iter().map(|t| PronyTerm { g: t.g as f32, tau_s: t.tau_s as f32 }).collect::<Vec<_>>(),
             )
             .unwrap_or(PronyTerms::NONE),
+            tent_n_per_mm: l.tent_n_per_mm.unwrap_or(0.0) as f32,
         }),
     }
 }

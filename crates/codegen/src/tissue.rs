@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use toml::Spanned;
 
 pub use needle_contract::{
-    MAX_PRONY_TERMS, MAX_TISSUE_LAYERS as MAX_LAYERS, PRESLIDING_MM_RANGE, PRONY_G_SUM_MAX, SOFTENING_FRACTION_MAX, TISSUE_FORMAT,
+    MAX_PRONY_TERMS, MAX_TISSUE_LAYERS as MAX_LAYERS, PRESLIDING_MM_RANGE, PRONY_G_SUM_MAX, TENT_N_PER_MM_RANGE, SOFTENING_FRACTION_MAX, TISSUE_FORMAT,
     TISSUE_FORMATS_READ,
 };
 /// The folder of a set that holds its tissue stacks.
@@ -93,6 +93,13 @@ pub struct Layer {
     /// [`MAX_PRONY_TERMS`], long-term normalisation; needs `presliding_mm`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub shaft_prony: Vec<PronyTerm>,
+    /// Format 2: the tissue's tent stiffness, N/mm, within [`TENT_N_PER_MM_RANGE`]
+    /// (none, the default: the bristles move with the needle; needs `presliding_mm`): the
+    /// layer's tissue around the shaft, a spring in series with its friction, turns the
+    /// held force over within about the force's change over it and is lifted with a
+    /// withdrawing needle, lengthening the shaft in the layer.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tent_n_per_mm: Option<f64>,
 }
 
 fn one() -> f64 {
@@ -172,6 +179,7 @@ struct RawLayer {
     presliding_mm: Option<Spanned<f64>>,
     relaxation_slip_mm: Option<Spanned<f64>>,
     shaft_prony: Option<Spanned<Vec<Spanned<RawProny>>>>,
+    tent_n_per_mm: Option<Spanned<f64>>,
 }
 
 #[derive(Deserialize, Clone)]
@@ -282,7 +290,7 @@ fn layer(
 ) -> Result<Layer, CodegenError> {
     use Bound::{NonNegative, Positive};
     let shape = shape(&l, format, domain, err)?;
-    let (presliding_mm, relaxation_slip_mm, shaft_prony) = presliding_fields(&l, format, err)?;
+    let (presliding_mm, relaxation_slip_mm, shaft_prony, tent_n_per_mm) = presliding_fields(&l, format, err)?;
     let (prony, prony_span) = match l.prony {
         None => (Vec::new(), l.thickness_mm.span()),
         Some(p) => {
@@ -301,6 +309,7 @@ fn layer(
         presliding_mm,
         relaxation_slip_mm,
         shaft_prony,
+        tent_n_per_mm,
         prony_source: l.prony_source.map(Spanned::into_inner),
         thickness_mm: check(&l.thickness_mm, "thickness_mm", Positive, err)?,
         stiffness_scale: check(&l.stiffness_scale, "stiffness_scale", Positive, err)?,
@@ -411,10 +420,11 @@ fn shape(
 
 /// A layer's presliding fields, checked: the distance, the relaxation's slip distance,
 /// the shaft's terms.
-type PreslidingFields = (Option<f64>, Option<f64>, Vec<PronyTerm>);
+type PreslidingFields = (Option<f64>, Option<f64>, Vec<PronyTerm>, Option<f64>);
 
 /// The presliding fields of `l` (format 2): the distances within [`PRESLIDING_MM_RANGE`],
-/// the shaft's Prony terms checked as a layer's, both only with a presliding distance.
+/// the tent's stiffness within [`TENT_N_PER_MM_RANGE`],
+/// the shaft's Prony terms checked as a layer's, each only with a presliding distance.
 fn presliding_fields(
     l: &RawLayer,
     format: i64,
@@ -424,12 +434,13 @@ fn presliding_fields(
         l.presliding_mm.as_ref().map(Spanned::span),
         l.relaxation_slip_mm.as_ref().map(Spanned::span),
         l.shaft_prony.as_ref().map(Spanned::span),
+        l.tent_n_per_mm.as_ref().map(Spanned::span),
     ];
     if format < 2 {
         if let Some(span) = spans.into_iter().flatten().next() {
             return Err(err(
                 span,
-                "presliding_mm, relaxation_slip_mm, shaft_prony: format 2 fields (the shaft's presliding); write format = 2".into(),
+                "presliding_mm, relaxation_slip_mm, shaft_prony, tent_n_per_mm: format 2 fields (the shaft's presliding); write format = 2".into(),
             ));
         }
     }
@@ -458,7 +469,21 @@ fn presliding_fields(
             terms
         }
     };
-    Ok((distance, slip, terms))
+    let tent = match &l.tent_n_per_mm {
+        None => None,
+        Some(v) => {
+            let (lo, hi) = TENT_N_PER_MM_RANGE;
+            let x = *v.get_ref();
+            if !(x.is_finite() && (lo..=hi).contains(&x)) {
+                return Err(err(v.span(), format!("tent_n_per_mm = {x}: must be from {lo} to {hi} N/mm (leave it out for none)")));
+            }
+            if distance.is_none() {
+                return Err(err(v.span(), format!("layer {:?}: tent_n_per_mm needs presliding_mm (the friction it is in series with)", l.name)));
+            }
+            Some(x)
+        }
+    };
+    Ok((distance, slip, terms, tent))
 }
 
 /// The Prony terms: at most [`MAX_PRONY_TERMS`], each `g >= 0` and `tau_s > 0`, the sum
@@ -651,7 +676,7 @@ pub fn render_rust_stacks(stacks: &[(PathBuf, Stack)], needle: Option<FeNeedle>)
                 render_prony(&l.prony),
                 render_family(l.family_weight),
                 render_softening(l.softening_fraction, l.softening_onset_ratio),
-                render_presliding(l.presliding_mm, l.relaxation_slip_mm, &l.shaft_prony),
+                render_presliding(l.presliding_mm, l.relaxation_slip_mm, &l.shaft_prony, l.tent_n_per_mm),
                 l.name.replace('\n', " ")
             ));
         }
@@ -750,14 +775,15 @@ fn has_presliding(stack: &Stack) -> bool {
 }
 
 /// A layer's presliding: `Presliding::NONE` without one.
-fn render_presliding(distance_mm: Option<f64>, slip_mm: Option<f64>, terms: &[PronyTerm]) -> String {
+fn render_presliding(distance_mm: Option<f64>, slip_mm: Option<f64>, terms: &[PronyTerm], tent_n_per_mm: Option<f64>) -> String {
     match distance_mm {
         None => "Presliding::NONE".into(),
         Some(d) => format!(
-            "Presliding {{ distance_mm: {}, relaxation_slip_mm: {}, shaft_prony: {} }}",
+            "Presliding {{ distance_mm: {}, relaxation_slip_mm: {}, shaft_prony: {}, tent_n_per_mm: {} }}",
             lit(d),
             lit(slip_mm.unwrap_or(d)),
-            render_prony(terms)
+            render_prony(terms),
+            lit(tent_n_per_mm.unwrap_or(0.0))
         ),
     }
 }
@@ -840,7 +866,7 @@ mod tests {
         );
         assert!(rust.contains("#[cfg(all(not(feature = \"shaft-presliding\")))]\npub const ALL: [Stack<'static>; 1] = [LIVER];"), "{rust}");
         assert!(
-            rust.contains("#[cfg(feature = \"shaft-presliding\")] presliding: Presliding { distance_mm: 1.5, relaxation_slip_mm: 1.5, shaft_prony: PronyTerms::NONE }"),
+            rust.contains("#[cfg(feature = \"shaft-presliding\")] presliding: Presliding { distance_mm: 1.5, relaxation_slip_mm: 1.5, shaft_prony: PronyTerms::NONE, tent_n_per_mm: 0.0 }"),
             "the layer's field, its slip distance defaulting to the distance:\n{rust}"
         );
         let plain_only = render_rust_stacks(&[plain], None);

@@ -148,6 +148,11 @@ pub const SOFTENING_FRACTION_MAX: f64 = 0.5;
 /// The range of a layer's presliding distance (tissue format 2's `presliding_mm`, the
 /// `shaft-presliding` feature), mm: the shaft's stuck state turns over within twice it.
 pub const PRESLIDING_MM_RANGE: (f64, f64) = (0.01, 50.0);
+/// The range of a layer's tissue tent stiffness (tissue format 2's `tent_n_per_mm`, the
+/// `shaft-presliding` feature), N/mm: the layer's tissue around the shaft, a spring to the
+/// ground in series with the shaft's friction (it turns over over millimetres and is
+/// lifted with a withdrawing needle).
+pub const TENT_N_PER_MM_RANGE: (f64, f64) = (0.001, 100.0);
 
 /// Format version of a set's unsolved region (`unsolved.toml`).
 pub const UNSOLVED_FORMAT: i64 = 1;

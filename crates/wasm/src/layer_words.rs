@@ -13,8 +13,9 @@ const PRONY_WORDS: usize = 1 + 2 * MAX_TERMS;
 /// Words per layer: thickness mm, stiffness scale, puncture N, cutting N, the Karnopp
 /// friction (static, Coulomb N/mm, viscous N·s/mm², stick band mm/s), track stiffness
 /// N/mm², the Prony set, the family weight, the softening (fraction, onset ratio), the
-/// presliding (distance mm, relaxation slip mm, the shaft's Prony set).
-pub const LAYER_WORDS: usize = 9 + PRONY_WORDS + 3 + 2 + PRONY_WORDS;
+/// presliding (distance mm, relaxation slip mm, the shaft's Prony set, the tissue's tent
+/// N/mm).
+pub const LAYER_WORDS: usize = 9 + PRONY_WORDS + 3 + 2 + PRONY_WORDS + 1;
 
 fn prony_words(p: &PronyTerms) -> [f32; PRONY_WORDS] {
     let (terms, count) = p.as_array();
@@ -56,7 +57,8 @@ pub fn to_words(l: &Layer) -> [f32; LAYER_WORDS] {
     let mid = [l.family.weight(), l.softening.fraction, l.softening.onset_ratio];
     let slide = [l.presliding.distance_mm, l.presliding.relaxation_slip_mm];
     let mut out = [0.0; LAYER_WORDS];
-    let parts: [&[f32]; 5] = [&head, &prony_words(&l.prony), &mid, &slide, &prony_words(&l.presliding.shaft_prony)];
+    let tent = [l.presliding.tent_n_per_mm];
+    let parts: [&[f32]; 6] = [&head, &prony_words(&l.prony), &mid, &slide, &prony_words(&l.presliding.shaft_prony), &tent];
     for (slot, v) in out.iter_mut().zip(parts.into_iter().flatten()) {
         *slot = *v;
     }
@@ -74,6 +76,7 @@ pub fn from_words(w: &[f32]) -> Option<Layer> {
     let at = 9 + PRONY_WORDS;
     let [weight, fraction, onset_ratio, distance_mm, relaxation_slip_mm] = *w.get(at..at + 5)? else { return None };
     let shaft_prony = prony_from(w.get(at + 5..at + 5 + PRONY_WORDS)?)?;
+    let tent_n_per_mm = *w.get(at + 5 + PRONY_WORDS)?;
     Some(Layer {
         thickness_mm,
         stiffness_scale,
@@ -84,6 +87,6 @@ pub fn from_words(w: &[f32]) -> Option<Layer> {
         prony,
         family: FamilyMember::new(weight)?,
         softening: Softening { fraction, onset_ratio },
-        presliding: Presliding { distance_mm, relaxation_slip_mm, shaft_prony },
+        presliding: Presliding { distance_mm, relaxation_slip_mm, shaft_prony, tent_n_per_mm },
     })
 }

@@ -542,7 +542,7 @@ impl Insertion {
             soft
         };
         #[cfg(feature = "shaft-presliding")]
-        let shaft = presliding::Shaft::new(stack.layers.iter().map(|l| &l.presliding), config.period_s).ok_or(InsertionError::Value)?;
+        let shaft = presliding::Shaft::new(stack.layers.iter().map(|l| (&l.presliding, l.thickness_mm)), config.period_s).ok_or(InsertionError::Value)?;
         let mut layers = [stack.layers.first().copied().ok_or(InsertionError::LayerCount)?; MAX_LAYERS];
         for (slot, l) in layers.iter_mut().zip(stack.layers) {
             *slot = *l;
@@ -926,24 +926,27 @@ impl Insertion {
         #[cfg(feature = "shaft-presliding")]
         let mut held = (0.0f32, 0.0f32);
         for j in 0..m {
-            let (Some(layer), lo) = (self.layers.get(j), bound(j)) else { break };
+            let (Some(&Layer { friction, track_stiffness_n_per_mm2: track_k, .. }), lo) = (self.layers.get(j), bound(j)) else { break };
             let hi = bound(j + 1);
             let (q1, q2) = (lo, if hi < top { hi } else { top });
             if q2 <= q1 {
+                // the tip above the layer: its tissue lets go of the shaft
+                #[cfg(feature = "shaft-presliding")]
+                self.shaft.settle(j, 0.0);
                 continue;
             }
             #[cfg(feature = "shaft-presliding")]
-            if let Some((f, k)) = self.held_friction(j, layer, v, q2 - q1) {
+            if let Some((f, k)) = self.held_friction(j, &friction, v, q2 - q1) {
                 held = (held.0 + f, held.1 + k);
             } else {
-                axial_n += (q2 - q1) * layer.friction.per_mm(v);
+                axial_n += (q2 - q1) * friction.per_mm(v);
             }
             #[cfg(not(feature = "shaft-presliding"))]
             {
-                axial_n += (q2 - q1) * layer.friction.per_mm(v);
+                axial_n += (q2 - q1) * friction.per_mm(v);
             }
             if let Some(d) = &deviation {
-                d.add_hold(layer.track_stiffness_n_per_mm2, q1, q2, w);
+                d.add_hold(track_k, q1, q2, w);
             }
         }
         // cutting layer m - 1, or carrying its cutting force onto boundary m: ramped in
@@ -988,13 +991,17 @@ impl Insertion {
         (phase, axial_n, held)
     }
 
-    /// Layer `j`'s presliding friction over `length_mm` of shaft in it at speed `v` and
-    /// its stiffness (N, N/mm); `None` when the layer has none (its Karnopp friction).
+    /// Layer `j`'s presliding friction over `length_mm` of shaft in it (and the tissue its
+    /// tent lifted with it) at speed `v` and its stiffness (N, N/mm), its tissue settled
+    /// to it; `None` when the layer has none (its Karnopp friction).
     #[cfg(feature = "shaft-presliding")]
-    fn held_friction(&self, j: usize, layer: &Layer, v: f32, length_mm: f32) -> Option<(f32, f32)> {
-        let k = &layer.friction;
-        let f = self.shaft.friction_per_mm(j, k.coulomb_n_per_mm, k.viscous_n_s_per_mm2, v)?;
-        Some((length_mm * f, self.shaft.stiffness(j, k.coulomb_n_per_mm * length_mm)))
+    fn held_friction(&mut self, j: usize, k: &Karnopp, v: f32, length_mm: f32) -> Option<(f32, f32)> {
+        let per_mm = self.shaft.level_per_mm(j, k.coulomb_n_per_mm, k.static_n_per_mm);
+        let f = self.shaft.friction_per_mm(j, per_mm, k.viscous_n_s_per_mm2, v)?;
+        let length_mm = self.shaft.lifted_length_mm(j, length_mm);
+        let level_n = per_mm * length_mm;
+        self.shaft.settle(j, level_n);
+        Some((length_mm * f, self.shaft.stiffness(j, level_n)))
     }
 
     /// The cutting force of layer `m - 1` held at the tip at `depth_mm` and its stiffness

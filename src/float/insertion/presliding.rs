@@ -27,6 +27,21 @@
 //! where the tip began to cut the layer (its puncture): the tissue ahead of the tip is
 //! loaded over the first `p` of the cut, never at once.
 //!
+//! **The tissue's tent** ([`Presliding::tent_n_per_mm`], `k`; 0: none): the layer's
+//! tissue around the shaft, lifted by a shaft that pulls it, is a spring to the ground in
+//! series with its bristles (pushed down it rests on the tissue below: no tent while the
+//! held force resists a deeper needle, so insertion and hold are as without one). While
+//! the held force pulls, a tick's step `Δd` is shared: the bristles advance by `s`, the
+//! solution of `k Δd + ΔR = k s + ΔF(s)`, `ΔR` the force the arms let go over the tick
+//! and `ΔF` the bristles' change (piecewise linear: each a spring until it slips), and
+//! the tissue by the rest, its lift set each tick to the held pull over `k`. So the pull
+//! builds over about `ΔF / k` of travel (millimetres for soft tissue) instead of the
+//! bristles' `2 p`, and the lift (capped at the layer's thickness) lengthens the shaft in
+//! the layer. The lifted tissue is held by the stuck shaft: its level is the layer's
+//! Karnopp static level `c_s` (the Coulomb one while the held force resists), so the
+//! slipping pull is about `c_s L / (1 - c_s / k)` and grows while the tissue is lifted. The lift goes when the tip leaves the layer (its length is zero) or the
+//! path ends.
+//!
 //! **Passive**: each bristle is a spring (stiffness `level / p`) that slips at its level,
 //! each arm a spring and slider in series with a dashpot; the stored energy of a state is
 //! `level ∫ (shaft length) (s - d0) / p ds >= 0` over its elastic stretch, slipping and
@@ -37,7 +52,7 @@
 //! renders the held force through a bristle of its own ([`HeldTerms`] is what it reads
 //! of a tick; `control::held_bristle`, `docs/insertion.md`, "Presliding").
 use crate::float::viscoelastic::{PronyTerms, MAX_TERMS};
-use needle_contract::{MAX_TISSUE_LAYERS as MAX_LAYERS, PRESLIDING_MM_RANGE};
+use needle_contract::{MAX_TISSUE_LAYERS as MAX_LAYERS, PRESLIDING_MM_RANGE, TENT_N_PER_MM_RANGE};
 
 /// A layer's presliding; [`Presliding::NONE`]: today's Karnopp friction, zero at rest.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -52,11 +67,14 @@ pub struct Presliding {
     pub relaxation_slip_mm: f32,
     /// The relaxation of the held shaft force and cutting (none: no relaxation).
     pub shaft_prony: PronyTerms,
+    /// The tissue's tent stiffness `k`, N/mm (0: none, the bristles move with the
+    /// needle; else within `needle_contract::TENT_N_PER_MM_RANGE`).
+    pub tent_n_per_mm: f32,
 }
 
 impl Presliding {
     /// No presliding: the layer's Karnopp friction and ramped cutting.
-    pub const NONE: Self = Self { distance_mm: 0.0, relaxation_slip_mm: 0.0, shaft_prony: PronyTerms::NONE };
+    pub const NONE: Self = Self { distance_mm: 0.0, relaxation_slip_mm: 0.0, shaft_prony: PronyTerms::NONE, tent_n_per_mm: 0.0 };
 
     /// Whether the layer has a presliding state.
     #[must_use]
@@ -71,11 +89,11 @@ impl Presliding {
     pub fn is_valid(&self) -> bool {
         let checked = PronyTerms::new(self.shaft_prony.as_slice()).is_ok();
         if !self.is_active() {
-            return self.distance_mm == 0.0 && self.relaxation_slip_mm == 0.0 && self.shaft_prony.is_empty();
+            return self.distance_mm == 0.0 && self.relaxation_slip_mm == 0.0 && self.shaft_prony.is_empty() && self.tent_n_per_mm == 0.0;
         }
-        let (lo, hi) = PRESLIDING_MM_RANGE;
-        let in_range = |d: f32| d.is_finite() && d >= lo as f32 && d <= hi as f32;
-        in_range(self.distance_mm) && in_range(self.relaxation_slip_mm) && checked
+        let in_range = |d: f32, (lo, hi): (f64, f64)| d.is_finite() && d >= lo as f32 && d <= hi as f32;
+        let tent = self.tent_n_per_mm == 0.0 || in_range(self.tent_n_per_mm, TENT_N_PER_MM_RANGE);
+        in_range(self.distance_mm, PRESLIDING_MM_RANGE) && in_range(self.relaxation_slip_mm, PRESLIDING_MM_RANGE) && checked && tent
     }
 }
 
@@ -135,14 +153,19 @@ struct Coefficients {
     share: [f32; MAX_TERMS],
     /// The long-term share, `1 / (1 + sum g)`.
     long_term: f32,
+    /// The tissue's tent stiffness `k`, N/mm (0: none).
+    tent: f32,
+    /// The layer's thickness, mm: the largest lift.
+    thickness_mm: f32,
 }
 
 impl Coefficients {
-    const NONE: Self = Self { per_mm: 0.0, arm_per_mm: 0.0, decay: [0.0; MAX_TERMS], share: [0.0; MAX_TERMS], long_term: 1.0 };
+    const NONE: Self =
+        Self { per_mm: 0.0, arm_per_mm: 0.0, decay: [0.0; MAX_TERMS], share: [0.0; MAX_TERMS], long_term: 1.0, tent: 0.0, thickness_mm: 0.0 };
 
-    /// The layer's coefficients for ticks of `period_s` (> 0); `None` for a presliding
-    /// out of range.
-    fn new(p: &Presliding, period_s: f32) -> Option<Self> {
+    /// The layer's coefficients for ticks of `period_s` (> 0) in a layer `thickness_mm`
+    /// thick; `None` for a presliding out of range.
+    fn new(p: &Presliding, thickness_mm: f32, period_s: f32) -> Option<Self> {
         if !(p.is_valid() && period_s.is_finite() && period_s > 0.0) {
             return None;
         }
@@ -153,7 +176,14 @@ impl Coefficients {
         let total = 1.0 + terms.iter().map(|t| t.g).sum::<f32>();
         // total >= 1 (every g >= 0, checked), tau_s > 0 and both distances > 0 (checked):
         // no division by zero
-        let mut out = Self { per_mm: 1.0 / p.distance_mm, arm_per_mm: 1.0 / p.relaxation_slip_mm, long_term: 1.0 / total, ..Self::NONE };
+        let mut out = Self {
+            per_mm: 1.0 / p.distance_mm,
+            arm_per_mm: 1.0 / p.relaxation_slip_mm,
+            long_term: 1.0 / total,
+            tent: p.tent_n_per_mm,
+            thickness_mm,
+            ..Self::NONE
+        };
         for ((a, s), t) in out.decay.iter_mut().zip(out.share.iter_mut()).zip(terms) {
             *a = libm::expf(-period_s / t.tau_s);
             *s = t.g / total;
@@ -173,27 +203,106 @@ pub(super) struct Shaft {
     arms: [[f32; MAX_TERMS]; MAX_LAYERS],
     /// Where the tip began to cut its present layer (its puncture's depth), mm.
     cut_from_mm: f32,
+    /// Each layer's tissue displacement along the axis, mm (positive: dragged deeper; 0
+    /// without a tent).
+    tent_mm: [f32; MAX_LAYERS],
+    /// Each layer's held level at the last tick (its Coulomb friction over the shaft in
+    /// it), N: the bristles' stiffness the next step is shared with.
+    level_n: [f32; MAX_LAYERS],
 }
 
 fn clamp_unit(x: f32) -> f32 {
     x.clamp(-1.0, 1.0)
 }
 
-impl Shaft {
-    /// The coefficients of the layers' `presliding` for ticks of `period_s`, every state
-    /// at rest; `None` for a presliding out of range.
-    pub(super) fn new<'a>(presliding: impl Iterator<Item = &'a Presliding>, period_s: f32) -> Option<Self> {
-        let mut coefficients = [Coefficients::NONE; MAX_LAYERS];
-        for (c, p) in coefficients.iter_mut().zip(presliding) {
-            *c = Coefficients::new(p, period_s)?;
+/// The held share of the sliding level: the long-term bristle's and each arm's.
+fn held_share(c: &Coefficients, z: f32, arms: &[f32; MAX_TERMS]) -> f32 {
+    let mut held = c.long_term * z;
+    for (s, arm) in c.share.iter().zip(arms) {
+        held += s * arm;
+    }
+    held
+}
+
+/// The step the bristles take when a tent of stiffness `c.tent` (> 0) shares `pull`
+/// (N: the tent's stiffness times the needle's step, plus the force the arms let go) with
+/// them at level `level_n`, mm: `pull = tent s + ΔF(s)`, `ΔF` their force's change,
+/// piecewise linear (each bristle a spring until it reaches its slip at ±1); solved
+/// exactly by moving the bristles that would pass their slip to it, at most once each.
+fn shared_step(c: &Coefficients, z: f32, arms: &[f32; MAX_TERMS], level_n: f32, pull: f32) -> f32 {
+    let dir = if pull > 0.0 { 1.0 } else { -1.0 };
+    let mut parts = [(c.long_term * level_n, c.per_mm, z, false); 1 + MAX_TERMS];
+    for (part, (share, arm)) in parts.iter_mut().skip(1).zip(c.share.iter().zip(arms)) {
+        *part = (share * level_n, c.arm_per_mm, *arm, false);
+    }
+    for part in &mut parts {
+        part.3 = part.2 * dir >= 1.0;
+    }
+    let mut s = 0.0;
+    for _ in 0..=MAX_TERMS {
+        let (mut fixed, mut stiffness) = (0.0, c.tent);
+        for &(w, rate, x, at_slip) in &parts {
+            if at_slip {
+                fixed += w * (dir - x);
+            } else {
+                stiffness += w * rate;
+            }
         }
-        Some(Self { coefficients, z: [0.0; MAX_LAYERS], arms: [[0.0; MAX_TERMS]; MAX_LAYERS], cut_from_mm: 0.0 })
+        // stiffness >= tent > 0: no division by zero
+        s = (pull - fixed) / stiffness;
+        let mut more = false;
+        for part in &mut parts {
+            if !part.3 && (part.2 + s * part.1) * dir > 1.0 {
+                part.3 = true;
+                more = true;
+            }
+        }
+        if !more {
+            break;
+        }
+    }
+    s
+}
+
+impl Shaft {
+    /// The coefficients of the layers' `presliding` (with each layer's thickness, mm) for
+    /// ticks of `period_s`, every state at rest; `None` for a presliding out of range.
+    pub(super) fn new<'a>(presliding: impl Iterator<Item = (&'a Presliding, f32)>, period_s: f32) -> Option<Self> {
+        let mut coefficients = [Coefficients::NONE; MAX_LAYERS];
+        for (c, (p, thickness_mm)) in coefficients.iter_mut().zip(presliding) {
+            *c = Coefficients::new(p, thickness_mm, period_s)?;
+        }
+        Some(Self {
+            coefficients,
+            z: [0.0; MAX_LAYERS],
+            arms: [[0.0; MAX_TERMS]; MAX_LAYERS],
+            cut_from_mm: 0.0,
+            tent_mm: [0.0; MAX_LAYERS],
+            level_n: [0.0; MAX_LAYERS],
+        })
     }
 
     /// One tick of `step_mm` along the axis (0: at rest, or a glitch tick: the arms relax).
     pub(super) fn advance(&mut self, step_mm: f32) {
-        for ((c, z), arms) in self.coefficients.iter().zip(self.z.iter_mut()).zip(self.arms.iter_mut()) {
-            if c.per_mm > 0.0 {
+        for (((c, z), arms), level_n) in self.coefficients.iter().zip(self.z.iter_mut()).zip(self.arms.iter_mut()).zip(self.level_n) {
+            if c.per_mm <= 0.0 {
+                continue;
+            }
+            let before = held_share(c, *z, arms);
+            if c.tent > 0.0 && before <= 0.0 {
+                // the arms relax first; the tissue, lifted in equilibrium with the held
+                // pull before, follows what they let go and the step: the bristles see the
+                // rest
+                for (arm, a) in arms.iter_mut().zip(c.decay) {
+                    *arm *= a;
+                }
+                let pull = c.tent * step_mm + level_n * (before - held_share(c, *z, arms));
+                let s = shared_step(c, *z, arms, level_n, pull);
+                *z = clamp_unit(*z + s * c.per_mm);
+                for arm in arms.iter_mut() {
+                    *arm = clamp_unit(*arm + s * c.arm_per_mm);
+                }
+            } else {
                 *z = clamp_unit(*z + step_mm * c.per_mm);
                 let s = step_mm * c.arm_per_mm;
                 for (arm, a) in arms.iter_mut().zip(c.decay) {
@@ -208,6 +317,30 @@ impl Shaft {
         self.z = [0.0; MAX_LAYERS];
         self.arms = [[0.0; MAX_TERMS]; MAX_LAYERS];
         self.cut_from_mm = 0.0;
+        self.tent_mm = [0.0; MAX_LAYERS];
+        self.level_n = [0.0; MAX_LAYERS];
+    }
+
+    /// The shaft in layer `j` counting the tissue lifted with it, mm, for `length_mm` of
+    /// shaft below the layer's boundary (0: the tip is above the layer).
+    pub(super) fn lifted_length_mm(&self, j: usize, length_mm: f32) -> f32 {
+        let (Some(c), Some(&u)) = (self.coefficients.get(j), self.tent_mm.get(j)) else { return length_mm };
+        if length_mm > 0.0 && u < 0.0 {
+            length_mm + if -u < c.thickness_mm { -u } else { c.thickness_mm }
+        } else {
+            length_mm
+        }
+    }
+
+    /// Layer `j`'s tissue in equilibrium with its held Coulomb friction over a shaft
+    /// whose sliding level is `level_n` (N; 0 when the tip has left the layer).
+    pub(super) fn settle(&mut self, j: usize, level_n: f32) {
+        let (Some(c), Some(z), Some(arms)) = (self.coefficients.get(j), self.z.get(j), self.arms.get(j)) else { return };
+        let held = level_n * held_share(c, *z, arms);
+        let (Some(u), Some(l)) = (self.tent_mm.get_mut(j), self.level_n.get_mut(j)) else { return };
+        *l = level_n;
+        // only lifted (a pull), tent > 0: no division by zero
+        *u = if c.tent > 0.0 && held < 0.0 { held / c.tent } else { 0.0 };
     }
 
     /// A boundary punctured with the tip at `depth_mm`: the tip begins to cut there.
@@ -215,15 +348,22 @@ impl Shaft {
         self.cut_from_mm = depth_mm;
     }
 
+    /// Layer `j`'s level per mm of shaft, N/mm: its Karnopp static level while its tent
+    /// is lifted (the stuck shaft holds the tissue with it), else its Coulomb level (the
+    /// held force is zero where they meet).
+    pub(super) fn level_per_mm(&self, j: usize, coulomb_n_per_mm: f32, static_n_per_mm: f32) -> f32 {
+        match self.layer(j) {
+            Some((c, z, arms)) if c.tent > 0.0 && held_share(c, z, arms) < 0.0 => static_n_per_mm,
+            _ => coulomb_n_per_mm,
+        }
+    }
+
     /// Layer `j`'s friction per mm of shaft at speed `v` (mm/s, zero when against the
     /// last motion) with its sliding levels `coulomb_n_per_mm` and `viscous_n_s_per_mm2`,
     /// N/mm, of the force's sign along the axis; `None` when the layer has no presliding.
     pub(super) fn friction_per_mm(&self, j: usize, coulomb_n_per_mm: f32, viscous_n_s_per_mm2: f32, v: f32) -> Option<f32> {
         let (c, z, arms) = self.layer(j)?;
-        let mut held = c.long_term * z;
-        for (s, arm) in c.share.iter().zip(arms) {
-            held += s * arm;
-        }
+        let held = held_share(c, z, arms);
         let viscous = if z * v > 0.0 { viscous_n_s_per_mm2 * libm::fabsf(v) * z } else { 0.0 };
         Some(coulomb_n_per_mm * held + viscous)
     }
@@ -255,7 +395,12 @@ impl Shaft {
     /// friction or its cutting at their sliding level), N/mm: the long-term share over
     /// `p`, each arm's share over `p_r`; 0 without presliding.
     pub(super) fn stiffness(&self, j: usize, level_n: f32) -> f32 {
-        level_n * self.gain(j)
+        let s = level_n * self.gain(j);
+        match self.coefficients.get(j) {
+            // in series with the tissue's tent (s >= 0, tent > 0: no division by zero)
+            Some(c) if c.tent > 0.0 => s * c.tent / (s + c.tent),
+            _ => s,
+        }
     }
 
     /// The bristles' stiffness per unit level, 1/mm.

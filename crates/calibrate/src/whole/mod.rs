@@ -26,6 +26,7 @@ pub mod presliding;
 pub mod repeats;
 pub mod stack;
 pub mod stats;
+pub mod tent;
 pub mod tied;
 pub mod trials;
 
@@ -94,7 +95,19 @@ pub fn calibrate_trials(opts: &TrialsOptions<'_>) -> Result<TrialsCalibration> {
     let trials: Vec<trials::Trial> =
         opts.trials.iter().map(|p| trials::prepare(p, opts.rule, &u, similarity, true)).collect::<Result<_>>()?;
     let mut notes: Vec<String> = trials.iter().flat_map(|t| t.phases.notes.clone()).collect();
-    let fitted = stack::fit(&trials, opts, diameter, &u, &mut notes)?;
+    let mut fitted = stack::fit(&trials, opts, diameter, &u, &mut notes)?;
+    let tent = tent::fit(&mut fitted.stack, diameter, &trials)?;
+    if let Some(k) = tent.tent_n_per_mm {
+        let note = format!(
+            "the replays' least squares over the trials from their contact (grid {:?} N/mm, the static friction level {} times the Coulomb one with it; sum of squares {:.4} -> {:.4})",
+            tent::TENT_GRID_N_PER_MM, tent.static_factor, tent.cost.0, tent.cost.1
+        );
+        for (l, u) in fitted.stack.layers.iter().zip(fitted.uncertainty.iter_mut()) {
+            if l.tent_n_per_mm == Some(k) {
+                u.push(("tent_n_per_mm", note.clone()));
+            }
+        }
+    }
     let layers: Vec<insertion::Layer> = fitted.stack.layers.iter().map(crate::to_layer).collect();
     let lib = insertion::Stack { name: &fitted.stack.name, needle_diameter_mm: diameter as f32, layers: &layers };
     let mut replays = Vec::with_capacity(trials.len());

@@ -403,6 +403,7 @@ fn layer(
         softening_fraction_range: None,
         presliding_mm: None,
         relaxation_slip_mm: None,
+        tent_n_per_mm: None,
         shaft_prony: Vec::new(),
     };
     let se = |s: Option<f64>, unit: &str, k: usize| match s {

@@ -1,0 +1,113 @@
+//! The tissue's tent (`tent_n_per_mm`, the library's `Presliding::tent_n_per_mm`): the
+//! tissue around the shaft a spring in series with its friction, so that a reversal
+//! turns over over millimetres and a withdrawing shaft lifts the tissue, lengthening the
+//! shaft in it (`docs/insertion.md`, "Presliding").
+//!
+//! Fitted last, on the stack the other steps made: one stiffness `k` for every layer
+//! with a presliding and one factor on their sliding friction (static and Coulomb: with
+//! a tent the shaft slips at `c L / (1 - c / k)` with the lift, so the level the
+//! withdrawals read without it is refitted with it), both from a grid, by the replays'
+//! least squares over every trial from its contact to its end (each trial's sum of
+//! squares over its rows and its peak force squared, so that each trial weighs the
+//! same). Without a tent (`k` none) is a grid point: a stack keeps none when no tent
+//! fits the trials better by [`BETTER_BY`].
+use super::trials::Trial;
+use crate::trial_replay::replay;
+use anyhow::Result;
+use needle_codegen::tissue as file;
+use needle_haptics::insertion;
+
+/// The tent stiffnesses tried, N/mm (0: none), a factor of about 1.6 apart over the
+/// range the rig's withdrawals span (`withdrawal_tent` example: 0.18-0.68).
+pub const TENT_GRID_N_PER_MM: [f64; 10] = [0.0, 0.04, 0.063, 0.1, 0.16, 0.25, 0.4, 0.63, 1.0, 1.6];
+/// The factors tried on the static level over the Coulomb one with a tent (the level at
+/// which the stuck shaft holds the lifted tissue).
+pub const STATIC_FACTORS: [f64; 10] = [1.0, 1.2, 1.45, 1.75, 2.1, 2.5, 3.0, 3.6, 4.3, 5.2];
+/// A tent is kept only when the model's pull over the withdrawals (the pulled-back rows'
+/// mean, the level the friction is read at) stays within this share of the measured one.
+pub const LEVEL_TOLERANCE: f64 = 0.05;
+/// A tent is kept when its sum of squares is below this share of the stack's without.
+pub const BETTER_BY: f64 = 0.9;
+
+/// What the fit chose: the tent (N/mm; `None`: none), the static level's factor, and the
+/// sums of squares without a tent and with the choice.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TentFit {
+    /// The tent's stiffness, N/mm (`None`: none fitted better).
+    pub tent_n_per_mm: Option<f64>,
+    /// The static level over the Coulomb one (1 without a tent).
+    pub static_factor: f64,
+    /// The trials' normalised sum of squares without a tent and with the choice.
+    pub cost: (f64, f64),
+}
+
+/// `stack` with the tent `k` (N/mm, 0: none) on every layer with a presliding and their
+/// static level `factor` times their Coulomb one.
+fn with_tent(stack: &file::Stack, k: f64, factor: f64) -> file::Stack {
+    let mut s = stack.clone();
+    for l in s.layers.iter_mut().filter(|l| l.presliding_mm.is_some()) {
+        l.tent_n_per_mm = (k > 0.0).then_some(k);
+        l.friction_static_n_per_mm = l.friction_coulomb_n_per_mm * factor;
+    }
+    s
+}
+
+/// The trials' sum of squares from each contact on, each over its rows and its peak
+/// squared, and the mean over the trials of the model's pull over each withdrawal's
+/// pulled-back rows (the measured force below zero, the tip below the contact) over the
+/// measured one; `None` when the library refuses the stack.
+fn cost(stack: &file::Stack, diameter_mm: f64, trials: &[Trial]) -> Option<(f64, f64)> {
+    let layers: Vec<insertion::Layer> = stack.layers.iter().map(crate::to_layer).collect();
+    let lib = insertion::Stack { name: &stack.name, needle_diameter_mm: diameter_mm as f32, layers: &layers };
+    let (mut total, mut level, mut levels) = (0.0, 0.0, 0.0);
+    for t in trials {
+        let r = replay(&lib, t.onset_mm(), &t.samples).ok()?;
+        let (mut sum, mut n, mut peak) = (0.0, 0.0, 0.0f64);
+        for (s, m) in t.samples.iter().zip(&r.rows).skip(t.phases.contact) {
+            sum += (s.force_n - m.force_n).powi(2);
+            n += 1.0;
+            peak = peak.max(s.force_n.abs());
+        }
+        if n > 0.0 && peak > 0.0 {
+            total += sum / n / (peak * peak);
+        }
+        let pulled = t.phases.withdrawal.clone().filter_map(|i| Some((t.samples.get(i)?, r.rows.get(i)?)));
+        let (mut measured, mut model) = (0.0, 0.0);
+        for (s, m) in pulled.filter(|(s, _)| s.force_n < 0.0 && s.position_mm > t.onset_mm()) {
+            measured += s.force_n;
+            model += m.force_n;
+        }
+        if measured < 0.0 {
+            level += model / measured;
+            levels += 1.0;
+        }
+    }
+    Some((total, if levels > 0.0 { level / levels } else { 1.0 }))
+}
+
+/// Fits the tent and the friction's factor to `trials` (module docs) and writes them
+/// into `stack`; a stack without a presliding layer is left as it is.
+///
+/// # Errors
+/// The library refuses the stack as the other steps made it.
+pub fn fit(stack: &mut file::Stack, diameter_mm: f64, trials: &[Trial]) -> Result<TentFit> {
+    let (none, _) = cost(stack, diameter_mm, trials).ok_or_else(|| anyhow::anyhow!("the calibrated stack is refused by the library"))?;
+    let mut best = TentFit { tent_n_per_mm: None, static_factor: 1.0, cost: (none, none) };
+    if !stack.layers.iter().any(|l| l.presliding_mm.is_some()) {
+        return Ok(best);
+    }
+    for &k in TENT_GRID_N_PER_MM.iter().filter(|&&k| k > 0.0) {
+        for &factor in &STATIC_FACTORS {
+            let Some((c, level)) = cost(&with_tent(stack, k, factor), diameter_mm, trials) else { continue };
+            if c < best.cost.1 && (level - 1.0).abs() <= LEVEL_TOLERANCE {
+                best = TentFit { tent_n_per_mm: Some(k), static_factor: factor, cost: (none, c) };
+            }
+        }
+    }
+    if best.cost.1 < BETTER_BY * none {
+        *stack = with_tent(stack, best.tent_n_per_mm.unwrap_or(0.0), best.static_factor);
+        Ok(best)
+    } else {
+        Ok(TentFit { tent_n_per_mm: None, static_factor: 1.0, cost: (none, none) })
+    }
+}
