@@ -1,7 +1,8 @@
 //! The shaft's presliding (issue 65, the `shaft-presliding` feature): a needle at rest
 //! keeps its shaft friction and cutting force, relaxing through the shaft's Prony terms
 //! to the long-term share, and a reversal turns the held force over within twice the
-//! presliding distance; the fixed-point insertion refuses such a stack. Run on the
+//! presliding distance; the tissue's tent builds a withdrawal's pull over millimetres and
+//! lifts it; the fixed-point insertion refuses such a stack. Run on the
 //! shipped liver with a presliding on every layer (values to exercise the model, not a
 //! tissue's), against the same stack without (the Karnopp friction, zero at rest).
 use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, InsertionError, Layer, Presliding, Stack};
@@ -91,10 +92,60 @@ fn a_reversal_turns_the_held_force_over_within_twice_the_presliding_distance() {
     assert!((last - karnopp_last).abs() <= 1e-3 * karnopp_last.abs(), "pulls {last} N, Karnopp {karnopp_last} N");
 }
 
+/// The liver with a presliding of `P_MM` on every layer, the tissue's tent `tent_n_per_mm`
+/// and the static level twice the Coulomb one.
+fn with_tent(tent_n_per_mm: f32) -> Vec<Layer> {
+    liver()
+        .layers
+        .iter()
+        .map(|l| {
+            let mut friction = l.friction;
+            friction.static_n_per_mm = 2.0 * friction.coulomb_n_per_mm;
+            let presliding = Presliding { distance_mm: P_MM, relaxation_slip_mm: P_MM, shaft_prony: PronyTerms::NONE, tent_n_per_mm };
+            Layer { friction, presliding, ..*l }
+        })
+        .collect()
+}
+
+#[test]
+fn a_tent_leaves_the_insertion_alone_builds_the_pull_over_millimetres_and_lifts_it() {
+    let back_mm = 10.0;
+    let rigid = run(&Stack { layers: &with_tent(0.0), ..*liver() }, DEEP_MM, 0.5, back_mm);
+    let soft = run(&Stack { layers: &with_tent(0.1), ..*liver() }, DEEP_MM, 0.5, back_mm);
+    let stiff = run(&Stack { layers: &with_tent(1.0), ..*liver() }, DEEP_MM, 0.5, back_mm);
+    let reversal = rigid.iter().rposition(|(d, _)| *d >= DEEP_MM).expect("the reversal");
+    // pushed down the tissue rests on the tissue below: insertion and hold bit for bit
+    for (r, t) in rigid.iter().zip(&soft).take(reversal + 1) {
+        assert_eq!(r.1.to_bits(), t.1.to_bits(), "at {} mm: {} N without a tent, {} N with", r.0, r.1, t.1);
+    }
+    // the held force unloads as without a tent, then the pull builds through the tent
+    let crossing = |t: &[(f64, f32)]| t[reversal..].iter().position(|(_, f)| *f < 0.0).map(|i| i + reversal).expect("turns over");
+    let (cr, cs) = (crossing(&rigid), crossing(&soft));
+    assert!(cr.abs_diff(cs) <= 1, "the held force crosses zero at tick {cr} without a tent, {cs} with");
+    let after = |t: &[(f64, f32)], from: usize, mm: f64| {
+        t[from..].iter().find(|(d, _)| *d <= t[from].0 - mm).map(|x| x.1).expect("withdrawn that far")
+    };
+    let (pull_rigid, pull_soft) = (after(&rigid, cr, 1.0), after(&soft, cs, 1.0));
+    assert!(pull_rigid < -0.5, "without a tent the shaft pulls {pull_rigid} N 1 mm past the crossing");
+    // each layer the shaft is in has its tent (in parallel): 0.1 N/mm each over 1 mm, in
+    // series with the bristles, at most 0.1 N a layer and at least half of it
+    let tops: Vec<f32> = liver().layers.iter().scan(0.0, |top, l| Some(std::mem::replace(top, *top + l.thickness_mm))).collect();
+    let layers = tops.iter().filter(|&&t| f64::from(t) < soft[cs].0 - 1.0).count() as f32;
+    assert!(
+        (-0.1 * layers..=-0.05 * layers).contains(&pull_soft),
+        "with a 0.1 N/mm tent in each of {layers} layers it pulls {pull_soft} N 1 mm past the crossing"
+    );
+    // a stiff tent reaches the lifted level: the static level over the lengthened shaft
+    let (end_rigid, end_stiff) = (after(&rigid, reversal, back_mm), after(&stiff, reversal, back_mm));
+    assert!(end_stiff < 1.5 * end_rigid, "withdrawn {back_mm} mm: {end_stiff} N with a 1 N/mm tent, {end_rigid} N without");
+}
+
 #[test]
 fn the_fixed_point_insertion_refuses_a_presliding_layer() {
-    let layers: &'static [Layer] =
-        Box::leak(with(Presliding { distance_mm: P_MM, relaxation_slip_mm: P_MM, shaft_prony: PronyTerms::NONE, tent_n_per_mm: 0.0 }).into_boxed_slice());
+    let layers: &'static [Layer] = Box::leak(
+        with(Presliding { distance_mm: P_MM, relaxation_slip_mm: P_MM, shaft_prony: PronyTerms::NONE, tent_n_per_mm: 0.0 })
+            .into_boxed_slice(),
+    );
     let stack: &'static Stack<'static> = Box::leak(Box::new(Stack { layers, ..*liver() }));
     let fixed: &'static needle_haptics::fixed::insertion::Stack =
         Box::leak(Box::new(needle_haptics::fixed::insertion::Stack::from_f32(stack)));

@@ -239,14 +239,16 @@ fn the_build_refuses_bad_prony_terms_with_file_and_line() {
 
 /// The presliding keys (issue 65): read with their values and round-tripped, none by
 /// default (the Karnopp friction), refused in a format 1 file, out of their range, and
-/// the shaft's terms or the relaxation's slip distance without a presliding distance,
-/// each at its line.
+/// the shaft's terms, the relaxation's slip distance or the tissue's tent without a
+/// presliding distance, each at its line.
 #[test]
 fn presliding_keys_are_read_checked_and_refused_at_their_line() {
-    let good = format2("presliding_mm = 1.5\nrelaxation_slip_mm = 0.2\n\n[[layer.shaft_prony]]\ng = 0.6\ntau_s = 1.9");
+    let good =
+        format2("presliding_mm = 1.5\nrelaxation_slip_mm = 0.2\ntent_n_per_mm = 0.16\n\n[[layer.shaft_prony]]\ng = 0.6\ntau_s = 1.9");
     let s = parse_stack_str(&good, Path::new("two.toml")).unwrap_or_else(|e| panic!("{e}"));
     let l = &s.layers[1];
     assert_eq!((l.presliding_mm, l.relaxation_slip_mm, l.shaft_prony.len()), (Some(1.5), Some(0.2), 1));
+    assert_eq!((l.tent_n_per_mm, s.layers[0].tent_n_per_mm), (Some(0.16), None), "the tent, none by default");
     assert_eq!((l.shaft_prony[0].g, l.shaft_prony[0].tau_s), (0.6, 1.9));
     assert_eq!((s.layers[0].presliding_mm, s.layers[0].shaft_prony.len()), (None, 0), "the default: none");
     let again = parse_stack_str(&s.to_toml("round trip"), Path::new("two.toml")).unwrap_or_else(|e| panic!("{e}"));
@@ -259,6 +261,9 @@ fn presliding_keys_are_read_checked_and_refused_at_their_line() {
         ("presliding_mm = 51.0", "presliding_mm = 51"),
         ("presliding_mm = 1.0\nrelaxation_slip_mm = 0.001", "relaxation_slip_mm = 0.001"),
         ("relaxation_slip_mm = 0.2", "relaxation_slip_mm needs presliding_mm"),
+        ("presliding_mm = 1.0\ntent_n_per_mm = 0.0", "tent_n_per_mm = 0: must be from 0.001 to 100 N/mm"),
+        ("presliding_mm = 1.0\ntent_n_per_mm = 101.0", "tent_n_per_mm = 101"),
+        ("tent_n_per_mm = 0.2", "tent_n_per_mm needs presliding_mm"),
         ("\n[[layer.shaft_prony]]\ng = 0.5\ntau_s = 1.0", "shaft_prony needs presliding_mm"),
         ("presliding_mm = 1.0\n\n[[layer.shaft_prony]]\ng = -0.5\ntau_s = 1.0", "prony g = -0.5"),
     ] {

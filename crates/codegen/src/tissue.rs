@@ -13,8 +13,8 @@ use std::path::{Path, PathBuf};
 use toml::Spanned;
 
 pub use needle_contract::{
-    MAX_PRONY_TERMS, MAX_TISSUE_LAYERS as MAX_LAYERS, PRESLIDING_MM_RANGE, PRONY_G_SUM_MAX, TENT_N_PER_MM_RANGE, SOFTENING_FRACTION_MAX, TISSUE_FORMAT,
-    TISSUE_FORMATS_READ,
+    MAX_PRONY_TERMS, MAX_TISSUE_LAYERS as MAX_LAYERS, PRESLIDING_MM_RANGE, PRONY_G_SUM_MAX, SOFTENING_FRACTION_MAX, TENT_N_PER_MM_RANGE,
+    TISSUE_FORMAT, TISSUE_FORMATS_READ,
 };
 /// The folder of a set that holds its tissue stacks.
 pub const TISSUE_DIR: &str = "tissue";
@@ -440,7 +440,8 @@ fn presliding_fields(
         if let Some(span) = spans.into_iter().flatten().next() {
             return Err(err(
                 span,
-                "presliding_mm, relaxation_slip_mm, shaft_prony, tent_n_per_mm: format 2 fields (the shaft's presliding); write format = 2".into(),
+                "presliding_mm, relaxation_slip_mm, shaft_prony, tent_n_per_mm: format 2 fields (the shaft's presliding); write format = 2"
+                    .into(),
             ));
         }
     }
@@ -478,7 +479,10 @@ fn presliding_fields(
                 return Err(err(v.span(), format!("tent_n_per_mm = {x}: must be from {lo} to {hi} N/mm (leave it out for none)")));
             }
             if distance.is_none() {
-                return Err(err(v.span(), format!("layer {:?}: tent_n_per_mm needs presliding_mm (the friction it is in series with)", l.name)));
+                return Err(err(
+                    v.span(),
+                    format!("layer {:?}: tent_n_per_mm needs presliding_mm (the friction it is in series with)", l.name),
+                ));
             }
             Some(x)
         }

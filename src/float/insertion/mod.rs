@@ -542,7 +542,8 @@ impl Insertion {
             soft
         };
         #[cfg(feature = "shaft-presliding")]
-        let shaft = presliding::Shaft::new(stack.layers.iter().map(|l| (&l.presliding, l.thickness_mm)), config.period_s).ok_or(InsertionError::Value)?;
+        let shaft = presliding::Shaft::new(stack.layers.iter().map(|l| (&l.presliding, l.thickness_mm)), config.period_s)
+            .ok_or(InsertionError::Value)?;
         let mut layers = [stack.layers.first().copied().ok_or(InsertionError::LayerCount)?; MAX_LAYERS];
         for (slot, l) in layers.iter_mut().zip(stack.layers) {
             *slot = *l;

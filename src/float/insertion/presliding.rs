@@ -160,8 +160,15 @@ struct Coefficients {
 }
 
 impl Coefficients {
-    const NONE: Self =
-        Self { per_mm: 0.0, arm_per_mm: 0.0, decay: [0.0; MAX_TERMS], share: [0.0; MAX_TERMS], long_term: 1.0, tent: 0.0, thickness_mm: 0.0 };
+    const NONE: Self = Self {
+        per_mm: 0.0,
+        arm_per_mm: 0.0,
+        decay: [0.0; MAX_TERMS],
+        share: [0.0; MAX_TERMS],
+        long_term: 1.0,
+        tent: 0.0,
+        thickness_mm: 0.0,
+    };
 
     /// The layer's coefficients for ticks of `period_s` (> 0) in a layer `thickness_mm`
     /// thick; `None` for a presliding out of range.
