@@ -927,7 +927,7 @@ impl Insertion {
         #[cfg(feature = "shaft-presliding")]
         let mut held = (0.0f32, 0.0f32);
         for j in 0..m {
-            let (Some(&Layer { friction, track_stiffness_n_per_mm2: track_k, .. }), lo) = (self.layers.get(j), bound(j)) else { break };
+            let (Some(layer), lo) = (self.layers.get(j), bound(j)) else { break };
             let hi = bound(j + 1);
             let (q1, q2) = (lo, if hi < top { hi } else { top });
             if q2 <= q1 {
@@ -936,6 +936,9 @@ impl Insertion {
                 self.shaft.settle(j, 0.0);
                 continue;
             }
+            // (copied: the presliding's state changes below; a default build reads the layer)
+            #[cfg(feature = "shaft-presliding")]
+            let (friction, track_k) = (layer.friction, layer.track_stiffness_n_per_mm2);
             #[cfg(feature = "shaft-presliding")]
             if let Some((f, k)) = self.held_friction(j, &friction, v, q2 - q1) {
                 held = (held.0 + f, held.1 + k);
@@ -943,9 +946,10 @@ impl Insertion {
                 axial_n += (q2 - q1) * friction.per_mm(v);
             }
             #[cfg(not(feature = "shaft-presliding"))]
-            {
-                axial_n += (q2 - q1) * friction.per_mm(v);
-            }
+            let track_k = {
+                axial_n += (q2 - q1) * layer.friction.per_mm(v);
+                layer.track_stiffness_n_per_mm2
+            };
             if let Some(d) = &deviation {
                 d.add_hold(track_k, q1, q2, w);
             }
