@@ -256,6 +256,15 @@ fn with_the_tissue_s_tent_no_closed_cycle_delivers_energy() {
     }
 }
 
+/// The tent's stacks through the guarded loop on the weakly damped device (the held
+/// force's stiffness the guard reads is the bristles' in series with the tent).
+#[test]
+fn with_the_tissue_s_tent_the_guarded_loop_delivers_no_energy() {
+    for tent in [0.1, 2.0] {
+        for_each_presliding_stack_with_tent(tent, |held| the_guarded_loop_delivers_no_energy(held, 100));
+    }
+}
+
 /// The same stacks through the guarded loop on the weakly damped device (0.1 N·s/m:
 /// the held force's stiffness, about `b / (2 T)` of the stronger device, is five times
 /// the guard's). Before the guard rendered the held force as a bristle of its own
