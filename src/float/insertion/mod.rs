@@ -936,15 +936,10 @@ impl Insertion {
                 self.shaft.settle(j, 0.0);
                 continue;
             }
-            // (copied: the presliding's state changes below; a default build reads the layer)
             #[cfg(feature = "shaft-presliding")]
-            let (friction, track_k) = (layer.friction, layer.track_stiffness_n_per_mm2);
+            let track_k = layer.track_stiffness_n_per_mm2;
             #[cfg(feature = "shaft-presliding")]
-            if let Some((f, k)) = self.held_friction(j, &friction, v, q2 - q1) {
-                held = (held.0 + f, held.1 + k);
-            } else {
-                axial_n += (q2 - q1) * friction.per_mm(v);
-            }
+            self.add_friction(j, layer.friction, v, q2 - q1, (&mut held, &mut axial_n));
             #[cfg(not(feature = "shaft-presliding"))]
             let track_k = {
                 axial_n += (q2 - q1) * layer.friction.per_mm(v);
@@ -996,17 +991,22 @@ impl Insertion {
         (phase, axial_n, held)
     }
 
-    /// Layer `j`'s presliding friction over `length_mm` of shaft in it (and the tissue its
-    /// tent lifted with it) at speed `v` and its stiffness (N, N/mm), its tissue settled
-    /// to it; `None` when the layer has none (its Karnopp friction).
+    /// Layer `j`'s friction over `length_mm` of shaft in it at speed `v`, added to `to`: a
+    /// presliding's (over the shaft and the tissue its tent lifted with it, the tissue
+    /// settled to it) to the held force and its stiffness (N, N/mm), else the Karnopp
+    /// friction to the axial force (N).
     #[cfg(feature = "shaft-presliding")]
-    fn held_friction(&mut self, j: usize, k: &Karnopp, v: f32, length_mm: f32) -> Option<(f32, f32)> {
+    fn add_friction(&mut self, j: usize, k: Karnopp, v: f32, length_mm: f32, to: (&mut (f32, f32), &mut f32)) {
         let per_mm = self.shaft.level_per_mm(j, k.coulomb_n_per_mm, k.static_n_per_mm);
-        let f = self.shaft.friction_per_mm(j, per_mm, k.viscous_n_s_per_mm2, v)?;
+        let Some(f) = self.shaft.friction_per_mm(j, per_mm, k.viscous_n_s_per_mm2, v) else {
+            *to.1 += length_mm * k.per_mm(v);
+            return;
+        };
         let length_mm = self.shaft.lifted_length_mm(j, length_mm);
         let level_n = per_mm * length_mm;
         self.shaft.settle(j, level_n);
-        Some((length_mm * f, self.shaft.stiffness(j, level_n)))
+        let held = to.0;
+        *held = (held.0 + length_mm * f, held.1 + self.shaft.stiffness(j, level_n));
     }
 
     /// The cutting force of layer `m - 1` held at the tip at `depth_mm` and its stiffness

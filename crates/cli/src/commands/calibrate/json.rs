@@ -61,7 +61,7 @@ pub fn layer(l: &needle_codegen::tissue::Layer) -> Value {
         "family_weight": l.family_weight, "family_weight_range": range(l.family_weight_range),
         "softening_fraction": l.softening_fraction, "softening_onset_ratio": l.softening_onset_ratio,
         "softening_fraction_range": range(l.softening_fraction_range),
-        "presliding_mm": l.presliding_mm, "relaxation_slip_mm": l.relaxation_slip_mm,
+        "presliding_mm": l.presliding_mm, "relaxation_slip_mm": l.relaxation_slip_mm, "tent_n_per_mm": l.tent_n_per_mm,
         "shaft_prony": l.shaft_prony.iter().map(|t| json!({"g": t.g, "tau_s": t.tau_s})).collect::<Vec<_>>(),
     })
 }
