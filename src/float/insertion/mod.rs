@@ -542,8 +542,7 @@ impl Insertion {
             soft
         };
         #[cfg(feature = "shaft-presliding")]
-        let shaft = presliding::Shaft::new(stack.layers.iter().map(|l| (&l.presliding, l.thickness_mm)), config.period_s)
-            .ok_or(InsertionError::Value)?;
+        let shaft = presliding::Shaft::new(stack.layers.iter().map(|l| &l.presliding), config.period_s).ok_or(InsertionError::Value)?;
         let mut layers = [stack.layers.first().copied().ok_or(InsertionError::LayerCount)?; MAX_LAYERS];
         for (slot, l) in layers.iter_mut().zip(stack.layers) {
             *slot = *l;
@@ -939,7 +938,7 @@ impl Insertion {
             #[cfg(feature = "shaft-presliding")]
             let track_k = layer.track_stiffness_n_per_mm2;
             #[cfg(feature = "shaft-presliding")]
-            self.add_friction(j, layer.friction, v, q2 - q1, (&mut held, &mut axial_n));
+            self.add_friction(j, v, q2 - q1, (&mut held, &mut axial_n));
             #[cfg(not(feature = "shaft-presliding"))]
             let track_k = {
                 axial_n += (q2 - q1) * layer.friction.per_mm(v);
@@ -996,13 +995,14 @@ impl Insertion {
     /// settled to it) to the held force and its stiffness (N, N/mm), else the Karnopp
     /// friction to the axial force (N).
     #[cfg(feature = "shaft-presliding")]
-    fn add_friction(&mut self, j: usize, k: Karnopp, v: f32, length_mm: f32, to: (&mut (f32, f32), &mut f32)) {
+    fn add_friction(&mut self, j: usize, v: f32, length_mm: f32, to: (&mut (f32, f32), &mut f32)) {
+        let Some(&Layer { friction: k, thickness_mm, .. }) = self.layers.get(j) else { return };
         let per_mm = self.shaft.level_per_mm(j, k.coulomb_n_per_mm, k.static_n_per_mm);
         let Some(f) = self.shaft.friction_per_mm(j, per_mm, k.viscous_n_s_per_mm2, v) else {
             *to.1 += length_mm * k.per_mm(v);
             return;
         };
-        let length_mm = self.shaft.lifted_length_mm(j, length_mm);
+        let length_mm = self.shaft.lifted_length_mm(j, length_mm, thickness_mm);
         let level_n = per_mm * length_mm;
         self.shaft.settle(j, level_n);
         let held = to.0;

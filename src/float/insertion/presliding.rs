@@ -39,8 +39,8 @@
 //! bristles' `2 p`, and the lift (capped at the layer's thickness) lengthens the shaft in
 //! the layer. The lifted tissue is held by the stuck shaft: its level is the layer's
 //! Karnopp static level `c_s` (the Coulomb one while the held force resists), so the
-//! slipping pull is about `c_s L / (1 - c_s / k)` and grows while the tissue is lifted. The lift goes when the tip leaves the layer (its length is zero) or the
-//! path ends.
+//! slipping pull is about `c_s L / (1 - c_s / k)` and grows while the tissue is lifted.
+//! The lift goes when the tip leaves the layer (its length is zero) or the path ends.
 //!
 //! **Passive**: each bristle is a spring (stiffness `level / p`) that slips at its level,
 //! each arm a spring and slider in series with a dashpot; the stored energy of a state is
@@ -155,24 +155,14 @@ struct Coefficients {
     long_term: f32,
     /// The tissue's tent stiffness `k`, N/mm (0: none).
     tent: f32,
-    /// The layer's thickness, mm: the largest lift.
-    thickness_mm: f32,
 }
 
 impl Coefficients {
-    const NONE: Self = Self {
-        per_mm: 0.0,
-        arm_per_mm: 0.0,
-        decay: [0.0; MAX_TERMS],
-        share: [0.0; MAX_TERMS],
-        long_term: 1.0,
-        tent: 0.0,
-        thickness_mm: 0.0,
-    };
+    const NONE: Self = Self { per_mm: 0.0, arm_per_mm: 0.0, decay: [0.0; MAX_TERMS], share: [0.0; MAX_TERMS], long_term: 1.0, tent: 0.0 };
 
-    /// The layer's coefficients for ticks of `period_s` (> 0) in a layer `thickness_mm`
-    /// thick; `None` for a presliding out of range.
-    fn new(p: &Presliding, thickness_mm: f32, period_s: f32) -> Option<Self> {
+    /// The layer's coefficients for ticks of `period_s` (> 0); `None` for a presliding
+    /// out of range.
+    fn new(p: &Presliding, period_s: f32) -> Option<Self> {
         if !(p.is_valid() && period_s.is_finite() && period_s > 0.0) {
             return None;
         }
@@ -188,7 +178,6 @@ impl Coefficients {
             arm_per_mm: 1.0 / p.relaxation_slip_mm,
             long_term: 1.0 / total,
             tent: p.tent_n_per_mm,
-            thickness_mm,
             ..Self::NONE
         };
         for ((a, s), t) in out.decay.iter_mut().zip(out.share.iter_mut()).zip(terms) {
@@ -213,8 +202,9 @@ pub(super) struct Shaft {
     /// Each layer's tissue displacement along the axis, mm (positive: dragged deeper; 0
     /// without a tent).
     tent_mm: [f32; MAX_LAYERS],
-    /// Each layer's held level at the last tick (its Coulomb friction over the shaft in
-    /// it), N: the bristles' stiffness the next step is shared with.
+    /// Each layer's sliding level at the last tick (its friction level per mm over the
+    /// shaft in it, the static one while lifted), N: the bristles' stiffness the next step
+    /// is shared with.
     level_n: [f32; MAX_LAYERS],
 }
 
@@ -272,12 +262,12 @@ fn shared_step(c: &Coefficients, z: f32, arms: &[f32; MAX_TERMS], level_n: f32, 
 }
 
 impl Shaft {
-    /// The coefficients of the layers' `presliding` (with each layer's thickness, mm) for
-    /// ticks of `period_s`, every state at rest; `None` for a presliding out of range.
-    pub(super) fn new<'a>(presliding: impl Iterator<Item = (&'a Presliding, f32)>, period_s: f32) -> Option<Self> {
+    /// The coefficients of the layers' `presliding` for ticks of `period_s`, every state
+    /// at rest; `None` for a presliding out of range.
+    pub(super) fn new<'a>(presliding: impl Iterator<Item = &'a Presliding>, period_s: f32) -> Option<Self> {
         let mut coefficients = [Coefficients::NONE; MAX_LAYERS];
-        for (c, (p, thickness_mm)) in coefficients.iter_mut().zip(presliding) {
-            *c = Coefficients::new(p, thickness_mm, period_s)?;
+        for (c, p) in coefficients.iter_mut().zip(presliding) {
+            *c = Coefficients::new(p, period_s)?;
         }
         Some(Self {
             coefficients,
@@ -329,18 +319,18 @@ impl Shaft {
     }
 
     /// The shaft in layer `j` counting the tissue lifted with it, mm, for `length_mm` of
-    /// shaft below the layer's boundary (0: the tip is above the layer).
-    pub(super) fn lifted_length_mm(&self, j: usize, length_mm: f32) -> f32 {
-        let (Some(c), Some(&u)) = (self.coefficients.get(j), self.tent_mm.get(j)) else { return length_mm };
-        if length_mm > 0.0 && u < 0.0 {
-            length_mm + if -u < c.thickness_mm { -u } else { c.thickness_mm }
-        } else {
-            length_mm
+    /// shaft below the layer's boundary (0: the tip is above the layer), the lift capped
+    /// at the layer's `thickness_mm`.
+    pub(super) fn lifted_length_mm(&self, j: usize, length_mm: f32, thickness_mm: f32) -> f32 {
+        match self.tent_mm.get(j) {
+            Some(&u) if length_mm > 0.0 && u < 0.0 => length_mm + if -u < thickness_mm { -u } else { thickness_mm },
+            _ => length_mm,
         }
     }
 
-    /// Layer `j`'s tissue in equilibrium with its held Coulomb friction over a shaft
-    /// whose sliding level is `level_n` (N; 0 when the tip has left the layer).
+    /// Layer `j`'s tissue in equilibrium with its held friction (without the viscous
+    /// part) over a shaft whose sliding level is `level_n` (N; 0 when the tip has left
+    /// the layer).
     pub(super) fn settle(&mut self, j: usize, level_n: f32) {
         let (Some(c), Some(z), Some(arms)) = (self.coefficients.get(j), self.z.get(j), self.arms.get(j)) else { return };
         let held = level_n * held_share(c, *z, arms);

@@ -97,26 +97,7 @@ pub fn calibrate_trials(opts: &TrialsOptions<'_>) -> Result<TrialsCalibration> {
     let mut notes: Vec<String> = trials.iter().flat_map(|t| t.phases.notes.clone()).collect();
     let mut fitted = stack::fit(&trials, opts, diameter, &u, &mut notes)?;
     let tent = tent::fit(&mut fitted.stack, diameter, &trials)?;
-    if let Some(k) = tent.tent_n_per_mm {
-        let note = format!(
-            "the replays' least squares over the trials from their contact (grid {:?} N/mm, the static friction level {} times the Coulomb one with it; sum of squares {:.4} -> {:.4})",
-            tent::TENT_GRID_N_PER_MM, tent.static_factor, tent.cost.0, tent.cost.1
-        );
-        let level = format!(
-            "the level holding the tissue the tent lifts: {} times the Coulomb level, fitted with tent_n_per_mm",
-            tent.static_factor
-        );
-        for (l, u) in fitted.stack.layers.iter_mut().zip(fitted.uncertainty.iter_mut()) {
-            if l.tent_n_per_mm == Some(k) {
-                u.push(("tent_n_per_mm", note.clone()));
-                u.push(("friction_static_n_per_mm", level.clone()));
-                l.source = l.source.replace(
-                    "(static = sliding level at the stick band's edge",
-                    "(static = the tent's holding level, see its line; without a tent the sliding level at the stick band's edge",
-                );
-            }
-        }
-    }
+    tent::annotate(&tent, &fitted.stack, &mut fitted.uncertainty);
     let layers: Vec<insertion::Layer> = fitted.stack.layers.iter().map(crate::to_layer).collect();
     let lib = insertion::Stack { name: &fitted.stack.name, needle_diameter_mm: diameter as f32, layers: &layers };
     let mut replays = Vec::with_capacity(trials.len());

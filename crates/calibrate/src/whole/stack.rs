@@ -427,7 +427,7 @@ fn layer(
 fn source(opts: &TrialsOptions<'_>, ts: &[Trial], band: f64) -> String {
     let speeds: Vec<String> = ts.iter().map(|t| format!("{:.2}", t.phases.insertion_speed_mm_per_s)).collect();
     format!(
-        "needle calibrate --trials on {} trials at {} mm/s: pre-puncture shape and first puncture from each trial's insertion (today's model), friction from the withdrawals (static = sliding level at the stick band's edge, {band:.3} mm/s, assumed), each layer below a puncture and its cutting from the intervals, Prony terms from the holds; values are means or joint fits over the trials; track stiffness = E = 3 s mu0 (Winkler subgrade k ~ E, Vesic 1961); needle {} mm",
+        "needle calibrate --trials on {} trials at {} mm/s: pre-puncture shape and first puncture from each trial's insertion (today's model), friction from the withdrawals (static = sliding level at the stick band's edge, {band:.3} mm/s, assumed; with a tissue tent the level holding the lifted tissue, see its line), each layer below a puncture and its cutting from the intervals, Prony terms from the holds; values are means or joint fits over the trials; track stiffness = E = 3 s mu0 (Winkler subgrade k ~ E, Vesic 1961); needle {} mm",
         ts.len(),
         speeds.join(", "),
         opts.needle_diameter_mm.first().copied().unwrap_or(0.0)

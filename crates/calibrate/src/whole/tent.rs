@@ -111,3 +111,21 @@ pub fn fit(stack: &mut file::Stack, diameter_mm: f64, trials: &[Trial]) -> Resul
         Ok(TentFit { tent_n_per_mm: None, static_factor: 1.0, cost: (none, none) })
     }
 }
+
+/// The notes written beside the tent and the static level of each layer that has the
+/// fitted tent (`uncertainty`: per layer, `(key, note)`, as [`super::stack::Fitted`]).
+pub fn annotate(fit: &TentFit, stack: &file::Stack, uncertainty: &mut [Vec<(&'static str, String)>]) {
+    let Some(k) = fit.tent_n_per_mm else { return };
+    let tent = format!(
+        "the replays' least squares over the trials from their contact (grid {TENT_GRID_N_PER_MM:?} N/mm, the static friction level {} times the Coulomb one with it; sum of squares {:.4} -> {:.4})",
+        fit.static_factor, fit.cost.0, fit.cost.1
+    );
+    let level =
+        format!("the level holding the tissue the tent lifts: {} times the Coulomb level, fitted with tent_n_per_mm", fit.static_factor);
+    for (l, u) in stack.layers.iter().zip(uncertainty.iter_mut()) {
+        if l.tent_n_per_mm == Some(k) {
+            u.push(("tent_n_per_mm", tent.clone()));
+            u.push(("friction_static_n_per_mm", level.clone()));
+        }
+    }
+}
