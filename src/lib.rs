@@ -3,7 +3,8 @@
 //! Siva Kumar ("Parametric modelling of needle-tissue interaction using finite element
 //! analysis").
 //!
-//! `no_std`, no allocation, no `unsafe`, no panics. The coefficients are fitted on the
+//! `no_std`, no allocation, no `unsafe` (the FPU's square root instruction is called
+//! from `needle-fpu`), no panics. The coefficients are fitted on the
 //! host (`needle fit`) from finite-element runs and compiled in at build time from the
 //! coefficient set named by `NEEDLE_COEFFS` (default `coeffs/default`).
 //!

@@ -117,7 +117,7 @@ macro_rules! tilt_impl {
 
 /// `libm` versions (the default).
 pub mod exact {
-    tilt_impl!(libm::sqrtf, libm::asinf, libm::atan2f);
+    tilt_impl!(needle_fpu::sqrtf, libm::asinf, libm::atan2f);
 }
 
 /// `micromath` approximations (feature `fast-math`): both angles from `micromath`'s
@@ -132,7 +132,7 @@ pub mod fast {
     pub fn tilt_from_axis(axis: [f32; 3]) -> Result<super::Tilt, super::AxisError> {
         let [ax, ay, az] = axis;
         super::checked_length2(axis)?;
-        let h = libm::sqrtf(ax * ax + ay * ay);
+        let h = needle_fpu::sqrtf(ax * ax + ay * ay);
         Ok(super::Tilt {
             theta_x_deg: micromath::F32Ext::atan2(az, h) * super::DEG_PER_RAD,
             theta_z_deg: micromath::F32Ext::atan2(-ax, ay) * super::DEG_PER_RAD,

@@ -30,9 +30,9 @@ const RULES: &[(&str, Forbid)] = &[
         },
     ),
     (
-        "the library knows no std: needle-haptics and needle-contract depend on no std-only workspace crate (a build dependency, the generator, runs on the host)",
+        "the library knows no std: needle-haptics, needle-contract and needle-fpu depend on no std-only workspace crate (a build dependency, the generator, runs on the host)",
         Forbid::Path {
-            from: &["needle-haptics", "needle-contract"],
+            from: &["needle-haptics", "needle-contract", "needle-fpu"],
             to: &[
                 "needle-stdx",
                 "needle-set",

@@ -10,9 +10,10 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// The crates' source folders, from the workspace root.
-const CRATES: [&str; 15] = [
+const CRATES: [&str; 16] = [
     "src",
     "crates/contract/src",
+    "crates/fpu/src",
     "crates/stdx/src",
     "crates/set/src",
     "crates/codegen/src",

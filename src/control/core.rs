@@ -284,7 +284,7 @@ impl<const N: usize> LoopCore<N> {
                 // rates by x and z the guard does not use
                 let (e, [dfx, dfy, dfz]) = crate::wrench_and_depth_rate(pose);
                 let k2 = dfx * dfx + dfy * dfy + dfz * dfz;
-                (e.wrench, e.status, Some((p, GuardTerms { stiffness_n_per_mm: libm::sqrtf(k2), ..GuardTerms::NONE })))
+                (e.wrench, e.status, Some((p, GuardTerms { stiffness_n_per_mm: needle_fpu::sqrtf(k2), ..GuardTerms::NONE })))
             }
             None => {
                 let e = crate::wrench(pose);
@@ -306,7 +306,7 @@ impl<const N: usize> LoopCore<N> {
         match self.config.over_limit {
             OverLimit::RampToZero => Some(LoopFlags::OVER_LIMIT),
             OverLimit::Saturate => {
-                let scale = limit / libm::sqrtf(norm2);
+                let scale = limit / needle_fpu::sqrtf(norm2);
                 s.force_cmd_n = f.map(|c| c * scale);
                 s.flags |= LoopFlags::FORCE_SATURATED;
                 None

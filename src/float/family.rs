@@ -26,7 +26,7 @@ impl FamilyMember {
     /// The member of weight `weight`, `None` unless `0 <= weight <= 1`.
     #[must_use]
     pub fn new(weight: f32) -> Option<Self> {
-        (0.0..=1.0).contains(&weight).then(|| Self { weight, sqrt_weight: libm::sqrtf(weight) })
+        (0.0..=1.0).contains(&weight).then(|| Self { weight, sqrt_weight: needle_fpu::sqrtf(weight) })
     }
 
     /// The member from its weight and the f32 nearest `sqrt(weight)`, as the generator

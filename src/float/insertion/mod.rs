@@ -245,7 +245,7 @@ fn deflection_at(pose: &Pose, indentation_mm: f32, scale: f32, similarity: f32, 
     let fe = Pose { x_mm: pose.x_mm / lambda, z_mm: pose.z_mm / lambda, depth_mm: indentation_mm / lambda, ..*pose };
     let (e, k) = if rate {
         let (e, [rx, ry, rz]) = extended_wrench_and_depth_rate(&fe);
-        (e, libm::sqrtf(rx * rx + ry * ry + rz * rz) * scale * lambda)
+        (e, needle_fpu::sqrtf(rx * rx + ry * ry + rz * rz) * scale * lambda)
     } else {
         (extended_wrench(&fe), 0.0)
     };
