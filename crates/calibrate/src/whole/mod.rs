@@ -10,7 +10,9 @@
 //! 5. after the last puncture and the hold: the boundary below and its Prony terms
 //!    ([`hold`]); then the shaft's presliding, its distance from the withdrawals' onsets
 //!    and its relaxation from the holds ([`presliding`], [`hold::fit_with_shaft`]);
-//! 6. the stack replayed along every trial through the library's insertion model
+//! 6. each puncture's force against the insertion speed, where the trials have several
+//!    ([`speed`]: whether the data show a dependence, said in the notes);
+//! 7. the stack replayed along every trial through the library's insertion model
 //!    ([`crate::trial_replay`]) and held against it ([`goals`]); a group's repeats and
 //!    a prediction's error against their spread: [`repeats`].
 //!
@@ -24,6 +26,7 @@ pub mod hold;
 pub mod intervals;
 pub mod presliding;
 pub mod repeats;
+pub mod speed;
 pub mod stack;
 pub mod stats;
 pub mod tent;
@@ -96,6 +99,7 @@ pub fn calibrate_trials(opts: &TrialsOptions<'_>) -> Result<TrialsCalibration> {
         opts.trials.iter().map(|p| trials::prepare(p, opts.rule, &u, similarity, true)).collect::<Result<_>>()?;
     let mut notes: Vec<String> = trials.iter().flat_map(|t| t.phases.notes.clone()).collect();
     let mut fitted = stack::fit(&trials, opts, diameter, &u, &mut notes)?;
+    notes.extend(speed::of_trials(&trials, fitted.punctures).iter().map(speed::SpeedDependence::note));
     let tent = tent::fit(&mut fitted.stack, diameter, &trials)?;
     tent::annotate(&tent, &fitted.stack, &mut fitted.uncertainty);
     let layers: Vec<insertion::Layer> = fitted.stack.layers.iter().map(crate::to_layer).collect();
