@@ -263,9 +263,7 @@ mod firmware {
         out.str(" evaluator=");
         out.str(evaluator);
         out.str(" instructions_per_wrench=");
-        out.dec(tenths / 10);
-        out.str(".");
-        out.dec(tenths % 10);
+        out.tenths(tenths);
         out.str(" stack_bytes=");
         if stack >= STACK_WINDOW {
             out.str(">=");

@@ -95,9 +95,7 @@ mod firmware {
         out.str("needle-loop-tick what=");
         out.str(what);
         out.str(" instructions=");
-        out.dec(tenths / 10);
-        out.str(".");
-        out.dec(tenths % 10);
+        out.tenths(tenths);
         out.nl();
     }
 

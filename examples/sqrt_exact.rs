@@ -90,9 +90,7 @@ mod firmware {
             out.str("needle-sqrt what=");
             out.str(what);
             out.str(" instructions=");
-            out.dec(tenths / 10);
-            out.str(".");
-            out.dec(tenths % 10);
+            out.tenths(tenths);
             out.str("\n");
         }
         out.str("needle-sqrt end\n");

@@ -65,6 +65,14 @@ impl Out {
         self.bytes(&b[..2 + digits as usize]);
     }
 
+    /// Appends a count in tenths as a decimal with one digit after the point (`17189`:
+    /// `1718.9`), as the instruction counts print.
+    pub fn tenths(&mut self, tenths: u64) {
+        self.dec(tenths / 10);
+        self.str(".");
+        self.dec(tenths % 10);
+    }
+
     /// Appends an unsigned decimal number.
     pub fn dec(&mut self, mut v: u64) {
         let mut b = [0u8; 20];

@@ -445,17 +445,16 @@ fn presliding_fields(
             ));
         }
     }
-    let in_range = |v: &Spanned<f64>, key: &str| -> Result<f64, CodegenError> {
-        let (lo, hi) = PRESLIDING_MM_RANGE;
+    let in_range = |v: &Spanned<f64>, key: &str, (lo, hi): (f64, f64), unit: &str| -> Result<f64, CodegenError> {
         let x = *v.get_ref();
         if x.is_finite() && (lo..=hi).contains(&x) {
             Ok(x)
         } else {
-            Err(err(v.span(), format!("{key} = {x}: must be from {lo} to {hi} mm (leave it out for none)")))
+            Err(err(v.span(), format!("{key} = {x}: must be from {lo} to {hi} {unit} (leave it out for none)")))
         }
     };
-    let distance = l.presliding_mm.as_ref().map(|v| in_range(v, "presliding_mm")).transpose()?;
-    let slip = l.relaxation_slip_mm.as_ref().map(|v| in_range(v, "relaxation_slip_mm")).transpose()?;
+    let distance = l.presliding_mm.as_ref().map(|v| in_range(v, "presliding_mm", PRESLIDING_MM_RANGE, "mm")).transpose()?;
+    let slip = l.relaxation_slip_mm.as_ref().map(|v| in_range(v, "relaxation_slip_mm", PRESLIDING_MM_RANGE, "mm")).transpose()?;
     if let (None, Some(v)) = (distance, &l.relaxation_slip_mm) {
         return Err(err(v.span(), format!("layer {:?}: relaxation_slip_mm needs presliding_mm", l.name)));
     }
@@ -470,23 +469,10 @@ fn presliding_fields(
             terms
         }
     };
-    let tent = match &l.tent_n_per_mm {
-        None => None,
-        Some(v) => {
-            let (lo, hi) = TENT_N_PER_MM_RANGE;
-            let x = *v.get_ref();
-            if !(x.is_finite() && (lo..=hi).contains(&x)) {
-                return Err(err(v.span(), format!("tent_n_per_mm = {x}: must be from {lo} to {hi} N/mm (leave it out for none)")));
-            }
-            if distance.is_none() {
-                return Err(err(
-                    v.span(),
-                    format!("layer {:?}: tent_n_per_mm needs presliding_mm (the friction it is in series with)", l.name),
-                ));
-            }
-            Some(x)
-        }
-    };
+    let tent = l.tent_n_per_mm.as_ref().map(|v| in_range(v, "tent_n_per_mm", TENT_N_PER_MM_RANGE, "N/mm")).transpose()?;
+    if let (None, Some(v)) = (distance, &l.tent_n_per_mm) {
+        return Err(err(v.span(), format!("layer {:?}: tent_n_per_mm needs presliding_mm (the friction it is in series with)", l.name)));
+    }
     Ok((distance, slip, terms, tent))
 }
 

@@ -932,7 +932,7 @@ impl Insertion {
             if q2 <= q1 {
                 // the tip above the layer: its tissue lets go of the shaft
                 #[cfg(feature = "shaft-presliding")]
-                self.shaft.settle(j, 0.0);
+                self.shaft.release(j);
                 continue;
             }
             #[cfg(feature = "shaft-presliding")]
@@ -991,22 +991,16 @@ impl Insertion {
     }
 
     /// Layer `j`'s friction over `length_mm` of shaft in it at speed `v`, added to `to`: a
-    /// presliding's (over the shaft and the tissue its tent lifted with it, the tissue
-    /// settled to it) to the held force and its stiffness (N, N/mm), else the Karnopp
-    /// friction to the axial force (N).
+    /// presliding's ([`presliding::Shaft::held_friction`]) to the held force and its
+    /// stiffness (N, N/mm), else the Karnopp friction to the axial force (N).
     #[cfg(feature = "shaft-presliding")]
     fn add_friction(&mut self, j: usize, v: f32, length_mm: f32, to: (&mut (f32, f32), &mut f32)) {
         let Some(&Layer { friction: k, thickness_mm, .. }) = self.layers.get(j) else { return };
-        let per_mm = self.shaft.level_per_mm(j, k.coulomb_n_per_mm, k.static_n_per_mm);
-        let Some(f) = self.shaft.friction_per_mm(j, per_mm, k.viscous_n_s_per_mm2, v) else {
-            *to.1 += length_mm * k.per_mm(v);
-            return;
-        };
-        let length_mm = self.shaft.lifted_length_mm(j, length_mm, thickness_mm);
-        let level_n = per_mm * length_mm;
-        self.shaft.settle(j, level_n);
-        let held = to.0;
-        *held = (held.0 + length_mm * f, held.1 + self.shaft.stiffness(j, level_n));
+        let levels = [k.coulomb_n_per_mm, k.static_n_per_mm, k.viscous_n_s_per_mm2];
+        match self.shaft.held_friction(j, levels, v, length_mm, thickness_mm) {
+            Some((f, stiffness)) => *to.0 = (to.0 .0 + f, to.0 .1 + stiffness),
+            None => *to.1 += length_mm * k.per_mm(v),
+        }
     }
 
     /// The cutting force of layer `m - 1` held at the tip at `depth_mm` and its stiffness

@@ -321,23 +321,18 @@ impl Shaft {
     /// The shaft in layer `j` counting the tissue lifted with it, mm, for `length_mm` of
     /// shaft below the layer's boundary (0: the tip is above the layer), the lift capped
     /// at the layer's `thickness_mm`.
-    pub(super) fn lifted_length_mm(&self, j: usize, length_mm: f32, thickness_mm: f32) -> f32 {
+    fn lifted_length_mm(&self, j: usize, length_mm: f32, thickness_mm: f32) -> f32 {
         match self.tent_mm.get(j) {
             Some(&u) if length_mm > 0.0 && u < 0.0 => length_mm + if -u < thickness_mm { -u } else { thickness_mm },
             _ => length_mm,
         }
     }
 
-    /// Layer `j`'s tissue in equilibrium with its held friction (without the viscous
-    /// part) over a shaft whose sliding level is `level_n` (N; 0 when the tip has left
-    /// the layer).
-    pub(super) fn settle(&mut self, j: usize, level_n: f32) {
-        let (Some(c), Some(z), Some(arms)) = (self.coefficients.get(j), self.z.get(j), self.arms.get(j)) else { return };
-        let held = level_n * held_share(c, *z, arms);
-        let (Some(u), Some(l)) = (self.tent_mm.get_mut(j), self.level_n.get_mut(j)) else { return };
-        *l = level_n;
-        // only lifted (a pull), tent > 0: no division by zero
-        *u = if c.tent > 0.0 && held < 0.0 { held / c.tent } else { 0.0 };
+    /// The tip has left layer `j`: its tissue lets go of the shaft (no lift, no level).
+    pub(super) fn release(&mut self, j: usize) {
+        if let (Some(u), Some(l)) = (self.tent_mm.get_mut(j), self.level_n.get_mut(j)) {
+            (*u, *l) = (0.0, 0.0);
+        }
     }
 
     /// A boundary punctured with the tip at `depth_mm`: the tip begins to cut there.
@@ -345,24 +340,31 @@ impl Shaft {
         self.cut_from_mm = depth_mm;
     }
 
-    /// Layer `j`'s level per mm of shaft, N/mm: its Karnopp static level while its tent
-    /// is lifted (the stuck shaft holds the tissue with it), else its Coulomb level (the
-    /// held force is zero where they meet).
-    pub(super) fn level_per_mm(&self, j: usize, coulomb_n_per_mm: f32, static_n_per_mm: f32) -> f32 {
-        match self.layer(j) {
-            Some((c, z, arms)) if c.tent > 0.0 && held_share(c, z, arms) < 0.0 => static_n_per_mm,
-            _ => coulomb_n_per_mm,
-        }
-    }
-
-    /// Layer `j`'s friction per mm of shaft at speed `v` (mm/s, zero when against the
-    /// last motion) with its sliding levels `coulomb_n_per_mm` and `viscous_n_s_per_mm2`,
-    /// N/mm, of the force's sign along the axis; `None` when the layer has no presliding.
-    pub(super) fn friction_per_mm(&self, j: usize, coulomb_n_per_mm: f32, viscous_n_s_per_mm2: f32, v: f32) -> Option<f32> {
+    /// Layer `j`'s held friction over `length_mm` of shaft below its boundary, moving at
+    /// `v` (mm/s, its viscous part zero when against the last motion), and its stiffness:
+    /// `(N, N/mm)`, of the force's sign along the axis; `None` when the layer has no
+    /// presliding (its Karnopp friction). `levels`: the layer's Coulomb and static levels,
+    /// N/mm, and its viscous one, N·s/mm². The level per mm is the static one while the
+    /// tent is lifted (the stuck shaft holds the tissue with it), else the Coulomb one (the
+    /// held force is zero where they meet); the length counts the lifted tissue (capped at
+    /// `thickness_mm`); the layer's tissue is then settled in equilibrium with the held
+    /// force (without its viscous part), the level kept for the next step.
+    pub(super) fn held_friction(&mut self, j: usize, levels: [f32; 3], v: f32, length_mm: f32, thickness_mm: f32) -> Option<(f32, f32)> {
         let (c, z, arms) = self.layer(j)?;
-        let held = held_share(c, z, arms);
-        let viscous = if z * v > 0.0 { viscous_n_s_per_mm2 * libm::fabsf(v) * z } else { 0.0 };
-        Some(coulomb_n_per_mm * held + viscous)
+        let (tent, held) = (c.tent, held_share(c, z, arms));
+        let [coulomb, static_level, viscous] = levels;
+        let per_mm = if tent > 0.0 && held < 0.0 { static_level } else { coulomb };
+        let viscous = if z * v > 0.0 { viscous * libm::fabsf(v) * z } else { 0.0 };
+        let f = per_mm * held + viscous;
+        let length_mm = self.lifted_length_mm(j, length_mm, thickness_mm);
+        let level_n = per_mm * length_mm;
+        let pull = level_n * held;
+        if let (Some(u), Some(l)) = (self.tent_mm.get_mut(j), self.level_n.get_mut(j)) {
+            *l = level_n;
+            // only lifted (a pull), tent > 0: no division by zero
+            *u = if tent > 0.0 && pull < 0.0 { pull / tent } else { 0.0 };
+        }
+        Some((length_mm * f, self.stiffness(j, level_n)))
     }
 
     /// Layer `j`'s cutting force `cutting_n` held at the tip, N, with the tip at

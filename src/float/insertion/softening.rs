@@ -139,9 +139,9 @@ mod tests {
     /// kind of `x`: NaN, the infinities, both zeros, below and above the fraction.
     #[test]
     fn the_factor_is_the_min_max_form_bit_for_bit() {
-        let Some(t) = SofteningTerms::new(2.0, &Softening { fraction: 0.2, onset_ratio: 0.6 }) else {
-            panic!("a valid softening has terms")
-        };
+        let terms = SofteningTerms::new(2.0, &Softening { fraction: 0.2, onset_ratio: 0.6 });
+        assert!(terms.is_some(), "a valid softening has terms");
+        let Some(t) = terms else { return };
         let forces = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 0.0, -0.0, 1.5, t.onset_n, 2.0, 2.4, t.critical_n, 3.0, 1e30, -1e30];
         let steps = (0..=1000).map(|k| k as f32 * 0.003);
         for f in forces.into_iter().chain(steps) {

@@ -92,10 +92,11 @@ fn cost(stack: &file::Stack, diameter_mm: f64, trials: &[Trial]) -> Option<(f64,
 /// The library refuses the stack as the other steps made it.
 pub fn fit(stack: &mut file::Stack, diameter_mm: f64, trials: &[Trial]) -> Result<TentFit> {
     let (none, _) = cost(stack, diameter_mm, trials).ok_or_else(|| anyhow::anyhow!("the calibrated stack is refused by the library"))?;
-    let mut best = TentFit { tent_n_per_mm: None, static_factor: 1.0, cost: (none, none) };
+    let without = TentFit { tent_n_per_mm: None, static_factor: 1.0, cost: (none, none) };
     if !stack.layers.iter().any(|l| l.presliding_mm.is_some()) {
-        return Ok(best);
+        return Ok(without);
     }
+    let mut best = without;
     for &k in TENT_GRID_N_PER_MM.iter().filter(|&&k| k > 0.0) {
         for &factor in &STATIC_FACTORS {
             let Some((c, level)) = cost(&with_tent(stack, k, factor), diameter_mm, trials) else { continue };
@@ -108,7 +109,7 @@ pub fn fit(stack: &mut file::Stack, diameter_mm: f64, trials: &[Trial]) -> Resul
         *stack = with_tent(stack, best.tent_n_per_mm.unwrap_or(0.0), best.static_factor);
         Ok(best)
     } else {
-        Ok(TentFit { tent_n_per_mm: None, static_factor: 1.0, cost: (none, none) })
+        Ok(without)
     }
 }
 
