@@ -9,8 +9,12 @@
 //! withdrawals read without it is refitted with it), both from a grid, by the replays'
 //! least squares over every trial from its contact to its end (each trial's sum of
 //! squares over its rows and its peak force squared, so that each trial weighs the
-//! same). Without a tent (`k` none) is a grid point: a stack keeps none when no tent
-//! fits the trials better by [`BETTER_BY`].
+//! same), among the grid points whose mean pull over the withdrawals stays within
+//! [`LEVEL_TOLERANCE`] of the measured one (read where the goals read the withdrawal,
+//! 10-20 mm of stage travel: the level there, not only its sign's rows, is what the tent
+//! and the friction together must give). Without a tent (`k` none) is a grid point: a
+//! stack keeps none when no tent fits the trials better by [`BETTER_BY`].
+use super::goals::WITHDRAWAL_WINDOW_MM;
 use super::trials::Trial;
 use crate::trial_replay::replay;
 use anyhow::Result;
@@ -23,8 +27,8 @@ pub const TENT_GRID_N_PER_MM: [f64; 10] = [0.0, 0.04, 0.063, 0.1, 0.16, 0.25, 0.
 /// The factors tried on the static level over the Coulomb one with a tent (the level at
 /// which the stuck shaft holds the lifted tissue).
 pub const STATIC_FACTORS: [f64; 10] = [1.0, 1.2, 1.45, 1.75, 2.1, 2.5, 3.0, 3.6, 4.3, 5.2];
-/// A tent is kept only when the model's pull over the withdrawals (the pulled-back rows'
-/// mean, the level the friction is read at) stays within this share of the measured one.
+/// A tent is kept only when the model's pull over the withdrawals (the mean over each
+/// one's [`level_rows`]) stays within this share of the measured one.
 pub const LEVEL_TOLERANCE: f64 = 0.05;
 /// A tent is kept when its sum of squares is below this share of the stack's without.
 pub const BETTER_BY: f64 = 0.9;
@@ -52,10 +56,23 @@ fn with_tent(stack: &file::Stack, k: f64, factor: f64) -> file::Stack {
     s
 }
 
+/// The rows of trial `t`'s withdrawal its pull is read on: those within the goal's window
+/// of stage travel ([`WITHDRAWAL_WINDOW_MM`], where the checks read the
+/// withdrawal), or, for a trial whose withdrawal has none there, its pulled-back rows
+/// (the measured force below zero, the tip below the contact).
+fn level_rows(t: &Trial) -> Vec<usize> {
+    let (lo, hi) = WITHDRAWAL_WINDOW_MM;
+    let at = |i: &usize| t.samples.get(*i);
+    let window: Vec<usize> = t.phases.withdrawal.clone().filter(|i| at(i).is_some_and(|s| (lo..=hi).contains(&s.position_mm))).collect();
+    if !window.is_empty() {
+        return window;
+    }
+    t.phases.withdrawal.clone().filter(|i| at(i).is_some_and(|s| s.force_n < 0.0 && s.position_mm > t.onset_mm())).collect()
+}
+
 /// The trials' sum of squares from each contact on, each over its rows and its peak
 /// squared, and the mean over the trials of the model's pull over each withdrawal's
-/// pulled-back rows (the measured force below zero, the tip below the contact) over the
-/// measured one; `None` when the library refuses the stack.
+/// [`level_rows`] over the measured one; `None` when the library refuses the stack.
 fn cost(stack: &file::Stack, diameter_mm: f64, trials: &[Trial]) -> Option<(f64, f64)> {
     let layers: Vec<insertion::Layer> = stack.layers.iter().map(crate::to_layer).collect();
     let lib = insertion::Stack { name: &stack.name, needle_diameter_mm: diameter_mm as f32, layers: &layers };
@@ -71,9 +88,8 @@ fn cost(stack: &file::Stack, diameter_mm: f64, trials: &[Trial]) -> Option<(f64,
         if n > 0.0 && peak > 0.0 {
             total += sum / n / (peak * peak);
         }
-        let pulled = t.phases.withdrawal.clone().filter_map(|i| Some((t.samples.get(i)?, r.rows.get(i)?)));
         let (mut measured, mut model) = (0.0, 0.0);
-        for (s, m) in pulled.filter(|(s, _)| s.force_n < 0.0 && s.position_mm > t.onset_mm()) {
+        for (s, m) in level_rows(t).into_iter().filter_map(|i| Some((t.samples.get(i)?, r.rows.get(i)?))) {
             measured += s.force_n;
             model += m.force_n;
         }
