@@ -28,7 +28,8 @@ pub const TENT_GRID_N_PER_MM: [f64; 10] = [0.0, 0.04, 0.063, 0.1, 0.16, 0.25, 0.
 /// which the stuck shaft holds the lifted tissue).
 pub const STATIC_FACTORS: [f64; 10] = [1.0, 1.2, 1.45, 1.75, 2.1, 2.5, 3.0, 3.6, 4.3, 5.2];
 /// A tent is kept only when the model's pull over the withdrawals (the mean over each
-/// one's [`level_rows`]) stays within this share of the measured one.
+/// one's rows within the goals' window, [`WITHDRAWAL_WINDOW_MM`]) stays within this share
+/// of the measured one.
 pub const LEVEL_TOLERANCE: f64 = 0.05;
 /// A tent is kept when its sum of squares is below this share of the stack's without.
 pub const BETTER_BY: f64 = 0.9;
