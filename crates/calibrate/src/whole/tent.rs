@@ -14,7 +14,7 @@
 //! 10-20 mm of stage travel: the level there, not only its sign's rows, is what the tent
 //! and the friction together must give). Without a tent (`k` none) is a grid point: a
 //! stack keeps none when no tent fits the trials better by [`BETTER_BY`].
-use super::goals::WITHDRAWAL_WINDOW_MM;
+use super::goals::{HOLD_AVERAGE_SAMPLES, WITHDRAWAL_WINDOW_MM};
 use super::trials::Trial;
 use crate::trial_replay::replay;
 use anyhow::Result;
@@ -59,16 +59,20 @@ fn with_tent(stack: &file::Stack, k: f64, factor: f64) -> file::Stack {
 
 /// The rows of trial `t`'s withdrawal its pull is read on: those within the goal's window
 /// of stage travel ([`WITHDRAWAL_WINDOW_MM`], where the checks read the
-/// withdrawal), or, for a trial whose withdrawal has none there, its pulled-back rows
-/// (the measured force below zero, the tip below the contact).
+/// withdrawal) with the tip below the contact; or, for a trial with fewer than
+/// [`HOLD_AVERAGE_SAMPLES`] such rows (a window outside its tissue: too few to average
+/// the raw force's noise), its pulled-back rows (the measured force below zero, the tip
+/// below the contact).
 fn level_rows(t: &Trial) -> Vec<usize> {
     let (lo, hi) = WITHDRAWAL_WINDOW_MM;
-    let at = |i: &usize| t.samples.get(*i);
-    let window: Vec<usize> = t.phases.withdrawal.clone().filter(|i| at(i).is_some_and(|s| (lo..=hi).contains(&s.position_mm))).collect();
-    if !window.is_empty() {
+    let inside = |i: &usize, keep: &dyn Fn(f64, f64) -> bool| {
+        t.samples.get(*i).is_some_and(|s| s.position_mm > t.onset_mm() && keep(s.position_mm, s.force_n))
+    };
+    let window: Vec<usize> = t.phases.withdrawal.clone().filter(|i| inside(i, &|x, _| (lo..=hi).contains(&x))).collect();
+    if window.len() >= HOLD_AVERAGE_SAMPLES {
         return window;
     }
-    t.phases.withdrawal.clone().filter(|i| at(i).is_some_and(|s| s.force_n < 0.0 && s.position_mm > t.onset_mm())).collect()
+    t.phases.withdrawal.clone().filter(|i| inside(i, &|_, f| f < 0.0)).collect()
 }
 
 /// The trials' sum of squares from each contact on, each over its rows and its peak
