@@ -13,6 +13,20 @@ use needle_calibrate::replay::Check;
 use needle_calibrate::whole::TrialsCalibration;
 use std::path::{Path, PathBuf};
 
+/// The goals met on the rig's trials when this test was last changed (calibrated on all
+/// 2 mm/s trials of a sample; skin on muscle's 1 and 3 mm/s trials predicted; each 2 mm/s
+/// trial held out), printed by this test: a change that loses a goal fails here (raise
+/// them when a change gains). Not the goal, which is every check met; what
+/// misses and why: `docs/insertion.md`, "What the model cannot do yet".
+const MET_AT_LEAST: Met = Met { calibrated: 59, predicted: 26, held_out: 61 };
+
+/// Goals met per set.
+struct Met {
+    calibrated: usize,
+    predicted: usize,
+    held_out: usize,
+}
+
 fn predict(c: &TrialsCalibration, file: &Path, g: &Goals) -> Vec<Check> {
     let t = prepare(file);
     goals::checks(&t, &replay(c, &t), g)
@@ -46,7 +60,7 @@ fn find<'a>(checks: &'a [Check], what: &str) -> Vec<&'a Check> {
 
 #[test]
 fn calibrated_at_2_mm_per_s_and_predicted() {
-    let mut totals = (0, 0);
+    let (mut totals, mut predicted) = ((0, 0), (0, 0));
     for sample in ["skin_2mmps", "muscle_2mmps", "skin-on-muscle_2mmps"] {
         let files = group(sample);
         let started = std::time::Instant::now();
@@ -69,7 +83,8 @@ fn calibrated_at_2_mm_per_s_and_predicted() {
             for speed in ["skin-on-muscle_1mmps", "skin-on-muscle_3mmps"] {
                 for file in group(speed) {
                     let checks = predict(&c, &file, &goals::PREDICTED);
-                    show("predicted", &file, &checks);
+                    let (m, n) = show("predicted", &file, &checks);
+                    predicted = (predicted.0 + m, predicted.1 + n);
                     // asserted: the skin's puncture is made by the model at the other speeds
                     // (the muscle's is missed at 3 mm/s: the stack has no speed dependence
                     // of the puncture force; printed above)
@@ -83,6 +98,10 @@ fn calibrated_at_2_mm_per_s_and_predicted() {
         }
     }
     eprintln!("calibrated: {} of {} goals met over the 2 mm/s trials", totals.0, totals.1);
+    eprintln!("predicted: {} of {} goals met over skin on muscle's 1 and 3 mm/s trials", predicted.0, predicted.1);
+    // asserted: no goal lost against the last measured counts (`MET_AT_LEAST`)
+    assert!(totals.0 >= MET_AT_LEAST.calibrated, "calibrated: {} goals met, fewer than {}", totals.0, MET_AT_LEAST.calibrated);
+    assert!(predicted.0 >= MET_AT_LEAST.predicted, "predicted: {} goals met, fewer than {}", predicted.0, MET_AT_LEAST.predicted);
 }
 
 #[test]
@@ -101,4 +120,6 @@ fn each_trial_held_out_and_predicted() {
         }
     }
     eprintln!("held out: {} of {} goals met", totals.0, totals.1);
+    // asserted: no goal lost against the last measured count (`MET_AT_LEAST`)
+    assert!(totals.0 >= MET_AT_LEAST.held_out, "held out: {} goals met, fewer than {}", totals.0, MET_AT_LEAST.held_out);
 }
