@@ -16,6 +16,7 @@
 //! stack keeps none when no tent fits the trials better by [`BETTER_BY`].
 use super::goals::{HOLD_AVERAGE_SAMPLES, WITHDRAWAL_WINDOW_MM};
 use super::trials::Trial;
+use crate::trial::Sample;
 use crate::trial_replay::replay;
 use anyhow::Result;
 use needle_codegen::tissue as file;
@@ -65,24 +66,24 @@ fn with_tent(stack: &file::Stack, k: f64, factor: f64) -> file::Stack {
 /// below the contact).
 fn level_rows(t: &Trial) -> Vec<usize> {
     let (lo, hi) = WITHDRAWAL_WINDOW_MM;
-    let inside = |i: &usize, keep: &dyn Fn(f64, f64) -> bool| {
-        t.samples.get(*i).is_some_and(|s| s.position_mm > t.onset_mm() && keep(s.position_mm, s.force_n))
-    };
-    let window: Vec<usize> = t.phases.withdrawal.clone().filter(|i| inside(i, &|x, _| (lo..=hi).contains(&x))).collect();
+    let in_tissue: Vec<(usize, &Sample)> =
+        t.phases.withdrawal.clone().filter_map(|i| Some((i, t.samples.get(i)?))).filter(|(_, s)| s.position_mm > t.onset_mm()).collect();
+    let window: Vec<usize> = in_tissue.iter().filter(|(_, s)| (lo..=hi).contains(&s.position_mm)).map(|(i, _)| *i).collect();
     if window.len() >= HOLD_AVERAGE_SAMPLES {
         return window;
     }
-    t.phases.withdrawal.clone().filter(|i| inside(i, &|_, f| f < 0.0)).collect()
+    in_tissue.iter().filter(|(_, s)| s.force_n < 0.0).map(|(i, _)| *i).collect()
 }
 
 /// The trials' sum of squares from each contact on, each over its rows and its peak
 /// squared, and the mean over the trials of the model's pull over each withdrawal's
-/// [`level_rows`] over the measured one; `None` when the library refuses the stack.
-fn cost(stack: &file::Stack, diameter_mm: f64, trials: &[Trial]) -> Option<(f64, f64)> {
+/// `rows` (its [`level_rows`]) over the measured one; `None` when the library refuses the
+/// stack.
+fn cost(stack: &file::Stack, diameter_mm: f64, trials: &[Trial], rows: &[Vec<usize>]) -> Option<(f64, f64)> {
     let layers: Vec<insertion::Layer> = stack.layers.iter().map(crate::to_layer).collect();
     let lib = insertion::Stack { name: &stack.name, needle_diameter_mm: diameter_mm as f32, layers: &layers };
     let (mut total, mut level, mut levels) = (0.0, 0.0, 0.0);
-    for t in trials {
+    for (t, rows) in trials.iter().zip(rows) {
         let r = replay(&lib, t.onset_mm(), &t.samples).ok()?;
         let (mut sum, mut n, mut peak) = (0.0, 0.0, 0.0f64);
         for (s, m) in t.samples.iter().zip(&r.rows).skip(t.phases.contact) {
@@ -94,7 +95,7 @@ fn cost(stack: &file::Stack, diameter_mm: f64, trials: &[Trial]) -> Option<(f64,
             total += sum / n / (peak * peak);
         }
         let (mut measured, mut model) = (0.0, 0.0);
-        for (s, m) in level_rows(t).into_iter().filter_map(|i| Some((t.samples.get(i)?, r.rows.get(i)?))) {
+        for (s, m) in rows.iter().filter_map(|&i| Some((t.samples.get(i)?, r.rows.get(i)?))) {
             measured += s.force_n;
             model += m.force_n;
         }
@@ -112,7 +113,9 @@ fn cost(stack: &file::Stack, diameter_mm: f64, trials: &[Trial]) -> Option<(f64,
 /// # Errors
 /// The library refuses the stack as the other steps made it.
 pub fn fit(stack: &mut file::Stack, diameter_mm: f64, trials: &[Trial]) -> Result<TentFit> {
-    let (none, _) = cost(stack, diameter_mm, trials).ok_or_else(|| anyhow::anyhow!("the calibrated stack is refused by the library"))?;
+    let rows: Vec<Vec<usize>> = trials.iter().map(level_rows).collect();
+    let (none, _) =
+        cost(stack, diameter_mm, trials, &rows).ok_or_else(|| anyhow::anyhow!("the calibrated stack is refused by the library"))?;
     let without = TentFit { tent_n_per_mm: None, static_factor: 1.0, cost: (none, none) };
     if !stack.layers.iter().any(|l| l.presliding_mm.is_some()) {
         return Ok(without);
@@ -120,7 +123,7 @@ pub fn fit(stack: &mut file::Stack, diameter_mm: f64, trials: &[Trial]) -> Resul
     let mut best = without;
     for &k in TENT_GRID_N_PER_MM.iter().filter(|&&k| k > 0.0) {
         for &factor in &STATIC_FACTORS {
-            let Some((c, level)) = cost(&with_tent(stack, k, factor), diameter_mm, trials) else { continue };
+            let Some((c, level)) = cost(&with_tent(stack, k, factor), diameter_mm, trials, &rows) else { continue };
             if c < best.cost.1 && (level - 1.0).abs() <= LEVEL_TOLERANCE {
                 best = TentFit { tent_n_per_mm: Some(k), static_factor: factor, cost: (none, c) };
             }
