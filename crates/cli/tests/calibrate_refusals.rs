@@ -273,3 +273,18 @@ fn message_a_folder_output_under_a_file_says_file_not_file_exists() {
     let err = refused(&o, &["is a file, not a folder"]);
     assert!(!err.contains("os error 17"), "{err}");
 }
+
+#[test]
+fn a_stack_sent_out_of_the_set_takes_its_figure_with_it() {
+    let (d, set) = set_copy();
+    let before = snapshot(&set);
+    let out = d.path().join("elsewhere/liver2.toml");
+    std::fs::create_dir_all(d.path().join("elsewhere")).expect("mkdir");
+    let o = calibrate(&set, &liver_curve(&set), &["--out", out.to_str().expect("utf-8")]);
+    assert_eq!(o.status.code(), Some(0), "{}", show(&o));
+    let figure = d.path().join("elsewhere/liver2.svg");
+    let svg = std::fs::read_to_string(&figure).unwrap_or_else(|e| panic!("{}: {e}\n{}", figure.display(), show(&o)));
+    assert!(svg.starts_with("<svg"), "{}: not an SVG", figure.display());
+    assert!(String::from_utf8_lossy(&o.stdout).contains(&format!("wrote {}", figure.display())), "{}", show(&o));
+    assert!(snapshot(&set) == before, "--out without --figure changes no file of the set");
+}

@@ -48,10 +48,12 @@ pub struct CalibratePublishedArgs {
     /// Write the sampled published curve (position_mm, force_n) here.
     #[arg(long)]
     pub sampled_out: PathBuf,
-    /// Write the stack here instead of <set>/tissue/<name>.toml.
+    /// Write the stack here instead of <set>/tissue/<name>.toml (the figure then goes beside
+    /// it, x.toml -> x.svg, unless --figure).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Write the figure here instead of <set>/figures/calibration-<name>.svg.
+    /// Write the figure here instead of beside --out (x.svg), or without --out
+    /// <set>/figures/calibration-<name>.svg.
     #[arg(long)]
     pub figure: Option<PathBuf>,
     /// Replace an existing stack, figure or sampled curve (without it, an existing one is
@@ -94,8 +96,7 @@ pub fn run(a: CalibratePublishedArgs) -> Result<ExitCode> {
         with_prony: a.with_prony,
         fe_shear_modulus_n_per_mm2: mu0,
     };
-    let out = a.out.clone().unwrap_or_else(|| a.set.join(needle_codegen::tissue::TISSUE_DIR).join(format!("{}.toml", a.name)));
-    let figure = a.figure.clone().unwrap_or_else(|| a.set.join("figures").join(format!("calibration-{}.svg", a.name)));
+    let (out, figure) = super::calibrate::output_paths(&a.set, &a.name, a.out.as_deref(), a.figure.as_deref());
     let planned = [
         Planned { option: "--sampled-out", path: &a.sampled_out },
         Planned { option: "--out", path: &out },

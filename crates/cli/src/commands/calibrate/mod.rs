@@ -10,7 +10,7 @@ use crate::planned_outputs::{self, Planned};
 use anyhow::{Context, Result};
 use clap::Args;
 use needle_calibrate::{events::EventRule, Options};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
@@ -49,10 +49,12 @@ pub struct CalibrateArgs {
     /// Smallest drop that counts as a puncture, fraction of the peak force, 0.001 to 0.999.
     #[arg(long, default_value_t = EventRule::default().drop_fraction, allow_negative_numbers = true)]
     pub drop_fraction: f64,
-    /// Write the stack here instead of <set>/tissue/<name>.toml.
+    /// Write the stack here instead of <set>/tissue/<name>.toml (the figure then goes beside
+    /// it, x.toml -> x.svg, unless --figure).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Write the figure here instead of <set>/figures/calibration-<name>.svg (--curve:
+    /// Write the figure here instead of beside --out (x.svg), or without --out
+    /// <set>/figures/calibration-<name>.svg (--curve:
     /// the curve, the model and the residual against position, and before the first
     /// puncture against depth; --trials: per trial the measured and the model force
     /// against time over insertion, hold and withdrawal, the punctures, the residual).
@@ -71,6 +73,21 @@ pub struct CalibrateArgs {
     /// force per measured row (of each trial).
     #[arg(long)]
     pub json: bool,
+}
+
+/// Where a calibration of stack `name` writes its stack and its figure: the stack to
+/// `out`, else the set's `<set>/tissue/<name>.toml`; the figure to `figure`, else beside
+/// an `out` stack (`x.toml` -> `x.svg`: a stack sent out of the set leaves the set
+/// unchanged), else the set's `<set>/figures/calibration-<name>.svg`.
+#[must_use]
+pub fn output_paths(set: &Path, name: &str, out: Option<&Path>, figure: Option<&Path>) -> (PathBuf, PathBuf) {
+    let stack = out.map_or_else(|| set.join(needle_codegen::tissue::TISSUE_DIR).join(format!("{name}.toml")), Path::to_path_buf);
+    let svg = match (figure, out) {
+        (Some(f), _) => f.to_path_buf(),
+        (None, Some(o)) => o.with_extension("svg"),
+        (None, None) => set.join("figures").join(format!("calibration-{name}.svg")),
+    };
+    (stack, svg)
 }
 
 /// Runs `needle calibrate`: the options, the name and the outputs are checked first (no
@@ -103,8 +120,7 @@ pub fn run(a: CalibrateArgs) -> Result<ExitCode> {
     opts.fe_shear_modulus_n_per_mm2 = needle_codegen::tissue::read_fe_shear_modulus(&a.set)?
         .with_context(|| format!("{}: no campaign.toml: the FE tissue's shear modulus sets the track stiffness", a.set.display()))?;
     let mu0 = opts.fe_shear_modulus_n_per_mm2;
-    let out = a.out.clone().unwrap_or_else(|| a.set.join(needle_codegen::tissue::TISSUE_DIR).join(format!("{}.toml", a.name)));
-    let figure = a.figure.clone().unwrap_or_else(|| a.set.join("figures").join(format!("calibration-{}.svg", a.name)));
+    let (out, figure) = output_paths(&a.set, &a.name, a.out.as_deref(), a.figure.as_deref());
     let planned = [Planned { option: "--out", path: &out }, Planned { option: "--figure", path: &figure }];
     planned_outputs::check(&planned, Some(&a.set), &[("--curve", &curve)], a.force)?;
     let points = needle_calibrate::measured::read_curve(&curve)?;

@@ -22,9 +22,8 @@ pub fn run_trials(a: &CalibrateArgs) -> Result<ExitCode> {
     check_compiled_set_except(&a.set, Some(&a.name))?;
     let mu0 = needle_codegen::tissue::read_fe_shear_modulus(&a.set)?
         .with_context(|| format!("{}: no campaign.toml: the FE tissue's shear modulus sets the track stiffness", a.set.display()))?;
-    let out = a.out.clone().unwrap_or_else(|| a.set.join(needle_codegen::tissue::TISSUE_DIR).join(format!("{}.toml", a.name)));
+    let (out, figure) = super::output_paths(&a.set, &a.name, a.out.as_deref(), a.figure.as_deref());
     let inputs: Vec<(&str, &std::path::Path)> = a.trials.iter().map(|p| ("--trials", p.as_path())).collect();
-    let figure = a.figure.clone().unwrap_or_else(|| a.set.join("figures").join(format!("calibration-{}.svg", a.name)));
     let spread_out = needle_calibrate::spread::beside(&out);
     let planned = [
         Planned { option: "--out", path: &out },
