@@ -92,6 +92,29 @@ fn a_reversal_turns_the_held_force_over_within_twice_the_presliding_distance() {
     assert!((last - karnopp_last).abs() <= 1e-3 * karnopp_last.abs(), "pulls {last} N, Karnopp {karnopp_last} N");
 }
 
+/// Each shaft term's arm is loaded within its own slip distance, `p_r tau_i / tau_min` (at
+/// most the presliding distance): a slow term that carries most of the held force turns
+/// over on a reversal within twice its distance, not within the shortest term's. Here
+/// `p_r` = 0.05 mm (the fast term, 0.05 s) and the slow term (2 s, g 3) loads within
+/// `min(0.05 * 40, P_MM)` = 1 mm: the held force crosses zero after about 0.9 mm of travel
+/// back (long-term share 0.22 and the slow arm's 0.67 against the fast arm's 0.11), where
+/// with every arm at 0.05 mm it would cross within 0.1 mm.
+#[test]
+fn a_slow_shaft_term_turns_over_within_its_own_slip_distance() {
+    let slow_and_fast = PronyTerms::new(&[PronyTerm { g: 0.5, tau_s: 0.05 }, PronyTerm { g: 3.0, tau_s: 2.0 }]).expect("valid terms");
+    let layers = with(Presliding { distance_mm: P_MM, relaxation_slip_mm: 0.05, shaft_prony: slow_and_fast, tent_n_per_mm: 0.0 });
+    let ticks = run(&Stack { layers: &layers, ..*liver() }, DEEP_MM, 0.0, 3.0 * f64::from(P_MM));
+    let reversal = ticks.iter().rposition(|(d, _)| *d >= DEEP_MM).expect("the reversal");
+    let held_n = ticks[reversal].1;
+    assert!(held_n > 0.5, "held at the reversal: {held_n} N");
+    let crossing = ticks[reversal..].iter().find(|(_, f)| *f < 0.0).map(|(d, _)| DEEP_MM - d).expect("the force turns over");
+    println!("held {held_n} N at the reversal, crosses zero after {crossing:.3} mm of travel back");
+    assert!(
+        crossing >= 0.5 && crossing <= 2.0 * f64::from(P_MM),
+        "crosses zero after {crossing} mm: expected about 0.9 mm, within 2 x {P_MM} mm"
+    );
+}
+
 /// The liver with a presliding of `P_MM` on every layer, the tissue's tent `tent_n_per_mm`
 /// and the static level twice the Coulomb one.
 fn with_tent(tent_n_per_mm: f32) -> Vec<Layer> {

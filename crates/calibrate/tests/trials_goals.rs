@@ -17,8 +17,11 @@ use std::path::{Path, PathBuf};
 /// 2 mm/s trials of a sample; skin on muscle's 1 and 3 mm/s trials predicted; each 2 mm/s
 /// trial held out), printed by this test: a change that loses a goal fails here (raise
 /// them when a change gains). Not the goal, which is every check met; what
-/// misses and why: `docs/insertion.md`, "What the model cannot do yet".
-const MET_AT_LEAST: Met = Met { calibrated: 59, predicted: 26, held_out: 61 };
+/// misses and why: `docs/insertion.md`, "What the model cannot do yet". Predicted went
+/// 26 -> 24 when each shaft term's arm got its own slip distance (the one the holds are
+/// fitted with): two of skin on muscle's 1 mm/s withdrawal means (goal 15 %) missed, for
+/// 5 more repeats met (the measurement notebook).
+const MET_AT_LEAST: Met = Met { calibrated: 59, predicted: 24, held_out: 61 };
 
 /// Goals met per set.
 struct Met {

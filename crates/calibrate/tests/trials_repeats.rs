@@ -14,12 +14,14 @@ use needle_calibrate::whole::repeats::{GroupSpread, Rms, RATIO_GOAL};
 use std::path::PathBuf;
 
 /// The cases that miss the goal today (`group: calibrated on -> predicted`; each one's
-/// figures are printed): muscle 29 of 30 (ratio 1.51-3.27), skin on muscle at 1 mm/s 4 of
-/// 12 (1.50-1.78); skin and skin on muscle at 2 and 3 mm/s meet it in every case since
-/// the tissue's tent (`whole::tent`). Where they come from (the muscle's insertion, and
-/// its withdrawal's pull, which lets go near the surface; the tent's level read over the
-/// goals' withdrawal window, which costs the muscle's pull near its peak): `docs/insertion.md`,
-/// "Repeats". Not a tolerance: every other case must meet the goal.
+/// figures are printed): muscle 24 of 30 (ratio 1.51-3.11), skin on muscle at 1 mm/s 1 of
+/// 12 (1.69), at 3 mm/s 2 of 30 (1.52-1.54), skin 1 of 30 (1.54); skin on muscle at 2 mm/s
+/// meets it in every case. Where they come from (the muscle's insertion, and its
+/// withdrawal's pull, which lets go near the surface; the tent's level read over the
+/// goals' withdrawal window, which costs the muscle's pull near its peak; the slow shaft
+/// terms' own slip distances, which turn the withdrawal over as the rig's but cost the
+/// skin's and the 3 mm/s pulls a little): `docs/insertion.md`, "Repeats". Not a
+/// tolerance: every other case must meet the goal.
 const MISSED: &[&str] = &[
     "muscle_2mmps_0deg_needle2: trial1+trial2 -> trial3",
     "muscle_2mmps_0deg_needle2: trial1+trial2 -> trial4",
@@ -31,8 +33,6 @@ const MISSED: &[&str] = &[
     "muscle_2mmps_0deg_needle2: trial1+trial4 -> trial3",
     "muscle_2mmps_0deg_needle2: trial1+trial4 -> trial5",
     "muscle_2mmps_0deg_needle2: trial1+trial5 -> trial2",
-    "muscle_2mmps_0deg_needle2: trial1+trial5 -> trial3",
-    "muscle_2mmps_0deg_needle2: trial1+trial5 -> trial4",
     "muscle_2mmps_0deg_needle2: trial2+trial3 -> trial1",
     "muscle_2mmps_0deg_needle2: trial2+trial3 -> trial4",
     "muscle_2mmps_0deg_needle2: trial2+trial3 -> trial5",
@@ -40,20 +40,17 @@ const MISSED: &[&str] = &[
     "muscle_2mmps_0deg_needle2: trial2+trial4 -> trial3",
     "muscle_2mmps_0deg_needle2: trial2+trial4 -> trial5",
     "muscle_2mmps_0deg_needle2: trial2+trial5 -> trial1",
-    "muscle_2mmps_0deg_needle2: trial2+trial5 -> trial4",
     "muscle_2mmps_0deg_needle2: trial3+trial4 -> trial1",
     "muscle_2mmps_0deg_needle2: trial3+trial4 -> trial2",
     "muscle_2mmps_0deg_needle2: trial3+trial4 -> trial5",
     "muscle_2mmps_0deg_needle2: trial3+trial5 -> trial1",
-    "muscle_2mmps_0deg_needle2: trial3+trial5 -> trial2",
     "muscle_2mmps_0deg_needle2: trial3+trial5 -> trial4",
     "muscle_2mmps_0deg_needle2: trial4+trial5 -> trial1",
     "muscle_2mmps_0deg_needle2: trial4+trial5 -> trial2",
-    "muscle_2mmps_0deg_needle2: trial4+trial5 -> trial3",
-    "skin-on-muscle_1mmps_0deg_needle2: trial1+trial3 -> trial4",
-    "skin-on-muscle_1mmps_0deg_needle2: trial1+trial3 -> trial5",
-    "skin-on-muscle_1mmps_0deg_needle2: trial3+trial4 -> trial5",
-    "skin-on-muscle_1mmps_0deg_needle2: trial4+trial5 -> trial3",
+    "skin-on-muscle_1mmps_0deg_needle2: trial1+trial4 -> trial5",
+    "skin-on-muscle_3mmps_0deg_needle2: trial1+trial2 -> trial4",
+    "skin-on-muscle_3mmps_0deg_needle2: trial1+trial3 -> trial4",
+    "skin_2mmps_0deg_needle2: trial2+trial3 -> trial1",
 ];
 
 /// The rig's trials by group: the file name without its `_trial<k>` (sample, speed,

@@ -3,12 +3,12 @@
 /// Motor channels of the C loop.
 pub const NEEDLE_CHANNELS: usize = 3;
 /// 64-bit words of opaque storage in a [`needle_loop_t`].
-pub const NEEDLE_LOOP_STORAGE_WORDS: usize = 307;
+pub const NEEDLE_LOOP_STORAGE_WORDS: usize = 315;
 /// [`needle_loop_t::magic`] of an initialised loop.
 pub const NEEDLE_LOOP_MAGIC: u32 = 0x4e4c_4f50;
 
 /// 64-bit words of opaque storage in a [`needle_insertion_t`].
-pub const NEEDLE_INSERTION_STORAGE_WORDS: usize = 270;
+pub const NEEDLE_INSERTION_STORAGE_WORDS: usize = 278;
 /// [`needle_insertion_t::magic`] of an initialised insertion.
 pub const NEEDLE_INSERTION_MAGIC: u32 = 0x4e49_4e53;
 

@@ -9,13 +9,15 @@
 //!
 //! **Relaxation** (the shaft's own Prony terms, [`Presliding::shaft_prony`], FEBio's
 //! long-term normalisation `G(t) = 1 + sum g_i exp(-t / tau_i)`, at most three terms):
-//! each term is a bristle of its own, `z_i <- clamp(a_i z_i + Δd / p_r, -1, 1)` with the
+//! each term is a bristle of its own, `z_i <- clamp(a_i z_i + Δd / p_i, -1, 1)` with the
 //! QLV recursion's decay `a_i = exp(-dt / tau_i)` (the library's viscoelastic filter's
-//! coefficient) and the relaxation's slip distance `p_r`
-//! ([`Presliding::relaxation_slip_mm`]): a Maxwell arm that slips at its share. Sliding
-//! faster than `p_r / tau_i`, every `z_i` is at ±1; at rest each decays with its time
+//! coefficient) and its slip distance `p_i = p_r tau_i / tau_min`, at most
+//! `max(p, p_r)` (`p_r` [`Presliding::relaxation_slip_mm`], the shortest term's: every
+//! term slips at the same speed `p_r / tau_min`): a Maxwell arm that slips at its share.
+//! Sliding faster than that speed, every `z_i` is at ±1; at rest each decays with its time
 //! constant, so a held force relaxes as `G(t) / G(0)` to `1 / (1 + sum g_i)` of the
-//! sliding one, by the same share whatever the speed it slid at.
+//! sliding one, by the same share whatever the speed it slid at. A reversal turns each
+//! term over within `2 p_i`: the slow terms over millimetres, as the long-term bristle.
 //!
 //! **Forces** (the tissue file's levels are the sliding ones, as the Karnopp friction's):
 //! per mm of shaft in the layer
@@ -61,9 +63,10 @@ pub struct Presliding {
     /// The presliding distance `p`, mm (0: none; else within
     /// `needle_contract::PRESLIDING_MM_RANGE`).
     pub distance_mm: f32,
-    /// The distance within which the relaxing part of the held force (each Prony term's
-    /// arm) is loaded, mm (within the same range as `distance_mm`; with no terms, any
-    /// value in range).
+    /// The distance within which the shortest Prony term's arm of the held force is
+    /// loaded, mm; each longer term's is it times `tau_i / tau_min`, at most
+    /// `max(distance_mm, relaxation_slip_mm)` (within the same range as `distance_mm`;
+    /// with no terms, any value in range).
     pub relaxation_slip_mm: f32,
     /// The relaxation of the held shaft force and cutting (none: no relaxation).
     pub shaft_prony: PronyTerms,
@@ -145,8 +148,8 @@ impl HeldTerms {
 struct Coefficients {
     /// `1 / p`, 1/mm (0: the layer has no presliding).
     per_mm: f32,
-    /// `1 / p_r`, 1/mm.
-    arm_per_mm: f32,
+    /// Each term's `1 / p_i`, 1/mm (0 unused).
+    arm_per_mm: [f32; MAX_TERMS],
     /// Each term's decay per tick, `exp(-dt / tau_i)` (0 for an unused term).
     decay: [f32; MAX_TERMS],
     /// Each term's share of the sliding force, `g_i / (1 + sum g)` (0 unused).
@@ -158,7 +161,8 @@ struct Coefficients {
 }
 
 impl Coefficients {
-    const NONE: Self = Self { per_mm: 0.0, arm_per_mm: 0.0, decay: [0.0; MAX_TERMS], share: [0.0; MAX_TERMS], long_term: 1.0, tent: 0.0 };
+    const NONE: Self =
+        Self { per_mm: 0.0, arm_per_mm: [0.0; MAX_TERMS], decay: [0.0; MAX_TERMS], share: [0.0; MAX_TERMS], long_term: 1.0, tent: 0.0 };
 
     /// The layer's coefficients for ticks of `period_s` (> 0); `None` for a presliding
     /// out of range.
@@ -173,16 +177,15 @@ impl Coefficients {
         let total = 1.0 + terms.iter().map(|t| t.g).sum::<f32>();
         // total >= 1 (every g >= 0, checked), tau_s > 0 and both distances > 0 (checked):
         // no division by zero
-        let mut out = Self {
-            per_mm: 1.0 / p.distance_mm,
-            arm_per_mm: 1.0 / p.relaxation_slip_mm,
-            long_term: 1.0 / total,
-            tent: p.tent_n_per_mm,
-            ..Self::NONE
-        };
-        for ((a, s), t) in out.decay.iter_mut().zip(out.share.iter_mut()).zip(terms) {
+        let mut out = Self { per_mm: 1.0 / p.distance_mm, long_term: 1.0 / total, tent: p.tent_n_per_mm, ..Self::NONE };
+        let shortest = terms.iter().map(|t| t.tau_s).fold(f32::INFINITY, f32::min);
+        let longest_mm = if p.distance_mm > p.relaxation_slip_mm { p.distance_mm } else { p.relaxation_slip_mm };
+        for (((a, s), r), t) in out.decay.iter_mut().zip(out.share.iter_mut()).zip(out.arm_per_mm.iter_mut()).zip(terms) {
             *a = libm::expf(-period_s / t.tau_s);
             *s = t.g / total;
+            // tau_s >= shortest > 0 (checked): p_i >= p_r > 0
+            let slip_mm = p.relaxation_slip_mm * (t.tau_s / shortest);
+            *r = 1.0 / if slip_mm < longest_mm { slip_mm } else { longest_mm };
         }
         Some(out)
     }
@@ -229,8 +232,8 @@ fn held_share(c: &Coefficients, z: f32, arms: &[f32; MAX_TERMS]) -> f32 {
 fn shared_step(c: &Coefficients, z: f32, arms: &[f32; MAX_TERMS], level_n: f32, pull: f32) -> f32 {
     let dir = if pull > 0.0 { 1.0 } else { -1.0 };
     let mut parts = [(c.long_term * level_n, c.per_mm, z, false); 1 + MAX_TERMS];
-    for (part, (share, arm)) in parts.iter_mut().skip(1).zip(c.share.iter().zip(arms)) {
-        *part = (share * level_n, c.arm_per_mm, *arm, false);
+    for (part, ((share, arm), rate)) in parts.iter_mut().skip(1).zip(c.share.iter().zip(arms).zip(c.arm_per_mm)) {
+        *part = (share * level_n, rate, *arm, false);
     }
     for part in &mut parts {
         part.3 = part.2 * dir >= 1.0;
@@ -296,14 +299,13 @@ impl Shaft {
                 let pull = c.tent * step_mm + level_n * (before - held_share(c, *z, arms));
                 let s = shared_step(c, *z, arms, level_n, pull);
                 *z = clamp_unit(*z + s * c.per_mm);
-                for arm in arms.iter_mut() {
-                    *arm = clamp_unit(*arm + s * c.arm_per_mm);
+                for (arm, rate) in arms.iter_mut().zip(c.arm_per_mm) {
+                    *arm = clamp_unit(*arm + s * rate);
                 }
             } else {
                 *z = clamp_unit(*z + step_mm * c.per_mm);
-                let s = step_mm * c.arm_per_mm;
-                for (arm, a) in arms.iter_mut().zip(c.decay) {
-                    *arm = clamp_unit(a * *arm + s);
+                for ((arm, a), rate) in arms.iter_mut().zip(c.decay).zip(c.arm_per_mm) {
+                    *arm = clamp_unit(a * *arm + step_mm * rate);
                 }
             }
         }
@@ -404,7 +406,7 @@ impl Shaft {
 
     /// The bristles' stiffness per unit level, 1/mm.
     fn gain(&self, j: usize) -> f32 {
-        self.coefficients.get(j).map_or(0.0, |c| c.long_term * c.per_mm + c.share.iter().sum::<f32>() * c.arm_per_mm)
+        self.coefficients.get(j).map_or(0.0, |c| c.long_term * c.per_mm + c.share.iter().zip(c.arm_per_mm).map(|(s, r)| s * r).sum::<f32>())
     }
 
     fn layer(&self, j: usize) -> Option<(&Coefficients, f32, &[f32; MAX_TERMS])> {

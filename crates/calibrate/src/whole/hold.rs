@@ -26,8 +26,9 @@
 //! the presliding distance), so it slips while the needle slides at any speed above the
 //! stick band: the held force relaxes by the same share at every sliding speed (as the
 //! rig's trials do, at 1, 2 and 3 mm/s) and the sliding force is the friction and
-//! cutting the trials show. The stack's relaxation slip distance is the smallest of the
-//! chosen terms' (each arm then slips sooner, the same while sliding and at rest).
+//! cutting the trials show. The stack's relaxation slip distance is the shortest term's;
+//! the library loads each longer term within it times `tau_i / tau_min`, at most the
+//! presliding distance: the distances fitted here.
 //!
 //! The boundary's filter starts from rest at the last puncture's peak (the library
 //! resets it there and steps it to the deflection at once when the boundary lies above
