@@ -50,7 +50,8 @@
 //! relaxing only lower it, and `w` is a function of the depth for a fixed track end
 //! (which moves only while the tip cuts at full force, storing at most half the work:
 //! `cutting (e - a) / 2`). A closed cycle of the insertion alone gives nothing back
-//! (`host-tests/tests/insertion_energy.rs` holds it). The control loop's passivity guard
+//! (`host-tests/tests/insertion_energy.rs` holds it), nor does a ratchet out from inside
+//! the tissue beyond what the held force stored (`insertion_ratchet.rs`). The control loop's passivity guard
 //! renders the held force through a bristle of its own ([`HeldTerms`] is what it reads
 //! of a tick; `control::held_bristle`, `docs/insertion.md`, "Presliding").
 use crate::float::viscoelastic::{PronyTerms, MAX_TERMS};
