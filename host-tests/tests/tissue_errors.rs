@@ -259,7 +259,8 @@ fn presliding_keys_are_read_checked_and_refused_at_their_line() {
     for (lines, what) in [
         ("presliding_mm = 0.0", "presliding_mm = 0"),
         ("presliding_mm = 51.0", "presliding_mm = 51"),
-        ("presliding_mm = 1.0\nrelaxation_slip_mm = 0.001", "relaxation_slip_mm = 0.001"),
+        ("presliding_mm = 1.0\nrelaxation_slip_mm = 0.00005", "relaxation_slip_mm = 0.00005: must be from 0.0001 to 50 mm"),
+        ("presliding_mm = 1.0\nrelaxation_slip_mm = 51.0", "relaxation_slip_mm = 51"),
         ("relaxation_slip_mm = 0.2", "relaxation_slip_mm needs presliding_mm"),
         ("presliding_mm = 1.0\ntent_n_per_mm = 0.0", "tent_n_per_mm = 0: must be from 0.001 to 100 N/mm"),
         ("presliding_mm = 1.0\ntent_n_per_mm = 101.0", "tent_n_per_mm = 101"),

@@ -13,8 +13,8 @@ use std::path::{Path, PathBuf};
 use toml::Spanned;
 
 pub use needle_contract::{
-    MAX_PRONY_TERMS, MAX_TISSUE_LAYERS as MAX_LAYERS, PRESLIDING_MM_RANGE, PRONY_G_SUM_MAX, SOFTENING_FRACTION_MAX, TENT_N_PER_MM_RANGE,
-    TISSUE_FORMAT, TISSUE_FORMATS_READ,
+    MAX_PRONY_TERMS, MAX_TISSUE_LAYERS as MAX_LAYERS, PRESLIDING_MM_RANGE, PRONY_G_SUM_MAX, RELAXATION_SLIP_MM_RANGE,
+    SOFTENING_FRACTION_MAX, TENT_N_PER_MM_RANGE, TISSUE_FORMAT, TISSUE_FORMATS_READ,
 };
 /// The folder of a set that holds its tissue stacks.
 pub const TISSUE_DIR: &str = "tissue";
@@ -84,7 +84,7 @@ pub struct Layer {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub presliding_mm: Option<f64>,
     /// Format 2: the distance within which the relaxing part of the held force (each
-    /// `shaft_prony` term) is loaded, mm, within [`PRESLIDING_MM_RANGE`] (default:
+    /// `shaft_prony` term) is loaded, mm, within [`RELAXATION_SLIP_MM_RANGE`] (default:
     /// `presliding_mm`; needs it): sliding faster than it over a term's time constant keeps
     /// the term at its slip, so the held force relaxes by the same share at any such speed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -422,7 +422,8 @@ fn shape(
 /// the shaft's terms.
 type PreslidingFields = (Option<f64>, Option<f64>, Vec<PronyTerm>, Option<f64>);
 
-/// The presliding fields of `l` (format 2): the distances within [`PRESLIDING_MM_RANGE`],
+/// The presliding fields of `l` (format 2): the distances within [`PRESLIDING_MM_RANGE`]
+/// and [`RELAXATION_SLIP_MM_RANGE`],
 /// the tent's stiffness within [`TENT_N_PER_MM_RANGE`],
 /// the shaft's Prony terms checked as a layer's, each only with a presliding distance.
 fn presliding_fields(
@@ -454,7 +455,7 @@ fn presliding_fields(
         }
     };
     let distance = l.presliding_mm.as_ref().map(|v| in_range(v, "presliding_mm", PRESLIDING_MM_RANGE, "mm")).transpose()?;
-    let slip = l.relaxation_slip_mm.as_ref().map(|v| in_range(v, "relaxation_slip_mm", PRESLIDING_MM_RANGE, "mm")).transpose()?;
+    let slip = l.relaxation_slip_mm.as_ref().map(|v| in_range(v, "relaxation_slip_mm", RELAXATION_SLIP_MM_RANGE, "mm")).transpose()?;
     if let (None, Some(v)) = (distance, &l.relaxation_slip_mm) {
         return Err(err(v.span(), format!("layer {:?}: relaxation_slip_mm needs presliding_mm", l.name)));
     }

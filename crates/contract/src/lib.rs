@@ -148,6 +148,12 @@ pub const SOFTENING_FRACTION_MAX: f64 = 0.5;
 /// The range of a layer's presliding distance (tissue format 2's `presliding_mm`, the
 /// `shaft-presliding` feature), mm: the shaft's stuck state turns over within twice it.
 pub const PRESLIDING_MM_RANGE: (f64, f64) = (0.01, 50.0);
+/// The range of a layer's relaxation slip distance (tissue format 2's
+/// `relaxation_slip_mm`: the travel within which the shortest shaft term's arm is
+/// loaded, the stick band's edge times that term's time constant), mm. Below the
+/// presliding distance's: a term of a few milliseconds (three sampling periods of a 1 kHz
+/// rig) slipping at a stick band's edge of 0.05 mm/s is loaded within 1.5e-4 mm.
+pub const RELAXATION_SLIP_MM_RANGE: (f64, f64) = (1.0e-4, 50.0);
 /// The range of a layer's tissue tent stiffness (tissue format 2's `tent_n_per_mm`, the
 /// `shaft-presliding` feature), N/mm: the layer's tissue around the shaft, a spring to the
 /// ground in series with the shaft's friction (it turns over over millimetres and is

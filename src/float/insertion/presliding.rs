@@ -55,7 +55,7 @@
 //! renders the held force through a bristle of its own ([`HeldTerms`] is what it reads
 //! of a tick; `control::held_bristle`, `docs/insertion.md`, "Presliding").
 use crate::float::viscoelastic::{PronyTerms, MAX_TERMS};
-use needle_contract::{MAX_TISSUE_LAYERS as MAX_LAYERS, PRESLIDING_MM_RANGE, TENT_N_PER_MM_RANGE};
+use needle_contract::{MAX_TISSUE_LAYERS as MAX_LAYERS, PRESLIDING_MM_RANGE, RELAXATION_SLIP_MM_RANGE, TENT_N_PER_MM_RANGE};
 
 /// A layer's presliding; [`Presliding::NONE`]: today's Karnopp friction, zero at rest.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -66,8 +66,8 @@ pub struct Presliding {
     pub distance_mm: f32,
     /// The distance within which the shortest Prony term's arm of the held force is
     /// loaded, mm; each longer term's is it times `tau_i / tau_min`, at most
-    /// `max(distance_mm, relaxation_slip_mm)` (within the same range as `distance_mm`;
-    /// with no terms, any value in range).
+    /// `max(distance_mm, relaxation_slip_mm)` ([`Presliding::term_slip_mm`]; within
+    /// `needle_contract::RELAXATION_SLIP_MM_RANGE`; with no terms, any value in range).
     pub relaxation_slip_mm: f32,
     /// The relaxation of the held shaft force and cutting (none: no relaxation).
     pub shaft_prony: PronyTerms,
@@ -97,7 +97,31 @@ impl Presliding {
         }
         let in_range = |d: f32, (lo, hi): (f64, f64)| d.is_finite() && d >= lo as f32 && d <= hi as f32;
         let tent = self.tent_n_per_mm == 0.0 || in_range(self.tent_n_per_mm, TENT_N_PER_MM_RANGE);
-        in_range(self.distance_mm, PRESLIDING_MM_RANGE) && in_range(self.relaxation_slip_mm, PRESLIDING_MM_RANGE) && checked && tent
+        in_range(self.distance_mm, PRESLIDING_MM_RANGE) && in_range(self.relaxation_slip_mm, RELAXATION_SLIP_MM_RANGE) && checked && tent
+    }
+
+    /// The slip distance of the shaft term of time constant `tau_s`, mm: the relaxation
+    /// slip distance times `tau_s / tau_min` (`tau_min` the shortest of
+    /// [`Presliding::shaft_prony`]'s time constants: every term slips at one speed), at
+    /// most `max(distance_mm, relaxation_slip_mm)`. The calibration loads each arm within
+    /// the stick band's edge times its time constant, at most the presliding distance
+    /// (`needle_calibrate::whole::hold::ShaftGuess::slip_mm`): the same distances for a
+    /// stack whose `relaxation_slip_mm` is the shortest term's. Without terms (or a
+    /// `tau_s` that is not finite and > 0), the relaxation slip distance.
+    #[must_use]
+    pub fn term_slip_mm(&self, tau_s: f32) -> f32 {
+        let shortest = self.shaft_prony.as_slice().iter().map(|t| t.tau_s).fold(f32::INFINITY, f32::min);
+        let longest_mm = if self.distance_mm > self.relaxation_slip_mm { self.distance_mm } else { self.relaxation_slip_mm };
+        if !(shortest.is_finite() && shortest > 0.0 && tau_s.is_finite() && tau_s > 0.0) {
+            return self.relaxation_slip_mm;
+        }
+        // shortest > 0 (above): no division by zero
+        let slip_mm = self.relaxation_slip_mm * (tau_s / shortest);
+        if slip_mm < longest_mm {
+            slip_mm
+        } else {
+            longest_mm
+        }
     }
 }
 
@@ -179,14 +203,11 @@ impl Coefficients {
         // total >= 1 (every g >= 0, checked), tau_s > 0 and both distances > 0 (checked):
         // no division by zero
         let mut out = Self { per_mm: 1.0 / p.distance_mm, long_term: 1.0 / total, tent: p.tent_n_per_mm, ..Self::NONE };
-        let shortest = terms.iter().map(|t| t.tau_s).fold(f32::INFINITY, f32::min);
-        let longest_mm = if p.distance_mm > p.relaxation_slip_mm { p.distance_mm } else { p.relaxation_slip_mm };
         for (((a, s), r), t) in out.decay.iter_mut().zip(out.share.iter_mut()).zip(out.arm_per_mm.iter_mut()).zip(terms) {
             *a = libm::expf(-period_s / t.tau_s);
             *s = t.g / total;
             // tau_s >= shortest > 0 (checked): p_i >= p_r > 0
-            let slip_mm = p.relaxation_slip_mm * (t.tau_s / shortest);
-            *r = 1.0 / if slip_mm < longest_mm { slip_mm } else { longest_mm };
+            *r = 1.0 / p.term_slip_mm(t.tau_s);
         }
         Some(out)
     }

@@ -59,10 +59,15 @@ pub struct ShaftGuess {
 }
 
 impl ShaftGuess {
-    /// The slip distance of an arm of time constant `tau_s` (module docs), mm.
+    /// The slip distance of an arm of time constant `tau_s` (module docs), mm: the slip
+    /// speed times `tau_s`, at most the presliding distance, at least the least
+    /// relaxation slip distance a stack may hold. A stack whose `relaxation_slip_mm` is
+    /// its shortest term's gives the library the same distance for every term
+    /// (`needle_haptics::insertion::Presliding::term_slip_mm`) whenever the shortest
+    /// term's is above that least one (1e-4 mm: a speed of 0.1 mm/s over 1 ms).
     #[must_use]
     pub fn slip_mm(&self, tau_s: f64) -> f64 {
-        let (lo, _) = needle_codegen::tissue::PRESLIDING_MM_RANGE;
+        let (lo, _) = needle_codegen::tissue::RELAXATION_SLIP_MM_RANGE;
         (self.slip_speed_mm_per_s * tau_s).clamp(lo, self.presliding_mm.max(lo))
     }
 }
