@@ -17,9 +17,10 @@
 //! The fitted values are compared through the force they give, not one by one: the
 //! candidate time constants start at three sampling periods, and 5 s holds tell a 5 s
 //! term from a 16 s one with another weight only through that force; the long-term share
-//! they leave weighs the withdrawals' friction fit and the tent's grid (the muscle: its
-//! Coulomb level 0.1145 and 0.1116 N/mm, 2.3 standard errors apart, its tent 0.4 and
-//! 0.25 N/mm; its forces 3.1-3.5 % of the peak apart, its spread 3.83 %).
+//! they leave weighs the withdrawals' friction fit (the muscle's Coulomb level 0.1145 and
+//! 0.1116 N/mm, 2.3 standard errors apart). With the tent snapped to its grid the
+//! muscle's tent was 0.4 and 0.25 N/mm and its forces 3.1-3.5 % of the peak apart (its
+//! spread 3.83 %); refined between the grid points (`whole::tent`), 1.4-2.0 %.
 //!
 //! Before the relaxation slip distance had a range of its own (`shaft_slip_rule.rs`) this
 //! test failed: at 1 kHz skin on muscle met 19 goals against 24 at 100 Hz and the muscle

@@ -6,7 +6,8 @@
 //! Fitted last, on the stack the other steps made: one stiffness `k` for every layer
 //! with a presliding and one factor on their sliding friction (static and Coulomb: with
 //! a tent the shaft slips at `c L / (1 - c / k)` with the lift, so the level the
-//! withdrawals read without it is refitted with it), both from a grid, by the replays'
+//! withdrawals read without it is refitted with it), both from a grid (`k` then refined
+//! between its grid neighbours: [`refine`]), by the replays'
 //! least squares over every trial from its contact to its end (each trial's sum of
 //! squares over its rows and its peak force squared, so that each trial weighs the
 //! same), among the grid points whose mean pull over the withdrawals stays within
@@ -121,14 +122,17 @@ pub fn fit(stack: &mut file::Stack, diameter_mm: f64, trials: &[Trial]) -> Resul
         return Ok(without);
     }
     let mut best = without;
-    for &k in TENT_GRID_N_PER_MM.iter().filter(|&&k| k > 0.0) {
-        for &factor in &STATIC_FACTORS {
+    let mut costs = vec![[None; STATIC_FACTORS.len()]; TENT_GRID_N_PER_MM.len()];
+    for (ki, &k) in TENT_GRID_N_PER_MM.iter().enumerate().filter(|(_, &k)| k > 0.0) {
+        for (fi, &factor) in STATIC_FACTORS.iter().enumerate() {
             let Some((c, level)) = cost(&with_tent(stack, k, factor), diameter_mm, trials, &rows) else { continue };
+            costs[ki][fi] = Some(c);
             if c < best.cost.1 && (level - 1.0).abs() <= LEVEL_TOLERANCE {
                 best = TentFit { tent_n_per_mm: Some(k), static_factor: factor, cost: (none, c) };
             }
         }
     }
+    let best = refine(stack, diameter_mm, trials, &rows, &costs, best);
     if best.cost.1 < BETTER_BY * none {
         *stack = with_tent(stack, best.tent_n_per_mm.unwrap_or(0.0), best.static_factor);
         Ok(best)
@@ -137,12 +141,51 @@ pub fn fit(stack: &mut file::Stack, diameter_mm: f64, trials: &[Trial]) -> Resul
     }
 }
 
+/// The grid's best `k` refined at its factor: the vertex, in `ln k`, of the parabola
+/// through the costs of the best grid point and its two neighbours, when it opens
+/// upwards; kept when it costs less and keeps the withdrawals' level. A stiffness between
+/// two grid points is then found as such, not snapped to one of them: on trials that
+/// differ a little (another sampling rate, a trial more) the fit moves a little (the
+/// muscle's 0.4 and 0.25 N/mm grid points at 100 Hz and 1 kHz:
+/// `crates/calibrate/tests/trials_sampling_rate.rs`).
+fn refine(
+    stack: &file::Stack,
+    diameter_mm: f64,
+    trials: &[Trial],
+    rows: &[Vec<usize>],
+    costs: &[[Option<f64>; STATIC_FACTORS.len()]],
+    best: TentFit,
+) -> TentFit {
+    let Some(k0) = best.tent_n_per_mm else { return best };
+    let ki = TENT_GRID_N_PER_MM.iter().position(|&k| k == k0).unwrap_or(0);
+    let fi = STATIC_FACTORS.iter().position(|&f| f == best.static_factor).unwrap_or(0);
+    let at = |i: usize| Some((TENT_GRID_N_PER_MM.get(i).copied().filter(|k| *k > 0.0)?.ln(), costs.get(i)?.get(fi).copied()??));
+    let (Some(lo), Some(mid), Some(hi)) = (ki.checked_sub(1).and_then(at), at(ki), at(ki + 1)) else { return best };
+    let Some(k) = vertex(lo, mid, hi).map(f64::exp) else { return best };
+    match cost(&with_tent(stack, k, best.static_factor), diameter_mm, trials, rows) {
+        Some((c, level)) if c < best.cost.1 && (level - 1.0).abs() <= LEVEL_TOLERANCE => {
+            TentFit { tent_n_per_mm: Some(k), cost: (best.cost.0, c), ..best }
+        }
+        _ => best,
+    }
+}
+
+/// The vertex of the parabola through three points `(x, y)` with `x` increasing,
+/// clamped between the outer two; `None` when it does not open upwards.
+fn vertex((x0, y0): (f64, f64), (x1, y1): (f64, f64), (x2, y2): (f64, f64)) -> Option<f64> {
+    let (d01, d12) = ((y1 - y0) / (x1 - x0), (y2 - y1) / (x2 - x1));
+    let curvature = (d12 - d01) / (x2 - x0);
+    // the parabola a (x - v)^2 + b has the slope d01 at the middle of (x0, x1) and a = curvature
+    let x = 0.5 * (x0 + x1) - d01 / (2.0 * curvature);
+    (curvature > 0.0 && x.is_finite()).then(|| x.clamp(x0, x2))
+}
+
 /// The notes written beside the tent and the static level of each layer that has the
 /// fitted tent (`uncertainty`: per layer, `(key, note)`, as [`super::stack::Fitted`]).
 pub fn annotate(fit: &TentFit, stack: &file::Stack, uncertainty: &mut [Vec<(&'static str, String)>]) {
     let Some(k) = fit.tent_n_per_mm else { return };
     let tent = format!(
-        "the replays' least squares over the trials from their contact (grid {TENT_GRID_N_PER_MM:?} N/mm, the static friction level {} times the Coulomb one with it; sum of squares {:.4} -> {:.4})",
+        "the replays' least squares over the trials from their contact (grid {TENT_GRID_N_PER_MM:?} N/mm refined between its neighbours, the static friction level {} times the Coulomb one with it; sum of squares {:.4} -> {:.4})",
         fit.static_factor, fit.cost.0, fit.cost.1
     );
     let level =
@@ -152,5 +195,20 @@ pub fn annotate(fit: &TentFit, stack: &file::Stack, uncertainty: &mut [Vec<(&'st
             u.push(("tent_n_per_mm", tent.clone()));
             u.push(("friction_static_n_per_mm", level.clone()));
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::vertex;
+
+    #[test]
+    fn the_vertex_of_a_parabola_through_three_points() {
+        let y = |x: f64| 2.0 * (x - 0.7) * (x - 0.7) + 1.0;
+        let v = vertex((0.0, y(0.0)), (1.0, y(1.0)), (2.5, y(2.5))).expect("opens upwards");
+        assert!((v - 0.7).abs() < 1e-12, "{v}");
+        let far = |x: f64| (x - 9.0) * (x - 9.0);
+        assert_eq!(vertex((0.0, far(0.0)), (1.0, far(1.0)), (2.0, far(2.0))), Some(2.0), "clamped to the outer points");
+        assert_eq!(vertex((0.0, -y(0.0)), (1.0, -y(1.0)), (2.5, -y(2.5))), None, "opens downwards");
     }
 }
