@@ -7,7 +7,7 @@
 //! with a presliding and one factor on their sliding friction (static and Coulomb: with
 //! a tent the shaft slips at `c L / (1 - c / k)` with the lift, so the level the
 //! withdrawals read without it is refitted with it), both from a grid (`k` then refined
-//! between its grid neighbours: [`refine`]), by the replays'
+//! between its grid neighbours by a parabola through their costs), by the replays'
 //! least squares over every trial from its contact to its end (each trial's sum of
 //! squares over its rows and its peak force squared, so that each trial weighs the
 //! same), among the grid points whose mean pull over the withdrawals stays within
