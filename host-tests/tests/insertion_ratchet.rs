@@ -31,6 +31,7 @@
 //! travel than it loaded over) gives back about the sliding force over the whole ratchet:
 //! 8.57 N·mm in the liver with the soft tent (bound 0.379), 3.06 N·mm on the calibrated
 //! rig skin (bound 2.12), and fails both tests; `insertion_energy.rs` passes it.
+use needle_calibrate::runtime_stack::OwnedStack;
 use needle_haptics::insertion::{stacks, Insertion, InsertionConfig, Layer, Presliding, Stack};
 use needle_haptics::viscoelastic::{PronyTerm, PronyTerms};
 use needle_haptics::Pose;
@@ -78,15 +79,13 @@ fn with(stack: &Stack<'_>, presliding: Presliding) -> Vec<Layer> {
 /// The most energy `p`'s bristle and arms store per N of the level they hold, mm: each a
 /// spring of stiffness `share level / p_i` that slips at `share level`, so at most
 /// `share level p_i / 2` (the long-term share `1 / (1 + sum g)` over the presliding
-/// distance, each term's `g_i / (1 + sum g)` over its slip distance `p_r tau_i / tau_min`,
-/// at most `max(p, p_r)`: `insertion::presliding`).
+/// distance, each term's `g_i / (1 + sum g)` over the library's slip distance for it,
+/// `Presliding::term_slip_mm`).
 fn stored_mm_per_n(p: &Presliding) -> f64 {
     let terms = p.shaft_prony.as_slice();
     let total = 1.0 + terms.iter().map(|t| f64::from(t.g)).sum::<f64>();
-    let tau_min = terms.iter().map(|t| f64::from(t.tau_s)).fold(f64::INFINITY, f64::min);
-    let (distance, slip) = (f64::from(p.distance_mm), f64::from(p.relaxation_slip_mm));
-    let arms: f64 = terms.iter().map(|t| f64::from(t.g) * (slip * f64::from(t.tau_s) / tau_min).min(distance.max(slip))).sum();
-    (distance + arms) / total / 2.0
+    let arms: f64 = terms.iter().map(|t| f64::from(t.g) * f64::from(p.term_slip_mm(t.tau_s))).sum();
+    (f64::from(p.distance_mm) + arms) / total / 2.0
 }
 
 /// The most energy `layers` can store in their held forces while they push (the module
@@ -166,11 +165,10 @@ fn a_ratchet_out_gives_back_at_most_what_the_held_force_stored() {
 }
 
 /// The shipped calibrated rig stack (`coeffs/default/calibrated/`, its values as
-/// `needle calibrate --trials` wrote them), as the library's layers.
-fn calibrated_rig_layers() -> Vec<Layer> {
+/// `needle calibrate --trials` wrote them), loaded as `needle replay` loads a stack file.
+fn calibrated_rig() -> OwnedStack {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../coeffs/default/calibrated/rig_skin_2mmps_t1.toml");
-    let file = needle_codegen::tissue::parse_stack(&path).expect("the shipped calibrated stack");
-    file.layers.iter().map(needle_calibrate::to_layer).collect()
+    OwnedStack::load(&path).unwrap_or_else(|e| panic!("the shipped calibrated stack: {e:#}"))
 }
 
 /// The same on the tissue the calibration fitted to the rig's skin (its presliding of
@@ -179,9 +177,8 @@ fn calibrated_rig_layers() -> Vec<Layer> {
 /// turns the long-term bristle over within twice its distance).
 #[test]
 fn a_ratchet_out_of_the_calibrated_rig_skin_gives_back_at_most_what_it_stored() {
-    let layers = calibrated_rig_layers();
-    assert!(layers.iter().any(|l| l.presliding.tent_n_per_mm > 0.0), "the calibrated stack has a tent");
-    let stack = Stack { name: "rig_skin_2mmps_t1", needle_diameter_mm: 1.27, layers: &layers };
+    let rig = calibrated_rig();
+    assert!(rig.layers.iter().any(|l| l.presliding.tent_n_per_mm > 0.0), "the calibrated stack has a tent");
     let r = Ratchet { deep_mm: 16.8, out_mm: 4.0, in_mm: 2.0, cycles: 5 };
-    gives_back_at_most_what_was_stored(&stack, &layers, r, "calibrated rig skin");
+    gives_back_at_most_what_was_stored(&rig.as_stack(), &rig.layers, r, "calibrated rig skin");
 }
