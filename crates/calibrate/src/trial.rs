@@ -2,7 +2,9 @@
 //! (`time_s,position_mm,force_n`), read and checked, and cut into its phases: the
 //! insertion (the stage advancing), the hold (the stage at rest at its furthest travel)
 //! and the withdrawal (the stage returning), each with its speed fitted from the
-//! encoder, and the contact (the first sample where the force leaves the tare's noise).
+//! encoder, the tare (the force at rest before the stage moves: the sensor's zero, which
+//! [`remove_tare`] subtracts) and the contact (the first sample where the force leaves
+//! the tare's noise).
 //!
 //! Nothing here is fitted to a tissue: the phases come from the stage's position alone,
 //! the contact from the force's own noise before the stage moved, so the same code cuts
@@ -104,6 +106,8 @@ pub struct Phases {
     pub withdrawal: Range<usize>,
     /// The first sample of the insertion where the force leaves the tare's noise band.
     pub contact: usize,
+    /// The force at rest before the stage moves: the sensor's zero ([`remove_tare`]).
+    pub tare: Tare,
     /// The insertion's speed, mm/s (least squares of position against time over its
     /// middle 80 %).
     pub insertion_speed_mm_per_s: f64,
@@ -187,7 +191,8 @@ pub fn phases(s: &[Sample], what: &str) -> Result<Phases> {
     let withdrawal_speed_mm_per_s = if withdrawal.is_empty() { 0.0 } else { fit(middle(&until_back(s, &withdrawal, start + tol)))? };
     let contact =
         contact(s, begin, &insertion).with_context(|| format!("{what}: the force never leaves the tare's noise during the insertion"))?;
-    Ok(Phases { insertion, hold, withdrawal, contact, insertion_speed_mm_per_s, withdrawal_speed_mm_per_s, hold_s, travel_mm, notes })
+    let tare = tare(&s[..begin]);
+    Ok(Phases { insertion, hold, withdrawal, contact, tare, insertion_speed_mm_per_s, withdrawal_speed_mm_per_s, hold_s, travel_mm, notes })
 }
 
 /// The last sample at rest at the furthest travel: `last` (the last within the at-rest
@@ -226,15 +231,51 @@ fn slope(s: &[Sample]) -> Option<f64> {
     (stt > 0.0).then(|| stp / stt)
 }
 
+/// The force of a trial at rest before its stage moves: the sensor's zero and its noise.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tare {
+    /// The mean force over the samples before the stage moves, N.
+    pub mean_n: f64,
+    /// The noise band around it, N: [`CONTACT_SIGMAS`] standard deviations, at least
+    /// [`CONTACT_FLOOR_N`].
+    pub band_n: f64,
+    /// The 1-based line of the trial's first sample (where the tare is read from).
+    pub line: usize,
+}
+
+/// The tare of `rest`, the samples before the stage moves (at least one: [`phases`]
+/// refuses a trial with fewer than two).
+fn tare(rest: &[Sample]) -> Tare {
+    let n = rest.len().max(1) as f64;
+    let mean_n = rest.iter().map(|x| x.force_n).sum::<f64>() / n;
+    let sd = (rest.iter().map(|x| (x.force_n - mean_n).powi(2)).sum::<f64>() / n).sqrt();
+    Tare { mean_n, band_n: (CONTACT_SIGMAS * sd).max(CONTACT_FLOOR_N), line: rest.first().map_or(0, |x| x.line) }
+}
+
+/// Subtracts the tare of `p` from every force of `s` (the trial `what` cut into `p`):
+/// every force is then from the sensor's zero at rest, whether or not the rig tared it
+/// at the start. A tare beyond its noise band (a sensor not tared, or tared under a
+/// load) is said in `p`'s notes, naming the file, the line and the force; after this
+/// the tare is zero.
+pub fn remove_tare(s: &mut [Sample], p: &mut Phases, what: &str) {
+    let Tare { mean_n, band_n, line } = p.tare;
+    for x in s.iter_mut() {
+        x.force_n -= mean_n;
+    }
+    if mean_n.abs() > band_n {
+        p.notes.push(format!(
+            "{what}:{line}: the force at rest before the stage moves averages {mean_n:+.4} N, beyond its noise (+-{band_n:.4} N): \
+             subtracted from every sample as the sensor's zero"
+        ));
+    }
+    p.tare.mean_n = 0.0;
+}
+
 /// The first sample of `insertion` whose force is beyond the tare's noise band, the
 /// tare measured on the samples before the stage moves (`..begin`).
 fn contact(s: &[Sample], begin: usize, insertion: &Range<usize>) -> Option<usize> {
-    let tare = &s[..begin];
-    let n = tare.len() as f64;
-    let mean = tare.iter().map(|x| x.force_n).sum::<f64>() / n;
-    let sd = (tare.iter().map(|x| (x.force_n - mean).powi(2)).sum::<f64>() / n).sqrt();
-    let band = (CONTACT_SIGMAS * sd).max(CONTACT_FLOOR_N);
+    let Tare { mean_n, band_n, .. } = tare(&s[..begin]);
     // beyond the band and staying beyond it for the next samples (one spike is not a contact)
-    let beyond = |k: usize| s.get(k).is_some_and(|x| x.force_n - mean > band);
+    let beyond = |k: usize| s.get(k).is_some_and(|x| x.force_n - mean_n > band_n);
     insertion.clone().find(|&k| (k..k + 5).all(beyond))
 }

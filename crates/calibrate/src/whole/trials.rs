@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 pub struct Trial {
     /// Its file.
     pub path: PathBuf,
-    /// Every sample.
+    /// Every sample, its force from the sensor's zero at rest ([`trial::remove_tare`]).
     pub samples: Vec<Sample>,
     /// Its phases.
     pub phases: Phases,
@@ -53,7 +53,8 @@ impl Trial {
     }
 }
 
-/// Reads, screens and prepares the trial at `path`; `surrogate` is the boundary's axial
+/// Reads, screens and prepares the trial at `path` (its forces from the sensor's zero at
+/// rest: [`trial::remove_tare`]); `surrogate` is the boundary's axial
 /// force at an indentation with scale 1 (the library's, for the needle). Without a
 /// puncture the onset is today's fit over the whole insertion (for a replay).
 ///
@@ -62,9 +63,10 @@ impl Trial {
 /// or (with `need_puncture`) one without a puncture.
 pub fn prepare(path: &Path, rule: EventRule, surrogate: &dyn Fn(f64) -> f64, similarity: f64, need_puncture: bool) -> Result<Trial> {
     let what = path.display().to_string();
-    let samples = trial::read_trial(path)?;
+    let mut samples = trial::read_trial(path)?;
     crate::trial_screen::screen(&samples, &what)?;
-    let phases = trial::phases(&samples, &what)?;
+    let mut phases = trial::phases(&samples, &what)?;
+    trial::remove_tare(&mut samples, &mut phases, &what);
     let points: Vec<Point> =
         samples[phases.insertion.clone()].iter().map(|s| Point { position_mm: s.position_mm, force_n: s.force_n, line: s.line }).collect();
     let events = events::punctures(&points, rule);
