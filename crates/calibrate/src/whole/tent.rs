@@ -14,7 +14,7 @@
 //! [`LEVEL_TOLERANCE`] of the measured one (read where the goals read the withdrawal,
 //! 10-20 mm of stage travel: the level there, not only its sign's rows, is what the tent
 //! and the friction together must give) and the points between two grid neighbours where
-//! that level crosses the measured one ([`level_crossings`]). Without a tent (`k` none)
+//! that level crosses the measured one (`level_crossings`). Without a tent (`k` none)
 //! is a grid point: a stack keeps none when no tent lowers the sum of squares. (A tent
 //! had to lower it by 10 %: skin on muscle's 1 mm/s trials 3 and 4, 0.0143 -> 0.0129,
 //! kept one before their tares were subtracted and not after; a threshold makes nearly
@@ -196,10 +196,11 @@ fn refine(
     best: TentFit,
 ) -> TentFit {
     let Some(k0) = best.tent_n_per_mm else { return best };
-    let ki = TENT_GRID_N_PER_MM.iter().position(|&k| k == k0).unwrap_or(0);
+    // a stiffness between the grid's (a level crossing) is on the level already
+    let Some(ki) = TENT_GRID_N_PER_MM.iter().position(|&k| k == k0) else { return best };
     let fi = STATIC_FACTORS.iter().position(|&f| f == best.static_factor);
     // the grid's cost at stiffness i and the best's factor (replayed for a factor between
-    // the grid's, `level_factor`)
+    // the grid's, a level crossing)
     let at = |i: usize| {
         let k = TENT_GRID_N_PER_MM.get(i).copied().filter(|k| *k > 0.0)?;
         let c = match fi {
@@ -249,7 +250,23 @@ pub fn annotate(fit: &TentFit, stack: &file::Stack, uncertainty: &mut [Vec<(&'st
 
 #[cfg(test)]
 mod tests {
-    use super::vertex;
+    use super::{level_crossings, vertex, STATIC_FACTORS, TENT_GRID_N_PER_MM};
+
+    #[test]
+    fn the_level_crosses_between_grid_neighbours() {
+        // a level growing with ln k and flat in the factor: 1 at k = 0.08 N/mm only
+        let level = |k: f64| 1.0 + (k / 0.08).ln();
+        let grid: Vec<[Option<(f64, f64)>; STATIC_FACTORS.len()]> =
+            TENT_GRID_N_PER_MM.iter().map(|&k| [(k > 0.0).then(|| (1.0, level(k))); STATIC_FACTORS.len()]).collect();
+        let found = level_crossings(&grid);
+        assert_eq!(found.len(), STATIC_FACTORS.len(), "one crossing per factor, along k: {found:?}");
+        for ((k, f), g) in found.iter().zip(STATIC_FACTORS) {
+            assert!((k - 0.08).abs() < 1e-12 && *f == g, "{k} N/mm at {f}");
+        }
+        // a level that never reaches 1 crosses nowhere
+        let below: Vec<_> = grid.iter().map(|row| row.map(|at| at.map(|(c, l)| (c, l - 10.0)))).collect();
+        assert!(level_crossings(&below).is_empty());
+    }
 
     #[test]
     fn the_vertex_of_a_parabola_through_three_points() {
