@@ -271,6 +271,29 @@ pub fn remove_tare(s: &mut [Sample], p: &mut Phases, what: &str) {
     p.tare.mean_n = 0.0;
 }
 
+/// A trial whose stage starts further from zero than this, mm, is said to (its positions
+/// are moved to start at zero all the same): an encoder's count and the servo's settling
+/// are far below it.
+pub const START_NOTE_MM: f64 = 0.05;
+
+/// Moves every position of `s` (the trial `what`, cut into `p`) by the first sample's,
+/// so that the positions are the stage's travel from where the trial started (the
+/// format's `position_mm`), whatever the encoder read there; a start further from zero
+/// than [`START_NOTE_MM`] is said in `p`'s notes (`FILE:LINE`, the position). The phases
+/// and the contact are cut on differences of positions, so they are the same.
+pub fn zero_travel(s: &mut [Sample], p: &mut Phases, what: &str) {
+    let Some(&Sample { position_mm: start, line, .. }) = s.first() else { return };
+    for x in s.iter_mut() {
+        x.position_mm -= start;
+    }
+    if start.abs() > START_NOTE_MM {
+        p.notes.push(format!(
+            "{what}:{line}: the stage starts at {start} mm: every position moved by {:+} mm to be the travel from the start",
+            -start
+        ));
+    }
+}
+
 /// The first sample of `insertion` whose force is beyond the tare's noise band, the
 /// tare measured on the samples before the stage moves (`..begin`).
 fn contact(s: &[Sample], begin: usize, insertion: &Range<usize>) -> Option<usize> {

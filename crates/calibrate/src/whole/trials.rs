@@ -14,7 +14,8 @@ use std::path::{Path, PathBuf};
 pub struct Trial {
     /// Its file.
     pub path: PathBuf,
-    /// Every sample, its force from the sensor's zero at rest ([`trial::remove_tare`]).
+    /// Every sample, its force from the sensor's zero at rest ([`trial::remove_tare`]) and
+    /// its position from the stage's start ([`trial::zero_travel`]).
     pub samples: Vec<Sample>,
     /// Its phases.
     pub phases: Phases,
@@ -54,7 +55,8 @@ impl Trial {
 }
 
 /// Reads, screens and prepares the trial at `path` (its forces from the sensor's zero at
-/// rest: [`trial::remove_tare`]); `surrogate` is the boundary's axial
+/// rest, its positions from the stage's start: [`trial::remove_tare`],
+/// [`trial::zero_travel`]); `surrogate` is the boundary's axial
 /// force at an indentation with scale 1 (the library's, for the needle). Without a
 /// puncture the onset is today's fit over the whole insertion (for a replay).
 ///
@@ -67,6 +69,7 @@ pub fn prepare(path: &Path, rule: EventRule, surrogate: &dyn Fn(f64) -> f64, sim
     crate::trial_screen::screen(&samples, &what)?;
     let mut phases = trial::phases(&samples, &what)?;
     trial::remove_tare(&mut samples, &mut phases, &what);
+    trial::zero_travel(&mut samples, &mut phases, &what);
     let points: Vec<Point> =
         samples[phases.insertion.clone()].iter().map(|s| Point { position_mm: s.position_mm, force_n: s.force_n, line: s.line }).collect();
     let events = events::punctures(&points, rule);
