@@ -19,10 +19,12 @@ pub struct ReplayArgs {
     /// of a compiled-in stack.
     #[arg(long)]
     pub stack: String,
-    /// The trial: CSV with columns time_s, position_mm (stage travel) and force_n.
+    /// The trial: CSV with columns time_s, position_mm (stage travel) and force_n, each
+    /// force taken from the force at rest before the stage moves and each position from
+    /// the stage's start (the notes say when either is not zero).
     #[arg(long)]
     pub trial: PathBuf,
-    /// Print one JSON document (rows, punctures, checks) instead of the text.
+    /// Print one JSON document (notes, rows, punctures, checks) instead of the text.
     #[arg(long)]
     pub json: bool,
     /// Also write the figure here (SVG): the measured and the model force against time
@@ -64,7 +66,7 @@ pub fn run(a: ReplayArgs) -> Result<ExitCode> {
     }
     if a.json {
         let doc = serde_json::json!({
-            "stack": stack.name, "trial": t.name(), "contact_mm": t.onset_mm(),
+            "stack": stack.name, "trial": t.name(), "notes": t.phases.notes, "contact_mm": t.onset_mm(),
             "phases": {"insertion_lines": line_range(&t, &t.phases.insertion), "hold_lines": line_range(&t, &t.phases.hold),
                        "withdrawal_lines": line_range(&t, &t.phases.withdrawal)},
             "measured_punctures": (0..t.events.len()).filter_map(|k| t.peak(k)).map(|(p, f)| serde_json::json!({"position_mm": p, "force_n": f})).collect::<Vec<_>>(),
