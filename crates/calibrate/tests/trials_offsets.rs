@@ -10,10 +10,10 @@
 //! - each shifted trial's calibration says so, naming its file and first line, the force
 //!   it read at rest (within the noise of the constant added) and the stage's start;
 //! - replayed along each measured trial, the two stacks' forces differ by at most
-//!   [`TIE_PCT`] of the trial's peak force: the tare is the force at rest before the
-//!   stage moves, subtracted from every sample (`trial::remove_tare`), and the positions
-//!   are moved to start at zero (`trial::zero_travel`), so the shifted copies are the
-//!   measured trials up to the rounding of the sums (the 16th digit);
+//!   [`TIE_PCT`] of the trial's peak force: the tare (the force at rest before the stage
+//!   moves) beyond its noise is subtracted from every sample (`trial::remove_tare`), and
+//!   a start beyond 0.05 mm moved to zero (`trial::zero_travel`), so the shifted copies
+//!   are the measured trials less their own tare, up to the rounding of the sums;
 //! - the goals met within [`TIE_GOALS`] of each other.
 //!
 //! Before the tare was subtracted the muscle shifted by +0.25 N met 8 goals against 16:
@@ -28,16 +28,17 @@ use common::{calibrate, group, name, replay};
 use needle_calibrate::whole::TrialsCalibration;
 use std::path::{Path, PathBuf};
 
-/// The largest RMS difference of the two stacks' replayed forces, % of the trial's peak:
-/// the copies differ from the measured trials in the 16th digit, which decides a near-tie
-/// of the calibration's scans (the muscle shifted +40 mm: the same stack to the last bit;
-/// skin on muscle +7.5 mm: its first layer 16.3039 and 16.3064 mm thick, trial 2's forces
-/// 0.027 N RMS, 0.5 % of its peak, apart), far below a repeat of the tissue (the groups'
-/// spreads, 3.8-9.0 %) and what the uncorrected offsets did (below).
-const TIE_PCT: f64 = 1.0;
+/// The largest RMS difference of the two stacks' replayed forces, % of the trial's peak.
+/// The shifted copies lose the rig's own tare with the offset (`trial::remove_tare`
+/// subtracts a tare beyond its noise; the measured trials' own, -0.001 to -0.007 N for
+/// the muscle, within it, are kept), and the calibration reads that: the muscle's stacks
+/// 1.30-1.42 % of the peak apart, goals 16 and 17; skin on muscle 0.02-0.62 %, goals 25
+/// and 25. Far below a repeat of the tissue (the groups' spreads, 3.8-9.0 %) and what
+/// the uncorrected offsets did (below).
+const TIE_PCT: f64 = 2.0;
 
-/// The goals met may differ by this many: a goal that a near-tie moves across its limit
-/// (skin on muscle +7.5 mm: 26 and 25).
+/// The goals met may differ by this many: a goal that the rig's own tare moves across its
+/// limit (the muscle 16 and 17).
 const TIE_GOALS: usize = 1;
 
 /// `file` with `offset_n` added to every force and `offset_mm` to every position, written

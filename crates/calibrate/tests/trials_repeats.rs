@@ -14,7 +14,7 @@ use needle_calibrate::whole::repeats::{GroupSpread, Rms, RATIO_GOAL};
 use std::path::PathBuf;
 
 /// The cases that miss the goal today (`group: calibrated on -> predicted`; each one's
-/// figures are printed): muscle 20 of 30 (ratio 1.53-3.35); every other group meets it in
+/// figures are printed): muscle 19 of 30 (ratio 1.52-3.09); every other group meets it in
 /// every case (since the tent's level is met between the grid points,
 /// `whole::tent::level_crossings`). Where they come from (the muscle's insertion, and its
 /// withdrawal's pull, which lets go near the surface; the tent's level read over the
@@ -25,7 +25,6 @@ use std::path::PathBuf;
 /// tolerance: every other case must meet the goal.
 const MISSED: &[&str] = &[
     "muscle_2mmps_0deg_needle2: trial1+trial2 -> trial3",
-    "muscle_2mmps_0deg_needle2: trial1+trial2 -> trial4",
     "muscle_2mmps_0deg_needle2: trial1+trial2 -> trial5",
     "muscle_2mmps_0deg_needle2: trial1+trial3 -> trial2",
     "muscle_2mmps_0deg_needle2: trial1+trial3 -> trial4",
