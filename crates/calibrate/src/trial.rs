@@ -189,9 +189,9 @@ pub fn phases(s: &[Sample], what: &str) -> Result<Phases> {
     };
     let insertion_speed_mm_per_s = fit(middle(&insertion))?;
     let withdrawal_speed_mm_per_s = if withdrawal.is_empty() { 0.0 } else { fit(middle(&until_back(s, &withdrawal, start + tol)))? };
-    let contact =
-        contact(s, begin, &insertion).with_context(|| format!("{what}: the force never leaves the tare's noise during the insertion"))?;
     let tare = tare(&s[..begin]);
+    let contact =
+        contact(s, &tare, &insertion).with_context(|| format!("{what}: the force never leaves the tare's noise during the insertion"))?;
     Ok(Phases { insertion, hold, withdrawal, contact, tare, insertion_speed_mm_per_s, withdrawal_speed_mm_per_s, hold_s, travel_mm, notes })
 }
 
@@ -298,10 +298,10 @@ pub fn zero_travel(s: &mut [Sample], p: &mut Phases, what: &str) {
     ));
 }
 
-/// The first sample of `insertion` whose force is beyond the tare's noise band, the
-/// tare measured on the samples before the stage moves (`..begin`).
-fn contact(s: &[Sample], begin: usize, insertion: &Range<usize>) -> Option<usize> {
-    let Tare { mean_n, band_n, .. } = tare(&s[..begin]);
+/// The first sample of `insertion` whose force is beyond the noise band of `tare` (the
+/// samples before the stage moves).
+fn contact(s: &[Sample], tare: &Tare, insertion: &Range<usize>) -> Option<usize> {
+    let Tare { mean_n, band_n, .. } = *tare;
     // beyond the band and staying beyond it for the next samples (one spike is not a contact)
     let beyond = |k: usize| s.get(k).is_some_and(|x| x.force_n - mean_n > band_n);
     insertion.clone().find(|&k| (k..k + 5).all(beyond))

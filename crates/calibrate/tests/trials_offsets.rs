@@ -24,8 +24,7 @@
 //! instead of 10.9 mm.
 mod common;
 
-use common::{calibrate, group, name, replay};
-use needle_calibrate::whole::TrialsCalibration;
+use common::{calibrate, group, met, name, replay};
 use std::path::{Path, PathBuf};
 
 /// The largest RMS difference of the two stacks' replayed forces, % of the trial's peak.
@@ -68,11 +67,6 @@ fn shifted(file: &Path, (offset_n, offset_mm): (f64, f64), dir: &Path) -> PathBu
     let to = dir.join(file.file_name().expect("a file name"));
     std::fs::write(&to, out).unwrap_or_else(|e| panic!("{}: {e}", to.display()));
     to
-}
-
-/// The goals met over every trial.
-fn met(c: &TrialsCalibration) -> usize {
-    c.checks.iter().flatten().filter(|k| k.met()).count()
 }
 
 #[test]

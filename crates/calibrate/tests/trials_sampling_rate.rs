@@ -28,7 +28,7 @@
 //! its static level 3 times the Coulomb one against 1.75, its force within 2.2 %).
 mod common;
 
-use common::{calibrate, group, name, replay};
+use common::{calibrate, group, met, name, replay};
 use needle_calibrate::whole::repeats::GroupSpread;
 use needle_calibrate::whole::TrialsCalibration;
 use std::path::{Path, PathBuf};
@@ -60,11 +60,6 @@ fn resampled(file: &Path, dir: &Path) -> PathBuf {
     let to = dir.join(file.file_name().expect("a file name"));
     std::fs::write(&to, out).unwrap_or_else(|e| panic!("{}: {e}", to.display()));
     to
-}
-
-/// The goals met over every trial.
-fn met(c: &TrialsCalibration) -> usize {
-    c.checks.iter().flatten().filter(|k| k.met()).count()
 }
 
 /// The RMS difference of the two stacks' forces replayed along `t` from its contact, N.

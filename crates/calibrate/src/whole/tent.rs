@@ -142,9 +142,8 @@ pub fn fit(stack: &mut file::Stack, diameter_mm: f64, trials: &[Trial]) -> Resul
             keep(k, factor, at, &mut best);
         }
     }
-    let costs: Vec<[Option<f64>; STATIC_FACTORS.len()]> = grid.iter().map(|row| row.map(|at| at.map(|(c, _)| c))).collect();
     // `best` starts without a tent and takes a tent only at a lower sum of squares
-    let best = refine(stack, diameter_mm, trials, &rows, &costs, best);
+    let best = refine(stack, diameter_mm, trials, &rows, &grid, best);
     if let Some(k) = best.tent_n_per_mm {
         *stack = with_tent(stack, k, best.static_factor);
     }
@@ -192,7 +191,7 @@ fn refine(
     diameter_mm: f64,
     trials: &[Trial],
     rows: &[Vec<usize>],
-    costs: &[[Option<f64>; STATIC_FACTORS.len()]],
+    grid: &[[Option<(f64, f64)>; STATIC_FACTORS.len()]],
     best: TentFit,
 ) -> TentFit {
     let Some(k0) = best.tent_n_per_mm else { return best };
@@ -204,7 +203,7 @@ fn refine(
     let at = |i: usize| {
         let k = TENT_GRID_N_PER_MM.get(i).copied().filter(|k| *k > 0.0)?;
         let c = match fi {
-            Some(fi) => costs.get(i)?.get(fi).copied()??,
+            Some(fi) => grid.get(i)?.get(fi).copied()??.0,
             None if i == ki => best.cost.1,
             None => cost(&with_tent(stack, k, best.static_factor), diameter_mm, trials, rows)?.0,
         };

@@ -76,3 +76,8 @@ pub fn replay(c: &TrialsCalibration, t: &trials::Trial) -> TrialReplay {
     let owned = OwnedStack { name: "rig".into(), needle_diameter_mm: NEEDLE_MM as f32, layers };
     needle_calibrate::trial_replay::replay(&owned.as_stack(), t.onset_mm(), &t.samples).unwrap_or_else(|e| panic!("{e}"))
 }
+
+/// The goals met over every trial of `c`.
+pub fn met(c: &TrialsCalibration) -> usize {
+    c.checks.iter().flatten().filter(|k| k.met()).count()
+}
